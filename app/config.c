@@ -1,0 +1,250 @@
+/* The scanner's config and calibration files: key tables, cross-checks, and their documentation. */
+#define _POSIX_C_SOURCE 200809L
+#include "config.h"
+
+#include "ini_schema.h"
+
+#include <errno.h>
+#include <libgen.h>
+#include <stddef.h>
+#include <string.h>
+
+#define C(member) offsetof(struct app_config, member)
+#define SZ(member) sizeof(((struct app_config *)0)->member)
+#define U32(sec, key, member, lo, hi, def, doc)                                                    \
+    {sec, key, INI_U32, C(member), 0, lo, hi, 0, def, NULL, doc}
+#define LIM(sec, key, member, lo, hi, def, doc)                                                    \
+    {sec, key, INI_U32, C(member), 0, lo, hi, 1, def, NULL, doc}
+#define F64(sec, key, member, lo, hi, def, doc)                                                    \
+    {sec, key, INI_F64, C(member), 0, lo, hi, 0, def, NULL, doc}
+#define STR(sec, key, member, def, doc) {sec, key, INI_STR, C(member), SZ(member), 0, 0, 0, def, NULL, doc}
+#define ENUM(sec, key, member, choices, def, doc)                                                  \
+    {sec, key, INI_ENUM, C(member), SZ(member), 0, 0, 0, def, choices, doc}
+#define GPIO(key, line)                                                                            \
+    {"gpio", key, INI_I32, C(gpio.line_offset[line]), 0, -1, 1023, 0, "-1", NULL,                  \
+     "line offset on the chip; -1 = not wired"}
+
+static const struct ini_key config_keys[] = {
+    ENUM("camera", "backend", camera_backend, "sim|v4l2|libcamera", NULL,
+         "which camera backend drives the camera (only those built in are accepted)"),
+    STR("camera", "device", camera.device, "/dev/video0", "V4L2 device path or libcamera id"),
+    LIM("camera", "width", camera.width, 16, HAL_MAX_WIDTH, NULL, "frame width in pixels"),
+    LIM("camera", "height", camera.height, 16, HAL_MAX_HEIGHT, NULL, "frame height in pixels"),
+    ENUM("camera", "pixel_format", camera_pixel_format, "rgb24|yuyv|grey", "rgb24",
+         "pixel format requested from the device (converted to RGB)"),
+    U32("camera", "exposure_us", camera.exposure_us, 10, 10000000, NULL,
+        "fixed exposure time (auto exposure is always off)"),
+    U32("camera", "gain_milli", camera.gain_milli, 1000, 64000, "1000",
+        "fixed analogue gain, 1000 = unity"),
+    U32("camera", "drop_frames", camera.drop_frames, 0, 16, "1",
+        "stale frames dropped after a light or pattern change"),
+    U32("camera", "capture_retries", scan.capture_retries, 0, 10, "2",
+        "extra tries of a capture that timed out or came back corrupt"),
+    U32("projector", "settle_us", scan.pattern_settle_us, 0, 1000000, "20000",
+        "wait after switching pattern before capturing"),
+    U32("projector", "trigger_pulse_us", scan.trigger_pulse_us, 1, 100000, "100",
+        "width of the trigger and reset pulses"),
+    LIM("lights", "count", light_count, 0, HAL_MAX_LIGHTS, "0",
+        "white lights wired to light_0 .. light_N-1"),
+    U32("scan", "views", views, 1, 360, "1", "views per scan"),
+    F64("scan", "start_angle_deg", start_angle_deg, -360, 360, "0", "turntable angle of view 0"),
+    U32("scan", "min_contrast_dn", scan.min_contrast_dn, 1, 255, "16",
+        "white minus black (grey levels) below this: too dark to decode, flagged 'dark'"),
+    U32("scan", "shadow_contrast_dn", scan.shadow_contrast_dn, 0, 254, "6",
+        "white minus black at or below this: no projector light, flagged 'shadow'"),
+    U32("scan", "min_bit_diff_dn", scan.min_bit_diff_dn, 0, 254, "4",
+        "each pattern and its inverse must differ by more than this, else 'low_contrast'"),
+    U32("scan", "saturation_dn", scan.saturation_dn, 1, 255, "250",
+        "a channel at or above this in any frame flags the pixel 'saturated'"),
+    U32("scan", "max_column_jump", scan.max_column_jump, 0, 1000, "3",
+        "neighbours whose columns differ by at most this agree"),
+    U32("scan", "min_consistent_neighbours", scan.min_consistent_neighbours, 0, 8, "3",
+        "a pixel needs this many agreeing neighbours (of 8), else 'inconsistent'"),
+    F64("scan", "max_depth_jump_mm", scan.max_depth_jump_mm, 0.01, 1000, "3",
+        "a larger depth step between neighbours is a surface boundary (for normals)"),
+    STR("scan", "calibration", calibration_file, NULL,
+        "calibration file, relative to this config file"),
+    STR("output", "dir", output_dir, "scans/latest", "scan directory (created if missing)"),
+    STR("gpio", "chip", gpio.chip, "gpiochip0", "GPIO chip name or path"),
+    GPIO("projector_enable", HAL_GPIO_PROJECTOR_ENABLE),
+    GPIO("projector_trigger", HAL_GPIO_PROJECTOR_TRIGGER),
+    GPIO("projector_reset", HAL_GPIO_PROJECTOR_RESET),
+    GPIO("light_0", HAL_GPIO_LIGHT_0 + 0), GPIO("light_1", HAL_GPIO_LIGHT_0 + 1),
+    GPIO("light_2", HAL_GPIO_LIGHT_0 + 2), GPIO("light_3", HAL_GPIO_LIGHT_0 + 3),
+    GPIO("light_4", HAL_GPIO_LIGHT_0 + 4), GPIO("light_5", HAL_GPIO_LIGHT_0 + 5),
+    GPIO("light_6", HAL_GPIO_LIGHT_0 + 6), GPIO("light_7", HAL_GPIO_LIGHT_0 + 7),
+    ENUM("turntable", "transport", turntable.transport, "tcp|rtu", "tcp",
+         "Modbus transport to the turntable controller"),
+    STR("turntable", "host", turntable.host, "127.0.0.1", "Modbus TCP host"),
+    U32("turntable", "port", turntable.port, 1, 65535, "1502", "Modbus TCP port"),
+    STR("turntable", "device", turntable.device, "/dev/ttyUSB0", "Modbus RTU serial device"),
+    U32("turntable", "baud", turntable.baud, 1200, 1000000, "19200", "Modbus RTU baud rate"),
+    ENUM("turntable", "parity", turntable.parity, "none|even|odd", "even", "Modbus RTU parity"),
+    U32("turntable", "unit_id", turntable.unit_id, 1, 247, "1", "Modbus unit / slave id"),
+    U32("turntable", "response_timeout_ms", turntable.response_timeout_ms, 10, 60000, "500",
+        "Modbus response timeout"),
+    ENUM("sim", "object", sim.object, "sphere|cylinder|box|torus|mesh", "sphere",
+         "simulated object"),
+    STR("sim", "mesh_file", sim.mesh_file, "", "PLY mesh for object = mesh, relative to this file"),
+    F64("sim", "object_height_mm", sim.object_height_mm, 1, 1000, "150",
+        "object height after scaling (sphere: diameter)"),
+    U32("sim", "segments", sim.segments, 8, 4096, "384", "tessellation of analytic shapes"),
+    ENUM("sim", "material", sim.material, "lambert|phong|merl", "lambert", "reflectance model"),
+    STR("sim", "merl_file", sim.merl_file, "", "MERL/ABC table (CSV), relative to this file"),
+    STR("sim", "merl_name", sim.merl_name, "", "material name in the MERL/ABC table"),
+    F64("sim", "phong_ks", sim.phong_ks, 0, 100, "0.5", "Phong specular strength ks"),
+    F64("sim", "phong_ke", sim.phong_ke, 1, 10000, "40", "Phong shininess ke"),
+    ENUM("sim", "albedo_pattern", sim.albedo_pattern, "patches|uniform", "patches",
+         "painted patches and stripes (with a very dark one), or one colour"),
+    {"sim", "albedo", INI_VEC, C(sim.albedo), 3, 0, 1, 0, "0.8, 0.8, 0.8", NULL,
+     "albedo for albedo_pattern = uniform"},
+    F64("sim", "object_angle_deg", sim.object_angle_deg, -360, 360, "0",
+        "turntable angle while there is no turntable backend"),
+    U32("sim", "seed", sim.seed, 0, 4294967295.0, "1", "noise seed (runs are repeatable)"),
+    F64("sim", "black_offset_dn", sim.black_offset_dn, 0, 255, "51",
+        "camera black offset (Jost et al. Table 1: 51)"),
+    F64("sim", "ambient_dn", sim.ambient_dn, 0, 255, "3", "indirect light on a white surface"),
+    F64("sim", "read_noise_dn", sim.read_noise_dn, 0, 50, "1.5", "Gaussian read noise (sigma)"),
+    F64("sim", "electrons_per_dn", sim.electrons_per_dn, 0.1, 10000, "20",
+        "sensor conversion gain, sets the shot noise"),
+    F64("sim", "projector_intensity_dn", sim.projector_intensity_dn, 0, 10000, "170",
+        "white Lambertian facing the projector at the reference distance, in grey levels"),
+    F64("sim", "projector_black_level", sim.projector_black_level, 0, 1, "0.01",
+        "light the projector leaks in its black"),
+    F64("sim", "projector_blur_px", sim.projector_blur_px, 0, 1, "0.6",
+        "projector defocus, as a box width in projector pixels"),
+    F64("sim", "light_intensity_dn", sim.light_intensity_dn, 0, 10000, "120",
+        "like projector_intensity_dn, for each white light"),
+    F64("sim", "reference_distance_mm", sim.reference_distance_mm, 1, 100000, "600",
+        "distance at which the intensities above hold (inverse-square falloff)"),
+    U32("sim", "reference_exposure_us", sim.reference_exposure_us, 1, 10000000, "10000",
+        "exposure at which the intensities above hold"),
+};
+
+#undef C
+#undef SZ
+#define K(member) offsetof(struct scan_calib, member)
+#define CF(sec, key, member, lo, hi, doc) {sec, key, INI_F64, K(member), 0, lo, hi, 0, NULL, NULL, doc}
+#define CU(sec, key, member, hi, doc) {sec, key, INI_U32, K(member), 0, 1, hi, 1, NULL, NULL, doc}
+#define CV(sec, key, member, n, lo, hi, def, doc)                                                  \
+    {sec, key, INI_VEC, K(member), n, lo, hi, 0, def, NULL, doc}
+#define LIGHT(i)                                                                                   \
+    CV("lights", "light_" #i "_mm", light_pos_mm[i], 3, -1e5, 1e5, "0, 0, 0",                      \
+       "position of light " #i " (camera frame)")
+
+static const struct ini_key calib_keys[] = {
+    CF("camera", "fx_px", cam_fx_px, 1, 1e6, "focal length x"),
+    CF("camera", "fy_px", cam_fy_px, 1, 1e6, "focal length y"),
+    CF("camera", "cx_px", cam_cx_px, -1e5, 1e5, "principal point x"),
+    CF("camera", "cy_px", cam_cy_px, -1e5, 1e5, "principal point y"),
+    CU("camera", "width", cam_width, HAL_MAX_WIDTH, "image width the intrinsics belong to"),
+    CU("camera", "height", cam_height, HAL_MAX_HEIGHT, "image height"),
+    CF("projector", "fx_px", proj_fx_px, 1, 1e6, "focal length x"),
+    CF("projector", "fy_px", proj_fy_px, 1, 1e6, "focal length y"),
+    CF("projector", "cx_px", proj_cx_px, -1e5, 1e5, "principal point x"),
+    CF("projector", "cy_px", proj_cy_px, -1e5, 1e5, "principal point y"),
+    CU("projector", "width", proj_width, HAL_MAX_PROJECTOR_WIDTH, "projector columns"),
+    CU("projector", "height", proj_height, HAL_MAX_PROJECTOR_HEIGHT, "projector rows"),
+    CV("projector", "rotation", proj_rot, 9, -1, 1, NULL,
+       "rotation camera -> projector, row-major 3x3 (p_proj = R p_cam + t)"),
+    CV("projector", "translation_mm", proj_trans_mm, 3, -1e5, 1e5, NULL,
+       "translation camera -> projector"),
+    CV("turntable", "axis_point_mm", axis_point_mm, 3, -1e5, 1e5, NULL,
+       "a point of the turntable axis on the table surface (camera frame)"),
+    CV("turntable", "axis_dir", axis_dir, 3, -1, 1, NULL, "unit direction of the axis, upwards"),
+    LIGHT(0), LIGHT(1), LIGHT(2), LIGHT(3), LIGHT(4), LIGHT(5), LIGHT(6), LIGHT(7),
+};
+
+_Static_assert(HAL_MAX_LIGHTS == 8, "calib_keys lists light_0 .. light_7");
+
+static enum hal_pixel_format pixel_format_of(const char *s)
+{
+    return strcmp(s, "yuyv") == 0 ? HAL_PIX_YUYV
+                                  : strcmp(s, "grey") == 0 ? HAL_PIX_GREY : HAL_PIX_RGB24;
+}
+
+int config_load(struct app_config *cfg, const char *path, char *err, size_t err_len)
+{
+    memset(cfg, 0, sizeof(*cfg));
+    int rc = ini_schema_load(config_keys, sizeof(config_keys) / sizeof(config_keys[0]), cfg, path,
+                             err, err_len);
+    if (rc != 0)
+        return rc;
+    snprintf(cfg->path, sizeof(cfg->path), "%s", path);
+    cfg->camera.pixel_format = pixel_format_of(cfg->camera_pixel_format);
+    cfg->scan.width = cfg->camera.width;
+    cfg->scan.height = cfg->camera.height;
+    if (cfg->scan.shadow_contrast_dn >= cfg->scan.min_contrast_dn) {
+        snprintf(err, err_len, "%s: [scan] shadow_contrast_dn: %u must be below min_contrast_dn %u",
+                 path, (unsigned)cfg->scan.shadow_contrast_dn, (unsigned)cfg->scan.min_contrast_dn);
+        return -EINVAL;
+    }
+    if (strcmp(cfg->sim.object, "mesh") == 0 && cfg->sim.mesh_file[0] == '\0') {
+        snprintf(err, err_len, "%s: [sim] mesh_file: required when object = mesh", path);
+        return -EINVAL;
+    }
+    if (strcmp(cfg->sim.material, "merl") == 0 &&
+        (cfg->sim.merl_file[0] == '\0' || cfg->sim.merl_name[0] == '\0')) {
+        snprintf(err, err_len, "%s: [sim] merl_name: merl_file and merl_name are required when "
+                               "material = merl", path);
+        return -EINVAL;
+    }
+    /* The calibration file is named relative to the config file. */
+    if (cfg->calibration_file[0] != '/') {
+        char dir_buf[HAL_MAX_PATH], joined[HAL_MAX_PATH * 2];
+        snprintf(dir_buf, sizeof(dir_buf), "%s", path);
+        snprintf(joined, sizeof(joined), "%s/%s", dirname(dir_buf), cfg->calibration_file);
+        if (strlen(joined) >= sizeof(cfg->calibration_file)) {
+            snprintf(err, err_len, "%s: [scan] calibration: path too long", path);
+            return -EINVAL;
+        }
+        snprintf(cfg->calibration_file, sizeof(cfg->calibration_file), "%s", joined);
+    }
+    return 0;
+}
+
+int calib_load(struct scan_calib *calib, const char *path, uint32_t light_count, char *err,
+               size_t err_len)
+{
+    memset(calib, 0, sizeof(*calib));
+    int rc = ini_schema_load(calib_keys, sizeof(calib_keys) / sizeof(calib_keys[0]), calib, path,
+                             err, err_len);
+    if (rc != 0)
+        return rc;
+    vec3 axis = v3_from(calib->axis_dir);
+    if (fabs(v3_len(axis) - 1.0) > 1e-3) {
+        snprintf(err, err_len, "%s: [turntable] axis_dir: not a unit vector (length %.4f)", path,
+                 v3_len(axis));
+        return -EINVAL;
+    }
+    /* R must be a rotation: R R^T = I within calibration-file rounding. */
+    for (int r = 0; r < 3; r++) {
+        for (int c = 0; c < 3; c++) {
+            double dot = 0.0;
+            for (int k = 0; k < 3; k++)
+                dot += calib->proj_rot[r * 3 + k] * calib->proj_rot[c * 3 + k];
+            if (fabs(dot - (r == c ? 1.0 : 0.0)) > 1e-4) {
+                snprintf(err, err_len, "%s: [projector] rotation: not a rotation matrix", path);
+                return -EINVAL;
+            }
+        }
+    }
+    calib->light_count = light_count;
+    for (uint32_t i = 0; i < light_count; i++) {
+        if (v3_len(v3_from(calib->light_pos_mm[i])) == 0.0) {
+            snprintf(err, err_len, "%s: [lights] light_%u_mm: required, [lights] count is %u",
+                     path, (unsigned)i, (unsigned)light_count);
+            return -EINVAL;
+        }
+    }
+    return 0;
+}
+
+void config_print_doc(FILE *out)
+{
+    fprintf(out, "## Scan config (e.g. `config/sim.ini`)\n");
+    ini_schema_print_doc(config_keys, sizeof(config_keys) / sizeof(config_keys[0]), out);
+    fprintf(out, "\n## Calibration file (e.g. `config/sim-calib.ini`)\n\nAll geometry is in the "
+                 "camera frame (x right, y down, z forward), in millimetres.\n");
+    ini_schema_print_doc(calib_keys, sizeof(calib_keys) / sizeof(calib_keys[0]), out);
+}

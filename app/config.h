@@ -1,0 +1,76 @@
+/* Scanner configuration: INI files parsed with inih into plain structs, checked against the limits. */
+#ifndef CONFIG_H
+#define CONFIG_H
+
+#include "hal.h"
+#include "scan_types.h"
+#include "vec3.h"
+
+#include <stddef.h>
+#include <stdio.h>
+
+/** The simulated rig ([sim]); read in every build so that configs stay portable, used only by
+ *  the simulator board. */
+struct sim_config {
+    char object[16];            /**< sphere | cylinder | box | torus | mesh */
+    char mesh_file[HAL_MAX_PATH];
+    double object_height_mm;
+    uint32_t segments;          /**< tessellation of analytic shapes */
+    char material[16];          /**< lambert | phong | merl */
+    char merl_file[HAL_MAX_PATH];
+    char merl_name[64];
+    double phong_ks, phong_ke;
+    char albedo_pattern[16];    /**< patches | uniform */
+    double albedo[3];
+    double object_angle_deg;
+    uint32_t seed;
+    double black_offset_dn, ambient_dn, read_noise_dn, electrons_per_dn;
+    double projector_intensity_dn, projector_black_level, projector_blur_px;
+    double light_intensity_dn, reference_distance_mm;
+    uint32_t reference_exposure_us;
+};
+
+struct gpio_config {
+    char chip[64];                           /**< gpiochip device or name */
+    int32_t line_offset[HAL_GPIO_LINE_COUNT]; /**< -1 = not wired */
+};
+
+struct turntable_config {
+    char transport[8];          /**< tcp | rtu */
+    char host[64];
+    uint32_t port;
+    char device[128];
+    uint32_t baud;
+    char parity[8];             /**< none | even | odd */
+    uint32_t unit_id;
+    uint32_t response_timeout_ms;
+};
+
+struct app_config {
+    char path[HAL_MAX_PATH];        /**< the file it came from */
+    char camera_backend[16];        /**< sim | v4l2 | libcamera */
+    char camera_pixel_format[8];    /**< rgb24 | yuyv | grey, as written */
+    struct hal_camera_config camera;
+    uint32_t light_count;
+    struct scan_params scan;
+    uint32_t views;
+    double start_angle_deg;
+    char calibration_file[HAL_MAX_PATH]; /**< resolved against the config file's directory */
+    char output_dir[HAL_MAX_PATH];
+    struct gpio_config gpio;
+    struct turntable_config turntable;
+    struct sim_config sim;
+};
+
+/** Parse and check @p path. On error @p err says file, line and key.
+ *  @retval 0 ok @retval -EINVAL bad content @retval -ENOENT no such file */
+int config_load(struct app_config *cfg, const char *path, char *err, size_t err_len);
+
+/** Parse and check a calibration file. @retval 0 ok, otherwise @p err says file, line and key */
+int calib_load(struct scan_calib *calib, const char *path, uint32_t light_count, char *err,
+               size_t err_len);
+
+/** Write the documentation of every key (Markdown) to @p out. */
+void config_print_doc(FILE *out);
+
+#endif

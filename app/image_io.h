@@ -1,0 +1,20 @@
+/* Image files: PNG through libpng, PFM (portable float map) for range and normal images. */
+#ifndef IMAGE_IO_H
+#define IMAGE_IO_H
+
+#include "hal.h"
+
+#include <stdint.h>
+
+/** Write an 8-bit PNG (channels 1 or 3) atomically. @retval 0 ok @retval -errno */
+int image_write_png(const struct hal_storage *st, const char *path, const uint8_t *pixels,
+                    uint32_t width, uint32_t height, int channels);
+/** Read an 8-bit PNG into @p pixels (capacity bytes), converting to @p channels (1 or 3).
+ *  @retval 0 ok @retval -EINVAL not a PNG or wrong size @retval -errno */
+int image_read_png(const char *path, uint8_t *pixels, size_t capacity, uint32_t *width,
+                   uint32_t *height, int channels);
+/** Write a PFM (channels 1 or 3; NaN allowed) atomically. @retval 0 ok @retval -errno */
+int image_write_pfm(const struct hal_storage *st, const char *path, const float *pixels,
+                    uint32_t width, uint32_t height, int channels);
+
+#endif

@@ -1,0 +1,254 @@
+/* inih-based parser driven by a key table; tracks line numbers through a counting reader. */
+#define _POSIX_C_SOURCE 200809L
+#include "ini_schema.h"
+
+#include <errno.h>
+#include <ini.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct parse_state {
+    const struct ini_key *keys;
+    size_t key_count;
+    void *target;
+    const char *path;
+    FILE *file;
+    int line;                       /* line inih is handling now */
+    int seen_line[INI_MAX_KEYS];    /* 0 = not seen */
+    char *err;
+    size_t err_len;
+    int failed;
+};
+
+/* inih reads one line per call: counting here gives the line of the key being handled. */
+static char *counting_reader(char *str, int num, void *stream)
+{
+    struct parse_state *st = stream;
+    char *r = fgets(str, num, st->file);
+    if (r != NULL)
+        st->line++;
+    return r;
+}
+
+static int parse_double(const char *s, double *out)
+{
+    char *end;
+    errno = 0;
+    *out = strtod(s, &end);
+    while (*end == ' ' || *end == '\t')
+        end++;
+    return (end != s && *end == '\0' && errno == 0 && isfinite(*out)) ? 0 : -1;
+}
+
+static int choice_ok(const char *choices, const char *value)
+{
+    size_t len = strlen(value);
+    for (const char *p = choices; *p != '\0';) {
+        const char *bar = strchr(p, '|');
+        size_t n = bar ? (size_t)(bar - p) : strlen(p);
+        if (n == len && strncmp(p, value, n) == 0)
+            return 1;
+        p += n + (bar ? 1 : 0);
+    }
+    return 0;
+}
+
+static void format_where(char *err, size_t len, const char *path, int line,
+                         const struct ini_key *k, const char *what)
+{
+    if (line > 0)
+        snprintf(err, len, "%s:%d: [%s] %s: %s", path, line, k->section, k->name, what);
+    else
+        snprintf(err, len, "%s: [%s] %s: %s", path, k->section, k->name, what);
+}
+
+static int range_error(const struct ini_key *k, double v, char *msg, size_t len)
+{
+    if (v >= k->min && v <= k->max)
+        return 0;
+    if (k->max_is_limit && v > k->max)
+        snprintf(msg, len, "%g exceeds the compiled limit %g (see hal/include/hal_limits.h)", v,
+                 k->max);
+    else
+        snprintf(msg, len, "%g is out of range %g..%g", v, k->min, k->max);
+    return -1;
+}
+
+/* Store @p value for key @p k, or write what is wrong into @p msg. */
+static int set_value(const struct ini_key *k, void *target, const char *value, char *msg,
+                     size_t len)
+{
+    char *dst = (char *)target + k->offset;
+    double v;
+    switch (k->type) {
+    case INI_U32:
+    case INI_I32:
+        if (parse_double(value, &v) != 0 || v != floor(v)) {
+            snprintf(msg, len, "'%s' is not a whole number", value);
+            return -1;
+        }
+        if (range_error(k, v, msg, len))
+            return -1;
+        if (k->type == INI_U32)
+            *(uint32_t *)(void *)dst = (uint32_t)v;
+        else
+            *(int32_t *)(void *)dst = (int32_t)v;
+        return 0;
+    case INI_F64:
+        if (parse_double(value, &v) != 0) {
+            snprintf(msg, len, "'%s' is not a number", value);
+            return -1;
+        }
+        if (range_error(k, v, msg, len))
+            return -1;
+        *(double *)(void *)dst = v;
+        return 0;
+    case INI_ENUM:
+        if (!choice_ok(k->choices, value)) {
+            snprintf(msg, len, "'%s' is not one of %s", value, k->choices);
+            return -1;
+        }
+        /* A valid choice is stored as a string. */
+        __attribute__((fallthrough));
+    case INI_STR:
+        if (strlen(value) >= k->size) {
+            snprintf(msg, len, "value longer than %zu characters", k->size - 1);
+            return -1;
+        }
+        memcpy(dst, value, strlen(value) + 1);
+        return 0;
+    case INI_VEC: {
+        char buf[512];
+        snprintf(buf, sizeof(buf), "%s", value);
+        size_t n = 0;
+        for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok != NULL;
+             tok = strtok_r(NULL, ",", &save)) {
+            while (*tok == ' ' || *tok == '\t')
+                tok++;
+            if (n == k->size || parse_double(tok, &v) != 0 || range_error(k, v, msg, len)) {
+                if (n == k->size || parse_double(tok, &v) != 0)
+                    snprintf(msg, len, "'%s' is not a list of %zu numbers", value, k->size);
+                return -1;
+            }
+            ((double *)(void *)dst)[n++] = v;
+        }
+        if (n != k->size) {
+            snprintf(msg, len, "'%s' is not a list of %zu numbers", value, k->size);
+            return -1;
+        }
+        return 0;
+    }
+    }
+    return -1;
+}
+
+static int handler(void *user, const char *section, const char *name, const char *value)
+{
+    struct parse_state *st = user;
+    char msg[256];
+    if (st->failed) /* report the first error, not the last */
+        return 0;
+    for (size_t i = 0; i < st->key_count; i++) {
+        const struct ini_key *k = &st->keys[i];
+        if (strcmp(k->section, section) != 0 || strcmp(k->name, name) != 0)
+            continue;
+        if (st->seen_line[i] != 0) {
+            snprintf(msg, sizeof(msg), "set twice (first on line %d)", st->seen_line[i]);
+            format_where(st->err, st->err_len, st->path, st->line, k, msg);
+            st->failed = 1;
+            return 0;
+        }
+        if (set_value(k, st->target, value, msg, sizeof(msg)) != 0) {
+            format_where(st->err, st->err_len, st->path, st->line, k, msg);
+            st->failed = 1;
+            return 0;
+        }
+        st->seen_line[i] = st->line;
+        return 1;
+    }
+    int section_known = 0;
+    for (size_t i = 0; i < st->key_count; i++)
+        section_known |= strcmp(st->keys[i].section, section) == 0;
+    if (section_known)
+        snprintf(st->err, st->err_len, "%s:%d: [%s] %s: unknown key", st->path, st->line, section,
+                 name);
+    else
+        snprintf(st->err, st->err_len, "%s:%d: [%s] %s: unknown section '%s'", st->path, st->line,
+                 section, name, section);
+    st->failed = 1;
+    return 0;
+}
+
+int ini_schema_load(const struct ini_key *keys, size_t key_count, void *target, const char *path,
+                    char *err, size_t err_len)
+{
+    struct parse_state st = {.keys = keys, .key_count = key_count, .target = target,
+                             .path = path, .err = err, .err_len = err_len};
+    if (key_count > INI_MAX_KEYS) {
+        snprintf(err, err_len, "internal: schema has %zu keys, more than %d", key_count,
+                 INI_MAX_KEYS);
+        return -EINVAL;
+    }
+    st.file = fopen(path, "r");
+    if (st.file == NULL) {
+        int e = errno;
+        snprintf(err, err_len, "%s: cannot open: %s", path, strerror(e));
+        return -e;
+    }
+    int rc = ini_parse_stream(counting_reader, &st, handler, &st);
+    fclose(st.file);
+    if (st.failed)
+        return -EINVAL;
+    if (rc != 0) { /* a syntax error inih found itself: rc is its line */
+        snprintf(err, err_len, "%s:%d: syntax error (expected [section] or key = value)", path, rc);
+        return -EINVAL;
+    }
+    for (size_t i = 0; i < key_count; i++) {
+        if (st.seen_line[i] != 0)
+            continue;
+        char msg[256];
+        if (keys[i].def == NULL) {
+            format_where(err, err_len, path, 0, &keys[i], "required key is missing");
+            return -EINVAL;
+        }
+        if (set_value(&keys[i], target, keys[i].def, msg, sizeof(msg)) != 0) {
+            format_where(err, err_len, "(built-in default)", 0, &keys[i], msg);
+            return -EINVAL;
+        }
+    }
+    return 0;
+}
+
+static const char *type_name(const struct ini_key *k)
+{
+    switch (k->type) {
+    case INI_U32: return "unsigned";
+    case INI_I32: return "integer";
+    case INI_F64: return "number";
+    case INI_STR: return "text";
+    case INI_ENUM: return k->choices;
+    case INI_VEC: return k->size == 3 ? "x, y, z" : "list of numbers";
+    }
+    return "?";
+}
+
+void ini_schema_print_doc(const struct ini_key *keys, size_t key_count, FILE *out)
+{
+    const char *section = "";
+    for (size_t i = 0; i < key_count; i++) {
+        const struct ini_key *k = &keys[i];
+        if (strcmp(section, k->section) != 0) {
+            section = k->section;
+            fprintf(out, "\n### [%s]\n\n| key | type | default | range | meaning |\n"
+                         "|---|---|---|---|---|\n", section);
+        }
+        char range[64] = "";
+        if (k->type == INI_U32 || k->type == INI_I32 || k->type == INI_F64 || k->type == INI_VEC)
+            snprintf(range, sizeof(range), "%g .. %g%s", k->min, k->max,
+                     k->max_is_limit ? " (compiled limit)" : "");
+        fprintf(out, "| `%s` | %s | %s | %s | %s |\n", k->name, type_name(k),
+                k->def == NULL ? "**required**" : (k->def[0] ? k->def : "(empty)"), range, k->doc);
+    }
+}

@@ -1,0 +1,176 @@
+/* Gray-code decoding in static buffers: one pass per frame, so frames need not be kept. */
+#include "decode.h"
+
+#include "gray.h"
+
+#include <errno.h>
+#include <string.h>
+
+static uint16_t column_map[HAL_MAX_PIXELS];  /* Gray code while decoding, column afterwards */
+static uint8_t reason_map[HAL_MAX_PIXELS];
+static uint8_t grey_white[HAL_MAX_PIXELS];   /* white frame, then scratch for the positive frame */
+static uint8_t consistent_scratch[HAL_MAX_PIXELS];
+
+static struct {
+    struct scan_params params;
+    uint32_t bits;
+    uint32_t proj_width;
+    uint32_t next_pattern;
+    struct decode_maps maps;
+} dec;
+
+const char *scan_reason_name(unsigned reason)
+{
+    static const char *const names[SCAN_REASON_COUNT] = {
+        "valid", "shadow", "dark", "low_contrast", "saturated", "inconsistent"};
+    return reason < SCAN_REASON_COUNT ? names[reason] : "unknown";
+}
+
+int decode_begin(const struct scan_params *params, uint32_t proj_width)
+{
+    if (params->width == 0 || params->height == 0 || params->width > HAL_MAX_WIDTH ||
+        params->height > HAL_MAX_HEIGHT || proj_width == 0 || proj_width > HAL_MAX_PROJECTOR_WIDTH)
+        return -EINVAL;
+    dec.params = *params;
+    dec.bits = gray_bits_for_width(proj_width);
+    dec.proj_width = proj_width;
+    dec.next_pattern = 0;
+    dec.maps.column = column_map;
+    dec.maps.reason = reason_map;
+    dec.maps.width = params->width;
+    dec.maps.height = params->height;
+    size_t n = (size_t)params->width * params->height;
+    memset(column_map, 0, n * sizeof(column_map[0]));
+    memset(reason_map, SCAN_VALID, n);
+    return 0;
+}
+
+static int rgb_saturated(const uint8_t *rgb, uint32_t level)
+{
+    return rgb[0] >= level || rgb[1] >= level || rgb[2] >= level;
+}
+
+/* Reject a pixel, keeping the first reason found: later frames do not overwrite it. */
+static void reject(size_t i, enum scan_reason why)
+{
+    if (reason_map[i] == SCAN_VALID)
+        reason_map[i] = (uint8_t)why;
+}
+
+static void take_white(const uint8_t *rgb, size_t n)
+{
+    for (size_t i = 0; i < n; i++, rgb += 3) {
+        grey_white[i] = decode_grey(rgb);
+        if (rgb_saturated(rgb, dec.params.saturation_dn))
+            reject(i, SCAN_SATURATED);
+    }
+}
+
+static void take_black(const uint8_t *rgb, size_t n)
+{
+    for (size_t i = 0; i < n; i++, rgb += 3) {
+        int contrast = (int)grey_white[i] - (int)decode_grey(rgb);
+        if (contrast <= (int)dec.params.shadow_contrast_dn)
+            reject(i, SCAN_SHADOW);
+        else if (contrast < (int)dec.params.min_contrast_dn)
+            reject(i, SCAN_DARK);
+        else if (rgb_saturated(rgb, dec.params.saturation_dn))
+            reject(i, SCAN_SATURATED);
+    }
+}
+
+static void take_positive(const uint8_t *rgb, size_t n)
+{
+    /* The white frame is no longer needed: its buffer holds the positive frame until its inverse. */
+    for (size_t i = 0; i < n; i++, rgb += 3) {
+        grey_white[i] = decode_grey(rgb);
+        if (rgb_saturated(rgb, dec.params.saturation_dn))
+            reject(i, SCAN_SATURATED);
+    }
+}
+
+static void take_inverse(const uint8_t *rgb, size_t n)
+{
+    const int min_diff = (int)dec.params.min_bit_diff_dn;
+    for (size_t i = 0; i < n; i++, rgb += 3) {
+        int diff = (int)grey_white[i] - (int)decode_grey(rgb);
+        column_map[i] = (uint16_t)((column_map[i] << 1) | (diff > 0 ? 1u : 0u));
+        if (diff <= min_diff && diff >= -min_diff)
+            reject(i, SCAN_LOW_CONTRAST);
+        else if (rgb_saturated(rgb, dec.params.saturation_dn))
+            reject(i, SCAN_SATURATED);
+    }
+}
+
+int decode_frame(uint32_t pattern_index, const uint8_t *rgb)
+{
+    if (pattern_index != dec.next_pattern || pattern_index >= gray_pattern_count(dec.bits))
+        return -EINVAL;
+    size_t n = (size_t)dec.params.width * dec.params.height;
+    if (pattern_index == GRAY_PATTERN_WHITE)
+        take_white(rgb, n);
+    else if (pattern_index == GRAY_PATTERN_BLACK)
+        take_black(rgb, n);
+    else if ((pattern_index - GRAY_PATTERN_FIRST_BIT) % 2u == 0u)
+        take_positive(rgb, n);
+    else
+        take_inverse(rgb, n);
+    dec.next_pattern++;
+    return 0;
+}
+
+static int columns_agree(size_t a, size_t b)
+{
+    if (reason_map[b] != SCAN_VALID)
+        return 0;
+    int d = (int)column_map[a] - (int)column_map[b];
+    return d <= (int)dec.params.max_column_jump && d >= -(int)dec.params.max_column_jump;
+}
+
+/* A correct decode agrees with most of its neighbours; a wrong bit makes a lone jump. */
+static void check_neighbours(void)
+{
+    const uint32_t w = dec.params.width, h = dec.params.height;
+    for (uint32_t y = 0; y < h; y++) {
+        for (uint32_t x = 0; x < w; x++) {
+            size_t i = (size_t)y * w + x;
+            consistent_scratch[i] = 1;
+            if (reason_map[i] != SCAN_VALID)
+                continue;
+            uint32_t agree = 0;
+            for (int dy = -1; dy <= 1; dy++) {
+                for (int dx = -1; dx <= 1; dx++) {
+                    int nx = (int)x + dx, ny = (int)y + dy;
+                    if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= (int)w || ny >= (int)h)
+                        continue;
+                    agree += (uint32_t)columns_agree(i, (size_t)ny * w + (size_t)nx);
+                }
+            }
+            consistent_scratch[i] = agree >= dec.params.min_consistent_neighbours;
+        }
+    }
+    size_t n = (size_t)w * h;
+    for (size_t i = 0; i < n; i++)
+        if (!consistent_scratch[i])
+            reject(i, SCAN_INCONSISTENT);
+}
+
+int decode_finish(void)
+{
+    if (dec.next_pattern != gray_pattern_count(dec.bits))
+        return -EINVAL;
+    size_t n = (size_t)dec.params.width * dec.params.height;
+    for (size_t i = 0; i < n; i++) {
+        uint32_t col = gray_decode(column_map[i]);
+        column_map[i] = (uint16_t)col;
+        if (col >= dec.proj_width)
+            reject(i, SCAN_INCONSISTENT);
+    }
+    check_neighbours();
+    return 0;
+}
+
+const struct decode_maps *decode_get_maps(void)
+{
+    return &dec.maps;
+}

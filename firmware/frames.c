@@ -1,0 +1,32 @@
+/* Turntable and object frames derived from the calibration. */
+#include "frames.h"
+
+void frame_table_from_camera(const struct scan_calib *calib, struct frame_xform *t)
+{
+    vec3 origin = v3_from(calib->axis_point_mm);
+    vec3 ez = v3_norm(v3_from(calib->axis_dir));
+    /* The camera centre is the camera frame's origin: x points from the axis towards it. */
+    vec3 to_cam = v3_scale(origin, -1.0);
+    vec3 ex = v3_norm(v3_sub(to_cam, v3_scale(ez, v3_dot(to_cam, ez))));
+    vec3 ey = v3_cross(ez, ex);
+    double rows[9] = {ex.x, ex.y, ex.z, ey.x, ey.y, ey.z, ez.x, ez.y, ez.z};
+    for (int i = 0; i < 9; i++)
+        t->rot[i] = rows[i];
+    t->origin = origin;
+}
+
+void frame_object_from_camera(const struct scan_calib *calib, int32_t angle_mdeg,
+                              struct frame_xform *o)
+{
+    struct frame_xform t;
+    frame_table_from_camera(calib, &t);
+    /* The table turned the object by +angle; undo it: Rz(-angle) * table_from_cam. */
+    double a = (double)angle_mdeg * (M_PI / 180000.0);
+    double c = cos(a), s = sin(a);
+    double rz[9] = {c, s, 0, -s, c, 0, 0, 0, 1};
+    for (int r = 0; r < 3; r++)
+        for (int k = 0; k < 3; k++)
+            o->rot[r * 3 + k] = rz[r * 3 + 0] * t.rot[0 * 3 + k] + rz[r * 3 + 1] * t.rot[1 * 3 + k] +
+                                rz[r * 3 + 2] * t.rot[2 * 3 + k];
+    o->origin = t.origin;
+}

@@ -1,0 +1,23 @@
+/* Binary little-endian PLY output of a view's point cloud, written atomically through the HAL. */
+#ifndef PLY_H
+#define PLY_H
+
+#include "decode.h"
+#include "frames.h"
+#include "hal.h"
+#include "tri.h"
+
+/** Write every valid pixel as a vertex with position, normal (both through @p xform) and colour.
+ *  @param storage  where to write (atomic: the old file survives any failure)
+ *  @param path     final file path
+ *  @param maps     reason per pixel; only SCAN_VALID pixels are written
+ *  @param range    positions and normals in the camera frame
+ *  @param rgb      colour per pixel (RGB24, same size as the maps)
+ *  @param xform    camera frame to output frame
+ *  @param vertex_count  out: vertices written
+ *  @retval 0 ok @retval -errno from storage */
+int ply_write_cloud(const struct hal_storage *storage, const char *path,
+                    const struct decode_maps *maps, const struct tri_range *range,
+                    const uint8_t *rgb, const struct frame_xform *xform, uint32_t *vertex_count);
+
+#endif

@@ -1,0 +1,186 @@
+/* One view: projector pattern sequence, capture with bounded retries, decode, triangulate. */
+#include "scan.h"
+
+#include "frames.h"
+#include "gray.h"
+#include "ply.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <string.h>
+
+static uint8_t colour_rgb[HAL_MAX_PIXELS * 3]; /* projector-white frame, kept as the view's colour */
+static uint8_t frame_rgb[HAL_MAX_PIXELS * 3];  /* every other frame, consumed at once */
+static int32_t last_angle_mdeg;
+
+int scan_check(const struct scan_params *p, const struct scan_calib *c, char *msg, size_t len)
+{
+    if (p->width > HAL_MAX_WIDTH || p->height > HAL_MAX_HEIGHT) {
+        snprintf(msg, len, "camera %ux%u exceeds the compiled limit %ux%u", (unsigned)p->width,
+                 (unsigned)p->height, HAL_MAX_WIDTH, HAL_MAX_HEIGHT);
+        return -EINVAL;
+    }
+    if (c->cam_width != p->width || c->cam_height != p->height) {
+        snprintf(msg, len, "calibration is for a %ux%u camera but the camera is set to %ux%u",
+                 (unsigned)c->cam_width, (unsigned)c->cam_height, (unsigned)p->width,
+                 (unsigned)p->height);
+        return -EINVAL;
+    }
+    if (c->proj_width == 0 || c->proj_width > HAL_MAX_PROJECTOR_WIDTH) {
+        snprintf(msg, len, "projector width %u outside 1..%u", (unsigned)c->proj_width,
+                 HAL_MAX_PROJECTOR_WIDTH);
+        return -EINVAL;
+    }
+    if (c->light_count > HAL_MAX_LIGHTS) {
+        snprintf(msg, len, "%u lights exceed the compiled limit %u", (unsigned)c->light_count,
+                 HAL_MAX_LIGHTS);
+        return -EINVAL;
+    }
+    return 0;
+}
+
+int scan_open(const struct hal *hal, const struct hal_camera_config *cam_cfg)
+{
+    int rc = hal->gpio.ops->safe_state(hal->gpio.priv);
+    if (rc != 0) {
+        hal->log(HAL_LOG_ERROR, "gpio: cannot switch lights and projector off: %s", strerror(-rc));
+        return rc;
+    }
+    rc = hal_cam_open(&hal->camera, cam_cfg);
+    if (rc != 0)
+        hal->log(HAL_LOG_ERROR, "camera: cannot open '%s' at %ux%u: %s", cam_cfg->device,
+                 (unsigned)cam_cfg->width, (unsigned)cam_cfg->height, strerror(-rc));
+    return rc;
+}
+
+/* Capture into @p buf, retrying faults that a second try can cure (timeout, corrupt frame). */
+static int capture(const struct hal *hal, const struct scan_params *p, uint8_t *buf,
+                   uint32_t pattern, struct scan_view_info *info)
+{
+    struct hal_image img = {.rgb = buf, .capacity = sizeof(frame_rgb)};
+    int rc = -EIO;
+    for (uint32_t attempt = 0; attempt <= p->capture_retries; attempt++) {
+        if (attempt > 0)
+            info->capture_retries++;
+        rc = hal_cam_capture(&hal->camera, &img);
+        if (rc == 0 && (img.width != p->width || img.height != p->height))
+            rc = -EIO; /* a frame of the wrong size is as bad as a corrupt one */
+        if (rc == 0)
+            return 0;
+        hal->log(HAL_LOG_WARN, "camera: capture of pattern %u failed (%s), try %u of %u",
+                 (unsigned)pattern, strerror(-rc), (unsigned)attempt + 1,
+                 (unsigned)p->capture_retries + 1);
+        if (rc != -ETIMEDOUT && rc != -EIO && rc != -EAGAIN)
+            break;
+    }
+    hal->log(HAL_LOG_ERROR, "camera: giving up on pattern %u: %s", (unsigned)pattern,
+             strerror(-rc));
+    return rc;
+}
+
+static int lights_off(const struct hal *hal, uint32_t light_count)
+{
+    int rc = 0;
+    for (uint32_t i = 0; i < light_count && rc == 0; i++)
+        rc = hal_gpio_set(&hal->gpio, (enum hal_gpio_line)(HAL_GPIO_LIGHT_0 + i), 0);
+    return rc;
+}
+
+/* Show pattern 0 (white) with only the projector lighting the object. */
+static int projector_start(const struct hal *hal, const struct scan_params *p, uint32_t lights)
+{
+    int rc = lights_off(hal, lights);
+    if (rc == 0)
+        rc = hal_gpio_set(&hal->gpio, HAL_GPIO_PROJECTOR_ENABLE, 1);
+    if (rc == 0)
+        rc = hal_gpio_pulse(&hal->gpio, &hal->clock, HAL_GPIO_PROJECTOR_RESET, p->trigger_pulse_us);
+    if (rc == 0)
+        rc = hal_clock_sleep_us(&hal->clock, p->pattern_settle_us);
+    return rc;
+}
+
+static int capture_patterns(const struct hal *hal, const struct scan_params *p, uint32_t count,
+                            struct scan_view_info *info)
+{
+    for (uint32_t i = 0; i < count; i++) {
+        if (hal_should_stop(hal))
+            return -EINTR;
+        uint8_t *buf = i == GRAY_PATTERN_WHITE ? colour_rgb : frame_rgb;
+        int rc = capture(hal, p, buf, i, info);
+        if (rc != 0)
+            return rc;
+        info->frames_captured++;
+        rc = decode_frame(i, buf);
+        if (rc != 0)
+            return rc;
+        if (i + 1 == count)
+            break;
+        rc = hal_gpio_pulse(&hal->gpio, &hal->clock, HAL_GPIO_PROJECTOR_TRIGGER,
+                            p->trigger_pulse_us);
+        if (rc == 0)
+            rc = hal_clock_sleep_us(&hal->clock, p->pattern_settle_us);
+        if (rc != 0)
+            return rc;
+    }
+    return 0;
+}
+
+int scan_view(const struct hal *hal, const struct scan_params *p, const struct scan_calib *c,
+              int32_t angle_mdeg, struct scan_view_info *info)
+{
+    memset(info, 0, sizeof(*info));
+    info->angle_mdeg = angle_mdeg;
+    int rc = decode_begin(p, c->proj_width);
+    if (rc != 0)
+        return rc;
+    uint32_t count = gray_pattern_count(gray_bits_for_width(c->proj_width));
+    rc = projector_start(hal, p, c->light_count);
+    if (rc == 0)
+        rc = capture_patterns(hal, p, count, info);
+    /* Projector off as soon as the last frame is in, and on every failure. */
+    int rc_off = hal_gpio_set(&hal->gpio, HAL_GPIO_PROJECTOR_ENABLE, 0);
+    if (rc != 0 || rc_off != 0)
+        goto out_safe;
+    const struct decode_maps *maps = decode_get_maps();
+    rc = decode_finish();
+    if (rc == 0)
+        rc = tri_range_image(c, maps);
+    if (rc == 0)
+        rc = tri_normals(maps, p->max_depth_jump_mm);
+    if (rc != 0)
+        return rc;
+    size_t n = (size_t)maps->width * maps->height;
+    for (size_t i = 0; i < n; i++)
+        info->reason_count[maps->reason[i]]++;
+    info->valid_points = info->reason_count[SCAN_VALID];
+    last_angle_mdeg = angle_mdeg;
+    return 0;
+out_safe:
+    hal->gpio.ops->safe_state(hal->gpio.priv);
+    return rc != 0 ? rc : rc_off;
+}
+
+int scan_save_cloud(const struct hal *hal, const struct scan_calib *calib, const char *path)
+{
+    struct frame_xform obj_from_cam;
+    uint32_t written = 0;
+    frame_object_from_camera(calib, last_angle_mdeg, &obj_from_cam);
+    int rc = ply_write_cloud(&hal->storage, path, decode_get_maps(), tri_get_range(), colour_rgb,
+                             &obj_from_cam, &written);
+    if (rc != 0)
+        hal->log(HAL_LOG_ERROR, "storage: cannot write %s: %s", path, strerror(-rc));
+    else
+        hal->log(HAL_LOG_INFO, "wrote %u points to %s", (unsigned)written, path);
+    return rc;
+}
+
+const uint8_t *scan_colour_frame(void)
+{
+    return colour_rgb;
+}
+
+void scan_close(const struct hal *hal)
+{
+    hal_cam_close(&hal->camera);
+    hal_safe_state(hal);
+}

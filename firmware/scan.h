@@ -1,0 +1,44 @@
+/* View sequencing: drive projector and camera through the pattern set, then decode and triangulate. */
+#ifndef SCAN_H
+#define SCAN_H
+
+#include "decode.h"
+#include "hal.h"
+#include "scan_types.h"
+#include "tri.h"
+
+/** What one view produced. */
+struct scan_view_info {
+    int32_t angle_mdeg;                       /**< turntable angle of the view */
+    uint32_t frames_captured;                 /**< frames taken, retries not counted */
+    uint32_t capture_retries;                 /**< captures that had to be repeated */
+    uint32_t valid_points;                    /**< pixels with depth and normal */
+    uint32_t reason_count[SCAN_REASON_COUNT]; /**< pixels per reason code */
+};
+
+/** Check parameters and calibration against each other and the compiled limits.
+ *  @param msg  out: a sentence saying what is wrong
+ *  @retval 0 ok @retval -EINVAL */
+int scan_check(const struct scan_params *params, const struct scan_calib *calib, char *msg,
+               size_t msg_len);
+
+/** Put the rig in its idle state and open the camera. @retval 0 ok @retval what the camera said */
+int scan_open(const struct hal *hal, const struct hal_camera_config *cam_cfg);
+
+/** Capture and process one view at the current turntable angle. On any failure the projector
+ *  and lights are off when it returns.
+ *  @retval 0 ok @retval -EINTR stop requested @retval capture or processing error */
+int scan_view(const struct hal *hal, const struct scan_params *params,
+              const struct scan_calib *calib, int32_t angle_mdeg, struct scan_view_info *info);
+
+/** Write the last view's point cloud (object frame) as binary PLY.
+ *  @retval 0 ok @retval -errno from storage */
+int scan_save_cloud(const struct hal *hal, const struct scan_calib *calib, const char *path);
+
+/** Colour of the last view: the projector-white frame, RGB24 (registered with the range image). */
+const uint8_t *scan_colour_frame(void);
+
+/** Close the camera and put every device in its safe state. */
+void scan_close(const struct hal *hal);
+
+#endif

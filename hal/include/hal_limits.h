@@ -1,0 +1,23 @@
+/* Compile-time limits shared by the HAL and the firmware: every static buffer is sized from here. */
+#ifndef HAL_LIMITS_H
+#define HAL_LIMITS_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+/* The Raspberry Pi HQ camera's 2x2 binned mode is 2028 x 1520; leave room for it. */
+#define HAL_MAX_WIDTH 2048u
+#define HAL_MAX_HEIGHT 1536u
+#define HAL_MAX_PIXELS (HAL_MAX_WIDTH * HAL_MAX_HEIGHT)
+/* White lights around the object (Jost et al. method 3 needs several). */
+#define HAL_MAX_LIGHTS 8u
+/* Projector columns are coded with at most 11 Gray-code bits (2048 columns). */
+#define HAL_MAX_PROJECTOR_WIDTH 2048u
+#define HAL_MAX_PROJECTOR_HEIGHT 2048u
+#define HAL_MAX_PATH 512u
+
+_Static_assert(HAL_MAX_WIDTH % 2u == 0u, "YUYV conversion needs an even width");
+_Static_assert(HAL_MAX_PIXELS <= (1u << 23), "pixel indices must fit comfortably in 32 bits");
+_Static_assert(HAL_MAX_PROJECTOR_WIDTH <= 65535u, "projector columns are stored as uint16_t");
+
+#endif

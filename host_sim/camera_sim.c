@@ -1,0 +1,73 @@
+/* Simulated camera: renders the rig in its current light state, with injectable faults. */
+#include "sim_devices.h"
+
+#include <errno.h>
+#include <string.h>
+
+static int camera_sim_open(void *priv, const struct hal_camera_config *cfg)
+{
+    struct camera_sim *cam = priv;
+    if (cfg->width != cam->rig->width || cfg->height != cam->rig->height)
+        return -EINVAL; /* the simulated sensor has the calibrated size only */
+    if (cfg->pixel_format != HAL_PIX_RGB24 || cfg->exposure_us == 0 || cfg->gain_milli == 0)
+        return -EINVAL;
+    cam->cfg = *cfg;
+    cam->is_open = 1;
+    cam->frames = 0;
+    return 0;
+}
+
+static int camera_sim_capture(void *priv, struct hal_image *img)
+{
+    struct camera_sim *cam = priv;
+    if (!cam->is_open)
+        return -EBADF;
+    uint64_t frame = cam->frames++;
+    if (cam->fault != SIM_FAULT_NONE && frame >= cam->fault_first &&
+        frame < cam->fault_first + cam->fault_count) {
+        static const int code[] = {0, -ETIMEDOUT, -EIO, -ENODEV};
+        return code[cam->fault];
+    }
+    size_t need = (size_t)cam->rig->width * cam->rig->height * 3;
+    if (img->capacity < need)
+        return -ENOSPC;
+    struct sim_sources src;
+    gpio_sim_sources(cam->gpio, cam->light_count, &src);
+    src.exposure_us = cam->cfg.exposure_us;
+    src.gain_milli = cam->cfg.gain_milli;
+    sim_rig_render(cam->rig, &src, frame, img->rgb);
+    img->width = cam->rig->width;
+    img->height = cam->rig->height;
+    img->sequence = frame;
+    return 0;
+}
+
+static int camera_sim_close(void *priv)
+{
+    ((struct camera_sim *)priv)->is_open = 0;
+    return 0;
+}
+
+static int camera_sim_safe_state(void *priv)
+{
+    (void)priv; /* a simulated sensor has nothing to stop */
+    return 0;
+}
+
+static const struct hal_camera_ops camera_sim_ops = {
+    .open = camera_sim_open,
+    .capture = camera_sim_capture,
+    .close = camera_sim_close,
+    .safe_state = camera_sim_safe_state,
+};
+
+void camera_sim_init(struct camera_sim *cam, struct sim_rig *rig, const struct gpio_sim *gpio,
+                     uint32_t light_count, struct hal_camera *out)
+{
+    memset(cam, 0, sizeof(*cam));
+    cam->rig = rig;
+    cam->gpio = gpio;
+    cam->light_count = light_count;
+    out->ops = &camera_sim_ops;
+    out->priv = cam;
+}

@@ -1,0 +1,37 @@
+/* The simulator's device backends behind the HAL interfaces. */
+#ifndef SIM_DEVICES_H
+#define SIM_DEVICES_H
+
+#include "hal.h"
+#include "sim_ctl.h"
+#include "sim_rig.h"
+
+struct gpio_sim {
+    int line[HAL_GPIO_LINE_COUNT];
+    uint32_t pattern_index;
+    uint32_t pattern_count;
+};
+
+struct clock_sim {
+    uint64_t now_us;
+};
+
+struct camera_sim {
+    struct sim_rig *rig;
+    const struct gpio_sim *gpio;
+    uint32_t light_count;
+    struct hal_camera_config cfg;
+    int is_open;
+    uint64_t frames;          /* captures attempted since open */
+    enum sim_cam_fault fault;
+    uint64_t fault_first;
+    uint32_t fault_count;
+};
+
+void gpio_sim_init(struct gpio_sim *g, uint32_t pattern_count, struct hal_gpio *out);
+void gpio_sim_sources(const struct gpio_sim *g, uint32_t light_count, struct sim_sources *src);
+void clock_sim_init(struct clock_sim *c, struct hal_clock *out);
+void camera_sim_init(struct camera_sim *cam, struct sim_rig *rig, const struct gpio_sim *gpio,
+                     uint32_t light_count, struct hal_camera *out);
+
+#endif

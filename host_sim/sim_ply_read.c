@@ -1,0 +1,250 @@
+/* PLY reader for the simulated object: ASCII and binary little-endian, triangles and polygons. */
+#define _POSIX_C_SOURCE 200809L
+#include "sim_mesh.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+enum ply_type { PT_NONE, PT_I8, PT_U8, PT_I16, PT_U16, PT_I32, PT_U32, PT_F32, PT_F64 };
+
+struct ply_prop {
+    enum ply_type type;
+    enum ply_type list_count_type; /* PT_NONE when not a list */
+    int role;                      /* 0 x, 1 y, 2 z, 3 face indices, -1 skipped */
+};
+
+#define PLY_MAX_PROPS 32
+struct ply_element {
+    char name[32];
+    unsigned long count;
+    int prop_count;
+    struct ply_prop props[PLY_MAX_PROPS];
+};
+
+static enum ply_type ply_type_of(const char *s)
+{
+    static const struct {
+        const char *name;
+        enum ply_type type;
+    } map[] = {{"char", PT_I8},    {"int8", PT_I8},     {"uchar", PT_U8},   {"uint8", PT_U8},
+               {"short", PT_I16},  {"int16", PT_I16},   {"ushort", PT_U16}, {"uint16", PT_U16},
+               {"int", PT_I32},    {"int32", PT_I32},   {"uint", PT_U32},   {"uint32", PT_U32},
+               {"float", PT_F32},  {"float32", PT_F32}, {"double", PT_F64}, {"float64", PT_F64}};
+    for (size_t i = 0; i < sizeof(map) / sizeof(map[0]); i++)
+        if (strcmp(s, map[i].name) == 0)
+            return map[i].type;
+    return PT_NONE;
+}
+
+static size_t ply_type_size(enum ply_type t)
+{
+    static const size_t sizes[] = {0, 1, 1, 2, 2, 4, 4, 4, 8};
+    return sizes[t];
+}
+
+/* Read one scalar, ASCII or binary little-endian. @retval 0 ok, -1 at end or on a bad token */
+static int read_scalar(FILE *f, int binary, enum ply_type t, double *out)
+{
+    if (!binary)
+        return fscanf(f, "%lf", out) == 1 ? 0 : -1;
+    unsigned char b[8];
+    size_t n = ply_type_size(t);
+    if (fread(b, 1, n, f) != n)
+        return -1;
+    uint64_t u = 0;
+    for (size_t i = 0; i < n; i++)
+        u |= (uint64_t)b[i] << (8 * i);
+    switch (t) {
+    case PT_I8: *out = (int8_t)u; break;
+    case PT_U8: *out = (uint8_t)u; break;
+    case PT_I16: *out = (int16_t)u; break;
+    case PT_U16: *out = (uint16_t)u; break;
+    case PT_I32: *out = (int32_t)u; break;
+    case PT_U32: *out = (uint32_t)u; break;
+    case PT_F32: { uint32_t w = (uint32_t)u; float fl; memcpy(&fl, &w, 4); *out = fl; break; }
+    case PT_F64: { double d; memcpy(&d, &u, 8); *out = d; break; }
+    default: return -1;
+    }
+    return 0;
+}
+
+struct ply_header {
+    int binary;
+    int elem_count;
+    struct ply_element elems[8];
+};
+
+static int parse_header(FILE *f, struct ply_header *h, char *err, unsigned err_len, const char *path)
+{
+    char line[256];
+    memset(h, 0, sizeof(*h));
+    if (fgets(line, sizeof(line), f) == NULL || strncmp(line, "ply", 3) != 0) {
+        snprintf(err, err_len, "%s: not a PLY file (no 'ply' magic)", path);
+        return -EINVAL;
+    }
+    while (fgets(line, sizeof(line), f) != NULL) {
+        char a[64] = "", b[64] = "", c[64] = "", d[64] = "", e[64] = "";
+        int n = sscanf(line, "%63s %63s %63s %63s %63s", a, b, c, d, e);
+        if (n <= 0 || strcmp(a, "comment") == 0 || strcmp(a, "obj_info") == 0)
+            continue;
+        if (strcmp(a, "end_header") == 0)
+            return 0;
+        if (strcmp(a, "format") == 0) {
+            if (strcmp(b, "ascii") == 0)
+                h->binary = 0;
+            else if (strcmp(b, "binary_little_endian") == 0)
+                h->binary = 1;
+            else {
+                snprintf(err, err_len, "%s: PLY format '%s' is not supported", path, b);
+                return -EINVAL;
+            }
+        } else if (strcmp(a, "element") == 0 && n >= 3) {
+            if (h->elem_count == 8) {
+                snprintf(err, err_len, "%s: more than 8 PLY elements", path);
+                return -EINVAL;
+            }
+            struct ply_element *el = &h->elems[h->elem_count++];
+            snprintf(el->name, sizeof(el->name), "%s", b);
+            el->count = strtoul(c, NULL, 10);
+        } else if (strcmp(a, "property") == 0 && h->elem_count > 0) {
+            struct ply_element *el = &h->elems[h->elem_count - 1];
+            if (el->prop_count == PLY_MAX_PROPS) {
+                snprintf(err, err_len, "%s: too many properties in '%s'", path, el->name);
+                return -EINVAL;
+            }
+            struct ply_prop *p = &el->props[el->prop_count++];
+            const char *pname = b;
+            p->list_count_type = PT_NONE;
+            if (strcmp(b, "list") == 0) {
+                p->list_count_type = ply_type_of(c);
+                p->type = ply_type_of(d);
+                pname = e;
+            } else {
+                p->type = ply_type_of(b);
+                pname = c;
+            }
+            if (p->type == PT_NONE || (strcmp(b, "list") == 0 && p->list_count_type == PT_NONE)) {
+                snprintf(err, err_len, "%s: unknown PLY property type in '%s'", path, line);
+                return -EINVAL;
+            }
+            p->role = -1;
+            if (strcmp(el->name, "vertex") == 0 && p->list_count_type == PT_NONE) {
+                if (strcmp(pname, "x") == 0) p->role = 0;
+                if (strcmp(pname, "y") == 0) p->role = 1;
+                if (strcmp(pname, "z") == 0) p->role = 2;
+            }
+            if (strcmp(el->name, "face") == 0 && p->list_count_type != PT_NONE &&
+                (strcmp(pname, "vertex_indices") == 0 || strcmp(pname, "vertex_index") == 0))
+                p->role = 3;
+        }
+    }
+    snprintf(err, err_len, "%s: PLY header has no end_header", path);
+    return -EINVAL;
+}
+
+/* Faces are polygons: count the triangles of their fans in a first pass over the counts only
+ * would need a second read, so triangles are appended to a growing array instead. */
+static int push_tri(struct sim_mesh *m, uint32_t *cap, uint32_t a, uint32_t b, uint32_t c)
+{
+    if (m->tri_count == *cap) {
+        uint32_t ncap = *cap ? *cap * 2 : 1024;
+        uint32_t *t = realloc(m->tri, (size_t)ncap * 3 * sizeof(uint32_t));
+        if (t == NULL)
+            return -ENOMEM;
+        m->tri = t;
+        *cap = ncap;
+    }
+    m->tri[3 * m->tri_count] = a;
+    m->tri[3 * m->tri_count + 1] = b;
+    m->tri[3 * m->tri_count + 2] = c;
+    m->tri_count++;
+    return 0;
+}
+
+static int read_element(FILE *f, const struct ply_header *h, const struct ply_element *el,
+                        struct sim_mesh *m, uint32_t *tri_cap)
+{
+    int is_vertex = strcmp(el->name, "vertex") == 0;
+    for (unsigned long r = 0; r < el->count; r++) {
+        for (int k = 0; k < el->prop_count; k++) {
+            const struct ply_prop *p = &el->props[k];
+            double v;
+            if (p->list_count_type == PT_NONE) {
+                if (read_scalar(f, h->binary, p->type, &v) != 0)
+                    return -EINVAL;
+                if (is_vertex && p->role >= 0)
+                    m->pos[3 * r + (unsigned long)p->role] = (float)v;
+                continue;
+            }
+            double cnt;
+            if (read_scalar(f, h->binary, p->list_count_type, &cnt) != 0 || cnt < 0 || cnt > 64)
+                return -EINVAL;
+            uint32_t idx[64];
+            for (int j = 0; j < (int)cnt; j++) {
+                if (read_scalar(f, h->binary, p->type, &v) != 0 || v < 0 ||
+                    v >= (double)m->vert_count)
+                    return -EINVAL;
+                idx[j] = (uint32_t)v;
+            }
+            for (int j = 2; p->role == 3 && j < (int)cnt; j++)
+                if (push_tri(m, tri_cap, idx[0], idx[j - 1], idx[j]) != 0)
+                    return -ENOMEM;
+        }
+    }
+    return 0;
+}
+
+int sim_mesh_load_ply(struct sim_mesh *m, const char *path, char *err, unsigned err_len)
+{
+    struct ply_header h;
+    uint32_t tri_cap = 0;
+    int rc;
+    memset(m, 0, sizeof(*m));
+    FILE *f = fopen(path, "rb");
+    if (f == NULL) {
+        rc = -errno;
+        snprintf(err, err_len, "%s: %s", path, strerror(errno));
+        return rc;
+    }
+    rc = parse_header(f, &h, err, err_len, path);
+    if (rc != 0)
+        goto out_close;
+    for (int e = 0; e < h.elem_count; e++)
+        if (strcmp(h.elems[e].name, "vertex") == 0 && h.elems[e].count < (1ul << 26))
+            m->vert_count = (uint32_t)h.elems[e].count;
+    rc = -EINVAL;
+    if (m->vert_count == 0) {
+        snprintf(err, err_len, "%s: no vertices", path);
+        goto out_close;
+    }
+    m->pos = calloc((size_t)m->vert_count * 3, sizeof(float));
+    m->normal = calloc((size_t)m->vert_count * 3, sizeof(float));
+    if (m->pos == NULL || m->normal == NULL) {
+        rc = -ENOMEM;
+        snprintf(err, err_len, "%s: out of memory", path);
+        goto out_free;
+    }
+    for (int e = 0; e < h.elem_count; e++) {
+        rc = read_element(f, &h, &h.elems[e], m, &tri_cap);
+        if (rc != 0) {
+            snprintf(err, err_len, "%s: element '%s' is truncated or has a bad value", path,
+                     h.elems[e].name);
+            goto out_free;
+        }
+    }
+    if (m->tri_count == 0) {
+        rc = -EINVAL;
+        snprintf(err, err_len, "%s: no faces", path);
+        goto out_free;
+    }
+    fclose(f);
+    sim_mesh_compute_normals(m);
+    return 0;
+out_free:
+    sim_mesh_free(m);
+out_close:
+    fclose(f);
+    return rc;
+}

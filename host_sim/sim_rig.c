@@ -1,0 +1,368 @@
+/* Simulated rig renderer: ray-cast geometry once per angle, then cheap per-frame shading + noise. */
+#define _POSIX_C_SOURCE 200809L
+#include "sim_rig.h"
+
+#include "frames.h"
+#include "gray.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define GAUSS_TABLE 65536u
+
+static uint64_t splitmix64(uint64_t *state)
+{
+    uint64_t z = (*state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+static void fill_gauss(float *table, uint64_t seed)
+{
+    /* Box-Muller pairs; indexing this table with random bits is much faster than logs per pixel. */
+    for (uint32_t i = 0; i < GAUSS_TABLE; i += 2) {
+        double u1 = ((double)(splitmix64(&seed) >> 11) + 1.0) / 9007199254740993.0;
+        double u2 = (double)(splitmix64(&seed) >> 11) / 9007199254740992.0;
+        double r = sqrt(-2.0 * log(u1));
+        table[i] = (float)(r * cos(2.0 * M_PI * u2));
+        table[i + 1] = (float)(r * sin(2.0 * M_PI * u2));
+    }
+}
+
+int sim_albedo_at(const struct sim_config *cfg, double height_mm, vec3 p, double albedo[3])
+{
+    static const double palette[5][3] = {
+        {0.80, 0.78, 0.70}, /* ivory */
+        {0.70, 0.15, 0.12}, /* red */
+        {0.18, 0.55, 0.22}, /* green */
+        {0.15, 0.22, 0.65}, /* blue */
+        {0.85, 0.70, 0.15}, /* yellow */
+    };
+    if (strcmp(cfg->albedo_pattern, "uniform") == 0) {
+        memcpy(albedo, cfg->albedo, 3 * sizeof(double));
+        return 0;
+    }
+    double az = atan2(p.y, p.x);
+    if (az < 0.0)
+        az += 2.0 * M_PI;
+    int sector = (int)(az / (M_PI / 4.0)) % 8;
+    double h = p.z / height_mm;
+    int band = h < 0.0 ? 0 : (h >= 1.0 ? 4 : (int)(h * 5.0));
+    /* A narrow stripe of very dark paint, facing the camera at angle 0. */
+    if (sector == 0 && h >= 0.50 && h < 0.53) {
+        albedo[0] = albedo[1] = albedo[2] = 0.03;
+        return 1;
+    }
+    memcpy(albedo, palette[(sector + 3 * band) % 5], 3 * sizeof(double));
+    return 0;
+}
+
+static int build_object(struct sim_rig *rig, const char *dir, char *err, size_t len)
+{
+    const struct sim_config *c = &rig->cfg;
+    double h = c->object_height_mm;
+    int rc;
+    if (strcmp(c->object, "sphere") == 0)
+        rc = sim_mesh_sphere(&rig->mesh, 0.5 * h, c->segments);
+    else if (strcmp(c->object, "cylinder") == 0)
+        rc = sim_mesh_cylinder(&rig->mesh, 0.3 * h, h, c->segments);
+    else if (strcmp(c->object, "box") == 0)
+        rc = sim_mesh_box(&rig->mesh, 0.6 * h, 0.45 * h, h, c->segments);
+    else if (strcmp(c->object, "torus") == 0)
+        rc = sim_mesh_torus(&rig->mesh, 0.7 * h, 0.25 * h, c->segments);
+    else {
+        char path[HAL_MAX_PATH * 2];
+        snprintf(path, sizeof(path), "%s%s%s", c->mesh_file[0] == '/' ? "" : dir,
+                 c->mesh_file[0] == '/' ? "" : "/", c->mesh_file);
+        rc = sim_mesh_load_ply(&rig->mesh, path, err, (unsigned)len);
+        if (rc != 0)
+            return rc;
+        sim_mesh_y_up_to_z_up(&rig->mesh);
+    }
+    if (rc != 0) {
+        snprintf(err, len, "sim: cannot build the %s: %s", c->object, strerror(-rc));
+        return rc;
+    }
+    sim_mesh_place(&rig->mesh, h);
+    return 0;
+}
+
+static int build_material(struct sim_rig *rig, const char *dir, char *err, size_t len)
+{
+    const struct sim_config *c = &rig->cfg;
+    memset(&rig->material, 0, sizeof(rig->material));
+    if (strcmp(c->material, "lambert") == 0) {
+        rig->material.kind = SIM_MAT_LAMBERT;
+    } else if (strcmp(c->material, "phong") == 0) {
+        rig->material.kind = SIM_MAT_PHONG;
+        rig->material.ks = c->phong_ks;
+        rig->material.ke = c->phong_ke;
+    } else {
+        char path[HAL_MAX_PATH * 2];
+        snprintf(path, sizeof(path), "%s%s%s", c->merl_file[0] == '/' ? "" : dir,
+                 c->merl_file[0] == '/' ? "" : "/", c->merl_file);
+        int rc = sim_material_load_abc(&rig->material, path, c->merl_name);
+        if (rc != 0) {
+            snprintf(err, len, "sim: material '%s' from %s: %s", c->merl_name, path,
+                     rc == -ENOENT ? "not in the table" : strerror(-rc));
+            return rc;
+        }
+    }
+    return 0;
+}
+
+int sim_rig_init(struct sim_rig *rig, const struct sim_config *cfg, const struct scan_calib *calib,
+                 const char *dir, char *err, size_t len)
+{
+    memset(rig, 0, sizeof(*rig));
+    rig->cfg = *cfg;
+    rig->calib = *calib;
+    rig->width = calib->cam_width;
+    rig->height = calib->cam_height;
+    rig->bits = gray_bits_for_width(calib->proj_width);
+    rig->table_angle_mdeg = (int32_t)lround(cfg->object_angle_deg * 1000.0);
+    int rc = build_object(rig, dir, err, len);
+    if (rc == 0)
+        rc = build_material(rig, dir, err, len);
+    if (rc == 0)
+        rc = sim_bvh_build(&rig->bvh, &rig->mesh);
+    if (rc != 0)
+        goto out_free;
+    size_t n = (size_t)rig->width * rig->height;
+    struct sim_truth *t = &rig->truth;
+    t->hit = calloc(n, 1);
+    t->pos_cam = calloc(n * 3, sizeof(float));
+    t->normal_cam = calloc(n * 3, sizeof(float));
+    t->albedo = calloc(n * 3, sizeof(float));
+    t->proj_u = calloc(n, sizeof(float));
+    t->proj_lit = calloc(n, 1);
+    t->dark = calloc(n, 1);
+    rig->proj_radiance = calloc(n * 3, sizeof(float));
+    rig->light_vis = calloc(n, 1);
+    rig->gauss = calloc(GAUSS_TABLE, sizeof(float));
+    if (!t->hit || !t->pos_cam || !t->normal_cam || !t->albedo || !t->proj_u || !t->proj_lit ||
+        !t->dark || !rig->proj_radiance || !rig->light_vis || !rig->gauss) {
+        rc = -ENOMEM;
+        snprintf(err, len, "sim: out of memory for a %ux%u frame", (unsigned)rig->width,
+                 (unsigned)rig->height);
+        goto out_free;
+    }
+    fill_gauss(rig->gauss, 0x5ca77e5ull ^ cfg->seed);
+    return 0;
+out_free:
+    sim_rig_free(rig);
+    return rc;
+}
+
+void sim_rig_free(struct sim_rig *rig)
+{
+    struct sim_truth *t = &rig->truth;
+    free(t->hit);
+    free(t->pos_cam);
+    free(t->normal_cam);
+    free(t->albedo);
+    free(t->proj_u);
+    free(t->proj_lit);
+    free(t->dark);
+    free(rig->proj_radiance);
+    free(rig->light_vis);
+    free(rig->gauss);
+    sim_bvh_free(&rig->bvh);
+    sim_mesh_free(&rig->mesh);
+    memset(rig, 0, sizeof(*rig));
+}
+
+static vec3 projector_centre_cam(const struct scan_calib *c)
+{
+    /* p_proj = R p_cam + t, so the projector centre (p_proj = 0) is -R^T t. */
+    return v3_scale(m3_tmul(c->proj_rot, v3_from(c->proj_trans_mm)), -1.0);
+}
+
+/* Is the segment from @p p_obj (on the surface, normal @p n_obj) to @p src_obj blocked? */
+static int occluded(const struct sim_rig *rig, vec3 p_obj, vec3 n_obj, vec3 src_obj)
+{
+    vec3 start = v3_add(p_obj, v3_scale(n_obj, 0.01)); /* 10 um off the surface */
+    return sim_bvh_occluded(&rig->bvh, start, v3_sub(src_obj, start), 1e-6, 1.0 - 1e-6);
+}
+
+static double falloff(const struct sim_rig *rig, double dist_mm)
+{
+    double r = rig->cfg.reference_distance_mm / dist_mm;
+    return r * r; /* inverse-square law, 1 at the reference distance */
+}
+
+/* Cast the camera ray of pixel (x, y); fill truth and the projector's reflected light. */
+static void update_pixel(struct sim_rig *rig, const struct frame_xform *obj, vec3 cam_obj,
+                         vec3 proj_cam, vec3 proj_obj, uint32_t x, uint32_t y)
+{
+    const struct scan_calib *c = &rig->calib;
+    struct sim_truth *t = &rig->truth;
+    size_t i = (size_t)y * rig->width + x;
+    vec3 d_cam = v3(((double)x - c->cam_cx_px) / c->cam_fx_px,
+                    ((double)y - c->cam_cy_px) / c->cam_fy_px, 1.0);
+    struct sim_hit hit;
+    t->hit[i] = (uint8_t)sim_bvh_intersect(&rig->bvh, cam_obj, frame_dir(obj, d_cam), 1e-6, 1e9,
+                                           &hit);
+    t->proj_lit[i] = 0;
+    t->dark[i] = 0;
+    for (int k = 0; k < 3; k++)
+        rig->proj_radiance[3 * i + k] = 0.0f;
+    if (!t->hit[i])
+        return;
+    const struct sim_mesh *m = &rig->mesh;
+    const uint32_t *tv = &m->tri[3 * hit.tri];
+    double w0 = 1.0 - hit.u - hit.v;
+    vec3 n_obj = v3(0, 0, 0), p_obj = v3(0, 0, 0);
+    double w[3] = {w0, hit.u, hit.v};
+    for (int k = 0; k < 3; k++) {
+        const float *pn = &m->normal[3 * tv[k]], *pp = &m->pos[3 * tv[k]];
+        n_obj = v3_add(n_obj, v3_scale(v3(pn[0], pn[1], pn[2]), w[k]));
+        p_obj = v3_add(p_obj, v3_scale(v3(pp[0], pp[1], pp[2]), w[k]));
+    }
+    n_obj = v3_norm(n_obj);
+    vec3 p_cam = v3_scale(d_cam, hit.t);
+    vec3 n_cam = frame_dir_inv(obj, n_obj);
+    double albedo[3];
+    t->dark[i] = (uint8_t)sim_albedo_at(&rig->cfg, rig->cfg.object_height_mm, p_obj, albedo);
+    for (int k = 0; k < 3; k++) {
+        t->albedo[3 * i + k] = (float)albedo[k];
+        t->pos_cam[3 * i + k] = (float)(k == 0 ? p_cam.x : k == 1 ? p_cam.y : p_cam.z);
+        t->normal_cam[3 * i + k] = (float)(k == 0 ? n_cam.x : k == 1 ? n_cam.y : n_cam.z);
+    }
+    /* Where the point falls in the projector image. */
+    vec3 pp = v3_add(m3_mul(c->proj_rot, p_cam), v3_from(c->proj_trans_mm));
+    if (pp.z <= 0.0)
+        return;
+    double u = c->proj_fx_px * pp.x / pp.z + c->proj_cx_px;
+    double v = c->proj_fy_px * pp.y / pp.z + c->proj_cy_px;
+    t->proj_u[i] = (float)u;
+    vec3 to_proj = v3_sub(proj_cam, p_cam);
+    vec3 l = v3_norm(to_proj);
+    if (u < -0.5 || u >= c->proj_width - 0.5 || v < -0.5 || v >= c->proj_height - 0.5 ||
+        v3_dot(n_cam, l) <= 0.0 || occluded(rig, p_obj, n_obj, proj_obj))
+        return;
+    t->proj_lit[i] = 1;
+    double rho[3];
+    sim_material_eval(&rig->material, albedo, n_cam, l, v3_norm(v3_scale(p_cam, -1.0)), rho);
+    double e = rig->cfg.projector_intensity_dn * falloff(rig, v3_len(to_proj));
+    for (int k = 0; k < 3; k++)
+        rig->proj_radiance[3 * i + k] = (float)(e * rho[k]);
+}
+
+void sim_rig_update(struct sim_rig *rig)
+{
+    if (rig->truth_valid && rig->truth_angle_mdeg == rig->table_angle_mdeg)
+        return;
+    struct frame_xform obj;
+    frame_object_from_camera(&rig->calib, rig->table_angle_mdeg, &obj);
+    vec3 cam_obj = frame_point(&obj, v3(0, 0, 0));
+    vec3 proj_cam = projector_centre_cam(&rig->calib);
+    vec3 proj_obj = frame_point(&obj, proj_cam);
+    for (uint32_t y = 0; y < rig->height; y++)
+        for (uint32_t x = 0; x < rig->width; x++)
+            update_pixel(rig, &obj, cam_obj, proj_cam, proj_obj, x, y);
+    rig->truth_angle_mdeg = rig->table_angle_mdeg;
+    rig->truth_valid = 1;
+    rig->lights_done = 0;
+}
+
+/* Shadow rays towards light @p li for every visible pixel, once per angle. */
+static void ensure_light(struct sim_rig *rig, uint32_t li)
+{
+    if (rig->lights_done & (1u << li))
+        return;
+    struct frame_xform obj;
+    frame_object_from_camera(&rig->calib, rig->truth_angle_mdeg, &obj);
+    vec3 light_obj = frame_point(&obj, v3_from(rig->calib.light_pos_mm[li]));
+    size_t n = (size_t)rig->width * rig->height;
+    for (size_t i = 0; i < n; i++) {
+        rig->light_vis[i] &= (uint8_t) ~(1u << li);
+        if (!rig->truth.hit[i])
+            continue;
+        const float *pc = &rig->truth.pos_cam[3 * i], *nc = &rig->truth.normal_cam[3 * i];
+        vec3 p_obj = frame_point(&obj, v3(pc[0], pc[1], pc[2]));
+        vec3 n_obj = frame_dir(&obj, v3(nc[0], nc[1], nc[2]));
+        if (!occluded(rig, p_obj, n_obj, light_obj))
+            rig->light_vis[i] |= (uint8_t)(1u << li);
+    }
+    rig->lights_done |= 1u << li;
+}
+
+/* Light of the current pattern at continuous column u: the lens blurs it over a box of
+ * projector_blur_px columns, and "black" still leaks projector_black_level of white. */
+static double pattern_light(const struct sim_rig *rig, uint32_t pattern, double u)
+{
+    double b = rig->cfg.projector_blur_px, lo = u - 0.5 * b, hi = u + 0.5 * b;
+    double c0 = floor(lo + 0.5), c1 = floor(hi + 0.5), lit;
+    int w = (int)rig->calib.proj_width;
+#define LIT(c) (((c) < 0 || (c) >= w) ? 0 : gray_pattern_lit(rig->bits, pattern, (uint32_t)(c)))
+    if (c0 == c1 || b <= 0.0) {
+        lit = LIT((int)floor(u + 0.5));
+    } else {
+        double f0 = (c0 + 0.5 - lo) / b;
+        lit = f0 * LIT((int)c0) + (1.0 - f0) * LIT((int)c1);
+    }
+#undef LIT
+    double black = rig->cfg.projector_black_level;
+    return black + (1.0 - black) * lit;
+}
+
+/* Light-i radiance at pixel i, computed on the fly (light frames are few). */
+static void add_light(const struct sim_rig *rig, size_t i, uint32_t li, double sig[3])
+{
+    if (!(rig->light_vis[i] & (1u << li)))
+        return;
+    const float *pc = &rig->truth.pos_cam[3 * i], *nc = &rig->truth.normal_cam[3 * i];
+    const float *al = &rig->truth.albedo[3 * i];
+    vec3 p = v3(pc[0], pc[1], pc[2]);
+    vec3 to_light = v3_sub(v3_from(rig->calib.light_pos_mm[li]), p);
+    double albedo[3] = {al[0], al[1], al[2]}, rho[3];
+    sim_material_eval(&rig->material, albedo, v3(nc[0], nc[1], nc[2]), v3_norm(to_light),
+                      v3_norm(v3_scale(p, -1.0)), rho);
+    double e = rig->cfg.light_intensity_dn * falloff(rig, v3_len(to_light));
+    for (int k = 0; k < 3; k++)
+        sig[k] += e * rho[k];
+}
+
+void sim_rig_render(struct sim_rig *rig, const struct sim_sources *src, uint64_t frame_no,
+                    uint8_t *rgb)
+{
+    sim_rig_update(rig);
+    uint32_t lights = src->lights_mask;
+    for (uint32_t li = 0; li < rig->calib.light_count; li++)
+        if (lights & (1u << li))
+            ensure_light(rig, li);
+    const struct sim_config *c = &rig->cfg;
+    double gain = (double)src->exposure_us / c->reference_exposure_us * src->gain_milli / 1000.0;
+    uint64_t state = ((uint64_t)c->seed << 32) ^ (frame_no * 0x9E3779B97F4A7C15ull) ^
+                     (uint64_t)(uint32_t)rig->truth_angle_mdeg;
+    double var_read = c->read_noise_dn * c->read_noise_dn;
+    size_t n = (size_t)rig->width * rig->height;
+    for (size_t i = 0; i < n; i++) {
+        double sig[3] = {0, 0, 0};
+        if (rig->truth.hit[i]) {
+            const float *al = &rig->truth.albedo[3 * i];
+            for (int k = 0; k < 3; k++)
+                sig[k] = c->ambient_dn * al[k]; /* indirect light: small, from everywhere */
+            if (src->projector_on && rig->truth.proj_lit[i]) {
+                double p = pattern_light(rig, src->pattern_index, rig->truth.proj_u[i]);
+                for (int k = 0; k < 3; k++)
+                    sig[k] += p * rig->proj_radiance[3 * i + k];
+            }
+            for (uint32_t li = 0; lights != 0 && li < rig->calib.light_count; li++)
+                if (lights & (1u << li))
+                    add_light(rig, i, li, sig);
+        }
+        uint64_t r = splitmix64(&state);
+        for (int k = 0; k < 3; k++) {
+            double s = sig[k] * gain;
+            double sigma = sqrt(var_read + (s > 0.0 ? s / c->electrons_per_dn : 0.0));
+            double dn = c->black_offset_dn + s + sigma * rig->gauss[(r >> (16 * k)) & 0xFFFFu];
+            dn = floor(dn + 0.5);
+            rgb[3 * i + (size_t)k] = (uint8_t)(dn < 0.0 ? 0.0 : dn > 255.0 ? 255.0 : dn);
+        }
+    }
+}

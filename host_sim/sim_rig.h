@@ -1,0 +1,66 @@
+/* The simulated rig: renders what the camera sees of the object on the turntable under the
+ * projector and the lights, and keeps the ground truth of every pixel. */
+#ifndef SIM_RIG_H
+#define SIM_RIG_H
+
+#include "config.h"
+#include "scan_types.h"
+#include "sim_bvh.h"
+#include "sim_material.h"
+#include "sim_mesh.h"
+
+/** What lights the object while a frame is taken. */
+struct sim_sources {
+    int projector_on;
+    uint32_t pattern_index; /**< index into the Gray-code stored sequence */
+    uint32_t lights_mask;   /**< bit i: light i on */
+    uint32_t exposure_us;
+    uint32_t gain_milli;
+};
+
+/** Per-pixel ground truth of the current angle (all arrays width * height). */
+struct sim_truth {
+    uint8_t *hit;        /**< the pixel sees the object */
+    float *pos_cam;      /**< 3 per pixel: surface point in the camera frame, mm */
+    float *normal_cam;   /**< 3 per pixel: unit shading normal, camera frame */
+    float *albedo;       /**< 3 per pixel: diffuse colour (linear, 0..1) */
+    float *proj_u;       /**< continuous projector column of the point (pixel centres at integers) */
+    uint8_t *proj_lit;   /**< the projector reaches the point (in frustum, facing, not shadowed) */
+    uint8_t *dark;       /**< the point lies on the very dark paint */
+};
+
+struct sim_rig {
+    struct sim_config cfg;
+    struct scan_calib calib;
+    struct sim_mesh mesh;
+    struct sim_bvh bvh;
+    struct sim_material material;
+    uint32_t width, height, bits;
+    int32_t table_angle_mdeg;  /**< where the turntable is; the camera renders at this angle */
+    int32_t truth_angle_mdeg;  /**< angle the truth buffers belong to */
+    int truth_valid;
+    struct sim_truth truth;
+    float *proj_radiance;      /**< 3 per pixel: projector light reflected at full white */
+    uint8_t *light_vis;        /**< bit i: light i reaches the point */
+    uint32_t lights_done;      /**< lights whose visibility is computed for truth_angle_mdeg */
+    float *gauss;              /**< table of standard normal samples for the noise */
+};
+
+/** Build the object, material and buffers. Allocates; nothing allocates after this.
+ *  @param config_dir  directory relative paths in @p cfg are resolved against
+ *  @retval 0 ok @retval -errno, with @p err saying what */
+int sim_rig_init(struct sim_rig *rig, const struct sim_config *cfg, const struct scan_calib *calib,
+                 const char *config_dir, char *err, size_t err_len);
+void sim_rig_free(struct sim_rig *rig);
+
+/** Bring the truth buffers up to date for the current table angle (ray casting). */
+void sim_rig_update(struct sim_rig *rig);
+
+/** Render one RGB24 frame with noise; @p frame_no seeds the noise (deterministic). */
+void sim_rig_render(struct sim_rig *rig, const struct sim_sources *src, uint64_t frame_no,
+                    uint8_t *rgb);
+
+/** Albedo of the painted pattern at an object-frame point. @retval 1 on the very dark paint */
+int sim_albedo_at(const struct sim_config *cfg, double height_mm, vec3 p_obj, double albedo[3]);
+
+#endif
