@@ -47,7 +47,7 @@ FW_OBJ := $(call obj,$(FW_SRC))
 HOST_OBJ := $(call obj,$(POSIX_SRC) $(APP_LIB_SRC) $(BOARD_SRC))
 MAIN_OBJ := $(call obj,app/main.c)
 
-.PHONY: all deps test run clean format docs check-firmware bench
+.PHONY: all deps test run clean format docs check-firmware bench measure
 all: deps $(BUILD)/scanner
 
 # Install missing Debian packages (fresh Debian 12): only when pkg-config cannot find them.
@@ -109,3 +109,9 @@ clean:
 	rm -rf build
 
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)
+
+# Decoding rate, depth error and time per view on the simulator (numbers for the notes).
+$(BUILD)/measure_view: $(BUILD)/tests/measure_view.o $(BUILD)/tests/test_util.o $(HOST_OBJ) $(BUILD)/libfirmware.a
+	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON) $(BOARD_LIBS)
+measure: deps $(BUILD)/measure_view
+	$(BUILD)/measure_view config/sim.ini

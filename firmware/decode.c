@@ -9,7 +9,8 @@
 static uint16_t column_map[HAL_MAX_PIXELS];  /* Gray code while decoding, column afterwards */
 static uint8_t reason_map[HAL_MAX_PIXELS];
 static uint8_t grey_white[HAL_MAX_PIXELS];   /* white frame, then scratch for the positive frame */
-static uint8_t consistent_scratch[HAL_MAX_PIXELS];
+/* While decoding: bits within the noise per pixel; in decode_finish: neighbour agreement. */
+static uint8_t scratch[HAL_MAX_PIXELS];
 
 static struct {
     struct scan_params params;
@@ -42,6 +43,7 @@ int decode_begin(const struct scan_params *params, uint32_t proj_width)
     size_t n = (size_t)params->width * params->height;
     memset(column_map, 0, n * sizeof(column_map[0]));
     memset(reason_map, SCAN_VALID, n);
+    memset(scratch, 0, n);
     return 0;
 }
 
@@ -89,15 +91,19 @@ static void take_positive(const uint8_t *rgb, size_t n)
     }
 }
 
+/* A bit whose pattern and inverse are within the noise is ambiguous. Where a pixel straddles the
+ * edge between two projector columns exactly one bit is ambiguous (adjacent Gray codes differ in
+ * one bit), and either reading gives one of the two columns: harmless. Two or more ambiguous bits
+ * mean the signal itself is too weak to trust. */
 static void take_inverse(const uint8_t *rgb, size_t n)
 {
     const int min_diff = (int)dec.params.min_bit_diff_dn;
     for (size_t i = 0; i < n; i++, rgb += 3) {
         int diff = (int)grey_white[i] - (int)decode_grey(rgb);
         column_map[i] = (uint16_t)((column_map[i] << 1) | (diff > 0 ? 1u : 0u));
-        if (diff <= min_diff && diff >= -min_diff)
+        if (diff <= min_diff && diff >= -min_diff && ++scratch[i] > dec.params.max_ambiguous_bits)
             reject(i, SCAN_LOW_CONTRAST);
-        else if (rgb_saturated(rgb, dec.params.saturation_dn))
+        if (rgb_saturated(rgb, dec.params.saturation_dn))
             reject(i, SCAN_SATURATED);
     }
 }
@@ -134,7 +140,7 @@ static void check_neighbours(void)
     for (uint32_t y = 0; y < h; y++) {
         for (uint32_t x = 0; x < w; x++) {
             size_t i = (size_t)y * w + x;
-            consistent_scratch[i] = 1;
+            scratch[i] = 1;
             if (reason_map[i] != SCAN_VALID)
                 continue;
             uint32_t agree = 0;
@@ -146,12 +152,12 @@ static void check_neighbours(void)
                     agree += (uint32_t)columns_agree(i, (size_t)ny * w + (size_t)nx);
                 }
             }
-            consistent_scratch[i] = agree >= dec.params.min_consistent_neighbours;
+            scratch[i] = agree >= dec.params.min_consistent_neighbours;
         }
     }
     size_t n = (size_t)w * h;
     for (size_t i = 0; i < n; i++)
-        if (!consistent_scratch[i])
+        if (!scratch[i])
             reject(i, SCAN_INCONSISTENT);
 }
 

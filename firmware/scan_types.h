@@ -25,7 +25,8 @@ struct scan_params {
     uint32_t width, height;          /**< camera frame size */
     uint32_t min_contrast_dn;        /**< white minus black below this: not lit enough */
     uint32_t shadow_contrast_dn;     /**< white minus black at or below this: no projector light */
-    uint32_t min_bit_diff_dn;        /**< every |I - I_inverse| must exceed this */
+    uint32_t min_bit_diff_dn;        /**< |I - I_inverse| at or below this: the bit is ambiguous */
+    uint32_t max_ambiguous_bits;     /**< more ambiguous bits than this: low contrast */
     uint32_t saturation_dn;          /**< a channel at or above this is saturated */
     uint32_t max_column_jump;        /**< neighbours differing by more are not consistent */
     uint32_t min_consistent_neighbours; /**< of 8; fewer makes the pixel inconsistent */

@@ -71,8 +71,8 @@ static int build_object(struct sim_rig *rig, const char *dir, char *err, size_t 
         rc = sim_mesh_cylinder(&rig->mesh, 0.3 * h, h, c->segments);
     else if (strcmp(c->object, "box") == 0)
         rc = sim_mesh_box(&rig->mesh, 0.6 * h, 0.45 * h, h, c->segments);
-    else if (strcmp(c->object, "torus") == 0)
-        rc = sim_mesh_torus(&rig->mesh, 0.7 * h, 0.25 * h, c->segments);
+    else if (strcmp(c->object, "torus") == 0) /* lying flat: h is its outer diameter */
+        rc = sim_mesh_torus(&rig->mesh, 0.36 * h, 0.14 * h, c->segments);
     else {
         char path[HAL_MAX_PATH * 2];
         snprintf(path, sizeof(path), "%s%s%s", c->mesh_file[0] == '/' ? "" : dir,
@@ -86,7 +86,8 @@ static int build_object(struct sim_rig *rig, const char *dir, char *err, size_t 
         snprintf(err, len, "sim: cannot build the %s: %s", c->object, strerror(-rc));
         return rc;
     }
-    sim_mesh_place(&rig->mesh, h);
+    rig->object_height_mm = strcmp(c->object, "torus") == 0 ? 0.28 * h : h;
+    sim_mesh_place(&rig->mesh, rig->object_height_mm);
     return 0;
 }
 
@@ -226,7 +227,7 @@ static void update_pixel(struct sim_rig *rig, const struct frame_xform *obj, vec
     vec3 p_cam = v3_scale(d_cam, hit.t);
     vec3 n_cam = frame_dir_inv(obj, n_obj);
     double albedo[3];
-    t->dark[i] = (uint8_t)sim_albedo_at(&rig->cfg, rig->cfg.object_height_mm, p_obj, albedo);
+    t->dark[i] = (uint8_t)sim_albedo_at(&rig->cfg, rig->object_height_mm, p_obj, albedo);
     for (int k = 0; k < 3; k++) {
         t->albedo[3 * i + k] = (float)albedo[k];
         t->pos_cam[3 * i + k] = (float)(k == 0 ? p_cam.x : k == 1 ? p_cam.y : p_cam.z);

@@ -36,6 +36,7 @@ struct sim_rig {
     struct sim_bvh bvh;
     struct sim_material material;
     uint32_t width, height, bits;
+    double object_height_mm;   /**< height of the placed object */
     int32_t table_angle_mdeg;  /**< where the turntable is; the camera renders at this angle */
     int32_t truth_angle_mdeg;  /**< angle the truth buffers belong to */
     int truth_valid;

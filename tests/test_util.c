@@ -1,0 +1,107 @@
+/* Test helpers: quiet logger, simulated rig set-up, and the view-quality measurement. */
+#define _POSIX_C_SOURCE 200809L
+#include "test_util.h"
+
+#include "vec3.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+char test_last_log[512];
+int test_error_count;
+
+static void test_log(enum hal_log_level level, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(test_last_log, sizeof(test_last_log), fmt, ap);
+    va_end(ap);
+    if (level == HAL_LOG_ERROR)
+        test_error_count++;
+}
+
+int test_rig_load(struct test_rig *t, const char *config_path)
+{
+    char err[512];
+    memset(t, 0, sizeof(*t));
+    int rc = config_load(&t->cfg, config_path, err, sizeof(err));
+    if (rc == 0)
+        rc = calib_load(&t->calib, t->cfg.calibration_file, t->cfg.light_count, err, sizeof(err));
+    if (rc != 0)
+        fprintf(stderr, "test_rig_load: %s\n", err);
+    return rc;
+}
+
+int test_rig_start(struct test_rig *t)
+{
+    char err[512];
+    t->hal.log = test_log;
+    test_error_count = 0;
+    int rc = board_init(&t->hal, &t->cfg, &t->calib, err, sizeof(err));
+    if (rc != 0) {
+        fprintf(stderr, "test_rig_start: %s\n", err);
+        return rc;
+    }
+    return scan_open(&t->hal, &t->cfg.camera);
+}
+
+void test_rig_stop(struct test_rig *t)
+{
+    scan_close(&t->hal);
+    board_shutdown(&t->hal);
+}
+
+void test_measure_view(const struct sim_rig *rig, struct view_quality *q)
+{
+    const struct decode_maps *maps = decode_get_maps();
+    const struct tri_range *range = tri_get_range();
+    const struct sim_truth *t = &rig->truth;
+    size_t n = (size_t)rig->width * rig->height;
+    double sum_sq = 0.0, sum_dist = 0.0;
+    const struct scan_calib *c = &rig->calib;
+    vec3 proj = v3_scale(m3_tmul(c->proj_rot, v3_from(c->proj_trans_mm)), -1.0);
+    double min_cos = cos(TEST_MAX_INCIDENCE_DEG * M_PI / 180.0);
+    memset(q, 0, sizeof(*q));
+    for (size_t i = 0; i < n; i++) {
+        int valid = maps->reason[i] == SCAN_VALID;
+        if (t->proj_lit[i]) {
+            int correct = valid && fabs((double)maps->column[i] - floor(t->proj_u[i] + 0.5)) <= 1.0;
+            q->lit++;
+            q->lit_correct += (uint32_t)correct;
+            sum_dist += t->pos_cam[3 * i + 2];
+            const float *pt = &t->pos_cam[3 * i], *nt = &t->normal_cam[3 * i];
+            vec3 to_proj = v3_norm(v3_sub(proj, v3(pt[0], pt[1], pt[2])));
+            double cos_in = v3_dot(to_proj, v3(nt[0], nt[1], nt[2]));
+            if (t->dark[i]) {
+                q->dark++;
+                q->dark_flagged += (uint32_t)!valid;
+            } else if (cos_in >= min_cos) {
+                q->lit_head_on++;
+                q->lit_head_on_correct += (uint32_t)correct;
+            }
+        }
+        if (!valid)
+            continue;
+        q->valid++;
+        if (!t->hit[i]) {
+            q->valid_unlit++;
+            q->outliers_2mm++;
+            q->max_surface_mm = INFINITY;
+            continue;
+        }
+        q->valid_unlit += (uint32_t)!t->proj_lit[i];
+        const float *p = &range->xyz_mm[3 * i], *pt = &t->pos_cam[3 * i];
+        const float *nt = &t->normal_cam[3 * i];
+        double dz = (double)p[2] - pt[2];
+        sum_sq += dz * dz;
+        /* Distance to the true tangent plane: the true surface, to first order. */
+        double plane = fabs(((double)p[0] - pt[0]) * nt[0] + ((double)p[1] - pt[1]) * nt[1] +
+                            ((double)p[2] - pt[2]) * nt[2]);
+        q->max_surface_mm = plane > q->max_surface_mm ? plane : q->max_surface_mm;
+        q->outliers_2mm += (uint32_t)(plane > 2.0);
+    }
+    q->depth_rms_mm = q->valid ? sqrt(sum_sq / q->valid) : 0.0;
+    q->distance_mm = q->lit ? sum_dist / q->lit : 0.0;
+}

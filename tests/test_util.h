@@ -1,0 +1,49 @@
+/* Shared helpers of the tests: a simulated rig from a config, and view quality against truth. */
+#ifndef TEST_UTIL_H
+#define TEST_UTIL_H
+
+#include "board.h"
+#include "config.h"
+#include "scan.h"
+#include "sim_ctl.h"
+
+struct test_rig {
+    struct app_config cfg;
+    struct scan_calib calib;
+    struct hal hal;
+};
+
+/** Last message logged through the test logger, and how many errors were logged. */
+extern char test_last_log[512];
+extern int test_error_count;
+
+/** Load a config and its calibration. @retval 0 ok (fails the test otherwise) */
+int test_rig_load(struct test_rig *t, const char *config_path);
+/** board_init + scan_open with the quiet test logger. @retval 0 or the error */
+int test_rig_start(struct test_rig *t);
+/** scan_close + board_shutdown. */
+void test_rig_stop(struct test_rig *t);
+
+/** How well the last view matches the simulator's ground truth. */
+struct view_quality {
+    uint32_t lit;            /**< pixels where the projector lights the visible surface */
+    uint32_t lit_correct;    /**< of those: valid and column within +-1 of the truth */
+    uint32_t lit_head_on;    /**< lit pixels not on the very dark paint, incidence below 75 deg */
+    uint32_t lit_head_on_correct;
+    uint32_t valid;          /**< all valid pixels */
+    uint32_t valid_unlit;    /**< valid pixels the projector does not light (must be 0) */
+    uint32_t dark;           /**< lit pixels on the very dark paint */
+    uint32_t dark_flagged;   /**< of those: rejected */
+    uint32_t outliers_2mm;   /**< valid points farther than 2 mm from the true surface */
+    double depth_rms_mm;     /**< RMS of reconstructed minus true depth (z), valid pixels */
+    double max_surface_mm;   /**< largest point-to-true-tangent-plane distance */
+    double distance_mm;      /**< mean camera-to-surface distance over lit pixels */
+};
+
+/** Incidence limit of lit_head_on: beyond 75 degrees the projector's light is a few grey levels. */
+#define TEST_MAX_INCIDENCE_DEG 75.0
+
+/** Compare the firmware's last view with the rig's truth. */
+void test_measure_view(const struct sim_rig *rig, struct view_quality *q);
+
+#endif
