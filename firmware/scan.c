@@ -4,6 +4,7 @@
 #include "frames.h"
 #include "gray.h"
 #include "ply.h"
+#include "refine.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -144,9 +145,11 @@ int scan_view(const struct hal *hal, const struct scan_params *p, const struct s
     const struct decode_maps *maps = decode_get_maps();
     rc = decode_finish();
     if (rc == 0)
-        rc = tri_range_image(c, maps);
+        rc = refine_columns(maps, (int)p->refine);
     if (rc == 0)
-        rc = tri_normals(maps, p->max_depth_jump_mm);
+        rc = tri_range_image(c, maps, refine_get_columns());
+    if (rc == 0)
+        rc = tri_normals(maps, p->normal_radius_px, p->max_depth_jump_mm);
     if (rc != 0)
         return rc;
     size_t n = (size_t)maps->width * maps->height;

@@ -7,31 +7,18 @@
 
 static float xyz_map[HAL_MAX_PIXELS * 3];
 static float normal_map[HAL_MAX_PIXELS * 3];
-/* Per projector column: plane normal in the camera frame and its offset, n . p + d = 0. */
-static struct {
-    vec3 normal;
-    double offset;
-} column_plane[HAL_MAX_PROJECTOR_WIDTH];
 static struct tri_range range;
 
-static void prepare_planes(const struct scan_calib *c)
+int tri_range_image(const struct scan_calib *c, const struct decode_maps *maps,
+                    const float *column)
 {
-    vec3 t = v3_from(c->proj_trans_mm);
-    for (uint32_t col = 0; col < c->proj_width; col++) {
-        /* Column centres sit on integer coordinates (pixel centre convention). */
-        vec3 n_proj = v3(1.0, 0.0, -((double)col - c->proj_cx_px) / c->proj_fx_px);
-        /* n_proj . (R p + t) = 0  <=>  (R^T n_proj) . p + n_proj . t = 0 */
-        column_plane[col].normal = m3_tmul(c->proj_rot, n_proj);
-        column_plane[col].offset = v3_dot(n_proj, t);
-    }
-}
-
-int tri_range_image(const struct scan_calib *c, const struct decode_maps *maps)
-{
-    if (maps->width != c->cam_width || maps->height != c->cam_height ||
-        c->proj_width > HAL_MAX_PROJECTOR_WIDTH)
+    if (maps->width != c->cam_width || maps->height != c->cam_height)
         return -EINVAL;
-    prepare_planes(c);
+    /* Plane of projector column u: n_p = e_x - a e_z with a = (u - cx) / fx, through the
+     * projector centre. n_p . (R p + t) = 0  <=>  (R^T n_p) . p + n_p . t = 0, and R^T n_p is
+     * linear in a: R^T e_x - a R^T e_z. */
+    const vec3 rt_ex = m3_tmul(c->proj_rot, v3(1, 0, 0)), rt_ez = m3_tmul(c->proj_rot, v3(0, 0, 1));
+    const vec3 t = v3_from(c->proj_trans_mm);
     range.xyz_mm = xyz_map;
     range.normal = normal_map;
     range.width = maps->width;
@@ -44,9 +31,10 @@ int tri_range_image(const struct scan_calib *c, const struct decode_maps *maps)
                 continue;
             vec3 ray = v3(((double)x - c->cam_cx_px) / c->cam_fx_px,
                           ((double)y - c->cam_cy_px) / c->cam_fy_px, 1.0);
-            uint16_t col = maps->column[i];
-            double denom = v3_dot(column_plane[col].normal, ray);
-            double s = denom != 0.0 ? -column_plane[col].offset / denom : -1.0;
+            double a = ((double)column[i] - c->proj_cx_px) / c->proj_fx_px;
+            vec3 normal = v3_sub(rt_ex, v3_scale(rt_ez, a));
+            double denom = v3_dot(normal, ray);
+            double s = denom != 0.0 ? -(t.x - a * t.z) / denom : -1.0;
             /* A grazing plane (|denom| tiny) would put the point at infinity. */
             if (s <= 0.0 || denom * denom < 1e-12 * v3_dot(ray, ray)) {
                 maps->reason[i] = SCAN_INCONSISTENT;
@@ -66,28 +54,39 @@ static vec3 point_at(size_t i)
     return v3(xyz_map[3 * i], xyz_map[3 * i + 1], xyz_map[3 * i + 2]);
 }
 
-/* Tangent along one image axis from the neighbours at -step and +step that lie on the same
- * surface; falls back to a one-sided difference. Returns 0 when neither neighbour qualifies. */
-static int tangent(const struct decode_maps *m, size_t i, int has_prev, int has_next, size_t step,
-                   double max_jump, vec3 *out)
+/* How far (in steps of @p step, at most @p max_steps) the surface continues from pixel i: every
+ * pixel on the way must be valid and no depth step may exceed max_jump. */
+static uint32_t reach(const struct decode_maps *m, size_t i, long step, uint32_t max_steps,
+                      double max_jump)
 {
-    vec3 p = point_at(i);
-    int ok_prev = has_prev && m->reason[i - step] == SCAN_VALID &&
-                  fabs(xyz_map[3 * (i - step) + 2] - p.z) <= max_jump;
-    int ok_next = has_next && m->reason[i + step] == SCAN_VALID &&
-                  fabs(xyz_map[3 * (i + step) + 2] - p.z) <= max_jump;
-    if (ok_prev && ok_next)
-        *out = v3_sub(point_at(i + step), point_at(i - step));
-    else if (ok_next)
-        *out = v3_sub(point_at(i + step), p);
-    else if (ok_prev)
-        *out = v3_sub(p, point_at(i - step));
-    else
+    uint32_t k = 0;
+    size_t cur = i;
+    while (k < max_steps) {
+        size_t next = (size_t)((long)cur + step);
+        if (m->reason[next] != SCAN_VALID || fabs(xyz_map[3 * next + 2] - xyz_map[3 * cur + 2]) > max_jump)
+            break;
+        cur = next;
+        k++;
+    }
+    return k;
+}
+
+/* Tangent along one image axis between the farthest continuous neighbours on either side.
+ * Column quantisation makes the range image a staircase; a wide stencil averages it out.
+ * @p before / @p after: how many steps exist in the image on each side. Returns 0 if none. */
+static int tangent(const struct decode_maps *m, size_t i, uint32_t before, uint32_t after,
+                   long step, uint32_t radius, double max_jump, vec3 *out)
+{
+    uint32_t back = reach(m, i, -step, before < radius ? before : radius, max_jump);
+    uint32_t fwd = reach(m, i, step, after < radius ? after : radius, max_jump);
+    if (back + fwd == 0)
         return 0;
+    *out = v3_sub(point_at((size_t)((long)i + step * (long)fwd)),
+                  point_at((size_t)((long)i - step * (long)back)));
     return 1;
 }
 
-int tri_normals(const struct decode_maps *m, double max_depth_jump_mm)
+int tri_normals(const struct decode_maps *m, uint32_t radius_px, double max_depth_jump_mm)
 {
     const uint32_t w = m->width, h = m->height;
     uint32_t valid = 0;
@@ -97,8 +96,8 @@ int tri_normals(const struct decode_maps *m, double max_depth_jump_mm)
             if (m->reason[i] != SCAN_VALID)
                 continue;
             vec3 du, dv;
-            if (!tangent(m, i, x > 0, x + 1 < w, 1, max_depth_jump_mm, &du) ||
-                !tangent(m, i, y > 0, y + 1 < h, w, max_depth_jump_mm, &dv)) {
+            if (!tangent(m, i, x, w - 1 - x, 1, radius_px, max_depth_jump_mm, &du) ||
+                !tangent(m, i, y, h - 1 - y, (long)w, radius_px, max_depth_jump_mm, &dv)) {
                 m->reason[i] = SCAN_INCONSISTENT;
                 continue;
             }

@@ -59,7 +59,7 @@ void test_measure_view(const struct sim_rig *rig, struct view_quality *q)
     const struct tri_range *range = tri_get_range();
     const struct sim_truth *t = &rig->truth;
     size_t n = (size_t)rig->width * rig->height;
-    double sum_sq = 0.0, sum_dist = 0.0;
+    double sum_sq = 0.0, sum_dist = 0.0, sum_angle = 0.0;
     const struct scan_calib *c = &rig->calib;
     vec3 proj = v3_scale(m3_tmul(c->proj_rot, v3_from(c->proj_trans_mm)), -1.0);
     double min_cos = cos(TEST_MAX_INCIDENCE_DEG * M_PI / 180.0);
@@ -94,6 +94,9 @@ void test_measure_view(const struct sim_rig *rig, struct view_quality *q)
         q->valid_unlit += (uint32_t)!t->proj_lit[i];
         const float *p = &range->xyz_mm[3 * i], *pt = &t->pos_cam[3 * i];
         const float *nt = &t->normal_cam[3 * i];
+        const float *ne = &range->normal[3 * i];
+        double cos_n = (double)ne[0] * nt[0] + (double)ne[1] * nt[1] + (double)ne[2] * nt[2];
+        sum_angle += acos(cos_n > 1.0 ? 1.0 : cos_n < -1.0 ? -1.0 : cos_n) * 180.0 / M_PI;
         double dz = (double)p[2] - pt[2];
         sum_sq += dz * dz;
         /* Distance to the true tangent plane: the true surface, to first order. */
@@ -103,5 +106,6 @@ void test_measure_view(const struct sim_rig *rig, struct view_quality *q)
         q->outliers_2mm += (uint32_t)(plane > 2.0);
     }
     q->depth_rms_mm = q->valid ? sqrt(sum_sq / q->valid) : 0.0;
+    q->normal_err_deg = q->valid ? sum_angle / q->valid : 0.0;
     q->distance_mm = q->lit ? sum_dist / q->lit : 0.0;
 }

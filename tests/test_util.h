@@ -35,6 +35,7 @@ struct view_quality {
     uint32_t dark;           /**< lit pixels on the very dark paint */
     uint32_t dark_flagged;   /**< of those: rejected */
     uint32_t outliers_2mm;   /**< valid points farther than 2 mm from the true surface */
+    double normal_err_deg;   /**< mean angle between estimated and true normals, valid pixels */
     double depth_rms_mm;     /**< RMS of reconstructed minus true depth (z), valid pixels */
     double max_surface_mm;   /**< largest point-to-true-tangent-plane distance */
     double distance_mm;      /**< mean camera-to-surface distance over lit pixels */

@@ -1,0 +1,16 @@
+/* Sub-stripe refinement: a continuous projector column per pixel from the runs of equal codes. */
+#ifndef REFINE_H
+#define REFINE_H
+
+#include "decode.h"
+
+/** Fill the continuous column map from the decoded integer columns. Along each camera row a
+ *  run of pixels with code c that lies between runs coded c - 1 and c + 1 (either order) spans
+ *  the projector interval [c - 0.5, c + 0.5]; each pixel gets its linear position in it. Other
+ *  pixels keep c. With @p enabled = 0 every pixel keeps c. @retval 0 */
+int refine_columns(const struct decode_maps *maps, int enabled);
+
+/** The continuous column map (row-major, meaningful where the pixel is valid). */
+const float *refine_get_columns(void);
+
+#endif

@@ -1,0 +1,157 @@
+/* Decoder on synthetic frames: right columns, and a reason code for every kind of bad pixel. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <errno.h>
+#include <string.h>
+
+#include "decode.h"
+#include "gray.h"
+
+#define W 64
+#define H 8
+#define PROJ_W 64
+
+static uint8_t frame[W * H * 3];
+
+static struct scan_params params(void)
+{
+    struct scan_params p;
+    memset(&p, 0, sizeof(p));
+    p.width = W;
+    p.height = H;
+    p.min_contrast_dn = 10;
+    p.shadow_contrast_dn = 5;
+    p.min_bit_diff_dn = 4;
+    p.max_ambiguous_bits = 1;
+    p.saturation_dn = 250;
+    p.max_column_jump = 3;
+    p.min_consistent_neighbours = 3;
+    return p;
+}
+
+/* Pixel (x, y) sees projector column x; rows choose the surface: 0-3 normal, 4 shadow (no
+ * projector light), 5 dark paint, 6 saturated in white, 7 normal. */
+static void render(uint32_t pattern, uint32_t bits)
+{
+    for (uint32_t y = 0; y < H; y++) {
+        for (uint32_t x = 0; x < W; x++) {
+            int lit = gray_pattern_lit(bits, pattern, x);
+            double gain = y == 4 ? 0.0 : y == 5 ? 0.03 : 1.0;
+            double v = 51.0 + gain * (lit ? 150.0 : 2.0);
+            if (y == 6 && lit)
+                v = 255.0;
+            uint8_t *px = &frame[3 * (y * W + x)];
+            px[0] = px[1] = px[2] = (uint8_t)v;
+        }
+    }
+}
+
+static void decode_all(uint32_t bits)
+{
+    struct scan_params p = params();
+    assert_int_equal(decode_begin(&p, PROJ_W), 0);
+    for (uint32_t i = 0; i < gray_pattern_count(bits); i++) {
+        render(i, bits);
+        assert_int_equal(decode_frame(i, frame), 0);
+    }
+    assert_int_equal(decode_finish(), 0);
+}
+
+static void test_columns_and_reasons(void **state)
+{
+    (void)state;
+    uint32_t bits = gray_bits_for_width(PROJ_W);
+    decode_all(bits);
+    const struct decode_maps *m = decode_get_maps();
+    for (uint32_t x = 0; x < W; x++) {
+        for (uint32_t y = 0; y < 4; y++) {
+            assert_int_equal(m->reason[y * W + x], SCAN_VALID);
+            assert_int_equal(m->column[y * W + x], x);
+        }
+        assert_int_equal(m->reason[4 * W + x], SCAN_SHADOW);
+        assert_int_equal(m->reason[5 * W + x], SCAN_SHADOW); /* 0.03 * 148 = 4 <= 5 */
+        assert_int_equal(m->reason[6 * W + x], SCAN_SATURATED);
+    }
+    assert_string_equal(scan_reason_name(SCAN_LOW_CONTRAST), "low_contrast");
+}
+
+static void test_frames_out_of_order_rejected(void **state)
+{
+    (void)state;
+    struct scan_params p = params();
+    assert_int_equal(decode_begin(&p, PROJ_W), 0);
+    render(0, 6);
+    assert_int_equal(decode_frame(1, frame), -EINVAL);
+    assert_int_equal(decode_frame(0, frame), 0);
+    assert_int_equal(decode_finish(), -EINVAL); /* frames missing */
+}
+
+static void test_size_above_limit_rejected(void **state)
+{
+    (void)state;
+    struct scan_params p = params();
+    p.width = HAL_MAX_WIDTH + 2;
+    assert_int_equal(decode_begin(&p, PROJ_W), -EINVAL);
+    p = params();
+    assert_int_equal(decode_begin(&p, HAL_MAX_PROJECTOR_WIDTH + 1), -EINVAL);
+}
+
+/* Two ambiguous bits in one pixel cannot be a column edge: low contrast. One is tolerated. */
+static void test_ambiguous_bits(void **state)
+{
+    (void)state;
+    uint32_t bits = gray_bits_for_width(PROJ_W);
+    struct scan_params p = params();
+    assert_int_equal(decode_begin(&p, PROJ_W), 0);
+    for (uint32_t i = 0; i < gray_pattern_count(bits); i++) {
+        render(i, bits);
+        uint32_t k = i >= 2 ? (i - 2) / 2 : 99;
+        /* pixel 10 of row 0: bit 0 ambiguous; pixel 20: bits 0 and 1 ambiguous */
+        if (k == 0)
+            memset(&frame[3 * 10], 120, 3);
+        if (k <= 1)
+            memset(&frame[3 * 20], 120, 3);
+        assert_int_equal(decode_frame(i, frame), 0);
+    }
+    assert_int_equal(decode_finish(), 0);
+    const struct decode_maps *m = decode_get_maps();
+    assert_int_equal(m->reason[10], SCAN_VALID);
+    assert_int_equal(m->reason[20], SCAN_LOW_CONTRAST);
+}
+
+/* A pixel whose code is wrong in a high bit disagrees with its neighbours. */
+static void test_lone_wrong_code_inconsistent(void **state)
+{
+    (void)state;
+    uint32_t bits = gray_bits_for_width(PROJ_W);
+    struct scan_params p = params();
+    assert_int_equal(decode_begin(&p, PROJ_W), 0);
+    for (uint32_t i = 0; i < gray_pattern_count(bits); i++) {
+        render(i, bits);
+        if (i == 2 || i == 3) { /* flip the top bit of pixel (10, 2): column 10 reads as 53 */
+            int lit = gray_pattern_lit(bits, i == 2 ? 3 : 2, 10);
+            memset(&frame[3 * (2 * W + 10)], lit ? 201 : 53, 3);
+        }
+        assert_int_equal(decode_frame(i, frame), 0);
+    }
+    assert_int_equal(decode_finish(), 0);
+    const struct decode_maps *m = decode_get_maps();
+    assert_int_equal(m->reason[2 * W + 10], SCAN_INCONSISTENT);
+    assert_int_equal(m->reason[2 * W + 11], SCAN_VALID);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_columns_and_reasons),
+        cmocka_unit_test(test_frames_out_of_order_rejected),
+        cmocka_unit_test(test_size_above_limit_rejected),
+        cmocka_unit_test(test_ambiguous_bits),
+        cmocka_unit_test(test_lone_wrong_code_inconsistent),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

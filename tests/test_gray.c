@@ -1,0 +1,59 @@
+/* Gray-code pattern set: coding properties the decoder relies on. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include "gray.h"
+
+static void test_bits_for_width(void **state)
+{
+    (void)state;
+    assert_int_equal(gray_bits_for_width(1024), 10);
+    assert_int_equal(gray_bits_for_width(1025), 11);
+    assert_int_equal(gray_bits_for_width(1920), 11);
+    assert_int_equal(gray_bits_for_width(2), 1);
+    assert_int_equal(gray_pattern_count(10), 22);
+}
+
+static void test_roundtrip_and_single_bit_steps(void **state)
+{
+    (void)state;
+    for (uint32_t c = 0; c < 4096; c++) {
+        assert_int_equal(gray_decode(gray_encode(c)), c);
+        if (c > 0) {
+            uint32_t diff = gray_encode(c) ^ gray_encode(c - 1);
+            assert_true(diff != 0 && (diff & (diff - 1)) == 0); /* exactly one bit */
+        }
+    }
+}
+
+/* Reading every pattern pair of a column as the decoder does gives the column back. */
+static void test_patterns_code_every_column(void **state)
+{
+    (void)state;
+    const uint32_t width = 1024, bits = gray_bits_for_width(width);
+    for (uint32_t c = 0; c < width; c++) {
+        assert_int_equal(gray_pattern_lit(bits, GRAY_PATTERN_WHITE, c), 1);
+        assert_int_equal(gray_pattern_lit(bits, GRAY_PATTERN_BLACK, c), 0);
+        uint32_t code = 0;
+        for (uint32_t k = 0; k < bits; k++) {
+            int pos = gray_pattern_lit(bits, GRAY_PATTERN_FIRST_BIT + 2 * k, c);
+            int neg = gray_pattern_lit(bits, GRAY_PATTERN_FIRST_BIT + 2 * k + 1, c);
+            assert_int_equal(pos, !neg);
+            code = (code << 1) | (uint32_t)pos;
+        }
+        assert_int_equal(gray_decode(code), c);
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_bits_for_width),
+        cmocka_unit_test(test_roundtrip_and_single_bit_steps),
+        cmocka_unit_test(test_patterns_code_every_column),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
