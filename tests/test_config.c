@@ -1,0 +1,183 @@
+/* Config and calibration errors name file, line and key; nothing is accepted silently. */
+#define _POSIX_C_SOURCE 200809L
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "board.h"
+#include "config.h"
+#include "scan.h"
+
+#define DIR "build/test_config"
+static struct app_config cfg;
+static char err[512];
+
+static const char *base =
+    "[camera]\nbackend = sim\nwidth = 1280\nheight = 960\nexposure_us = 10000\n"
+    "[scan]\ncalibration = ../../config/sim-calib.ini\n";
+
+static const char *write_file(const char *name, const char *text)
+{
+    static char path[256];
+    mkdir("build", 0755);
+    mkdir(DIR, 0755);
+    snprintf(path, sizeof(path), "%s/%s", DIR, name);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+    return path;
+}
+
+/* Load base + @p extra and expect failure with @p expect in the message. */
+static void expect_error(const char *extra, const char *expect)
+{
+    char text[2048];
+    snprintf(text, sizeof(text), "%s%s", base, extra);
+    const char *path = write_file("bad.ini", text);
+    err[0] = '\0';
+    assert_int_equal(config_load(&cfg, path, err, sizeof(err)), -EINVAL);
+    if (strstr(err, expect) == NULL)
+        fail_msg("expected '%s' in '%s'", expect, err);
+}
+
+static void test_good_config_and_defaults(void **state)
+{
+    (void)state;
+    const char *path = write_file("good.ini", base);
+    assert_int_equal(config_load(&cfg, path, err, sizeof(err)), 0);
+    assert_int_equal(cfg.camera.width, 1280);
+    assert_int_equal(cfg.scan.width, 1280);
+    assert_int_equal(cfg.scan.min_contrast_dn, 10); /* default */
+    assert_int_equal(cfg.gpio.line_offset[HAL_GPIO_LIGHT_0], -1);
+    assert_string_equal(cfg.calibration_file, DIR "/../../config/sim-calib.ini");
+    struct scan_calib calib;
+    assert_int_equal(calib_load(&calib, cfg.calibration_file, 4, err, sizeof(err)), 0);
+    assert_int_equal(scan_check(&cfg.scan, &calib, err, sizeof(err)), 0);
+}
+
+static void test_errors_name_file_line_and_key(void **state)
+{
+    (void)state;
+    expect_error("exposur_us = 5\n", DIR "/bad.ini:8: [scan] exposur_us: unknown key");
+    expect_error("[camra]\nwidth = 5\n", "bad.ini:9: [camra] width: unknown section 'camra'");
+    expect_error("[sim]\nseed = abc\n", "bad.ini:9: [sim] seed: 'abc' is not a whole number");
+    expect_error("[scan]\nmin_contrast_dn = 300\n",
+                 "bad.ini:9: [scan] min_contrast_dn: 300 is out of range 1..255");
+    expect_error("[camera]\npixel_format = bgr\n",
+                 "bad.ini:9: [camera] pixel_format: 'bgr' is not one of rgb24|yuyv|grey");
+    expect_error("[sim]\nalbedo = 0.5, 0.5\n", "bad.ini:9: [sim] albedo: '0.5, 0.5' is not a list");
+    expect_error("[sim]\nseed = 1.5\n", "[sim] seed: '1.5' is not a whole number");
+    expect_error("garbage line\n", "bad.ini:8: syntax error");
+}
+
+static void test_duplicate_key(void **state)
+{
+    (void)state;
+    const char *path = write_file("dup.ini", "[camera]\nwidth = 640\nwidth = 640\n");
+    assert_int_equal(config_load(&cfg, path, err, sizeof(err)), -EINVAL);
+    assert_non_null(strstr(err, "dup.ini:3: [camera] width: set twice (first on line 2)"));
+}
+
+static void test_missing_required_key(void **state)
+{
+    (void)state;
+    const char *path = write_file("missing.ini", "[camera]\nbackend = sim\nwidth = 640\nheight = 480\n");
+    assert_int_equal(config_load(&cfg, path, err, sizeof(err)), -EINVAL);
+    assert_non_null(strstr(err, "missing.ini: [camera] exposure_us: required key is missing"));
+}
+
+static void test_width_over_limit(void **state)
+{
+    (void)state;
+    const char *path = write_file("big.ini", "[camera]\nbackend = sim\nwidth = 4096\nheight = 960\n"
+                                             "exposure_us = 10000\n[scan]\ncalibration = x.ini\n");
+    assert_int_equal(config_load(&cfg, path, err, sizeof(err)), -EINVAL);
+    assert_non_null(strstr(err, "big.ini:3: [camera] width: 4096 exceeds the compiled limit 2048"));
+}
+
+static void test_calibration_errors(void **state)
+{
+    (void)state;
+    struct scan_calib calib;
+    assert_int_equal(calib_load(&calib, DIR "/nope.ini", 0, err, sizeof(err)), -ENOENT);
+    assert_non_null(strstr(err, "nope.ini: cannot open"));
+    const char *path = write_file(
+        "calib.ini", "[camera]\nfx_px = 100\nfy_px = 100\ncx_px = 1\ncy_px = 1\nwidth = 64\n"
+                     "height = 64\n[projector]\nfx_px = 100\nfy_px = 100\ncx_px = 1\ncy_px = 1\n"
+                     "width = 64\nheight = 64\nrotation = 1, 0, 0, 0, 1, 0, 0, 0, 0.9\n"
+                     "translation_mm = 0, 0, 0\n[turntable]\naxis_point_mm = 0, 0, 500\n"
+                     "axis_dir = 0, -1, 0\n");
+    assert_int_equal(calib_load(&calib, path, 0, err, sizeof(err)), -EINVAL);
+    assert_non_null(strstr(err, "[projector] rotation: not a rotation matrix"));
+    /* calibration for another camera size than configured */
+    const char *good = write_file("good.ini", base);
+    assert_int_equal(config_load(&cfg, good, err, sizeof(err)), 0);
+    assert_int_equal(calib_load(&calib, cfg.calibration_file, 4, err, sizeof(err)), 0);
+    calib.cam_width = 640;
+    assert_int_equal(scan_check(&cfg.scan, &calib, err, sizeof(err)), -EINVAL);
+    assert_non_null(strstr(err, "calibration is for a 640x960 camera"));
+    /* lights configured but not calibrated */
+    assert_int_equal(calib_load(&calib, path, 2, err, sizeof(err)), -EINVAL);
+}
+
+/* A HAL=sim build refuses a real-hardware backend rather than faking it. */
+static void test_backend_not_built_in(void **state)
+{
+    (void)state;
+    const char *path = write_file("v4l2.ini",
+        "[camera]\nbackend = v4l2\nwidth = 1280\nheight = 960\nexposure_us = 10000\n"
+        "[scan]\ncalibration = ../../config/sim-calib.ini\n");
+    assert_int_equal(config_load(&cfg, path, err, sizeof(err)), 0);
+    struct scan_calib calib;
+    assert_int_equal(calib_load(&calib, cfg.calibration_file, 0, err, sizeof(err)), 0);
+    struct hal hal;
+    memset(&hal, 0, sizeof(hal));
+    int rc = board_init(&hal, &cfg, &calib, err, sizeof(err));
+    assert_int_not_equal(rc, 0);
+    assert_non_null(strstr(err, "backend = v4l2 is not built in"));
+    assert_null(hal.gpio.ops); /* nothing was set up */
+}
+
+/* docs/config-keys.md is generated from the key tables: it must be current. */
+static void test_docs_cover_every_key(void **state)
+{
+    (void)state;
+    char *generated = NULL;
+    size_t len = 0;
+    FILE *mem = open_memstream(&generated, &len);
+    config_print_doc(mem);
+    fclose(mem);
+    FILE *f = fopen("docs/config-keys.md", "r");
+    assert_non_null(f);
+    static char committed[65536];
+    size_t n = fread(committed, 1, sizeof(committed) - 1, f);
+    fclose(f);
+    committed[n] = '\0';
+    if (strcmp(committed, generated) != 0)
+        fail_msg("docs/config-keys.md is stale: run 'make docs'");
+    free(generated);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_good_config_and_defaults),
+        cmocka_unit_test(test_errors_name_file_line_and_key),
+        cmocka_unit_test(test_duplicate_key),
+        cmocka_unit_test(test_missing_required_key),
+        cmocka_unit_test(test_width_over_limit),
+        cmocka_unit_test(test_calibration_errors),
+        cmocka_unit_test(test_backend_not_built_in),
+        cmocka_unit_test(test_docs_cover_every_key),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

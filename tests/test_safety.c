@@ -1,0 +1,149 @@
+/* Faults and stops: bounded retries, clear errors, and lights and projector off on every path. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <errno.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "test_util.h"
+
+static struct test_rig t;
+
+static int setup(void **state)
+{
+    (void)state;
+    if (test_rig_load(&t, "config/sim.ini") != 0)
+        return -1;
+    /* A small object keeps these tests quick; the geometry does not matter here. */
+    snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "box");
+    t.cfg.sim.segments = 16;
+    return test_rig_start(&t);
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    test_rig_stop(&t);
+    return 0;
+}
+
+static void assert_rig_dark(void)
+{
+    assert_int_equal(sim_ctl_line(HAL_GPIO_PROJECTOR_ENABLE), 0);
+    for (uint32_t i = 0; i < HAL_MAX_LIGHTS; i++)
+        assert_int_equal(sim_ctl_line((enum hal_gpio_line)(HAL_GPIO_LIGHT_0 + i)), 0);
+}
+
+static void test_transient_timeout_is_retried(void **state)
+{
+    (void)state;
+    struct scan_view_info info;
+    sim_ctl_inject_camera_fault(SIM_FAULT_TIMEOUT, 5, 2); /* two bad captures, retries = 2 */
+    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, &info), 0);
+    assert_int_equal(info.capture_retries, 2);
+    assert_int_equal(info.frames_captured, 22);
+    assert_true(info.valid_points > 10000);
+    assert_rig_dark();
+}
+
+static void test_persistent_fault_stops_with_projector_off(void **state)
+{
+    (void)state;
+    struct scan_view_info info;
+    uint64_t start = sim_ctl_frames();
+    sim_ctl_inject_camera_fault(SIM_FAULT_CORRUPT, start + 7, 100);
+    int rc = scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, &info);
+    assert_int_equal(rc, -EIO);
+    /* tried 1 + capture_retries times, then gave up and said which pattern */
+    assert_int_equal(sim_ctl_frames() - start, 7 + 1 + t.cfg.scan.capture_retries);
+    assert_non_null(strstr(test_last_log, "giving up on pattern 7"));
+    assert_rig_dark();
+    sim_ctl_inject_camera_fault(SIM_FAULT_NONE, 0, 0);
+}
+
+static void test_unplugged_camera_not_retried(void **state)
+{
+    (void)state;
+    struct scan_view_info info;
+    uint64_t start = sim_ctl_frames();
+    sim_ctl_inject_camera_fault(SIM_FAULT_NO_DEVICE, start + 3, 100);
+    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, &info), -ENODEV);
+    assert_int_equal(sim_ctl_frames() - start, 4); /* no retry can bring a camera back */
+    assert_rig_dark();
+    sim_ctl_inject_camera_fault(SIM_FAULT_NONE, 0, 0);
+}
+
+static int stop_after_frames(void)
+{
+    return sim_ctl_frames() >= 10;
+}
+
+static void test_stop_request_leaves_rig_dark(void **state)
+{
+    (void)state;
+    struct scan_view_info info;
+    t.hal.stop_requested = stop_after_frames;
+    int rc = scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, &info);
+    t.hal.stop_requested = NULL;
+    assert_int_equal(rc, -EINTR);
+    assert_true(info.frames_captured < 22);
+    assert_rig_dark();
+}
+
+/* Lights on and projector on, then the one shutdown path: everything off. */
+static void test_safe_state_turns_everything_off(void **state)
+{
+    (void)state;
+    assert_int_equal(hal_gpio_set(&t.hal.gpio, HAL_GPIO_PROJECTOR_ENABLE, 1), 0);
+    assert_int_equal(hal_gpio_set(&t.hal.gpio, HAL_GPIO_LIGHT_0 + 2, 1), 0);
+    assert_int_equal(sim_ctl_line(HAL_GPIO_LIGHT_0 + 2), 1);
+    assert_int_equal(hal_safe_state(&t.hal), 0);
+    assert_rig_dark();
+}
+
+/* The projector follows its stored sequence: triggers step, reset returns to pattern 0. */
+static void test_projector_sequence(void **state)
+{
+    (void)state;
+    assert_int_equal(hal_gpio_pulse(&t.hal.gpio, &t.hal.clock, HAL_GPIO_PROJECTOR_RESET, 10), 0);
+    assert_int_equal(sim_ctl_pattern_index(), 0);
+    uint64_t t0 = sim_ctl_time_us();
+    for (int i = 0; i < 5; i++)
+        assert_int_equal(hal_gpio_pulse(&t.hal.gpio, &t.hal.clock, HAL_GPIO_PROJECTOR_TRIGGER, 10), 0);
+    assert_int_equal(sim_ctl_pattern_index(), 5);
+    assert_int_equal(sim_ctl_time_us() - t0, 50); /* virtual time: only sleeps move it */
+    assert_int_equal(hal_gpio_pulse(&t.hal.gpio, &t.hal.clock, HAL_GPIO_PROJECTOR_RESET, 10), 0);
+    assert_int_equal(sim_ctl_pattern_index(), 0);
+}
+
+/* Zephyr-style wrappers: a device without an op answers -ENOSYS, it does not crash. */
+static void test_missing_ops_answer_enosys(void **state)
+{
+    (void)state;
+    struct hal_turntable none = {NULL, NULL};
+    struct hal_turntable_status st;
+    assert_int_equal(hal_table_home(&none), -ENOSYS);
+    assert_int_equal(hal_table_move_to(&none, 1000), -ENOSYS);
+    assert_int_equal(hal_table_get_status(&none, &st), -ENOSYS);
+    static const struct hal_camera_ops partial = {0};
+    struct hal_camera cam = {&partial, NULL};
+    assert_int_equal(hal_cam_capture(&cam, NULL), -ENOSYS);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_transient_timeout_is_retried),
+        cmocka_unit_test(test_persistent_fault_stops_with_projector_off),
+        cmocka_unit_test(test_unplugged_camera_not_retried),
+        cmocka_unit_test(test_stop_request_leaves_rig_dark),
+        cmocka_unit_test(test_safe_state_turns_everything_off),
+        cmocka_unit_test(test_projector_sequence),
+        cmocka_unit_test(test_missing_ops_answer_enosys),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}

@@ -1,0 +1,76 @@
+/* One simulated view against ground truth: decoding rate, depth error, and no outliers
+ * (issue "scanner core", done-when). Sphere and Stanford bunny, default noise. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <stdio.h>
+#include <string.h>
+
+#include "test_util.h"
+
+static void scan_and_measure(const char *object, struct view_quality *q)
+{
+    static struct test_rig t;
+    assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
+    snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "%s", object);
+    assert_int_equal(test_rig_start(&t), 0);
+    struct scan_view_info info;
+    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, &info), 0);
+    assert_int_equal(info.frames_captured, 22);
+    test_measure_view(sim_ctl_rig(), q);
+    assert_int_equal(info.valid_points, q->valid);
+    test_rig_stop(&t);
+    print_message("%s: %u lit, %.2f%% right (+-1), %.2f%% head-on right, depth RMS %.3f mm "
+                  "(%.3f%% of %.0f mm), max %.2f mm from the surface, %u of %u dark flagged, "
+                  "normals %.1f deg\n",
+                  object, q->lit, 100.0 * q->lit_correct / q->lit,
+                  100.0 * q->lit_head_on_correct / q->lit_head_on, q->depth_rms_mm,
+                  100.0 * q->depth_rms_mm / q->distance_mm, q->distance_mm, q->max_surface_mm,
+                  q->dark_flagged, q->dark, q->normal_err_deg);
+}
+
+static void check_quality(const struct view_quality *q)
+{
+    /* >= 98% of the lit surface decodes to the right column (+-1), where the projector lights
+     * it at less than 75 degrees incidence and the paint is not the very dark one. */
+    assert_true(q->lit_head_on > 50000);
+    assert_true(q->lit_head_on_correct >= 0.98 * q->lit_head_on);
+    /* Grazing light included, still most of it. */
+    assert_true(q->lit_correct >= 0.88 * q->lit);
+    /* Depth RMS below 0.2% of the camera-to-object distance. */
+    assert_true(q->depth_rms_mm < 0.002 * q->distance_mm);
+    /* Shadowed and very dark pixels are flagged, never triangulated into outliers. */
+    assert_int_equal(q->valid_unlit, 0);
+    assert_int_equal(q->outliers_2mm, 0);
+    assert_true(q->max_surface_mm < 2.0);
+    assert_true(q->dark > 500);
+    assert_true(q->dark_flagged >= 0.99 * q->dark);
+}
+
+static void test_sphere(void **state)
+{
+    (void)state;
+    struct view_quality q;
+    scan_and_measure("sphere", &q);
+    check_quality(&q);
+}
+
+static void test_bunny(void **state)
+{
+    (void)state;
+    struct view_quality q;
+    scan_and_measure("mesh", &q);
+    check_quality(&q);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_sphere),
+        cmocka_unit_test(test_bunny),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
