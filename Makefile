@@ -30,7 +30,7 @@ CFLAGS_COMMON := $(WARN) $(OPT) -g -MMD -MP
 FW_CFLAGS := $(CFLAGS_COMMON) -Ihal/include -Ifirmware
 PKG_CFLAGS = $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
 PKG_LIBS = $(shell pkg-config --libs inih libpng 2>/dev/null)
-HOST_CFLAGS = $(CFLAGS_COMMON) -Ihal/include -Ifirmware -Iapp -Ihal/posix -Ihost_sim $(PKG_CFLAGS)
+HOST_CFLAGS = $(CFLAGS_COMMON) -Ihal/include -Ifirmware -Iapp -Ihal/posix -Ihal/linux -Ihost_sim $(PKG_CFLAGS)
 LDFLAGS_COMMON := $(OPT) -g
 LDLIBS_COMMON = $(PKG_LIBS) -lm
 
@@ -47,7 +47,7 @@ FW_OBJ := $(call obj,$(FW_SRC))
 HOST_OBJ := $(call obj,$(POSIX_SRC) $(APP_LIB_SRC) $(BOARD_SRC))
 MAIN_OBJ := $(call obj,app/main.c)
 
-.PHONY: all deps test run clean format docs check-firmware bench measure
+.PHONY: all deps test-deps test run clean format docs check-firmware bench measure
 all: deps $(BUILD)/scanner
 
 # Install missing Debian packages (fresh Debian 12): only when pkg-config cannot find them.
@@ -69,12 +69,16 @@ $(BUILD)/scanner: $(MAIN_OBJ) $(HOST_OBJ) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON) $(BOARD_LIBS)
 
 # ---- tests ----
-TEST_SRC := $(wildcard tests/test_*.c)
+TEST_SRC := $(filter-out tests/test_util.c,$(wildcard tests/test_*.c))
 TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 TEST_LIBS = $(shell pkg-config --libs cmocka 2>/dev/null)
 
-$(BUILD)/tests/%: $(BUILD)/tests/%.o $(BUILD)/tests/test_util.o $(HOST_OBJ) $(BUILD)/libfirmware.a
-	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(TEST_LIBS) $(LDLIBS_COMMON) $(BOARD_LIBS)
+# The gpiod backend's pure parts are tested in every build (libgpiod is always installed).
+TEST_EXTRA_OBJ := $(if $(filter sim,$(HAL)),$(call obj,hal/linux/gpio_gpiod.c),)
+TEST_EXTRA_LIBS = $(shell pkg-config --libs libgpiod 2>/dev/null)
+
+$(BUILD)/tests/%: $(BUILD)/tests/%.o $(BUILD)/tests/test_util.o $(HOST_OBJ) $(TEST_EXTRA_OBJ) $(BUILD)/libfirmware.a
+	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(TEST_LIBS) $(LDLIBS_COMMON) $(TEST_EXTRA_LIBS)
 
 $(BUILD)/tests/test_util.o: tests/test_util.c | deps
 	@mkdir -p $(dir $@)
@@ -92,8 +96,12 @@ check-firmware: $(FW_OBJ)
 	if [ -n "$$bad" ]; then echo "firmware/ includes OS headers: $$bad"; exit 1; fi; \
 	echo "check-firmware: no allocator references and no OS headers in firmware/"
 
-test: deps $(BUILD)/scanner $(TEST_BIN) check-firmware
-	@BUILD=$(BUILD) tests/run.sh $(TEST_BIN)
+# Test-only packages (Open3D reads our PLY in tests/cli.sh).
+test-deps:
+	@/usr/bin/python3 -c 'import open3d' 2>/dev/null || scripts/install-deps.sh test
+
+test: deps test-deps $(BUILD)/scanner $(TEST_BIN) check-firmware
+	@BUILD=$(BUILD) tests/run.sh $(TEST_BIN) tests/cli.sh
 
 run: deps $(BUILD)/scanner
 	$(BUILD)/scanner scan --config config/sim.ini
@@ -107,6 +115,8 @@ format:
 
 clean:
 	rm -rf build
+
+.SECONDARY:
 
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)
 

@@ -1,8 +1,10 @@
 #!/bin/sh
 # Installs the Debian 12 packages the scanner builds and tests with (called by make when
 # pkg-config cannot find one of them). Needs root, as on the CI machine and a fresh rig.
+# With the argument "test" it adds what only the tests use (Open3D reads our PLY files).
 set -eu
 pkgs="build-essential pkg-config libinih-dev libpng-dev libcmocka-dev libmodbus-dev libgpiod-dev"
+[ "${1:-}" = "test" ] && pkgs="$pkgs python3 python3-numpy python3-open3d"
 missing=""
 for p in $pkgs; do
     dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"

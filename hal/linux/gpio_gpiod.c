@@ -1,0 +1,113 @@
+/* libgpiod v1.6 backend: lines requested once at start, driven low on every exit path. */
+#define _POSIX_C_SOURCE 200809L
+#include "gpio_gpiod.h"
+
+#include <errno.h>
+#include <gpiod.h>
+#include <stdio.h>
+#include <string.h>
+
+const char *gpio_line_name(enum hal_gpio_line line, char *buf, size_t len)
+{
+    static const char *const fixed[] = {"projector_enable", "projector_trigger", "projector_reset"};
+    if ((unsigned)line < HAL_GPIO_LIGHT_0)
+        snprintf(buf, len, "%s", fixed[line]);
+    else
+        snprintf(buf, len, "light_%u", (unsigned)(line - HAL_GPIO_LIGHT_0));
+    return buf;
+}
+
+static int gpiod_set(void *priv, enum hal_gpio_line line, int value)
+{
+    struct gpio_gpiod *g = priv;
+    if ((unsigned)line >= HAL_GPIO_LINE_COUNT)
+        return -EINVAL;
+    if (g->line[line] == NULL)
+        return value ? -EINVAL : 0; /* an unwired line can always be "off" */
+    if (gpiod_line_set_value(g->line[line], value ? 1 : 0) != 0)
+        return -errno;
+    g->value[line] = value ? 1 : 0;
+    return 0;
+}
+
+static int gpiod_get(void *priv, enum hal_gpio_line line, int *value)
+{
+    struct gpio_gpiod *g = priv;
+    if ((unsigned)line >= HAL_GPIO_LINE_COUNT)
+        return -EINVAL;
+    *value = g->value[line];
+    return 0;
+}
+
+static int gpiod_safe_state(void *priv)
+{
+    struct gpio_gpiod *g = priv;
+    int first_rc = 0;
+    for (unsigned i = 0; i < HAL_GPIO_LINE_COUNT; i++) {
+        int rc = gpiod_set(g, (enum hal_gpio_line)i, 0);
+        if (rc != 0 && first_rc == 0)
+            first_rc = rc;
+    }
+    return first_rc;
+}
+
+static const struct hal_gpio_ops gpiod_ops = {
+    .set = gpiod_set,
+    .get = gpiod_get,
+    .safe_state = gpiod_safe_state,
+};
+
+int gpio_gpiod_open(struct gpio_gpiod *g, const char *chip_name,
+                    const int32_t offset[HAL_GPIO_LINE_COUNT], struct hal_gpio *out, char *err,
+                    size_t err_len)
+{
+    char name[32];
+    int rc = 0;
+    memset(g, 0, sizeof(*g));
+    g->chip = gpiod_chip_open_lookup(chip_name);
+    if (g->chip == NULL) {
+        rc = -(errno != 0 ? errno : ENODEV);
+        snprintf(err, err_len, "gpio: cannot open chip '%s': %s", chip_name, strerror(-rc));
+        return rc;
+    }
+    for (unsigned i = 0; i < HAL_GPIO_LINE_COUNT; i++) {
+        if (offset[i] < 0)
+            continue;
+        gpio_line_name((enum hal_gpio_line)i, name, sizeof(name));
+        struct gpiod_line *line = gpiod_chip_get_line(g->chip, (unsigned)offset[i]);
+        if (line == NULL) {
+            rc = -errno;
+            snprintf(err, err_len, "gpio: %s: chip '%s' has no line %d: %s", name, chip_name,
+                     (int)offset[i], strerror(-rc));
+            goto out_release;
+        }
+        if (gpiod_line_request_output(line, "scanner", 0) != 0) {
+            rc = -errno;
+            const char *user = gpiod_line_consumer(line);
+            snprintf(err, err_len, "gpio: %s: cannot request %s line %d%s%s: %s", name, chip_name,
+                     (int)offset[i], user ? ", in use by " : "", user ? user : "", strerror(-rc));
+            goto out_release;
+        }
+        g->line[i] = line;
+    }
+    out->ops = &gpiod_ops;
+    out->priv = g;
+    return 0;
+out_release:
+    gpio_gpiod_close(g);
+    return rc;
+}
+
+void gpio_gpiod_close(struct gpio_gpiod *g)
+{
+    for (unsigned i = 0; i < HAL_GPIO_LINE_COUNT; i++) {
+        if (g->line[i] == NULL)
+            continue;
+        gpiod_line_set_value(g->line[i], 0);
+        gpiod_line_release(g->line[i]);
+        g->line[i] = NULL;
+    }
+    if (g->chip != NULL)
+        gpiod_chip_close(g->chip);
+    g->chip = NULL;
+}

@@ -1,0 +1,42 @@
+#!/bin/sh
+# The scanner program as a user meets it: version, config errors, a scan, and its PLY in Open3D.
+# Prints cmocka-style PASSED/FAILED lines for tests/run.sh.
+set -u
+cd "$(dirname "$0")/.."
+bin=${BUILD:-build}/scanner
+out=${BUILD:-build}/cli
+pass=0
+fail=0
+check() { # name, then a command that must succeed
+    name=$1
+    shift
+    if "$@" >"$out.log" 2>&1; then
+        echo "[       OK ] $name"
+        pass=$((pass + 1))
+    else
+        echo "[  FAILED  ] $name"
+        sed 's/^/    /' "$out.log"
+        fail=$((fail + 1))
+    fi
+}
+mkdir -p "$out"
+check version sh -c "$bin --version | grep -q 'HAL=sim'"
+check check_config sh -c "$bin check-config --config config/sim.ini | grep -q ': ok'"
+printf '[camera]\nbackend = sim\nwidth = 1280\nheight = 960\nexposure_us = 10000\nexposur = 1\n' >"$out/bad.ini"
+check bad_config_names_file_line_key sh -c \
+    "$bin scan --config $out/bad.ini 2>&1 | grep -q '$out/bad.ini:6: \[camera\] exposur: unknown key'"
+check bad_config_exit_code sh -c "$bin scan --config $out/bad.ini; test \$? -eq 2"
+rm -rf "$out/scan"
+check scan sh -c "$bin scan --config config/sim.ini --out $out/scan | grep -q 'scan finished'"
+check scan_dir_complete sh -c "for f in config.ini calibration.ini view_000/cloud.ply view_000/colour.png \
+    view_000/view.ini view_000/truth_depth_mm.pfm view_000/truth_albedo.png; do test -s $out/scan/\$f || exit 1; done"
+points=$(sed -n 's/^valid_points = //p' "$out/scan/view_000/view.ini")
+if /usr/bin/python3 -c 'import open3d' 2>/dev/null; then
+    check open3d_reads_ply /usr/bin/python3 tests/interop_open3d.py "$out/scan/view_000/cloud.ply" "$points"
+else
+    echo "[  FAILED  ] open3d_reads_ply: python3-open3d missing (scripts/install-deps.sh test)"
+    fail=$((fail + 1))
+fi
+echo "[  PASSED  ] $pass test(s)."
+[ "$fail" -eq 0 ] || echo "[  FAILED  ] $fail test(s)"
+[ "$fail" -eq 0 ]

@@ -1,0 +1,75 @@
+/* The PLY file of a view: header as MeshLab and Open3D expect, and every vertex as computed. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "frames.h"
+#include "test_util.h"
+
+static void test_ply_roundtrip(void **state)
+{
+    (void)state;
+    static struct test_rig t;
+    assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
+    snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "box");
+    t.cfg.sim.segments = 16;
+    assert_int_equal(test_rig_start(&t), 0);
+    struct scan_view_info info;
+    const int32_t angle_mdeg = 30000;
+    sim_ctl_rig()->table_angle_mdeg = angle_mdeg;
+    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, angle_mdeg, &info), 0);
+    assert_int_equal(scan_save_cloud(&t.hal, &t.calib, "build/test_ply.ply"), 0);
+
+    FILE *f = fopen("build/test_ply.ply", "rb");
+    assert_non_null(f);
+    char line[128];
+    unsigned count = 0;
+    int props = 0;
+    while (fgets(line, sizeof(line), f) != NULL && strcmp(line, "end_header\n") != 0) {
+        sscanf(line, "element vertex %u", &count);
+        props += strncmp(line, "property", 8) == 0;
+        if (strncmp(line, "format", 6) == 0)
+            assert_string_equal(line, "format binary_little_endian 1.0\n");
+    }
+    assert_int_equal(count, info.valid_points);
+    assert_int_equal(props, 9);
+    /* Vertices are in the object frame: rotating back by the angle gives the camera points. */
+    struct frame_xform obj;
+    frame_object_from_camera(&t.calib, angle_mdeg, &obj);
+    const struct decode_maps *maps = decode_get_maps();
+    const struct tri_range *r = tri_get_range();
+    const uint8_t *rgb = scan_colour_frame();
+    size_t n = (size_t)maps->width * maps->height, seen = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (maps->reason[i] != SCAN_VALID)
+            continue;
+        unsigned char rec[27];
+        assert_int_equal(fread(rec, 1, 27, f), 27);
+        float v[6];
+        memcpy(v, rec, sizeof(v)); /* little-endian host, as the file */
+        vec3 p = frame_point_inv(&obj, v3(v[0], v[1], v[2]));
+        assert_true(fabs(p.x - r->xyz_mm[3 * i]) < 1e-3 && fabs(p.z - r->xyz_mm[3 * i + 2]) < 1e-3);
+        assert_true(fabs(sqrt(v[3] * v[3] + v[4] * v[4] + v[5] * v[5]) - 1.0) < 1e-4);
+        assert_memory_equal(rec + 24, rgb + 3 * i, 3);
+        seen++;
+    }
+    assert_int_equal(fread(line, 1, 1, f), 0); /* nothing after the last vertex */
+    fclose(f);
+    assert_int_equal(seen, count);
+    /* The object frame puts the table at z = 0: the box stands on it. */
+    test_rig_stop(&t);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_ply_roundtrip),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

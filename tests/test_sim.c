@@ -1,0 +1,179 @@
+/* The simulated rig: meshes, ray casting, determinism and the camera's noise model. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sim_bvh.h"
+#include "sim_material.h"
+#include "test_util.h"
+
+static void test_bunny_ply_loads(void **state)
+{
+    (void)state;
+    struct sim_mesh m;
+    char err[256];
+    assert_int_equal(sim_mesh_load_ply(&m, "../shared/data/bunny/bun_zipper.ply", err, sizeof(err)), 0);
+    assert_int_equal(m.vert_count, 35947);
+    assert_int_equal(m.tri_count, 69451);
+    sim_mesh_y_up_to_z_up(&m);
+    sim_mesh_place(&m, 150.0);
+    float zmin = 1e9f, zmax = -1e9f;
+    for (uint32_t i = 0; i < m.vert_count; i++) {
+        zmin = fminf(zmin, m.pos[3 * i + 2]);
+        zmax = fmaxf(zmax, m.pos[3 * i + 2]);
+    }
+    assert_true(fabsf(zmin) < 1e-3f && fabsf(zmax - 150.0f) < 1e-3f);
+    sim_mesh_free(&m);
+    assert_int_not_equal(sim_mesh_load_ply(&m, "config/sim.ini", err, sizeof(err)), 0);
+    assert_non_null(strstr(err, "not a PLY file"));
+}
+
+/* The BVH finds the same closest hit as testing every triangle. */
+static void test_bvh_matches_brute_force(void **state)
+{
+    (void)state;
+    struct sim_mesh m;
+    char err[256];
+    assert_int_equal(sim_mesh_load_ply(&m, "../shared/data/bunny/bun_zipper_res3.ply", err, sizeof(err)), 0);
+    sim_mesh_place(&m, 150.0);
+    struct sim_bvh bvh;
+    assert_int_equal(sim_bvh_build(&bvh, &m), 0);
+    struct sim_mesh one = m;
+    uint32_t hits = 0;
+    srand(7);
+    for (int r = 0; r < 300; r++) {
+        vec3 o = v3(300.0, (rand() % 200) - 100.0, (rand() % 200) - 20.0);
+        vec3 d = v3(-1.0, (rand() % 100 - 50) / 500.0, (rand() % 100 - 50) / 500.0);
+        struct sim_hit h;
+        int got = sim_bvh_intersect(&bvh, o, d, 1e-6, 1e9, &h);
+        double best = 1e18;
+        for (uint32_t t = 0; t < m.tri_count; t++) { /* one-triangle BVHs: brute force */
+            struct sim_bvh single;
+            one.tri = &m.tri[3 * t];
+            one.tri_count = 1;
+            assert_int_equal(sim_bvh_build(&single, &one), 0);
+            struct sim_hit hh;
+            if (sim_bvh_intersect(&single, o, d, 1e-6, 1e9, &hh) && hh.t < best)
+                best = hh.t;
+            sim_bvh_free(&single);
+        }
+        assert_int_equal(got, best < 1e18);
+        if (got) {
+            assert_true(fabs(h.t - best) < 1e-9);
+            assert_int_equal(sim_bvh_occluded(&bvh, o, d, 1e-6, 1e9), 1);
+            hits++;
+        }
+    }
+    assert_true(hits > 30);
+    sim_bvh_free(&bvh);
+    sim_mesh_free(&m);
+}
+
+static void test_closed_shapes_have_outward_normals(void **state)
+{
+    (void)state;
+    struct sim_mesh m;
+    for (int s = 0; s < 4; s++) {
+        int rc = s == 0   ? sim_mesh_sphere(&m, 50, 64)
+                 : s == 1 ? sim_mesh_cylinder(&m, 30, 100, 64)
+                 : s == 2 ? sim_mesh_box(&m, 60, 40, 100, 32)
+                          : sim_mesh_torus(&m, 50, 20, 64);
+        assert_int_equal(rc, 0);
+        sim_mesh_place(&m, 100.0);
+        /* Outward: the normal points away from the centroid of the axis at that height for
+         * convex shapes; the torus: away from its tube centre. */
+        for (uint32_t i = 0; i < m.vert_count; i++) {
+            vec3 p = v3(m.pos[3 * i], m.pos[3 * i + 1], m.pos[3 * i + 2]);
+            vec3 n = v3(m.normal[3 * i], m.normal[3 * i + 1], m.normal[3 * i + 2]);
+            vec3 c = v3(0, 0, 50.0);
+            if (s == 3) {
+                double r = hypot(p.x, p.y);
+                double major = 50.0 * 100.0 / 40.0;
+                c = r > 1e-9 ? v3(p.x / r * major, p.y / r * major, 50.0) : c;
+            }
+            if (v3_len(n) > 0.5)
+                assert_true(v3_dot(n, v3_sub(p, c)) > -1e-6);
+        }
+        sim_mesh_free(&m);
+    }
+}
+
+/* Same seed, same frame; another seed, other noise. Black frame statistics as configured. */
+static void test_deterministic_noise_and_black_level(void **state)
+{
+    (void)state;
+    static struct test_rig t;
+    assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
+    snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "box");
+    t.cfg.sim.segments = 16;
+    assert_int_equal(test_rig_start(&t), 0);
+    struct sim_rig *rig = sim_ctl_rig();
+    size_t n = (size_t)rig->width * rig->height * 3;
+    static uint8_t a[HAL_MAX_PIXELS * 3], b[HAL_MAX_PIXELS * 3];
+    struct sim_sources dark = {.exposure_us = 10000, .gain_milli = 1000};
+    sim_rig_render(rig, &dark, 1, a);
+    sim_rig_render(rig, &dark, 1, b);
+    assert_memory_equal(a, b, n);
+    sim_rig_render(rig, &dark, 2, b);
+    assert_true(memcmp(a, b, n) != 0);
+    /* Background pixels of the dark frame: offset 51, read noise 1.5 */
+    double sum = 0, sum_sq = 0;
+    size_t count = 0;
+    for (size_t i = 0; i < n / 3; i++) {
+        if (rig->truth.hit[i])
+            continue;
+        sum += a[3 * i];
+        sum_sq += (double)a[3 * i] * a[3 * i];
+        count++;
+    }
+    double mean = sum / count, sd = sqrt(sum_sq / count - mean * mean);
+    print_message("dark frame: mean %.2f, sd %.2f over %zu pixels\n", mean, sd, count);
+    assert_true(fabs(mean - 51.0) < 0.05);
+    assert_true(fabs(sd - 1.5) < 0.1 + 0.3); /* rounding to integers adds 1/12 variance */
+    /* A strong exposure saturates at 255, never wraps */
+    struct sim_sources bright = {.projector_on = 1, .pattern_index = 0, .exposure_us = 80000,
+                                 .gain_milli = 1000};
+    sim_rig_render(rig, &bright, 3, a);
+    size_t saturated = 0;
+    for (size_t i = 0; i < n; i++)
+        saturated += a[i] == 255;
+    assert_true(saturated > 1000);
+    test_rig_stop(&t);
+}
+
+/* The ABC model of a measured material reflects more near the mirror direction. */
+static void test_merl_material(void **state)
+{
+    (void)state;
+    struct sim_material mat;
+    const char *csv = "../shared/data/materials/merl_abc_lowetal2012.csv";
+    assert_int_equal(sim_material_load_abc(&mat, csv, "red-plastic"), 0);
+    assert_int_not_equal(sim_material_load_abc(&mat, csv, "unobtainium"), 0);
+    assert_int_equal(sim_material_load_abc(&mat, csv, "gold-metallic-paint"), 0);
+    double albedo[3] = {mat.abc_kd[0], mat.abc_kd[1], mat.abc_kd[2]}, mirror[3], off[3];
+    vec3 n = v3(0, 0, 1), l = v3_norm(v3(1, 0, 1));
+    sim_material_eval(&mat, albedo, n, l, v3_norm(v3(-1, 0, 1)), mirror);
+    sim_material_eval(&mat, albedo, n, l, v3_norm(v3(1, 0.3, 1)), off);
+    assert_true(mirror[0] > 5.0 * off[0]);
+    sim_material_eval(&mat, albedo, n, v3(0, 0, -1), v3(0, 0, 1), off); /* lit from behind */
+    assert_true(off[0] == 0.0 && off[1] == 0.0 && off[2] == 0.0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_bunny_ply_loads),
+        cmocka_unit_test(test_bvh_matches_brute_force),
+        cmocka_unit_test(test_closed_shapes_have_outward_normals),
+        cmocka_unit_test(test_deterministic_noise_and_black_level),
+        cmocka_unit_test(test_merl_material),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
