@@ -204,7 +204,7 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
             snprintf(err, err_len, "%s: [scan] calibration: path too long", path);
             return -EINVAL;
         }
-        snprintf(cfg->calibration_file, sizeof(cfg->calibration_file), "%s", joined);
+        memcpy(cfg->calibration_file, joined, strlen(joined) + 1);
     }
     return 0;
 }

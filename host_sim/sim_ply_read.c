@@ -17,7 +17,7 @@ struct ply_prop {
 
 #define PLY_MAX_PROPS 32
 struct ply_element {
-    char name[32];
+    char name[64];
     unsigned long count;
     int prop_count;
     struct ply_prop props[PLY_MAX_PROPS];
