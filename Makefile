@@ -105,10 +105,9 @@ test: deps test-deps $(BUILD)/scanner $(TEST_BIN) check-firmware
 
 run: deps $(BUILD)/scanner
 	$(BUILD)/scanner scan --config config/sim.ini
-	@echo "result: scans/sim/view_000/cloud.ply (open it in MeshLab, CloudCompare or Open3D)"
 
 docs: $(BUILD)/scanner
-	$(BUILD)/scanner config-doc > docs/config-keys.md
+	$(BUILD)/scanner config-doc > docs/config.md
 
 format:
 	clang-format -i $$(git ls-files '*.c' '*.h')
@@ -125,3 +124,12 @@ $(BUILD)/measure_view: $(BUILD)/tests/measure_view.o $(BUILD)/tests/test_util.o 
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON) $(BOARD_LIBS)
 measure: deps $(BUILD)/measure_view
 	$(BUILD)/measure_view config/sim.ini
+
+# Time per view, split between the simulated capture and the firmware's processing.
+$(BUILD)/bench_view: $(BUILD)/bench/bench_view.o $(BUILD)/tests/test_util.o $(HOST_OBJ) $(BUILD)/libfirmware.a
+	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON) $(BOARD_LIBS)
+$(BUILD)/bench/%.o: bench/%.c | deps
+	@mkdir -p $(dir $@)
+	$(CC) $(HOST_CFLAGS) -Itests -c $< -o $@
+bench: deps $(BUILD)/bench_view
+	$(BUILD)/bench_view config/sim.ini

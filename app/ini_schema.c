@@ -221,14 +221,26 @@ int ini_schema_load(const struct ini_key *keys, size_t key_count, void *target, 
     return 0;
 }
 
-static const char *type_name(const struct ini_key *k)
+static const char *type_name(const struct ini_key *k, char *buf, size_t len)
 {
     switch (k->type) {
     case INI_U32: return "unsigned";
     case INI_I32: return "integer";
     case INI_F64: return "number";
     case INI_STR: return "text";
-    case INI_ENUM: return k->choices;
+    case INI_ENUM: { /* "a|b" would split a Markdown table cell */
+        size_t n = 0;
+        for (const char *p = k->choices; *p != '\0' && n + 3 < len; p++) {
+            if (*p == '|') {
+                buf[n++] = ',';
+                buf[n++] = ' ';
+            } else {
+                buf[n++] = *p;
+            }
+        }
+        buf[n] = '\0';
+        return buf;
+    }
     case INI_VEC: return k->size == 3 ? "x, y, z" : "list of numbers";
     }
     return "?";
@@ -244,11 +256,12 @@ void ini_schema_print_doc(const struct ini_key *keys, size_t key_count, FILE *ou
             fprintf(out, "\n### [%s]\n\n| key | type | default | range | meaning |\n"
                          "|---|---|---|---|---|\n", section);
         }
-        char range[64] = "";
+        char range[64] = "", type_buf[128];
         if (k->type == INI_U32 || k->type == INI_I32 || k->type == INI_F64 || k->type == INI_VEC)
-            snprintf(range, sizeof(range), "%g .. %g%s", k->min, k->max,
+            snprintf(range, sizeof(range), "%.10g .. %.10g%s", k->min, k->max,
                      k->max_is_limit ? " (compiled limit)" : "");
-        fprintf(out, "| `%s` | %s | %s | %s | %s |\n", k->name, type_name(k),
+        fprintf(out, "| `%s` | %s | %s | %s | %s |\n", k->name,
+                type_name(k, type_buf, sizeof(type_buf)),
                 k->def == NULL ? "**required**" : (k->def[0] ? k->def : "(empty)"), range, k->doc);
     }
 }

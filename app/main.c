@@ -218,7 +218,9 @@ static int cmd_scan(const char *config_path, const char *out_dir)
     board_shutdown(&the_hal);
     hal_ready = 0;
     if (rc == 0)
-        printf("scan finished: %s\n", cfg.output_dir);
+        printf("scan finished: %s (point cloud of view 0: %s/view_000/cloud.ply; open it in "
+               "MeshLab, CloudCompare, Blender or Open3D)\n",
+               cfg.output_dir, cfg.output_dir);
     return rc == 0 ? 0 : 1;
 }
 

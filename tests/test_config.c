@@ -147,7 +147,7 @@ static void test_backend_not_built_in(void **state)
     assert_null(hal.gpio.ops); /* nothing was set up */
 }
 
-/* docs/config-keys.md is generated from the key tables: it must be current. */
+/* docs/config.md is generated from the key tables: it must be current. */
 static void test_docs_cover_every_key(void **state)
 {
     (void)state;
@@ -156,14 +156,14 @@ static void test_docs_cover_every_key(void **state)
     FILE *mem = open_memstream(&generated, &len);
     config_print_doc(mem);
     fclose(mem);
-    FILE *f = fopen("docs/config-keys.md", "r");
+    FILE *f = fopen("docs/config.md", "r");
     assert_non_null(f);
     static char committed[65536];
     size_t n = fread(committed, 1, sizeof(committed) - 1, f);
     fclose(f);
     committed[n] = '\0';
     if (strcmp(committed, generated) != 0)
-        fail_msg("docs/config-keys.md is stale: run 'make docs'");
+        fail_msg("docs/config.md is stale: run 'make docs'");
     free(generated);
 }
 

@@ -1,0 +1,82 @@
+/* Time per view, split: rendering the 22 frames (the simulator, standing in for the camera) and
+ * the firmware's processing of them (decode, refine, triangulate, normals, PLY). make bench. */
+#define _POSIX_C_SOURCE 200809L
+#include "decode.h"
+#include "gray.h"
+#include "refine.h"
+#include "test_util.h"
+#include "tri.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#define REPEAT 5
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
+}
+
+int main(int argc, char **argv)
+{
+    static struct test_rig t;
+    if (test_rig_load(&t, argc > 1 ? argv[1] : "config/sim.ini") != 0 || test_rig_start(&t) != 0)
+        return 1;
+    struct sim_rig *rig = sim_ctl_rig();
+    uint32_t count = gray_pattern_count(gray_bits_for_width(t.calib.proj_width));
+    size_t frame_bytes = (size_t)rig->width * rig->height * 3;
+    uint8_t *frames = malloc(frame_bytes * count);
+    if (frames == NULL)
+        return 1;
+    double t0 = now_ms();
+    sim_rig_update(rig);
+    double t_geometry = now_ms() - t0;
+    t0 = now_ms();
+    for (uint32_t i = 0; i < count; i++) {
+        struct sim_sources src = {.projector_on = 1, .pattern_index = i,
+                                  .exposure_us = t.cfg.camera.exposure_us, .gain_milli = 1000};
+        sim_rig_render(rig, &src, i, frames + frame_bytes * i);
+    }
+    double t_render = now_ms() - t0;
+    double best[5] = {1e9, 1e9, 1e9, 1e9, 1e9};
+    for (int r = 0; r < REPEAT; r++) {
+        double s[6];
+        s[0] = now_ms();
+        decode_begin(&t.cfg.scan, t.calib.proj_width);
+        for (uint32_t i = 0; i < count; i++)
+            decode_frame(i, frames + frame_bytes * i);
+        decode_finish();
+        s[1] = now_ms();
+        const struct decode_maps *maps = decode_get_maps();
+        refine_columns(maps, (int)t.cfg.scan.refine);
+        s[2] = now_ms();
+        tri_range_image(&t.calib, maps, refine_get_columns());
+        s[3] = now_ms();
+        tri_normals(maps, t.cfg.scan.normal_radius_px, t.cfg.scan.max_depth_jump_mm);
+        s[4] = now_ms();
+        scan_save_cloud(&t.hal, &t.calib, "build/bench_view.ply");
+        s[5] = now_ms();
+        for (int k = 0; k < 5; k++)
+            best[k] = s[k + 1] - s[k] < best[k] ? s[k + 1] - s[k] : best[k];
+    }
+    printf("view %ux%u, %u frames, object '%s' (best of %d runs, one core)\n",
+           (unsigned)rig->width, (unsigned)rig->height, (unsigned)count, t.cfg.sim.object, REPEAT);
+    printf("| stage | ms |\n|---|---|\n");
+    printf("| simulator: ray casting (once per angle) | %.1f |\n", t_geometry);
+    printf("| simulator: rendering %u frames | %.1f |\n", (unsigned)count, t_render);
+    const char *names[5] = {"decode (22 frames)", "sub-stripe refinement", "triangulation",
+                            "normals", "PLY write"};
+    double total = 0.0;
+    for (int k = 0; k < 5; k++) {
+        printf("| firmware: %s | %.1f |\n", names[k], best[k]);
+        total += best[k];
+    }
+    printf("| **firmware total per view** | **%.1f** |\n", total);
+    free(frames);
+    test_rig_stop(&t);
+    return 0;
+}
