@@ -40,7 +40,7 @@ APP_LIB_SRC := app/config.c app/ini_schema.c app/image_io.c
 SIM_SRC := $(wildcard host_sim/*.c)
 LINUX_SRC := $(wildcard hal/linux/*.c)
 BOARD_SRC := $(if $(filter sim,$(HAL)),$(SIM_SRC),$(LINUX_SRC))
-BOARD_LIBS := $(if $(filter linux,$(HAL)),$(shell pkg-config --libs libgpiod 2>/dev/null),)
+BOARD_LIBS = $(if $(filter linux,$(HAL)),$(shell pkg-config --libs libgpiod 2>/dev/null),)
 
 obj = $(patsubst %.c,$(BUILD)/%.o,$(1))
 FW_OBJ := $(call obj,$(FW_SRC))

@@ -12,17 +12,30 @@
 #define C(member) offsetof(struct app_config, member)
 #define SZ(member) sizeof(((struct app_config *)0)->member)
 #define U32(sec, key, member, lo, hi, def, doc)                                                    \
-    {sec, key, INI_U32, C(member), 0, lo, hi, 0, def, NULL, doc}
+    {                                                                                              \
+        sec, key, INI_U32, C(member), 0, lo, hi, 0, def, NULL, doc                                 \
+    }
 #define LIM(sec, key, member, lo, hi, def, doc)                                                    \
-    {sec, key, INI_U32, C(member), 0, lo, hi, 1, def, NULL, doc}
+    {                                                                                              \
+        sec, key, INI_U32, C(member), 0, lo, hi, 1, def, NULL, doc                                 \
+    }
 #define F64(sec, key, member, lo, hi, def, doc)                                                    \
-    {sec, key, INI_F64, C(member), 0, lo, hi, 0, def, NULL, doc}
-#define STR(sec, key, member, def, doc) {sec, key, INI_STR, C(member), SZ(member), 0, 0, 0, def, NULL, doc}
+    {                                                                                              \
+        sec, key, INI_F64, C(member), 0, lo, hi, 0, def, NULL, doc                                 \
+    }
+#define STR(sec, key, member, def, doc)                                                            \
+    {                                                                                              \
+        sec, key, INI_STR, C(member), SZ(member), 0, 0, 0, def, NULL, doc                          \
+    }
 #define ENUM(sec, key, member, choices, def, doc)                                                  \
-    {sec, key, INI_ENUM, C(member), SZ(member), 0, 0, 0, def, choices, doc}
+    {                                                                                              \
+        sec, key, INI_ENUM, C(member), SZ(member), 0, 0, 0, def, choices, doc                      \
+    }
 #define GPIO(key, line)                                                                            \
-    {"gpio", key, INI_I32, C(gpio.line_offset[line]), 0, -1, 1023, 0, "-1", NULL,                  \
-     "line offset on the chip; -1 = not wired"}
+    {                                                                                              \
+        "gpio", key, INI_I32, C(gpio.line_offset[line]), 0, -1, 1023, 0, "-1", NULL,               \
+            "line offset on the chip; -1 = not wired"                                              \
+    }
 
 static const struct ini_key config_keys[] = {
     ENUM("camera", "backend", camera_backend, "sim|v4l2|libcamera", NULL,
@@ -75,10 +88,14 @@ static const struct ini_key config_keys[] = {
     GPIO("projector_enable", HAL_GPIO_PROJECTOR_ENABLE),
     GPIO("projector_trigger", HAL_GPIO_PROJECTOR_TRIGGER),
     GPIO("projector_reset", HAL_GPIO_PROJECTOR_RESET),
-    GPIO("light_0", HAL_GPIO_LIGHT_0 + 0), GPIO("light_1", HAL_GPIO_LIGHT_0 + 1),
-    GPIO("light_2", HAL_GPIO_LIGHT_0 + 2), GPIO("light_3", HAL_GPIO_LIGHT_0 + 3),
-    GPIO("light_4", HAL_GPIO_LIGHT_0 + 4), GPIO("light_5", HAL_GPIO_LIGHT_0 + 5),
-    GPIO("light_6", HAL_GPIO_LIGHT_0 + 6), GPIO("light_7", HAL_GPIO_LIGHT_0 + 7),
+    GPIO("light_0", HAL_GPIO_LIGHT_0 + 0),
+    GPIO("light_1", HAL_GPIO_LIGHT_0 + 1),
+    GPIO("light_2", HAL_GPIO_LIGHT_0 + 2),
+    GPIO("light_3", HAL_GPIO_LIGHT_0 + 3),
+    GPIO("light_4", HAL_GPIO_LIGHT_0 + 4),
+    GPIO("light_5", HAL_GPIO_LIGHT_0 + 5),
+    GPIO("light_6", HAL_GPIO_LIGHT_0 + 6),
+    GPIO("light_7", HAL_GPIO_LIGHT_0 + 7),
     ENUM("turntable", "transport", turntable.transport, "tcp|rtu", "tcp",
          "Modbus transport to the turntable controller"),
     STR("turntable", "host", turntable.host, "127.0.0.1", "Modbus TCP host"),
@@ -130,10 +147,18 @@ static const struct ini_key config_keys[] = {
 #undef C
 #undef SZ
 #define K(member) offsetof(struct scan_calib, member)
-#define CF(sec, key, member, lo, hi, doc) {sec, key, INI_F64, K(member), 0, lo, hi, 0, NULL, NULL, doc}
-#define CU(sec, key, member, hi, doc) {sec, key, INI_U32, K(member), 0, 1, hi, 1, NULL, NULL, doc}
+#define CF(sec, key, member, lo, hi, doc)                                                          \
+    {                                                                                              \
+        sec, key, INI_F64, K(member), 0, lo, hi, 0, NULL, NULL, doc                                \
+    }
+#define CU(sec, key, member, hi, doc)                                                              \
+    {                                                                                              \
+        sec, key, INI_U32, K(member), 0, 1, hi, 1, NULL, NULL, doc                                 \
+    }
 #define CV(sec, key, member, n, lo, hi, def, doc)                                                  \
-    {sec, key, INI_VEC, K(member), n, lo, hi, 0, def, NULL, doc}
+    {                                                                                              \
+        sec, key, INI_VEC, K(member), n, lo, hi, 0, def, NULL, doc                                 \
+    }
 #define LIGHT(i)                                                                                   \
     CV("lights", "light_" #i "_mm", light_pos_mm[i], 3, -1e5, 1e5, "0, 0, 0",                      \
        "position of light " #i " (camera frame)")
@@ -158,15 +183,23 @@ static const struct ini_key calib_keys[] = {
     CV("turntable", "axis_point_mm", axis_point_mm, 3, -1e5, 1e5, NULL,
        "a point of the turntable axis on the table surface (camera frame)"),
     CV("turntable", "axis_dir", axis_dir, 3, -1, 1, NULL, "unit direction of the axis, upwards"),
-    LIGHT(0), LIGHT(1), LIGHT(2), LIGHT(3), LIGHT(4), LIGHT(5), LIGHT(6), LIGHT(7),
+    LIGHT(0),
+    LIGHT(1),
+    LIGHT(2),
+    LIGHT(3),
+    LIGHT(4),
+    LIGHT(5),
+    LIGHT(6),
+    LIGHT(7),
 };
 
 _Static_assert(HAL_MAX_LIGHTS == 8, "calib_keys lists light_0 .. light_7");
 
 static enum hal_pixel_format pixel_format_of(const char *s)
 {
-    return strcmp(s, "yuyv") == 0 ? HAL_PIX_YUYV
-                                  : strcmp(s, "grey") == 0 ? HAL_PIX_GREY : HAL_PIX_RGB24;
+    return strcmp(s, "yuyv") == 0   ? HAL_PIX_YUYV
+           : strcmp(s, "grey") == 0 ? HAL_PIX_GREY
+                                    : HAL_PIX_RGB24;
 }
 
 int config_load(struct app_config *cfg, const char *path, char *err, size_t err_len)
@@ -191,8 +224,10 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
     }
     if (strcmp(cfg->sim.material, "merl") == 0 &&
         (cfg->sim.merl_file[0] == '\0' || cfg->sim.merl_name[0] == '\0')) {
-        snprintf(err, err_len, "%s: [sim] merl_name: merl_file and merl_name are required when "
-                               "material = merl", path);
+        snprintf(err, err_len,
+                 "%s: [sim] merl_name: merl_file and merl_name are required when "
+                 "material = merl",
+                 path);
         return -EINVAL;
     }
     /* The calibration file is named relative to the config file. */
@@ -238,8 +273,8 @@ int calib_load(struct scan_calib *calib, const char *path, uint32_t light_count,
     calib->light_count = light_count;
     for (uint32_t i = 0; i < light_count; i++) {
         if (v3_len(v3_from(calib->light_pos_mm[i])) == 0.0) {
-            snprintf(err, err_len, "%s: [lights] light_%u_mm: required, [lights] count is %u",
-                     path, (unsigned)i, (unsigned)light_count);
+            snprintf(err, err_len, "%s: [lights] light_%u_mm: required, [lights] count is %u", path,
+                     (unsigned)i, (unsigned)light_count);
             return -EINVAL;
         }
     }
@@ -248,20 +283,21 @@ int calib_load(struct scan_calib *calib, const char *path, uint32_t light_count,
 
 void config_print_doc(FILE *out)
 {
-    fprintf(out, "# Configuration reference\n\n"
-                 "Generated by `scanner config-doc` (`make docs`); a test fails when it is stale.\n\n"
-                 "A scan is driven by an INI file (`scanner scan --config FILE`) that names a "
-                 "calibration file. Any unknown section or key, a value that is not a number or "
-                 "not one of the listed words, a value out of range, a key set twice, a missing "
-                 "required key, or a size above the compiled buffer limits "
-                 "(`hal/include/hal_limits.h`) stops the scanner before it touches any device, "
-                 "with a message naming the file, the line and the key, for example:\n\n"
-                 "    config/rig.ini:12: [camera] width: 4096 exceeds the compiled limit 2048 "
-                 "(see hal/include/hal_limits.h)\n\n"
-                 "Relative paths (`calibration`, `mesh_file`, `merl_file`) are resolved against "
-                 "the directory of the file that names them; `[output] dir` against the working "
-                 "directory.\n\n"
-                 "## Scan config (e.g. `config/sim.ini`)\n");
+    fprintf(out,
+            "# Configuration reference\n\n"
+            "Generated by `scanner config-doc` (`make docs`); a test fails when it is stale.\n\n"
+            "A scan is driven by an INI file (`scanner scan --config FILE`) that names a "
+            "calibration file. Any unknown section or key, a value that is not a number or "
+            "not one of the listed words, a value out of range, a key set twice, a missing "
+            "required key, or a size above the compiled buffer limits "
+            "(`hal/include/hal_limits.h`) stops the scanner before it touches any device, "
+            "with a message naming the file, the line and the key, for example:\n\n"
+            "    config/rig.ini:12: [camera] width: 4096 exceeds the compiled limit 2048 "
+            "(see hal/include/hal_limits.h)\n\n"
+            "Relative paths (`calibration`, `mesh_file`, `merl_file`) are resolved against "
+            "the directory of the file that names them; `[output] dir` against the working "
+            "directory.\n\n"
+            "## Scan config (e.g. `config/sim.ini`)\n");
     ini_schema_print_doc(config_keys, sizeof(config_keys) / sizeof(config_keys[0]), out);
     fprintf(out, "\n## Calibration file (e.g. `config/sim-calib.ini`)\n\nAll geometry is in the "
                  "camera frame (x right, y down, z forward), in millimetres.\n");

@@ -1,4 +1,5 @@
-/* Scanner configuration: INI files parsed with inih into plain structs, checked against the limits. */
+/* Scanner configuration: INI files parsed with inih into plain structs, checked against the limits.
+ */
 #ifndef CONFIG_H
 #define CONFIG_H
 
@@ -12,15 +13,15 @@
 /** The simulated rig ([sim]); read in every build so that configs stay portable, used only by
  *  the simulator board. */
 struct sim_config {
-    char object[16];            /**< sphere | cylinder | box | torus | mesh */
+    char object[16]; /**< sphere | cylinder | box | torus | mesh */
     char mesh_file[HAL_MAX_PATH];
     double object_height_mm;
-    uint32_t segments;          /**< tessellation of analytic shapes */
-    char material[16];          /**< lambert | phong | merl */
+    uint32_t segments; /**< tessellation of analytic shapes */
+    char material[16]; /**< lambert | phong | merl */
     char merl_file[HAL_MAX_PATH];
     char merl_name[64];
     double phong_ks, phong_ke;
-    char albedo_pattern[16];    /**< patches | uniform */
+    char albedo_pattern[16]; /**< patches | uniform */
     double albedo[3];
     double object_angle_deg;
     uint32_t seed;
@@ -31,25 +32,25 @@ struct sim_config {
 };
 
 struct gpio_config {
-    char chip[64];                           /**< gpiochip device or name */
+    char chip[64];                            /**< gpiochip device or name */
     int32_t line_offset[HAL_GPIO_LINE_COUNT]; /**< -1 = not wired */
 };
 
 struct turntable_config {
-    char transport[8];          /**< tcp | rtu */
+    char transport[8]; /**< tcp | rtu */
     char host[64];
     uint32_t port;
     char device[128];
     uint32_t baud;
-    char parity[8];             /**< none | even | odd */
+    char parity[8]; /**< none | even | odd */
     uint32_t unit_id;
     uint32_t response_timeout_ms;
 };
 
 struct app_config {
-    char path[HAL_MAX_PATH];        /**< the file it came from */
-    char camera_backend[16];        /**< sim | v4l2 | libcamera */
-    char camera_pixel_format[8];    /**< rgb24 | yuyv | grey, as written */
+    char path[HAL_MAX_PATH];     /**< the file it came from */
+    char camera_backend[16];     /**< sim | v4l2 | libcamera */
+    char camera_pixel_format[8]; /**< rgb24 | yuyv | grey, as written */
     struct hal_camera_config camera;
     uint32_t light_count;
     struct scan_params scan;

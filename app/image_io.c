@@ -54,8 +54,9 @@ int image_write_png(const struct hal_storage *st, const char *path, const uint8_
     png_set_write_fn(png, &sink, sink_write, sink_flush);
     /* Fast compression: captures are many and large; the files stay lossless. */
     png_set_compression_level(png, 1);
-    png_set_IHDR(png, info, width, height, 8, channels == 3 ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_GRAY,
-                 PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_set_IHDR(png, info, width, height, 8,
+                 channels == 3 ? PNG_COLOR_TYPE_RGB : PNG_COLOR_TYPE_GRAY, PNG_INTERLACE_NONE,
+                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     png_write_info(png, info);
     for (uint32_t y = 0; y < height; y++)
         png_write_row(png, (png_const_bytep)(pixels + (size_t)y * width * (size_t)channels));

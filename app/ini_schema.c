@@ -15,8 +15,8 @@ struct parse_state {
     void *target;
     const char *path;
     FILE *file;
-    int line;                       /* line inih is handling now */
-    int seen_line[INI_MAX_KEYS];    /* 0 = not seen */
+    int line;                    /* line inih is handling now */
+    int seen_line[INI_MAX_KEYS]; /* 0 = not seen */
     char *err;
     size_t err_len;
     int failed;
@@ -55,8 +55,8 @@ static int choice_ok(const char *choices, const char *value)
     return 0;
 }
 
-static void format_where(char *err, size_t len, const char *path, int line,
-                         const struct ini_key *k, const char *what)
+static void format_where(char *err, size_t len, const char *path, int line, const struct ini_key *k,
+                         const char *what)
 {
     if (line > 0)
         snprintf(err, len, "%s:%d: [%s] %s: %s", path, line, k->section, k->name, what);
@@ -184,8 +184,12 @@ static int handler(void *user, const char *section, const char *name, const char
 int ini_schema_load(const struct ini_key *keys, size_t key_count, void *target, const char *path,
                     char *err, size_t err_len)
 {
-    struct parse_state st = {.keys = keys, .key_count = key_count, .target = target,
-                             .path = path, .err = err, .err_len = err_len};
+    struct parse_state st = {.keys = keys,
+                             .key_count = key_count,
+                             .target = target,
+                             .path = path,
+                             .err = err,
+                             .err_len = err_len};
     if (key_count > INI_MAX_KEYS) {
         snprintf(err, err_len, "internal: schema has %zu keys, more than %d", key_count,
                  INI_MAX_KEYS);
@@ -224,10 +228,14 @@ int ini_schema_load(const struct ini_key *keys, size_t key_count, void *target, 
 static const char *type_name(const struct ini_key *k, char *buf, size_t len)
 {
     switch (k->type) {
-    case INI_U32: return "unsigned";
-    case INI_I32: return "integer";
-    case INI_F64: return "number";
-    case INI_STR: return "text";
+    case INI_U32:
+        return "unsigned";
+    case INI_I32:
+        return "integer";
+    case INI_F64:
+        return "number";
+    case INI_STR:
+        return "text";
     case INI_ENUM: { /* "a|b" would split a Markdown table cell */
         size_t n = 0;
         for (const char *p = k->choices; *p != '\0' && n + 3 < len; p++) {
@@ -241,7 +249,8 @@ static const char *type_name(const struct ini_key *k, char *buf, size_t len)
         buf[n] = '\0';
         return buf;
     }
-    case INI_VEC: return k->size == 3 ? "x, y, z" : "list of numbers";
+    case INI_VEC:
+        return k->size == 3 ? "x, y, z" : "list of numbers";
     }
     return "?";
 }
@@ -253,8 +262,10 @@ void ini_schema_print_doc(const struct ini_key *keys, size_t key_count, FILE *ou
         const struct ini_key *k = &keys[i];
         if (strcmp(section, k->section) != 0) {
             section = k->section;
-            fprintf(out, "\n### [%s]\n\n| key | type | default | range | meaning |\n"
-                         "|---|---|---|---|---|\n", section);
+            fprintf(out,
+                    "\n### [%s]\n\n| key | type | default | range | meaning |\n"
+                    "|---|---|---|---|---|\n",
+                    section);
         }
         char range[64] = "", type_buf[128];
         if (k->type == INI_U32 || k->type == INI_I32 || k->type == INI_F64 || k->type == INI_VEC)

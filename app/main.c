@@ -152,10 +152,11 @@ static int run_views(const struct app_config *cfg, const struct scan_calib *cali
         rc = save_view(cfg, calib, view_dir, &info, ms);
         if (rc != 0)
             return rc;
-        printf("view %u of %u: %u points (%.1f%% of pixels), %u frames in %.0f ms -> %s/cloud.ply\n",
-               (unsigned)v + 1, (unsigned)cfg->views, (unsigned)info.valid_points,
-               100.0 * info.valid_points / ((double)cfg->camera.width * cfg->camera.height),
-               (unsigned)info.frames_captured, ms, view_dir);
+        printf(
+            "view %u of %u: %u points (%.1f%% of pixels), %u frames in %.0f ms -> %s/cloud.ply\n",
+            (unsigned)v + 1, (unsigned)cfg->views, (unsigned)info.valid_points,
+            100.0 * info.valid_points / ((double)cfg->camera.width * cfg->camera.height),
+            (unsigned)info.frames_captured, ms, view_dir);
     }
     return 0;
 }
@@ -183,8 +184,9 @@ static int cmd_scan(const char *config_path, const char *out_dir)
     if (out_dir != NULL)
         snprintf(cfg.output_dir, sizeof(cfg.output_dir), "%s", out_dir);
     if (cfg.views > 1) {
-        fprintf(stderr, "scanner: error: %s: [scan] views: %u views need the turntable, which "
-                        "this build does not drive yet; use views = 1\n",
+        fprintf(stderr,
+                "scanner: error: %s: [scan] views: %u views need the turntable, which "
+                "this build does not drive yet; use views = 1\n",
                 config_path, (unsigned)cfg.views);
         return 2;
     }
@@ -226,10 +228,11 @@ static int cmd_scan(const char *config_path, const char *out_dir)
 
 static void usage(FILE *out)
 {
-    fprintf(out, "usage: scanner scan --config FILE [--out DIR]   take a scan\n"
-                 "       scanner check-config --config FILE      check a config and its calibration\n"
-                 "       scanner config-doc                      print the config reference (Markdown)\n"
-                 "       scanner --version\n");
+    fprintf(out,
+            "usage: scanner scan --config FILE [--out DIR]   take a scan\n"
+            "       scanner check-config --config FILE      check a config and its calibration\n"
+            "       scanner config-doc                      print the config reference (Markdown)\n"
+            "       scanner --version\n");
 }
 
 int main(int argc, char **argv)

@@ -37,8 +37,10 @@ int main(int argc, char **argv)
     double t_geometry = now_ms() - t0;
     t0 = now_ms();
     for (uint32_t i = 0; i < count; i++) {
-        struct sim_sources src = {.projector_on = 1, .pattern_index = i,
-                                  .exposure_us = t.cfg.camera.exposure_us, .gain_milli = 1000};
+        struct sim_sources src = {.projector_on = 1,
+                                  .pattern_index = i,
+                                  .exposure_us = t.cfg.camera.exposure_us,
+                                  .gain_milli = 1000};
         sim_rig_render(rig, &src, i, frames + frame_bytes * i);
     }
     double t_render = now_ms() - t0;
@@ -63,8 +65,8 @@ int main(int argc, char **argv)
         for (int k = 0; k < 5; k++)
             best[k] = s[k + 1] - s[k] < best[k] ? s[k + 1] - s[k] : best[k];
     }
-    printf("view %ux%u, %u frames, object '%s' (best of %d runs, one core)\n",
-           (unsigned)rig->width, (unsigned)rig->height, (unsigned)count, t.cfg.sim.object, REPEAT);
+    printf("view %ux%u, %u frames, object '%s' (best of %d runs, one core)\n", (unsigned)rig->width,
+           (unsigned)rig->height, (unsigned)count, t.cfg.sim.object, REPEAT);
     printf("| stage | ms |\n|---|---|\n");
     printf("| simulator: ray casting (once per angle) | %.1f |\n", t_geometry);
     printf("| simulator: rendering %u frames | %.1f |\n", (unsigned)count, t_render);

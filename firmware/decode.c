@@ -6,9 +6,9 @@
 #include <errno.h>
 #include <string.h>
 
-static uint16_t column_map[HAL_MAX_PIXELS];  /* Gray code while decoding, column afterwards */
+static uint16_t column_map[HAL_MAX_PIXELS]; /* Gray code while decoding, column afterwards */
 static uint8_t reason_map[HAL_MAX_PIXELS];
-static uint8_t grey_white[HAL_MAX_PIXELS];   /* white frame, then scratch for the positive frame */
+static uint8_t grey_white[HAL_MAX_PIXELS]; /* white frame, then scratch for the positive frame */
 /* While decoding: bits within the noise per pixel; in decode_finish: neighbour agreement. */
 static uint8_t scratch[HAL_MAX_PIXELS];
 
@@ -83,7 +83,8 @@ static void take_black(const uint8_t *rgb, size_t n)
 
 static void take_positive(const uint8_t *rgb, size_t n)
 {
-    /* The white frame is no longer needed: its buffer holds the positive frame until its inverse. */
+    /* The white frame is no longer needed: its buffer holds the positive frame until its inverse.
+     */
     for (size_t i = 0; i < n; i++, rgb += 3) {
         grey_white[i] = decode_grey(rgb);
         if (rgb_saturated(rgb, dec.params.saturation_dn))

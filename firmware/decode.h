@@ -1,4 +1,5 @@
-/* Structured-light decoding: per-pixel projector column and a reason code for every rejected pixel. */
+/* Structured-light decoding: per-pixel projector column and a reason code for every rejected pixel.
+ */
 #ifndef DECODE_H
 #define DECODE_H
 
@@ -9,18 +10,18 @@
 /** Why a pixel has no depth; SCAN_VALID means it has one. */
 enum scan_reason {
     SCAN_VALID = 0,
-    SCAN_SHADOW,        /**< the projector does not reach it (white ~ black) */
-    SCAN_DARK,          /**< lit, but too dark a surface to decode reliably */
-    SCAN_LOW_CONTRAST,  /**< some bit's |I - I_inverse| is within the noise */
-    SCAN_SATURATED,     /**< a channel clipped in some frame */
-    SCAN_INCONSISTENT,  /**< decodes outside the projector or disagrees with its neighbours */
+    SCAN_SHADOW,       /**< the projector does not reach it (white ~ black) */
+    SCAN_DARK,         /**< lit, but too dark a surface to decode reliably */
+    SCAN_LOW_CONTRAST, /**< some bit's |I - I_inverse| is within the noise */
+    SCAN_SATURATED,    /**< a channel clipped in some frame */
+    SCAN_INCONSISTENT, /**< decodes outside the projector or disagrees with its neighbours */
     SCAN_REASON_COUNT
 };
 
 /** Read-only view of the decoder's static maps (row-major, width * height). */
 struct decode_maps {
-    const uint16_t *column;  /**< projector column, meaningful where reason == SCAN_VALID */
-    uint8_t *reason;         /**< enum scan_reason per pixel; later stages add their own */
+    const uint16_t *column; /**< projector column, meaningful where reason == SCAN_VALID */
+    uint8_t *reason;        /**< enum scan_reason per pixel; later stages add their own */
     uint32_t width, height;
 };
 

@@ -26,7 +26,7 @@ void frame_object_from_camera(const struct scan_calib *calib, int32_t angle_mdeg
     double rz[9] = {c, s, 0, -s, c, 0, 0, 0, 1};
     for (int r = 0; r < 3; r++)
         for (int k = 0; k < 3; k++)
-            o->rot[r * 3 + k] = rz[r * 3 + 0] * t.rot[0 * 3 + k] + rz[r * 3 + 1] * t.rot[1 * 3 + k] +
-                                rz[r * 3 + 2] * t.rot[2 * 3 + k];
+            o->rot[r * 3 + k] = rz[r * 3 + 0] * t.rot[0 * 3 + k] +
+                                rz[r * 3 + 1] * t.rot[1 * 3 + k] + rz[r * 3 + 2] * t.rot[2 * 3 + k];
     o->origin = t.origin;
 }

@@ -1,4 +1,5 @@
-/* Coordinate frames: camera, turntable (axis = z, up) and object (turntable frame undone by angle). */
+/* Coordinate frames: camera, turntable (axis = z, up) and object (turntable frame undone by angle).
+ */
 #ifndef FRAMES_H
 #define FRAMES_H
 

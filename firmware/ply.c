@@ -54,10 +54,10 @@ int ply_write_cloud(const struct hal_storage *st, const char *path, const struct
             rc = hal_storage_write(st, &file, chunk, used);
             used = 0;
         }
-        vec3 p = frame_point(xform, v3(range->xyz_mm[3 * i], range->xyz_mm[3 * i + 1],
-                                       range->xyz_mm[3 * i + 2]));
-        vec3 nn = frame_dir(xform, v3(range->normal[3 * i], range->normal[3 * i + 1],
-                                      range->normal[3 * i + 2]));
+        vec3 p = frame_point(
+            xform, v3(range->xyz_mm[3 * i], range->xyz_mm[3 * i + 1], range->xyz_mm[3 * i + 2]));
+        vec3 nn = frame_dir(
+            xform, v3(range->normal[3 * i], range->normal[3 * i + 1], range->normal[3 * i + 2]));
         uint8_t *q = chunk + used;
         q = put_f32le(q, (float)p.x);
         q = put_f32le(q, (float)p.y);

@@ -10,8 +10,9 @@
 #include <stdio.h>
 #include <string.h>
 
-static uint8_t colour_rgb[HAL_MAX_PIXELS * 3]; /* projector-white frame, kept as the view's colour */
-static uint8_t frame_rgb[HAL_MAX_PIXELS * 3];  /* every other frame, consumed at once */
+static uint8_t
+    colour_rgb[HAL_MAX_PIXELS * 3];           /* projector-white frame, kept as the view's colour */
+static uint8_t frame_rgb[HAL_MAX_PIXELS * 3]; /* every other frame, consumed at once */
 static int32_t last_angle_mdeg;
 
 int scan_check(const struct scan_params *p, const struct scan_calib *c, char *msg, size_t len)

@@ -1,4 +1,5 @@
-/* View sequencing: drive projector and camera through the pattern set, then decode and triangulate. */
+/* View sequencing: drive projector and camera through the pattern set, then decode and triangulate.
+ */
 #ifndef SCAN_H
 #define SCAN_H
 

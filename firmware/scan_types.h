@@ -11,31 +11,31 @@ struct scan_calib {
     double cam_fx_px, cam_fy_px, cam_cx_px, cam_cy_px; /**< camera pinhole intrinsics */
     uint32_t cam_width, cam_height;                    /**< image size the intrinsics belong to */
     double proj_fx_px, proj_fy_px, proj_cx_px, proj_cy_px; /**< projector pinhole intrinsics */
-    uint32_t proj_width, proj_height;                  /**< projector resolution */
-    double proj_rot[9];       /**< rotation camera -> projector, row-major: p_proj = R p_cam + t */
-    double proj_trans_mm[3];  /**< translation camera -> projector */
-    double axis_point_mm[3];  /**< a point on the turntable axis, on the table surface */
-    double axis_dir[3];       /**< unit direction of the axis, pointing up */
-    uint32_t light_count;     /**< number of white lights */
+    uint32_t proj_width, proj_height;                      /**< projector resolution */
+    double proj_rot[9];      /**< rotation camera -> projector, row-major: p_proj = R p_cam + t */
+    double proj_trans_mm[3]; /**< translation camera -> projector */
+    double axis_point_mm[3]; /**< a point on the turntable axis, on the table surface */
+    double axis_dir[3];      /**< unit direction of the axis, pointing up */
+    uint32_t light_count;    /**< number of white lights */
     double light_pos_mm[HAL_MAX_LIGHTS][3]; /**< light positions */
 };
 
 /** Processing and sequencing parameters of one view. */
 struct scan_params {
-    uint32_t width, height;          /**< camera frame size */
-    uint32_t min_contrast_dn;        /**< white minus black below this: not lit enough */
-    uint32_t shadow_contrast_dn;     /**< white minus black at or below this: no projector light */
-    uint32_t min_bit_diff_dn;        /**< |I - I_inverse| at or below this: the bit is ambiguous */
-    uint32_t max_ambiguous_bits;     /**< more ambiguous bits than this: low contrast */
-    uint32_t saturation_dn;          /**< a channel at or above this is saturated */
-    uint32_t max_column_jump;        /**< neighbours differing by more are not consistent */
+    uint32_t width, height;      /**< camera frame size */
+    uint32_t min_contrast_dn;    /**< white minus black below this: not lit enough */
+    uint32_t shadow_contrast_dn; /**< white minus black at or below this: no projector light */
+    uint32_t min_bit_diff_dn;    /**< |I - I_inverse| at or below this: the bit is ambiguous */
+    uint32_t max_ambiguous_bits; /**< more ambiguous bits than this: low contrast */
+    uint32_t saturation_dn;      /**< a channel at or above this is saturated */
+    uint32_t max_column_jump;    /**< neighbours differing by more are not consistent */
     uint32_t min_consistent_neighbours; /**< of 8; fewer makes the pixel inconsistent */
-    double max_depth_jump_mm;        /**< neighbour depth step that breaks the surface (normals) */
-    uint32_t refine;                 /**< 1: sub-stripe refinement of the columns (refine.h) */
-    uint32_t normal_radius_px;       /**< normals span up to this many pixels each side */
-    uint32_t pattern_settle_us;      /**< wait after the projector changes pattern */
-    uint32_t trigger_pulse_us;       /**< projector trigger/reset pulse width */
-    uint32_t capture_retries;        /**< extra tries of a failed capture */
+    double max_depth_jump_mm;   /**< neighbour depth step that breaks the surface (normals) */
+    uint32_t refine;            /**< 1: sub-stripe refinement of the columns (refine.h) */
+    uint32_t normal_radius_px;  /**< normals span up to this many pixels each side */
+    uint32_t pattern_settle_us; /**< wait after the projector changes pattern */
+    uint32_t trigger_pulse_us;  /**< projector trigger/reset pulse width */
+    uint32_t capture_retries;   /**< extra tries of a failed capture */
 };
 
 #endif

@@ -9,8 +9,7 @@ static float xyz_map[HAL_MAX_PIXELS * 3];
 static float normal_map[HAL_MAX_PIXELS * 3];
 static struct tri_range range;
 
-int tri_range_image(const struct scan_calib *c, const struct decode_maps *maps,
-                    const float *column)
+int tri_range_image(const struct scan_calib *c, const struct decode_maps *maps, const float *column)
 {
     if (maps->width != c->cam_width || maps->height != c->cam_height)
         return -EINVAL;
@@ -63,7 +62,8 @@ static uint32_t reach(const struct decode_maps *m, size_t i, long step, uint32_t
     size_t cur = i;
     while (k < max_steps) {
         size_t next = (size_t)((long)cur + step);
-        if (m->reason[next] != SCAN_VALID || fabs(xyz_map[3 * next + 2] - xyz_map[3 * cur + 2]) > max_jump)
+        if (m->reason[next] != SCAN_VALID ||
+            fabs(xyz_map[3 * next + 2] - xyz_map[3 * cur + 2]) > max_jump)
             break;
         cur = next;
         k++;

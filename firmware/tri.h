@@ -7,8 +7,8 @@
 
 /** Read-only view of the range image (camera frame, millimetres), row-major. */
 struct tri_range {
-    const float *xyz_mm;  /**< 3 floats per pixel, meaningful where the reason is SCAN_VALID */
-    const float *normal;  /**< unit normal per pixel, facing the camera */
+    const float *xyz_mm; /**< 3 floats per pixel, meaningful where the reason is SCAN_VALID */
+    const float *normal; /**< unit normal per pixel, facing the camera */
     uint32_t width, height;
     uint32_t valid_count; /**< pixels left valid after triangulation and normals */
 };

@@ -9,8 +9,9 @@
          ? -ENOSYS                                                                                 \
          : (dev)->ops->op((dev)->priv, __VA_ARGS__))
 #define HAL_CALL0(dev, op)                                                                         \
-    (((dev) == NULL || (dev)->ops == NULL || (dev)->ops->op == NULL) ? -ENOSYS                     \
-                                                                      : (dev)->ops->op((dev)->priv))
+    (((dev) == NULL || (dev)->ops == NULL || (dev)->ops->op == NULL)                               \
+         ? -ENOSYS                                                                                 \
+         : (dev)->ops->op((dev)->priv))
 
 int hal_cam_open(const struct hal_camera *cam, const struct hal_camera_config *cfg)
 {

@@ -19,9 +19,9 @@ struct sim_bvh {
 };
 
 struct sim_hit {
-    double t;       /**< distance along the (unnormalised) ray direction */
-    uint32_t tri;   /**< triangle index */
-    double u, v;    /**< barycentric weights of vertices 1 and 2 */
+    double t;     /**< distance along the (unnormalised) ray direction */
+    uint32_t tri; /**< triangle index */
+    double u, v;  /**< barycentric weights of vertices 1 and 2 */
 };
 
 /** @retval 0 ok @retval -ENOMEM */

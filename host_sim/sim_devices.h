@@ -22,7 +22,7 @@ struct camera_sim {
     uint32_t light_count;
     struct hal_camera_config cfg;
     int is_open;
-    uint64_t frames;          /* captures attempted since open */
+    uint64_t frames; /* captures attempted since open */
     enum sim_cam_fault fault;
     uint64_t fault_first;
     uint32_t fault_count;

@@ -28,10 +28,10 @@ static enum ply_type ply_type_of(const char *s)
     static const struct {
         const char *name;
         enum ply_type type;
-    } map[] = {{"char", PT_I8},    {"int8", PT_I8},     {"uchar", PT_U8},   {"uint8", PT_U8},
-               {"short", PT_I16},  {"int16", PT_I16},   {"ushort", PT_U16}, {"uint16", PT_U16},
-               {"int", PT_I32},    {"int32", PT_I32},   {"uint", PT_U32},   {"uint32", PT_U32},
-               {"float", PT_F32},  {"float32", PT_F32}, {"double", PT_F64}, {"float64", PT_F64}};
+    } map[] = {{"char", PT_I8},   {"int8", PT_I8},     {"uchar", PT_U8},   {"uint8", PT_U8},
+               {"short", PT_I16}, {"int16", PT_I16},   {"ushort", PT_U16}, {"uint16", PT_U16},
+               {"int", PT_I32},   {"int32", PT_I32},   {"uint", PT_U32},   {"uint32", PT_U32},
+               {"float", PT_F32}, {"float32", PT_F32}, {"double", PT_F64}, {"float64", PT_F64}};
     for (size_t i = 0; i < sizeof(map) / sizeof(map[0]); i++)
         if (strcmp(s, map[i].name) == 0)
             return map[i].type;
@@ -57,15 +57,39 @@ static int read_scalar(FILE *f, int binary, enum ply_type t, double *out)
     for (size_t i = 0; i < n; i++)
         u |= (uint64_t)b[i] << (8 * i);
     switch (t) {
-    case PT_I8: *out = (int8_t)u; break;
-    case PT_U8: *out = (uint8_t)u; break;
-    case PT_I16: *out = (int16_t)u; break;
-    case PT_U16: *out = (uint16_t)u; break;
-    case PT_I32: *out = (int32_t)u; break;
-    case PT_U32: *out = (uint32_t)u; break;
-    case PT_F32: { uint32_t w = (uint32_t)u; float fl; memcpy(&fl, &w, 4); *out = fl; break; }
-    case PT_F64: { double d; memcpy(&d, &u, 8); *out = d; break; }
-    default: return -1;
+    case PT_I8:
+        *out = (int8_t)u;
+        break;
+    case PT_U8:
+        *out = (uint8_t)u;
+        break;
+    case PT_I16:
+        *out = (int16_t)u;
+        break;
+    case PT_U16:
+        *out = (uint16_t)u;
+        break;
+    case PT_I32:
+        *out = (int32_t)u;
+        break;
+    case PT_U32:
+        *out = (uint32_t)u;
+        break;
+    case PT_F32: {
+        uint32_t w = (uint32_t)u;
+        float fl;
+        memcpy(&fl, &w, 4);
+        *out = fl;
+        break;
+    }
+    case PT_F64: {
+        double d;
+        memcpy(&d, &u, 8);
+        *out = d;
+        break;
+    }
+    default:
+        return -1;
     }
     return 0;
 }
@@ -76,7 +100,8 @@ struct ply_header {
     struct ply_element elems[8];
 };
 
-static int parse_header(FILE *f, struct ply_header *h, char *err, unsigned err_len, const char *path)
+static int parse_header(FILE *f, struct ply_header *h, char *err, unsigned err_len,
+                        const char *path)
 {
     char line[256];
     memset(h, 0, sizeof(*h));
@@ -131,9 +156,12 @@ static int parse_header(FILE *f, struct ply_header *h, char *err, unsigned err_l
             }
             p->role = -1;
             if (strcmp(el->name, "vertex") == 0 && p->list_count_type == PT_NONE) {
-                if (strcmp(pname, "x") == 0) p->role = 0;
-                if (strcmp(pname, "y") == 0) p->role = 1;
-                if (strcmp(pname, "z") == 0) p->role = 2;
+                if (strcmp(pname, "x") == 0)
+                    p->role = 0;
+                if (strcmp(pname, "y") == 0)
+                    p->role = 1;
+                if (strcmp(pname, "z") == 0)
+                    p->role = 2;
             }
             if (strcmp(el->name, "face") == 0 && p->list_count_type != PT_NONE &&
                 (strcmp(pname, "vertex_indices") == 0 || strcmp(pname, "vertex_index") == 0))

@@ -1,4 +1,5 @@
-/* Simulated rig renderer: ray-cast geometry once per angle, then cheap per-frame shading + noise. */
+/* Simulated rig renderer: ray-cast geometry once per angle, then cheap per-frame shading + noise.
+ */
 #define _POSIX_C_SOURCE 200809L
 #include "sim_rig.h"
 
@@ -205,8 +206,8 @@ static void update_pixel(struct sim_rig *rig, const struct frame_xform *obj, vec
     vec3 d_cam = v3(((double)x - c->cam_cx_px) / c->cam_fx_px,
                     ((double)y - c->cam_cy_px) / c->cam_fy_px, 1.0);
     struct sim_hit hit;
-    t->hit[i] = (uint8_t)sim_bvh_intersect(&rig->bvh, cam_obj, frame_dir(obj, d_cam), 1e-6, 1e9,
-                                           &hit);
+    t->hit[i] =
+        (uint8_t)sim_bvh_intersect(&rig->bvh, cam_obj, frame_dir(obj, d_cam), 1e-6, 1e9, &hit);
     t->proj_lit[i] = 0;
     t->dark[i] = 0;
     for (int k = 0; k < 3; k++)

@@ -20,13 +20,13 @@ struct sim_sources {
 
 /** Per-pixel ground truth of the current angle (all arrays width * height). */
 struct sim_truth {
-    uint8_t *hit;        /**< the pixel sees the object */
-    float *pos_cam;      /**< 3 per pixel: surface point in the camera frame, mm */
-    float *normal_cam;   /**< 3 per pixel: unit shading normal, camera frame */
-    float *albedo;       /**< 3 per pixel: diffuse colour (linear, 0..1) */
-    float *proj_u;       /**< continuous projector column of the point (pixel centres at integers) */
-    uint8_t *proj_lit;   /**< the projector reaches the point (in frustum, facing, not shadowed) */
-    uint8_t *dark;       /**< the point lies on the very dark paint */
+    uint8_t *hit;      /**< the pixel sees the object */
+    float *pos_cam;    /**< 3 per pixel: surface point in the camera frame, mm */
+    float *normal_cam; /**< 3 per pixel: unit shading normal, camera frame */
+    float *albedo;     /**< 3 per pixel: diffuse colour (linear, 0..1) */
+    float *proj_u;     /**< continuous projector column of the point (pixel centres at integers) */
+    uint8_t *proj_lit; /**< the projector reaches the point (in frustum, facing, not shadowed) */
+    uint8_t *dark;     /**< the point lies on the very dark paint */
 };
 
 struct sim_rig {
@@ -36,15 +36,15 @@ struct sim_rig {
     struct sim_bvh bvh;
     struct sim_material material;
     uint32_t width, height, bits;
-    double object_height_mm;   /**< height of the placed object */
-    int32_t table_angle_mdeg;  /**< where the turntable is; the camera renders at this angle */
-    int32_t truth_angle_mdeg;  /**< angle the truth buffers belong to */
+    double object_height_mm;  /**< height of the placed object */
+    int32_t table_angle_mdeg; /**< where the turntable is; the camera renders at this angle */
+    int32_t truth_angle_mdeg; /**< angle the truth buffers belong to */
     int truth_valid;
     struct sim_truth truth;
-    float *proj_radiance;      /**< 3 per pixel: projector light reflected at full white */
-    uint8_t *light_vis;        /**< bit i: light i reaches the point */
-    uint32_t lights_done;      /**< lights whose visibility is computed for truth_angle_mdeg */
-    float *gauss;              /**< table of standard normal samples for the noise */
+    float *proj_radiance; /**< 3 per pixel: projector light reflected at full white */
+    uint8_t *light_vis;   /**< bit i: light i reaches the point */
+    uint32_t lights_done; /**< lights whose visibility is computed for truth_angle_mdeg */
+    float *gauss;         /**< table of standard normal samples for the noise */
 };
 
 /** Build the object, material and buffers. Allocates; nothing allocates after this.

@@ -90,7 +90,8 @@ static void test_duplicate_key(void **state)
 static void test_missing_required_key(void **state)
 {
     (void)state;
-    const char *path = write_file("missing.ini", "[camera]\nbackend = sim\nwidth = 640\nheight = 480\n");
+    const char *path =
+        write_file("missing.ini", "[camera]\nbackend = sim\nwidth = 640\nheight = 480\n");
     assert_int_equal(config_load(&cfg, path, err, sizeof(err)), -EINVAL);
     assert_non_null(strstr(err, "missing.ini: [camera] exposure_us: required key is missing"));
 }
@@ -133,9 +134,9 @@ static void test_calibration_errors(void **state)
 static void test_backend_not_built_in(void **state)
 {
     (void)state;
-    const char *path = write_file("v4l2.ini",
-        "[camera]\nbackend = v4l2\nwidth = 1280\nheight = 960\nexposure_us = 10000\n"
-        "[scan]\ncalibration = ../../config/sim-calib.ini\n");
+    const char *path = write_file(
+        "v4l2.ini", "[camera]\nbackend = v4l2\nwidth = 1280\nheight = 960\nexposure_us = 10000\n"
+                    "[scan]\ncalibration = ../../config/sim-calib.ini\n");
     assert_int_equal(config_load(&cfg, path, err, sizeof(err)), 0);
     struct scan_calib calib;
     assert_int_equal(calib_load(&calib, cfg.calibration_file, 0, err, sizeof(err)), 0);

@@ -21,8 +21,8 @@ static void test_missing_chip(void **state)
     int rc = gpio_gpiod_open(&g, "/dev/gpiochip-does-not-exist", offsets, &out, err, sizeof(err));
     assert_true(rc < 0);
     assert_non_null(strstr(err, "cannot open chip '/dev/gpiochip-does-not-exist'"));
-    assert_null(out.ops);  /* no device handed to the firmware */
-    assert_null(g.chip);   /* nothing left open */
+    assert_null(out.ops); /* no device handed to the firmware */
+    assert_null(g.chip);  /* nothing left open */
     for (unsigned i = 0; i < HAL_GPIO_LINE_COUNT; i++)
         assert_null(g.line[i]);
 }

@@ -68,9 +68,7 @@ void free(void *ptr)
         alloc_calls++;
     __libc_free(ptr);
 }
-static void install_counter(void)
-{
-}
+static void install_counter(void) {}
 #endif
 
 /* The counter itself must see allocations, or a zero below would prove nothing. */

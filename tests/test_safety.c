@@ -113,7 +113,8 @@ static void test_projector_sequence(void **state)
     assert_int_equal(sim_ctl_pattern_index(), 0);
     uint64_t t0 = sim_ctl_time_us();
     for (int i = 0; i < 5; i++)
-        assert_int_equal(hal_gpio_pulse(&t.hal.gpio, &t.hal.clock, HAL_GPIO_PROJECTOR_TRIGGER, 10), 0);
+        assert_int_equal(hal_gpio_pulse(&t.hal.gpio, &t.hal.clock, HAL_GPIO_PROJECTOR_TRIGGER, 10),
+                         0);
     assert_int_equal(sim_ctl_pattern_index(), 5);
     assert_int_equal(sim_ctl_time_us() - t0, 50); /* virtual time: only sleeps move it */
     assert_int_equal(hal_gpio_pulse(&t.hal.gpio, &t.hal.clock, HAL_GPIO_PROJECTOR_RESET, 10), 0);

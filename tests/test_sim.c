@@ -19,7 +19,8 @@ static void test_bunny_ply_loads(void **state)
     (void)state;
     struct sim_mesh m;
     char err[256];
-    assert_int_equal(sim_mesh_load_ply(&m, "../shared/data/bunny/bun_zipper.ply", err, sizeof(err)), 0);
+    assert_int_equal(sim_mesh_load_ply(&m, "../shared/data/bunny/bun_zipper.ply", err, sizeof(err)),
+                     0);
     assert_int_equal(m.vert_count, 35947);
     assert_int_equal(m.tri_count, 69451);
     sim_mesh_y_up_to_z_up(&m);
@@ -41,7 +42,8 @@ static void test_bvh_matches_brute_force(void **state)
     (void)state;
     struct sim_mesh m;
     char err[256];
-    assert_int_equal(sim_mesh_load_ply(&m, "../shared/data/bunny/bun_zipper_res3.ply", err, sizeof(err)), 0);
+    assert_int_equal(
+        sim_mesh_load_ply(&m, "../shared/data/bunny/bun_zipper_res3.ply", err, sizeof(err)), 0);
     sim_mesh_place(&m, 150.0);
     struct sim_bvh bvh;
     assert_int_equal(sim_bvh_build(&bvh, &m), 0);
@@ -138,8 +140,8 @@ static void test_deterministic_noise_and_black_level(void **state)
     assert_true(fabs(mean - 51.0) < 0.05);
     assert_true(fabs(sd - 1.5) < 0.1 + 0.3); /* rounding to integers adds 1/12 variance */
     /* A strong exposure saturates at 255, never wraps */
-    struct sim_sources bright = {.projector_on = 1, .pattern_index = 0, .exposure_us = 80000,
-                                 .gain_milli = 1000};
+    struct sim_sources bright = {
+        .projector_on = 1, .pattern_index = 0, .exposure_us = 80000, .gain_milli = 1000};
     sim_rig_render(rig, &bright, 3, a);
     size_t saturated = 0;
     for (size_t i = 0; i < n; i++)

@@ -109,7 +109,7 @@ static void test_normals_of_a_plane(void **state)
     (void)state;
     double plain = plane_normals(0), refined = plane_normals(1);
     print_message("mean cos to the true normal: %.4f plain, %.4f refined\n", plain, refined);
-    assert_true(plain > 0.95);   /* staircase of whole columns */
+    assert_true(plain > 0.95);           /* staircase of whole columns */
     assert_true(refined > plain + 0.01); /* 13 -> 8 degrees mean error on a noise-free plane */
 }
 

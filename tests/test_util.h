@@ -26,19 +26,19 @@ void test_rig_stop(struct test_rig *t);
 
 /** How well the last view matches the simulator's ground truth. */
 struct view_quality {
-    uint32_t lit;            /**< pixels where the projector lights the visible surface */
-    uint32_t lit_correct;    /**< of those: valid and column within +-1 of the truth */
-    uint32_t lit_head_on;    /**< lit pixels not on the very dark paint, incidence below 75 deg */
+    uint32_t lit;         /**< pixels where the projector lights the visible surface */
+    uint32_t lit_correct; /**< of those: valid and column within +-1 of the truth */
+    uint32_t lit_head_on; /**< lit pixels not on the very dark paint, incidence below 75 deg */
     uint32_t lit_head_on_correct;
-    uint32_t valid;          /**< all valid pixels */
-    uint32_t valid_unlit;    /**< valid pixels the projector does not light (must be 0) */
-    uint32_t dark;           /**< lit pixels on the very dark paint */
-    uint32_t dark_flagged;   /**< of those: rejected */
-    uint32_t outliers_2mm;   /**< valid points farther than 2 mm from the true surface */
-    double normal_err_deg;   /**< mean angle between estimated and true normals, valid pixels */
-    double depth_rms_mm;     /**< RMS of reconstructed minus true depth (z), valid pixels */
-    double max_surface_mm;   /**< largest point-to-true-tangent-plane distance */
-    double distance_mm;      /**< mean camera-to-surface distance over lit pixels */
+    uint32_t valid;        /**< all valid pixels */
+    uint32_t valid_unlit;  /**< valid pixels the projector does not light (must be 0) */
+    uint32_t dark;         /**< lit pixels on the very dark paint */
+    uint32_t dark_flagged; /**< of those: rejected */
+    uint32_t outliers_2mm; /**< valid points farther than 2 mm from the true surface */
+    double normal_err_deg; /**< mean angle between estimated and true normals, valid pixels */
+    double depth_rms_mm;   /**< RMS of reconstructed minus true depth (z), valid pixels */
+    double max_surface_mm; /**< largest point-to-true-tangent-plane distance */
+    double distance_mm;    /**< mean camera-to-surface distance over lit pixels */
 };
 
 /** Incidence limit of lit_head_on: beyond 75 degrees the projector's light is a few grey levels. */

@@ -14,22 +14,22 @@ enum hal_pixel_format {
 
 /** Everything a camera needs to produce repeatable frames: no auto exposure, no AWB. */
 struct hal_camera_config {
-    char device[128];   /**< device path or camera id; unused by the simulator */
-    uint32_t width;     /**< frame width in pixels */
-    uint32_t height;    /**< frame height in pixels */
+    char device[128];                   /**< device path or camera id; unused by the simulator */
+    uint32_t width;                     /**< frame width in pixels */
+    uint32_t height;                    /**< frame height in pixels */
     enum hal_pixel_format pixel_format; /**< format requested from the device */
-    uint32_t exposure_us; /**< fixed exposure time */
-    uint32_t gain_milli;  /**< fixed analogue gain, 1000 = unity */
+    uint32_t exposure_us;               /**< fixed exposure time */
+    uint32_t gain_milli;                /**< fixed analogue gain, 1000 = unity */
     uint32_t drop_frames; /**< stale frames to discard after a light or pattern change */
 };
 
 /** One RGB24 frame in a caller-owned buffer of at least width * height * 3 bytes. */
 struct hal_image {
-    uint8_t *rgb;       /**< caller-owned pixel buffer */
-    size_t capacity;    /**< size of @c rgb in bytes */
-    uint32_t width;     /**< filled in by capture */
-    uint32_t height;    /**< filled in by capture */
-    uint64_t sequence;  /**< frame counter of the device, filled in by capture */
+    uint8_t *rgb;      /**< caller-owned pixel buffer */
+    size_t capacity;   /**< size of @c rgb in bytes */
+    uint32_t width;    /**< filled in by capture */
+    uint32_t height;   /**< filled in by capture */
+    uint64_t sequence; /**< frame counter of the device, filled in by capture */
 };
 
 struct hal_camera_ops {

@@ -14,7 +14,8 @@ enum hal_gpio_line {
 };
 
 struct hal_gpio_ops {
-    /** Drive a line. @retval 0 ok @retval -EINVAL unknown or unmapped line @retval -EIO device error */
+    /** Drive a line. @retval 0 ok @retval -EINVAL unknown or unmapped line @retval -EIO device
+     * error */
     int (*set)(void *priv, enum hal_gpio_line line, int value);
     /** Read back the driven value (optional). @retval 0 ok, *value set */
     int (*get)(void *priv, enum hal_gpio_line line, int *value);

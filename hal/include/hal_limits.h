@@ -1,4 +1,5 @@
-/* Compile-time limits shared by the HAL and the firmware: every static buffer is sized from here. */
+/* Compile-time limits shared by the HAL and the firmware: every static buffer is sized from here.
+ */
 #ifndef HAL_LIMITS_H
 #define HAL_LIMITS_H
 

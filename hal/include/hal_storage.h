@@ -1,4 +1,5 @@
-/* Storage interface: durable, atomic file writes (temp file, fsync, rename, fsync of the directory). */
+/* Storage interface: durable, atomic file writes (temp file, fsync, rename, fsync of the
+ * directory). */
 #ifndef HAL_STORAGE_H
 #define HAL_STORAGE_H
 
@@ -6,9 +7,9 @@
 
 /** An open atomic write: nothing is visible at the final path until commit. */
 struct hal_file {
-    int fd;                 /**< backend handle, -1 when closed */
-    char final_path[512];   /**< where the file appears on commit */
-    char temp_path[512];    /**< where it is written meanwhile */
+    int fd;               /**< backend handle, -1 when closed */
+    char final_path[512]; /**< where the file appears on commit */
+    char temp_path[512];  /**< where it is written meanwhile */
 };
 
 struct hal_storage_ops {

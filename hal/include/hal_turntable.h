@@ -12,7 +12,8 @@ struct hal_turntable_status {
 };
 
 struct hal_turntable_ops {
-    /** Find the reference position and wait until done. @retval 0 ok @retval -ETIMEDOUT @retval -EIO */
+    /** Find the reference position and wait until done. @retval 0 ok @retval -ETIMEDOUT @retval
+     * -EIO */
     int (*home)(void *priv);
     /** Move to an absolute angle and wait until in position.
      *  @retval 0 ok @retval -ETIMEDOUT not idle in time @retval -EIO alarm or wrong position */

@@ -35,16 +35,17 @@ int board_init(struct hal *hal, const struct app_config *cfg, const struct scan_
 {
     (void)calib;
     if (strcmp(cfg->camera_backend, "sim") == 0) {
-        snprintf(err, err_len, "%s: [camera] backend = sim is not built in: this scanner was built "
-                 "with HAL=linux and drives real hardware only", cfg->path);
+        snprintf(err, err_len,
+                 "%s: [camera] backend = sim is not built in: this scanner was built "
+                 "with HAL=linux and drives real hardware only",
+                 cfg->path);
         return -ENODEV;
     }
     /* Camera first: a camera that fails leaves no GPIO line requested. */
     int rc = camera_init(&hal->camera, cfg, err, err_len);
     if (rc != 0)
         return rc;
-    rc = gpio_gpiod_open(&gpio, cfg->gpio.chip, cfg->gpio.line_offset, &hal->gpio, err,
-                             err_len);
+    rc = gpio_gpiod_open(&gpio, cfg->gpio.chip, cfg->gpio.line_offset, &hal->gpio, err, err_len);
     if (rc != 0)
         return rc;
     clock_posix_init(&hal->clock);
