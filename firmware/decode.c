@@ -59,7 +59,9 @@ static void reject(size_t i, enum scan_reason why)
         reason_map[i] = (uint8_t)why;
 }
 
-static void take_white(const uint8_t *rgb, size_t n)
+/* Grey copy of a frame that a later frame is compared with: the white frame (against black), then
+ * each bit's positive pattern (against its inverse), which reuses the buffer once white is done. */
+static void take_reference(const uint8_t *rgb, size_t n)
 {
     for (size_t i = 0; i < n; i++, rgb += 3) {
         grey_white[i] = decode_grey(rgb);
@@ -77,17 +79,6 @@ static void take_black(const uint8_t *rgb, size_t n)
         else if (contrast < (int)dec.params.min_contrast_dn)
             reject(i, SCAN_DARK);
         else if (rgb_saturated(rgb, dec.params.saturation_dn))
-            reject(i, SCAN_SATURATED);
-    }
-}
-
-static void take_positive(const uint8_t *rgb, size_t n)
-{
-    /* The white frame is no longer needed: its buffer holds the positive frame until its inverse.
-     */
-    for (size_t i = 0; i < n; i++, rgb += 3) {
-        grey_white[i] = decode_grey(rgb);
-        if (rgb_saturated(rgb, dec.params.saturation_dn))
             reject(i, SCAN_SATURATED);
     }
 }
@@ -114,12 +105,11 @@ int decode_frame(uint32_t pattern_index, const uint8_t *rgb)
     if (pattern_index != dec.next_pattern || pattern_index >= gray_pattern_count(dec.bits))
         return -EINVAL;
     size_t n = (size_t)dec.params.width * dec.params.height;
-    if (pattern_index == GRAY_PATTERN_WHITE)
-        take_white(rgb, n);
-    else if (pattern_index == GRAY_PATTERN_BLACK)
+    if (pattern_index == GRAY_PATTERN_BLACK)
         take_black(rgb, n);
-    else if ((pattern_index - GRAY_PATTERN_FIRST_BIT) % 2u == 0u)
-        take_positive(rgb, n);
+    else if (pattern_index == GRAY_PATTERN_WHITE ||
+             (pattern_index - GRAY_PATTERN_FIRST_BIT) % 2u == 0u)
+        take_reference(rgb, n);
     else
         take_inverse(rgb, n);
     dec.next_pattern++;

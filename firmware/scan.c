@@ -186,5 +186,10 @@ const uint8_t *scan_colour_frame(void)
 void scan_close(const struct hal *hal)
 {
     hal_cam_close(&hal->camera);
-    hal_safe_state(hal);
+    int rc = hal_safe_state(hal);
+    if (rc != 0)
+        hal->log(HAL_LOG_ERROR, "safe state: a device did not answer (%s); check the rig",
+                 strerror(-rc));
+    else
+        hal->log(HAL_LOG_INFO, "safe state: lights and projector off, camera closed");
 }

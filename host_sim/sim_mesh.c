@@ -70,6 +70,21 @@ static uint32_t grid_verts(uint32_t nu, uint32_t nv)
     return (nu + 1) * (nv + 1);
 }
 
+/* A mesh that is one closed grid (sphere, torus). */
+static int single_grid_mesh(struct sim_mesh *m, uint32_t nu, uint32_t nv, grid_fn f,
+                            const double *shape)
+{
+    int rc = mesh_alloc(m, grid_verts(nu, nv), 2 * nu * nv);
+    if (rc != 0)
+        return rc;
+    uint32_t vert = 0, tri = 0;
+    add_grid(m, &vert, &tri, nu, nv, f, shape);
+    m->vert_count = vert;
+    m->tri_count = tri;
+    sim_mesh_compute_normals(m);
+    return 0;
+}
+
 static vec3 sphere_fn(double u, double v, const double *s)
 {
     double phi = 2.0 * M_PI * u, th = M_PI * (1.0 - v); /* v = 0 at the bottom pole */
@@ -78,17 +93,8 @@ static vec3 sphere_fn(double u, double v, const double *s)
 
 int sim_mesh_sphere(struct sim_mesh *m, double r, uint32_t seg)
 {
-    uint32_t nu = seg, nv = seg / 2;
-    int rc = mesh_alloc(m, grid_verts(nu, nv), 2 * nu * nv);
-    if (rc != 0)
-        return rc;
-    uint32_t vert = 0, tri = 0;
     double shape[1] = {r};
-    add_grid(m, &vert, &tri, nu, nv, sphere_fn, shape);
-    m->vert_count = vert;
-    m->tri_count = tri;
-    sim_mesh_compute_normals(m);
-    return 0;
+    return single_grid_mesh(m, seg, seg / 2, sphere_fn, shape);
 }
 
 static vec3 cyl_side_fn(double u, double v, const double *s)
@@ -151,7 +157,6 @@ int sim_mesh_box(struct sim_mesh *m, double sx, double sy, double sz, uint32_t s
     }
     m->vert_count = vert;
     m->tri_count = tri;
-    sim_mesh_compute_normals(m);
     /* Winding of the grids is not uniform across faces: orient each triangle outwards. */
     for (uint32_t t = 0; t < m->tri_count; t++) {
         uint32_t *v = &m->tri[3 * t];
@@ -178,17 +183,8 @@ static vec3 torus_fn(double u, double v, const double *s)
 
 int sim_mesh_torus(struct sim_mesh *m, double major, double minor, uint32_t seg)
 {
-    uint32_t nu = seg, nv = seg / 2;
-    int rc = mesh_alloc(m, grid_verts(nu, nv), 2 * nu * nv);
-    if (rc != 0)
-        return rc;
-    uint32_t vert = 0, tri = 0;
     double shape[2] = {major, minor};
-    add_grid(m, &vert, &tri, nu, nv, torus_fn, shape);
-    m->vert_count = vert;
-    m->tri_count = tri;
-    sim_mesh_compute_normals(m);
-    return 0;
+    return single_grid_mesh(m, seg, seg / 2, torus_fn, shape);
 }
 
 void sim_mesh_compute_normals(struct sim_mesh *m)

@@ -30,6 +30,19 @@ rm -rf "$out/scan"
 check scan sh -c "$bin scan --config config/sim.ini --out $out/scan | grep -q 'scan finished'"
 check scan_dir_complete sh -c "for f in config.ini calibration.ini view_000/cloud.ply view_000/colour.png \
     view_000/view.ini view_000/truth_depth_mm.pfm view_000/truth_albedo.png; do test -s $out/scan/\$f || exit 1; done"
+# SIGINT mid-scan: the scan stops between frames, says so, and the rig ends in its safe state.
+sigint_test() {
+    "$bin" scan --config config/sim.ini --out "$out/interrupted" >"$out/int.log" 2>&1 &
+    pid=$!
+    sleep 0.4
+    kill -INT "$pid"
+    wait "$pid"
+    rc=$?
+    cat "$out/int.log"
+    [ "$rc" -eq 1 ] && grep -q 'stopped by request' "$out/int.log" &&
+        grep -q 'safe state: lights and projector off' "$out/int.log"
+}
+check sigint_stops_safely sigint_test
 points=$(sed -n 's/^valid_points = //p' "$out/scan/view_000/view.ini")
 if /usr/bin/python3 -c 'import open3d' 2>/dev/null; then
     check open3d_reads_ply /usr/bin/python3 tests/interop_open3d.py "$out/scan/view_000/cloud.ply" "$points"
