@@ -29,13 +29,13 @@ CFLAGS_COMMON := $(WARN) $(OPT) -g -MMD -MP
 # firmware/ sees the world only through hal/include.
 FW_CFLAGS := $(CFLAGS_COMMON) -Ihal/include -Ifirmware
 PKG_CFLAGS = $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
-PKG_LIBS = $(shell pkg-config --libs inih libpng 2>/dev/null)
-HOST_CFLAGS = $(CFLAGS_COMMON) -Ihal/include -Ifirmware -Iapp -Ihal/posix -Ihal/linux -Ihost_sim $(PKG_CFLAGS)
+PKG_LIBS = $(shell pkg-config --libs inih libpng libmodbus 2>/dev/null) -lpthread
+HOST_CFLAGS = $(CFLAGS_COMMON) -Ihal/include -Ifirmware -Iapp -Ihal/posix -Ihal/linux -Ihal/modbus -Ihost_sim $(PKG_CFLAGS)
 LDFLAGS_COMMON := $(OPT) -g
 LDLIBS_COMMON = $(PKG_LIBS) -lm
 
 FW_SRC := $(wildcard firmware/*.c) hal/hal.c
-POSIX_SRC := $(wildcard hal/posix/*.c)
+POSIX_SRC := $(wildcard hal/posix/*.c) $(wildcard hal/modbus/*.c)
 APP_LIB_SRC := app/config.c app/ini_schema.c app/image_io.c
 SIM_SRC := $(wildcard host_sim/*.c)
 LINUX_SRC := $(wildcard hal/linux/*.c)

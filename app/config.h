@@ -5,6 +5,7 @@
 
 #include "hal.h"
 #include "scan_types.h"
+#include "turntable_modbus.h"
 #include "vec3.h"
 
 #include <stddef.h>
@@ -23,7 +24,6 @@ struct sim_config {
     double phong_ks, phong_ke;
     char albedo_pattern[16]; /**< patches | uniform */
     double albedo[3];
-    double object_angle_deg;
     uint32_t seed;
     double black_offset_dn, ambient_dn, read_noise_dn, electrons_per_dn;
     double projector_intensity_dn, projector_black_level, projector_blur_px;
@@ -36,16 +36,6 @@ struct gpio_config {
     int32_t line_offset[HAL_GPIO_LINE_COUNT]; /**< -1 = not wired */
 };
 
-struct turntable_config {
-    char transport[8]; /**< tcp | rtu */
-    char host[64];
-    uint32_t port;
-    char device[128];
-    uint32_t baud;
-    char parity[8]; /**< none | even | odd */
-    uint32_t unit_id;
-    uint32_t response_timeout_ms;
-};
 
 struct app_config {
     char path[HAL_MAX_PATH];     /**< the file it came from */
@@ -59,7 +49,7 @@ struct app_config {
     char calibration_file[HAL_MAX_PATH]; /**< resolved against the config file's directory */
     char output_dir[HAL_MAX_PATH];
     struct gpio_config gpio;
-    struct turntable_config turntable;
+    struct tt_client_config turntable;
     struct sim_config sim;
 };
 

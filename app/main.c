@@ -134,13 +134,15 @@ static int run_views(const struct app_config *cfg, const struct scan_calib *cali
 {
     for (uint32_t v = 0; v < cfg->views; v++) {
         int32_t angle_mdeg = (int32_t)((cfg->start_angle_deg + 360.0 * v / cfg->views) * 1000.0);
-        if (the_hal.turntable.ops == NULL)
-            angle_mdeg = (int32_t)(cfg->sim.object_angle_deg * 1000.0);
-        else if (hal_table_move_to(&the_hal.turntable, angle_mdeg) != 0)
-            return -EIO;
+        int rc = hal_table_move_to(&the_hal.turntable, angle_mdeg);
+        if (rc != 0) {
+            app_log(HAL_LOG_ERROR, "view %u: the turntable did not reach %.3f deg", (unsigned)v,
+                    angle_mdeg / 1000.0);
+            return rc;
+        }
         struct scan_view_info info;
         double t0 = wall_ms();
-        int rc = scan_view(&the_hal, &cfg->scan, calib, angle_mdeg, &info);
+        rc = scan_view(&the_hal, &cfg->scan, calib, angle_mdeg, &info);
         double ms = wall_ms() - t0;
         if (rc != 0) {
             app_log(HAL_LOG_ERROR, "view %u at %.1f deg failed: %s", (unsigned)v,
@@ -183,13 +185,6 @@ static int cmd_scan(const char *config_path, const char *out_dir)
         return 2;
     if (out_dir != NULL)
         snprintf(cfg.output_dir, sizeof(cfg.output_dir), "%s", out_dir);
-    if (cfg.views > 1) {
-        fprintf(stderr,
-                "scanner: error: %s: [scan] views: %u views need the turntable, which "
-                "this build does not drive yet; use views = 1\n",
-                config_path, (unsigned)cfg.views);
-        return 2;
-    }
     the_hal.log = app_log;
     the_hal.stop_requested = app_stop_requested;
     install_signals();
@@ -214,6 +209,11 @@ static int cmd_scan(const char *config_path, const char *out_dir)
     }
     if (rc == 0)
         rc = scan_open(&the_hal, &cfg.camera);
+    if (rc == 0) {
+        rc = hal_table_home(&the_hal.turntable);
+        if (rc != 0)
+            app_log(HAL_LOG_ERROR, "the turntable did not home");
+    }
     if (rc == 0)
         rc = run_views(&cfg, &calib);
     scan_close(&the_hal);

@@ -5,7 +5,10 @@
 #include "gray.h"
 #include "image_io.h"
 #include "sim_devices.h"
+#include "pty_link.h"
 #include "storage_posix.h"
+#include "tt_server.h"
+#include "turntable_modbus.h"
 
 #include <errno.h>
 #include <libgen.h>
@@ -19,12 +22,65 @@ static struct {
     struct gpio_sim gpio;
     struct clock_sim clock;
     struct camera_sim camera;
+    struct tt_server server;  /* the simulated controller, a Modbus slave in its own thread */
+    struct pty_link link;     /* RTU: the serial cable between client and controller */
+    struct tt_client client;  /* the scanner's real Modbus client */
+    int server_open, link_open;
     int ready;
 } sim;
 
 const char *board_name(void)
 {
     return "sim";
+}
+
+static int32_t table_angle(void *priv)
+{
+    return tt_server_position(priv);
+}
+
+/* The controller on loopback TCP or on one end of a pty pair, and the client on the other. */
+static int start_turntable(struct hal *hal, const struct app_config *cfg, char *err,
+                           size_t err_len)
+{
+    struct tt_client_config cc = cfg->turntable;
+    int rc;
+    if (strcmp(cc.transport, "tcp") == 0) {
+        rc = tt_server_open_tcp(&sim.server, cc.host, (int)cc.port, clock_sim_now, &sim.clock,
+                                err, err_len);
+        cc.port = (uint32_t)sim.server.port;
+    } else {
+        rc = pty_link_open(&sim.link, err, err_len);
+        if (rc != 0)
+            return rc;
+        sim.link_open = 1;
+        char parity = cc.parity[0] == 'e' ? 'E' : cc.parity[0] == 'o' ? 'O' : 'N';
+        rc = tt_server_open_rtu(&sim.server, sim.link.path[1], (int)cc.baud, parity,
+                                (int)cc.unit_id, clock_sim_now, &sim.clock, err, err_len);
+        snprintf(cc.device, sizeof(cc.device), "%s", sim.link.path[0]);
+    }
+    if (rc != 0)
+        return rc;
+    sim.server_open = 1;
+    rc = tt_server_start(&sim.server);
+    if (rc == 0)
+        rc = tt_client_open(&sim.client, &cc, &hal->clock, hal->log, &hal->turntable, err,
+                            err_len);
+    if (rc != 0)
+        return rc;
+    sim.camera.table_angle = table_angle;
+    sim.camera.table_priv = &sim.server;
+    return 0;
+}
+
+static void stop_turntable(void)
+{
+    tt_client_close(&sim.client);
+    if (sim.server_open)
+        tt_server_close(&sim.server);
+    if (sim.link_open)
+        pty_link_close(&sim.link);
+    sim.server_open = sim.link_open = 0;
 }
 
 int board_init(struct hal *hal, const struct app_config *cfg, const struct scan_calib *calib,
@@ -47,10 +103,11 @@ int board_init(struct hal *hal, const struct app_config *cfg, const struct scan_
     clock_sim_init(&sim.clock, &hal->clock);
     camera_sim_init(&sim.camera, &sim.rig, &sim.gpio, calib->light_count, &hal->camera);
     storage_posix_init(&hal->storage);
-    hal->turntable.ops = NULL; /* the multi-view issue brings the Modbus turntable */
-    hal->turntable.priv = NULL;
     sim.ready = 1;
-    return 0;
+    rc = start_turntable(hal, cfg, err, err_len);
+    if (rc != 0)
+        board_shutdown(hal);
+    return rc;
 }
 
 static int write_truth(const struct hal *hal, const char *dir)
@@ -100,6 +157,8 @@ int board_write_view_extras(const struct hal *hal, const char *view_dir)
 void board_shutdown(struct hal *hal)
 {
     hal_safe_state(hal);
+    stop_turntable();
+    hal->turntable.ops = NULL;
     if (sim.ready)
         sim_rig_free(&sim.rig);
     sim.ready = 0;
@@ -131,12 +190,27 @@ uint64_t sim_ctl_frames(void)
 
 uint64_t sim_ctl_time_us(void)
 {
-    return sim.clock.now_us;
+    return clock_sim_now(&sim.clock);
 }
 
 void sim_ctl_advance_us(uint64_t us)
 {
-    sim.clock.now_us += us;
+    atomic_fetch_add(&sim.clock.now_us, us);
+}
+
+struct tt_server *sim_ctl_turntable(void)
+{
+    return &sim.server;
+}
+
+struct pty_link *sim_ctl_serial_link(void)
+{
+    return &sim.link;
+}
+
+struct tt_client *sim_ctl_turntable_client(void)
+{
+    return &sim.client;
 }
 
 struct sim_rig *sim_ctl_rig(void)

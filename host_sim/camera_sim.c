@@ -31,6 +31,8 @@ static int camera_sim_capture(void *priv, struct hal_image *img)
     size_t need = (size_t)cam->rig->width * cam->rig->height * 3;
     if (img->capacity < need)
         return -ENOSPC;
+    if (cam->table_angle != NULL)
+        cam->rig->table_angle_mdeg = cam->table_angle(cam->table_priv);
     struct sim_sources src;
     gpio_sim_sources(cam->gpio, cam->light_count, &src);
     src.exposure_us = cam->cfg.exposure_us;

@@ -25,6 +25,12 @@ uint64_t sim_ctl_frames(void);
 /** Virtual time in microseconds; sleeping through the HAL advances it. */
 uint64_t sim_ctl_time_us(void);
 void sim_ctl_advance_us(uint64_t us);
+/** The simulated turntable controller (its state: ->ctrl under ->lock). */
+struct tt_server *sim_ctl_turntable(void);
+/** The pty pair between client and controller when the transport is RTU. */
+struct pty_link *sim_ctl_serial_link(void);
+/** The scanner's Modbus client (retry counters). */
+struct tt_client *sim_ctl_turntable_client(void);
 /** The renderer and its ground truth. */
 struct sim_rig *sim_ctl_rig(void);
 

@@ -3,6 +3,8 @@
 #define SIM_DEVICES_H
 
 #include "hal.h"
+
+#include <stdatomic.h>
 #include "sim_ctl.h"
 #include "sim_rig.h"
 
@@ -13,7 +15,7 @@ struct gpio_sim {
 };
 
 struct clock_sim {
-    uint64_t now_us;
+    _Atomic uint64_t now_us; /* read by the turntable controller's thread */
 };
 
 struct camera_sim {
@@ -21,6 +23,8 @@ struct camera_sim {
     const struct gpio_sim *gpio;
     uint32_t light_count;
     struct hal_camera_config cfg;
+    int32_t (*table_angle)(void *priv); /* where the turntable is, if there is one */
+    void *table_priv;
     int is_open;
     uint64_t frames; /* captures attempted since open */
     enum sim_cam_fault fault;
@@ -31,6 +35,8 @@ struct camera_sim {
 void gpio_sim_init(struct gpio_sim *g, uint32_t pattern_count, struct hal_gpio *out);
 void gpio_sim_sources(const struct gpio_sim *g, uint32_t light_count, struct sim_sources *src);
 void clock_sim_init(struct clock_sim *c, struct hal_clock *out);
+/** Virtual time now, for other threads of the simulator. */
+uint64_t clock_sim_now(void *clock_sim);
 void camera_sim_init(struct camera_sim *cam, struct sim_rig *rig, const struct gpio_sim *gpio,
                      uint32_t light_count, struct hal_camera *out);
 

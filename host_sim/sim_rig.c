@@ -125,7 +125,7 @@ int sim_rig_init(struct sim_rig *rig, const struct sim_config *cfg, const struct
     rig->width = calib->cam_width;
     rig->height = calib->cam_height;
     rig->bits = gray_bits_for_width(calib->proj_width);
-    rig->table_angle_mdeg = (int32_t)lround(cfg->object_angle_deg * 1000.0);
+    rig->table_angle_mdeg = 0; /* the turntable, when there is one, sets it per frame */
     int rc = build_object(rig, dir, err, len);
     if (rc == 0)
         rc = build_material(rig, dir, err, len);

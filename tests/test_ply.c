@@ -22,7 +22,7 @@ static void test_ply_roundtrip(void **state)
     assert_int_equal(test_rig_start(&t), 0);
     struct scan_view_info info;
     const int32_t angle_mdeg = 30000;
-    sim_ctl_rig()->table_angle_mdeg = angle_mdeg;
+    assert_int_equal(hal_table_move_to(&t.hal.turntable, angle_mdeg), 0);
     assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, angle_mdeg, &info), 0);
     assert_int_equal(scan_save_cloud(&t.hal, &t.calib, "build/test_ply.ply"), 0);
 

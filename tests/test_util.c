@@ -44,7 +44,10 @@ int test_rig_start(struct test_rig *t)
         fprintf(stderr, "test_rig_start: %s\n", err);
         return rc;
     }
-    return scan_open(&t->hal, &t->cfg.camera);
+    rc = scan_open(&t->hal, &t->cfg.camera);
+    if (rc == 0)
+        rc = hal_table_home(&t->hal.turntable); /* the object at angle 0, as scans start */
+    return rc;
 }
 
 void test_rig_stop(struct test_rig *t)
