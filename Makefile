@@ -71,7 +71,7 @@ $(BUILD)/scanner: $(MAIN_OBJ) $(HOST_OBJ) $(BUILD)/libfirmware.a
 # ---- tests ----
 TEST_SRC := $(filter-out tests/test_util.c,$(wildcard tests/test_*.c))
 TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
-TEST_LIBS = $(shell pkg-config --libs cmocka 2>/dev/null)
+TEST_LIBS = $(shell pkg-config --libs cmocka libmodbus 2>/dev/null)
 
 # The gpiod backend's pure parts are tested in every build (libgpiod is always installed).
 TEST_EXTRA_OBJ := $(if $(filter sim,$(HAL)),$(call obj,hal/linux/gpio_gpiod.c),)

@@ -1,0 +1,267 @@
+/* The turntable client against the simulated controller, a real libmodbus slave, over TCP and
+ * RTU: every fault the issue lists answered with a bounded, reported error. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <errno.h>
+#include <modbus.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "pty_link.h"
+#include "sim_devices.h"
+#include "tt_server.h"
+#include "turntable_modbus.h"
+
+static struct clock_sim vclock;
+static struct hal_clock vhal_clock;
+static struct tt_server server;
+static struct pty_link link;
+static struct tt_client client;
+static struct hal_turntable table;
+static char last_log[512];
+static int errors_logged;
+
+static void log_capture(enum hal_log_level level, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(last_log, sizeof(last_log), fmt, ap);
+    va_end(ap);
+    errors_logged += level == HAL_LOG_ERROR;
+}
+
+static struct tt_client_config base_config(void)
+{
+    struct tt_client_config c;
+    memset(&c, 0, sizeof(c));
+    snprintf(c.transport, sizeof(c.transport), "tcp");
+    snprintf(c.host, sizeof(c.host), "127.0.0.1");
+    snprintf(c.parity, sizeof(c.parity), "even");
+    c.baud = 115200;
+    c.unit_id = 1;
+    c.response_timeout_ms = 200;
+    c.byte_timeout_ms = 50;
+    c.retries = 2;
+    c.poll_interval_ms = 50;
+    c.move_timeout_ms = 30000;
+    c.speed_dps = 30;
+    c.accel_dps2 = 60;
+    c.tolerance_mdeg = 10;
+    return c;
+}
+
+static int open_tcp(void **state)
+{
+    (void)state;
+    char err[256];
+    errors_logged = 0;
+    last_log[0] = '\0';
+    clock_sim_init(&vclock, &vhal_clock);
+    if (tt_server_open_tcp(&server, "127.0.0.1", 0, clock_sim_now, &vclock, err, sizeof(err)) ||
+        tt_server_start(&server))
+        return -1;
+    struct tt_client_config c = base_config();
+    c.port = (uint32_t)server.port;
+    return tt_client_open(&client, &c, &vhal_clock, log_capture, &table, err, sizeof(err));
+}
+
+static int open_rtu(void **state)
+{
+    (void)state;
+    char err[256];
+    errors_logged = 0;
+    last_log[0] = '\0';
+    clock_sim_init(&vclock, &vhal_clock);
+    if (pty_link_open(&link, err, sizeof(err)) ||
+        tt_server_open_rtu(&server, link.path[1], 115200, 'E', 1, clock_sim_now, &vclock, err,
+                           sizeof(err)) ||
+        tt_server_start(&server))
+        return -1;
+    struct tt_client_config c = base_config();
+    snprintf(c.transport, sizeof(c.transport), "rtu");
+    snprintf(c.device, sizeof(c.device), "%s", link.path[0]);
+    return tt_client_open(&client, &c, &vhal_clock, log_capture, &table, err, sizeof(err));
+}
+
+static int close_all(void **state)
+{
+    (void)state;
+    tt_client_close(&client);
+    tt_server_close(&server);
+    if (link.running)
+        pty_link_close(&link);
+    return 0;
+}
+
+/* Home, move, read back: the move takes virtual time as the profile says. */
+static void test_home_and_move(void **state)
+{
+    (void)state;
+    struct hal_turntable_status st;
+    assert_int_equal(hal_table_get_status(&table, &st), 0);
+    assert_int_equal(st.homed, 0);
+    assert_int_equal(st.position_mdeg, 37500);
+    assert_int_equal(hal_table_home(&table), 0);
+    assert_int_equal(hal_table_get_status(&table, &st), 0);
+    assert_true(st.homed && !st.busy && st.position_mdeg == 0);
+    uint64_t t0 = clock_sim_now(&vclock);
+    assert_int_equal(hal_table_move_to(&table, 90000), 0);
+    double took_s = (double)(clock_sim_now(&vclock) - t0) / 1e6;
+    /* 90 deg at 30 deg/s with 60 deg/s^2: 90/30 + 30/60 = 3.5 s (+ one poll interval) */
+    assert_true(took_s >= 3.5 && took_s < 3.5 + 0.2);
+    assert_int_equal(hal_table_get_status(&table, &st), 0);
+    assert_int_equal(st.position_mdeg, 90000);
+    assert_int_equal(hal_table_move_to(&table, -45000), 0);
+    assert_int_equal(tt_server_position(&server), -45000);
+    assert_int_equal(errors_logged, 0);
+}
+
+static void test_move_before_home_raises_alarm(void **state)
+{
+    (void)state;
+    errors_logged = 0;
+    assert_int_equal(hal_table_move_to(&table, 10000), -EIO);
+    assert_non_null(strstr(last_log, "alarm 2 (move before homing)"));
+    assert_int_equal(tt_server_position(&server), 37500); /* it did not move */
+    /* the alarm blocks homing too, until cleared */
+    modbus_t *raw = client.ctx;
+    uint16_t clear[2] = {TT_CMD_CLEAR_ALARM, 999};
+    assert_int_equal(modbus_write_registers(raw, TT_REG_COMMAND, 2, clear), 2);
+    assert_int_equal(hal_table_home(&table), 0);
+}
+
+static void test_stall_reported_with_position(void **state)
+{
+    (void)state;
+    assert_int_equal(hal_table_home(&table), 0);
+    pthread_mutex_lock(&server.lock);
+    server.ctrl.stall_at_mdeg = 20000;
+    pthread_mutex_unlock(&server.lock);
+    assert_int_equal(hal_table_move_to(&table, 45000), -EIO);
+    assert_non_null(strstr(last_log, "alarm 1 (stall (following error)) at 20.000 deg"));
+    pthread_mutex_lock(&server.lock);
+    server.ctrl.stall_at_mdeg = INT32_MIN;
+    pthread_mutex_unlock(&server.lock);
+}
+
+/* A read-only register written: the controller's exception, reported as such, not retried. */
+static void test_illegal_address_exception(void **state)
+{
+    (void)state;
+    modbus_t *raw = client.ctx;
+    uint16_t v = 1;
+    assert_int_equal(modbus_write_registers(raw, TT_REG_ACTUAL_HI, 1, &v), -1);
+    assert_int_equal(errno, EMBXILADD);
+    uint16_t regs[20];
+    assert_int_equal(modbus_read_registers(raw, 0, 20, regs), -1); /* past the map */
+    assert_int_equal(errno, EMBXILADD);
+}
+
+/* The same COMMAND_ID again is a repeat: the controller does not move twice. */
+static void test_command_applied_once(void **state)
+{
+    (void)state;
+    assert_int_equal(hal_table_home(&table), 0);
+    modbus_t *raw = client.ctx;
+    uint16_t target[2] = {0, 10000};
+    uint16_t cmd[2] = {TT_CMD_MOVE, 4242};
+    assert_int_equal(modbus_write_registers(raw, TT_REG_TARGET_HI, 2, target), 2);
+    assert_int_equal(modbus_write_registers(raw, TT_REG_COMMAND, 2, cmd), 2);
+    hal_clock_sleep_us(&vhal_clock, 5000000);
+    assert_int_equal(tt_server_position(&server), 10000);
+    target[1] = 30000; /* new target, but the command is a repeat */
+    assert_int_equal(modbus_write_registers(raw, TT_REG_TARGET_HI, 2, target), 2);
+    assert_int_equal(modbus_write_registers(raw, TT_REG_COMMAND, 2, cmd), 2);
+    hal_clock_sleep_us(&vhal_clock, 5000000);
+    assert_int_equal(tt_server_position(&server), 10000);
+    uint16_t last;
+    assert_int_equal(modbus_read_registers(raw, TT_REG_LAST_ID, 1, &last), 1);
+    assert_int_equal(last, 4242);
+}
+
+/* The controller goes silent: bounded retries, then a timeout that says so. */
+static void test_no_reply_times_out(void **state)
+{
+    (void)state;
+    struct hal_turntable_status st;
+    server.stop = 1;
+    pthread_join(server.thread, NULL); /* the slave stops answering */
+    server.running = 0;
+    errors_logged = 0;
+    unsigned long before = client.retries_used;
+    int rc = hal_table_get_status(&table, &st);
+    assert_true(rc == -ETIMEDOUT || rc == -ECONNRESET || rc == -EPIPE || rc < 0);
+    assert_int_equal(client.retries_used - before, client.cfg.retries);
+    assert_int_equal(errors_logged, 1);
+    assert_non_null(strstr(last_log, "turntable: reading the status failed"));
+}
+
+/* RTU: a reply with a bad CRC is dropped, flushed and asked again. */
+static void test_rtu_bad_crc_retried(void **state)
+{
+    (void)state;
+    struct hal_turntable_status st;
+    unsigned long before = client.retries_used;
+    link.corrupt_next_reply = 1;
+    errors_logged = 0;
+    assert_int_equal(hal_table_get_status(&table, &st), 0);
+    assert_int_equal(client.retries_used - before, 1);
+    assert_int_equal(errors_logged, 0);
+    assert_int_equal(hal_table_home(&table), 0);
+    assert_int_equal(hal_table_move_to(&table, 180000), 0);
+    assert_int_equal(tt_server_position(&server), 180000);
+}
+
+/* RTU: nobody answers for another unit id. */
+static void test_rtu_wrong_unit_is_silent(void **state)
+{
+    (void)state;
+    struct tt_client other;
+    struct hal_turntable other_table;
+    struct tt_client_config c = base_config();
+    char err[256];
+    snprintf(c.transport, sizeof(c.transport), "rtu");
+    snprintf(c.device, sizeof(c.device), "%s", link.path[0]);
+    c.unit_id = 7;
+    c.retries = 1;
+    tt_client_close(&client); /* one master on the line at a time */
+    int rc = tt_client_open(&other, &c, &vhal_clock, log_capture, &other_table, err, sizeof(err));
+    assert_int_equal(rc, -ETIMEDOUT);
+    assert_non_null(strstr(err, "no turntable controller answers at"));
+    assert_non_null(strstr(err, "(unit 7)"));
+}
+
+/* Connecting where nothing listens: a clear error naming the address. */
+static void test_connection_refused(void **state)
+{
+    (void)state;
+    struct tt_client c0;
+    struct hal_turntable t0 = {NULL, NULL};
+    struct tt_client_config c = base_config();
+    char err[256];
+    c.port = 1; /* privileged, nothing listens there */
+    assert_int_not_equal(tt_client_open(&c0, &c, &vhal_clock, log_capture, &t0, err, sizeof(err)), 0);
+    assert_non_null(strstr(err, "cannot connect to 127.0.0.1:1"));
+    assert_null(t0.ops);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test_setup_teardown(test_home_and_move, open_tcp, close_all),
+        cmocka_unit_test_setup_teardown(test_move_before_home_raises_alarm, open_tcp, close_all),
+        cmocka_unit_test_setup_teardown(test_stall_reported_with_position, open_tcp, close_all),
+        cmocka_unit_test_setup_teardown(test_illegal_address_exception, open_tcp, close_all),
+        cmocka_unit_test_setup_teardown(test_command_applied_once, open_tcp, close_all),
+        cmocka_unit_test_setup_teardown(test_no_reply_times_out, open_tcp, close_all),
+        cmocka_unit_test_setup_teardown(test_home_and_move, open_rtu, close_all),
+        cmocka_unit_test_setup_teardown(test_rtu_bad_crc_retried, open_rtu, close_all),
+        cmocka_unit_test_setup_teardown(test_rtu_wrong_unit_is_silent, open_rtu, close_all),
+        cmocka_unit_test(test_connection_refused),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
