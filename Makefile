@@ -37,7 +37,7 @@ LDLIBS_COMMON = $(PKG_LIBS) -lm
 FW_SRC := $(wildcard firmware/*.c) hal/hal.c
 POSIX_SRC := $(wildcard hal/posix/*.c) $(wildcard hal/modbus/*.c)
 APP_LIB_SRC := app/config.c app/ini_schema.c app/image_io.c
-SIM_SRC := $(wildcard host_sim/*.c)
+SIM_SRC := $(filter-out host_sim/turntable_sim_main.c,$(wildcard host_sim/*.c))
 LINUX_SRC := $(wildcard hal/linux/*.c)
 BOARD_SRC := $(if $(filter sim,$(HAL)),$(SIM_SRC),$(LINUX_SRC))
 BOARD_LIBS = $(if $(filter linux,$(HAL)),$(shell pkg-config --libs libgpiod 2>/dev/null),)
@@ -48,7 +48,8 @@ HOST_OBJ := $(call obj,$(POSIX_SRC) $(APP_LIB_SRC) $(BOARD_SRC))
 MAIN_OBJ := $(call obj,app/main.c)
 
 .PHONY: all deps test-deps test run clean format docs check-firmware bench measure
-all: deps $(BUILD)/scanner
+SIM_TOOLS := $(if $(filter sim,$(HAL)),$(BUILD)/turntable-sim $(BUILD)/tt-client,)
+all: deps $(BUILD)/scanner $(SIM_TOOLS)
 
 # Install missing Debian packages (fresh Debian 12): only when pkg-config cannot find them.
 deps:
@@ -67,6 +68,12 @@ $(BUILD)/libfirmware.a: $(FW_OBJ)
 
 $(BUILD)/scanner: $(MAIN_OBJ) $(HOST_OBJ) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON) $(BOARD_LIBS)
+
+# The simulated controller as its own program, and the client as a command (interop tests).
+$(BUILD)/turntable-sim: $(call obj,host_sim/turntable_sim_main.c host_sim/tt_server.c host_sim/tt_ctrl.c)
+	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON)
+$(BUILD)/tt-client: $(call obj,tests/tt_client_main.c hal/modbus/turntable_modbus.c hal/posix/clock_posix.c) $(BUILD)/libfirmware.a
+	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON)
 
 # ---- tests ----
 TEST_SRC := $(filter-out tests/test_util.c,$(wildcard tests/test_*.c))
@@ -96,12 +103,14 @@ check-firmware: $(FW_OBJ)
 	if [ -n "$$bad" ]; then echo "firmware/ includes OS headers: $$bad"; exit 1; fi; \
 	echo "check-firmware: no allocator references and no OS headers in firmware/"
 
-# Test-only packages (Open3D reads our PLY in tests/cli.sh).
+# Test-only packages: Open3D reads our PLY (tests/cli.sh); pymodbus and socat are the Modbus
+# peers of tests/interop.sh.
 test-deps:
-	@/usr/bin/python3 -c 'import open3d' 2>/dev/null || scripts/install-deps.sh test
+	@{ /usr/bin/python3 -c 'import open3d, pymodbus, serial_asyncio' && command -v socat; } \
+		>/dev/null 2>&1 || scripts/install-deps.sh test
 
-test: deps test-deps $(BUILD)/scanner $(TEST_BIN) check-firmware
-	@BUILD=$(BUILD) tests/run.sh $(TEST_BIN) tests/cli.sh
+test: deps test-deps $(BUILD)/scanner $(SIM_TOOLS) $(TEST_BIN) check-firmware
+	@BUILD=$(BUILD) tests/run.sh $(TEST_BIN) tests/cli.sh tests/interop.sh
 
 run: deps $(BUILD)/scanner
 	$(BUILD)/scanner scan --config config/sim.ini

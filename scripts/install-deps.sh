@@ -4,7 +4,7 @@
 # With the argument "test" it adds what only the tests use (Open3D reads our PLY files).
 set -eu
 pkgs="build-essential pkg-config libinih-dev libpng-dev libcmocka-dev libmodbus-dev libgpiod-dev"
-[ "${1:-}" = "test" ] && pkgs="$pkgs python3 python3-numpy python3-open3d"
+[ "${1:-}" = "test" ] && pkgs="$pkgs python3 python3-numpy python3-open3d python3-pymodbus python3-serial python3-serial-asyncio socat"
 missing=""
 for p in $pkgs; do
     dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"
