@@ -2,8 +2,10 @@
 #define _POSIX_C_SOURCE 200809L
 #include "board.h"
 #include "config.h"
-#include "image_io.h"
 #include "scan.h"
+#include "scan_job.h"
+#include "clock_posix.h"
+#include "storage_posix.h"
 
 #include <errno.h>
 #include <signal.h>
@@ -69,100 +71,6 @@ static void install_signals(void)
     sigaction(SIGABRT, &sa, NULL);
 }
 
-static double wall_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
-}
-
-static int copy_file(const struct hal_storage *st, const char *from, const char *to)
-{
-    static char buf[1 << 16]; /* config and calibration files are small */
-    FILE *f = fopen(from, "rb");
-    if (f == NULL)
-        return -errno;
-    size_t n = fread(buf, 1, sizeof(buf), f);
-    int too_big = !feof(f);
-    fclose(f);
-    return too_big ? -EFBIG : hal_storage_write_file(st, to, buf, n);
-}
-
-static int write_view_meta(const struct hal_storage *st, const char *path,
-                           const struct scan_view_info *info, double ms)
-{
-    char text[1024];
-    int len = snprintf(text, sizeof(text),
-                       "; one view of a scan: see docs/scan-format.md\n[view]\nangle_mdeg = %d\n"
-                       "frames = %u\ncapture_retries = %u\nvalid_points = %u\nwall_ms = %.1f\n"
-                       "[pixels]\n",
-                       (int)info->angle_mdeg, (unsigned)info->frames_captured,
-                       (unsigned)info->capture_retries, (unsigned)info->valid_points, ms);
-    for (unsigned r = 0; r < SCAN_REASON_COUNT && len > 0 && (size_t)len < sizeof(text); r++)
-        len += snprintf(text + len, sizeof(text) - (size_t)len, "%s = %u\n", scan_reason_name(r),
-                        (unsigned)info->reason_count[r]);
-    return hal_storage_write_file(st, path, text, (size_t)len);
-}
-
-/* Save everything of a finished view: cloud, colour, metadata, and the board's extras. */
-static int save_view(const struct app_config *cfg, const struct scan_calib *calib,
-                     const char *view_dir, const struct scan_view_info *info, double ms)
-{
-    char path[HAL_MAX_PATH + 32];
-    int rc = hal_storage_mkdir_p(&the_hal.storage, view_dir);
-    if (rc == 0) {
-        snprintf(path, sizeof(path), "%s/cloud.ply", view_dir);
-        rc = scan_save_cloud(&the_hal, calib, path);
-    }
-    if (rc == 0) {
-        snprintf(path, sizeof(path), "%s/colour.png", view_dir);
-        rc = image_write_png(&the_hal.storage, path, scan_colour_frame(), cfg->camera.width,
-                             cfg->camera.height, 3);
-    }
-    if (rc == 0)
-        rc = board_write_view_extras(&the_hal, view_dir);
-    if (rc == 0) {
-        snprintf(path, sizeof(path), "%s/view.ini", view_dir);
-        rc = write_view_meta(&the_hal.storage, path, info, ms);
-    }
-    if (rc != 0)
-        app_log(HAL_LOG_ERROR, "cannot save %s: %s", view_dir, strerror(-rc));
-    return rc;
-}
-
-static int run_views(const struct app_config *cfg, const struct scan_calib *calib)
-{
-    for (uint32_t v = 0; v < cfg->views; v++) {
-        int32_t angle_mdeg = (int32_t)((cfg->start_angle_deg + 360.0 * v / cfg->views) * 1000.0);
-        int rc = hal_table_move_to(&the_hal.turntable, angle_mdeg);
-        if (rc != 0) {
-            app_log(HAL_LOG_ERROR, "view %u: the turntable did not reach %.3f deg", (unsigned)v,
-                    angle_mdeg / 1000.0);
-            return rc;
-        }
-        struct scan_view_info info;
-        double t0 = wall_ms();
-        rc = scan_view(&the_hal, &cfg->scan, calib, angle_mdeg, &info);
-        double ms = wall_ms() - t0;
-        if (rc != 0) {
-            app_log(HAL_LOG_ERROR, "view %u at %.1f deg failed: %s", (unsigned)v,
-                    angle_mdeg / 1000.0, rc == -EINTR ? "stopped by request" : strerror(-rc));
-            return rc;
-        }
-        char view_dir[HAL_MAX_PATH + 16];
-        snprintf(view_dir, sizeof(view_dir), "%s/view_%03u", cfg->output_dir, (unsigned)v);
-        rc = save_view(cfg, calib, view_dir, &info, ms);
-        if (rc != 0)
-            return rc;
-        printf(
-            "view %u of %u: %u points (%.1f%% of pixels), %u frames in %.0f ms -> %s/cloud.ply\n",
-            (unsigned)v + 1, (unsigned)cfg->views, (unsigned)info.valid_points,
-            100.0 * info.valid_points / ((double)cfg->camera.width * cfg->camera.height),
-            (unsigned)info.frames_captured, ms, view_dir);
-    }
-    return 0;
-}
-
 static int load_all(const char *config_path, struct app_config *cfg, struct scan_calib *calib)
 {
     char err[512];
@@ -176,15 +84,13 @@ static int load_all(const char *config_path, struct app_config *cfg, struct scan
     return rc;
 }
 
-static int cmd_scan(const char *config_path, const char *out_dir)
+static int cmd_scan(const char *config_path, const struct scan_job_opts *opts)
 {
     static struct app_config cfg;
     static struct scan_calib calib;
-    char err[512], path[HAL_MAX_PATH + 32];
+    char err[512];
     if (load_all(config_path, &cfg, &calib) != 0)
         return 2;
-    if (out_dir != NULL)
-        snprintf(cfg.output_dir, sizeof(cfg.output_dir), "%s", out_dir);
     the_hal.log = app_log;
     the_hal.stop_requested = app_stop_requested;
     install_signals();
@@ -194,59 +100,57 @@ static int cmd_scan(const char *config_path, const char *out_dir)
         return 1;
     }
     hal_ready = 1;
-    rc = hal_storage_mkdir_p(&the_hal.storage, cfg.output_dir);
-    if (rc != 0)
-        app_log(HAL_LOG_ERROR, "cannot create %s: %s", cfg.output_dir, strerror(-rc));
-    if (rc == 0) {
-        snprintf(path, sizeof(path), "%s/config.ini", cfg.output_dir);
-        rc = copy_file(&the_hal.storage, config_path, path);
-        snprintf(path, sizeof(path), "%s/calibration.ini", cfg.output_dir);
-        if (rc == 0)
-            rc = copy_file(&the_hal.storage, cfg.calibration_file, path);
-        if (rc != 0)
-            app_log(HAL_LOG_ERROR, "cannot copy the config into %s: %s", cfg.output_dir,
-                    strerror(-rc));
-    }
+    rc = scan_open(&the_hal, &cfg.camera);
     if (rc == 0)
-        rc = scan_open(&the_hal, &cfg.camera);
-    if (rc == 0) {
-        rc = hal_table_home(&the_hal.turntable);
-        if (rc != 0)
-            app_log(HAL_LOG_ERROR, "the turntable did not home");
-    }
-    if (rc == 0)
-        rc = run_views(&cfg, &calib);
+        rc = scan_job_live(&the_hal, &cfg, &calib, opts);
     scan_close(&the_hal);
     board_shutdown(&the_hal);
     hal_ready = 0;
-    if (rc == 0)
-        printf("scan finished: %s (point cloud of view 0: %s/view_000/cloud.ply; open it in "
-               "MeshLab, CloudCompare, Blender or Open3D)\n",
-               cfg.output_dir, cfg.output_dir);
     return rc == 0 ? 0 : 1;
+}
+
+/* Offline: only storage, a clock and the log; no device is opened. */
+static int cmd_process(const char *scan_dir, const struct scan_job_opts *opts)
+{
+    struct hal hal;
+    memset(&hal, 0, sizeof(hal));
+    hal.log = app_log;
+    storage_posix_init(&hal.storage);
+    clock_posix_init(&hal.clock);
+    return scan_job_process(&hal, scan_dir, opts) == 0 ? 0 : 1;
 }
 
 static void usage(FILE *out)
 {
     fprintf(out,
-            "usage: scanner scan --config FILE [--out DIR]   take a scan\n"
-            "       scanner check-config --config FILE      check a config and its calibration\n"
-            "       scanner config-doc                      print the config reference (Markdown)\n"
+            "usage: scanner scan --config FILE [--out DIR] [--json]   take a scan\n"
+            "       scanner process DIR [--out DIR2] [--json]        recompute a scan from its "
+            "frames\n"
+            "       scanner check-config --config FILE    check a config and its calibration\n"
+            "       scanner config-doc                    print the config reference (Markdown)\n"
             "       scanner --version\n");
 }
 
 int main(int argc, char **argv)
 {
-    const char *config_path = NULL, *out_dir = NULL;
+    const char *config_path = NULL, *scan_dir = NULL;
+    struct scan_job_opts opts = {0, NULL};
     if (argc < 2) {
         usage(stderr);
         return 2;
     }
-    for (int i = 2; i < argc; i++) {
+    int first = 2;
+    if (strcmp(argv[1], "process") == 0 && argc > 2 && argv[2][0] != '-') {
+        scan_dir = argv[2];
+        first = 3;
+    }
+    for (int i = first; i < argc; i++) {
         if (strcmp(argv[i], "--config") == 0 && i + 1 < argc)
             config_path = argv[++i];
         else if (strcmp(argv[i], "--out") == 0 && i + 1 < argc)
-            out_dir = argv[++i];
+            opts.out_dir = argv[++i];
+        else if (strcmp(argv[i], "--json") == 0)
+            opts.json = 1;
         else {
             fprintf(stderr, "scanner: unknown argument '%s'\n", argv[i]);
             usage(stderr);
@@ -265,6 +169,8 @@ int main(int argc, char **argv)
         usage(stdout);
         return 0;
     }
+    if (strcmp(argv[1], "process") == 0 && scan_dir != NULL)
+        return cmd_process(scan_dir, &opts);
     if (config_path == NULL) {
         usage(stderr);
         return 2;
@@ -278,7 +184,7 @@ int main(int argc, char **argv)
         return 0;
     }
     if (strcmp(argv[1], "scan") == 0)
-        return cmd_scan(config_path, out_dir);
+        return cmd_scan(config_path, &opts);
     usage(stderr);
     return 2;
 }

@@ -47,9 +47,13 @@ int decode_begin(const struct scan_params *params, uint32_t proj_width)
     return 0;
 }
 
-static int rgb_saturated(const uint8_t *rgb, uint32_t level)
+void decode_rgb_to_grey(const uint8_t *rgb, uint8_t *grey, size_t n, uint32_t saturation_dn)
 {
-    return rgb[0] >= level || rgb[1] >= level || rgb[2] >= level;
+    for (size_t i = 0; i < n; i++, rgb += 3) {
+        int saturated = rgb[0] >= saturation_dn || rgb[1] >= saturation_dn || rgb[2] >= saturation_dn;
+        uint32_t luma = (77u * rgb[0] + 150u * rgb[1] + 29u * rgb[2]) >> 8; /* BT.601 weights */
+        grey[i] = saturated ? DECODE_SATURATED : (uint8_t)(luma < 254u ? luma : 254u);
+    }
 }
 
 /* Reject a pixel, keeping the first reason found: later frames do not overwrite it. */
@@ -59,27 +63,27 @@ static void reject(size_t i, enum scan_reason why)
         reason_map[i] = (uint8_t)why;
 }
 
-/* Grey copy of a frame that a later frame is compared with: the white frame (against black), then
- * each bit's positive pattern (against its inverse), which reuses the buffer once white is done. */
-static void take_reference(const uint8_t *rgb, size_t n)
+/* Keep a frame that a later frame is compared with: the white frame (against black), then each
+ * bit's positive pattern (against its inverse), which reuses the buffer once white is done. */
+static void take_reference(const uint8_t *grey, size_t n)
 {
-    for (size_t i = 0; i < n; i++, rgb += 3) {
-        grey_white[i] = decode_grey(rgb);
-        if (rgb_saturated(rgb, dec.params.saturation_dn))
+    for (size_t i = 0; i < n; i++) {
+        grey_white[i] = grey[i];
+        if (grey[i] == DECODE_SATURATED)
             reject(i, SCAN_SATURATED);
     }
 }
 
-static void take_black(const uint8_t *rgb, size_t n)
+static void take_black(const uint8_t *grey, size_t n)
 {
-    for (size_t i = 0; i < n; i++, rgb += 3) {
-        int contrast = (int)grey_white[i] - (int)decode_grey(rgb);
-        if (contrast <= (int)dec.params.shadow_contrast_dn)
+    for (size_t i = 0; i < n; i++) {
+        int contrast = (int)grey_white[i] - (int)grey[i];
+        if (grey[i] == DECODE_SATURATED)
+            reject(i, SCAN_SATURATED);
+        else if (contrast <= (int)dec.params.shadow_contrast_dn)
             reject(i, SCAN_SHADOW);
         else if (contrast < (int)dec.params.min_contrast_dn)
             reject(i, SCAN_DARK);
-        else if (rgb_saturated(rgb, dec.params.saturation_dn))
-            reject(i, SCAN_SATURATED);
     }
 }
 
@@ -87,31 +91,32 @@ static void take_black(const uint8_t *rgb, size_t n)
  * edge between two projector columns exactly one bit is ambiguous (adjacent Gray codes differ in
  * one bit), and either reading gives one of the two columns: harmless. Two or more ambiguous bits
  * mean the signal itself is too weak to trust. */
-static void take_inverse(const uint8_t *rgb, size_t n)
+static void take_inverse(const uint8_t *grey, size_t n)
 {
     const int min_diff = (int)dec.params.min_bit_diff_dn;
-    for (size_t i = 0; i < n; i++, rgb += 3) {
-        int diff = (int)grey_white[i] - (int)decode_grey(rgb);
+    for (size_t i = 0; i < n; i++) {
+        int diff = (int)grey_white[i] - (int)grey[i];
         column_map[i] = (uint16_t)((column_map[i] << 1) | (diff > 0 ? 1u : 0u));
-        if (diff <= min_diff && diff >= -min_diff && ++scratch[i] > dec.params.max_ambiguous_bits)
-            reject(i, SCAN_LOW_CONTRAST);
-        if (rgb_saturated(rgb, dec.params.saturation_dn))
+        if (grey[i] == DECODE_SATURATED)
             reject(i, SCAN_SATURATED);
+        else if (diff <= min_diff && diff >= -min_diff &&
+                 ++scratch[i] > dec.params.max_ambiguous_bits)
+            reject(i, SCAN_LOW_CONTRAST);
     }
 }
 
-int decode_frame(uint32_t pattern_index, const uint8_t *rgb)
+int decode_frame(uint32_t pattern_index, const uint8_t *grey)
 {
     if (pattern_index != dec.next_pattern || pattern_index >= gray_pattern_count(dec.bits))
         return -EINVAL;
     size_t n = (size_t)dec.params.width * dec.params.height;
     if (pattern_index == GRAY_PATTERN_BLACK)
-        take_black(rgb, n);
+        take_black(grey, n);
     else if (pattern_index == GRAY_PATTERN_WHITE ||
              (pattern_index - GRAY_PATTERN_FIRST_BIT) % 2u == 0u)
-        take_reference(rgb, n);
+        take_reference(grey, n);
     else
-        take_inverse(rgb, n);
+        take_inverse(grey, n);
     dec.next_pattern++;
     return 0;
 }

@@ -5,6 +5,7 @@
 
 #include "scan_types.h"
 
+#include <stddef.h>
 #include <stdint.h>
 
 /** Why a pixel has no depth; SCAN_VALID means it has one. */
@@ -28,17 +29,19 @@ struct decode_maps {
 /** Short name of a reason code, for logs and reports. */
 const char *scan_reason_name(unsigned reason);
 
-/** Grey value of one RGB pixel (ITU-R BT.601 weights, integer). */
-static inline uint8_t decode_grey(const uint8_t *rgb)
-{
-    return (uint8_t)((77u * rgb[0] + 150u * rgb[1] + 29u * rgb[2]) >> 8);
-}
+/** Grey level that marks a pixel saturated in some channel; real grey levels stop at 254. */
+#define DECODE_SATURATED 255u
+
+/** Convert an RGB24 frame to the decoder's grey frame (ITU-R BT.601 weights, integer): a pixel
+ *  with a channel at or above @p saturation_dn becomes DECODE_SATURATED. The live scan and the
+ *  offline re-processing both decode exactly such frames, so they agree to the bit. */
+void decode_rgb_to_grey(const uint8_t *rgb, uint8_t *grey, size_t n, uint32_t saturation_dn);
 
 /** Start a view. @retval 0 ok @retval -EINVAL size above the compiled limits */
 int decode_begin(const struct scan_params *params, uint32_t proj_width);
-/** Feed the frame of stored pattern @p pattern_index (in sequence order), RGB24.
+/** Feed the grey frame (see decode_rgb_to_grey) of stored pattern @p pattern_index, in order.
  *  @retval 0 ok @retval -EINVAL out of order */
-int decode_frame(uint32_t pattern_index, const uint8_t *rgb);
+int decode_frame(uint32_t pattern_index, const uint8_t *grey);
 /** Gray to binary, range and neighbour checks. @retval 0 ok @retval -EINVAL frames missing */
 int decode_finish(void);
 /** The maps of the last finished view. */

@@ -13,6 +13,8 @@
 static uint8_t
     colour_rgb[HAL_MAX_PIXELS * 3];           /* projector-white frame, kept as the view's colour */
 static uint8_t frame_rgb[HAL_MAX_PIXELS * 3]; /* every other frame, consumed at once */
+static uint8_t frame_grey[HAL_MAX_PIXELS];    /* what the decoder sees, and what is saved */
+static struct scan_params view_params;        /* of the view being fed */
 static int32_t last_angle_mdeg;
 
 int scan_check(const struct scan_params *p, const struct scan_calib *c, char *msg, size_t len)
@@ -101,8 +103,58 @@ static int projector_start(const struct hal *hal, const struct scan_params *p, u
     return rc;
 }
 
+int scan_begin_view(const struct scan_params *p, const struct scan_calib *c)
+{
+    view_params = *p;
+    return decode_begin(p, c->proj_width);
+}
+
+int scan_feed_frame(uint32_t pattern, const uint8_t *pixels, uint32_t channels,
+                    const struct scan_frame_sink *sink)
+{
+    size_t n = (size_t)view_params.width * view_params.height;
+    const uint8_t *grey = pixels;
+    if (channels == 3) {
+        if (pattern == GRAY_PATTERN_WHITE && pixels != colour_rgb)
+            memcpy(colour_rgb, pixels, n * 3); /* the view's colour */
+        decode_rgb_to_grey(pixels, frame_grey, n, view_params.saturation_dn);
+        grey = frame_grey;
+    }
+    int rc = decode_frame(pattern, grey);
+    /* The white frame is kept in colour (its grey is derived again offline); the others are
+     * kept exactly as the decoder saw them. */
+    if (rc == 0 && sink != NULL && sink->save != NULL)
+        rc = pattern == GRAY_PATTERN_WHITE
+                 ? sink->save(sink->priv, pattern, colour_rgb, view_params.width,
+                              view_params.height, 3)
+                 : sink->save(sink->priv, pattern, grey, view_params.width, view_params.height, 1);
+    return rc;
+}
+
+int scan_finish_view(const struct scan_calib *c, int32_t angle_mdeg, struct scan_view_info *info)
+{
+    const struct decode_maps *maps = decode_get_maps();
+    int rc = decode_finish();
+    if (rc == 0)
+        rc = refine_columns(maps, (int)view_params.refine);
+    if (rc == 0)
+        rc = tri_range_image(c, maps, refine_get_columns());
+    if (rc == 0)
+        rc = tri_normals(maps, view_params.normal_radius_px, view_params.max_depth_jump_mm);
+    if (rc != 0)
+        return rc;
+    info->angle_mdeg = angle_mdeg;
+    memset(info->reason_count, 0, sizeof(info->reason_count));
+    size_t n = (size_t)maps->width * maps->height;
+    for (size_t i = 0; i < n; i++)
+        info->reason_count[maps->reason[i]]++;
+    info->valid_points = info->reason_count[SCAN_VALID];
+    last_angle_mdeg = angle_mdeg;
+    return 0;
+}
+
 static int capture_patterns(const struct hal *hal, const struct scan_params *p, uint32_t count,
-                            struct scan_view_info *info)
+                            const struct scan_frame_sink *sink, struct scan_view_info *info)
 {
     for (uint32_t i = 0; i < count; i++) {
         if (hal_should_stop(hal))
@@ -112,7 +164,7 @@ static int capture_patterns(const struct hal *hal, const struct scan_params *p, 
         if (rc != 0)
             return rc;
         info->frames_captured++;
-        rc = decode_frame(i, buf);
+        rc = scan_feed_frame(i, buf, 3, sink);
         if (rc != 0)
             return rc;
         if (i + 1 == count)
@@ -128,37 +180,22 @@ static int capture_patterns(const struct hal *hal, const struct scan_params *p, 
 }
 
 int scan_view(const struct hal *hal, const struct scan_params *p, const struct scan_calib *c,
-              int32_t angle_mdeg, struct scan_view_info *info)
+              int32_t angle_mdeg, const struct scan_frame_sink *sink, struct scan_view_info *info)
 {
     memset(info, 0, sizeof(*info));
     info->angle_mdeg = angle_mdeg;
-    int rc = decode_begin(p, c->proj_width);
+    int rc = scan_begin_view(p, c);
     if (rc != 0)
         return rc;
     uint32_t count = gray_pattern_count(gray_bits_for_width(c->proj_width));
     rc = projector_start(hal, p, c->light_count);
     if (rc == 0)
-        rc = capture_patterns(hal, p, count, info);
+        rc = capture_patterns(hal, p, count, sink, info);
     /* Projector off as soon as the last frame is in, and on every failure. */
     int rc_off = hal_gpio_set(&hal->gpio, HAL_GPIO_PROJECTOR_ENABLE, 0);
     if (rc != 0 || rc_off != 0)
         goto out_safe;
-    const struct decode_maps *maps = decode_get_maps();
-    rc = decode_finish();
-    if (rc == 0)
-        rc = refine_columns(maps, (int)p->refine);
-    if (rc == 0)
-        rc = tri_range_image(c, maps, refine_get_columns());
-    if (rc == 0)
-        rc = tri_normals(maps, p->normal_radius_px, p->max_depth_jump_mm);
-    if (rc != 0)
-        return rc;
-    size_t n = (size_t)maps->width * maps->height;
-    for (size_t i = 0; i < n; i++)
-        info->reason_count[maps->reason[i]]++;
-    info->valid_points = info->reason_count[SCAN_VALID];
-    last_angle_mdeg = angle_mdeg;
-    return 0;
+    return scan_finish_view(c, angle_mdeg, info);
 out_safe:
     hal->gpio.ops->safe_state(hal->gpio.priv);
     return rc != 0 ? rc : rc_off;

@@ -26,11 +26,31 @@ int scan_check(const struct scan_params *params, const struct scan_calib *calib,
 /** Put the rig in its idle state and open the camera. @retval 0 ok @retval what the camera said */
 int scan_open(const struct hal *hal, const struct hal_camera_config *cam_cfg);
 
+/** Where the frames of a view go to be kept (the scan directory); optional. */
+struct scan_frame_sink {
+    /** Keep frame @p pattern: RGB24 (channels 3, the white frame) or the decoder's grey.
+     *  @retval 0 ok @retval -errno, which stops the view */
+    int (*save)(void *priv, uint32_t pattern, const uint8_t *pixels, uint32_t width,
+                uint32_t height, uint32_t channels);
+    void *priv;
+};
+
 /** Capture and process one view at the current turntable angle. On any failure the projector
  *  and lights are off when it returns.
+ *  @param sink  keeps every frame as captured (NULL: frames are not kept)
  *  @retval 0 ok @retval -EINTR stop requested @retval capture or processing error */
 int scan_view(const struct hal *hal, const struct scan_params *params,
-              const struct scan_calib *calib, int32_t angle_mdeg, struct scan_view_info *info);
+              const struct scan_calib *calib, int32_t angle_mdeg,
+              const struct scan_frame_sink *sink, struct scan_view_info *info);
+
+/** The same processing without a rig, from kept frames (scanner process): begin, feed every
+ *  pattern in order (the white frame as RGB, channels 3; the others grey, channels 1, or RGB),
+ *  then finish. The live scan runs exactly this path. @retval 0 or -EINVAL */
+int scan_begin_view(const struct scan_params *params, const struct scan_calib *calib);
+int scan_feed_frame(uint32_t pattern, const uint8_t *pixels, uint32_t channels,
+                    const struct scan_frame_sink *sink);
+int scan_finish_view(const struct scan_calib *calib, int32_t angle_mdeg,
+                     struct scan_view_info *info);
 
 /** Write the last view's point cloud (object frame) as binary PLY.
  *  @retval 0 ok @retval -errno from storage */

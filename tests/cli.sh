@@ -26,10 +26,21 @@ printf '[camera]\nbackend = sim\nwidth = 1280\nheight = 960\nexposure_us = 10000
 check bad_config_names_file_line_key sh -c \
     "$bin scan --config $out/bad.ini 2>&1 | grep -q '$out/bad.ini:6: \[camera\] exposur: unknown key'"
 check bad_config_exit_code sh -c "$bin scan --config $out/bad.ini; test \$? -eq 2"
-rm -rf "$out/scan"
+rm -rf "$out/scan" "$out/broken" "$out/broken_out"
 check scan sh -c "$bin scan --config config/sim.ini --out $out/scan | grep -q 'scan finished'"
-check scan_dir_complete sh -c "for f in config.ini calibration.ini view_000/cloud.ply view_000/colour.png \
-    view_000/view.ini view_000/truth_depth_mm.pfm view_000/truth_albedo.png; do test -s $out/scan/\$f || exit 1; done"
+check scan_dir_complete sh -c "for f in config.ini calibration.ini view_000/cloud.ply view_000/frame_00.png \
+    view_000/frame_21.png view_000/view.ini view_000/truth_depth_mm.pfm view_000/truth_albedo.png; do \
+    test -s $out/scan/\$f || exit 1; done"
+rm -rf "$out/processed"
+check process_reproduces_scan sh -c "$bin process $out/scan --out $out/processed >/dev/null && \
+    cmp $out/scan/view_000/cloud.ply $out/processed/view_000/cloud.ply"
+check json_events sh -c "$bin process $out/scan --out $out/processed --json | /usr/bin/python3 -c '
+import json, sys
+events = [json.loads(line)[\"event\"] for line in sys.stdin]
+assert events[0] == \"process_start\" and events[-1] == \"process_done\" and \"saved\" in events, events'"
+cp -r "$out/scan" "$out/broken" 2>/dev/null; rm -f "$out/broken/view_000/frame_07.png"
+check process_names_missing_frame sh -c "$bin process $out/broken --out $out/broken_out 2>&1 | \
+    grep -q 'view_000/frame_07.png: No such file'; test \$? -eq 0"
 # SIGINT mid-scan: the scan stops between frames, says so, and the rig ends in its safe state.
 sigint_test() {
     "$bin" scan --config config/sim.ini --out "$out/interrupted" >"$out/int.log" 2>&1 &

@@ -36,7 +36,7 @@ int main(int argc, char **argv)
                     return 1;
                 struct scan_view_info info;
                 double t0 = now_ms();
-                int rc = scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, &info);
+                int rc = scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info);
                 double ms = now_ms() - t0;
                 if (rc != 0)
                     return 1;

@@ -16,6 +16,14 @@
 #define PROJ_W 64
 
 static uint8_t frame[W * H * 3];
+static uint8_t grey[W * H];
+
+/* The decoder sees grey frames, converted as the scan converts camera frames. */
+static int feed(uint32_t pattern)
+{
+    decode_rgb_to_grey(frame, grey, W * H, 250);
+    return decode_frame(pattern, grey);
+}
 
 static struct scan_params params(void)
 {
@@ -56,7 +64,7 @@ static void decode_all(uint32_t bits)
     assert_int_equal(decode_begin(&p, PROJ_W), 0);
     for (uint32_t i = 0; i < gray_pattern_count(bits); i++) {
         render(i, bits);
-        assert_int_equal(decode_frame(i, frame), 0);
+        assert_int_equal(feed(i), 0);
     }
     assert_int_equal(decode_finish(), 0);
 }
@@ -79,14 +87,29 @@ static void test_columns_and_reasons(void **state)
     assert_string_equal(scan_reason_name(SCAN_LOW_CONTRAST), "low_contrast");
 }
 
+/* Saturation in any channel marks the grey pixel; real grey levels never reach the mark. */
+static void test_grey_conversion(void **state)
+{
+    (void)state;
+    const uint8_t rgb[4 * 3] = {255, 255, 255, 10, 250, 10, 249, 249, 249, 0, 0, 0};
+    uint8_t g[4];
+    decode_rgb_to_grey(rgb, g, 4, 250);
+    assert_int_equal(g[0], DECODE_SATURATED);
+    assert_int_equal(g[1], DECODE_SATURATED); /* one channel is enough */
+    assert_int_equal(g[2], 249); /* weights sum to 256: a grey stays itself */
+    assert_int_equal(g[3], 0);
+    decode_rgb_to_grey(rgb, g, 1, 256); /* no saturation level: 255 still cannot be a grey */
+    assert_int_equal(g[0], 254);
+}
+
 static void test_frames_out_of_order_rejected(void **state)
 {
     (void)state;
     struct scan_params p = params();
     assert_int_equal(decode_begin(&p, PROJ_W), 0);
     render(0, 6);
-    assert_int_equal(decode_frame(1, frame), -EINVAL);
-    assert_int_equal(decode_frame(0, frame), 0);
+    assert_int_equal(feed(1), -EINVAL);
+    assert_int_equal(feed(0), 0);
     assert_int_equal(decode_finish(), -EINVAL); /* frames missing */
 }
 
@@ -115,7 +138,7 @@ static void test_ambiguous_bits(void **state)
             memset(&frame[3 * 10], 120, 3);
         if (k <= 1)
             memset(&frame[3 * 20], 120, 3);
-        assert_int_equal(decode_frame(i, frame), 0);
+        assert_int_equal(feed(i), 0);
     }
     assert_int_equal(decode_finish(), 0);
     const struct decode_maps *m = decode_get_maps();
@@ -136,7 +159,7 @@ static void test_lone_wrong_code_inconsistent(void **state)
             int lit = gray_pattern_lit(bits, i == 2 ? 3 : 2, 10);
             memset(&frame[3 * (2 * W + 10)], lit ? 201 : 53, 3);
         }
-        assert_int_equal(decode_frame(i, frame), 0);
+        assert_int_equal(feed(i), 0);
     }
     assert_int_equal(decode_finish(), 0);
     const struct decode_maps *m = decode_get_maps();
@@ -148,6 +171,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_columns_and_reasons),
+        cmocka_unit_test(test_grey_conversion),
         cmocka_unit_test(test_frames_out_of_order_rejected),
         cmocka_unit_test(test_size_above_limit_rejected),
         cmocka_unit_test(test_ambiguous_bits),

@@ -96,7 +96,7 @@ static void test_no_allocation_during_a_view(void **state)
     struct scan_view_info info;
     alloc_calls = 0;
     counting = 1;
-    int rc = scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, &info);
+    int rc = scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info);
     int rc_save = rc == 0 ? scan_save_cloud(&t.hal, &t.calib, "build/test_nomalloc.ply") : rc;
     counting = 0;
     assert_int_equal(rc, 0);

@@ -43,7 +43,7 @@ static void test_transient_timeout_is_retried(void **state)
     (void)state;
     struct scan_view_info info;
     sim_ctl_inject_camera_fault(SIM_FAULT_TIMEOUT, 5, 2); /* two bad captures, retries = 2 */
-    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, &info), 0);
+    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info), 0);
     assert_int_equal(info.capture_retries, 2);
     assert_int_equal(info.frames_captured, 22);
     assert_true(info.valid_points > 10000);
@@ -56,7 +56,7 @@ static void test_persistent_fault_stops_with_projector_off(void **state)
     struct scan_view_info info;
     uint64_t start = sim_ctl_frames();
     sim_ctl_inject_camera_fault(SIM_FAULT_CORRUPT, start + 7, 100);
-    int rc = scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, &info);
+    int rc = scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info);
     assert_int_equal(rc, -EIO);
     /* tried 1 + capture_retries times, then gave up and said which pattern */
     assert_int_equal(sim_ctl_frames() - start, 7 + 1 + t.cfg.scan.capture_retries);
@@ -71,7 +71,7 @@ static void test_unplugged_camera_not_retried(void **state)
     struct scan_view_info info;
     uint64_t start = sim_ctl_frames();
     sim_ctl_inject_camera_fault(SIM_FAULT_NO_DEVICE, start + 3, 100);
-    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, &info), -ENODEV);
+    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info), -ENODEV);
     assert_int_equal(sim_ctl_frames() - start, 4); /* no retry can bring a camera back */
     assert_rig_dark();
     sim_ctl_inject_camera_fault(SIM_FAULT_NONE, 0, 0);
@@ -87,7 +87,7 @@ static void test_stop_request_leaves_rig_dark(void **state)
     (void)state;
     struct scan_view_info info;
     t.hal.stop_requested = stop_after_frames;
-    int rc = scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, &info);
+    int rc = scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info);
     t.hal.stop_requested = NULL;
     assert_int_equal(rc, -EINTR);
     assert_true(info.frames_captured < 22);

@@ -18,7 +18,7 @@ static void scan_and_measure(const char *object, struct view_quality *q)
     snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "%s", object);
     assert_int_equal(test_rig_start(&t), 0);
     struct scan_view_info info;
-    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, &info), 0);
+    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info), 0);
     assert_int_equal(info.frames_captured, 22);
     test_measure_view(sim_ctl_rig(), q);
     assert_int_equal(info.valid_points, q->valid);

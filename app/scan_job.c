@@ -1,0 +1,340 @@
+/* Scan jobs: the view loop shared by live scans and offline re-processing. */
+#define _POSIX_C_SOURCE 200809L
+#include "scan_job.h"
+
+#include "board.h"
+#include "gray.h"
+#include "image_io.h"
+#include "scan.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <ini.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+struct job {
+    const struct hal *hal;
+    const struct app_config *cfg;
+    const struct scan_calib *calib;
+    const struct scan_job_opts *opts;
+    const char *out_dir;
+    uint32_t views;
+    double start_ms;
+    int tty;
+    char view_dir[HAL_MAX_PATH + 32];
+};
+
+static double wall_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
+}
+
+static void utc_now(char *buf, size_t len)
+{
+    time_t t = time(NULL);
+    struct tm tm;
+    gmtime_r(&t, &tm);
+    strftime(buf, len, "%Y-%m-%dT%H:%M:%SZ", &tm);
+}
+
+/* ---- progress: a status line on a terminal, plain lines in a log, JSON for a front end ---- */
+
+static void json_string(FILE *out, const char *s)
+{
+    fputc('"', out);
+    for (; *s != '\0'; s++) {
+        if (*s == '"' || *s == '\\')
+            fprintf(out, "\\%c", *s);
+        else if ((unsigned char)*s < 0x20)
+            fprintf(out, "\\u%04x", (unsigned)(unsigned char)*s);
+        else
+            fputc(*s, out);
+    }
+    fputc('"', out);
+}
+
+/* One event. @p view < 0: not about a view. @p done: views finished so far, for the estimate. */
+static void progress(struct job *j, const char *event, int view, uint32_t done, const char *detail)
+{
+    double elapsed_s = (wall_ms() - j->start_ms) / 1000.0;
+    double left_s = done > 0 ? elapsed_s / done * (j->views - done) : -1.0;
+    if (j->opts->json) {
+        printf("{\"event\":\"%s\",\"view\":%d,\"views\":%u,\"elapsed_s\":%.1f,\"left_s\":%.1f,"
+               "\"detail\":",
+               event, view, (unsigned)j->views, elapsed_s, left_s);
+        json_string(stdout, detail);
+        printf("}\n");
+    } else if (j->tty && view >= 0) {
+        printf("\r\033[Kview %d of %u: %-10s %s  %.0f s elapsed%s", view + 1, (unsigned)j->views,
+               event, detail, elapsed_s, left_s >= 0 ? "" : "");
+        if (left_s >= 0)
+            printf(", ~%.0f s left", left_s);
+        if (strcmp(event, "saved") == 0)
+            printf("\n");
+    } else if (view >= 0 && strcmp(event, "saved") == 0) {
+        printf("view %d of %u: %s\n", view + 1, (unsigned)j->views, detail);
+    } else if (view < 0) {
+        static const char *const human[][2] = {{"scan_start", "scanning into"},
+                                               {"scan_done", "scan finished:"},
+                                               {"scan_failed", "scan failed:"},
+                                               {"process_start", "processing"},
+                                               {"process_done", "process finished:"}};
+        const char *text = event;
+        for (size_t k = 0; k < sizeof(human) / sizeof(human[0]); k++)
+            if (strcmp(event, human[k][0]) == 0)
+                text = human[k][1];
+        printf("%s %s\n", text, detail);
+    }
+    fflush(stdout);
+}
+
+/* ---- the scan directory ---- */
+
+static int save_frame(void *priv, uint32_t pattern, const uint8_t *pixels, uint32_t width,
+                      uint32_t height, uint32_t channels)
+{
+    struct job *j = priv;
+    char path[HAL_MAX_PATH + 64];
+    snprintf(path, sizeof(path), "%s/frame_%02u.png", j->view_dir, (unsigned)pattern);
+    return image_write_png(&j->hal->storage, path, pixels, width, height, (int)channels);
+}
+
+static int copy_file(const struct hal_storage *st, const char *from, const char *to)
+{
+    static char buf[1 << 16]; /* config and calibration files are small */
+    FILE *f = fopen(from, "rb");
+    if (f == NULL)
+        return -errno;
+    size_t n = fread(buf, 1, sizeof(buf), f);
+    int too_big = !feof(f);
+    fclose(f);
+    return too_big ? -EFBIG : hal_storage_write_file(st, to, buf, n);
+}
+
+static const char *pattern_name(uint32_t pattern, uint32_t bits, char *buf, size_t len)
+{
+    if (pattern == GRAY_PATTERN_WHITE)
+        snprintf(buf, len, "white, RGB (the view's colour)");
+    else if (pattern == GRAY_PATTERN_BLACK)
+        snprintf(buf, len, "black, grey");
+    else
+        snprintf(buf, len, "column bit %u of %u%s, grey",
+                 (unsigned)(pattern - GRAY_PATTERN_FIRST_BIT) / 2u, (unsigned)bits,
+                 (pattern - GRAY_PATTERN_FIRST_BIT) % 2u ? " inverse" : "");
+    return buf;
+}
+
+static int write_view_meta(struct job *j, uint32_t view, const struct scan_view_info *info,
+                           const char *started, double ms)
+{
+    char text[4096], finished[32], name[64];
+    utc_now(finished, sizeof(finished));
+    uint32_t bits = gray_bits_for_width(j->calib->proj_width);
+    int len = snprintf(
+        text, sizeof(text),
+        "; one view of a scan: see docs/scan-format.md\n[view]\nindex = %u\nangle_mdeg = %d\n"
+        "started = %s\nfinished = %s\nframes = %u\ncapture_retries = %u\nvalid_points = %u\n"
+        "wall_ms = %.1f\n[capture]\nexposure_us = %u\ngain_milli = %u\nprojector = on\n"
+        "lights = off\n",
+        (unsigned)view, (int)info->angle_mdeg, started, finished, (unsigned)info->frames_captured,
+        (unsigned)info->capture_retries, (unsigned)info->valid_points, ms,
+        (unsigned)j->cfg->camera.exposure_us, (unsigned)j->cfg->camera.gain_milli);
+    for (uint32_t p = 0; p < gray_pattern_count(bits) && (size_t)len < sizeof(text); p++)
+        len += snprintf(text + len, sizeof(text) - (size_t)len, "frame_%02u = %s\n", (unsigned)p,
+                        pattern_name(p, bits, name, sizeof(name)));
+    len += snprintf(text + len, sizeof(text) - (size_t)len, "[pixels]\n");
+    for (unsigned r = 0; r < SCAN_REASON_COUNT && (size_t)len < sizeof(text); r++)
+        len += snprintf(text + len, sizeof(text) - (size_t)len, "%s = %u\n", scan_reason_name(r),
+                        (unsigned)info->reason_count[r]);
+    char path[HAL_MAX_PATH + 64];
+    snprintf(path, sizeof(path), "%s/view.ini", j->view_dir);
+    return hal_storage_write_file(&j->hal->storage, path, text, (size_t)len);
+}
+
+/* Results of a processed view (its frames, the colour among them, were kept while capturing). */
+static int save_results(struct job *j)
+{
+    char path[HAL_MAX_PATH + 64];
+    snprintf(path, sizeof(path), "%s/cloud.ply", j->view_dir);
+    return scan_save_cloud(j->hal, j->calib, path);
+}
+
+static void set_view_dir(struct job *j, uint32_t view)
+{
+    snprintf(j->view_dir, sizeof(j->view_dir), "%s/view_%03u", j->out_dir, (unsigned)view);
+}
+
+/* ---- live ---- */
+
+static int live_view(struct job *j, uint32_t v)
+{
+    const struct hal *hal = j->hal;
+    int32_t target = (int32_t)((j->cfg->start_angle_deg + 360.0 * v / j->views) * 1000.0);
+    char detail[HAL_MAX_PATH + 128], started[32];
+    snprintf(detail, sizeof(detail), "to %.1f deg", target / 1000.0);
+    progress(j, "moving", (int)v, v, detail);
+    int rc = hal_table_move_to(&hal->turntable, target);
+    struct hal_turntable_status st;
+    if (rc == 0)
+        rc = hal_table_get_status(&hal->turntable, &st); /* the angle the controller reports */
+    if (rc != 0) {
+        hal->log(HAL_LOG_ERROR, "view %u: the turntable did not reach %.3f deg", (unsigned)v,
+                 target / 1000.0);
+        return rc;
+    }
+    set_view_dir(j, v);
+    rc = hal_storage_mkdir_p(&hal->storage, j->view_dir);
+    if (rc != 0)
+        return rc;
+    utc_now(started, sizeof(started));
+    progress(j, "capturing", (int)v, v, "");
+    struct scan_frame_sink sink = {save_frame, j};
+    struct scan_view_info info;
+    double t0 = wall_ms();
+    rc = scan_view(hal, &j->cfg->scan, j->calib, st.position_mdeg, &sink, &info);
+    if (rc != 0) {
+        hal->log(HAL_LOG_ERROR, "view %u at %.3f deg failed: %s", (unsigned)v,
+                 st.position_mdeg / 1000.0, rc == -EINTR ? "stopped by request" : strerror(-rc));
+        return rc;
+    }
+    progress(j, "saving", (int)v, v, "");
+    rc = save_results(j);
+    if (rc == 0)
+        rc = board_write_view_extras(hal, j->view_dir);
+    /* view.ini last: its presence says the view is complete */
+    if (rc == 0)
+        rc = write_view_meta(j, v, &info, started, wall_ms() - t0);
+    if (rc != 0) {
+        hal->log(HAL_LOG_ERROR, "cannot save %s: %s", j->view_dir, strerror(-rc));
+        return rc;
+    }
+    snprintf(detail, sizeof(detail), "%u points at %.1f deg -> %s/cloud.ply",
+             (unsigned)info.valid_points, info.angle_mdeg / 1000.0, j->view_dir);
+    progress(j, "saved", (int)v, v + 1, detail);
+    return 0;
+}
+
+int scan_job_live(const struct hal *hal, const struct app_config *cfg,
+                  const struct scan_calib *calib, const struct scan_job_opts *opts)
+{
+    struct job j = {hal, cfg, calib, opts, opts->out_dir ? opts->out_dir : cfg->output_dir,
+                    cfg->views, wall_ms(), isatty(STDOUT_FILENO) && !opts->json, ""};
+    char path[HAL_MAX_PATH + 32];
+    int rc = hal_storage_mkdir_p(&hal->storage, j.out_dir);
+    if (rc == 0) {
+        snprintf(path, sizeof(path), "%s/config.ini", j.out_dir);
+        rc = copy_file(&hal->storage, cfg->path, path);
+    }
+    if (rc == 0) {
+        snprintf(path, sizeof(path), "%s/calibration.ini", j.out_dir);
+        rc = copy_file(&hal->storage, cfg->calibration_file, path);
+    }
+    if (rc != 0) {
+        hal->log(HAL_LOG_ERROR, "cannot set up the scan directory %s: %s", j.out_dir,
+                 strerror(-rc));
+        return rc;
+    }
+    progress(&j, "scan_start", -1, 0, j.out_dir);
+    progress(&j, "homing", 0, 0, "");
+    rc = hal_table_home(&hal->turntable);
+    if (rc != 0)
+        hal->log(HAL_LOG_ERROR, "the turntable did not home");
+    for (uint32_t v = 0; v < cfg->views && rc == 0; v++)
+        rc = live_view(&j, v);
+    if (rc == 0)
+        progress(&j, "scan_done", -1, j.views, j.out_dir);
+    else if (opts->json)
+        progress(&j, "scan_failed", -1, 0, strerror(-rc));
+    return rc;
+}
+
+/* ---- offline ---- */
+
+static int read_angle(void *user, const char *section, const char *name, const char *value)
+{
+    if (strcmp(section, "view") == 0 && strcmp(name, "angle_mdeg") == 0)
+        *(long *)user = strtol(value, NULL, 10);
+    return 1;
+}
+
+static int process_view(struct job *j, uint32_t v, const char *in_view_dir)
+{
+    static uint8_t pixels[HAL_MAX_PIXELS * 3];
+    const struct hal *hal = j->hal;
+    char path[HAL_MAX_PATH + 64];
+    long angle = LONG_MIN;
+    snprintf(path, sizeof(path), "%s/view.ini", in_view_dir);
+    if (ini_parse(path, read_angle, &angle) != 0 || angle == LONG_MIN) {
+        hal->log(HAL_LOG_ERROR, "%s: missing or without [view] angle_mdeg", path);
+        return -EINVAL;
+    }
+    int rc = scan_begin_view(&j->cfg->scan, j->calib);
+    uint32_t count = gray_pattern_count(gray_bits_for_width(j->calib->proj_width));
+    for (uint32_t p = 0; p < count && rc == 0; p++) {
+        uint32_t w, h;
+        int channels = p == GRAY_PATTERN_WHITE ? 3 : 1;
+        snprintf(path, sizeof(path), "%s/frame_%02u.png", in_view_dir, (unsigned)p);
+        rc = image_read_png(path, pixels, sizeof(pixels), &w, &h, channels);
+        if (rc == 0 && (w != j->cfg->camera.width || h != j->cfg->camera.height))
+            rc = -EINVAL;
+        if (rc != 0)
+            hal->log(HAL_LOG_ERROR, "%s: %s", path,
+                     rc == -EINVAL ? "not a frame of this scan's size" : strerror(-rc));
+        else
+            rc = scan_feed_frame(p, pixels, (uint32_t)channels, NULL);
+    }
+    struct scan_view_info info;
+    memset(&info, 0, sizeof(info));
+    if (rc == 0)
+        rc = scan_finish_view(j->calib, (int32_t)angle, &info);
+    set_view_dir(j, v);
+    if (rc == 0)
+        rc = hal_storage_mkdir_p(&hal->storage, j->view_dir);
+    if (rc == 0)
+        rc = save_results(j);
+    if (rc == 0) {
+        char detail[HAL_MAX_PATH + 96];
+        snprintf(detail, sizeof(detail), "%u points at %.1f deg -> %s/cloud.ply",
+                 (unsigned)info.valid_points, angle / 1000.0, j->view_dir);
+        progress(j, "saved", (int)v, v + 1, detail);
+    }
+    return rc;
+}
+
+int scan_job_process(const struct hal *hal, const char *scan_dir, const struct scan_job_opts *opts)
+{
+    static struct app_config cfg;
+    static struct scan_calib calib;
+    char path[HAL_MAX_PATH + 32], err[512];
+    snprintf(path, sizeof(path), "%s/config.ini", scan_dir);
+    int rc = config_load(&cfg, path, err, sizeof(err));
+    if (rc == 0) {
+        /* the calibration is the copy kept with the scan, whatever the config named */
+        snprintf(cfg.calibration_file, sizeof(cfg.calibration_file), "%s/calibration.ini",
+                 scan_dir);
+        rc = calib_load(&calib, cfg.calibration_file, cfg.light_count, err, sizeof(err));
+    }
+    if (rc != 0) {
+        hal->log(HAL_LOG_ERROR, "%s", err);
+        return rc;
+    }
+    struct job j = {hal, &cfg, &calib, opts, opts->out_dir ? opts->out_dir : scan_dir,
+                    cfg.views, wall_ms(), isatty(STDOUT_FILENO) && !opts->json, ""};
+    rc = hal_storage_mkdir_p(&hal->storage, j.out_dir);
+    progress(&j, "process_start", -1, 0, scan_dir);
+    for (uint32_t v = 0; v < cfg.views && rc == 0; v++) {
+        char in_dir[HAL_MAX_PATH + 32];
+        snprintf(in_dir, sizeof(in_dir), "%s/view_%03u", scan_dir, (unsigned)v);
+        rc = process_view(&j, v, in_dir);
+    }
+    if (rc == 0)
+        progress(&j, "process_done", -1, j.views, j.out_dir);
+    return rc;
+}

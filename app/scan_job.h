@@ -1,0 +1,24 @@
+/* A whole scan: views on the rig (live) or from a scan directory (offline), progress reports,
+ * and everything kept in the scan directory (docs/scan-format.md). */
+#ifndef SCAN_JOB_H
+#define SCAN_JOB_H
+
+#include "config.h"
+#include "hal.h"
+
+struct scan_job_opts {
+    int json;           /**< one JSON status line per event instead of the terminal display */
+    const char *out_dir; /**< results go here (process: default the scan directory itself) */
+};
+
+/** Home the table and take every configured view, saving each before the next move.
+ *  @retval 0 ok @retval the first error (views finished before it are kept) */
+int scan_job_live(const struct hal *hal, const struct app_config *cfg,
+                  const struct scan_calib *calib, const struct scan_job_opts *opts);
+
+/** Recompute every result of the scan in @p scan_dir from its kept frames alone.
+ *  @param hal  storage, clock and log only; no device is touched
+ *  @retval 0 ok @retval -errno with the file named in the log */
+int scan_job_process(const struct hal *hal, const char *scan_dir, const struct scan_job_opts *opts);
+
+#endif
