@@ -48,7 +48,7 @@ HOST_OBJ := $(call obj,$(POSIX_SRC) $(APP_LIB_SRC) $(BOARD_SRC))
 MAIN_OBJ := $(call obj,app/main.c)
 
 .PHONY: all deps test-deps test run clean format docs check-firmware bench measure
-SIM_TOOLS := $(if $(filter sim,$(HAL)),$(BUILD)/turntable-sim $(BUILD)/tt-client,)
+SIM_TOOLS := $(if $(filter sim,$(HAL)),$(BUILD)/turntable-sim $(BUILD)/tt-client $(BUILD)/mesh-compare,)
 all: deps $(BUILD)/scanner $(SIM_TOOLS)
 
 # Install missing Debian packages (fresh Debian 12): only when pkg-config cannot find them.
@@ -75,8 +75,12 @@ $(BUILD)/turntable-sim: $(call obj,host_sim/turntable_sim_main.c host_sim/tt_ser
 $(BUILD)/tt-client: $(call obj,tests/tt_client_main.c hal/modbus/turntable_modbus.c hal/posix/clock_posix.c) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON)
 
+$(BUILD)/mesh-compare: $(call obj,tests/mesh_compare.c tests/mesh_compare_lib.c host_sim/sim_bvh.c host_sim/sim_mesh.c host_sim/sim_ply_read.c app/config.c app/ini_schema.c) $(BUILD)/libfirmware.a
+	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON)
+
 # ---- tests ----
 TEST_SRC := $(filter-out tests/test_util.c,$(wildcard tests/test_*.c))
+TEST_SUPPORT := $(BUILD)/tests/test_util.o $(BUILD)/tests/mesh_compare_lib.o
 TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 TEST_LIBS = $(shell pkg-config --libs cmocka libmodbus 2>/dev/null)
 
@@ -84,7 +88,7 @@ TEST_LIBS = $(shell pkg-config --libs cmocka libmodbus 2>/dev/null)
 TEST_EXTRA_OBJ := $(if $(filter sim,$(HAL)),$(call obj,hal/linux/gpio_gpiod.c),)
 TEST_EXTRA_LIBS = $(shell pkg-config --libs libgpiod 2>/dev/null)
 
-$(BUILD)/tests/%: $(BUILD)/tests/%.o $(BUILD)/tests/test_util.o $(HOST_OBJ) $(TEST_EXTRA_OBJ) $(BUILD)/libfirmware.a
+$(BUILD)/tests/%: $(BUILD)/tests/%.o $(TEST_SUPPORT) $(HOST_OBJ) $(TEST_EXTRA_OBJ) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(TEST_LIBS) $(LDLIBS_COMMON) $(TEST_EXTRA_LIBS)
 
 $(BUILD)/tests/test_util.o: tests/test_util.c | deps

@@ -14,6 +14,9 @@ const char *board_name(void);
 int board_init(struct hal *hal, const struct app_config *cfg, const struct scan_calib *calib,
                char *err, size_t err_len);
 
+/** Extra files for a whole scan (the simulator writes its true mesh). @retval 0 or -errno */
+int board_write_scan_extras(const struct hal *hal, const char *scan_dir);
+
 /** Extra files for a finished view (the simulator writes its ground truth). @retval 0 or -errno */
 int board_write_view_extras(const struct hal *hal, const char *view_dir);
 

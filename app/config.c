@@ -122,6 +122,19 @@ static const struct ini_key config_keys[] = {
         "the reached angle must be this close to the target"),
     U32("turntable", "settle_ms", turntable.settle_ms, 0, 60000, "300",
         "wait after a move before capturing"),
+    F64("fusion", "voxel_mm", fusion.voxel_mm, 0.1, 20, "1.0", "edge of a fusion voxel"),
+    F64("fusion", "radius_mm", fusion.radius_mm, 5, 2000, "100",
+        "the fused volume spans this radius around the turntable axis"),
+    F64("fusion", "bottom_mm", fusion.bottom_mm, -1000, 1000, "-3",
+        "lowest height fused (table surface = 0)"),
+    F64("fusion", "top_mm", fusion.top_mm, -1000, 2000, "165", "highest height fused"),
+    F64("fusion", "truncation_mm", fusion.truncation_mm, 0.1, 100, "2.5",
+        "signed distances are clamped to +- this"),
+    F64("fusion", "max_weight", fusion.max_weight, 1, 60, "50", "a voxel's weight stops here"),
+    U32("fusion", "edge_fade_px", fusion.edge_fade_px, 0, 200, "12",
+        "view weights ramp up over this many pixels from the view's edge"),
+    F64("fusion", "min_weight", fusion.min_weight, 0, 1, "0.05",
+        "pixels weighing less (grazing, far) are not fused"),
     ENUM("sim", "object", sim.object, "sphere|cylinder|box|torus|mesh", "sphere",
          "simulated object"),
     STR("sim", "mesh_file", sim.mesh_file, "", "PLY mesh for object = mesh, relative to this file"),
@@ -230,6 +243,16 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
     if (cfg->scan.shadow_contrast_dn >= cfg->scan.min_contrast_dn) {
         snprintf(err, err_len, "%s: [scan] shadow_contrast_dn: %u must be below min_contrast_dn %u",
                  path, (unsigned)cfg->scan.shadow_contrast_dn, (unsigned)cfg->scan.min_contrast_dn);
+        return -EINVAL;
+    }
+    uint32_t dims[3];
+    if (fusion_dims(&cfg->fusion, dims) != 0) {
+        snprintf(err, err_len,
+                 "%s: [fusion] voxel_mm: a %.2f mm grid over radius %.0f mm and heights %.0f..%.0f "
+                 "mm exceeds the compiled limit (%u per axis, %u voxels: FUSION_MAX_* in "
+                 "firmware/fusion.h)",
+                 path, cfg->fusion.voxel_mm, cfg->fusion.radius_mm, cfg->fusion.bottom_mm,
+                 cfg->fusion.top_mm, FUSION_MAX_DIM, FUSION_MAX_VOXELS);
         return -EINVAL;
     }
     if (strcmp(cfg->sim.object, "mesh") == 0 && cfg->sim.mesh_file[0] == '\0') {

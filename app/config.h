@@ -4,6 +4,7 @@
 #define CONFIG_H
 
 #include "hal.h"
+#include "fusion.h"
 #include "scan_types.h"
 #include "turntable_modbus.h"
 #include "vec3.h"
@@ -50,6 +51,7 @@ struct app_config {
     char output_dir[HAL_MAX_PATH];
     struct gpio_config gpio;
     struct tt_client_config turntable;
+    struct fusion_params fusion;
     struct sim_config sim;
 };
 

@@ -3,6 +3,7 @@
 #include "scan_job.h"
 
 #include "board.h"
+#include "fusion.h"
 #include "gray.h"
 #include "image_io.h"
 #include "scan.h"
@@ -158,12 +159,40 @@ static int write_view_meta(struct job *j, uint32_t view, const struct scan_view_
     return hal_storage_write_file(&j->hal->storage, path, text, (size_t)len);
 }
 
-/* Results of a processed view (its frames, the colour among them, were kept while capturing). */
+/* Results of a processed view (its frames, the colour among them, were kept while capturing):
+ * its point cloud, and its part of the fused model. */
 static int save_results(struct job *j)
 {
     char path[HAL_MAX_PATH + 64];
     snprintf(path, sizeof(path), "%s/cloud.ply", j->view_dir);
-    return scan_save_cloud(j->hal, j->calib, path);
+    int rc = scan_save_cloud(j->hal, j->calib, path);
+    struct frame_xform pose;
+    scan_view_pose(j->calib, &pose);
+    if (rc == 0)
+        rc = scan_fuse_view(j->calib, &pose);
+    return rc;
+}
+
+/* The fused model: mesh.ply and mesh.obj in the scan directory. */
+static int write_model(struct job *j)
+{
+    char path[HAL_MAX_PATH + 32], detail[HAL_MAX_PATH + 96];
+    uint32_t vertices = 0, triangles = 0;
+    progress(j, "meshing", -1, j->views, "marching cubes");
+    snprintf(path, sizeof(path), "%s/mesh.ply", j->out_dir);
+    int rc = fusion_write_ply(&j->hal->storage, path, &vertices, &triangles);
+    if (rc == 0) {
+        snprintf(path, sizeof(path), "%s/mesh.obj", j->out_dir);
+        rc = fusion_write_obj(&j->hal->storage, path);
+    }
+    if (rc != 0) {
+        j->hal->log(HAL_LOG_ERROR, "cannot write %s: %s", path, strerror(-rc));
+        return rc;
+    }
+    snprintf(detail, sizeof(detail), "%u vertices, %u triangles -> %s/mesh.ply and mesh.obj",
+             (unsigned)vertices, (unsigned)triangles, j->out_dir);
+    progress(j, "mesh", -1, j->views, detail);
+    return 0;
 }
 
 static void set_view_dir(struct job *j, uint32_t view)
@@ -241,6 +270,11 @@ int scan_job_live(const struct hal *hal, const struct app_config *cfg,
                  strerror(-rc));
         return rc;
     }
+    rc = fusion_begin(&cfg->fusion);
+    if (rc == 0)
+        rc = board_write_scan_extras(hal, j.out_dir);
+    if (rc != 0)
+        return rc;
     progress(&j, "scan_start", -1, 0, j.out_dir);
     progress(&j, "homing", 0, 0, "");
     rc = hal_table_home(&hal->turntable);
@@ -248,6 +282,8 @@ int scan_job_live(const struct hal *hal, const struct app_config *cfg,
         hal->log(HAL_LOG_ERROR, "the turntable did not home");
     for (uint32_t v = 0; v < cfg->views && rc == 0; v++)
         rc = live_view(&j, v);
+    if (rc == 0)
+        rc = write_model(&j);
     if (rc == 0)
         progress(&j, "scan_done", -1, j.views, j.out_dir);
     else if (opts->json)
@@ -328,12 +364,16 @@ int scan_job_process(const struct hal *hal, const char *scan_dir, const struct s
     struct job j = {hal, &cfg, &calib, opts, opts->out_dir ? opts->out_dir : scan_dir,
                     cfg.views, wall_ms(), isatty(STDOUT_FILENO) && !opts->json, ""};
     rc = hal_storage_mkdir_p(&hal->storage, j.out_dir);
+    if (rc == 0)
+        rc = fusion_begin(&cfg.fusion);
     progress(&j, "process_start", -1, 0, scan_dir);
     for (uint32_t v = 0; v < cfg.views && rc == 0; v++) {
         char in_dir[HAL_MAX_PATH + 32];
         snprintf(in_dir, sizeof(in_dir), "%s/view_%03u", scan_dir, (unsigned)v);
         rc = process_view(&j, v, in_dir);
     }
+    if (rc == 0)
+        rc = write_model(&j);
     if (rc == 0)
         progress(&j, "process_done", -1, j.views, j.out_dir);
     return rc;

@@ -30,3 +30,27 @@ void frame_object_from_camera(const struct scan_calib *calib, int32_t angle_mdeg
                                 rz[r * 3 + 1] * t.rot[1 * 3 + k] + rz[r * 3 + 2] * t.rot[2 * 3 + k];
     o->origin = t.origin;
 }
+
+static void m3_mul_m3(const double a[9], const double b[9], double out[9])
+{
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++)
+            out[r * 3 + c] = a[r * 3] * b[c] + a[r * 3 + 1] * b[3 + c] + a[r * 3 + 2] * b[6 + c];
+}
+
+void frame_compose(const struct frame_xform *a, const struct frame_xform *b,
+                   struct frame_xform *out)
+{
+    /* a(b(p)) = Ra (Rb (p - ob) - oa) = Ra Rb (p - (ob + Rb^T oa)) */
+    m3_mul_m3(a->rot, b->rot, out->rot);
+    out->origin = v3_add(b->origin, m3_tmul(b->rot, a->origin));
+}
+
+void frame_invert(const struct frame_xform *a, struct frame_xform *out)
+{
+    /* q = Ra (p - oa)  <=>  p = Ra^T q + oa = Ra^T (q - (-Ra oa)) */
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++)
+            out->rot[r * 3 + c] = a->rot[c * 3 + r];
+    out->origin = v3_scale(m3_mul(a->rot, a->origin), -1.0);
+}

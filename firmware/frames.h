@@ -42,4 +42,10 @@ static inline vec3 frame_dir_inv(const struct frame_xform *x, vec3 d)
     return m3_tmul(x->rot, d);
 }
 
+/** out(p) = a(b(p)). @p out may alias neither input. */
+void frame_compose(const struct frame_xform *a, const struct frame_xform *b,
+                   struct frame_xform *out);
+/** out = a^-1. */
+void frame_invert(const struct frame_xform *a, struct frame_xform *out);
+
 #endif

@@ -1,22 +1,7 @@
-/* Binary PLY writer: fixed-size chunk buffer, explicit little-endian byte order. */
+/* Binary PLY point cloud of a view, explicit little-endian byte order. */
 #include "ply.h"
 
-#include <stdio.h>
-#include <string.h>
-
-#define PLY_VERTEX_BYTES 27u /* 6 floats + 3 uchar */
-static uint8_t chunk[64u * 1024u];
-
-static uint8_t *put_f32le(uint8_t *p, float f)
-{
-    uint32_t u;
-    memcpy(&u, &f, sizeof(u));
-    p[0] = (uint8_t)u;
-    p[1] = (uint8_t)(u >> 8);
-    p[2] = (uint8_t)(u >> 16);
-    p[3] = (uint8_t)(u >> 24);
-    return p + 4;
-}
+#include "outbuf.h"
 
 static uint32_t count_valid(const struct decode_maps *maps)
 {
@@ -27,56 +12,52 @@ static uint32_t count_valid(const struct decode_maps *maps)
     return n;
 }
 
+void ply_put_vertex(struct outbuf *o, vec3 p, vec3 n, const uint8_t rgb[3])
+{
+    outbuf_f32le(o, (float)p.x);
+    outbuf_f32le(o, (float)p.y);
+    outbuf_f32le(o, (float)p.z);
+    outbuf_f32le(o, (float)n.x);
+    outbuf_f32le(o, (float)n.y);
+    outbuf_f32le(o, (float)n.z);
+    outbuf_put(o, rgb, 3);
+}
+
+void ply_put_header(struct outbuf *o, const char *what, uint32_t vertices, uint32_t faces)
+{
+    outbuf_printf(o,
+                  "ply\nformat binary_little_endian 1.0\n"
+                  "comment turntable colour scanner: %s; units: millimetres\n"
+                  "element vertex %u\n"
+                  "property float x\nproperty float y\nproperty float z\n"
+                  "property float nx\nproperty float ny\nproperty float nz\n"
+                  "property uchar red\nproperty uchar green\nproperty uchar blue\n",
+                  what, (unsigned)vertices);
+    if (faces > 0)
+        outbuf_printf(o, "element face %u\nproperty list uchar uint vertex_indices\n",
+                      (unsigned)faces);
+    outbuf_printf(o, "end_header\n");
+}
+
 int ply_write_cloud(const struct hal_storage *st, const char *path, const struct decode_maps *maps,
                     const struct tri_range *range, const uint8_t *rgb,
                     const struct frame_xform *xform, uint32_t *vertex_count)
 {
-    struct hal_file file;
+    struct outbuf o;
     uint32_t n = count_valid(maps);
-    int rc = hal_storage_open(st, &file, path);
-    if (rc != 0)
-        return rc;
-    int len = snprintf((char *)chunk, sizeof(chunk),
-                       "ply\nformat binary_little_endian 1.0\n"
-                       "comment turntable colour scanner, one view; units: millimetres\n"
-                       "element vertex %u\n"
-                       "property float x\nproperty float y\nproperty float z\n"
-                       "property float nx\nproperty float ny\nproperty float nz\n"
-                       "property uchar red\nproperty uchar green\nproperty uchar blue\n"
-                       "end_header\n",
-                       (unsigned)n);
-    size_t used = (size_t)len;
+    if (outbuf_open(&o, st, path) != 0)
+        return o.rc;
+    ply_put_header(&o, "one view", n, 0);
     size_t total = (size_t)maps->width * maps->height;
-    for (size_t i = 0; i < total && rc == 0; i++) {
+    for (size_t i = 0; i < total && o.rc == 0; i++) {
         if (maps->reason[i] != SCAN_VALID)
             continue;
-        if (used + PLY_VERTEX_BYTES > sizeof(chunk)) {
-            rc = hal_storage_write(st, &file, chunk, used);
-            used = 0;
-        }
-        vec3 p = frame_point(
-            xform, v3(range->xyz_mm[3 * i], range->xyz_mm[3 * i + 1], range->xyz_mm[3 * i + 2]));
-        vec3 nn = frame_dir(
-            xform, v3(range->normal[3 * i], range->normal[3 * i + 1], range->normal[3 * i + 2]));
-        uint8_t *q = chunk + used;
-        q = put_f32le(q, (float)p.x);
-        q = put_f32le(q, (float)p.y);
-        q = put_f32le(q, (float)p.z);
-        q = put_f32le(q, (float)nn.x);
-        q = put_f32le(q, (float)nn.y);
-        q = put_f32le(q, (float)nn.z);
-        memcpy(q, rgb + 3 * i, 3);
-        used += PLY_VERTEX_BYTES;
+        const float *p = &range->xyz_mm[3 * i], *nn = &range->normal[3 * i];
+        ply_put_vertex(&o, frame_point(xform, v3(p[0], p[1], p[2])),
+                       frame_dir(xform, v3(nn[0], nn[1], nn[2])), rgb + 3 * i);
     }
-    if (rc == 0 && used > 0)
-        rc = hal_storage_write(st, &file, chunk, used);
+    int rc = outbuf_close(&o);
     if (rc == 0)
-        rc = hal_storage_commit(st, &file);
-    if (rc != 0)
-        goto out_abort;
-    *vertex_count = n;
-    return 0;
-out_abort:
-    hal_storage_abort(st, &file);
+        *vertex_count = n;
     return rc;
 }

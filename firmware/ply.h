@@ -20,4 +20,10 @@ int ply_write_cloud(const struct hal_storage *storage, const char *path,
                     const struct decode_maps *maps, const struct tri_range *range,
                     const uint8_t *rgb, const struct frame_xform *xform, uint32_t *vertex_count);
 
+struct outbuf;
+/** The PLY header of a cloud (faces = 0) or a mesh, vertex layout as ply_put_vertex writes. */
+void ply_put_header(struct outbuf *o, const char *what, uint32_t vertices, uint32_t faces);
+/** One vertex: float x y z nx ny nz, uchar red green blue (27 bytes). */
+void ply_put_vertex(struct outbuf *o, vec3 pos, vec3 normal, const uint8_t rgb[3]);
+
 #endif

@@ -2,6 +2,7 @@
 #include "scan.h"
 
 #include "frames.h"
+#include "fusion.h"
 #include "gray.h"
 #include "ply.h"
 #include "refine.h"
@@ -199,6 +200,16 @@ int scan_view(const struct hal *hal, const struct scan_params *p, const struct s
 out_safe:
     hal->gpio.ops->safe_state(hal->gpio.priv);
     return rc != 0 ? rc : rc_off;
+}
+
+void scan_view_pose(const struct scan_calib *calib, struct frame_xform *obj_from_cam)
+{
+    frame_object_from_camera(calib, last_angle_mdeg, obj_from_cam);
+}
+
+int scan_fuse_view(const struct scan_calib *calib, const struct frame_xform *obj_from_cam)
+{
+    return fusion_integrate(calib, obj_from_cam, decode_get_maps(), tri_get_range(), colour_rgb);
 }
 
 int scan_save_cloud(const struct hal *hal, const struct scan_calib *calib, const char *path)

@@ -6,6 +6,7 @@
 #include "decode.h"
 #include "hal.h"
 #include "scan_types.h"
+#include "frames.h"
 #include "tri.h"
 
 /** What one view produced. */
@@ -51,6 +52,12 @@ int scan_feed_frame(uint32_t pattern, const uint8_t *pixels, uint32_t channels,
                     const struct scan_frame_sink *sink);
 int scan_finish_view(const struct scan_calib *calib, int32_t angle_mdeg,
                      struct scan_view_info *info);
+
+/** Pose of the last view: camera frame to object frame, from the turntable axis and angle. */
+void scan_view_pose(const struct scan_calib *calib, struct frame_xform *obj_from_cam);
+
+/** Fuse the last view into the volume (fusion_begin first) seen through @p obj_from_cam. */
+int scan_fuse_view(const struct scan_calib *calib, const struct frame_xform *obj_from_cam);
 
 /** Write the last view's point cloud (object frame) as binary PLY.
  *  @retval 0 ok @retval -errno from storage */

@@ -149,6 +149,35 @@ out_free:
     return rc;
 }
 
+/* The object as the simulator renders it, in the object frame (mm): what a scan should give. */
+int board_write_scan_extras(const struct hal *hal, const char *scan_dir)
+{
+    const struct sim_mesh *m = &sim.rig.mesh;
+    char path[HAL_MAX_PATH + 32], header[256];
+    snprintf(path, sizeof(path), "%s/truth_mesh.ply", scan_dir);
+    int hl = snprintf(header, sizeof(header),
+                      "ply\nformat binary_little_endian 1.0\ncomment simulator ground truth, "
+                      "object frame, mm\nelement vertex %u\nproperty float x\nproperty float y\n"
+                      "property float z\nelement face %u\nproperty list uchar uint "
+                      "vertex_indices\nend_header\n",
+                      (unsigned)m->vert_count, (unsigned)m->tri_count);
+    size_t len = (size_t)hl + (size_t)m->vert_count * 12 + (size_t)m->tri_count * 13;
+    uint8_t *buf = malloc(len), *q;
+    if (buf == NULL)
+        return -ENOMEM;
+    memcpy(buf, header, (size_t)hl);
+    q = buf + hl;
+    memcpy(q, m->pos, (size_t)m->vert_count * 12); /* little-endian host, as the header says */
+    q += (size_t)m->vert_count * 12;
+    for (uint32_t t = 0; t < m->tri_count; t++, q += 13) {
+        q[0] = 3;
+        memcpy(q + 1, &m->tri[3 * t], 12);
+    }
+    int rc = hal_storage_write_file(&hal->storage, path, buf, len);
+    free(buf);
+    return rc;
+}
+
 int board_write_view_extras(const struct hal *hal, const char *view_dir)
 {
     return write_truth(hal, view_dir);

@@ -189,3 +189,70 @@ int sim_bvh_occluded(const struct sim_bvh *b, vec3 o, vec3 d, double t_min, doub
     struct sim_hit unused;
     return traverse(b, o, d, t_min, t_max, &unused, 1);
 }
+
+/* Closest point of triangle abc to p (Ericson, Real-Time Collision Detection, 5.1.5). */
+static vec3 closest_on_triangle(vec3 p, vec3 a, vec3 b, vec3 c)
+{
+    vec3 ab = v3_sub(b, a), ac = v3_sub(c, a), ap = v3_sub(p, a);
+    double d1 = v3_dot(ab, ap), d2 = v3_dot(ac, ap);
+    if (d1 <= 0.0 && d2 <= 0.0)
+        return a;
+    vec3 bp = v3_sub(p, b);
+    double d3 = v3_dot(ab, bp), d4 = v3_dot(ac, bp);
+    if (d3 >= 0.0 && d4 <= d3)
+        return b;
+    double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0)
+        return v3_add(a, v3_scale(ab, d1 / (d1 - d3)));
+    vec3 cp = v3_sub(p, c);
+    double d5 = v3_dot(ab, cp), d6 = v3_dot(ac, cp);
+    if (d6 >= 0.0 && d5 <= d6)
+        return c;
+    double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0)
+        return v3_add(a, v3_scale(ac, d2 / (d2 - d6)));
+    double va = d3 * d6 - d5 * d4;
+    if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0)
+        return v3_add(b, v3_scale(v3_sub(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6))));
+    double denom = 1.0 / (va + vb + vc);
+    return v3_add(a, v3_add(v3_scale(ab, vb * denom), v3_scale(ac, vc * denom)));
+}
+
+static double box_distance(const struct sim_bvh_node *n, vec3 p)
+{
+    double pa[3] = {p.x, p.y, p.z}, sum = 0.0;
+    for (int a = 0; a < 3; a++) {
+        double d = pa[a] < n->lo[a] ? n->lo[a] - pa[a] : pa[a] > n->hi[a] ? pa[a] - n->hi[a] : 0.0;
+        sum += d * d;
+    }
+    return sqrt(sum);
+}
+
+double sim_bvh_distance(const struct sim_bvh *b, vec3 p, double max_dist)
+{
+    uint32_t stack[STACK_DEPTH * 2], sp = 0;
+    double best = max_dist;
+    stack[sp++] = 0;
+    while (sp > 0) {
+        const struct sim_bvh_node *n = &b->nodes[stack[--sp]];
+        if (box_distance(n, p) >= best)
+            continue;
+        if (n->count == 0) {
+            /* nearer child last, so it is searched first */
+            uint32_t l = n->first, r = n->first + 1;
+            int left_first = box_distance(&b->nodes[l], p) <= box_distance(&b->nodes[r], p);
+            stack[sp++] = left_first ? r : l;
+            stack[sp++] = left_first ? l : r;
+            continue;
+        }
+        for (uint32_t i = n->first; i < n->first + n->count; i++) {
+            uint32_t t = b->tri_order[i];
+            const float *a = vert(b->mesh, t, 0), *bb = vert(b->mesh, t, 1), *c = vert(b->mesh, t, 2);
+            vec3 q = closest_on_triangle(p, v3(a[0], a[1], a[2]), v3(bb[0], bb[1], bb[2]),
+                                         v3(c[0], c[1], c[2]));
+            double d = v3_len(v3_sub(p, q));
+            best = d < best ? d : best;
+        }
+    }
+    return best;
+}

@@ -33,4 +33,7 @@ int sim_bvh_intersect(const struct sim_bvh *bvh, vec3 origin, vec3 dir, double t
 /** Any hit with t in (t_min, t_max). @retval 1 occluded, 0 free */
 int sim_bvh_occluded(const struct sim_bvh *bvh, vec3 origin, vec3 dir, double t_min, double t_max);
 
+/** Distance from @p p to the nearest triangle, or @p max_dist if none is closer. */
+double sim_bvh_distance(const struct sim_bvh *bvh, vec3 p, double max_dist);
+
 #endif

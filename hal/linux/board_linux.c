@@ -54,6 +54,13 @@ int board_init(struct hal *hal, const struct app_config *cfg, const struct scan_
     return 0;
 }
 
+int board_write_scan_extras(const struct hal *hal, const char *scan_dir)
+{
+    (void)hal;
+    (void)scan_dir;
+    return 0; /* real hardware has no ground truth to write */
+}
+
 int board_write_view_extras(const struct hal *hal, const char *view_dir)
 {
     (void)hal;

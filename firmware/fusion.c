@@ -1,0 +1,283 @@
+/* Truncated signed distance fusion in a static voxel grid, and marching cubes over it. */
+#include "fusion.h"
+
+#include "mc_table.h"
+#include "vec3.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <string.h>
+
+/* 8 bytes: distance in units of truncation / 32767, weight in thousandths, colour. */
+struct voxel {
+    int16_t sdf;
+    uint16_t weight;
+    uint8_t rgb[3];
+    uint8_t pad;
+};
+_Static_assert(sizeof(struct voxel) == 8, "voxel layout");
+
+static struct voxel grid[FUSION_MAX_VOXELS];
+static float weight_map[HAL_MAX_PIXELS];
+static uint16_t edge_dist[HAL_MAX_PIXELS];
+/* vertex numbers of the grid edges of two sample planes (x, y edges) and between them (z) */
+static uint32_t edge_vertex_x[2][FUSION_MAX_DIM * FUSION_MAX_DIM];
+static uint32_t edge_vertex_y[2][FUSION_MAX_DIM * FUSION_MAX_DIM];
+static uint32_t edge_vertex_z[FUSION_MAX_DIM * FUSION_MAX_DIM];
+
+static struct {
+    struct fusion_params p;
+    uint32_t dims[3];
+    vec3 origin; /* object-frame position of voxel (0, 0, 0) */
+} fz;
+
+#define NO_VERTEX 0xFFFFFFFFu
+#define WEIGHT_SCALE 1000.0
+
+int fusion_dims(const struct fusion_params *p, uint32_t dims[3])
+{
+    double span[3] = {2.0 * p->radius_mm, 2.0 * p->radius_mm, p->top_mm - p->bottom_mm};
+    for (int a = 0; a < 3; a++) {
+        double d = span[a] / p->voxel_mm + 1.0;
+        if (d < 2.0 || d > FUSION_MAX_DIM)
+            return -E2BIG;
+        dims[a] = (uint32_t)d;
+    }
+    if ((uint64_t)dims[0] * dims[1] * dims[2] > FUSION_MAX_VOXELS ||
+        p->max_weight * WEIGHT_SCALE > 65535.0)
+        return -E2BIG;
+    return 0;
+}
+
+int fusion_begin(const struct fusion_params *p)
+{
+    int rc = fusion_dims(p, fz.dims);
+    if (rc != 0)
+        return rc;
+    fz.p = *p;
+    fz.origin = v3(-p->radius_mm, -p->radius_mm, p->bottom_mm);
+    memset(grid, 0, (size_t)fz.dims[0] * fz.dims[1] * fz.dims[2] * sizeof(grid[0]));
+    mc_table_build();
+    return 0;
+}
+
+static size_t vidx(uint32_t x, uint32_t y, uint32_t z)
+{
+    return ((size_t)z * fz.dims[1] + y) * fz.dims[0] + x;
+}
+
+/* City-block distance of each valid pixel to the nearest invalid one (two passes), capped. */
+static void distance_to_edge(const struct decode_maps *m, uint16_t cap)
+{
+    const uint32_t w = m->width, h = m->height;
+    for (uint32_t y = 0; y < h; y++) {
+        for (uint32_t x = 0; x < w; x++) {
+            size_t i = (size_t)y * w + x;
+            uint16_t d = 0;
+            if (m->reason[i] == SCAN_VALID) {
+                d = cap;
+                if (x > 0 && edge_dist[i - 1] + 1 < d)
+                    d = (uint16_t)(edge_dist[i - 1] + 1);
+                if (y > 0 && edge_dist[i - w] + 1 < d)
+                    d = (uint16_t)(edge_dist[i - w] + 1);
+                if (x == 0 || y == 0 || x + 1 == w || y + 1 == h)
+                    d = 1;
+            }
+            edge_dist[i] = d;
+        }
+    }
+    for (uint32_t y = h; y-- > 0;) {
+        for (uint32_t x = w; x-- > 0;) {
+            size_t i = (size_t)y * w + x;
+            if (x + 1 < w && edge_dist[i + 1] + 1 < edge_dist[i])
+                edge_dist[i] = (uint16_t)(edge_dist[i + 1] + 1);
+            if (y + 1 < h && edge_dist[i + w] + 1 < edge_dist[i])
+                edge_dist[i] = (uint16_t)(edge_dist[i + w] + 1);
+        }
+    }
+}
+
+/* How much a pixel is trusted: head-on, close (finer sampling), and away from the view's edge,
+ * where depth is least reliable and colour seams would show (Jost et al., boundary filtering). */
+static void pixel_weights(const struct scan_calib *c, const struct decode_maps *m,
+                          const struct tri_range *r)
+{
+    const double fade = fz.p.edge_fade_px > 0 ? (double)fz.p.edge_fade_px : 1.0;
+    distance_to_edge(m, (uint16_t)(fz.p.edge_fade_px > 0 ? fz.p.edge_fade_px : 1));
+    for (uint32_t y = 0; y < m->height; y++) {
+        for (uint32_t x = 0; x < m->width; x++) {
+            size_t i = (size_t)y * m->width + x;
+            weight_map[i] = 0.0f;
+            if (m->reason[i] != SCAN_VALID)
+                continue;
+            vec3 ray = v3_norm(
+                v3((x - c->cam_cx_px) / c->cam_fx_px, (y - c->cam_cy_px) / c->cam_fy_px, 1.0));
+            vec3 n = v3(r->normal[3 * i], r->normal[3 * i + 1], r->normal[3 * i + 2]);
+            double head_on = -v3_dot(n, ray), z = r->xyz_mm[3 * i + 2];
+            double w = head_on * (600.0 / z) * (600.0 / z) * fmin(1.0, edge_dist[i] / fade);
+            weight_map[i] = w >= fz.p.min_weight ? (float)w : 0.0f;
+        }
+    }
+}
+
+static void fuse_voxel(struct voxel *vx, double sdf, double w, const uint8_t *rgb)
+{
+    double trunc = fz.p.truncation_mm;
+    if (sdf > trunc)
+        sdf = trunc;
+    double old_w = vx->weight / WEIGHT_SCALE, old_s = vx->sdf / 32767.0 * trunc;
+    double new_w = old_w + w;
+    double s = (old_s * old_w + sdf * w) / new_w;
+    if (fabs(sdf) < trunc) /* colour comes from near the surface only */
+        for (int k = 0; k < 3; k++)
+            vx->rgb[k] = (uint8_t)((vx->rgb[k] * old_w + rgb[k] * w) / new_w + 0.5);
+    vx->sdf = (int16_t)lround(s / trunc * 32767.0);
+    vx->weight = (uint16_t)lround(fmin(new_w, fz.p.max_weight) * WEIGHT_SCALE);
+}
+
+int fusion_integrate(const struct scan_calib *c, const struct frame_xform *obj_from_cam,
+                     const struct decode_maps *m, const struct tri_range *r, const uint8_t *rgb)
+{
+    pixel_weights(c, m, r);
+    const double trunc = fz.p.truncation_mm, vox = fz.p.voxel_mm;
+    const vec3 step_x = m3_tmul(obj_from_cam->rot, v3(vox, 0, 0));
+    for (uint32_t z = 0; z < fz.dims[2]; z++) {
+        for (uint32_t y = 0; y < fz.dims[1]; y++) {
+            vec3 p_obj = v3_add(fz.origin, v3(0, y * vox, z * vox));
+            vec3 p = frame_point_inv(obj_from_cam, p_obj); /* camera frame */
+            for (uint32_t x = 0; x < fz.dims[0]; x++, p = v3_add(p, step_x)) {
+                if (p.z <= 1.0)
+                    continue;
+                double a = p.x / p.z, b = p.y / p.z;
+                long u = lround(c->cam_fx_px * a + c->cam_cx_px);
+                long v = lround(c->cam_fy_px * b + c->cam_cy_px);
+                if (u < 0 || v < 0 || u >= (long)m->width || v >= (long)m->height)
+                    continue;
+                size_t i = (size_t)v * m->width + (size_t)u;
+                if (weight_map[i] <= 0.0f)
+                    continue;
+                /* distance along the ray from the voxel to the measured surface */
+                double sdf = (r->xyz_mm[3 * i + 2] - p.z) * sqrt(1.0 + a * a + b * b);
+                if (sdf < -trunc)
+                    continue; /* hidden behind the surface: this view knows nothing of it */
+                fuse_voxel(&grid[vidx(x, y, z)], sdf, weight_map[i], rgb + 3 * i);
+            }
+        }
+    }
+    return 0;
+}
+
+/* ---- marching cubes ---- */
+
+static double sdf_at(uint32_t x, uint32_t y, uint32_t z)
+{
+    return grid[vidx(x, y, z)].sdf / 32767.0 * fz.p.truncation_mm;
+}
+
+/* Distance gradient at a sample (central differences, one-sided at the border): it points out. */
+static vec3 gradient(uint32_t x, uint32_t y, uint32_t z)
+{
+    uint32_t lo[3] = {x ? x - 1 : x, y ? y - 1 : y, z ? z - 1 : z};
+    uint32_t hi[3] = {x + 1 < fz.dims[0] ? x + 1 : x, y + 1 < fz.dims[1] ? y + 1 : y,
+                      z + 1 < fz.dims[2] ? z + 1 : z};
+    return v3((sdf_at(hi[0], y, z) - sdf_at(lo[0], y, z)) / (double)(hi[0] - lo[0] + (hi[0] == lo[0])),
+              (sdf_at(x, hi[1], z) - sdf_at(x, lo[1], z)) / (double)(hi[1] - lo[1] + (hi[1] == lo[1])),
+              (sdf_at(x, y, hi[2]) - sdf_at(x, y, lo[2])) / (double)(hi[2] - lo[2] + (hi[2] == lo[2])));
+}
+
+struct extract_state {
+    const struct mesh_sink *sink;
+    uint32_t next_vertex;
+};
+
+/* The vertex on the grid edge from sample s along @p axis, made once and numbered. */
+static int edge_vertex(struct extract_state *st, const uint32_t s[3], int axis, uint32_t *slot,
+                       uint32_t *out)
+{
+    if (*slot != NO_VERTEX) {
+        *out = *slot;
+        return 0;
+    }
+    uint32_t t[3] = {s[0], s[1], s[2]};
+    t[axis]++;
+    const struct voxel *va = &grid[vidx(s[0], s[1], s[2])], *vb = &grid[vidx(t[0], t[1], t[2])];
+    double da = sdf_at(s[0], s[1], s[2]), db = sdf_at(t[0], t[1], t[2]);
+    double f = da / (da - db);
+    vec3 ga = gradient(s[0], s[1], s[2]), gb = gradient(t[0], t[1], t[2]);
+    vec3 n = v3_norm(v3_add(v3_scale(ga, 1.0 - f), v3_scale(gb, f)));
+    vec3 pos = v3_add(fz.origin, v3_scale(v3(s[0], s[1], s[2]), fz.p.voxel_mm));
+    double shift[3] = {0, 0, 0};
+    shift[axis] = f * fz.p.voxel_mm;
+    pos = v3_add(pos, v3(shift[0], shift[1], shift[2]));
+    float fp[3] = {(float)pos.x, (float)pos.y, (float)pos.z};
+    float fn[3] = {(float)n.x, (float)n.y, (float)n.z};
+    uint8_t rgb[3];
+    for (int k = 0; k < 3; k++)
+        rgb[k] = (uint8_t)(va->rgb[k] * (1.0 - f) + vb->rgb[k] * f + 0.5);
+    int rc = st->sink->vertex != NULL ? st->sink->vertex(st->sink->priv, fp, fn, rgb) : 0;
+    *slot = *out = st->next_vertex++;
+    return rc;
+}
+
+static uint32_t *edge_slot(uint32_t x, uint32_t y, uint32_t z, int e)
+{
+    unsigned a = mc_edge_corner[e][0]; /* the lower corner of the edge */
+    uint32_t sx = x + (a & 1u), sy = y + ((a >> 1) & 1u), sz = z + (a >> 2);
+    size_t i = (size_t)sy * fz.dims[0] + sx;
+    if (e < 4)
+        return &edge_vertex_x[sz & 1u][i];
+    if (e < 8)
+        return &edge_vertex_y[sz & 1u][i];
+    return &edge_vertex_z[i];
+}
+
+static int extract_cell(struct extract_state *st, uint32_t x, uint32_t y, uint32_t z)
+{
+    unsigned pattern = 0;
+    for (unsigned c = 0; c < 8; c++) {
+        const struct voxel *v = &grid[vidx(x + (c & 1u), y + ((c >> 1) & 1u), z + (c >> 2))];
+        if (v->weight == 0)
+            return 0; /* a corner no view has seen: no surface can be claimed here */
+        pattern |= (v->sdf < 0 ? 1u : 0u) << c;
+    }
+    const struct mc_case *mc = mc_table_case(pattern);
+    for (unsigned t = 0; t < mc->tri_count; t++) {
+        uint32_t idx[3];
+        for (int k = 0; k < 3; k++) {
+            int e = mc->edge[t][k];
+            unsigned a = mc_edge_corner[e][0];
+            uint32_t s[3] = {x + (a & 1u), y + ((a >> 1) & 1u), z + (a >> 2)};
+            int rc = edge_vertex(st, s, e / 4, edge_slot(x, y, z, e), &idx[k]);
+            if (rc != 0)
+                return rc;
+        }
+        int rc = st->sink->triangle != NULL
+                     ? st->sink->triangle(st->sink->priv, idx[0], idx[1], idx[2])
+                     : 0;
+        if (rc != 0)
+            return rc;
+    }
+    return 0;
+}
+
+int fusion_extract(const struct mesh_sink *sink)
+{
+    struct extract_state st = {sink, 0};
+    size_t plane = (size_t)fz.dims[0] * fz.dims[1];
+    memset(edge_vertex_x[0], 0xFF, plane * sizeof(uint32_t));
+    memset(edge_vertex_y[0], 0xFF, plane * sizeof(uint32_t));
+    for (uint32_t z = 0; z + 1 < fz.dims[2]; z++) {
+        /* plane z+1 starts empty; plane z keeps what the layer below made */
+        memset(edge_vertex_x[(z + 1) & 1u], 0xFF, plane * sizeof(uint32_t));
+        memset(edge_vertex_y[(z + 1) & 1u], 0xFF, plane * sizeof(uint32_t));
+        memset(edge_vertex_z, 0xFF, plane * sizeof(uint32_t));
+        for (uint32_t y = 0; y + 1 < fz.dims[1]; y++) {
+            for (uint32_t x = 0; x + 1 < fz.dims[0]; x++) {
+                int rc = extract_cell(&st, x, y, z);
+                if (rc != 0)
+                    return rc;
+            }
+        }
+    }
+    return 0;
+}

@@ -1,0 +1,56 @@
+/* Volumetric fusion of views (truncated signed distance, Curless and Levoy 1996) in a static grid,
+ * with blended vertex colour, and the mesh of its zero level by marching cubes. */
+#ifndef FUSION_H
+#define FUSION_H
+
+#include "decode.h"
+#include "frames.h"
+#include "hal.h"
+#include "tri.h"
+
+/* The grid is sized in the config and bounded here: 8 bytes a voxel. */
+#define FUSION_MAX_DIM 400u
+#define FUSION_MAX_VOXELS (320u * 320u * 280u)
+
+struct fusion_params {
+    double voxel_mm;        /**< edge of a voxel */
+    double radius_mm;       /**< grid spans [-radius, radius] in x and y (object frame) */
+    double bottom_mm, top_mm; /**< and [bottom, top] in z */
+    double truncation_mm;   /**< distances are clamped to +-this */
+    double max_weight;      /**< a voxel's weight stops growing here (older views fade) */
+    uint32_t edge_fade_px;  /**< view weights ramp up over this many pixels from its edge */
+    double min_weight;      /**< pixels weighing less are not fused (grazing views) */
+};
+
+/** Grid dimensions for @p p. @retval 0 ok @retval -E2BIG above FUSION_MAX_* */
+int fusion_dims(const struct fusion_params *p, uint32_t dims[3]);
+
+/** Empty grid. @retval 0 ok @retval -E2BIG the grid does not fit the compiled limits */
+int fusion_begin(const struct fusion_params *p);
+
+/** Fuse the last view: its range image, normals and colour, seen through @p obj_from_cam.
+ *  Weight of a pixel: cos(view angle) x (600 mm / depth)^2 x edge fade.
+ *  @retval 0 */
+int fusion_integrate(const struct scan_calib *calib, const struct frame_xform *obj_from_cam,
+                     const struct decode_maps *maps, const struct tri_range *range,
+                     const uint8_t *rgb);
+
+/** Receives the mesh: vertices are numbered from 0 in the order given. */
+struct mesh_sink {
+    int (*vertex)(void *priv, const float pos[3], const float normal[3], const uint8_t rgb[3]);
+    int (*triangle)(void *priv, uint32_t a, uint32_t b, uint32_t c);
+    void *priv;
+};
+
+/** Marching cubes over the cells whose eight corners were all observed. Deterministic: two
+ *  runs give the same vertices in the same order (writers count in a first pass).
+ *  @retval 0 or what the sink returned */
+int fusion_extract(const struct mesh_sink *sink);
+
+/** Write the mesh as binary PLY (vertex x y z nx ny nz red green blue, faces) and as OBJ (with
+ *  vertex colours and normals), atomically. @retval 0 or -errno */
+int fusion_write_ply(const struct hal_storage *st, const char *path, uint32_t *vertices,
+                     uint32_t *triangles);
+int fusion_write_obj(const struct hal_storage *st, const char *path);
+
+#endif

@@ -1,0 +1,71 @@
+/* One static chunk serves every file the firmware writes (one at a time). */
+#include "outbuf.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+static uint8_t chunk[64u * 1024u];
+
+int outbuf_open(struct outbuf *o, const struct hal_storage *st, const char *path)
+{
+    o->st = st;
+    o->used = 0;
+    o->rc = hal_storage_open(st, &o->file, path);
+    return o->rc;
+}
+
+static void flush(struct outbuf *o)
+{
+    if (o->rc == 0 && o->used > 0)
+        o->rc = hal_storage_write(o->st, &o->file, chunk, o->used);
+    o->used = 0;
+}
+
+void outbuf_put(struct outbuf *o, const void *data, size_t len)
+{
+    const uint8_t *p = data;
+    while (len > 0 && o->rc == 0) {
+        if (o->used == sizeof(chunk))
+            flush(o);
+        size_t n = sizeof(chunk) - o->used < len ? sizeof(chunk) - o->used : len;
+        memcpy(chunk + o->used, p, n);
+        o->used += n;
+        p += n;
+        len -= n;
+    }
+}
+
+void outbuf_printf(struct outbuf *o, const char *fmt, ...)
+{
+    char line[512];
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(line, sizeof(line), fmt, ap);
+    va_end(ap);
+    if (n > 0)
+        outbuf_put(o, line, (size_t)n < sizeof(line) ? (size_t)n : sizeof(line) - 1);
+}
+
+void outbuf_u32le(struct outbuf *o, uint32_t u)
+{
+    uint8_t b[4] = {(uint8_t)u, (uint8_t)(u >> 8), (uint8_t)(u >> 16), (uint8_t)(u >> 24)};
+    outbuf_put(o, b, 4);
+}
+
+void outbuf_f32le(struct outbuf *o, float f)
+{
+    uint32_t u;
+    memcpy(&u, &f, sizeof(u));
+    outbuf_u32le(o, u);
+}
+
+int outbuf_close(struct outbuf *o)
+{
+    flush(o);
+    if (o->rc == 0)
+        o->rc = hal_storage_commit(o->st, &o->file);
+    if (o->rc != 0)
+        hal_storage_abort(o->st, &o->file);
+    return o->rc;
+}

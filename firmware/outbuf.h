@@ -1,0 +1,29 @@
+/* Buffered, atomic file output through the HAL storage: a fixed chunk, flushed as it fills. */
+#ifndef OUTBUF_H
+#define OUTBUF_H
+
+#include "hal.h"
+
+#include <stdint.h>
+
+struct outbuf {
+    const struct hal_storage *st;
+    struct hal_file file;
+    size_t used;
+    int rc; /* first error; later calls do nothing */
+};
+
+/** Start an atomic write of @p path. @retval 0 or -errno */
+int outbuf_open(struct outbuf *o, const struct hal_storage *st, const char *path);
+/** Append bytes (errors are kept in o->rc). */
+void outbuf_put(struct outbuf *o, const void *data, size_t len);
+/** Append printf-formatted text. */
+void outbuf_printf(struct outbuf *o, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/** Append a float, little-endian. */
+void outbuf_f32le(struct outbuf *o, float f);
+/** Append a uint32, little-endian. */
+void outbuf_u32le(struct outbuf *o, uint32_t v);
+/** Flush and commit, or abort on any earlier error. @retval 0 or the first error */
+int outbuf_close(struct outbuf *o);
+
+#endif

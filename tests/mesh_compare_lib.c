@@ -1,0 +1,227 @@
+/* Mesh-to-mesh distances by area-weighted sampling and BVH closest-point queries. */
+#define _POSIX_C_SOURCE 200809L
+#include "mesh_compare.h"
+
+#include "config.h"
+#include "frames.h"
+#include "sim_bvh.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static uint64_t rng_next(uint64_t *s)
+{
+    uint64_t z = (*s += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+static double rng_unit(uint64_t *s)
+{
+    return (double)(rng_next(s) >> 11) / 9007199254740992.0;
+}
+
+static vec3 vtx(const struct sim_mesh *m, uint32_t t, int k)
+{
+    const float *p = &m->pos[3 * m->tri[3 * t + (uint32_t)k]];
+    return v3(p[0], p[1], p[2]);
+}
+
+static int reaches(const struct sim_bvh *self, vec3 p, vec3 n, vec3 src, double min_cos)
+{
+    vec3 d = v3_sub(src, p);
+    if (v3_dot(n, d) < min_cos * v3_len(d))
+        return 0;
+    return !sim_bvh_occluded(self, v3_add(p, v3_scale(n, 0.01)), d, 1e-6, 1.0);
+}
+
+/* Can some view's camera and projector both reach p (object frame, normal n)? */
+static int observable(const struct mesh_visibility *vis, const struct sim_bvh *self, vec3 p,
+                      vec3 n)
+{
+    double min_cos = cos(vis->max_incidence_deg * M_PI / 180.0);
+    for (uint32_t k = 0; k < vis->views; k++) {
+        double a = 2.0 * M_PI * k / vis->views, c = cos(a), s = sin(a);
+        /* the table turned the object by +a: devices are at Rz(-a) in the object frame */
+        vec3 cam = v3(c * vis->camera_table.x + s * vis->camera_table.y,
+                      -s * vis->camera_table.x + c * vis->camera_table.y, vis->camera_table.z);
+        vec3 proj = v3(c * vis->projector_table.x + s * vis->projector_table.y,
+                       -s * vis->projector_table.x + c * vis->projector_table.y,
+                       vis->projector_table.z);
+        if (reaches(self, p, n, cam, min_cos) && reaches(self, p, n, proj, min_cos))
+            return 1;
+    }
+    return 0;
+}
+
+/* Distances of @p n area-uniform samples of @p from to @p to; sample heights in @p z; and
+ * whether each is observable (when @p vis and @p self, the BVH of @p from, are given). */
+static int sample_distances(const struct sim_mesh *from, const struct sim_bvh *to, uint32_t n,
+                            double *dist, double *z, const struct mesh_visibility *vis,
+                            const struct sim_bvh *self, uint8_t *seen)
+{
+    double *cum = malloc(sizeof(double) * from->tri_count);
+    if (cum == NULL)
+        return -1;
+    double total = 0.0;
+    for (uint32_t t = 0; t < from->tri_count; t++) {
+        vec3 a = vtx(from, t, 0);
+        total += 0.5 * v3_len(v3_cross(v3_sub(vtx(from, t, 1), a), v3_sub(vtx(from, t, 2), a)));
+        cum[t] = total;
+    }
+    uint64_t seed = 12345;
+    for (uint32_t i = 0; i < n; i++) {
+        double target = rng_unit(&seed) * total;
+        uint32_t lo = 0, hi = from->tri_count - 1;
+        while (lo < hi) { /* first triangle whose cumulative area exceeds target */
+            uint32_t mid = (lo + hi) / 2;
+            if (cum[mid] < target)
+                lo = mid + 1;
+            else
+                hi = mid;
+        }
+        double r1 = sqrt(rng_unit(&seed)), r2 = rng_unit(&seed);
+        vec3 a = vtx(from, lo, 0), b = vtx(from, lo, 1), c = vtx(from, lo, 2);
+        vec3 p = v3_add(v3_scale(a, 1.0 - r1), v3_add(v3_scale(b, r1 * (1.0 - r2)),
+                                                      v3_scale(c, r1 * r2)));
+        dist[i] = sim_bvh_distance(to, p, 1e9);
+        z[i] = p.z;
+        if (seen != NULL) {
+            vec3 nn = v3_norm(v3_cross(v3_sub(b, a), v3_sub(c, a)));
+            seen[i] = (uint8_t)observable(vis, self, p, nn);
+        }
+    }
+    free(cum);
+    return 0;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+int mesh_compare_files(const char *result_ply, const char *truth_ply, uint32_t n,
+                       const struct mesh_visibility *vis, struct mesh_comparison *out, char *err,
+                       size_t err_len)
+{
+    struct sim_mesh res, tru;
+    struct sim_bvh res_bvh, tru_bvh;
+    int rc = sim_mesh_load_ply(&res, result_ply, err, (unsigned)err_len);
+    if (rc != 0)
+        return rc;
+    rc = sim_mesh_load_ply(&tru, truth_ply, err, (unsigned)err_len);
+    if (rc != 0) {
+        sim_mesh_free(&res);
+        return rc;
+    }
+    double *d1 = malloc(sizeof(double) * n), *d2 = malloc(sizeof(double) * n);
+    double *z1 = malloc(sizeof(double) * n), *z2 = malloc(sizeof(double) * n);
+    uint8_t *observed = vis != NULL ? malloc(n) : NULL;
+    rc = -1;
+    if (d1 && d2 && z1 && z2 && sim_bvh_build(&res_bvh, &res) == 0) {
+        if (sim_bvh_build(&tru_bvh, &tru) == 0) {
+            rc = sample_distances(&res, &tru_bvh, n, d1, z1, NULL, NULL, NULL);
+            if (rc == 0)
+                rc = sample_distances(&tru, &res_bvh, n, d2, z2, vis, &tru_bvh, observed);
+            sim_bvh_free(&tru_bvh);
+        }
+        sim_bvh_free(&res_bvh);
+    }
+    if (rc == 0) {
+        memset(out, 0, sizeof(*out));
+        out->result_triangles = res.tri_count;
+        double s1 = 0, s2 = 0, s2_seen = 0;
+        uint32_t within = 0, seen = 0, seen_within = 0;
+        for (uint32_t i = 0; i < n; i++) {
+            s1 += d1[i];
+            s2 += d2[i];
+            within += d2[i] <= 1.0;
+            if (z2[i] >= 1.0) {
+                seen++;
+                seen_within += d2[i] <= 1.0;
+                s2_seen += d2[i];
+            }
+        }
+        if (observed != NULL) {
+            uint32_t obs = 0, obs_within = 0;
+            double s_obs = 0.0;
+            for (uint32_t i = 0; i < n; i++) {
+                if (!observed[i])
+                    continue;
+                obs++;
+                obs_within += d2[i] <= 1.0;
+                s_obs += d2[i];
+            }
+            out->observable_share = (double)obs / n;
+            out->truth_observable_within_1mm = obs ? (double)obs_within / obs : 0.0;
+            out->truth_observable_to_result_mean_mm = obs ? s_obs / obs : 0.0;
+            out->symmetric_observable_mean_mm =
+                0.5 * (s1 / n + out->truth_observable_to_result_mean_mm);
+        }
+        qsort(d1, n, sizeof(double), cmp_double);
+        out->result_to_truth_mean_mm = s1 / n;
+        out->result_to_truth_p95_mm = d1[(size_t)(0.95 * (n - 1))];
+        out->result_to_truth_max_mm = d1[n - 1];
+        out->truth_to_result_mean_mm = s2 / n;
+        out->truth_within_1mm = (double)within / n;
+        out->truth_seen_within_1mm = seen ? (double)seen_within / seen : 0.0;
+        out->truth_seen_to_result_mean_mm = seen ? s2_seen / seen : 0.0;
+        out->symmetric_mean_mm = 0.5 * (out->result_to_truth_mean_mm +
+                                        out->truth_seen_to_result_mean_mm);
+    } else {
+        snprintf(err, err_len, "out of memory");
+    }
+    free(d1);
+    free(d2);
+    free(z1);
+    free(z2);
+    free(observed);
+    sim_mesh_free(&res);
+    sim_mesh_free(&tru);
+    return rc;
+}
+
+void mesh_compare_print(const struct mesh_comparison *r, FILE *out)
+{
+    fprintf(out,
+            "result triangles: %u\n"
+            "result -> truth: mean %.3f mm, 95%% %.3f mm, max %.3f mm\n"
+            "truth -> result: mean %.3f mm, within 1 mm %.2f%%\n"
+            "truth above the table (z >= 1 mm) -> result: mean %.3f mm, within 1 mm %.2f%%\n"
+            "symmetric mean surface distance: %.3f mm\n"
+            "observable true surface: %.2f%% of it; within 1 mm of the result %.2f%%, mean "
+            "distance %.3f mm\n"
+            "symmetric mean surface distance over the observable surface: %.3f mm\n",
+            (unsigned)r->result_triangles, r->result_to_truth_mean_mm, r->result_to_truth_p95_mm,
+            r->result_to_truth_max_mm, r->truth_to_result_mean_mm, 100.0 * r->truth_within_1mm,
+            r->truth_seen_to_result_mean_mm, 100.0 * r->truth_seen_within_1mm,
+            r->symmetric_mean_mm, 100.0 * r->observable_share,
+            100.0 * r->truth_observable_within_1mm, r->truth_observable_to_result_mean_mm,
+            r->symmetric_observable_mean_mm);
+}
+
+int mesh_visibility_from_scan(const char *scan_dir, struct mesh_visibility *vis, char *err,
+                              size_t err_len)
+{
+    static struct app_config cfg;
+    struct scan_calib calib;
+    char path[HAL_MAX_PATH + 32];
+    snprintf(path, sizeof(path), "%s/config.ini", scan_dir);
+    int rc = config_load(&cfg, path, err, err_len);
+    snprintf(path, sizeof(path), "%s/calibration.ini", scan_dir);
+    if (rc == 0)
+        rc = calib_load(&calib, path, cfg.light_count, err, err_len);
+    if (rc != 0)
+        return rc;
+    struct frame_xform t;
+    frame_table_from_camera(&calib, &t);
+    vis->camera_table = frame_point(&t, v3(0, 0, 0));
+    vec3 proj_cam = v3_scale(m3_tmul(calib.proj_rot, v3_from(calib.proj_trans_mm)), -1.0);
+    vis->projector_table = frame_point(&t, proj_cam);
+    vis->views = cfg.views;
+    vis->max_incidence_deg = 75.0;
+    return 0;
+}
