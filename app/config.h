@@ -5,6 +5,7 @@
 
 #include "hal.h"
 #include "fusion.h"
+#include "icp.h"
 #include "scan_types.h"
 #include "turntable_modbus.h"
 #include "vec3.h"
@@ -52,6 +53,7 @@ struct app_config {
     struct gpio_config gpio;
     struct tt_client_config turntable;
     struct fusion_params fusion;
+    struct icp_params registration;
     struct sim_config sim;
 };
 

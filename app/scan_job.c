@@ -159,18 +159,53 @@ static int write_view_meta(struct job *j, uint32_t view, const struct scan_view_
     return hal_storage_write_file(&j->hal->storage, path, text, (size_t)len);
 }
 
+static int write_registration(struct job *j, const struct icp_report *r)
+{
+    char text[1024], path[HAL_MAX_PATH + 64];
+    int len = snprintf(
+        text, sizeof(text),
+        "; registration of this view against the previous one (docs/scan-format.md)\n"
+        "[registration]\nhas_pair = %d\naccepted = %d\noverlap_before = %u\n"
+        "coupled_before = %u\ncoupled_share_before = %.4f\noverlap_after = %u\n"
+        "coupled_after = %u\ncoupled_share_after = %.4f\nrms_before_mm = %.4f\n"
+        "rms_after_mm = %.4f\ncorrection_mm = %.4f\ncorrection_deg = %.4f\n",
+        r->has_pair, r->accepted, (unsigned)r->overlap_before, (unsigned)r->coupled_before,
+        r->overlap_before ? (double)r->coupled_before / r->overlap_before : 0.0,
+        (unsigned)r->overlap_after, (unsigned)r->coupled_after,
+        r->overlap_after ? (double)r->coupled_after / r->overlap_after : 0.0, r->rms_before_mm,
+        r->rms_after_mm, r->correction_mm, r->correction_deg);
+    snprintf(path, sizeof(path), "%s/registration.ini", j->view_dir);
+    return hal_storage_write_file(&j->hal->storage, path, text, (size_t)len);
+}
+
 /* Results of a processed view (its frames, the colour among them, were kept while capturing):
- * its point cloud, and its part of the fused model. */
-static int save_results(struct job *j)
+ * its pose (turntable, refined by registration), its point cloud, its part of the fused model. */
+static int save_results(struct job *j, struct icp_report *report)
 {
     char path[HAL_MAX_PATH + 64];
-    snprintf(path, sizeof(path), "%s/cloud.ply", j->view_dir);
-    int rc = scan_save_cloud(j->hal, j->calib, path);
     struct frame_xform pose;
     scan_view_pose(j->calib, &pose);
+    int rc = scan_register_view(&j->cfg->registration, j->calib, &pose, report);
+    if (rc == 0)
+        rc = write_registration(j, report);
+    snprintf(path, sizeof(path), "%s/cloud.ply", j->view_dir);
+    if (rc == 0)
+        rc = scan_save_cloud(j->hal, &pose, path);
     if (rc == 0)
         rc = scan_fuse_view(j->calib, &pose);
     return rc;
+}
+
+static void describe(char *buf, size_t len, const struct scan_view_info *info,
+                     const struct icp_report *r, const char *dir)
+{
+    int n = snprintf(buf, len, "%u points at %.1f deg", (unsigned)info->valid_points,
+                     info->angle_mdeg / 1000.0);
+    if (r->has_pair && r->overlap_before > 0 && r->overlap_after > 0)
+        n += snprintf(buf + n, len - (size_t)n, ", coupled %.1f%% -> %.1f%% of the overlap",
+                      100.0 * r->coupled_before / r->overlap_before,
+                      100.0 * r->coupled_after / r->overlap_after);
+    snprintf(buf + n, len - (size_t)n, " -> %s/cloud.ply", dir);
 }
 
 /* The fused model: mesh.ply and mesh.obj in the scan directory. */
@@ -206,7 +241,7 @@ static int live_view(struct job *j, uint32_t v)
 {
     const struct hal *hal = j->hal;
     int32_t target = (int32_t)((j->cfg->start_angle_deg + 360.0 * v / j->views) * 1000.0);
-    char detail[HAL_MAX_PATH + 128], started[32];
+    char detail[HAL_MAX_PATH + 160], started[32];
     snprintf(detail, sizeof(detail), "to %.1f deg", target / 1000.0);
     progress(j, "moving", (int)v, v, detail);
     int rc = hal_table_move_to(&hal->turntable, target);
@@ -234,7 +269,8 @@ static int live_view(struct job *j, uint32_t v)
         return rc;
     }
     progress(j, "saving", (int)v, v, "");
-    rc = save_results(j);
+    struct icp_report reg;
+    rc = save_results(j, &reg);
     if (rc == 0)
         rc = board_write_view_extras(hal, j->view_dir);
     /* view.ini last: its presence says the view is complete */
@@ -244,8 +280,7 @@ static int live_view(struct job *j, uint32_t v)
         hal->log(HAL_LOG_ERROR, "cannot save %s: %s", j->view_dir, strerror(-rc));
         return rc;
     }
-    snprintf(detail, sizeof(detail), "%u points at %.1f deg -> %s/cloud.ply",
-             (unsigned)info.valid_points, info.angle_mdeg / 1000.0, j->view_dir);
+    describe(detail, sizeof(detail), &info, &reg, j->view_dir);
     progress(j, "saved", (int)v, v + 1, detail);
     return 0;
 }
@@ -271,6 +306,7 @@ int scan_job_live(const struct hal *hal, const struct app_config *cfg,
         return rc;
     }
     rc = fusion_begin(&cfg->fusion);
+    icp_reset();
     if (rc == 0)
         rc = board_write_scan_extras(hal, j.out_dir);
     if (rc != 0)
@@ -333,12 +369,12 @@ static int process_view(struct job *j, uint32_t v, const char *in_view_dir)
     set_view_dir(j, v);
     if (rc == 0)
         rc = hal_storage_mkdir_p(&hal->storage, j->view_dir);
+    struct icp_report reg;
     if (rc == 0)
-        rc = save_results(j);
+        rc = save_results(j, &reg);
     if (rc == 0) {
-        char detail[HAL_MAX_PATH + 96];
-        snprintf(detail, sizeof(detail), "%u points at %.1f deg -> %s/cloud.ply",
-                 (unsigned)info.valid_points, angle / 1000.0, j->view_dir);
+        char detail[HAL_MAX_PATH + 160];
+        describe(detail, sizeof(detail), &info, &reg, j->view_dir);
         progress(j, "saved", (int)v, v + 1, detail);
     }
     return rc;
@@ -366,6 +402,7 @@ int scan_job_process(const struct hal *hal, const char *scan_dir, const struct s
     rc = hal_storage_mkdir_p(&hal->storage, j.out_dir);
     if (rc == 0)
         rc = fusion_begin(&cfg.fusion);
+    icp_reset();
     progress(&j, "process_start", -1, 0, scan_dir);
     for (uint32_t v = 0; v < cfg.views && rc == 0; v++) {
         char in_dir[HAL_MAX_PATH + 32];

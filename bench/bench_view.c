@@ -65,7 +65,7 @@ int main(int argc, char **argv)
         s[3] = now_ms();
         tri_normals(maps, t.cfg.scan.normal_radius_px, t.cfg.scan.max_depth_jump_mm);
         s[4] = now_ms();
-        scan_save_cloud(&t.hal, &t.calib, "build/bench_view.ply");
+        scan_save_cloud_at_turntable_pose(&t, "build/bench_view.ply");
         s[5] = now_ms();
         for (int k = 0; k < 5; k++)
             best[k] = s[k + 1] - s[k] < best[k] ? s[k + 1] - s[k] : best[k];

@@ -207,22 +207,28 @@ void scan_view_pose(const struct scan_calib *calib, struct frame_xform *obj_from
     frame_object_from_camera(calib, last_angle_mdeg, obj_from_cam);
 }
 
+int scan_register_view(const struct icp_params *params, const struct scan_calib *calib,
+                       struct frame_xform *pose, struct icp_report *report)
+{
+    return icp_register(params, calib, decode_get_maps(), tri_get_range(), colour_rgb, pose,
+                        report);
+}
+
 int scan_fuse_view(const struct scan_calib *calib, const struct frame_xform *obj_from_cam)
 {
     return fusion_integrate(calib, obj_from_cam, decode_get_maps(), tri_get_range(), colour_rgb);
 }
 
-int scan_save_cloud(const struct hal *hal, const struct scan_calib *calib, const char *path)
+int scan_save_cloud(const struct hal *hal, const struct frame_xform *obj_from_cam,
+                    const char *path)
 {
-    struct frame_xform obj_from_cam;
     uint32_t written = 0;
-    frame_object_from_camera(calib, last_angle_mdeg, &obj_from_cam);
     int rc = ply_write_cloud(&hal->storage, path, decode_get_maps(), tri_get_range(), colour_rgb,
-                             &obj_from_cam, &written);
+                             obj_from_cam, &written);
     if (rc != 0)
         hal->log(HAL_LOG_ERROR, "storage: cannot write %s: %s", path, strerror(-rc));
     else
-        hal->log(HAL_LOG_INFO, "wrote %u points to %s", (unsigned)written, path);
+        hal->log(HAL_LOG_DEBUG, "wrote %u points to %s", (unsigned)written, path);
     return rc;
 }
 

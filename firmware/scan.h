@@ -7,6 +7,7 @@
 #include "hal.h"
 #include "scan_types.h"
 #include "frames.h"
+#include "icp.h"
 #include "tri.h"
 
 /** What one view produced. */
@@ -56,12 +57,17 @@ int scan_finish_view(const struct scan_calib *calib, int32_t angle_mdeg,
 /** Pose of the last view: camera frame to object frame, from the turntable axis and angle. */
 void scan_view_pose(const struct scan_calib *calib, struct frame_xform *obj_from_cam);
 
+/** Refine @p pose against the previous view (icp.h); the view becomes the next reference. */
+int scan_register_view(const struct icp_params *params, const struct scan_calib *calib,
+                       struct frame_xform *pose, struct icp_report *report);
+
 /** Fuse the last view into the volume (fusion_begin first) seen through @p obj_from_cam. */
 int scan_fuse_view(const struct scan_calib *calib, const struct frame_xform *obj_from_cam);
 
-/** Write the last view's point cloud (object frame) as binary PLY.
- *  @retval 0 ok @retval -errno from storage */
-int scan_save_cloud(const struct hal *hal, const struct scan_calib *calib, const char *path);
+/** Write the last view's point cloud as binary PLY, through @p obj_from_cam into the object
+ *  frame. @retval 0 ok @retval -errno from storage */
+int scan_save_cloud(const struct hal *hal, const struct frame_xform *obj_from_cam,
+                    const char *path);
 
 /** Colour of the last view: the projector-white frame, RGB24 (registered with the range image). */
 const uint8_t *scan_colour_frame(void);

@@ -24,7 +24,7 @@ static void test_ply_roundtrip(void **state)
     const int32_t angle_mdeg = 30000;
     assert_int_equal(hal_table_move_to(&t.hal.turntable, angle_mdeg), 0);
     assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, angle_mdeg, NULL, &info), 0);
-    assert_int_equal(scan_save_cloud(&t.hal, &t.calib, "build/test_ply.ply"), 0);
+    assert_int_equal(scan_save_cloud_at_turntable_pose(&t, "build/test_ply.ply"), 0);
 
     FILE *f = fopen("build/test_ply.ply", "rb");
     assert_non_null(f);

@@ -56,6 +56,13 @@ void test_rig_stop(struct test_rig *t)
     board_shutdown(&t->hal);
 }
 
+int scan_save_cloud_at_turntable_pose(struct test_rig *t, const char *path)
+{
+    struct frame_xform pose;
+    scan_view_pose(&t->calib, &pose);
+    return scan_save_cloud(&t->hal, &pose, path);
+}
+
 void test_measure_view(const struct sim_rig *rig, struct view_quality *q)
 {
     const struct decode_maps *maps = decode_get_maps();

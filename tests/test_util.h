@@ -24,6 +24,9 @@ int test_rig_start(struct test_rig *t);
 /** scan_close + board_shutdown. */
 void test_rig_stop(struct test_rig *t);
 
+/** scan_save_cloud with the view's turntable pose. @retval what it returned */
+int scan_save_cloud_at_turntable_pose(struct test_rig *t, const char *path);
+
 /** How well the last view matches the simulator's ground truth. */
 struct view_quality {
     uint32_t lit;         /**< pixels where the projector lights the visible surface */
