@@ -47,7 +47,7 @@ FW_OBJ := $(call obj,$(FW_SRC))
 HOST_OBJ := $(call obj,$(POSIX_SRC) $(APP_LIB_SRC) $(BOARD_SRC))
 MAIN_OBJ := $(call obj,app/main.c)
 
-.PHONY: all deps test-deps test run clean format docs check-firmware bench measure
+.PHONY: all deps test-deps test run clean format docs check-firmware bench measure measure-scan
 SIM_TOOLS := $(if $(filter sim,$(HAL)),$(BUILD)/turntable-sim $(BUILD)/tt-client $(BUILD)/mesh-compare,)
 all: deps $(BUILD)/scanner $(SIM_TOOLS)
 
@@ -137,6 +137,20 @@ $(BUILD)/measure_view: $(BUILD)/tests/measure_view.o $(BUILD)/tests/test_util.o 
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON) $(BOARD_LIBS)
 measure: deps $(BUILD)/measure_view
 	$(BUILD)/measure_view config/sim.ini
+
+# Full simulated scans measured against the true surface, and peak memory for 8 and 24 views.
+measure-scan: deps $(BUILD)/scanner $(BUILD)/mesh-compare
+	@for obj in mesh cylinder sphere; do \
+		sed "s/^object = .*/object = $$obj/" config/sim.ini > $(BUILD)/measure-$$obj.ini; \
+		sed -i "s|^calibration = .*|calibration = $(CURDIR)/config/sim-calib.ini|; s|^mesh_file = ../../|mesh_file = $(CURDIR)/../|" $(BUILD)/measure-$$obj.ini; \
+		rm -rf $(BUILD)/measure-scan/$$obj; \
+		$(BUILD)/scanner scan --config $(BUILD)/measure-$$obj.ini --out $(BUILD)/measure-scan/$$obj | tail -n 1; \
+		$(BUILD)/mesh-compare $(BUILD)/measure-scan/$$obj/mesh.ply $(BUILD)/measure-scan/$$obj/truth_mesh.ply $(BUILD)/measure-scan/$$obj; \
+	done
+	@sed "s/^views = .*/views = 24/" $(BUILD)/measure-mesh.ini > $(BUILD)/measure-24.ini; \
+		rm -rf $(BUILD)/measure-scan/bunny24; \
+		$(BUILD)/scanner scan --config $(BUILD)/measure-24.ini --out $(BUILD)/measure-scan/bunny24 | tail -n 1; \
+		$(BUILD)/mesh-compare $(BUILD)/measure-scan/bunny24/mesh.ply $(BUILD)/measure-scan/bunny24/truth_mesh.ply $(BUILD)/measure-scan/bunny24
 
 # Time per view, split between the simulated capture and the firmware's processing.
 $(BUILD)/bench_view: $(BUILD)/bench/bench_view.o $(BUILD)/tests/test_util.o $(HOST_OBJ) $(BUILD)/libfirmware.a

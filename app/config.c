@@ -168,6 +168,8 @@ static const struct ini_key config_keys[] = {
     {"sim", "albedo", INI_VEC, C(sim.albedo), 3, 0, 1, 0, "0.8, 0.8, 0.8", NULL,
      "albedo for albedo_pattern = uniform"},
     U32("sim", "seed", sim.seed, 0, 4294967295.0, "1", "noise seed (runs are repeatable)"),
+    U32("sim", "table_angle_error_mdeg", sim.table_angle_error_mdeg, 0, 10000, "0",
+        "the table ends each move up to this far from the angle it reports (open-loop stepper)"),
     F64("sim", "black_offset_dn", sim.black_offset_dn, 0, 255, "51",
         "camera black offset (Jost et al. Table 1: 51)"),
     F64("sim", "ambient_dn", sim.ambient_dn, 0, 255, "3", "indirect light on a white surface"),

@@ -27,6 +27,7 @@ struct sim_config {
     char albedo_pattern[16]; /**< patches | uniform */
     double albedo[3];
     uint32_t seed;
+    uint32_t table_angle_error_mdeg;
     double black_offset_dn, ambient_dn, read_noise_dn, electrons_per_dn;
     double projector_intensity_dn, projector_black_level, projector_blur_px;
     double light_intensity_dn, reference_distance_mm;

@@ -14,6 +14,7 @@
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <sys/resource.h>
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
@@ -94,6 +95,16 @@ static void progress(struct job *j, const char *event, int view, uint32_t done, 
         printf("%s %s\n", text, detail);
     }
     fflush(stdout);
+}
+
+/* Where the results are, and the peak memory: it must not grow with the number of views. */
+static const char *finished_detail(struct job *j, char *buf, size_t len)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    snprintf(buf, len, "%s (mesh: %s/mesh.ply, mesh.obj; peak memory %.1f MB)", j->out_dir,
+             j->out_dir, ru.ru_maxrss / 1024.0);
+    return buf;
 }
 
 /* ---- the scan directory ---- */
@@ -321,7 +332,7 @@ int scan_job_live(const struct hal *hal, const struct app_config *cfg,
     if (rc == 0)
         rc = write_model(&j);
     if (rc == 0)
-        progress(&j, "scan_done", -1, j.views, j.out_dir);
+        progress(&j, "scan_done", -1, j.views, finished_detail(&j, path, sizeof(path)));
     else if (opts->json)
         progress(&j, "scan_failed", -1, 0, strerror(-rc));
     return rc;
@@ -412,6 +423,6 @@ int scan_job_process(const struct hal *hal, const char *scan_dir, const struct s
     if (rc == 0)
         rc = write_model(&j);
     if (rc == 0)
-        progress(&j, "process_done", -1, j.views, j.out_dir);
+        progress(&j, "process_done", -1, j.views, finished_detail(&j, path, sizeof(path)));
     return rc;
 }

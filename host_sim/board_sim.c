@@ -36,7 +36,7 @@ const char *board_name(void)
 
 static int32_t table_angle(void *priv)
 {
-    return tt_server_position(priv);
+    return tt_server_physical_position(priv); /* what the camera sees, not what is reported */
 }
 
 /* The controller on loopback TCP or on one end of a pty pair, and the client on the other. */
@@ -62,6 +62,7 @@ static int start_turntable(struct hal *hal, const struct app_config *cfg, char *
     if (rc != 0)
         return rc;
     sim.server_open = 1;
+    sim.server.ctrl.angle_error_mdeg = (int32_t)cfg->sim.table_angle_error_mdeg;
     rc = tt_server_start(&sim.server);
     if (rc == 0)
         rc = tt_client_open(&sim.client, &cc, &hal->clock, hal->log, &hal->turntable, err,

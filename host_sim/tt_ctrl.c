@@ -124,12 +124,18 @@ static void execute(struct tt_ctrl *c, uint16_t cmd, uint64_t now_us)
             break;
         }
         start_move(c, get32(c->regs, TT_REG_TARGET_HI), now_us);
+        if (c->angle_error_mdeg != 0) { /* a fixed pseudo-random error per move, in +-max */
+            uint32_t h = (++c->moves) * 2654435761u;
+            h ^= h >> 15;
+            c->physical_offset_mdeg = ((double)(h % 2001u) / 1000.0 - 1.0) * c->angle_error_mdeg;
+        }
         break;
     case TT_CMD_HOME:
         if (c->alarm != TT_ALARM_NONE)
             break;
         /* The reference switch sits at the power-on zero: travel there, then call it 0. */
         start_move(c, 0.0, now_us);
+        c->physical_offset_mdeg = 0.0; /* the reference switch is exact */
         put32(c->regs, TT_REG_TARGET_HI, 0);
         c->homing = c->moving;
         c->homed = !c->moving; /* already at the reference */
@@ -164,4 +170,9 @@ void tt_ctrl_after_write(struct tt_ctrl *c, uint64_t now_us)
 int32_t tt_ctrl_position(const struct tt_ctrl *c)
 {
     return (int32_t)lround(c->pos_mdeg);
+}
+
+double tt_ctrl_physical_mdeg(const struct tt_ctrl *c)
+{
+    return c->pos_mdeg + c->physical_offset_mdeg;
 }

@@ -20,6 +20,11 @@ struct tt_ctrl {
     double speed_mdeg_s, accel_mdeg_s2, duration_s;
     /* fault injection (tests): the table blocks at this position (INT32_MIN: never) */
     int32_t stall_at_mdeg;
+    /* An open-loop stepper reports where it was told to go; the table itself ends up to this far
+     * off after each move (backlash, missed microsteps), deterministically per move. */
+    int32_t angle_error_mdeg;
+    uint32_t moves;
+    double physical_offset_mdeg;
 };
 
 /** Power-on state: not homed, at a random-ish position @p power_on_mdeg, idle. */
@@ -30,7 +35,9 @@ void tt_ctrl_update(struct tt_ctrl *c, uint64_t now_us);
  *  @retval 0 ok, or a Modbus exception code (2: illegal data address) */
 int tt_ctrl_check_write(const struct tt_ctrl *c, int addr, int count);
 void tt_ctrl_after_write(struct tt_ctrl *c, uint64_t now_us);
-/** Current position in millidegrees. */
+/** Current position in millidegrees, as the controller reports it. */
 int32_t tt_ctrl_position(const struct tt_ctrl *c);
+/** Where the table really is (reported position plus the mechanical error). */
+double tt_ctrl_physical_mdeg(const struct tt_ctrl *c);
 
 #endif

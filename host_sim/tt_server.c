@@ -5,6 +5,7 @@
 
 #include <arpa/inet.h>
 #include <errno.h>
+#include <math.h>
 #include <modbus.h>
 #include <netinet/in.h>
 #include <poll.h>
@@ -187,6 +188,15 @@ int32_t tt_server_position(struct tt_server *s)
     pthread_mutex_lock(&s->lock);
     tt_ctrl_update(&s->ctrl, s->now(s->now_priv));
     int32_t pos = tt_ctrl_position(&s->ctrl);
+    pthread_mutex_unlock(&s->lock);
+    return pos;
+}
+
+int32_t tt_server_physical_position(struct tt_server *s)
+{
+    pthread_mutex_lock(&s->lock);
+    tt_ctrl_update(&s->ctrl, s->now(s->now_priv));
+    int32_t pos = (int32_t)lround(tt_ctrl_physical_mdeg(&s->ctrl));
     pthread_mutex_unlock(&s->lock);
     return pos;
 }

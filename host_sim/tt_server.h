@@ -38,7 +38,9 @@ int tt_server_start(struct tt_server *s);
 /** Serve requests in the calling thread until ->stop is set (the standalone program). */
 void tt_server_run(struct tt_server *s);
 void tt_server_close(struct tt_server *s);
-/** Position now (advances the motion to now). */
+/** Position now as reported (advances the motion to now). */
 int32_t tt_server_position(struct tt_server *s);
+/** Where the table really is now, in millidegrees. */
+int32_t tt_server_physical_position(struct tt_server *s);
 
 #endif

@@ -12,7 +12,7 @@
 char test_last_log[512];
 int test_error_count;
 
-static void test_log(enum hal_log_level level, const char *fmt, ...)
+void test_rig_log(enum hal_log_level level, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
@@ -37,7 +37,7 @@ int test_rig_load(struct test_rig *t, const char *config_path)
 int test_rig_start(struct test_rig *t)
 {
     char err[512];
-    t->hal.log = test_log;
+    t->hal.log = test_rig_log;
     test_error_count = 0;
     int rc = board_init(&t->hal, &t->cfg, &t->calib, err, sizeof(err));
     if (rc != 0) {

@@ -17,6 +17,9 @@ struct test_rig {
 extern char test_last_log[512];
 extern int test_error_count;
 
+/** The quiet logger the test rig uses (records the last message). */
+void test_rig_log(enum hal_log_level level, const char *fmt, ...);
+
 /** Load a config and its calibration. @retval 0 ok (fails the test otherwise) */
 int test_rig_load(struct test_rig *t, const char *config_path);
 /** board_init + scan_open with the quiet test logger. @retval 0 or the error */
