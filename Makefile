@@ -47,7 +47,7 @@ FW_OBJ := $(call obj,$(FW_SRC))
 HOST_OBJ := $(call obj,$(POSIX_SRC) $(APP_LIB_SRC) $(BOARD_SRC))
 MAIN_OBJ := $(call obj,app/main.c)
 
-.PHONY: all deps test-deps test run clean format docs check-firmware bench measure measure-scan
+.PHONY: all deps test-deps test run clean format docs check-firmware bench measure measure-scan interop-meshlab
 SIM_TOOLS := $(if $(filter sim,$(HAL)),$(BUILD)/turntable-sim $(BUILD)/tt-client $(BUILD)/mesh-compare,)
 all: deps $(BUILD)/scanner $(SIM_TOOLS)
 
@@ -151,6 +151,12 @@ measure-scan: deps $(BUILD)/scanner $(BUILD)/mesh-compare
 		rm -rf $(BUILD)/measure-scan/bunny24; \
 		$(BUILD)/scanner scan --config $(BUILD)/measure-24.ini --out $(BUILD)/measure-scan/bunny24 | tail -n 1; \
 		$(BUILD)/mesh-compare $(BUILD)/measure-scan/bunny24/mesh.ply $(BUILD)/measure-scan/bunny24/truth_mesh.ply $(BUILD)/measure-scan/bunny24
+
+# MeshLab opens a scan's mesh (installs MeshLab and Xvfb when missing: large, so not in test).
+interop-meshlab: deps $(BUILD)/scanner
+	rm -rf $(BUILD)/meshlab-scan
+	$(BUILD)/scanner scan --config config/sim.ini --out $(BUILD)/meshlab-scan > /dev/null
+	tests/interop_meshlab.sh $(BUILD)/meshlab-scan
 
 # Time per view, split between the simulated capture and the firmware's processing.
 $(BUILD)/bench_view: $(BUILD)/bench/bench_view.o $(BUILD)/tests/test_util.o $(HOST_OBJ) $(BUILD)/libfirmware.a

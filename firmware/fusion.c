@@ -167,6 +167,21 @@ int fusion_integrate(const struct scan_calib *c, const struct frame_xform *obj_f
     return 0;
 }
 
+int fusion_fill(double (*sdf_mm)(vec3 p, void *ctx), void *ctx)
+{
+    for (uint32_t z = 0; z < fz.dims[2]; z++)
+        for (uint32_t y = 0; y < fz.dims[1]; y++)
+            for (uint32_t x = 0; x < fz.dims[0]; x++) {
+                struct voxel *v = &grid[vidx(x, y, z)];
+                double d = sdf_mm(v3_add(fz.origin, v3_scale(v3(x, y, z), fz.p.voxel_mm)), ctx);
+                d = fmax(-fz.p.truncation_mm, fmin(fz.p.truncation_mm, d));
+                v->sdf = (int16_t)lround(d / fz.p.truncation_mm * 32767.0);
+                v->weight = (uint16_t)WEIGHT_SCALE;
+                v->rgb[0] = v->rgb[1] = v->rgb[2] = 128;
+            }
+    return 0;
+}
+
 /* ---- marching cubes ---- */
 
 static double sdf_at(uint32_t x, uint32_t y, uint32_t z)
@@ -202,7 +217,9 @@ static int edge_vertex(struct extract_state *st, const uint32_t s[3], int axis, 
     t[axis]++;
     const struct voxel *va = &grid[vidx(s[0], s[1], s[2])], *vb = &grid[vidx(t[0], t[1], t[2])];
     double da = sdf_at(s[0], s[1], s[2]), db = sdf_at(t[0], t[1], t[2]);
-    double f = da / (da - db);
+    /* Strictly inside the edge: a zero distance at a sample would otherwise put the vertices of
+     * several edges on the same point (degenerate triangles, non-manifold fans). */
+    double f = fmin(fmax(da / (da - db), 1e-3), 1.0 - 1e-3);
     vec3 ga = gradient(s[0], s[1], s[2]), gb = gradient(t[0], t[1], t[2]);
     vec3 n = v3_norm(v3_add(v3_scale(ga, 1.0 - f), v3_scale(gb, f)));
     vec3 pos = v3_add(fz.origin, v3_scale(v3(s[0], s[1], s[2]), fz.p.voxel_mm));

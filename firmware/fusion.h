@@ -35,6 +35,10 @@ int fusion_integrate(const struct scan_calib *calib, const struct frame_xform *o
                      const struct decode_maps *maps, const struct tri_range *range,
                      const uint8_t *rgb);
 
+/** Set every voxel from a signed distance function of the object-frame position (mm), weight 1
+ *  and grey colour: synthetic objects and tests of the extraction. @retval 0 */
+int fusion_fill(double (*sdf_mm)(vec3 p, void *ctx), void *ctx);
+
 /** Receives the mesh: vertices are numbered from 0 in the order given. */
 struct mesh_sink {
     int (*vertex)(void *priv, const float pos[3], const float normal[3], const uint8_t rgb[3]);

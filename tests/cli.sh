@@ -57,6 +57,7 @@ check sigint_stops_safely sigint_test
 points=$(sed -n 's/^valid_points = //p' "$out/scan/view_000/view.ini")
 if /usr/bin/python3 -c 'import open3d' 2>/dev/null; then
     check open3d_reads_ply /usr/bin/python3 tests/interop_open3d.py "$out/scan/view_000/cloud.ply" "$points"
+    check open3d_reads_mesh_ply_and_obj /usr/bin/python3 tests/interop_open3d.py --mesh "$out/scan"
 else
     echo "[  FAILED  ] open3d_reads_ply: python3-open3d missing (scripts/install-deps.sh test)"
     fail=$((fail + 1))

@@ -1,9 +1,25 @@
 #!/usr/bin/python3
-"""Open3D (Debian's python3-open3d) reads a scanner PLY: points, normals and colours, with
-positions on the scanned object's scale. Usage: interop_open3d.py FILE.ply EXPECTED_POINTS"""
+"""Open3D (Debian's python3-open3d) reads the scanner's files.
+  interop_open3d.py CLOUD.ply EXPECTED_POINTS    a view: points, normals and colours, in mm
+  interop_open3d.py --mesh SCAN_DIR              the fused mesh, as PLY and as OBJ"""
 import sys
 import numpy as np
 import open3d as o3d
+
+if sys.argv[1] == "--mesh":
+    counts = []
+    for name in ("mesh.ply", "mesh.obj"):
+        m = o3d.io.read_triangle_mesh(sys.argv[2] + "/" + name)
+        assert len(m.triangles) > 10000, (name, len(m.triangles))
+        assert m.has_vertex_colors() and m.has_vertex_normals(), name
+        assert m.is_edge_manifold(), name + " is not edge-manifold"
+        v = np.asarray(m.vertices)
+        assert v[:, 2].min() > -4.0 and v[:, 2].max() < 166.0, (v[:, 2].min(), v[:, 2].max())
+        counts.append((len(m.vertices), len(m.triangles)))
+    assert counts[0] == counts[1], counts  # same mesh in both files
+    print("open3d %s read mesh.ply and mesh.obj: %d vertices, %d triangles, colours and normals"
+          % (o3d.__version__, counts[0][0], counts[0][1]))
+    sys.exit(0)
 
 pcd = o3d.io.read_point_cloud(sys.argv[1])
 pts = np.asarray(pcd.points)

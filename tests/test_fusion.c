@@ -1,0 +1,202 @@
+/* Marching cubes over the fusion grid: closed, consistently oriented surfaces with the right
+ * topology, over fields that exercise (nearly) every cube case, ambiguous ones included. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "fusion.h"
+#include "mc_table.h"
+
+struct collected {
+    float *pos;
+    uint32_t *tri;
+    uint32_t nv, nt, cap_v, cap_t;
+};
+
+static int on_vertex(void *priv, const float p[3], const float n[3], const uint8_t rgb[3])
+{
+    (void)n;
+    (void)rgb;
+    struct collected *c = priv;
+    if (c->nv == c->cap_v) {
+        c->cap_v = c->cap_v ? 2 * c->cap_v : 4096;
+        c->pos = realloc(c->pos, sizeof(float) * 3 * c->cap_v);
+    }
+    memcpy(&c->pos[3 * c->nv++], p, 3 * sizeof(float));
+    return 0;
+}
+
+static int on_triangle(void *priv, uint32_t a, uint32_t b, uint32_t t)
+{
+    struct collected *c = priv;
+    if (c->nt == c->cap_t) {
+        c->cap_t = c->cap_t ? 2 * c->cap_t : 4096;
+        c->tri = realloc(c->tri, sizeof(uint32_t) * 3 * c->cap_t);
+    }
+    c->tri[3 * c->nt] = a;
+    c->tri[3 * c->nt + 1] = b;
+    c->tri[3 * c->nt + 2] = t;
+    c->nt++;
+    return 0;
+}
+
+static int cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* Every directed edge once and its reverse once: closed and consistently oriented.
+ * Returns the Euler characteristic V - E + F. */
+static long check_closed(const struct collected *c)
+{
+    uint64_t *dir = malloc(sizeof(uint64_t) * 3 * c->nt);
+    for (uint32_t t = 0; t < c->nt; t++)
+        for (int k = 0; k < 3; k++) {
+            uint64_t a = c->tri[3 * t + k], b = c->tri[3 * t + (k + 1) % 3];
+            assert_true(a != b && a < c->nv && b < c->nv);
+            dir[3 * t + k] = a << 32 | b;
+        }
+    qsort(dir, 3 * (size_t)c->nt, sizeof(uint64_t), cmp_u64);
+    for (size_t i = 0; i < 3 * (size_t)c->nt; i++) {
+        if (i > 0 && dir[i] == dir[i - 1])
+            fail_msg("directed edge %llu used twice: orientation flips",
+                     (unsigned long long)dir[i]);
+        uint64_t rev = (dir[i] & 0xFFFFFFFFu) << 32 | dir[i] >> 32;
+        if (bsearch(&rev, dir, 3 * (size_t)c->nt, sizeof(uint64_t), cmp_u64) == NULL)
+            fail_msg("edge without its twin: the surface has a hole");
+    }
+    free(dir);
+    return (long)c->nv - (long)(3 * (size_t)c->nt / 2) + (long)c->nt;
+}
+
+static struct fusion_params grid_params(void)
+{
+    struct fusion_params p = {.voxel_mm = 1.0, .radius_mm = 30, .bottom_mm = 0, .top_mm = 60,
+                              .truncation_mm = 3.0, .max_weight = 50, .edge_fade_px = 10};
+    return p;
+}
+
+static double sphere(vec3 p, void *ctx)
+{
+    (void)ctx;
+    return v3_len(v3_sub(p, v3(0.3, -0.2, 30.1))) - 20.0;
+}
+
+static double torus(vec3 p, void *ctx)
+{
+    (void)ctx;
+    vec3 q = v3_sub(p, v3(0, 0, 30));
+    double ring = sqrt(q.x * q.x + q.y * q.y) - 18.0;
+    return sqrt(ring * ring + q.z * q.z) - 6.0;
+}
+
+/* Smooth random blobs, with a shell that keeps the surface inside the grid: many cube cases. */
+static double blobs(vec3 p, void *ctx)
+{
+    const double *c = ctx;
+    double d = 0.0;
+    for (int k = 0; k < 40; k++) {
+        vec3 q = v3_sub(p, v3(c[4 * k], c[4 * k + 1], c[4 * k + 2]));
+        d += c[4 * k + 3] * exp(-v3_dot(q, q) / 6.0);
+    }
+    double r = v3_len(v3_sub(p, v3(0, 0, 30)));
+    return r > 24.0 ? r - 24.0 + 1.0 : 0.4 - d;
+}
+
+static void extract(double (*fn)(vec3, void *), void *ctx, struct collected *c)
+{
+    struct fusion_params p = grid_params();
+    assert_int_equal(fusion_begin(&p), 0);
+    assert_int_equal(fusion_fill(fn, ctx), 0);
+    memset(c, 0, sizeof(*c));
+    struct mesh_sink sink = {on_vertex, on_triangle, c};
+    assert_int_equal(fusion_extract(&sink), 0);
+}
+
+static void test_sphere_is_closed_genus_0(void **state)
+{
+    (void)state;
+    struct collected c;
+    extract(sphere, NULL, &c);
+    assert_true(c.nt > 1000);
+    assert_int_equal(check_closed(&c), 2);
+    /* outward: every triangle faces away from the centre, and vertices lie on the sphere */
+    for (uint32_t t = 0; t < c.nt; t++) {
+        const float *a = &c.pos[3 * c.tri[3 * t]], *b = &c.pos[3 * c.tri[3 * t + 1]],
+                    *d = &c.pos[3 * c.tri[3 * t + 2]];
+        vec3 n = v3_cross(v3(b[0] - a[0], b[1] - a[1], b[2] - a[2]),
+                          v3(d[0] - a[0], d[1] - a[1], d[2] - a[2]));
+        assert_true(v3_dot(n, v3(a[0] - 0.3, a[1] + 0.2, a[2] - 30.1)) > 0.0);
+    }
+    for (uint32_t v = 0; v < c.nv; v++)
+        assert_true(fabs(sphere(v3(c.pos[3 * v], c.pos[3 * v + 1], c.pos[3 * v + 2]), NULL)) < 0.05);
+    free(c.pos);
+    free(c.tri);
+}
+
+static void test_torus_is_closed_genus_1(void **state)
+{
+    (void)state;
+    struct collected c;
+    extract(torus, NULL, &c);
+    assert_int_equal(check_closed(&c), 0);
+    free(c.pos);
+    free(c.tri);
+}
+
+static void test_random_blobs_stay_closed(void **state)
+{
+    (void)state;
+    double centres[40 * 4];
+    srand(3);
+    for (int k = 0; k < 40; k++) {
+        centres[4 * k] = (rand() % 300) / 10.0 - 15.0;
+        centres[4 * k + 1] = (rand() % 300) / 10.0 - 15.0;
+        centres[4 * k + 2] = 15.0 + (rand() % 300) / 10.0;
+        centres[4 * k + 3] = 0.5 + (rand() % 100) / 100.0;
+    }
+    struct collected c;
+    extract(blobs, centres, &c);
+    assert_true(c.nt > 1000);
+    check_closed(&c); /* any genus, but closed and oriented */
+    free(c.pos);
+    free(c.tri);
+}
+
+/* The generated table: complementary cases mirror each other, and every case's triangles are
+ * edges of the cube where the sign changes. */
+static void test_table_properties(void **state)
+{
+    (void)state;
+    mc_table_build();
+    assert_int_equal(mc_table_case(0)->tri_count, 0);
+    assert_int_equal(mc_table_case(255)->tri_count, 0);
+    assert_int_equal(mc_table_case(1)->tri_count, 1);
+    for (unsigned m = 1; m < 255; m++) {
+        const struct mc_case *c = mc_table_case(m);
+        assert_true(c->tri_count >= 1);
+        for (unsigned t = 0; t < c->tri_count; t++)
+            for (int k = 0; k < 3; k++) {
+                int e = c->edge[t][k];
+                unsigned a = mc_edge_corner[e][0], b = mc_edge_corner[e][1];
+                assert_int_not_equal((m >> a) & 1u, (m >> b) & 1u);
+            }
+    }
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_table_properties),
+        cmocka_unit_test(test_sphere_is_closed_genus_0),
+        cmocka_unit_test(test_torus_is_closed_genus_1),
+        cmocka_unit_test(test_random_blobs_stay_closed),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
