@@ -74,10 +74,15 @@ static void progress(struct job *j, const char *event, int view, uint32_t done, 
         json_string(stdout, detail);
         printf("}\n");
     } else if (j->tty && view >= 0) {
-        printf("\r\033[Kview %d of %u: %-10s %s  %.0f s elapsed%s", view + 1, (unsigned)j->views,
-               event, detail, elapsed_s, left_s >= 0 ? "" : "");
+        /* one status line, rewritten in place; a finished view keeps its line, without the path */
+        const char *arrow = NULL; /* the last " -> " introduces the path */
+        for (const char *a = strstr(detail, " -> "); a != NULL; a = strstr(a + 1, " -> "))
+            arrow = a;
+        int shown = arrow != NULL ? (int)(arrow - detail) : (int)strlen(detail);
+        printf("\r\033[Kview %d/%u %4.0f s", view + 1, (unsigned)j->views, elapsed_s);
         if (left_s >= 0)
-            printf(", ~%.0f s left", left_s);
+            printf(" (~%.0f s left)", left_s);
+        printf("  %s %.*s", event, shown, detail);
         if (strcmp(event, "saved") == 0)
             printf("\n");
     } else if (view >= 0 && strcmp(event, "saved") == 0) {
