@@ -5,6 +5,7 @@
 
 #include "frames.h"
 #include "gray.h"
+#include "sim_random.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -13,20 +14,12 @@
 
 #define GAUSS_TABLE 65536u
 
-static uint64_t splitmix64(uint64_t *state)
-{
-    uint64_t z = (*state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-
 static void fill_gauss(float *table, uint64_t seed)
 {
     /* Box-Muller pairs; indexing this table with random bits is much faster than logs per pixel. */
     for (uint32_t i = 0; i < GAUSS_TABLE; i += 2) {
-        double u1 = ((double)(splitmix64(&seed) >> 11) + 1.0) / 9007199254740993.0;
-        double u2 = (double)(splitmix64(&seed) >> 11) / 9007199254740992.0;
+        double u1 = 1.0 - sim_random_unit(&seed); /* (0, 1]: log() must not see 0 */
+        double u2 = sim_random_unit(&seed);
         double r = sqrt(-2.0 * log(u1));
         table[i] = (float)(r * cos(2.0 * M_PI * u2));
         table[i + 1] = (float)(r * sin(2.0 * M_PI * u2));
@@ -358,7 +351,7 @@ void sim_rig_render(struct sim_rig *rig, const struct sim_sources *src, uint64_t
                 if (lights & (1u << li))
                     add_light(rig, i, li, sig);
         }
-        uint64_t r = splitmix64(&state);
+        uint64_t r = sim_random_next(&state);
         for (int k = 0; k < 3; k++) {
             double s = sig[k] * gain;
             double sigma = sqrt(var_read + (s > 0.0 ? s / c->electrons_per_dn : 0.0));

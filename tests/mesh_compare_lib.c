@@ -5,23 +5,11 @@
 #include "config.h"
 #include "frames.h"
 #include "sim_bvh.h"
+#include "sim_random.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-static uint64_t rng_next(uint64_t *s)
-{
-    uint64_t z = (*s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-
-static double rng_unit(uint64_t *s)
-{
-    return (double)(rng_next(s) >> 11) / 9007199254740992.0;
-}
 
 static vec3 vtx(const struct sim_mesh *m, uint32_t t, int k)
 {
@@ -73,7 +61,7 @@ static int sample_distances(const struct sim_mesh *from, const struct sim_bvh *t
     }
     uint64_t seed = 12345;
     for (uint32_t i = 0; i < n; i++) {
-        double target = rng_unit(&seed) * total;
+        double target = sim_random_unit(&seed) * total;
         uint32_t lo = 0, hi = from->tri_count - 1;
         while (lo < hi) { /* first triangle whose cumulative area exceeds target */
             uint32_t mid = (lo + hi) / 2;
@@ -82,7 +70,7 @@ static int sample_distances(const struct sim_mesh *from, const struct sim_bvh *t
             else
                 hi = mid;
         }
-        double r1 = sqrt(rng_unit(&seed)), r2 = rng_unit(&seed);
+        double r1 = sqrt(sim_random_unit(&seed)), r2 = sim_random_unit(&seed);
         vec3 a = vtx(from, lo, 0), b = vtx(from, lo, 1), c = vtx(from, lo, 2);
         vec3 p = v3_add(v3_scale(a, 1.0 - r1), v3_add(v3_scale(b, r1 * (1.0 - r2)),
                                                       v3_scale(c, r1 * r2)));
