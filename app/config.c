@@ -77,6 +77,8 @@ static const struct ini_key config_keys[] = {
         "a pixel needs this many agreeing neighbours (of 8), else 'inconsistent'"),
     F64("scan", "max_depth_jump_mm", scan.max_depth_jump_mm, 0.01, 1000, "3",
         "a larger depth step between neighbours is a surface boundary (for normals)"),
+    U32("scan", "decode_rows", scan.decode_rows, 0, 1, "0",
+        "1: code projector rows too (twice the patterns; rows must agree with neighbours)"),
     U32("scan", "refine", scan.refine, 0, 1, "1",
         "1: interpolate the projector column across each stripe (sub-stripe refinement)"),
     U32("scan", "normal_radius_px", scan.normal_radius_px, 1, 32, "4",

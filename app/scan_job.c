@@ -135,15 +135,18 @@ static int copy_file(const struct hal_storage *st, const char *from, const char 
     return too_big ? -EFBIG : hal_storage_write_file(st, to, buf, n);
 }
 
-static const char *pattern_name(uint32_t pattern, uint32_t bits, char *buf, size_t len)
+static const char *pattern_name(uint32_t pattern, const struct gray_layout *l, char *buf,
+                                size_t len)
 {
+    uint32_t k = (pattern - GRAY_PATTERN_FIRST_BIT) / 2u;
     if (pattern == GRAY_PATTERN_WHITE)
         snprintf(buf, len, "white, RGB (the view's colour)");
     else if (pattern == GRAY_PATTERN_BLACK)
         snprintf(buf, len, "black, grey");
     else
-        snprintf(buf, len, "column bit %u of %u%s, grey",
-                 (unsigned)(pattern - GRAY_PATTERN_FIRST_BIT) / 2u, (unsigned)bits,
+        snprintf(buf, len, "%s bit %u of %u%s, grey", k < l->col_bits ? "column" : "row",
+                 (unsigned)(k < l->col_bits ? k : k - l->col_bits),
+                 (unsigned)(k < l->col_bits ? l->col_bits : l->row_bits),
                  (pattern - GRAY_PATTERN_FIRST_BIT) % 2u ? " inverse" : "");
     return buf;
 }
@@ -153,7 +156,8 @@ static int write_view_meta(struct job *j, uint32_t view, const struct scan_view_
 {
     char text[4096], finished[32], name[64];
     utc_now(finished, sizeof(finished));
-    uint32_t bits = gray_bits_for_width(j->calib->proj_width);
+    struct gray_layout layout;
+    scan_layout(&j->cfg->scan, j->calib, &layout);
     int len = snprintf(
         text, sizeof(text),
         "; one view of a scan: see docs/scan-format.md\n[view]\nindex = %u\nangle_mdeg = %d\n"
@@ -163,9 +167,9 @@ static int write_view_meta(struct job *j, uint32_t view, const struct scan_view_
         (unsigned)view, (int)info->angle_mdeg, started, finished, (unsigned)info->frames_captured,
         (unsigned)info->capture_retries, (unsigned)info->valid_points, ms,
         (unsigned)j->cfg->camera.exposure_us, (unsigned)j->cfg->camera.gain_milli);
-    for (uint32_t p = 0; p < gray_pattern_count(bits) && (size_t)len < sizeof(text); p++)
+    for (uint32_t p = 0; p < gray_layout_count(&layout) && (size_t)len < sizeof(text); p++)
         len += snprintf(text + len, sizeof(text) - (size_t)len, "frame_%02u = %s\n", (unsigned)p,
-                        pattern_name(p, bits, name, sizeof(name)));
+                        pattern_name(p, &layout, name, sizeof(name)));
     len += snprintf(text + len, sizeof(text) - (size_t)len, "[pixels]\n");
     for (unsigned r = 0; r < SCAN_REASON_COUNT && (size_t)len < sizeof(text); r++)
         len += snprintf(text + len, sizeof(text) - (size_t)len, "%s = %u\n", scan_reason_name(r),
@@ -364,7 +368,9 @@ static int process_view(struct job *j, uint32_t v, const char *in_view_dir)
         return -EINVAL;
     }
     int rc = scan_begin_view(&j->cfg->scan, j->calib);
-    uint32_t count = gray_pattern_count(gray_bits_for_width(j->calib->proj_width));
+    struct gray_layout layout;
+    scan_layout(&j->cfg->scan, j->calib, &layout);
+    uint32_t count = gray_layout_count(&layout);
     for (uint32_t p = 0; p < count && rc == 0; p++) {
         uint32_t w, h;
         int channels = p == GRAY_PATTERN_WHITE ? 3 : 1;

@@ -1,21 +1,23 @@
-/* Gray-code decoding in static buffers: one pass per frame, so frames need not be kept. */
+/* Gray-code decoding of a whole view from its kept frames, block by block. */
 #include "decode.h"
-
-#include "gray.h"
 
 #include <errno.h>
 #include <string.h>
 
-static uint16_t column_map[HAL_MAX_PIXELS]; /* Gray code while decoding, column afterwards */
+/* One block of pixels: its accumulators stay in the first-level cache while every frame streams
+ * through once. */
+#define DECODE_BLOCK 2048u
+
+static uint8_t frame_store[DECODE_MAX_PATTERNS][HAL_MAX_PIXELS];
+static uint16_t column_map[HAL_MAX_PIXELS];
+static uint16_t row_map[HAL_MAX_PIXELS];
 static uint8_t reason_map[HAL_MAX_PIXELS];
-static uint8_t grey_white[HAL_MAX_PIXELS]; /* white frame, then scratch for the positive frame */
-/* While decoding: bits within the noise per pixel; in decode_finish: neighbour agreement. */
-static uint8_t scratch[HAL_MAX_PIXELS];
+static uint8_t consistent[HAL_MAX_PIXELS];
 
 static struct {
     struct scan_params params;
-    uint32_t bits;
-    uint32_t proj_width;
+    struct gray_layout layout;
+    uint32_t proj_width, proj_height;
     uint32_t next_pattern;
     struct decode_maps maps;
 } dec;
@@ -27,26 +29,6 @@ const char *scan_reason_name(unsigned reason)
     return reason < SCAN_REASON_COUNT ? names[reason] : "unknown";
 }
 
-int decode_begin(const struct scan_params *params, uint32_t proj_width)
-{
-    if (params->width == 0 || params->height == 0 || params->width > HAL_MAX_WIDTH ||
-        params->height > HAL_MAX_HEIGHT || proj_width == 0 || proj_width > HAL_MAX_PROJECTOR_WIDTH)
-        return -EINVAL;
-    dec.params = *params;
-    dec.bits = gray_bits_for_width(proj_width);
-    dec.proj_width = proj_width;
-    dec.next_pattern = 0;
-    dec.maps.column = column_map;
-    dec.maps.reason = reason_map;
-    dec.maps.width = params->width;
-    dec.maps.height = params->height;
-    size_t n = (size_t)params->width * params->height;
-    memset(column_map, 0, n * sizeof(column_map[0]));
-    memset(reason_map, SCAN_VALID, n);
-    memset(scratch, 0, n);
-    return 0;
-}
-
 void decode_rgb_to_grey(const uint8_t *rgb, uint8_t *grey, size_t n, uint32_t saturation_dn)
 {
     for (size_t i = 0; i < n; i++, rgb += 3) {
@@ -56,68 +38,119 @@ void decode_rgb_to_grey(const uint8_t *rgb, uint8_t *grey, size_t n, uint32_t sa
     }
 }
 
-/* Reject a pixel, keeping the first reason found: later frames do not overwrite it. */
-static void reject(size_t i, enum scan_reason why)
+int decode_begin(const struct scan_params *params, const struct gray_layout *layout,
+                 uint32_t proj_width, uint32_t proj_height)
 {
-    if (reason_map[i] == SCAN_VALID)
-        reason_map[i] = (uint8_t)why;
+    if (params->width == 0 || params->height == 0 || params->width > HAL_MAX_WIDTH ||
+        params->height > HAL_MAX_HEIGHT || layout->col_bits == 0 || layout->col_bits > 16 ||
+        layout->row_bits > 16 || gray_layout_count(layout) > DECODE_MAX_PATTERNS)
+        return -EINVAL;
+    dec.params = *params;
+    dec.layout = *layout;
+    dec.proj_width = proj_width;
+    dec.proj_height = proj_height;
+    dec.next_pattern = 0;
+    dec.maps.column = column_map;
+    dec.maps.row = layout->row_bits > 0 ? row_map : NULL;
+    dec.maps.reason = reason_map;
+    dec.maps.width = params->width;
+    dec.maps.height = params->height;
+    return 0;
 }
 
-/* Keep a frame that a later frame is compared with: the white frame (against black), then each
- * bit's positive pattern (against its inverse), which reuses the buffer once white is done. */
-static void take_reference(const uint8_t *grey, size_t n)
+uint8_t *decode_frame_slot(uint32_t pattern)
 {
-    for (size_t i = 0; i < n; i++) {
-        grey_white[i] = grey[i];
-        if (grey[i] == DECODE_SATURATED)
-            reject(i, SCAN_SATURATED);
+    return pattern < gray_layout_count(&dec.layout) ? frame_store[pattern] : NULL;
+}
+
+int decode_frame(uint32_t pattern, const uint8_t *grey)
+{
+    if (pattern != dec.next_pattern || pattern >= gray_layout_count(&dec.layout))
+        return -EINVAL;
+    if (grey != frame_store[pattern])
+        memcpy(frame_store[pattern], grey, (size_t)dec.params.width * dec.params.height);
+    dec.next_pattern++;
+    return 0;
+}
+
+/* The bits of one coordinate for a block: Gray code, ambiguous-bit count, saturation.
+ * Written as plain loops over the block so that the compiler vectorises them. */
+static void accumulate(uint32_t first, uint32_t bits, size_t start, size_t len, uint16_t *code,
+                       uint8_t *ambiguous, uint8_t *saturated)
+{
+    const int t = (int)dec.params.min_bit_diff_dn;
+    memset(code, 0, len * sizeof(code[0]));
+    memset(ambiguous, 0, len);
+    for (uint32_t k = 0; k < bits; k++) {
+        const uint8_t *pos = frame_store[first + 2u * k] + start;
+        const uint8_t *neg = frame_store[first + 2u * k + 1u] + start;
+        for (size_t i = 0; i < len; i++) {
+            int d = (int)pos[i] - (int)neg[i];
+            code[i] = (uint16_t)((code[i] << 1) | (d > 0));
+            ambiguous[i] = (uint8_t)(ambiguous[i] + (d <= t && d >= -t));
+            saturated[i] |= (uint8_t)((pos[i] == DECODE_SATURATED) | (neg[i] == DECODE_SATURATED));
+        }
+    }
+    for (size_t i = 0; i < len; i++) { /* Gray to binary: prefix XOR */
+        uint16_t g = code[i];
+        g ^= (uint16_t)(g >> 1);
+        g ^= (uint16_t)(g >> 2);
+        g ^= (uint16_t)(g >> 4);
+        g ^= (uint16_t)(g >> 8);
+        code[i] = g;
     }
 }
 
-static void take_black(const uint8_t *grey, size_t n)
+/* The reasons, in order of precedence; shared by the blocked decoder and the reference. */
+static uint8_t classify(const struct scan_params *p, int white, int black, int saturated,
+                        unsigned amb_col, unsigned amb_row, int out_of_range)
 {
-    for (size_t i = 0; i < n; i++) {
-        int contrast = (int)grey_white[i] - (int)grey[i];
-        if (grey[i] == DECODE_SATURATED)
-            reject(i, SCAN_SATURATED);
-        else if (contrast <= (int)dec.params.shadow_contrast_dn)
-            reject(i, SCAN_SHADOW);
-        else if (contrast < (int)dec.params.min_contrast_dn)
-            reject(i, SCAN_DARK);
+    int contrast = white - black;
+    if (saturated)
+        return SCAN_SATURATED;
+    if (contrast <= (int)p->shadow_contrast_dn)
+        return SCAN_SHADOW;
+    if (contrast < (int)p->min_contrast_dn)
+        return SCAN_DARK;
+    /* One ambiguous bit per coordinate is a pixel on the edge between two columns (rows): adjacent
+     * Gray codes differ in one bit, so either reading is one of the two. More is weak signal. */
+    if (amb_col > p->max_ambiguous_bits || amb_row > p->max_ambiguous_bits)
+        return SCAN_LOW_CONTRAST;
+    return out_of_range ? SCAN_INCONSISTENT : SCAN_VALID;
+}
+
+static void decode_block(size_t start, size_t len)
+{
+    static uint16_t code_col[DECODE_BLOCK], code_row[DECODE_BLOCK];
+    static uint8_t amb_col[DECODE_BLOCK], amb_row[DECODE_BLOCK], sat[DECODE_BLOCK];
+    const uint8_t *white = frame_store[GRAY_PATTERN_WHITE] + start;
+    const uint8_t *black = frame_store[GRAY_PATTERN_BLACK] + start;
+    const struct gray_layout *l = &dec.layout;
+    for (size_t i = 0; i < len; i++)
+        sat[i] = (uint8_t)((white[i] == DECODE_SATURATED) | (black[i] == DECODE_SATURATED));
+    accumulate(GRAY_PATTERN_FIRST_BIT, l->col_bits, start, len, code_col, amb_col, sat);
+    if (l->row_bits > 0)
+        accumulate(GRAY_PATTERN_FIRST_BIT + 2u * l->col_bits, l->row_bits, start, len, code_row,
+                   amb_row, sat);
+    else
+        memset(amb_row, 0, len);
+    for (size_t i = 0; i < len; i++) {
+        int out = code_col[i] >= dec.proj_width ||
+                  (l->row_bits > 0 && code_row[i] >= dec.proj_height);
+        reason_map[start + i] =
+            classify(&dec.params, white[i], black[i], sat[i], amb_col[i], amb_row[i], out);
+        column_map[start + i] = code_col[i];
+        row_map[start + i] = l->row_bits > 0 ? code_row[i] : 0;
     }
 }
 
-/* A bit whose pattern and inverse are within the noise is ambiguous. Where a pixel straddles the
- * edge between two projector columns exactly one bit is ambiguous (adjacent Gray codes differ in
- * one bit), and either reading gives one of the two columns: harmless. Two or more ambiguous bits
- * mean the signal itself is too weak to trust. */
-static void take_inverse(const uint8_t *grey, size_t n)
+int decode_pixels(void)
 {
-    const int min_diff = (int)dec.params.min_bit_diff_dn;
-    for (size_t i = 0; i < n; i++) {
-        int diff = (int)grey_white[i] - (int)grey[i];
-        column_map[i] = (uint16_t)((column_map[i] << 1) | (diff > 0 ? 1u : 0u));
-        if (grey[i] == DECODE_SATURATED)
-            reject(i, SCAN_SATURATED);
-        else if (diff <= min_diff && diff >= -min_diff &&
-                 ++scratch[i] > dec.params.max_ambiguous_bits)
-            reject(i, SCAN_LOW_CONTRAST);
-    }
-}
-
-int decode_frame(uint32_t pattern_index, const uint8_t *grey)
-{
-    if (pattern_index != dec.next_pattern || pattern_index >= gray_pattern_count(dec.bits))
+    if (dec.next_pattern != gray_layout_count(&dec.layout))
         return -EINVAL;
     size_t n = (size_t)dec.params.width * dec.params.height;
-    if (pattern_index == GRAY_PATTERN_BLACK)
-        take_black(grey, n);
-    else if (pattern_index == GRAY_PATTERN_WHITE ||
-             (pattern_index - GRAY_PATTERN_FIRST_BIT) % 2u == 0u)
-        take_reference(grey, n);
-    else
-        take_inverse(grey, n);
-    dec.next_pattern++;
+    for (size_t start = 0; start < n; start += DECODE_BLOCK)
+        decode_block(start, n - start < DECODE_BLOCK ? n - start : DECODE_BLOCK);
     return 0;
 }
 
@@ -136,7 +169,7 @@ static void check_neighbours(void)
     for (uint32_t y = 0; y < h; y++) {
         for (uint32_t x = 0; x < w; x++) {
             size_t i = (size_t)y * w + x;
-            scratch[i] = 1;
+            consistent[i] = 1;
             if (reason_map[i] != SCAN_VALID)
                 continue;
             uint32_t agree = 0;
@@ -148,31 +181,62 @@ static void check_neighbours(void)
                     agree += (uint32_t)columns_agree(i, (size_t)ny * w + (size_t)nx);
                 }
             }
-            scratch[i] = agree >= dec.params.min_consistent_neighbours;
+            consistent[i] = agree >= dec.params.min_consistent_neighbours;
         }
     }
     size_t n = (size_t)w * h;
     for (size_t i = 0; i < n; i++)
-        if (!scratch[i])
-            reject(i, SCAN_INCONSISTENT);
+        if (!consistent[i] && reason_map[i] == SCAN_VALID)
+            reason_map[i] = SCAN_INCONSISTENT;
 }
 
 int decode_finish(void)
 {
-    if (dec.next_pattern != gray_pattern_count(dec.bits))
-        return -EINVAL;
-    size_t n = (size_t)dec.params.width * dec.params.height;
-    for (size_t i = 0; i < n; i++) {
-        uint32_t col = gray_decode(column_map[i]);
-        column_map[i] = (uint16_t)col;
-        if (col >= dec.proj_width)
-            reject(i, SCAN_INCONSISTENT);
-    }
-    check_neighbours();
-    return 0;
+    int rc = decode_pixels();
+    if (rc == 0)
+        check_neighbours();
+    return rc;
 }
 
 const struct decode_maps *decode_get_maps(void)
 {
     return &dec.maps;
+}
+
+/* ---- the plain reference: one pixel at a time, every frame ---- */
+
+static uint16_t reference_bits(const uint8_t *const *frames, uint32_t first, uint32_t bits,
+                               size_t i, int t, unsigned *ambiguous, int *saturated)
+{
+    uint32_t gray = 0;
+    *ambiguous = 0;
+    for (uint32_t k = 0; k < bits; k++) {
+        int a = frames[first + 2u * k][i], b = frames[first + 2u * k + 1u][i];
+        gray = (gray << 1) | (a > b ? 1u : 0u);
+        *ambiguous += a - b <= t && b - a <= t;
+        *saturated |= a == DECODE_SATURATED || b == DECODE_SATURATED;
+    }
+    return (uint16_t)gray_decode(gray);
+}
+
+void decode_reference(const struct scan_params *p, const struct gray_layout *l,
+                      uint32_t proj_width, uint32_t proj_height, const uint8_t *const *frames,
+                      size_t n, uint16_t *column, uint16_t *row, uint8_t *reason)
+{
+    const int t = (int)p->min_bit_diff_dn;
+    for (size_t i = 0; i < n; i++) {
+        unsigned amb_col = 0, amb_row = 0;
+        int white = frames[GRAY_PATTERN_WHITE][i], black = frames[GRAY_PATTERN_BLACK][i];
+        int sat = white == DECODE_SATURATED || black == DECODE_SATURATED;
+        column[i] = reference_bits(frames, GRAY_PATTERN_FIRST_BIT, l->col_bits, i, t, &amb_col,
+                                   &sat);
+        uint16_t r = 0;
+        if (l->row_bits > 0)
+            r = reference_bits(frames, GRAY_PATTERN_FIRST_BIT + 2u * l->col_bits, l->row_bits, i,
+                               t, &amb_row, &sat);
+        if (row != NULL)
+            row[i] = r;
+        int out = column[i] >= proj_width || (l->row_bits > 0 && r >= proj_height);
+        reason[i] = classify(p, white, black, sat, amb_col, amb_row, out);
+    }
 }

@@ -1,8 +1,10 @@
-/* Structured-light decoding: per-pixel projector column and a reason code for every rejected pixel.
- */
+/* Structured-light decoding: per-pixel projector column (and row) and a reason code for every
+ * rejected pixel. The frames of a view are kept in a static store and decoded together, in blocks
+ * of pixels small enough for the first-level cache, so each frame is read from memory once. */
 #ifndef DECODE_H
 #define DECODE_H
 
+#include "gray.h"
 #include "scan_types.h"
 
 #include <stddef.h>
@@ -13,7 +15,7 @@ enum scan_reason {
     SCAN_VALID = 0,
     SCAN_SHADOW,       /**< the projector does not reach it (white ~ black) */
     SCAN_DARK,         /**< lit, but too dark a surface to decode reliably */
-    SCAN_LOW_CONTRAST, /**< some bit's |I - I_inverse| is within the noise */
+    SCAN_LOW_CONTRAST, /**< too many bits' |I - I_inverse| within the noise */
     SCAN_SATURATED,    /**< a channel clipped in some frame */
     SCAN_INCONSISTENT, /**< decodes outside the projector or disagrees with its neighbours */
     SCAN_REASON_COUNT
@@ -22,9 +24,13 @@ enum scan_reason {
 /** Read-only view of the decoder's static maps (row-major, width * height). */
 struct decode_maps {
     const uint16_t *column; /**< projector column, meaningful where reason == SCAN_VALID */
+    const uint16_t *row;    /**< projector row, or NULL when rows are not coded */
     uint8_t *reason;        /**< enum scan_reason per pixel; later stages add their own */
     uint32_t width, height;
 };
+
+/** Patterns a view can have: white, black, 11 column and 11 row bits with inverses. */
+#define DECODE_MAX_PATTERNS (2u + 2u * 22u)
 
 /** Short name of a reason code, for logs and reports. */
 const char *scan_reason_name(unsigned reason);
@@ -37,14 +43,29 @@ const char *scan_reason_name(unsigned reason);
  *  offline re-processing both decode exactly such frames, so they agree to the bit. */
 void decode_rgb_to_grey(const uint8_t *rgb, uint8_t *grey, size_t n, uint32_t saturation_dn);
 
-/** Start a view. @retval 0 ok @retval -EINVAL size above the compiled limits */
-int decode_begin(const struct scan_params *params, uint32_t proj_width);
-/** Feed the grey frame (see decode_rgb_to_grey) of stored pattern @p pattern_index, in order.
- *  @retval 0 ok @retval -EINVAL out of order */
-int decode_frame(uint32_t pattern_index, const uint8_t *grey);
-/** Gray to binary, range and neighbour checks. @retval 0 ok @retval -EINVAL frames missing */
+/** Start a view of a @p proj_width x @p proj_height projector coded as @p layout.
+ *  @retval 0 ok @retval -EINVAL size or pattern count above the compiled limits */
+int decode_begin(const struct scan_params *params, const struct gray_layout *layout,
+                 uint32_t proj_width, uint32_t proj_height);
+/** Where frame @p pattern is kept: a capture may write its grey frame there directly.
+ *  @retval NULL when @p pattern is outside the layout */
+uint8_t *decode_frame_slot(uint32_t pattern);
+/** Hand over the grey frame of pattern @p pattern, in sequence order (copied into its slot
+ *  unless it already is the slot). @retval 0 ok @retval -EINVAL out of order */
+int decode_frame(uint32_t pattern, const uint8_t *grey);
+/** Decode every pixel from the kept frames (decode_pixels), then the neighbour check.
+ *  @retval 0 ok @retval -EINVAL frames missing */
 int decode_finish(void);
+/** The per-pixel stage of decode_finish alone (for tests and benchmarks). */
+int decode_pixels(void);
 /** The maps of the last finished view. */
 const struct decode_maps *decode_get_maps(void);
+
+/** The plain per-pixel reference the blocked decoder must match (tests compare them): decode
+ *  @p n pixels of @p frames (one pointer per pattern of @p layout) into @p column, @p row
+ *  (may be NULL when the layout has no rows) and @p reason. */
+void decode_reference(const struct scan_params *params, const struct gray_layout *layout,
+                      uint32_t proj_width, uint32_t proj_height, const uint8_t *const *frames,
+                      size_t n, uint16_t *column, uint16_t *row, uint8_t *reason);
 
 #endif

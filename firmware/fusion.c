@@ -135,17 +135,52 @@ static void fuse_voxel(struct voxel *vx, double sdf, double w, const uint8_t *rg
     vx->weight = (uint16_t)lround(fmin(new_w, fz.p.max_weight) * WEIGHT_SCALE);
 }
 
+/* Voxels this view can change: those within the truncation band of its fused points. Voxels
+ * farther in front of the surface would only be told "empty", which costs a projection each and
+ * changes no surface. @retval 0 when the view has no fused point */
+static int view_box(const struct frame_xform *obj_from_cam, const struct decode_maps *m,
+                    const struct tri_range *r, uint32_t lo[3], uint32_t hi[3])
+{
+    double mn[3] = {1e30, 1e30, 1e30}, mx[3] = {-1e30, -1e30, -1e30};
+    size_t n = (size_t)m->width * m->height;
+    int any = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (weight_map[i] <= 0.0f)
+            continue;
+        vec3 p = frame_point(obj_from_cam, v3(r->xyz_mm[3 * i], r->xyz_mm[3 * i + 1],
+                                              r->xyz_mm[3 * i + 2]));
+        double pa[3] = {p.x, p.y, p.z}, oa[3] = {fz.origin.x, fz.origin.y, fz.origin.z};
+        for (int a = 0; a < 3; a++) {
+            double g = (pa[a] - oa[a]) / fz.p.voxel_mm;
+            mn[a] = g < mn[a] ? g : mn[a];
+            mx[a] = g > mx[a] ? g : mx[a];
+        }
+        any = 1;
+    }
+    double margin = fz.p.truncation_mm / fz.p.voxel_mm + 1.0;
+    for (int a = 0; a < 3 && any; a++) {
+        double l = floor(mn[a] - margin), h = ceil(mx[a] + margin);
+        lo[a] = l < 0.0 ? 0u : (uint32_t)l;
+        hi[a] = h > fz.dims[a] - 1.0 ? fz.dims[a] - 1u : (uint32_t)h;
+        any = lo[a] <= hi[a];
+    }
+    return any;
+}
+
 int fusion_integrate(const struct scan_calib *c, const struct frame_xform *obj_from_cam,
                      const struct decode_maps *m, const struct tri_range *r, const uint8_t *rgb)
 {
     pixel_weights(c, m, r);
     const double trunc = fz.p.truncation_mm, vox = fz.p.voxel_mm;
     const vec3 step_x = m3_tmul(obj_from_cam->rot, v3(vox, 0, 0));
-    for (uint32_t z = 0; z < fz.dims[2]; z++) {
-        for (uint32_t y = 0; y < fz.dims[1]; y++) {
-            vec3 p_obj = v3_add(fz.origin, v3(0, y * vox, z * vox));
+    uint32_t lo[3], hi[3];
+    if (!view_box(obj_from_cam, m, r, lo, hi))
+        return 0;
+    for (uint32_t z = lo[2]; z <= hi[2]; z++) {
+        for (uint32_t y = lo[1]; y <= hi[1]; y++) {
+            vec3 p_obj = v3_add(fz.origin, v3(lo[0] * vox, y * vox, z * vox));
             vec3 p = frame_point_inv(obj_from_cam, p_obj); /* camera frame */
-            for (uint32_t x = 0; x < fz.dims[0]; x++, p = v3_add(p, step_x)) {
+            for (uint32_t x = lo[0]; x <= hi[0]; x++, p = v3_add(p, step_x)) {
                 if (p.z <= 1.0)
                     continue;
                 double a = p.x / p.z, b = p.y / p.z;

@@ -14,7 +14,6 @@
 static uint8_t
     colour_rgb[HAL_MAX_PIXELS * 3];           /* projector-white frame, kept as the view's colour */
 static uint8_t frame_rgb[HAL_MAX_PIXELS * 3]; /* every other frame, consumed at once */
-static uint8_t frame_grey[HAL_MAX_PIXELS];    /* what the decoder sees, and what is saved */
 static struct scan_params view_params;        /* of the view being fed */
 static int32_t last_angle_mdeg;
 
@@ -104,10 +103,17 @@ static int projector_start(const struct hal *hal, const struct scan_params *p, u
     return rc;
 }
 
+void scan_layout(const struct scan_params *p, const struct scan_calib *c, struct gray_layout *l)
+{
+    gray_layout_for(c->proj_width, c->proj_height, (int)p->decode_rows, l);
+}
+
 int scan_begin_view(const struct scan_params *p, const struct scan_calib *c)
 {
+    struct gray_layout layout;
     view_params = *p;
-    return decode_begin(p, c->proj_width);
+    scan_layout(p, c, &layout);
+    return decode_begin(p, &layout, c->proj_width, c->proj_height);
 }
 
 int scan_feed_frame(uint32_t pattern, const uint8_t *pixels, uint32_t channels,
@@ -115,11 +121,14 @@ int scan_feed_frame(uint32_t pattern, const uint8_t *pixels, uint32_t channels,
 {
     size_t n = (size_t)view_params.width * view_params.height;
     const uint8_t *grey = pixels;
+    uint8_t *slot = decode_frame_slot(pattern);
+    if (slot == NULL)
+        return -EINVAL;
     if (channels == 3) {
         if (pattern == GRAY_PATTERN_WHITE && pixels != colour_rgb)
             memcpy(colour_rgb, pixels, n * 3); /* the view's colour */
-        decode_rgb_to_grey(pixels, frame_grey, n, view_params.saturation_dn);
-        grey = frame_grey;
+        decode_rgb_to_grey(pixels, slot, n, view_params.saturation_dn);
+        grey = slot; /* converted straight into the decoder's store */
     }
     int rc = decode_frame(pattern, grey);
     /* The white frame is kept in colour (its grey is derived again offline); the others are
@@ -188,7 +197,9 @@ int scan_view(const struct hal *hal, const struct scan_params *p, const struct s
     int rc = scan_begin_view(p, c);
     if (rc != 0)
         return rc;
-    uint32_t count = gray_pattern_count(gray_bits_for_width(c->proj_width));
+    struct gray_layout layout;
+    scan_layout(p, c, &layout);
+    uint32_t count = gray_layout_count(&layout);
     rc = projector_start(hal, p, c->light_count);
     if (rc == 0)
         rc = capture_patterns(hal, p, count, sink, info);

@@ -49,6 +49,9 @@ int scan_view(const struct hal *hal, const struct scan_params *params,
  *  pattern in order (the white frame as RGB, channels 3; the others grey, channels 1, or RGB),
  *  then finish. The live scan runs exactly this path. @retval 0 or -EINVAL */
 int scan_begin_view(const struct scan_params *params, const struct scan_calib *calib);
+/** The pattern sequence of a view (columns, and rows when params->decode_rows). */
+void scan_layout(const struct scan_params *params, const struct scan_calib *calib,
+                 struct gray_layout *layout);
 int scan_feed_frame(uint32_t pattern, const uint8_t *pixels, uint32_t channels,
                     const struct scan_frame_sink *sink);
 int scan_finish_view(const struct scan_calib *calib, int32_t angle_mdeg,

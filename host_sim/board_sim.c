@@ -3,6 +3,7 @@
 #include "board.h"
 
 #include "gray.h"
+#include "scan.h"
 #include "image_io.h"
 #include "sim_devices.h"
 #include "pty_link.h"
@@ -96,11 +97,12 @@ int board_init(struct hal *hal, const struct app_config *cfg, const struct scan_
     }
     char dir_buf[HAL_MAX_PATH];
     snprintf(dir_buf, sizeof(dir_buf), "%s", cfg->path);
-    int rc = sim_rig_init(&sim.rig, &cfg->sim, calib, dirname(dir_buf), err, err_len);
+    struct gray_layout layout;
+    scan_layout(&cfg->scan, calib, &layout);
+    int rc = sim_rig_init(&sim.rig, &cfg->sim, calib, &layout, dirname(dir_buf), err, err_len);
     if (rc != 0)
         return rc;
-    gpio_sim_init(&sim.gpio, gray_pattern_count(gray_bits_for_width(calib->proj_width)),
-                  &hal->gpio);
+    gpio_sim_init(&sim.gpio, gray_layout_count(&layout), &hal->gpio);
     clock_sim_init(&sim.clock, &hal->clock);
     camera_sim_init(&sim.camera, &sim.rig, &sim.gpio, calib->light_count, &hal->camera);
     storage_posix_init(&hal->storage);

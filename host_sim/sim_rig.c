@@ -110,14 +110,14 @@ static int build_material(struct sim_rig *rig, const char *dir, char *err, size_
 }
 
 int sim_rig_init(struct sim_rig *rig, const struct sim_config *cfg, const struct scan_calib *calib,
-                 const char *dir, char *err, size_t len)
+                 const struct gray_layout *layout, const char *dir, char *err, size_t len)
 {
     memset(rig, 0, sizeof(*rig));
     rig->cfg = *cfg;
     rig->calib = *calib;
     rig->width = calib->cam_width;
     rig->height = calib->cam_height;
-    rig->bits = gray_bits_for_width(calib->proj_width);
+    rig->layout = *layout;
     rig->table_angle_mdeg = 0; /* the turntable, when there is one, sets it per frame */
     int rc = build_object(rig, dir, err, len);
     if (rc == 0)
@@ -133,12 +133,13 @@ int sim_rig_init(struct sim_rig *rig, const struct sim_config *cfg, const struct
     t->normal_cam = calloc(n * 3, sizeof(float));
     t->albedo = calloc(n * 3, sizeof(float));
     t->proj_u = calloc(n, sizeof(float));
+    t->proj_v = calloc(n, sizeof(float));
     t->proj_lit = calloc(n, 1);
     t->dark = calloc(n, 1);
     rig->proj_radiance = calloc(n * 3, sizeof(float));
     rig->light_vis = calloc(n, 1);
     rig->gauss = calloc(GAUSS_TABLE, sizeof(float));
-    if (!t->hit || !t->pos_cam || !t->normal_cam || !t->albedo || !t->proj_u || !t->proj_lit ||
+    if (!t->hit || !t->pos_cam || !t->normal_cam || !t->albedo || !t->proj_u || !t->proj_v || !t->proj_lit ||
         !t->dark || !rig->proj_radiance || !rig->light_vis || !rig->gauss) {
         rc = -ENOMEM;
         snprintf(err, len, "sim: out of memory for a %ux%u frame", (unsigned)rig->width,
@@ -160,6 +161,7 @@ void sim_rig_free(struct sim_rig *rig)
     free(t->normal_cam);
     free(t->albedo);
     free(t->proj_u);
+    free(t->proj_v);
     free(t->proj_lit);
     free(t->dark);
     free(rig->proj_radiance);
@@ -234,6 +236,7 @@ static void update_pixel(struct sim_rig *rig, const struct frame_xform *obj, vec
     double u = c->proj_fx_px * pp.x / pp.z + c->proj_cx_px;
     double v = c->proj_fy_px * pp.y / pp.z + c->proj_cy_px;
     t->proj_u[i] = (float)u;
+    t->proj_v[i] = (float)v;
     vec3 to_proj = v3_sub(proj_cam, p_cam);
     vec3 l = v3_norm(to_proj);
     if (u < -0.5 || u >= c->proj_width - 0.5 || v < -0.5 || v >= c->proj_height - 0.5 ||
@@ -286,16 +289,23 @@ static void ensure_light(struct sim_rig *rig, uint32_t li)
     rig->lights_done |= 1u << li;
 }
 
-/* Light of the current pattern at continuous column u: the lens blurs it over a box of
- * projector_blur_px columns, and "black" still leaks projector_black_level of white. */
-static double pattern_light(const struct sim_rig *rig, uint32_t pattern, double u)
+/* Light of the current pattern at projector position (u, v): the lens blurs it over a box of
+ * projector_blur_px pixels across the stripes (columns for column bits, rows for row bits), and
+ * "black" still leaks projector_black_level of white. */
+static double pattern_light(const struct sim_rig *rig, uint32_t pattern, double u, double v)
 {
-    double b = rig->cfg.projector_blur_px, lo = u - 0.5 * b, hi = u + 0.5 * b;
+    const struct gray_layout *l = &rig->layout;
+    int is_row = pattern >= GRAY_PATTERN_FIRST_BIT &&
+                 (pattern - GRAY_PATTERN_FIRST_BIT) / 2u >= l->col_bits;
+    double x = is_row ? v : u, b = rig->cfg.projector_blur_px, lo = x - 0.5 * b, hi = x + 0.5 * b;
+    int limit = (int)(is_row ? rig->calib.proj_height : rig->calib.proj_width);
     double c0 = floor(lo + 0.5), c1 = floor(hi + 0.5), lit;
-    int w = (int)rig->calib.proj_width;
-#define LIT(c) (((c) < 0 || (c) >= w) ? 0 : gray_pattern_lit(rig->bits, pattern, (uint32_t)(c)))
+#define LIT(c)                                                                                     \
+    (((c) < 0 || (c) >= limit)                                                                     \
+         ? 0                                                                                       \
+         : gray_layout_lit(l, pattern, is_row ? 0u : (uint32_t)(c), is_row ? (uint32_t)(c) : 0u))
     if (c0 == c1 || b <= 0.0) {
-        lit = LIT((int)floor(u + 0.5));
+        lit = LIT((int)floor(x + 0.5));
     } else {
         double f0 = (c0 + 0.5 - lo) / b;
         lit = f0 * LIT((int)c0) + (1.0 - f0) * LIT((int)c1);
@@ -343,7 +353,8 @@ void sim_rig_render(struct sim_rig *rig, const struct sim_sources *src, uint64_t
             for (int k = 0; k < 3; k++)
                 sig[k] = c->ambient_dn * al[k]; /* indirect light: small, from everywhere */
             if (src->projector_on && rig->truth.proj_lit[i]) {
-                double p = pattern_light(rig, src->pattern_index, rig->truth.proj_u[i]);
+                double p = pattern_light(rig, src->pattern_index, rig->truth.proj_u[i],
+                                         rig->truth.proj_v[i]);
                 for (int k = 0; k < 3; k++)
                     sig[k] += p * rig->proj_radiance[3 * i + k];
             }

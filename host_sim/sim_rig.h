@@ -4,6 +4,7 @@
 #define SIM_RIG_H
 
 #include "config.h"
+#include "gray.h"
 #include "scan_types.h"
 #include "sim_bvh.h"
 #include "sim_material.h"
@@ -25,6 +26,7 @@ struct sim_truth {
     float *normal_cam; /**< 3 per pixel: unit shading normal, camera frame */
     float *albedo;     /**< 3 per pixel: diffuse colour (linear, 0..1) */
     float *proj_u;     /**< continuous projector column of the point (pixel centres at integers) */
+    float *proj_v;       /**< continuous projector row of the point */
     uint8_t *proj_lit; /**< the projector reaches the point (in frustum, facing, not shadowed) */
     uint8_t *dark;     /**< the point lies on the very dark paint */
 };
@@ -35,7 +37,8 @@ struct sim_rig {
     struct sim_mesh mesh;
     struct sim_bvh bvh;
     struct sim_material material;
-    uint32_t width, height, bits;
+    uint32_t width, height;
+    struct gray_layout layout; /**< the projector's stored pattern sequence */
     double object_height_mm;  /**< height of the placed object */
     int32_t table_angle_mdeg; /**< where the turntable is; the camera renders at this angle */
     int32_t truth_angle_mdeg; /**< angle the truth buffers belong to */
@@ -51,7 +54,8 @@ struct sim_rig {
  *  @param config_dir  directory relative paths in @p cfg are resolved against
  *  @retval 0 ok @retval -errno, with @p err saying what */
 int sim_rig_init(struct sim_rig *rig, const struct sim_config *cfg, const struct scan_calib *calib,
-                 const char *config_dir, char *err, size_t err_len);
+                 const struct gray_layout *layout, const char *config_dir, char *err,
+                 size_t err_len);
 void sim_rig_free(struct sim_rig *rig);
 
 /** Bring the truth buffers up to date for the current table angle (ray casting). */

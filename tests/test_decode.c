@@ -58,10 +58,16 @@ static void render(uint32_t pattern, uint32_t bits)
     }
 }
 
+static int begin(struct scan_params *p, uint32_t bits)
+{
+    struct gray_layout l = {bits, 0};
+    return decode_begin(p, &l, PROJ_W, 1);
+}
+
 static void decode_all(uint32_t bits)
 {
     struct scan_params p = params();
-    assert_int_equal(decode_begin(&p, PROJ_W), 0);
+    assert_int_equal(begin(&p, bits), 0);
     for (uint32_t i = 0; i < gray_pattern_count(bits); i++) {
         render(i, bits);
         assert_int_equal(feed(i), 0);
@@ -106,7 +112,7 @@ static void test_frames_out_of_order_rejected(void **state)
 {
     (void)state;
     struct scan_params p = params();
-    assert_int_equal(decode_begin(&p, PROJ_W), 0);
+    assert_int_equal(begin(&p, 6), 0);
     render(0, 6);
     assert_int_equal(feed(1), -EINVAL);
     assert_int_equal(feed(0), 0);
@@ -118,9 +124,11 @@ static void test_size_above_limit_rejected(void **state)
     (void)state;
     struct scan_params p = params();
     p.width = HAL_MAX_WIDTH + 2;
-    assert_int_equal(decode_begin(&p, PROJ_W), -EINVAL);
+    assert_int_equal(begin(&p, 6), -EINVAL);
     p = params();
-    assert_int_equal(decode_begin(&p, HAL_MAX_PROJECTOR_WIDTH + 1), -EINVAL);
+    assert_int_equal(begin(&p, 17), -EINVAL);
+    struct gray_layout too_many = {16, 16}; /* more patterns than the frame store holds */
+    assert_int_equal(decode_begin(&p, &too_many, PROJ_W, 1), -EINVAL);
 }
 
 /* Two ambiguous bits in one pixel cannot be a column edge: low contrast. One is tolerated. */
@@ -129,7 +137,7 @@ static void test_ambiguous_bits(void **state)
     (void)state;
     uint32_t bits = gray_bits_for_width(PROJ_W);
     struct scan_params p = params();
-    assert_int_equal(decode_begin(&p, PROJ_W), 0);
+    assert_int_equal(begin(&p, bits), 0);
     for (uint32_t i = 0; i < gray_pattern_count(bits); i++) {
         render(i, bits);
         uint32_t k = i >= 2 ? (i - 2) / 2 : 99;
@@ -152,7 +160,7 @@ static void test_lone_wrong_code_inconsistent(void **state)
     (void)state;
     uint32_t bits = gray_bits_for_width(PROJ_W);
     struct scan_params p = params();
-    assert_int_equal(decode_begin(&p, PROJ_W), 0);
+    assert_int_equal(begin(&p, bits), 0);
     for (uint32_t i = 0; i < gray_pattern_count(bits); i++) {
         render(i, bits);
         if (i == 2 || i == 3) { /* flip the top bit of pixel (10, 2): column 10 reads as 53 */

@@ -6,6 +6,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -66,11 +67,54 @@ static void test_bunny(void **state)
     check_quality(&q);
 }
 
+/* The blocked decoder equals the plain per-pixel reference on real simulated frames, columns
+ * and rows (42 patterns), pixel for pixel: column, row and reason. */
+static void test_blocked_decoder_matches_reference(void **state)
+{
+    (void)state;
+    static struct test_rig t;
+    assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
+    t.cfg.scan.decode_rows = 1;
+    assert_int_equal(test_rig_start(&t), 0);
+    struct scan_view_info info;
+    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info), 0);
+    assert_int_equal(info.frames_captured, 42);
+    struct gray_layout layout;
+    scan_layout(&t.cfg.scan, &t.calib, &layout);
+    const uint8_t *frames[DECODE_MAX_PATTERNS];
+    for (uint32_t p = 0; p < gray_layout_count(&layout); p++)
+        frames[p] = decode_frame_slot(p);
+    assert_int_equal(decode_pixels(), 0); /* again, without the neighbour check */
+    const struct decode_maps *m = decode_get_maps();
+    size_t n = (size_t)m->width * m->height;
+    static uint16_t col[HAL_MAX_PIXELS], row[HAL_MAX_PIXELS];
+    static uint8_t reason[HAL_MAX_PIXELS];
+    decode_reference(&t.cfg.scan, &layout, t.calib.proj_width, t.calib.proj_height, frames, n,
+                     col, row, reason);
+    size_t valid = 0, row_right = 0;
+    const struct sim_rig *rig = sim_ctl_rig();
+    for (size_t i = 0; i < n; i++) {
+        assert_int_equal(m->reason[i], reason[i]);
+        if (reason[i] != SCAN_VALID)
+            continue;
+        assert_int_equal(m->column[i], col[i]);
+        assert_int_equal(m->row[i], row[i]);
+        valid++;
+        row_right += fabs((double)row[i] - floor(rig->truth.proj_v[i] + 0.5)) <= 1.0;
+    }
+    test_rig_stop(&t);
+    print_message("%zu valid pixels identical; rows right (+-1) at %.2f%%\n", valid,
+                  100.0 * row_right / valid);
+    assert_true(valid > 100000);
+    assert_true(row_right > 0.98 * valid);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_sphere),
         cmocka_unit_test(test_bunny),
+        cmocka_unit_test(test_blocked_decoder_matches_reference),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
