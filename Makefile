@@ -47,7 +47,7 @@ FW_OBJ := $(call obj,$(FW_SRC))
 HOST_OBJ := $(call obj,$(POSIX_SRC) $(APP_LIB_SRC) $(BOARD_SRC))
 MAIN_OBJ := $(call obj,app/main.c)
 
-.PHONY: all deps test-deps test run clean format docs check-firmware bench measure measure-scan interop-meshlab
+.PHONY: all deps test-deps test run clean format docs check-firmware bench measure measure-scan interop-meshlab bench-callgrind
 SIM_TOOLS := $(if $(filter sim,$(HAL)),$(BUILD)/turntable-sim $(BUILD)/tt-client $(BUILD)/mesh-compare,)
 all: deps $(BUILD)/scanner $(SIM_TOOLS)
 
@@ -57,7 +57,10 @@ deps:
 
 $(FW_OBJ): $(BUILD)/%.o: %.c | deps
 	@mkdir -p $(dir $@)
-	$(CC) $(FW_CFLAGS) -c $< -o $@
+	$(CC) $(FW_CFLAGS) $(FW_EXTRA) -c $< -o $@
+
+# The decoder's inner loops are written to be vectorised; GCC 12 does that from -O3.
+$(BUILD)/firmware/decode.o: FW_EXTRA = -O3
 
 $(BUILD)/%.o: %.c | deps
 	@mkdir -p $(dir $@)
@@ -164,5 +167,29 @@ $(BUILD)/bench_view: $(BUILD)/bench/bench_view.o $(BUILD)/tests/test_util.o $(HO
 $(BUILD)/bench/%.o: bench/%.c | deps
 	@mkdir -p $(dir $@)
 	$(CC) $(HOST_CFLAGS) -Itests -c $< -o $@
-bench: deps $(BUILD)/bench_view
+# The decode benchmark against OpenCV (C++, only here; Debian's libopencv-contrib-dev).
+$(BUILD)/bench/opencv_graycode.o: bench/opencv_graycode.cpp
+	@pkg-config --exists opencv4 || scripts/install-deps.sh bench
+	@mkdir -p $(dir $@)
+	$(CXX) -std=c++17 -O2 -Wall -Wextra -Werror $(shell pkg-config --cflags opencv4 2>/dev/null) -c $< -o $@
+$(BUILD)/bench_decode: $(BUILD)/bench/bench_decode.o $(BUILD)/bench/opencv_graycode.o $(BUILD)/tests/test_util.o $(HOST_OBJ) $(BUILD)/libfirmware.a
+	$(CXX) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON) $(shell pkg-config --libs opencv4 2>/dev/null)
+$(BUILD)/bench/bench_decode.o: bench/bench_decode.c | deps
+	@pkg-config --exists opencv4 || scripts/install-deps.sh bench
+	@mkdir -p $(dir $@)
+	$(CC) $(HOST_CFLAGS) -Itests -Ibench -c $< -o $@
+
+bench: deps $(BUILD)/bench_view $(BUILD)/bench_decode
+	$(BUILD)/bench_decode
+	@echo
 	$(BUILD)/bench_view config/sim.ini
+	@echo
+	@bench/static_memory.sh $(BUILD)/libfirmware.a
+
+# Instruction counts of one view's firmware processing (stable on a noisy machine): compare a
+# change with the one before it.
+bench-callgrind: deps $(BUILD)/bench_view
+	@command -v valgrind >/dev/null || scripts/install-deps.sh bench
+	BENCH_REPEAT=1 valgrind --tool=callgrind --callgrind-out-file=$(BUILD)/callgrind.out \
+		--toggle-collect=process_view_once $(BUILD)/bench_view config/sim.ini > /dev/null
+	@callgrind_annotate $(BUILD)/callgrind.out 2>/dev/null | sed -n '/Ir/,/^$$/p' | head -n 30

@@ -1,0 +1,131 @@
+/* The decode benchmark of make bench: on the same simulated frames (8-bit grey, columns and rows
+ * with inverses), time (a) OpenCV's getProjPixel over every pixel, (b) the scanner's decoder and
+ * (c) one plain read of all the frames (the memory floor); check that both decoders agree on
+ * every pixel both call valid, and that OpenCV's pattern set is ours. One core. */
+#define _POSIX_C_SOURCE 200809L
+#include "decode.h"
+#include "gray.h"
+#include "opencv_graycode.h"
+#include "test_util.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
+}
+
+static int our_lit(void *ctx, unsigned index, unsigned column, unsigned row)
+{
+    return gray_layout_lit(ctx, index + GRAY_PATTERN_FIRST_BIT, column, row);
+}
+
+/* The memory floor: every byte of every frame read once (summed, so it cannot be skipped). */
+static uint64_t read_all(const uint8_t *const *frames, uint32_t count, size_t n)
+{
+    uint64_t total = 0;
+    for (uint32_t k = 0; k < count; k++) {
+        uint32_t lane[64] = {0};
+        const uint8_t *f = frames[k];
+        for (size_t i = 0; i + 64 <= n; i += 64)
+            for (int j = 0; j < 64; j++)
+                lane[j] += f[i + (size_t)j];
+        for (int j = 0; j < 64; j++)
+            total += lane[j];
+    }
+    return total;
+}
+
+static int run(uint32_t width, uint32_t height)
+{
+    static struct test_rig t;
+    if (test_rig_load(&t, "config/sim.ini") != 0)
+        return 1;
+    /* the same rig with a sensor of width x height (the HQ camera's binned mode is 2028x1520) */
+    double s = (double)width / t.calib.cam_width;
+    t.calib.cam_fx_px *= s;
+    t.calib.cam_fy_px *= s;
+    t.calib.cam_cx_px = (width - 1) / 2.0;
+    t.calib.cam_cy_px = (height - 1) / 2.0;
+    t.calib.cam_width = t.cfg.camera.width = t.cfg.scan.width = width;
+    t.calib.cam_height = t.cfg.camera.height = t.cfg.scan.height = height;
+    t.cfg.scan.decode_rows = 1;
+    if (test_rig_start(&t) != 0)
+        return 1;
+    struct scan_view_info info;
+    if (scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info) != 0)
+        return 1;
+    struct gray_layout layout;
+    scan_layout(&t.cfg.scan, &t.calib, &layout);
+    uint32_t count = gray_layout_count(&layout), patterns = count - GRAY_PATTERN_FIRST_BIT;
+    const uint8_t *frames[DECODE_MAX_PATTERNS];
+    for (uint32_t p = 0; p < count; p++)
+        frames[p] = decode_frame_slot(p);
+    size_t n = (size_t)width * height;
+
+    int cv_count = 0;
+    long bad = opencv_graycode_pattern_mismatches((int)t.calib.proj_width,
+                                                  (int)t.calib.proj_height, &cv_count, our_lit,
+                                                  &layout);
+    double floor_ms = 1e9, ours_ms = 1e9, ours_full_ms = 1e9;
+    volatile uint64_t sink = 0;
+    for (int r = 0; r < 5; r++) {
+        double t0 = now_ms();
+        sink += read_all(frames + GRAY_PATTERN_FIRST_BIT, patterns, n);
+        double t1 = now_ms();
+        decode_pixels();
+        double t2 = now_ms();
+        decode_finish();
+        double t3 = now_ms();
+        floor_ms = t1 - t0 < floor_ms ? t1 - t0 : floor_ms;
+        ours_ms = t2 - t1 < ours_ms ? t2 - t1 : ours_ms;
+        ours_full_ms = t3 - t2 < ours_full_ms ? t3 - t2 : ours_full_ms;
+    }
+    decode_pixels(); /* maps without the neighbour check, as OpenCV's */
+    uint16_t *cv_col = malloc(n * 2), *cv_row = malloc(n * 2);
+    uint8_t *cv_ok = malloc(n);
+    double cv_ms = opencv_graycode_decode(frames + GRAY_PATTERN_FIRST_BIT, (int)patterns,
+                                          (int)width, (int)height, (int)t.calib.proj_width,
+                                          (int)t.calib.proj_height,
+                                          (int)t.cfg.scan.min_bit_diff_dn + 1, cv_col, cv_row,
+                                          cv_ok);
+    const struct decode_maps *m = decode_get_maps();
+    size_t both = 0, differ = 0, ours_valid = 0, cv_valid = 0;
+    for (size_t i = 0; i < n; i++) {
+        int mine = m->reason[i] == SCAN_VALID;
+        ours_valid += (size_t)mine;
+        cv_valid += cv_ok[i];
+        if (!mine || !cv_ok[i])
+            continue;
+        both++;
+        differ += m->column[i] != cv_col[i] || m->row[i] != cv_row[i];
+    }
+    printf("| %ux%u | %u | %.1f | %.2f | %.2f | %.2f | **%.0fx** | **%.2fx** | %zu | %zu | %zu | "
+           "%zu | %ld |\n",
+           (unsigned)width, (unsigned)height, (unsigned)patterns, cv_ms, ours_ms, ours_full_ms,
+           floor_ms, cv_ms / ours_ms, ours_ms / floor_ms, cv_valid, ours_valid, both, differ,
+           bad);
+    free(cv_col);
+    free(cv_row);
+    free(cv_ok);
+    test_rig_stop(&t);
+    (void)sink;
+    return differ != 0 || bad != 0 || cv_count != (int)patterns;
+}
+
+int main(void)
+{
+    printf("Gray-code decoding of one view, one core (best of 5 for (b) and (c); (a) once)\n\n"
+           "| frames | patterns | (a) OpenCV getProjPixel ms | (b) ours ms | ours + neighbour "
+           "check ms | (c) memory floor ms | (a)/(b) | (b)/(c) | OpenCV valid px | our valid px "
+           "| both valid | disagree | pattern pixels that differ |\n"
+           "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    int rc = run(1280, 960);
+    rc |= run(2028, 1520);
+    return rc;
+}
