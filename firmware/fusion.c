@@ -184,9 +184,13 @@ int fusion_integrate(const struct scan_calib *c, const struct frame_xform *obj_f
                 if (p.z <= 1.0)
                     continue;
                 double a = p.x / p.z, b = p.y / p.z;
-                long u = lround(c->cam_fx_px * a + c->cam_cx_px);
-                long v = lround(c->cam_fy_px * b + c->cam_cy_px);
-                if (u < 0 || v < 0 || u >= (long)m->width || v >= (long)m->height)
+                double fu = c->cam_fx_px * a + c->cam_cx_px, fv = c->cam_fy_px * b + c->cam_cy_px;
+                if (fu < -0.5 || fv < -0.5)
+                    continue;
+                /* nearest pixel; a cast rounds correctly once the value is known >= -0.5, and
+                 * avoids a libm call per voxel */
+                long u = (long)(fu + 0.5), v = (long)(fv + 0.5);
+                if (u >= (long)m->width || v >= (long)m->height)
                     continue;
                 size_t i = (size_t)v * m->width + (size_t)u;
                 if (weight_map[i] <= 0.0f)
