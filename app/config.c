@@ -124,6 +124,23 @@ static const struct ini_key config_keys[] = {
         "the reached angle must be this close to the target"),
     U32("turntable", "settle_ms", turntable.settle_ms, 0, 60000, "300",
         "wait after a move before capturing"),
+    ENUM("colour", "method", colour_method, "none|single|uniform|multi", "none",
+         "intrinsic colour: none (raw projector-lit colour), single (projector only, Jost eq. 4), "
+         "uniform (all lights), multi (each light alone, eq. 6)"),
+    ENUM("colour", "ca", colour_ca, "channel|pixel", "channel",
+         "ambient + black offset from the dark frame: one value per channel, or per pixel"),
+    F64("colour", "min_cos", scan.colour.min_cos, 0, 1, "0.2",
+        "light at a lower cos(incidence) is not used (it would amplify noise)"),
+    F64("colour", "ke", scan.colour.ke, 1, 10000, "40", "highlight rejection exponent ke (eq. 6)"),
+    F64("colour", "ko", scan.colour.ko, 0, 100, "2", "highlight rejection exponent ko (eq. 6)"),
+    F64("colour", "shadow_dn", scan.colour.shadow_dn, 0, 255, "6",
+        "a light's frame within this of Ca: the light is shadowed there"),
+    U32("colour", "falloff", scan.colour.falloff, 0, 1, "1",
+        "1: compensate the inverse-square falloff from each calibrated source"),
+    F64("colour", "reference_mm", scan.colour.reference_mm, 1, 100000, "600",
+        "distance at which the falloff compensation is 1"),
+    {"colour", "white_scale", INI_VEC, C(scan.colour.white_scale), 3, 0, 1000, 0, "1, 1, 1", NULL,
+     "per-channel scale that makes a white surface come out as 1 (white reference)"},
     U32("registration", "icp", registration.enabled, 0, 1, "1",
         "1: refine each view's turntable pose by ICP against the previous view"),
     U32("registration", "sample_stride", registration.sample_stride, 1, 64, "4",
@@ -260,6 +277,17 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
     snprintf(cfg->path, sizeof(cfg->path), "%s", path);
     cfg->camera.pixel_format = pixel_format_of(cfg->camera_pixel_format);
     cfg->scan.width = cfg->camera.width;
+    static const char *const methods[] = {"none", "single", "uniform", "multi"};
+    for (uint32_t k = 0; k < 4; k++)
+        if (strcmp(cfg->colour_method, methods[k]) == 0)
+            cfg->scan.colour.method = k;
+    cfg->scan.colour.ca_per_pixel = strcmp(cfg->colour_ca, "pixel") == 0;
+    cfg->scan.colour.saturation_dn = cfg->scan.saturation_dn;
+    if (cfg->scan.colour.method >= COLOUR_UNIFORM && cfg->light_count == 0) {
+        snprintf(err, err_len, "%s: [colour] method: '%s' needs lights ([lights] count is 0)", path,
+                 cfg->colour_method);
+        return -EINVAL;
+    }
     cfg->scan.height = cfg->camera.height;
     if (cfg->scan.shadow_contrast_dn >= cfg->scan.min_contrast_dn) {
         snprintf(err, err_len, "%s: [scan] shadow_contrast_dn: %u must be below min_contrast_dn %u",

@@ -44,6 +44,8 @@ struct app_config {
     char path[HAL_MAX_PATH];     /**< the file it came from */
     char camera_backend[16];     /**< sim | v4l2 | libcamera */
     char camera_pixel_format[8]; /**< rgb24 | yuyv | grey, as written */
+    char colour_method[16];  /**< none | single | uniform | multi, as written */
+    char colour_ca[16];      /**< channel | pixel, as written */
     struct hal_camera_config camera;
     uint32_t light_count;
     struct scan_params scan;

@@ -3,6 +3,7 @@
 #include "scan_job.h"
 
 #include "board.h"
+#include "colour.h"
 #include "fusion.h"
 #include "gray.h"
 #include "image_io.h"
@@ -138,8 +139,13 @@ static int copy_file(const struct hal_storage *st, const char *from, const char 
 static const char *pattern_name(uint32_t pattern, const struct gray_layout *l, char *buf,
                                 size_t len)
 {
-    uint32_t k = (pattern - GRAY_PATTERN_FIRST_BIT) / 2u;
-    if (pattern == GRAY_PATTERN_WHITE)
+    uint32_t k = (pattern - GRAY_PATTERN_FIRST_BIT) / 2u, light = pattern - gray_layout_count(l);
+    if (pattern >= gray_layout_count(l)) /* the colour frames after the patterns */
+        snprintf(buf, len, light == COLOUR_FRAME_DARK  ? "dark: projector and lights off, RGB"
+                           : light == COLOUR_FRAME_ALL ? "all lights on, projector off, RGB"
+                                                       : "light %u alone, RGB",
+                 (unsigned)(light - COLOUR_FRAME_LIGHT0));
+    else if (pattern == GRAY_PATTERN_WHITE)
         snprintf(buf, len, "white, RGB (the view's colour)");
     else if (pattern == GRAY_PATTERN_BLACK)
         snprintf(buf, len, "black, grey");
@@ -162,12 +168,13 @@ static int write_view_meta(struct job *j, uint32_t view, const struct scan_view_
         text, sizeof(text),
         "; one view of a scan: see docs/scan-format.md\n[view]\nindex = %u\nangle_mdeg = %d\n"
         "started = %s\nfinished = %s\nframes = %u\ncapture_retries = %u\nvalid_points = %u\n"
-        "wall_ms = %.1f\n[capture]\nexposure_us = %u\ngain_milli = %u\nprojector = on\n"
-        "lights = off\n",
+        "wall_ms = %.1f\n[capture]\nexposure_us = %u\ngain_milli = %u\n"
+        "; patterns: projector on, lights off; colour frames as named below\n",
         (unsigned)view, (int)info->angle_mdeg, started, finished, (unsigned)info->frames_captured,
         (unsigned)info->capture_retries, (unsigned)info->valid_points, ms,
         (unsigned)j->cfg->camera.exposure_us, (unsigned)j->cfg->camera.gain_milli);
-    for (uint32_t p = 0; p < gray_layout_count(&layout) && (size_t)len < sizeof(text); p++)
+    uint32_t frames = gray_layout_count(&layout) + scan_light_frame_count(&j->cfg->scan, j->calib);
+    for (uint32_t p = 0; p < frames && (size_t)len < sizeof(text); p++)
         len += snprintf(text + len, sizeof(text) - (size_t)len, "frame_%02u = %s\n", (unsigned)p,
                         pattern_name(p, &layout, name, sizeof(name)));
     len += snprintf(text + len, sizeof(text) - (size_t)len, "[pixels]\n");
@@ -383,6 +390,20 @@ static int process_view(struct job *j, uint32_t v, const char *in_view_dir)
                      rc == -EINVAL ? "not a frame of this scan's size" : strerror(-rc));
         else
             rc = scan_feed_frame(p, pixels, (uint32_t)channels, NULL);
+    }
+    uint32_t lights = scan_light_frame_count(&j->cfg->scan, j->calib);
+    for (uint32_t k = 0; k < lights && rc == 0; k++) {
+        uint32_t w, h;
+        snprintf(path, sizeof(path), "%s/frame_%02u.png", in_view_dir, (unsigned)(count + k));
+        rc = image_read_png(path, pixels, sizeof(pixels), &w, &h, 3);
+        if (rc == 0 && (w != j->cfg->camera.width || h != j->cfg->camera.height))
+            rc = -EINVAL;
+        if (rc != 0)
+            hal->log(HAL_LOG_ERROR, "%s: %s (needed by [colour] method = %s)", path,
+                     rc == -EINVAL ? "not a frame of this scan's size" : strerror(-rc),
+                     j->cfg->colour_method);
+        else
+            rc = scan_feed_light_frame(k, pixels);
     }
     struct scan_view_info info;
     memset(&info, 0, sizeof(info));

@@ -100,7 +100,7 @@ static void distance_to_edge(const struct decode_maps *m, uint16_t cap)
 /* How much a pixel is trusted: head-on, close (finer sampling), and away from the view's edge,
  * where depth is least reliable and colour seams would show (Jost et al., boundary filtering). */
 static void pixel_weights(const struct scan_calib *c, const struct decode_maps *m,
-                          const struct tri_range *r)
+                          const struct tri_range *r, const float *confidence)
 {
     const double fade = fz.p.edge_fade_px > 0 ? (double)fz.p.edge_fade_px : 1.0;
     distance_to_edge(m, (uint16_t)(fz.p.edge_fade_px > 0 ? fz.p.edge_fade_px : 1));
@@ -115,6 +115,8 @@ static void pixel_weights(const struct scan_calib *c, const struct decode_maps *
             vec3 n = v3(r->normal[3 * i], r->normal[3 * i + 1], r->normal[3 * i + 2]);
             double head_on = -v3_dot(n, ray), z = r->xyz_mm[3 * i + 2];
             double w = head_on * (600.0 / z) * (600.0 / z) * fmin(1.0, edge_dist[i] / fade);
+            if (confidence != NULL)
+                w *= confidence[i];
             weight_map[i] = w >= fz.p.min_weight ? (float)w : 0.0f;
         }
     }
@@ -168,9 +170,10 @@ static int view_box(const struct frame_xform *obj_from_cam, const struct decode_
 }
 
 int fusion_integrate(const struct scan_calib *c, const struct frame_xform *obj_from_cam,
-                     const struct decode_maps *m, const struct tri_range *r, const uint8_t *rgb)
+                     const struct decode_maps *m, const struct tri_range *r, const uint8_t *rgb,
+                     const float *confidence)
 {
-    pixel_weights(c, m, r);
+    pixel_weights(c, m, r, confidence);
     const double trunc = fz.p.truncation_mm, vox = fz.p.voxel_mm;
     const vec3 step_x = m3_tmul(obj_from_cam->rot, v3(vox, 0, 0));
     uint32_t lo[3], hi[3];

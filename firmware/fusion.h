@@ -29,11 +29,12 @@ int fusion_dims(const struct fusion_params *p, uint32_t dims[3]);
 int fusion_begin(const struct fusion_params *p);
 
 /** Fuse the last view: its range image, normals and colour, seen through @p obj_from_cam.
- *  Weight of a pixel: cos(view angle) x (600 mm / depth)^2 x edge fade.
+ *  Weight of a pixel: cos(view angle) x (600 mm / depth)^2 x edge fade, times the colour's
+ *  @p confidence per pixel when given (NULL: 1).
  *  @retval 0 */
 int fusion_integrate(const struct scan_calib *calib, const struct frame_xform *obj_from_cam,
                      const struct decode_maps *maps, const struct tri_range *range,
-                     const uint8_t *rgb);
+                     const uint8_t *rgb, const float *confidence);
 
 /** Set every voxel from a signed distance function of the object-frame position (mm), weight 1
  *  and grey colour: synthetic objects and tests of the extraction. @retval 0 */

@@ -4,6 +4,7 @@
 #include "frames.h"
 #include "fusion.h"
 #include "gray.h"
+#include "colour.h"
 #include "ply.h"
 #include "refine.h"
 
@@ -14,6 +15,11 @@
 static uint8_t
     colour_rgb[HAL_MAX_PIXELS * 3];           /* projector-white frame, kept as the view's colour */
 static uint8_t frame_rgb[HAL_MAX_PIXELS * 3]; /* every other frame, consumed at once */
+/* Light frames for the colour (colour.h): dark, all lights, each light alone. */
+static uint8_t light_rgb[COLOUR_FRAME_LIGHT0 + HAL_MAX_LIGHTS][HAL_MAX_PIXELS * 3];
+static int light_present[COLOUR_FRAME_LIGHT0 + HAL_MAX_LIGHTS];
+static uint8_t view_rgb[HAL_MAX_PIXELS * 3]; /* the view's colour: compensated, or raw */
+static float view_confidence[HAL_MAX_PIXELS];
 static struct scan_params view_params;        /* of the view being fed */
 static int32_t last_angle_mdeg;
 
@@ -112,6 +118,7 @@ int scan_begin_view(const struct scan_params *p, const struct scan_calib *c)
 {
     struct gray_layout layout;
     view_params = *p;
+    memset(light_present, 0, sizeof(light_present));
     scan_layout(p, c, &layout);
     return decode_begin(p, &layout, c->proj_width, c->proj_height);
 }
@@ -141,6 +148,21 @@ int scan_feed_frame(uint32_t pattern, const uint8_t *pixels, uint32_t channels,
     return rc;
 }
 
+uint32_t scan_light_frame_count(const struct scan_params *p, const struct scan_calib *c)
+{
+    return p->colour.method == COLOUR_NONE ? 0u : COLOUR_FRAME_LIGHT0 + c->light_count;
+}
+
+int scan_feed_light_frame(uint32_t k, const uint8_t *rgb)
+{
+    if (k >= COLOUR_FRAME_LIGHT0 + HAL_MAX_LIGHTS)
+        return -EINVAL;
+    if (rgb != light_rgb[k])
+        memcpy(light_rgb[k], rgb, (size_t)view_params.width * view_params.height * 3);
+    light_present[k] = 1;
+    return 0;
+}
+
 int scan_finish_view(const struct scan_calib *c, int32_t angle_mdeg, struct scan_view_info *info)
 {
     const struct decode_maps *maps = decode_get_maps();
@@ -151,6 +173,12 @@ int scan_finish_view(const struct scan_calib *c, int32_t angle_mdeg, struct scan
         rc = tri_range_image(c, maps, refine_get_columns());
     if (rc == 0)
         rc = tri_normals(maps, view_params.normal_radius_px, view_params.max_depth_jump_mm);
+    const uint8_t *lights[COLOUR_FRAME_LIGHT0 + HAL_MAX_LIGHTS];
+    for (uint32_t k = 0; k < COLOUR_FRAME_LIGHT0 + HAL_MAX_LIGHTS; k++)
+        lights[k] = light_present[k] ? light_rgb[k] : NULL;
+    if (rc == 0)
+        rc = colour_compute(&view_params.colour, c, maps, tri_get_range(), colour_rgb, lights,
+                            view_rgb, view_confidence);
     if (rc != 0)
         return rc;
     info->angle_mdeg = angle_mdeg;
@@ -189,6 +217,35 @@ static int capture_patterns(const struct hal *hal, const struct scan_params *p, 
     return 0;
 }
 
+/* The colour frames: projector off; dark, all lights, each light alone; lights off after. */
+static int capture_lights(const struct hal *hal, const struct scan_params *p,
+                          const struct scan_calib *c, uint32_t first_index,
+                          const struct scan_frame_sink *sink, struct scan_view_info *info)
+{
+    int rc = 0;
+    uint32_t frames = scan_light_frame_count(p, c);
+    for (uint32_t k = 0; k < frames && rc == 0; k++) {
+        for (uint32_t l = 0; l < c->light_count && rc == 0; l++) {
+            int on = k == COLOUR_FRAME_ALL || k == COLOUR_FRAME_LIGHT0 + l;
+            rc = hal_gpio_set(&hal->gpio, (enum hal_gpio_line)(HAL_GPIO_LIGHT_0 + l), on);
+        }
+        if (rc == 0)
+            rc = hal_clock_sleep_us(&hal->clock, p->pattern_settle_us);
+        if (rc == 0 && hal_should_stop(hal))
+            rc = -EINTR;
+        if (rc == 0)
+            rc = capture(hal, p, light_rgb[k], first_index + k, info);
+        if (rc == 0) {
+            info->frames_captured++;
+            rc = scan_feed_light_frame(k, light_rgb[k]);
+        }
+        if (rc == 0 && sink != NULL && sink->save != NULL)
+            rc = sink->save(sink->priv, first_index + k, light_rgb[k], p->width, p->height, 3);
+    }
+    int rc_off = lights_off(hal, c->light_count);
+    return rc != 0 ? rc : rc_off;
+}
+
 int scan_view(const struct hal *hal, const struct scan_params *p, const struct scan_calib *c,
               int32_t angle_mdeg, const struct scan_frame_sink *sink, struct scan_view_info *info)
 {
@@ -205,6 +262,8 @@ int scan_view(const struct hal *hal, const struct scan_params *p, const struct s
         rc = capture_patterns(hal, p, count, sink, info);
     /* Projector off as soon as the last frame is in, and on every failure. */
     int rc_off = hal_gpio_set(&hal->gpio, HAL_GPIO_PROJECTOR_ENABLE, 0);
+    if (rc == 0 && rc_off == 0)
+        rc = capture_lights(hal, p, c, count, sink, info);
     if (rc != 0 || rc_off != 0)
         goto out_safe;
     return scan_finish_view(c, angle_mdeg, info);
@@ -221,20 +280,21 @@ void scan_view_pose(const struct scan_calib *calib, struct frame_xform *obj_from
 int scan_register_view(const struct icp_params *params, const struct scan_calib *calib,
                        struct frame_xform *pose, struct icp_report *report)
 {
-    return icp_register(params, calib, decode_get_maps(), tri_get_range(), colour_rgb, pose,
+    return icp_register(params, calib, decode_get_maps(), tri_get_range(), view_rgb, pose,
                         report);
 }
 
 int scan_fuse_view(const struct scan_calib *calib, const struct frame_xform *obj_from_cam)
 {
-    return fusion_integrate(calib, obj_from_cam, decode_get_maps(), tri_get_range(), colour_rgb);
+    return fusion_integrate(calib, obj_from_cam, decode_get_maps(), tri_get_range(), view_rgb,
+                            view_params.colour.method == COLOUR_NONE ? NULL : view_confidence);
 }
 
 int scan_save_cloud(const struct hal *hal, const struct frame_xform *obj_from_cam,
                     const char *path)
 {
     uint32_t written = 0;
-    int rc = ply_write_cloud(&hal->storage, path, decode_get_maps(), tri_get_range(), colour_rgb,
+    int rc = ply_write_cloud(&hal->storage, path, decode_get_maps(), tri_get_range(), view_rgb,
                              obj_from_cam, &written);
     if (rc != 0)
         hal->log(HAL_LOG_ERROR, "storage: cannot write %s: %s", path, strerror(-rc));
@@ -246,6 +306,11 @@ int scan_save_cloud(const struct hal *hal, const struct frame_xform *obj_from_ca
 const uint8_t *scan_colour_frame(void)
 {
     return colour_rgb;
+}
+
+const uint8_t *scan_view_colour(void)
+{
+    return view_rgb;
 }
 
 void scan_close(const struct hal *hal)

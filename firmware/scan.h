@@ -72,8 +72,14 @@ int scan_fuse_view(const struct scan_calib *calib, const struct frame_xform *obj
 int scan_save_cloud(const struct hal *hal, const struct frame_xform *obj_from_cam,
                     const char *path);
 
-/** Colour of the last view: the projector-white frame, RGB24 (registered with the range image). */
+/** The projector-white frame of the last view, RGB24 (registered with the range image). */
 const uint8_t *scan_colour_frame(void);
+/** The last view's colour as saved and fused: compensated ([colour] method), else raw. */
+const uint8_t *scan_view_colour(void);
+/** Colour frames a view takes after its patterns (0 when [colour] method = none). */
+uint32_t scan_light_frame_count(const struct scan_params *params, const struct scan_calib *calib);
+/** Offline: hand over colour frame @p k (colour.h numbering), RGB24. @retval 0 or -EINVAL */
+int scan_feed_light_frame(uint32_t k, const uint8_t *rgb);
 
 /** Close the camera and put every device in its safe state. */
 void scan_close(const struct hal *hal);

@@ -20,6 +20,21 @@ struct scan_calib {
     double light_pos_mm[HAL_MAX_LIGHTS][3]; /**< light positions */
 };
 
+enum colour_method { COLOUR_NONE = 0, COLOUR_SINGLE, COLOUR_UNIFORM, COLOUR_MULTI };
+
+/** Intrinsic colour (firmware/colour.h). */
+struct colour_params {
+    uint32_t method;       /**< enum colour_method */
+    uint32_t ca_per_pixel; /**< 1: Ca per pixel from the dark frame; 0: per channel (mean) */
+    double min_cos;        /**< cos(theta) below this: not used (grazing light amplifies noise) */
+    double ke, ko;         /**< highlight rejection exponents of eq. 6 */
+    double shadow_dn;      /**< a light frame within this of Ca: the light does not reach */
+    uint32_t falloff;      /**< 1: inverse-square distance compensation */
+    double reference_mm;   /**< distance at which the falloff factor is 1 */
+    double white_scale[3]; /**< per channel: white surface -> 1 */
+    uint32_t saturation_dn;
+};
+
 /** Processing and sequencing parameters of one view. */
 struct scan_params {
     uint32_t width, height;      /**< camera frame size */
@@ -37,6 +52,7 @@ struct scan_params {
     uint32_t pattern_settle_us; /**< wait after the projector changes pattern */
     uint32_t trigger_pulse_us;  /**< projector trigger/reset pulse width */
     uint32_t capture_retries;   /**< extra tries of a failed capture */
+    struct colour_params colour; /**< intrinsic colour; its frames are captured unless none */
 };
 
 #endif

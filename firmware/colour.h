@@ -1,0 +1,30 @@
+/* Intrinsic colour of a view (Jost, Schutz and Hugli): the camera sees reflected light; knowing
+ * the geometry and the lights, invert the reflectance model. Ca (ambient + black offset) comes
+ * from a dark frame. Methods:
+ *   single  - projector as the only light, Cd = (C - Ca) / cos(theta)            (eq. 4)
+ *   uniform - all lights on (near-uniform diffuse light), Cd = C - Ca             (method 2)
+ *   multi   - each light alone, Cd = sum (Ci - Ca) wi' / sum cos(theta_i) wi',
+ *             wi' = (1 - cos(alpha_i)^ke)^ko, 0 where light i is shadowed         (eq. 6)
+ * with the inverse-square falloff from each calibrated source position, and a per-channel white
+ * scale so that a white surface comes out as 1. */
+#ifndef COLOUR_H
+#define COLOUR_H
+
+#include "decode.h"
+#include "tri.h"
+
+/** Light frames after the Gray-code patterns: dark, all lights, then each light alone. */
+#define COLOUR_FRAME_DARK 0u
+#define COLOUR_FRAME_ALL 1u
+#define COLOUR_FRAME_LIGHT0 2u
+
+/** Compute albedo (0..1 scaled to 0..255) and a confidence (0..1) for every valid pixel.
+ *  @param white  projector-white frame (RGB24); @param lights  light frames (RGB24) as above,
+ *  NULL entries allowed when the method does not need them. Pixels without a usable estimate
+ *  get confidence 0 and keep their raw colour. @retval 0 @retval -EINVAL a needed frame missing */
+int colour_compute(const struct colour_params *p, const struct scan_calib *calib,
+                   const struct decode_maps *maps, const struct tri_range *range,
+                   const uint8_t *white, const uint8_t *const *lights, uint8_t *albedo_rgb,
+                   float *confidence);
+
+#endif
