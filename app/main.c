@@ -4,6 +4,7 @@
 #include "config.h"
 #include "scan.h"
 #include "scan_job.h"
+#include "white_cal.h"
 #include "clock_posix.h"
 #include "storage_posix.h"
 
@@ -109,6 +110,57 @@ static int cmd_scan(const char *config_path, const struct scan_job_opts *opts)
     return rc == 0 ? 0 : 1;
 }
 
+/* One view of a white target with every colour frame: print each method's white_scale. */
+static int cmd_calibrate_white(const char *config_path, double target_albedo)
+{
+    static struct app_config cfg;
+    static struct scan_calib calib;
+    char err[512];
+    if (load_all(config_path, &cfg, &calib) != 0)
+        return 2;
+    if (cfg.light_count == 0) {
+        fprintf(stderr, "scanner: error: %s: [lights] count: the white calibration needs lights\n",
+                config_path);
+        return 2;
+    }
+    cfg.scan.colour.method = COLOUR_MULTI; /* captures the dark, all-lights and single frames */
+    the_hal.log = app_log;
+    the_hal.stop_requested = app_stop_requested;
+    install_signals();
+    int rc = board_init(&the_hal, &cfg, &calib, err, sizeof(err));
+    if (rc != 0) {
+        fprintf(stderr, "scanner: error: %s\n", err);
+        return 1;
+    }
+    hal_ready = 1;
+    struct scan_view_info info;
+    struct white_cal wc;
+    rc = scan_open(&the_hal, &cfg.camera);
+    if (rc == 0)
+        rc = hal_table_home(&the_hal.turntable);
+    if (rc == 0)
+        rc = scan_view(&the_hal, &cfg.scan, &calib, 0, NULL, &info);
+    if (rc == 0) {
+        rc = white_cal_from_view(&cfg, &calib, target_albedo, &wc);
+        if (rc != 0)
+            app_log(HAL_LOG_ERROR, "no usable white pixels: is the target in view, and not "
+                                   "saturated (lower [camera] exposure_us)?");
+    }
+    scan_close(&the_hal);
+    board_shutdown(&the_hal);
+    hal_ready = 0;
+    if (rc != 0)
+        return 1;
+    static const char *const names[] = {"", "single", "uniform", "multi"};
+    printf("; white reference (target albedo %.3f): put the line of your [colour] method in the "
+           "config's [colour] section\n",
+           target_albedo);
+    for (int m = COLOUR_SINGLE; m <= COLOUR_MULTI; m++)
+        printf("; %s (from %u pixels)\nwhite_scale = %.6f, %.6f, %.6f\n", names[m],
+               (unsigned)wc.pixels[m], wc.scale[m][0], wc.scale[m][1], wc.scale[m][2]);
+    return 0;
+}
+
 /* Offline: only storage, a clock and the log; no device is opened. */
 static int cmd_process(const char *scan_dir, const struct scan_job_opts *opts)
 {
@@ -126,6 +178,7 @@ static void usage(FILE *out)
             "usage: scanner scan --config FILE [--out DIR] [--json]   take a scan\n"
             "       scanner process DIR [--out DIR2] [--json]        recompute a scan from its "
             "frames\n"
+            "       scanner calibrate-white --config FILE [--albedo A]  white reference scales\n"
             "       scanner check-config --config FILE    check a config and its calibration\n"
             "       scanner config-doc                    print the config reference (Markdown)\n"
             "       scanner --version\n");
@@ -135,6 +188,7 @@ int main(int argc, char **argv)
 {
     const char *config_path = NULL, *scan_dir = NULL;
     struct scan_job_opts opts = {0, NULL};
+    double white_albedo = 0.95; /* a typical white reference target */
     if (argc < 2) {
         usage(stderr);
         return 2;
@@ -151,6 +205,8 @@ int main(int argc, char **argv)
             opts.out_dir = argv[++i];
         else if (strcmp(argv[i], "--json") == 0)
             opts.json = 1;
+        else if (strcmp(argv[i], "--albedo") == 0 && i + 1 < argc)
+            white_albedo = atof(argv[++i]);
         else {
             fprintf(stderr, "scanner: unknown argument '%s'\n", argv[i]);
             usage(stderr);
@@ -185,6 +241,8 @@ int main(int argc, char **argv)
     }
     if (strcmp(argv[1], "scan") == 0)
         return cmd_scan(config_path, &opts);
+    if (strcmp(argv[1], "calibrate-white") == 0)
+        return cmd_calibrate_white(config_path, white_albedo);
     usage(stderr);
     return 2;
 }

@@ -313,6 +313,20 @@ const uint8_t *scan_view_colour(void)
     return view_rgb;
 }
 
+const float *scan_view_confidence(void)
+{
+    return view_confidence;
+}
+
+int scan_recolour(const struct colour_params *colour, const struct scan_calib *c)
+{
+    const uint8_t *lights[COLOUR_FRAME_LIGHT0 + HAL_MAX_LIGHTS];
+    for (uint32_t k = 0; k < COLOUR_FRAME_LIGHT0 + HAL_MAX_LIGHTS; k++)
+        lights[k] = light_present[k] ? light_rgb[k] : NULL;
+    return colour_compute(colour, c, decode_get_maps(), tri_get_range(), colour_rgb, lights,
+                          view_rgb, view_confidence);
+}
+
 void scan_close(const struct hal *hal)
 {
     hal_cam_close(&hal->camera);

@@ -76,6 +76,12 @@ int scan_save_cloud(const struct hal *hal, const struct frame_xform *obj_from_ca
 const uint8_t *scan_colour_frame(void);
 /** The last view's colour as saved and fused: compensated ([colour] method), else raw. */
 const uint8_t *scan_view_colour(void);
+/** Recompute the last view's colour with other colour parameters (same frames, same geometry):
+ *  the white calibration compares the methods on one view. @retval 0 or -EINVAL */
+int scan_recolour(const struct colour_params *colour, const struct scan_calib *calib);
+/** The last view's colour confidence per pixel (0: no estimate). */
+const float *scan_view_confidence(void);
+
 /** Colour frames a view takes after its patterns (0 when [colour] method = none). */
 uint32_t scan_light_frame_count(const struct scan_params *params, const struct scan_calib *calib);
 /** Offline: hand over colour frame @p k (colour.h numbering), RGB24. @retval 0 or -EINVAL */

@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "test_util.h"
+#include "white_cal.h"
 #include "vec3.h"
 
 struct colour_stats {
@@ -107,10 +108,62 @@ static void test_compensation_flattens_shading_and_highlights(void **state)
     assert_true(fabs(single.red_green - 0.6 / 0.45) < 0.02);
 }
 
+/* Calibrate the white reference on a white sphere (albedo 0.95), then the painted sphere's
+ * compensated colour is its albedo: mean absolute error per channel against the truth. */
+static void test_white_reference_gives_albedo(void **state)
+{
+    (void)state;
+    static struct test_rig t;
+    struct white_cal wc;
+    struct scan_view_info info;
+    assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
+    snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "sphere");
+    snprintf(t.cfg.sim.albedo_pattern, sizeof(t.cfg.sim.albedo_pattern), "uniform");
+    t.cfg.sim.albedo[0] = t.cfg.sim.albedo[1] = t.cfg.sim.albedo[2] = 0.95;
+    t.cfg.scan.colour.method = COLOUR_MULTI; /* every colour frame */
+    assert_int_equal(test_rig_start(&t), 0);
+    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info), 0);
+    assert_int_equal(white_cal_from_view(&t.cfg, &t.calib, 0.95, &wc), 0);
+    test_rig_stop(&t);
+    /* the simulator's intensities are 170 (projector) and 120 (each light) grey levels */
+    assert_true(fabs(wc.scale[COLOUR_SINGLE][0] * 170.0 - 1.0) < 0.02);
+    assert_true(fabs(wc.scale[COLOUR_MULTI][1] * 120.0 - 1.0) < 0.02);
+
+    for (uint32_t method = COLOUR_SINGLE; method <= COLOUR_MULTI; method += 2) {
+        assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
+        snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "sphere");
+        t.cfg.scan.colour.method = method;
+        memcpy(t.cfg.scan.colour.white_scale, wc.scale[method], sizeof(wc.scale[method]));
+        assert_int_equal(test_rig_start(&t), 0);
+        assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info), 0);
+        const struct decode_maps *m = decode_get_maps();
+        const uint8_t *rgb = scan_view_colour();
+        const float *conf = scan_view_confidence();
+        const struct sim_rig *rig = sim_ctl_rig();
+        double err[3] = {0, 0, 0};
+        size_t n = (size_t)m->width * m->height, count = 0;
+        for (size_t i = 0; i < n; i++) {
+            if (m->reason[i] != SCAN_VALID || conf[i] < 0.5f)
+                continue;
+            for (int k = 0; k < 3; k++)
+                err[k] += fabs(rgb[3 * i + (size_t)k] / 255.0 - rig->truth.albedo[3 * i + (size_t)k]);
+            count++;
+        }
+        test_rig_stop(&t);
+        print_message("%s: %zu confident px, albedo error per channel %.3f %.3f %.3f\n",
+                      method == COLOUR_SINGLE ? "single" : "multi", count, err[0] / count,
+                      err[1] / count, err[2] / count);
+        assert_true(count > 100000);
+        for (int k = 0; k < 3; k++)
+            assert_true(err[k] / count < 0.05);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_compensation_flattens_shading_and_highlights),
+        cmocka_unit_test(test_white_reference_gives_albedo),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
