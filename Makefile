@@ -83,7 +83,7 @@ $(BUILD)/mesh-compare: $(call obj,tests/mesh_compare.c tests/mesh_compare_lib.c 
 
 # ---- tests ----
 TEST_SRC := $(filter-out tests/test_util.c,$(wildcard tests/test_*.c))
-TEST_SUPPORT := $(BUILD)/tests/test_util.o $(BUILD)/tests/mesh_compare_lib.o
+TEST_SUPPORT := $(BUILD)/tests/test_util.o $(BUILD)/tests/mesh_compare_lib.o $(BUILD)/tests/colour_metrics.o
 TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 TEST_LIBS = $(shell pkg-config --libs cmocka libmodbus 2>/dev/null)
 
