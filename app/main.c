@@ -85,28 +85,43 @@ static int load_all(const char *config_path, struct app_config *cfg, struct scan
     return rc;
 }
 
+/* Devices up: logging, signals, the board, the camera; lights and projector off. The one
+ * shutdown, rig_down, must follow whatever this returns. @retval 0 or the error (reported) */
+static int rig_up(const struct app_config *cfg, const struct scan_calib *calib)
+{
+    char err[512];
+    the_hal.log = app_log;
+    the_hal.stop_requested = app_stop_requested;
+    install_signals();
+    int rc = board_init(&the_hal, cfg, calib, err, sizeof(err));
+    if (rc != 0) {
+        fprintf(stderr, "scanner: error: %s\n", err);
+        return rc;
+    }
+    hal_ready = 1;
+    return scan_open(&the_hal, &cfg->camera);
+}
+
+/* Safe state, camera closed, board released (nothing to do when rig_up failed early). */
+static void rig_down(void)
+{
+    if (!hal_ready)
+        return;
+    scan_close(&the_hal);
+    board_shutdown(&the_hal);
+    hal_ready = 0;
+}
+
 static int cmd_scan(const char *config_path, const struct scan_job_opts *opts)
 {
     static struct app_config cfg;
     static struct scan_calib calib;
-    char err[512];
     if (load_all(config_path, &cfg, &calib) != 0)
         return 2;
-    the_hal.log = app_log;
-    the_hal.stop_requested = app_stop_requested;
-    install_signals();
-    int rc = board_init(&the_hal, &cfg, &calib, err, sizeof(err));
-    if (rc != 0) {
-        fprintf(stderr, "scanner: error: %s\n", err);
-        return 1;
-    }
-    hal_ready = 1;
-    rc = scan_open(&the_hal, &cfg.camera);
+    int rc = rig_up(&cfg, &calib);
     if (rc == 0)
         rc = scan_job_live(&the_hal, &cfg, &calib, opts);
-    scan_close(&the_hal);
-    board_shutdown(&the_hal);
-    hal_ready = 0;
+    rig_down();
     return rc == 0 ? 0 : 1;
 }
 
@@ -115,7 +130,6 @@ static int cmd_calibrate_white(const char *config_path, double target_albedo)
 {
     static struct app_config cfg;
     static struct scan_calib calib;
-    char err[512];
     if (load_all(config_path, &cfg, &calib) != 0)
         return 2;
     if (cfg.light_count == 0) {
@@ -124,18 +138,9 @@ static int cmd_calibrate_white(const char *config_path, double target_albedo)
         return 2;
     }
     cfg.scan.colour.method = COLOUR_MULTI; /* captures the dark, all-lights and single frames */
-    the_hal.log = app_log;
-    the_hal.stop_requested = app_stop_requested;
-    install_signals();
-    int rc = board_init(&the_hal, &cfg, &calib, err, sizeof(err));
-    if (rc != 0) {
-        fprintf(stderr, "scanner: error: %s\n", err);
-        return 1;
-    }
-    hal_ready = 1;
     struct scan_view_info info;
     struct white_cal wc;
-    rc = scan_open(&the_hal, &cfg.camera);
+    int rc = rig_up(&cfg, &calib);
     if (rc == 0)
         rc = hal_table_home(&the_hal.turntable);
     if (rc == 0)
@@ -146,9 +151,7 @@ static int cmd_calibrate_white(const char *config_path, double target_albedo)
             app_log(HAL_LOG_ERROR, "no usable white pixels: is the target in view, and not "
                                    "saturated (lower [camera] exposure_us)?");
     }
-    scan_close(&the_hal);
-    board_shutdown(&the_hal);
-    hal_ready = 0;
+    rig_down();
     if (rc != 0)
         return 1;
     static const char *const names[] = {"", "single", "uniform", "multi"};

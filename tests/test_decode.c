@@ -102,7 +102,7 @@ static void test_grey_conversion(void **state)
     decode_rgb_to_grey(rgb, g, 4, 250);
     assert_int_equal(g[0], DECODE_SATURATED);
     assert_int_equal(g[1], DECODE_SATURATED); /* one channel is enough */
-    assert_int_equal(g[2], 249); /* weights sum to 256: a grey stays itself */
+    assert_int_equal(g[2], 249);              /* weights sum to 256: a grey stays itself */
     assert_int_equal(g[3], 0);
     decode_rgb_to_grey(rgb, g, 1, 256); /* no saturation level: 255 still cannot be a grey */
     assert_int_equal(g[0], 254);
@@ -131,6 +131,21 @@ static void test_size_above_limit_rejected(void **state)
     assert_int_equal(decode_begin(&p, &too_many, PROJ_W, 1), -EINVAL);
 }
 
+/* Every pattern of the synthetic scene, with pixel 10 of row 0 ambiguous in bit 0 and pixel 20
+ * ambiguous in bits 0 and 1. */
+static void feed_ambiguous_scene(uint32_t bits)
+{
+    for (uint32_t i = 0; i < gray_pattern_count(bits); i++) {
+        render(i, bits);
+        uint32_t k = i >= 2 ? (i - 2) / 2 : 99;
+        if (k == 0)
+            memset(&frame[3 * 10], 120, 3);
+        if (k <= 1)
+            memset(&frame[3 * 20], 120, 3);
+        assert_int_equal(feed(i), 0);
+    }
+}
+
 /* Two ambiguous bits in one pixel cannot be a column edge: low contrast. One is tolerated. */
 static void test_ambiguous_bits(void **state)
 {
@@ -138,16 +153,7 @@ static void test_ambiguous_bits(void **state)
     uint32_t bits = gray_bits_for_width(PROJ_W);
     struct scan_params p = params();
     assert_int_equal(begin(&p, bits), 0);
-    for (uint32_t i = 0; i < gray_pattern_count(bits); i++) {
-        render(i, bits);
-        uint32_t k = i >= 2 ? (i - 2) / 2 : 99;
-        /* pixel 10 of row 0: bit 0 ambiguous; pixel 20: bits 0 and 1 ambiguous */
-        if (k == 0)
-            memset(&frame[3 * 10], 120, 3);
-        if (k <= 1)
-            memset(&frame[3 * 20], 120, 3);
-        assert_int_equal(feed(i), 0);
-    }
+    feed_ambiguous_scene(bits);
     assert_int_equal(decode_finish(), 0);
     const struct decode_maps *m = decode_get_maps();
     assert_int_equal(m->reason[10], SCAN_VALID);
@@ -184,15 +190,7 @@ static void test_blocked_matches_reference(void **state)
     struct scan_params p = params();
     struct gray_layout l = {bits, 0};
     assert_int_equal(decode_begin(&p, &l, PROJ_W, 1), 0);
-    for (uint32_t i = 0; i < gray_pattern_count(bits); i++) {
-        render(i, bits);
-        uint32_t k = i >= 2 ? (i - 2) / 2 : 99;
-        if (k == 0)
-            memset(&frame[3 * 10], 120, 3);
-        if (k <= 1)
-            memset(&frame[3 * 20], 120, 3);
-        assert_int_equal(feed(i), 0);
-    }
+    feed_ambiguous_scene(bits);
     assert_int_equal(decode_pixels(), 0);
     const uint8_t *frames[DECODE_MAX_PATTERNS];
     for (uint32_t i = 0; i < gray_pattern_count(bits); i++)
