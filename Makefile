@@ -47,8 +47,8 @@ FW_OBJ := $(call obj,$(FW_SRC))
 HOST_OBJ := $(call obj,$(POSIX_SRC) $(APP_LIB_SRC) $(BOARD_SRC))
 MAIN_OBJ := $(call obj,app/main.c)
 
-.PHONY: all deps test-deps test run clean format docs check-firmware bench measure measure-scan interop-meshlab bench-callgrind
-SIM_TOOLS := $(if $(filter sim,$(HAL)),$(BUILD)/turntable-sim $(BUILD)/tt-client $(BUILD)/mesh-compare,)
+.PHONY: all deps test-deps test run clean format docs check-firmware bench measure measure-scan interop-meshlab bench-callgrind eval
+SIM_TOOLS := $(if $(filter sim,$(HAL)),$(BUILD)/turntable-sim $(BUILD)/tt-client $(BUILD)/mesh-compare $(BUILD)/colour-eval,)
 all: deps $(BUILD)/scanner $(SIM_TOOLS)
 
 # Install missing Debian packages (fresh Debian 12): only when pkg-config cannot find them.
@@ -79,6 +79,9 @@ $(BUILD)/tt-client: $(call obj,tests/tt_client_main.c hal/modbus/turntable_modbu
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON)
 
 $(BUILD)/mesh-compare: $(call obj,tests/mesh_compare.c tests/mesh_compare_lib.c host_sim/sim_bvh.c host_sim/sim_mesh.c host_sim/sim_ply_read.c app/config.c app/ini_schema.c) $(BUILD)/libfirmware.a
+	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON)
+
+$(BUILD)/colour-eval: $(call obj,tests/colour_eval.c tests/colour_metrics.c host_sim/sim_bvh.c host_sim/sim_mesh.c host_sim/sim_ply_read.c host_sim/sim_rig.c host_sim/sim_material.c app/config.c app/ini_schema.c app/image_io.c hal/posix/storage_posix.c) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON)
 
 # ---- tests ----
@@ -112,7 +115,7 @@ check-firmware: $(FW_OBJ)
 
 # Test-only packages: Open3D reads our PLY (tests/cli.sh); pymodbus and socat are the Modbus
 # peers of tests/interop.sh.
-test-deps:
+test-deps: deps
 	@{ /usr/bin/python3 -c 'import open3d, pymodbus, serial_asyncio' && command -v socat; } \
 		>/dev/null 2>&1 || scripts/install-deps.sh test
 
@@ -140,6 +143,12 @@ $(BUILD)/measure_view: $(BUILD)/tests/measure_view.o $(BUILD)/tests/test_util.o 
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON) $(BOARD_LIBS)
 measure: deps $(BUILD)/measure_view
 	$(BUILD)/measure_view config/sim.ini
+
+# Intrinsic colour (issue 4): Jost et al.'s comparison reproduced on the simulator, written to
+# docs/colour-eval/ (table as Markdown and CSV, close-up PNGs of a view boundary). ~6 minutes.
+EVAL_DIR ?= docs/colour-eval
+eval: deps $(BUILD)/scanner $(BUILD)/colour-eval
+	tests/colour_eval.sh $(BUILD) $(EVAL_DIR)
 
 # Full simulated scans measured against the true surface, and peak memory for 8 and 24 views.
 measure-scan: deps $(BUILD)/scanner $(BUILD)/mesh-compare

@@ -129,6 +129,12 @@ static const struct ini_key config_keys[] = {
          "uniform (all lights), multi (each light alone, eq. 6)"),
     ENUM("colour", "ca", colour_ca, "channel|pixel", "channel",
          "ambient + black offset from the dark frame: one value per channel, or per pixel"),
+    U32("colour", "all_lights_exposure_us", scan.colour.all_lights_exposure_us, 0, 10000000, "0",
+        "exposure of the all-lights frame (0: [camera] exposure_us); a dark frame is taken at it "
+        "too"),
+    U32("colour", "light_exposure_us", scan.colour.light_exposure_us, 0, 10000000, "0",
+        "exposure of each single-light frame (0: [camera] exposure_us); a dark frame is taken "
+        "at it too"),
     F64("colour", "min_cos", scan.colour.min_cos, 0, 1, "0.2",
         "light at a lower cos(incidence) is not used (it would amplify noise)"),
     F64("colour", "ke", scan.colour.ke, 1, 10000, "40", "highlight rejection exponent ke (eq. 6)"),
@@ -139,8 +145,10 @@ static const struct ini_key config_keys[] = {
         "1: compensate the inverse-square falloff from each calibrated source"),
     F64("colour", "reference_mm", scan.colour.reference_mm, 1, 100000, "600",
         "distance at which the falloff compensation is 1"),
-    {"colour", "white_scale", INI_VEC, C(scan.colour.white_scale), 3, 0, 1000, 0, "1, 1, 1", NULL,
-     "per-channel scale that makes a white surface come out as 1 (white reference)"},
+    {"colour", "white_scale", INI_VEC, C(scan.colour.white_scale), 3, 0, 1000, 0,
+     "0.00392157, 0.00392157, 0.00392157", NULL,
+     "per channel, grey levels to albedo: a white surface comes out as 1 (from scanner "
+     "calibrate-white; the default 1/255 keeps grey levels)"},
     U32("registration", "icp", registration.enabled, 0, 1, "1",
         "1: refine each view's turntable pose by ICP against the previous view"),
     U32("registration", "sample_stride", registration.sample_stride, 1, 64, "4",
@@ -283,6 +291,8 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
             cfg->scan.colour.method = k;
     cfg->scan.colour.ca_per_pixel = strcmp(cfg->colour_ca, "pixel") == 0;
     cfg->scan.colour.saturation_dn = cfg->scan.saturation_dn;
+    cfg->scan.colour.exposure_us = cfg->camera.exposure_us;
+    cfg->scan.colour.gain_milli = cfg->camera.gain_milli;
     if (cfg->scan.colour.method >= COLOUR_UNIFORM && cfg->light_count == 0) {
         snprintf(err, err_len, "%s: [colour] method: '%s' needs lights ([lights] count is 0)", path,
                  cfg->colour_method);

@@ -150,6 +150,8 @@ static int handler(void *user, const char *section, const char *name, const char
     char msg[256];
     if (st->failed) /* report the first error, not the last */
         return 0;
+    if (strcmp(section, "color") == 0) /* both spellings of the one section */
+        section = "colour";
     for (size_t i = 0; i < st->key_count; i++) {
         const struct ini_key *k = &st->keys[i];
         if (strcmp(k->section, section) != 0 || strcmp(k->name, name) != 0)

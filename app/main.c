@@ -154,11 +154,11 @@ static int cmd_calibrate_white(const char *config_path, double target_albedo)
     rig_down();
     if (rc != 0)
         return 1;
-    static const char *const names[] = {"", "single", "uniform", "multi"};
+    static const char *const names[] = {"none", "single", "uniform", "multi"};
     printf("; white reference (target albedo %.3f): put the line of your [colour] method in the "
            "config's [colour] section\n",
            target_albedo);
-    for (int m = COLOUR_SINGLE; m <= COLOUR_MULTI; m++)
+    for (int m = COLOUR_NONE; m <= COLOUR_MULTI; m++)
         printf("; %s (from %u pixels)\nwhite_scale = %.6f, %.6f, %.6f\n", names[m],
                (unsigned)wc.pixels[m], wc.scale[m][0], wc.scale[m][1], wc.scale[m][2]);
     return 0;
@@ -179,8 +179,8 @@ static void usage(FILE *out)
 {
     fprintf(out,
             "usage: scanner scan --config FILE [--out DIR] [--json]   take a scan\n"
-            "       scanner process DIR [--out DIR2] [--json]        recompute a scan from its "
-            "frames\n"
+            "       scanner process DIR [--out DIR2] [--config F] [--json]  recompute a scan from "
+            "its frames\n"
             "       scanner calibrate-white --config FILE [--albedo A]  white reference scales\n"
             "       scanner check-config --config FILE    check a config and its calibration\n"
             "       scanner config-doc                    print the config reference (Markdown)\n"
@@ -190,7 +190,7 @@ static void usage(FILE *out)
 int main(int argc, char **argv)
 {
     const char *config_path = NULL, *scan_dir = NULL;
-    struct scan_job_opts opts = {0, NULL};
+    struct scan_job_opts opts = {0, NULL, NULL};
     double white_albedo = 0.95; /* a typical white reference target */
     if (argc < 2) {
         usage(stderr);
@@ -228,8 +228,10 @@ int main(int argc, char **argv)
         usage(stdout);
         return 0;
     }
-    if (strcmp(argv[1], "process") == 0 && scan_dir != NULL)
+    if (strcmp(argv[1], "process") == 0 && scan_dir != NULL) {
+        opts.config_path = config_path; /* optional: other settings for the same frames */
         return cmd_process(scan_dir, &opts);
+    }
     if (config_path == NULL) {
         usage(stderr);
         return 2;

@@ -136,15 +136,39 @@ static int copy_file(const struct hal_storage *st, const char *from, const char 
     return too_big ? -EFBIG : hal_storage_write_file(st, to, buf, n);
 }
 
-static const char *pattern_name(uint32_t pattern, const struct gray_layout *l, char *buf,
-                                size_t len)
+/* The config and calibration a scan's results came from, kept beside them. */
+static int keep_settings(const struct hal_storage *st, const struct app_config *cfg,
+                         const char *dir)
 {
-    uint32_t k = (pattern - GRAY_PATTERN_FIRST_BIT) / 2u, light = pattern - gray_layout_count(l);
+    char path[HAL_MAX_PATH + 32];
+    snprintf(path, sizeof(path), "%s/config.ini", dir);
+    int rc = copy_file(st, cfg->path, path);
+    snprintf(path, sizeof(path), "%s/calibration.ini", dir);
+    return rc != 0 ? rc : copy_file(st, cfg->calibration_file, path);
+}
+
+/* A colour frame (colour_layout order): its lights and exposure. */
+static void colour_frame_name(const struct colour_layout *lay, uint32_t k, char *buf, size_t len)
+{
+    uint32_t mask = lay->lights_mask[k], light = 0;
+    while (mask > 1u && !(mask & 1u)) {
+        mask >>= 1;
+        light++;
+    }
+    snprintf(buf, len, lay->lights_mask[k] == 0 ? "dark: projector and lights off, %u us, RGB"
+                       : k == COLOUR_FRAME_ALL  ? "all lights on, projector off, %u us, RGB"
+                                                : "light %u alone, %u us, RGB",
+             (unsigned)(lay->lights_mask[k] == 0 || k == COLOUR_FRAME_ALL ? lay->exposure_us[k]
+                                                                         : light),
+             (unsigned)lay->exposure_us[k]);
+}
+
+static const char *pattern_name(uint32_t pattern, const struct gray_layout *l,
+                                const struct colour_layout *lay, char *buf, size_t len)
+{
+    uint32_t k = (pattern - GRAY_PATTERN_FIRST_BIT) / 2u;
     if (pattern >= gray_layout_count(l)) /* the colour frames after the patterns */
-        snprintf(buf, len, light == COLOUR_FRAME_DARK  ? "dark: projector and lights off, RGB"
-                           : light == COLOUR_FRAME_ALL ? "all lights on, projector off, RGB"
-                                                       : "light %u alone, RGB",
-                 (unsigned)(light - COLOUR_FRAME_LIGHT0));
+        colour_frame_name(lay, pattern - gray_layout_count(l), buf, len);
     else if (pattern == GRAY_PATTERN_WHITE)
         snprintf(buf, len, "white, RGB (the view's colour)");
     else if (pattern == GRAY_PATTERN_BLACK)
@@ -163,7 +187,9 @@ static int write_view_meta(struct job *j, uint32_t view, const struct scan_view_
     char text[4096], finished[32], name[64];
     utc_now(finished, sizeof(finished));
     struct gray_layout layout;
+    struct colour_layout lay;
     scan_layout(&j->cfg->scan, j->calib, &layout);
+    colour_layout(&j->cfg->scan.colour, j->calib->light_count, &lay);
     int len = snprintf(
         text, sizeof(text),
         "; one view of a scan: see docs/scan-format.md\n[view]\nindex = %u\nangle_mdeg = %d\n"
@@ -173,10 +199,10 @@ static int write_view_meta(struct job *j, uint32_t view, const struct scan_view_
         (unsigned)view, (int)info->angle_mdeg, started, finished, (unsigned)info->frames_captured,
         (unsigned)info->capture_retries, (unsigned)info->valid_points, ms,
         (unsigned)j->cfg->camera.exposure_us, (unsigned)j->cfg->camera.gain_milli);
-    uint32_t frames = gray_layout_count(&layout) + scan_light_frame_count(&j->cfg->scan, j->calib);
+    uint32_t frames = gray_layout_count(&layout) + lay.count;
     for (uint32_t p = 0; p < frames && (size_t)len < sizeof(text); p++)
         len += snprintf(text + len, sizeof(text) - (size_t)len, "frame_%02u = %s\n", (unsigned)p,
-                        pattern_name(p, &layout, name, sizeof(name)));
+                        pattern_name(p, &layout, &lay, name, sizeof(name)));
     len += snprintf(text + len, sizeof(text) - (size_t)len, "[pixels]\n");
     for (unsigned r = 0; r < SCAN_REASON_COUNT && (size_t)len < sizeof(text); r++)
         len += snprintf(text + len, sizeof(text) - (size_t)len, "%s = %u\n", scan_reason_name(r),
@@ -319,14 +345,8 @@ int scan_job_live(const struct hal *hal, const struct app_config *cfg,
                     cfg->views, wall_ms(), isatty(STDOUT_FILENO) && !opts->json, ""};
     char path[HAL_MAX_PATH + 32];
     int rc = hal_storage_mkdir_p(&hal->storage, j.out_dir);
-    if (rc == 0) {
-        snprintf(path, sizeof(path), "%s/config.ini", j.out_dir);
-        rc = copy_file(&hal->storage, cfg->path, path);
-    }
-    if (rc == 0) {
-        snprintf(path, sizeof(path), "%s/calibration.ini", j.out_dir);
-        rc = copy_file(&hal->storage, cfg->calibration_file, path);
-    }
+    if (rc == 0)
+        rc = keep_settings(&hal->storage, cfg, j.out_dir);
     if (rc != 0) {
         hal->log(HAL_LOG_ERROR, "cannot set up the scan directory %s: %s", j.out_dir,
                  strerror(-rc));
@@ -429,7 +449,7 @@ int scan_job_process(const struct hal *hal, const char *scan_dir, const struct s
     static struct scan_calib calib;
     char path[HAL_MAX_PATH + 32], err[512];
     snprintf(path, sizeof(path), "%s/config.ini", scan_dir);
-    int rc = config_load(&cfg, path, err, sizeof(err));
+    int rc = config_load(&cfg, opts->config_path ? opts->config_path : path, err, sizeof(err));
     if (rc == 0) {
         /* the calibration is the copy kept with the scan, whatever the config named */
         snprintf(cfg.calibration_file, sizeof(cfg.calibration_file), "%s/calibration.ini",
@@ -443,6 +463,8 @@ int scan_job_process(const struct hal *hal, const char *scan_dir, const struct s
     struct job j = {hal, &cfg, &calib, opts, opts->out_dir ? opts->out_dir : scan_dir,
                     cfg.views, wall_ms(), isatty(STDOUT_FILENO) && !opts->json, ""};
     rc = hal_storage_mkdir_p(&hal->storage, j.out_dir);
+    if (rc == 0 && opts->out_dir != NULL) /* the results say how they were made */
+        rc = keep_settings(&hal->storage, &cfg, j.out_dir);
     if (rc == 0)
         rc = fusion_begin(&cfg.fusion);
     icp_reset();

@@ -9,6 +9,8 @@
 struct scan_job_opts {
     int json;           /**< one JSON status line per event instead of the terminal display */
     const char *out_dir; /**< results go here (process: default the scan directory itself) */
+    const char *config_path; /**< process: settings from this file instead of the scan's own
+                                  config.ini (e.g. another [colour] method); NULL: the scan's */
 };
 
 /** Home the table and take every configured view, saving each before the next move.

@@ -6,6 +6,8 @@
 #include <errno.h>
 #include <string.h>
 
+#define HALF 0.5
+
 /* Median of a channel over the confident pixels (histogram: values are bytes). */
 static int channel_median(const uint8_t *rgb, const float *conf, size_t n, int ch, uint32_t *count)
 {
@@ -30,11 +32,12 @@ int white_cal_from_view(const struct app_config *cfg, const struct scan_calib *c
 {
     memset(out, 0, sizeof(*out));
     size_t n = (size_t)cfg->camera.width * cfg->camera.height;
-    for (uint32_t m = COLOUR_SINGLE; m <= COLOUR_MULTI; m++) {
+    for (uint32_t m = COLOUR_NONE; m <= COLOUR_MULTI; m++) {
         struct colour_params p = cfg->scan.colour;
         p.method = m;
-        /* with a scale of 1/255 the stored byte is the compensated value in grey levels */
-        p.white_scale[0] = p.white_scale[1] = p.white_scale[2] = 1.0 / 255.0;
+        /* with this scale the stored byte is half the compensated value in grey levels: colour
+         * frames at a shorter exposure are scaled up to the camera's, beyond 255 */
+        p.white_scale[0] = p.white_scale[1] = p.white_scale[2] = HALF / 255.0;
         int rc = scan_recolour(&p, calib);
         if (rc != 0)
             return rc;
@@ -43,7 +46,7 @@ int white_cal_from_view(const struct app_config *cfg, const struct scan_calib *c
                                      &out->pixels[m]);
             if (med <= 0 || med >= 255)
                 return -EINVAL; /* nothing confident, or clipped: a dimmer exposure is needed */
-            out->scale[m][ch] = target_albedo / med;
+            out->scale[m][ch] = target_albedo * HALF / med;
         }
     }
     return 0;

@@ -6,7 +6,43 @@
 #include <errno.h>
 #include <string.h>
 
-/* Ca per channel: the mean of the dark frame over the pixels that have depth (the object), so
+static uint32_t add_frame(struct colour_layout *l, uint32_t lights_mask, uint32_t exposure_us)
+{
+    l->lights_mask[l->count] = lights_mask;
+    l->exposure_us[l->count] = exposure_us;
+    l->dark_of[l->count] = 0;
+    return l->count++;
+}
+
+/* The dark frame at @p exposure_us: Ca holds the black offset, which does not change with the
+ * exposure, and the ambient light, which does; so each exposure gets its own dark frame. */
+static uint32_t dark_at(struct colour_layout *l, uint32_t exposure_us)
+{
+    for (uint32_t k = 0; k < l->count; k++)
+        if (l->lights_mask[k] == 0 && l->exposure_us[k] == exposure_us)
+            return k;
+    uint32_t k = add_frame(l, 0, exposure_us);
+    l->dark_of[k] = k;
+    return k;
+}
+
+void colour_layout(const struct colour_params *p, uint32_t light_count, struct colour_layout *out)
+{
+    memset(out, 0, sizeof(*out));
+    if (p->method == COLOUR_NONE)
+        return;
+    uint32_t all_us = p->all_lights_exposure_us ? p->all_lights_exposure_us : p->exposure_us;
+    uint32_t one_us = p->light_exposure_us ? p->light_exposure_us : p->exposure_us;
+    add_frame(out, 0, p->exposure_us); /* COLOUR_FRAME_DARK */
+    add_frame(out, (1u << light_count) - 1u, all_us);
+    for (uint32_t l = 0; l < light_count; l++)
+        add_frame(out, 1u << l, one_us);
+    uint32_t lit = out->count;
+    for (uint32_t k = COLOUR_FRAME_ALL; k < lit; k++)
+        out->dark_of[k] = dark_at(out, out->exposure_us[k]);
+}
+
+/* Ca per channel: the mean of a dark frame over the pixels that have depth (the object), so
  * that ambient light on the object counts and the background does not. */
 static void channel_offset(const struct decode_maps *m, const uint8_t *dark, double ca[3])
 {
@@ -23,6 +59,29 @@ static void channel_offset(const struct decode_maps *m, const uint8_t *dark, dou
         ca[k] = count ? sum[k] / count : 0.0;
 }
 
+/* One frame's light at pixel i with its Ca taken off, in grey levels at the camera's exposure
+ * (so that one white reference serves every exposure); 0 when a channel is saturated. */
+struct frame_ctx {
+    const struct colour_params *prm;
+    const struct colour_layout *lay;
+    const uint8_t *const *frames;
+    double ca_channel[COLOUR_MAX_FRAMES][3];
+};
+
+static int frame_light(const struct frame_ctx *f, uint32_t k, const uint8_t *px, size_t i,
+                       double out[3])
+{
+    uint32_t d = f->lay->dark_of[k];
+    double gain = (double)f->prm->exposure_us / f->lay->exposure_us[k];
+    int sat = 0;
+    for (int c = 0; c < 3; c++) {
+        double ca = f->prm->ca_per_pixel ? f->frames[d][3 * i + (size_t)c] : f->ca_channel[d][c];
+        out[c] = (px[c] - ca) * gain;
+        sat |= px[c] >= f->prm->saturation_dn;
+    }
+    return !sat;
+}
+
 /* cos(theta) of a source at @p src for surface point p with normal n, and the falloff factor. */
 static double incidence(const struct colour_params *prm, vec3 p, vec3 n, vec3 src, double *fall)
 {
@@ -32,9 +91,14 @@ static double incidence(const struct colour_params *prm, vec3 p, vec3 n, vec3 sr
     return v3_dot(n, v3_scale(to, 1.0 / d));
 }
 
-static int saturated(const uint8_t *px, uint32_t level)
+/* No compensation: the raw colour, white-balanced only (the white reference's scale; the
+ * default 1/255 keeps it as it is). */
+static void white_balance(const struct colour_params *prm, uint8_t *rgb)
 {
-    return px[0] >= level || px[1] >= level || px[2] >= level;
+    for (int k = 0; k < 3; k++) {
+        double v = rgb[k] * prm->white_scale[k] * 255.0;
+        rgb[k] = (uint8_t)(v < 0.0 ? 0.0 : v > 255.0 ? 255.0 : v + 0.5);
+    }
 }
 
 int colour_compute(const struct colour_params *prm, const struct scan_calib *c,
@@ -42,58 +106,57 @@ int colour_compute(const struct colour_params *prm, const struct scan_calib *c,
                    const uint8_t *const *lights, uint8_t *albedo, float *confidence)
 {
     size_t n = (size_t)m->width * m->height;
-    const uint8_t *dark = lights != NULL ? lights[COLOUR_FRAME_DARK] : NULL;
-    if (prm->method != COLOUR_NONE && dark == NULL)
-        return -EINVAL;
-    if (prm->method == COLOUR_UNIFORM && lights[COLOUR_FRAME_ALL] == NULL)
-        return -EINVAL;
-    for (uint32_t l = 0; prm->method == COLOUR_MULTI && l < c->light_count; l++)
-        if (lights[COLOUR_FRAME_LIGHT0 + l] == NULL)
+    static struct frame_ctx f; /* static: the firmware keeps large state off the stack */
+    static struct colour_layout lay;
+    colour_layout(prm, c->light_count, &lay);
+    f.prm = prm;
+    f.lay = &lay;
+    f.frames = lights;
+    for (uint32_t k = 0; k < lay.count; k++) {
+        if (lights[k] == NULL && (prm->method == COLOUR_MULTI || k == COLOUR_FRAME_DARK ||
+                                  lay.dark_of[k] == k ||
+                                  (prm->method == COLOUR_UNIFORM && k == COLOUR_FRAME_ALL)))
             return -EINVAL;
-    double ca_channel[3] = {0, 0, 0};
-    if (dark != NULL)
-        channel_offset(m, dark, ca_channel);
+        if (lights[k] != NULL && lay.dark_of[k] == k)
+            channel_offset(m, lights[k], f.ca_channel[k]);
+    }
     vec3 proj = v3_scale(m3_tmul(c->proj_rot, v3_from(c->proj_trans_mm)), -1.0);
     for (size_t i = 0; i < n; i++) {
         memcpy(&albedo[3 * i], &white[3 * i], 3); /* raw colour unless compensated below */
         confidence[i] = prm->method == COLOUR_NONE && m->reason[i] == SCAN_VALID;
+        if (prm->method == COLOUR_NONE && m->reason[i] == SCAN_VALID)
+            white_balance(prm, &albedo[3 * i]);
         if (prm->method == COLOUR_NONE || m->reason[i] != SCAN_VALID)
             continue;
         vec3 p = v3(r->xyz_mm[3 * i], r->xyz_mm[3 * i + 1], r->xyz_mm[3 * i + 2]);
         vec3 nn = v3(r->normal[3 * i], r->normal[3 * i + 1], r->normal[3 * i + 2]);
         vec3 view = v3_norm(v3_scale(p, -1.0));
-        double ca[3];
-        for (int k = 0; k < 3; k++)
-            ca[k] = prm->ca_per_pixel ? dark[3 * i + (size_t)k] : ca_channel[k];
-        double num[3] = {0, 0, 0}, den = 0.0;
+        double num[3] = {0, 0, 0}, den = 0.0, light[3];
         if (prm->method == COLOUR_SINGLE) { /* eq. 4 */
             double fall, ct = incidence(prm, p, nn, proj, &fall);
-            if (ct < prm->min_cos || saturated(&white[3 * i], prm->saturation_dn))
+            if (ct < prm->min_cos || !frame_light(&f, COLOUR_FRAME_DARK, &white[3 * i], i, light))
                 continue;
             for (int k = 0; k < 3; k++)
-                num[k] = (white[3 * i + (size_t)k] - ca[k]) * fall;
+                num[k] = light[k] * fall;
             den = ct;
         } else if (prm->method == COLOUR_UNIFORM) { /* method 2 */
-            const uint8_t *all = &lights[COLOUR_FRAME_ALL][3 * i];
-            if (saturated(all, prm->saturation_dn))
+            if (!frame_light(&f, COLOUR_FRAME_ALL, &lights[COLOUR_FRAME_ALL][3 * i], i, num))
                 continue;
-            for (int k = 0; k < 3; k++)
-                num[k] = all[k] - ca[k];
             den = 1.0;
         } else { /* eq. 6, with shadowed lights weighted 0 */
             for (uint32_t l = 0; l < c->light_count; l++) {
-                const uint8_t *px = &lights[COLOUR_FRAME_LIGHT0 + l][3 * i];
+                uint32_t k = COLOUR_FRAME_LIGHT0 + l;
                 double fall, ct = incidence(prm, p, nn, v3_from(c->light_pos_mm[l]), &fall);
-                double lum = (px[0] + px[1] + px[2]) / 3.0 - (ca[0] + ca[1] + ca[2]) / 3.0;
-                if (ct < prm->min_cos || lum <= prm->shadow_dn ||
-                    saturated(px, prm->saturation_dn))
+                int ok = frame_light(&f, k, &lights[k][3 * i], i, light);
+                if (!ok || ct < prm->min_cos ||
+                    (light[0] + light[1] + light[2]) / 3.0 <= prm->shadow_dn)
                     continue;
                 vec3 s = v3_norm(v3_sub(v3_from(c->light_pos_mm[l]), p));
                 vec3 refl = v3_sub(v3_scale(nn, 2.0 * v3_dot(s, nn)), s);
-                double ca_ = v3_dot(refl, view);
-                double w = pow(1.0 - pow(ca_ > 0.0 ? ca_ : 0.0, prm->ke), prm->ko);
+                double cos_a = v3_dot(refl, view);
+                double w = pow(1.0 - pow(cos_a > 0.0 ? cos_a : 0.0, prm->ke), prm->ko);
                 for (int k = 0; k < 3; k++)
-                    num[k] += (px[k] - ca[k]) * fall * w;
+                    num[k] += light[k] * fall * w;
                 den += ct * w;
             }
         }

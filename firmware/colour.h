@@ -17,10 +17,25 @@
 #define COLOUR_FRAME_DARK 0u
 #define COLOUR_FRAME_ALL 1u
 #define COLOUR_FRAME_LIGHT0 2u
+/** At most: dark, all lights, every light, and two more dark frames for other exposures. */
+#define COLOUR_MAX_FRAMES (COLOUR_FRAME_LIGHT0 + HAL_MAX_LIGHTS + 2u)
+
+/** What each colour frame shows: its lights, its exposure and the dark frame (Ca) taken at the
+ *  same exposure. Frames: dark, all lights, each light alone, then a dark frame for each other
+ *  exposure the lights use. */
+struct colour_layout {
+    uint32_t count;
+    uint32_t lights_mask[COLOUR_MAX_FRAMES];
+    uint32_t exposure_us[COLOUR_MAX_FRAMES];
+    uint32_t dark_of[COLOUR_MAX_FRAMES]; /**< index of the frame's dark frame */
+};
+
+/** The colour frames of @p p with @p light_count lights (none when the method is none). */
+void colour_layout(const struct colour_params *p, uint32_t light_count, struct colour_layout *out);
 
 /** Compute albedo (0..1 scaled to 0..255) and a confidence (0..1) for every valid pixel.
- *  @param white  projector-white frame (RGB24); @param lights  light frames (RGB24) as above,
- *  NULL entries allowed when the method does not need them. Pixels without a usable estimate
+ *  @param white  projector-white frame (RGB24); @param lights  light frames (RGB24) in
+ *  colour_layout() order, NULL entries allowed when the method does not need them. Pixels without a usable estimate
  *  get confidence 0 and keep their raw colour. @retval 0 @retval -EINVAL a needed frame missing */
 int colour_compute(const struct colour_params *p, const struct scan_calib *calib,
                    const struct decode_maps *maps, const struct tri_range *range,

@@ -8,12 +8,15 @@
 #include <stdio.h>
 #include <string.h>
 
-/* 8 bytes: distance in units of truncation / 32767, weight in thousandths, colour. */
+/* 8 bytes: distance in units of truncation / 32767, weight in thousandths, colour, and the
+ * colour's own weight in 1/32 (it saturates at ~8: a voxel's colour stops changing once about
+ * eight good views agree). The colour has its own weight because a colour estimate can be
+ * unreliable (a highlight, a grazing light) where the geometry is fine. */
 struct voxel {
     int16_t sdf;
     uint16_t weight;
     uint8_t rgb[3];
-    uint8_t pad;
+    uint8_t colour_weight;
 };
 _Static_assert(sizeof(struct voxel) == 8, "voxel layout");
 
@@ -33,6 +36,7 @@ static struct {
 
 #define NO_VERTEX 0xFFFFFFFFu
 #define WEIGHT_SCALE 1000.0
+#define COLOUR_WEIGHT_SCALE 32.0
 
 int fusion_dims(const struct fusion_params *p, uint32_t dims[3])
 {
@@ -100,7 +104,7 @@ static void distance_to_edge(const struct decode_maps *m, uint16_t cap)
 /* How much a pixel is trusted: head-on, close (finer sampling), and away from the view's edge,
  * where depth is least reliable and colour seams would show (Jost et al., boundary filtering). */
 static void pixel_weights(const struct scan_calib *c, const struct decode_maps *m,
-                          const struct tri_range *r, const float *confidence)
+                          const struct tri_range *r)
 {
     const double fade = fz.p.edge_fade_px > 0 ? (double)fz.p.edge_fade_px : 1.0;
     distance_to_edge(m, (uint16_t)(fz.p.edge_fade_px > 0 ? fz.p.edge_fade_px : 1));
@@ -115,14 +119,27 @@ static void pixel_weights(const struct scan_calib *c, const struct decode_maps *
             vec3 n = v3(r->normal[3 * i], r->normal[3 * i + 1], r->normal[3 * i + 2]);
             double head_on = -v3_dot(n, ray), z = r->xyz_mm[3 * i + 2];
             double w = head_on * (600.0 / z) * (600.0 / z) * fmin(1.0, edge_dist[i] / fade);
-            if (confidence != NULL)
-                w *= confidence[i];
             weight_map[i] = w >= fz.p.min_weight ? (float)w : 0.0f;
         }
     }
 }
 
-static void fuse_voxel(struct voxel *vx, double sdf, double w, const uint8_t *rgb)
+/* Blend colour @p rgb with weight @p cw into the voxel; a voxel no confident view has coloured
+ * yet takes any estimate, so that every surface gets some colour. */
+static void fuse_colour(struct voxel *vx, double cw, const uint8_t *rgb)
+{
+    double old_cw = vx->colour_weight / COLOUR_WEIGHT_SCALE, new_cw = old_cw + cw;
+    if (new_cw <= 0.0) {
+        memcpy(vx->rgb, rgb, 3);
+        return;
+    }
+    for (int k = 0; k < 3; k++)
+        vx->rgb[k] = (uint8_t)((vx->rgb[k] * old_cw + rgb[k] * cw) / new_cw + 0.5);
+    new_cw = fmin(new_cw * COLOUR_WEIGHT_SCALE, 255.0);
+    vx->colour_weight = (uint8_t)(new_cw + 0.5);
+}
+
+static void fuse_voxel(struct voxel *vx, double sdf, double w, double cw, const uint8_t *rgb)
 {
     double trunc = fz.p.truncation_mm;
     if (sdf > trunc)
@@ -131,8 +148,7 @@ static void fuse_voxel(struct voxel *vx, double sdf, double w, const uint8_t *rg
     double new_w = old_w + w;
     double s = (old_s * old_w + sdf * w) / new_w;
     if (fabs(sdf) < trunc) /* colour comes from near the surface only */
-        for (int k = 0; k < 3; k++)
-            vx->rgb[k] = (uint8_t)((vx->rgb[k] * old_w + rgb[k] * w) / new_w + 0.5);
+        fuse_colour(vx, cw, rgb);
     vx->sdf = (int16_t)lround(s / trunc * 32767.0);
     vx->weight = (uint16_t)lround(fmin(new_w, fz.p.max_weight) * WEIGHT_SCALE);
 }
@@ -173,7 +189,7 @@ int fusion_integrate(const struct scan_calib *c, const struct frame_xform *obj_f
                      const struct decode_maps *m, const struct tri_range *r, const uint8_t *rgb,
                      const float *confidence)
 {
-    pixel_weights(c, m, r, confidence);
+    pixel_weights(c, m, r);
     const double trunc = fz.p.truncation_mm, vox = fz.p.voxel_mm;
     const vec3 step_x = m3_tmul(obj_from_cam->rot, v3(vox, 0, 0));
     uint32_t lo[3], hi[3];
@@ -202,7 +218,8 @@ int fusion_integrate(const struct scan_calib *c, const struct frame_xform *obj_f
                 double sdf = (r->xyz_mm[3 * i + 2] - p.z) * sqrt(1.0 + a * a + b * b);
                 if (sdf < -trunc)
                     continue; /* hidden behind the surface: this view knows nothing of it */
-                fuse_voxel(&grid[vidx(x, y, z)], sdf, weight_map[i], rgb + 3 * i);
+                double w = weight_map[i], cw = confidence != NULL ? w * confidence[i] : w;
+                fuse_voxel(&grid[vidx(x, y, z)], sdf, w, cw, rgb + 3 * i);
             }
         }
     }
@@ -220,6 +237,7 @@ int fusion_fill(double (*sdf_mm)(vec3 p, void *ctx), void *ctx)
                 v->sdf = (int16_t)lround(d / fz.p.truncation_mm * 32767.0);
                 v->weight = (uint16_t)WEIGHT_SCALE;
                 v->rgb[0] = v->rgb[1] = v->rgb[2] = 128;
+                v->colour_weight = (uint8_t)COLOUR_WEIGHT_SCALE;
             }
     return 0;
 }

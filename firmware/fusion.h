@@ -29,8 +29,9 @@ int fusion_dims(const struct fusion_params *p, uint32_t dims[3]);
 int fusion_begin(const struct fusion_params *p);
 
 /** Fuse the last view: its range image, normals and colour, seen through @p obj_from_cam.
- *  Weight of a pixel: cos(view angle) x (600 mm / depth)^2 x edge fade, times the colour's
- *  @p confidence per pixel when given (NULL: 1).
+ *  Weight of a pixel: cos(view angle) x (600 mm / depth)^2 x edge fade; its colour weighs that
+ *  times the colour's @p confidence per pixel when given (NULL: 1), so an unreliable colour
+ *  estimate (a highlight, a grazing light) still gives its geometry.
  *  @retval 0 */
 int fusion_integrate(const struct scan_calib *calib, const struct frame_xform *obj_from_cam,
                      const struct decode_maps *maps, const struct tri_range *range,

@@ -55,7 +55,7 @@ int fusion_write_ply(const struct hal_storage *st, const char *path, uint32_t *v
     struct outbuf o;
     if (outbuf_open(&o, st, path) != 0)
         return o.rc;
-    ply_put_header(&o, "fused mesh", count.vertices, count.triangles);
+    ply_put_header(&o, "fused mesh", count.vertices, count.triangles, 0);
     struct mesh_sink vertex_pass = {ply_vertex, NULL, &o};
     struct mesh_sink face_pass = {NULL, ply_triangle, &o};
     fusion_extract(&vertex_pass);

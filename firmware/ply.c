@@ -23,7 +23,8 @@ void ply_put_vertex(struct outbuf *o, vec3 p, vec3 n, const uint8_t rgb[3])
     outbuf_put(o, rgb, 3);
 }
 
-void ply_put_header(struct outbuf *o, const char *what, uint32_t vertices, uint32_t faces)
+void ply_put_header(struct outbuf *o, const char *what, uint32_t vertices, uint32_t faces,
+                    int with_quality)
 {
     outbuf_printf(o,
                   "ply\nformat binary_little_endian 1.0\n"
@@ -33,6 +34,8 @@ void ply_put_header(struct outbuf *o, const char *what, uint32_t vertices, uint3
                   "property float nx\nproperty float ny\nproperty float nz\n"
                   "property uchar red\nproperty uchar green\nproperty uchar blue\n",
                   what, (unsigned)vertices);
+    if (with_quality)
+        outbuf_printf(o, "property float quality\n");
     if (faces > 0)
         outbuf_printf(o, "element face %u\nproperty list uchar uint vertex_indices\n",
                       (unsigned)faces);
@@ -40,14 +43,14 @@ void ply_put_header(struct outbuf *o, const char *what, uint32_t vertices, uint3
 }
 
 int ply_write_cloud(const struct hal_storage *st, const char *path, const struct decode_maps *maps,
-                    const struct tri_range *range, const uint8_t *rgb,
+                    const struct tri_range *range, const uint8_t *rgb, const float *confidence,
                     const struct frame_xform *xform, uint32_t *vertex_count)
 {
     struct outbuf o;
     uint32_t n = count_valid(maps);
     if (outbuf_open(&o, st, path) != 0)
         return o.rc;
-    ply_put_header(&o, "one view", n, 0);
+    ply_put_header(&o, "one view; quality: colour confidence 0..1", n, 0, 1);
     size_t total = (size_t)maps->width * maps->height;
     for (size_t i = 0; i < total && o.rc == 0; i++) {
         if (maps->reason[i] != SCAN_VALID)
@@ -55,6 +58,7 @@ int ply_write_cloud(const struct hal_storage *st, const char *path, const struct
         const float *p = &range->xyz_mm[3 * i], *nn = &range->normal[3 * i];
         ply_put_vertex(&o, frame_point(xform, v3(p[0], p[1], p[2])),
                        frame_dir(xform, v3(nn[0], nn[1], nn[2])), rgb + 3 * i);
+        outbuf_f32le(&o, confidence != NULL ? confidence[i] : 1.0f);
     }
     int rc = outbuf_close(&o);
     if (rc == 0)

@@ -16,8 +16,8 @@ static uint8_t
     colour_rgb[HAL_MAX_PIXELS * 3];           /* projector-white frame, kept as the view's colour */
 static uint8_t frame_rgb[HAL_MAX_PIXELS * 3]; /* every other frame, consumed at once */
 /* Light frames for the colour (colour.h): dark, all lights, each light alone. */
-static uint8_t light_rgb[COLOUR_FRAME_LIGHT0 + HAL_MAX_LIGHTS][HAL_MAX_PIXELS * 3];
-static int light_present[COLOUR_FRAME_LIGHT0 + HAL_MAX_LIGHTS];
+static uint8_t light_rgb[COLOUR_MAX_FRAMES][HAL_MAX_PIXELS * 3];
+static int light_present[COLOUR_MAX_FRAMES];
 static uint8_t view_rgb[HAL_MAX_PIXELS * 3]; /* the view's colour: compensated, or raw */
 static float view_confidence[HAL_MAX_PIXELS];
 static struct scan_params view_params;        /* of the view being fed */
@@ -150,12 +150,14 @@ int scan_feed_frame(uint32_t pattern, const uint8_t *pixels, uint32_t channels,
 
 uint32_t scan_light_frame_count(const struct scan_params *p, const struct scan_calib *c)
 {
-    return p->colour.method == COLOUR_NONE ? 0u : COLOUR_FRAME_LIGHT0 + c->light_count;
+    struct colour_layout lay;
+    colour_layout(&p->colour, c->light_count, &lay);
+    return lay.count;
 }
 
 int scan_feed_light_frame(uint32_t k, const uint8_t *rgb)
 {
-    if (k >= COLOUR_FRAME_LIGHT0 + HAL_MAX_LIGHTS)
+    if (k >= COLOUR_MAX_FRAMES)
         return -EINVAL;
     if (rgb != light_rgb[k])
         memcpy(light_rgb[k], rgb, (size_t)view_params.width * view_params.height * 3);
@@ -173,8 +175,8 @@ int scan_finish_view(const struct scan_calib *c, int32_t angle_mdeg, struct scan
         rc = tri_range_image(c, maps, refine_get_columns());
     if (rc == 0)
         rc = tri_normals(maps, view_params.normal_radius_px, view_params.max_depth_jump_mm);
-    const uint8_t *lights[COLOUR_FRAME_LIGHT0 + HAL_MAX_LIGHTS];
-    for (uint32_t k = 0; k < COLOUR_FRAME_LIGHT0 + HAL_MAX_LIGHTS; k++)
+    const uint8_t *lights[COLOUR_MAX_FRAMES];
+    for (uint32_t k = 0; k < COLOUR_MAX_FRAMES; k++)
         lights[k] = light_present[k] ? light_rgb[k] : NULL;
     if (rc == 0)
         rc = colour_compute(&view_params.colour, c, maps, tri_get_range(), colour_rgb, lights,
@@ -217,17 +219,23 @@ static int capture_patterns(const struct hal *hal, const struct scan_params *p, 
     return 0;
 }
 
-/* The colour frames: projector off; dark, all lights, each light alone; lights off after. */
+/* The colour frames (colour_layout): projector off, each with its lights and exposure; lights off
+ * and the camera back at its own exposure after, also on failure. */
 static int capture_lights(const struct hal *hal, const struct scan_params *p,
                           const struct scan_calib *c, uint32_t first_index,
                           const struct scan_frame_sink *sink, struct scan_view_info *info)
 {
     int rc = 0;
-    uint32_t frames = scan_light_frame_count(p, c);
-    for (uint32_t k = 0; k < frames && rc == 0; k++) {
-        for (uint32_t l = 0; l < c->light_count && rc == 0; l++) {
-            int on = k == COLOUR_FRAME_ALL || k == COLOUR_FRAME_LIGHT0 + l;
-            rc = hal_gpio_set(&hal->gpio, (enum hal_gpio_line)(HAL_GPIO_LIGHT_0 + l), on);
+    struct colour_layout lay;
+    colour_layout(&p->colour, c->light_count, &lay);
+    uint32_t exposure_us = p->colour.exposure_us;
+    for (uint32_t k = 0; k < lay.count && rc == 0; k++) {
+        for (uint32_t l = 0; l < c->light_count && rc == 0; l++)
+            rc = hal_gpio_set(&hal->gpio, (enum hal_gpio_line)(HAL_GPIO_LIGHT_0 + l),
+                              (lay.lights_mask[k] >> l) & 1u);
+        if (rc == 0 && lay.exposure_us[k] != exposure_us) {
+            rc = hal_cam_set_exposure(&hal->camera, lay.exposure_us[k], p->colour.gain_milli);
+            exposure_us = lay.exposure_us[k];
         }
         if (rc == 0)
             rc = hal_clock_sleep_us(&hal->clock, p->pattern_settle_us);
@@ -243,6 +251,13 @@ static int capture_lights(const struct hal *hal, const struct scan_params *p,
             rc = sink->save(sink->priv, first_index + k, light_rgb[k], p->width, p->height, 3);
     }
     int rc_off = lights_off(hal, c->light_count);
+    if (exposure_us != p->colour.exposure_us) {
+        int rc_exp = hal_cam_set_exposure(&hal->camera, p->colour.exposure_us, p->colour.gain_milli);
+        rc_off = rc_off != 0 ? rc_off : rc_exp;
+    }
+    if (rc == -ENOSYS)
+        hal->log(HAL_LOG_ERROR, "camera: cannot change the exposure for the colour frames; set "
+                                "[colour] all_lights_exposure_us and light_exposure_us to 0");
     return rc != 0 ? rc : rc_off;
 }
 
@@ -295,7 +310,7 @@ int scan_save_cloud(const struct hal *hal, const struct frame_xform *obj_from_ca
 {
     uint32_t written = 0;
     int rc = ply_write_cloud(&hal->storage, path, decode_get_maps(), tri_get_range(), view_rgb,
-                             obj_from_cam, &written);
+                             view_confidence, obj_from_cam, &written);
     if (rc != 0)
         hal->log(HAL_LOG_ERROR, "storage: cannot write %s: %s", path, strerror(-rc));
     else
@@ -320,8 +335,8 @@ const float *scan_view_confidence(void)
 
 int scan_recolour(const struct colour_params *colour, const struct scan_calib *c)
 {
-    const uint8_t *lights[COLOUR_FRAME_LIGHT0 + HAL_MAX_LIGHTS];
-    for (uint32_t k = 0; k < COLOUR_FRAME_LIGHT0 + HAL_MAX_LIGHTS; k++)
+    const uint8_t *lights[COLOUR_MAX_FRAMES];
+    for (uint32_t k = 0; k < COLOUR_MAX_FRAMES; k++)
         lights[k] = light_present[k] ? light_rgb[k] : NULL;
     return colour_compute(colour, c, decode_get_maps(), tri_get_range(), colour_rgb, lights,
                           view_rgb, view_confidence);

@@ -33,6 +33,9 @@ struct colour_params {
     double reference_mm;   /**< distance at which the falloff factor is 1 */
     double white_scale[3]; /**< per channel: white surface -> 1 */
     uint32_t saturation_dn;
+    uint32_t exposure_us, gain_milli; /**< the camera's: patterns, projector white, dark */
+    uint32_t all_lights_exposure_us;  /**< the all-lights frame (0: exposure_us) */
+    uint32_t light_exposure_us;       /**< each single-light frame (0: exposure_us) */
 };
 
 /** Processing and sequencing parameters of one view. */

@@ -23,6 +23,11 @@ int hal_cam_capture(const struct hal_camera *cam, struct hal_image *img)
     return HAL_CALL(cam, capture, img);
 }
 
+int hal_cam_set_exposure(const struct hal_camera *cam, uint32_t exposure_us, uint32_t gain_milli)
+{
+    return HAL_CALL(cam, set_exposure, exposure_us, gain_milli);
+}
+
 int hal_cam_close(const struct hal_camera *cam)
 {
     return HAL_CALL0(cam, close);

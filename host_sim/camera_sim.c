@@ -44,6 +44,16 @@ static int camera_sim_capture(void *priv, struct hal_image *img)
     return 0;
 }
 
+static int camera_sim_set_exposure(void *priv, uint32_t exposure_us, uint32_t gain_milli)
+{
+    struct camera_sim *cam = priv;
+    if (exposure_us == 0 || gain_milli == 0)
+        return -EINVAL;
+    cam->cfg.exposure_us = exposure_us;
+    cam->cfg.gain_milli = gain_milli;
+    return 0;
+}
+
 static int camera_sim_close(void *priv)
 {
     ((struct camera_sim *)priv)->is_open = 0;
@@ -58,6 +68,7 @@ static int camera_sim_safe_state(void *priv)
 
 static const struct hal_camera_ops camera_sim_ops = {
     .open = camera_sim_open,
+    .set_exposure = camera_sim_set_exposure,
     .capture = camera_sim_capture,
     .close = camera_sim_close,
     .safe_state = camera_sim_safe_state,

@@ -230,8 +230,15 @@ static double box_distance(const struct sim_bvh_node *n, vec3 p)
 
 double sim_bvh_distance(const struct sim_bvh *b, vec3 p, double max_dist)
 {
+    vec3 closest;
+    return sim_bvh_closest(b, p, max_dist, &closest);
+}
+
+double sim_bvh_closest(const struct sim_bvh *b, vec3 p, double max_dist, vec3 *closest)
+{
     uint32_t stack[STACK_DEPTH * 2], sp = 0;
     double best = max_dist;
+    *closest = p;
     stack[sp++] = 0;
     while (sp > 0) {
         const struct sim_bvh_node *n = &b->nodes[stack[--sp]];
@@ -251,7 +258,10 @@ double sim_bvh_distance(const struct sim_bvh *b, vec3 p, double max_dist)
             vec3 q = closest_on_triangle(p, v3(a[0], a[1], a[2]), v3(bb[0], bb[1], bb[2]),
                                          v3(c[0], c[1], c[2]));
             double d = v3_len(v3_sub(p, q));
-            best = d < best ? d : best;
+            if (d < best) {
+                best = d;
+                *closest = q;
+            }
         }
     }
     return best;

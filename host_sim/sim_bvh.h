@@ -35,5 +35,7 @@ int sim_bvh_occluded(const struct sim_bvh *bvh, vec3 origin, vec3 dir, double t_
 
 /** Distance from @p p to the nearest triangle, or @p max_dist if none is closer. */
 double sim_bvh_distance(const struct sim_bvh *bvh, vec3 p, double max_dist);
+/** The same, and the closest surface point in @p closest (@p p itself when none is closer). */
+double sim_bvh_closest(const struct sim_bvh *bvh, vec3 p, double max_dist, vec3 *closest);
 
 #endif

@@ -27,6 +27,8 @@ void sim_mesh_free(struct sim_mesh *m)
     free(m->pos);
     free(m->normal);
     free(m->tri);
+    free(m->rgb);
+    free(m->quality);
     memset(m, 0, sizeof(*m));
 }
 

@@ -9,6 +9,8 @@ struct sim_mesh {
     float *pos;    /**< 3 per vertex, object frame, mm (z up, base on z = 0 once placed) */
     float *normal; /**< 3 per vertex, area-weighted smooth normals */
     uint32_t *tri; /**< 3 vertex indices per triangle, counter-clockwise seen from outside */
+    uint8_t *rgb;  /**< 3 per vertex when the PLY file has vertex colours, else NULL */
+    float *quality; /**< per vertex when the PLY file has `quality` (clouds: colour confidence) */
 };
 
 /** @retval 0 ok @retval -ENOMEM */
@@ -16,10 +18,12 @@ int sim_mesh_sphere(struct sim_mesh *m, double radius_mm, uint32_t segments);
 int sim_mesh_cylinder(struct sim_mesh *m, double radius_mm, double height_mm, uint32_t segments);
 int sim_mesh_box(struct sim_mesh *m, double sx_mm, double sy_mm, double sz_mm, uint32_t segments);
 int sim_mesh_torus(struct sim_mesh *m, double major_mm, double minor_mm, uint32_t segments);
-/** Load an ASCII or binary little-endian PLY (vertex x y z, faces as lists; other properties are
- *  skipped). @param err out: what is wrong, with the file name @retval 0 ok @retval -EINVAL -ENOMEM
+/** Load an ASCII or binary little-endian PLY (vertex x y z, uchar red green blue when present,
+ *  faces as lists; other properties are skipped). @param err out: what is wrong, with the file name @retval 0 ok @retval -EINVAL -ENOMEM
  * -errno */
 int sim_mesh_load_ply(struct sim_mesh *m, const char *path, char *err, unsigned err_len);
+/** The same for a point cloud: faces are optional. */
+int sim_mesh_load_ply_points(struct sim_mesh *m, const char *path, char *err, unsigned err_len);
 /** Rotate y-up data to z-up (the bunny's convention). */
 void sim_mesh_y_up_to_z_up(struct sim_mesh *m);
 /** Scale to @p height_mm, centre on the z axis, base on z = 0, then recompute normals. */

@@ -12,7 +12,7 @@ enum ply_type { PT_NONE, PT_I8, PT_U8, PT_I16, PT_U16, PT_I32, PT_U32, PT_F32, P
 struct ply_prop {
     enum ply_type type;
     enum ply_type list_count_type; /* PT_NONE when not a list */
-    int role;                      /* 0 x, 1 y, 2 z, 3 face indices, -1 skipped */
+    int role; /* 0 x, 1 y, 2 z, 3 face indices, 4..6 red green blue, 7 quality, -1 skipped */
 };
 
 #define PLY_MAX_PROPS 32
@@ -162,6 +162,14 @@ static int parse_header(FILE *f, struct ply_header *h, char *err, unsigned err_l
                     p->role = 1;
                 if (strcmp(pname, "z") == 0)
                     p->role = 2;
+                if (strcmp(pname, "red") == 0)
+                    p->role = 4;
+                if (strcmp(pname, "green") == 0)
+                    p->role = 5;
+                if (strcmp(pname, "blue") == 0)
+                    p->role = 6;
+                if (strcmp(pname, "quality") == 0)
+                    p->role = 7;
             }
             if (strcmp(el->name, "face") == 0 && p->list_count_type != PT_NONE &&
                 (strcmp(pname, "vertex_indices") == 0 || strcmp(pname, "vertex_index") == 0))
@@ -202,8 +210,13 @@ static int read_element(FILE *f, const struct ply_header *h, const struct ply_el
             if (p->list_count_type == PT_NONE) {
                 if (read_scalar(f, h->binary, p->type, &v) != 0)
                     return -EINVAL;
-                if (is_vertex && p->role >= 0)
+                if (is_vertex && p->role >= 0 && p->role < 3)
                     m->pos[3 * r + (unsigned long)p->role] = (float)v;
+                else if (is_vertex && p->role == 7 && m->quality != NULL)
+                    m->quality[r] = (float)v;
+                else if (is_vertex && p->role > 3 && p->role < 7 && m->rgb != NULL)
+                    m->rgb[3 * r + (unsigned long)(p->role - 4)] =
+                        (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : v);
                 continue;
             }
             double cnt;
@@ -224,7 +237,18 @@ static int read_element(FILE *f, const struct ply_header *h, const struct ply_el
     return 0;
 }
 
-int sim_mesh_load_ply(struct sim_mesh *m, const char *path, char *err, unsigned err_len)
+/* Does the vertex element have a property of @p role? */
+static int ply_has_role(const struct ply_header *h, int role)
+{
+    for (int e = 0; e < h->elem_count; e++)
+        for (int k = 0; strcmp(h->elems[e].name, "vertex") == 0 && k < h->elems[e].prop_count; k++)
+            if (h->elems[e].props[k].role == role)
+                return 1;
+    return 0;
+}
+
+static int load_ply(struct sim_mesh *m, const char *path, int need_faces, char *err,
+                    unsigned err_len)
 {
     struct ply_header h;
     uint32_t tri_cap = 0;
@@ -249,7 +273,12 @@ int sim_mesh_load_ply(struct sim_mesh *m, const char *path, char *err, unsigned 
     }
     m->pos = calloc((size_t)m->vert_count * 3, sizeof(float));
     m->normal = calloc((size_t)m->vert_count * 3, sizeof(float));
-    if (m->pos == NULL || m->normal == NULL) {
+    if (ply_has_role(&h, 4))
+        m->rgb = calloc((size_t)m->vert_count * 3, 1);
+    if (ply_has_role(&h, 7))
+        m->quality = calloc(m->vert_count, sizeof(float));
+    if (m->pos == NULL || m->normal == NULL || (m->rgb == NULL && ply_has_role(&h, 4)) ||
+        (m->quality == NULL && ply_has_role(&h, 7))) {
         rc = -ENOMEM;
         snprintf(err, err_len, "%s: out of memory", path);
         goto out_free;
@@ -262,7 +291,7 @@ int sim_mesh_load_ply(struct sim_mesh *m, const char *path, char *err, unsigned 
             goto out_free;
         }
     }
-    if (m->tri_count == 0) {
+    if (m->tri_count == 0 && need_faces) {
         rc = -EINVAL;
         snprintf(err, err_len, "%s: no faces", path);
         goto out_free;
@@ -275,4 +304,14 @@ out_free:
 out_close:
     fclose(f);
     return rc;
+}
+
+int sim_mesh_load_ply(struct sim_mesh *m, const char *path, char *err, unsigned err_len)
+{
+    return load_ply(m, path, 1, err, err_len);
+}
+
+int sim_mesh_load_ply_points(struct sim_mesh *m, const char *path, char *err, unsigned err_len)
+{
+    return load_ply(m, path, 0, err, err_len);
 }

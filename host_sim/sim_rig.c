@@ -54,6 +54,11 @@ int sim_albedo_at(const struct sim_config *cfg, double height_mm, vec3 p, double
     return 0;
 }
 
+double sim_rig_placed_height(const struct sim_config *cfg)
+{
+    return strcmp(cfg->object, "torus") == 0 ? 0.28 * cfg->object_height_mm : cfg->object_height_mm;
+}
+
 static int build_object(struct sim_rig *rig, const char *dir, char *err, size_t len)
 {
     const struct sim_config *c = &rig->cfg;
@@ -80,7 +85,7 @@ static int build_object(struct sim_rig *rig, const char *dir, char *err, size_t 
         snprintf(err, len, "sim: cannot build the %s: %s", c->object, strerror(-rc));
         return rc;
     }
-    rig->object_height_mm = strcmp(c->object, "torus") == 0 ? 0.28 * h : h;
+    rig->object_height_mm = sim_rig_placed_height(c);
     sim_mesh_place(&rig->mesh, rig->object_height_mm);
     return 0;
 }

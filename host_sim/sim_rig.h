@@ -65,6 +65,9 @@ void sim_rig_update(struct sim_rig *rig);
 void sim_rig_render(struct sim_rig *rig, const struct sim_sources *src, uint64_t frame_no,
                     uint8_t *rgb);
 
+/** Height of the object as placed on the table (a torus lies flat). */
+double sim_rig_placed_height(const struct sim_config *cfg);
+
 /** Albedo of the painted pattern at an object-frame point. @retval 1 on the very dark paint */
 int sim_albedo_at(const struct sim_config *cfg, double height_mm, vec3 p_obj, double albedo[3]);
 

@@ -14,6 +14,7 @@
 
 #include "test_util.h"
 #include "white_cal.h"
+#include "colour.h"
 #include "colour_metrics.h"
 #include "vec3.h"
 
@@ -169,9 +170,91 @@ static void test_white_reference_gives_albedo(void **state)
     }
 }
 
+/* Each exposure of the light frames gets its own dark frame; equal exposures share one. */
+static void test_layout_gives_each_exposure_a_dark_frame(void **state)
+{
+    (void)state;
+    struct colour_params p;
+    struct colour_layout l;
+    memset(&p, 0, sizeof(p));
+    p.exposure_us = 10000;
+    colour_layout(&p, 4, &l);
+    assert_int_equal(l.count, 0); /* method none: no colour frames */
+    p.method = COLOUR_MULTI;
+    colour_layout(&p, 4, &l);
+    assert_int_equal(l.count, 6);
+    assert_int_equal(l.lights_mask[COLOUR_FRAME_ALL], 0xF);
+    assert_int_equal(l.lights_mask[COLOUR_FRAME_LIGHT0 + 2], 0x4);
+    for (uint32_t k = 0; k < l.count; k++)
+        assert_int_equal(l.dark_of[k], COLOUR_FRAME_DARK);
+    p.all_lights_exposure_us = 4000;
+    colour_layout(&p, 4, &l);
+    assert_int_equal(l.count, 7);
+    assert_int_equal(l.lights_mask[6], 0);
+    assert_int_equal(l.exposure_us[6], 4000);
+    assert_int_equal(l.dark_of[COLOUR_FRAME_ALL], 6);
+    assert_int_equal(l.dark_of[COLOUR_FRAME_LIGHT0], COLOUR_FRAME_DARK);
+    p.light_exposure_us = 4000; /* the same exposure: the same dark frame */
+    colour_layout(&p, 4, &l);
+    assert_int_equal(l.count, 7);
+    assert_int_equal(l.dark_of[COLOUR_FRAME_LIGHT0 + 3], 6);
+    p.light_exposure_us = 20000;
+    colour_layout(&p, 4, &l);
+    assert_int_equal(l.count, 8);
+    assert_int_equal(l.exposure_us[COLOUR_FRAME_LIGHT0 + 1], 20000);
+    assert_int_equal(l.dark_of[COLOUR_FRAME_LIGHT0 + 1], 7);
+    assert_int_equal(l.exposure_us[7], 20000);
+}
+
+/* Mean compensated colour (uniform method) of the painted sphere with the all-lights frame at
+ * @p all_us: colour frames are normalised to the camera's exposure. */
+static void uniform_mean(uint32_t all_us, double mean[3])
+{
+    static struct test_rig t;
+    struct scan_view_info info;
+    assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
+    snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "sphere");
+    snprintf(t.cfg.sim.albedo_pattern, sizeof(t.cfg.sim.albedo_pattern), "uniform");
+    t.cfg.sim.albedo[0] = 0.6, t.cfg.sim.albedo[1] = 0.45, t.cfg.sim.albedo[2] = 0.3;
+    t.cfg.scan.colour.method = COLOUR_UNIFORM;
+    t.cfg.scan.colour.all_lights_exposure_us = all_us;
+    assert_int_equal(test_rig_start(&t), 0);
+    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info), 0);
+    const struct decode_maps *m = decode_get_maps();
+    const uint8_t *rgb = scan_view_colour();
+    const float *conf = scan_view_confidence();
+    size_t n = (size_t)m->width * m->height, count = 0;
+    mean[0] = mean[1] = mean[2] = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        if (m->reason[i] != SCAN_VALID || conf[i] < 0.5f)
+            continue;
+        for (int k = 0; k < 3; k++)
+            mean[k] += rgb[3 * i + (size_t)k];
+        count++;
+    }
+    test_rig_stop(&t);
+    assert_true(count > 100000);
+    for (int k = 0; k < 3; k++)
+        mean[k] /= count;
+}
+
+static void test_light_exposure_is_normalised(void **state)
+{
+    (void)state;
+    double full[3], short_exp[3];
+    uniform_mean(5000, full); /* at the camera's 10 ms four lights saturate much of the paint */
+    uniform_mean(2500, short_exp);
+    print_message("uniform, all lights at 5 ms: %.1f %.1f %.1f; at 2.5 ms: %.1f %.1f %.1f\n", full[0],
+                  full[1], full[2], short_exp[0], short_exp[1], short_exp[2]);
+    for (int k = 0; k < 3; k++) /* half the light, twice the gain: the same colour */
+        assert_true(fabs(short_exp[k] / full[k] - 1.0) < 0.03);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_layout_gives_each_exposure_a_dark_frame),
+        cmocka_unit_test(test_light_exposure_is_normalised),
         cmocka_unit_test(test_compensation_flattens_shading_and_highlights),
         cmocka_unit_test(test_white_reference_gives_albedo),
     };

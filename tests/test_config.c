@@ -64,6 +64,19 @@ static void test_good_config_and_defaults(void **state)
     assert_int_equal(scan_check(&cfg.scan, &calib, err, sizeof(err)), 0);
 }
 
+/* The issue and many users write [color]: the same section as [colour], still checked. */
+static void test_color_spelling(void **state)
+{
+    (void)state;
+    char text[1024];
+    snprintf(text, sizeof(text), "%s[color]\nmethod = single\nlight_exposure_us = 5000\n", base);
+    assert_int_equal(config_load(&cfg, write_file("color.ini", text), err, sizeof(err)), 0);
+    assert_int_equal(cfg.scan.colour.method, COLOUR_SINGLE);
+    assert_int_equal(cfg.scan.colour.light_exposure_us, 5000);
+    assert_int_equal(cfg.scan.colour.exposure_us, 10000); /* the camera's, for the dark frame */
+    expect_error("[color]\nmethod = rainbow\n", "[colour] method");
+}
+
 static void test_errors_name_file_line_and_key(void **state)
 {
     (void)state;
@@ -172,6 +185,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_good_config_and_defaults),
+        cmocka_unit_test(test_color_spelling),
         cmocka_unit_test(test_errors_name_file_line_and_key),
         cmocka_unit_test(test_duplicate_key),
         cmocka_unit_test(test_missing_required_key),

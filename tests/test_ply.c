@@ -38,7 +38,7 @@ static void test_ply_roundtrip(void **state)
             assert_string_equal(line, "format binary_little_endian 1.0\n");
     }
     assert_int_equal(count, info.valid_points);
-    assert_int_equal(props, 9);
+    assert_int_equal(props, 10);
     /* Vertices are in the object frame: rotating back by the angle gives the camera points. */
     struct frame_xform obj;
     frame_object_from_camera(&t.calib, angle_mdeg, &obj);
@@ -49,14 +49,18 @@ static void test_ply_roundtrip(void **state)
     for (size_t i = 0; i < n; i++) {
         if (maps->reason[i] != SCAN_VALID)
             continue;
-        unsigned char rec[27];
-        assert_int_equal(fread(rec, 1, 27, f), 27);
+        unsigned char rec[31];
+        assert_int_equal(fread(rec, 1, 31, f), 31);
         float v[6];
         memcpy(v, rec, sizeof(v)); /* little-endian host, as the file */
         vec3 p = frame_point_inv(&obj, v3(v[0], v[1], v[2]));
         assert_true(fabs(p.x - r->xyz_mm[3 * i]) < 1e-3 && fabs(p.z - r->xyz_mm[3 * i + 2]) < 1e-3);
         assert_true(fabs(sqrt(v[3] * v[3] + v[4] * v[4] + v[5] * v[5]) - 1.0) < 1e-4);
         assert_memory_equal(rec + 24, rgb + 3 * i, 3);
+        float quality;
+        memcpy(&quality, rec + 27, sizeof(quality));
+        assert_true(quality == scan_view_confidence()[i]); /* 1 for a valid pixel without method */
+        assert_true(quality == 1.0f);
         seen++;
     }
     assert_int_equal(fread(line, 1, 1, f), 0); /* nothing after the last vertex */

@@ -39,6 +39,9 @@ struct hal_camera_ops {
      *  @retval 0 ok @retval -ETIMEDOUT no frame in time @retval -EIO corrupt or short frame
      *  @retval -ENOSPC buffer too small */
     int (*capture)(void *priv, struct hal_image *img);
+    /** Optional: change the fixed exposure and gain for the frames that follow (colour frames
+     *  under different lights). @retval 0 ok @retval -EINVAL out of the device's range */
+    int (*set_exposure)(void *priv, uint32_t exposure_us, uint32_t gain_milli);
     /** @retval 0 ok (closing a closed camera is fine) */
     int (*close)(void *priv);
     /** Stop streaming; must be callable at any time, including from a shutdown path. */
@@ -54,6 +57,8 @@ struct hal_camera {
 int hal_cam_open(const struct hal_camera *cam, const struct hal_camera_config *cfg);
 /** @retval -ENOSYS when the backend lacks the op; otherwise what the op returns. */
 int hal_cam_capture(const struct hal_camera *cam, struct hal_image *img);
+/** @retval -ENOSYS when the backend lacks the op; otherwise what the op returns. */
+int hal_cam_set_exposure(const struct hal_camera *cam, uint32_t exposure_us, uint32_t gain_milli);
 /** @retval -ENOSYS when the backend lacks the op; otherwise what the op returns. */
 int hal_cam_close(const struct hal_camera *cam);
 
