@@ -101,6 +101,50 @@ static void white_balance(const struct colour_params *prm, uint8_t *rgb)
     }
 }
 
+/* Albedo estimate of valid pixel i: numerator per channel and the denominator (0: none).
+ * @p relaxed: the best effort for a pixel without a reliable estimate (grazing or saturated
+ * light still used). */
+static double pixel_estimate(const struct frame_ctx *f, const struct scan_calib *c, vec3 proj,
+                             const uint8_t *white, size_t i, vec3 p, vec3 nn, int relaxed,
+                             double num[3])
+{
+    const struct colour_params *prm = f->prm;
+    const double min_cos = relaxed ? 0.02 : prm->min_cos;
+    double den = 0.0, light[3];
+    num[0] = num[1] = num[2] = 0.0;
+    if (prm->method == COLOUR_SINGLE) { /* eq. 4 */
+        double fall, ct = incidence(prm, p, nn, proj, &fall);
+        int ok = frame_light(f, COLOUR_FRAME_DARK, &white[3 * i], i, light);
+        if (ct < min_cos || (!ok && !relaxed))
+            return 0.0;
+        for (int k = 0; k < 3; k++)
+            num[k] = light[k] * fall;
+        return ct;
+    }
+    if (prm->method == COLOUR_UNIFORM) { /* method 2 */
+        int ok = frame_light(f, COLOUR_FRAME_ALL, &f->frames[COLOUR_FRAME_ALL][3 * i], i, num);
+        int lit = (num[0] + num[1] + num[2]) / 3.0 > prm->shadow_dn; /* not every light shadowed */
+        return (ok && lit) || relaxed ? 1.0 : 0.0;
+    }
+    vec3 view = v3_norm(v3_scale(p, -1.0));
+    for (uint32_t l = 0; l < c->light_count; l++) { /* eq. 6, shadowed lights weigh 0 */
+        uint32_t k = COLOUR_FRAME_LIGHT0 + l;
+        double fall, ct = incidence(prm, p, nn, v3_from(c->light_pos_mm[l]), &fall);
+        int ok = frame_light(f, k, &f->frames[k][3 * i], i, light);
+        if ((!ok && !relaxed) || ct < min_cos ||
+            (light[0] + light[1] + light[2]) / 3.0 <= prm->shadow_dn)
+            continue;
+        vec3 s = v3_norm(v3_sub(v3_from(c->light_pos_mm[l]), p));
+        vec3 refl = v3_sub(v3_scale(nn, 2.0 * v3_dot(s, nn)), s);
+        double cos_a = v3_dot(refl, view);
+        double w = pow(1.0 - pow(cos_a > 0.0 ? cos_a : 0.0, prm->ke), prm->ko);
+        for (int k = 0; k < 3; k++)
+            num[k] += light[k] * fall * w;
+        den += ct * w;
+    }
+    return den;
+}
+
 int colour_compute(const struct colour_params *prm, const struct scan_calib *c,
                    const struct decode_maps *m, const struct tri_range *r, const uint8_t *white,
                    const uint8_t *const *lights, uint8_t *albedo, float *confidence)
@@ -130,35 +174,12 @@ int colour_compute(const struct colour_params *prm, const struct scan_calib *c,
             continue;
         vec3 p = v3(r->xyz_mm[3 * i], r->xyz_mm[3 * i + 1], r->xyz_mm[3 * i + 2]);
         vec3 nn = v3(r->normal[3 * i], r->normal[3 * i + 1], r->normal[3 * i + 2]);
-        vec3 view = v3_norm(v3_scale(p, -1.0));
-        double num[3] = {0, 0, 0}, den = 0.0, light[3];
-        if (prm->method == COLOUR_SINGLE) { /* eq. 4 */
-            double fall, ct = incidence(prm, p, nn, proj, &fall);
-            if (ct < prm->min_cos || !frame_light(&f, COLOUR_FRAME_DARK, &white[3 * i], i, light))
-                continue;
-            for (int k = 0; k < 3; k++)
-                num[k] = light[k] * fall;
-            den = ct;
-        } else if (prm->method == COLOUR_UNIFORM) { /* method 2 */
-            if (!frame_light(&f, COLOUR_FRAME_ALL, &lights[COLOUR_FRAME_ALL][3 * i], i, num))
-                continue;
-            den = 1.0;
-        } else { /* eq. 6, with shadowed lights weighted 0 */
-            for (uint32_t l = 0; l < c->light_count; l++) {
-                uint32_t k = COLOUR_FRAME_LIGHT0 + l;
-                double fall, ct = incidence(prm, p, nn, v3_from(c->light_pos_mm[l]), &fall);
-                int ok = frame_light(&f, k, &lights[k][3 * i], i, light);
-                if (!ok || ct < prm->min_cos ||
-                    (light[0] + light[1] + light[2]) / 3.0 <= prm->shadow_dn)
-                    continue;
-                vec3 s = v3_norm(v3_sub(v3_from(c->light_pos_mm[l]), p));
-                vec3 refl = v3_sub(v3_scale(nn, 2.0 * v3_dot(s, nn)), s);
-                double cos_a = v3_dot(refl, view);
-                double w = pow(1.0 - pow(cos_a > 0.0 ? cos_a : 0.0, prm->ke), prm->ko);
-                for (int k = 0; k < 3; k++)
-                    num[k] += light[k] * fall * w;
-                den += ct * w;
-            }
+        double num[3], den = pixel_estimate(&f, c, proj, white, i, p, nn, 0, num);
+        float conf = (float)(den > 1.0 ? 1.0 : den);
+        if (den <= 1e-6) { /* no reliable estimate: a best effort that weighs nothing in the
+                              fusion unless no view has better (raw colour is not an albedo) */
+            den = pixel_estimate(&f, c, proj, white, i, p, nn, 1, num);
+            conf = 0.0f;
         }
         if (den <= 1e-6)
             continue;
@@ -166,7 +187,7 @@ int colour_compute(const struct colour_params *prm, const struct scan_calib *c,
             double v = num[k] / den * prm->white_scale[k] * 255.0;
             albedo[3 * i + (size_t)k] = (uint8_t)(v < 0.0 ? 0.0 : v > 255.0 ? 255.0 : v + 0.5);
         }
-        confidence[i] = (float)(den > 1.0 ? 1.0 : den);
+        confidence[i] = conf;
     }
     return 0;
 }

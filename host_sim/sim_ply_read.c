@@ -100,6 +100,16 @@ struct ply_header {
     struct ply_element elems[8];
 };
 
+/* The role of a vertex property (struct ply_prop); -1 for one that is skipped. */
+static int vertex_role(const char *name)
+{
+    static const char *const names[] = {"x", "y", "z", "", "red", "green", "blue", "quality"};
+    for (int r = 0; r < (int)(sizeof(names) / sizeof(names[0])); r++)
+        if (names[r][0] != '\0' && strcmp(name, names[r]) == 0)
+            return r;
+    return -1;
+}
+
 static int parse_header(FILE *f, struct ply_header *h, char *err, unsigned err_len,
                         const char *path)
 {
@@ -155,22 +165,8 @@ static int parse_header(FILE *f, struct ply_header *h, char *err, unsigned err_l
                 return -EINVAL;
             }
             p->role = -1;
-            if (strcmp(el->name, "vertex") == 0 && p->list_count_type == PT_NONE) {
-                if (strcmp(pname, "x") == 0)
-                    p->role = 0;
-                if (strcmp(pname, "y") == 0)
-                    p->role = 1;
-                if (strcmp(pname, "z") == 0)
-                    p->role = 2;
-                if (strcmp(pname, "red") == 0)
-                    p->role = 4;
-                if (strcmp(pname, "green") == 0)
-                    p->role = 5;
-                if (strcmp(pname, "blue") == 0)
-                    p->role = 6;
-                if (strcmp(pname, "quality") == 0)
-                    p->role = 7;
-            }
+            if (strcmp(el->name, "vertex") == 0 && p->list_count_type == PT_NONE)
+                p->role = vertex_role(pname);
             if (strcmp(el->name, "face") == 0 && p->list_count_type != PT_NONE &&
                 (strcmp(pname, "vertex_indices") == 0 || strcmp(pname, "vertex_index") == 0))
                 p->role = 3;
