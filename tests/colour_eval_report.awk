@@ -55,7 +55,7 @@ END {
             worse = de[n] > de[k] && p95[n] > p95[k] && mae[n] > mae[k] && step[n] > step[k] && icp[n] < icp[k]
             what = sprintf("%s: none worse than %s on dE00 mean, p95, MAE, view step and ICP coupling", sc, methods[m])
             check(worse, what)
-            check(hl[n] >= hl[k], sprintf("%s: highlight none %.2f%% >= %s %.2f%% (the fused raw colour keeps little highlight: saturated pixels have no depth, and views blend)", sc, 100 * hl[n], methods[m], 100 * hl[k]))
+            check(hl[n] >= hl[k], sprintf("%s: highlight none %.2f%% >= %s %.2f%%%s", sc, 100 * hl[n], methods[m], 100 * hl[k], hl[n] >= hl[k] ? "" : " (the fused raw colour keeps little highlight: saturated pixels get no depth, and the views blend)"))
         }
         for (m = 2; m <= 4; m += 2) {
             k = sc "," methods[m]
