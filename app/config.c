@@ -5,8 +5,11 @@
 #include "ini_schema.h"
 
 #include <errno.h>
+#include <ini.h>
 #include <libgen.h>
+#include <limits.h>
 #include <stddef.h>
+#include <stdlib.h>
 #include <string.h>
 
 #define C(member) offsetof(struct app_config, member)
@@ -398,4 +401,18 @@ void config_print_doc(FILE *out)
     fprintf(out, "\n## Calibration file (e.g. `config/sim-calib.ini`)\n\nAll geometry is in the "
                  "camera frame (x right, y down, z forward), in millimetres.\n");
     ini_schema_print_doc(calib_keys, sizeof(calib_keys) / sizeof(calib_keys[0]), out);
+}
+
+static int read_angle(void *user, const char *section, const char *name, const char *value)
+{
+    if (strcmp(section, "view") == 0 && strcmp(name, "angle_mdeg") == 0)
+        *(long *)user = strtol(value, NULL, 10);
+    return 1;
+}
+
+int view_angle_load(const char *view_ini, long *angle_mdeg)
+{
+    *angle_mdeg = LONG_MIN;
+    return ini_parse(view_ini, read_angle, angle_mdeg) != 0 || *angle_mdeg == LONG_MIN ? -EINVAL
+                                                                                       : 0;
 }

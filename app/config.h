@@ -68,6 +68,10 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
 int calib_load(struct scan_calib *calib, const char *path, uint32_t light_count, char *err,
                size_t err_len);
 
+/** The turntable angle a scan directory's view.ini records ([view] angle_mdeg).
+ *  @retval 0 ok @retval -EINVAL the file is missing, unreadable or has no angle */
+int view_angle_load(const char *view_ini, long *angle_mdeg);
+
 /** Write the documentation of every key (Markdown) to @p out. */
 void config_print_doc(FILE *out);
 

@@ -10,8 +10,6 @@
 #include "scan.h"
 
 #include <errno.h>
-#include <limits.h>
-#include <ini.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -150,17 +148,13 @@ static int keep_settings(const struct hal_storage *st, const struct app_config *
 /* A colour frame (colour_layout order): its lights and exposure. */
 static void colour_frame_name(const struct colour_layout *lay, uint32_t k, char *buf, size_t len)
 {
-    uint32_t mask = lay->lights_mask[k], light = 0;
-    while (mask > 1u && !(mask & 1u)) {
-        mask >>= 1;
-        light++;
-    }
-    snprintf(buf, len, lay->lights_mask[k] == 0 ? "dark: projector and lights off, %u us, RGB"
-                       : k == COLOUR_FRAME_ALL  ? "all lights on, projector off, %u us, RGB"
-                                                : "light %u alone, %u us, RGB",
-             (unsigned)(lay->lights_mask[k] == 0 || k == COLOUR_FRAME_ALL ? lay->exposure_us[k]
-                                                                         : light),
-             (unsigned)lay->exposure_us[k]);
+    unsigned us = (unsigned)lay->exposure_us[k];
+    if (lay->lights_mask[k] == 0)
+        snprintf(buf, len, "dark: projector and lights off, %u us, RGB", us);
+    else if (k == COLOUR_FRAME_ALL)
+        snprintf(buf, len, "all lights on, projector off, %u us, RGB", us);
+    else
+        snprintf(buf, len, "light %u alone, %u us, RGB", (unsigned)(k - COLOUR_FRAME_LIGHT0), us);
 }
 
 static const char *pattern_name(uint32_t pattern, const struct gray_layout *l,
@@ -376,21 +370,14 @@ int scan_job_live(const struct hal *hal, const struct app_config *cfg,
 
 /* ---- offline ---- */
 
-static int read_angle(void *user, const char *section, const char *name, const char *value)
-{
-    if (strcmp(section, "view") == 0 && strcmp(name, "angle_mdeg") == 0)
-        *(long *)user = strtol(value, NULL, 10);
-    return 1;
-}
-
 static int process_view(struct job *j, uint32_t v, const char *in_view_dir)
 {
     static uint8_t pixels[HAL_MAX_PIXELS * 3];
     const struct hal *hal = j->hal;
     char path[HAL_MAX_PATH + 64];
-    long angle = LONG_MIN;
+    long angle;
     snprintf(path, sizeof(path), "%s/view.ini", in_view_dir);
-    if (ini_parse(path, read_angle, &angle) != 0 || angle == LONG_MIN) {
+    if (view_angle_load(path, &angle) != 0) {
         hal->log(HAL_LOG_ERROR, "%s: missing or without [view] angle_mdeg", path);
         return -EINVAL;
     }

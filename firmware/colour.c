@@ -59,8 +59,7 @@ static void channel_offset(const struct decode_maps *m, const uint8_t *dark, dou
         ca[k] = count ? sum[k] / count : 0.0;
 }
 
-/* One frame's light at pixel i with its Ca taken off, in grey levels at the camera's exposure
- * (so that one white reference serves every exposure); 0 when a channel is saturated. */
+/* What frame_light() needs: the frames in colour_layout() order and each dark frame's Ca. */
 struct frame_ctx {
     const struct colour_params *prm;
     const struct colour_layout *lay;
@@ -68,6 +67,9 @@ struct frame_ctx {
     double ca_channel[COLOUR_MAX_FRAMES][3];
 };
 
+/* Frame k's light at pixel i (@p px) with its Ca taken off, in grey levels at the camera's
+ * exposure, so that one white reference serves every exposure. @retval 0 when a channel is
+ * saturated (@p out is filled all the same), 1 otherwise */
 static int frame_light(const struct frame_ctx *f, uint32_t k, const uint8_t *px, size_t i,
                        double out[3])
 {
@@ -91,14 +93,19 @@ static double incidence(const struct colour_params *prm, vec3 p, vec3 n, vec3 sr
     return v3_dot(n, v3_scale(to, 1.0 / d));
 }
 
+/* Albedo 0..1 as the stored byte 0..255, rounded and clamped. */
+static uint8_t albedo_byte(double albedo)
+{
+    double v = albedo * 255.0;
+    return (uint8_t)(v < 0.0 ? 0.0 : v > 255.0 ? 255.0 : v + 0.5);
+}
+
 /* No compensation: the raw colour, white-balanced only (the white reference's scale; the
  * default 1/255 keeps it as it is). */
 static void white_balance(const struct colour_params *prm, uint8_t *rgb)
 {
-    for (int k = 0; k < 3; k++) {
-        double v = rgb[k] * prm->white_scale[k] * 255.0;
-        rgb[k] = (uint8_t)(v < 0.0 ? 0.0 : v > 255.0 ? 255.0 : v + 0.5);
-    }
+    for (int k = 0; k < 3; k++)
+        rgb[k] = albedo_byte(rgb[k] * prm->white_scale[k]);
 }
 
 /* Albedo estimate of valid pixel i: numerator per channel and the denominator (0: none).
@@ -157,9 +164,9 @@ int colour_compute(const struct colour_params *prm, const struct scan_calib *c,
     f.lay = &lay;
     f.frames = lights;
     for (uint32_t k = 0; k < lay.count; k++) {
-        if (lights[k] == NULL && (prm->method == COLOUR_MULTI || k == COLOUR_FRAME_DARK ||
-                                  lay.dark_of[k] == k ||
-                                  (prm->method == COLOUR_UNIFORM && k == COLOUR_FRAME_ALL)))
+        if (lights[k] == NULL &&
+            (prm->method == COLOUR_MULTI || k == COLOUR_FRAME_DARK || lay.dark_of[k] == k ||
+             (prm->method == COLOUR_UNIFORM && k == COLOUR_FRAME_ALL)))
             return -EINVAL;
         if (lights[k] != NULL && lay.dark_of[k] == k)
             channel_offset(m, lights[k], f.ca_channel[k]);
@@ -184,8 +191,7 @@ int colour_compute(const struct colour_params *prm, const struct scan_calib *c,
         if (den <= 1e-6)
             continue;
         for (int k = 0; k < 3; k++) {
-            double v = num[k] / den * prm->white_scale[k] * 255.0;
-            albedo[3 * i + (size_t)k] = (uint8_t)(v < 0.0 ? 0.0 : v > 255.0 ? 255.0 : v + 0.5);
+            albedo[3 * i + (size_t)k] = albedo_byte(num[k] / den * prm->white_scale[k]);
         }
         confidence[i] = conf;
     }

@@ -9,10 +9,13 @@
 
 enum ply_type { PT_NONE, PT_I8, PT_U8, PT_I16, PT_U16, PT_I32, PT_U32, PT_F32, PT_F64 };
 
+/* What a property is read into; x, y, z and red, green, blue are consecutive. */
+enum ply_role { ROLE_X, ROLE_Y, ROLE_Z, ROLE_FACE, ROLE_RED, ROLE_GREEN, ROLE_BLUE, ROLE_QUALITY };
+
 struct ply_prop {
     enum ply_type type;
     enum ply_type list_count_type; /* PT_NONE when not a list */
-    int role; /* 0 x, 1 y, 2 z, 3 face indices, 4..6 red green blue, 7 quality, -1 skipped */
+    int role;                      /* enum ply_role, or -1: skipped */
 };
 
 #define PLY_MAX_PROPS 32
@@ -100,10 +103,13 @@ struct ply_header {
     struct ply_element elems[8];
 };
 
-/* The role of a vertex property (struct ply_prop); -1 for one that is skipped. */
+/* The role of a vertex property (enum ply_role); -1 for one that is skipped. */
 static int vertex_role(const char *name)
 {
-    static const char *const names[] = {"x", "y", "z", "", "red", "green", "blue", "quality"};
+    static const char *const names[] = {[ROLE_X] = "x",       [ROLE_Y] = "y",
+                                        [ROLE_Z] = "z",       [ROLE_FACE] = "",
+                                        [ROLE_RED] = "red",   [ROLE_GREEN] = "green",
+                                        [ROLE_BLUE] = "blue", [ROLE_QUALITY] = "quality"};
     for (int r = 0; r < (int)(sizeof(names) / sizeof(names[0])); r++)
         if (names[r][0] != '\0' && strcmp(name, names[r]) == 0)
             return r;
@@ -169,7 +175,7 @@ static int parse_header(FILE *f, struct ply_header *h, char *err, unsigned err_l
                 p->role = vertex_role(pname);
             if (strcmp(el->name, "face") == 0 && p->list_count_type != PT_NONE &&
                 (strcmp(pname, "vertex_indices") == 0 || strcmp(pname, "vertex_index") == 0))
-                p->role = 3;
+                p->role = ROLE_FACE;
         }
     }
     snprintf(err, err_len, "%s: PLY header has no end_header", path);
@@ -206,13 +212,14 @@ static int read_element(FILE *f, const struct ply_header *h, const struct ply_el
             if (p->list_count_type == PT_NONE) {
                 if (read_scalar(f, h->binary, p->type, &v) != 0)
                     return -EINVAL;
-                if (is_vertex && p->role >= 0 && p->role < 3)
+                if (is_vertex && p->role >= ROLE_X && p->role <= ROLE_Z)
                     m->pos[3 * r + (unsigned long)p->role] = (float)v;
-                else if (is_vertex && p->role == 7 && m->quality != NULL)
+                else if (is_vertex && p->role == ROLE_QUALITY && m->quality != NULL)
                     m->quality[r] = (float)v;
-                else if (is_vertex && p->role > 3 && p->role < 7 && m->rgb != NULL)
-                    m->rgb[3 * r + (unsigned long)(p->role - 4)] =
-                        (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : v);
+                else if (is_vertex && p->role >= ROLE_RED && p->role <= ROLE_BLUE && m->rgb != NULL)
+                    m->rgb[3 * r + (unsigned long)(p->role - ROLE_RED)] = (uint8_t)(v < 0     ? 0
+                                                                                    : v > 255 ? 255
+                                                                                              : v);
                 continue;
             }
             double cnt;
@@ -225,7 +232,7 @@ static int read_element(FILE *f, const struct ply_header *h, const struct ply_el
                     return -EINVAL;
                 idx[j] = (uint32_t)v;
             }
-            for (int j = 2; p->role == 3 && j < (int)cnt; j++)
+            for (int j = 2; p->role == ROLE_FACE && j < (int)cnt; j++)
                 if (push_tri(m, tri_cap, idx[0], idx[j - 1], idx[j]) != 0)
                     return -ENOMEM;
         }
@@ -234,11 +241,11 @@ static int read_element(FILE *f, const struct ply_header *h, const struct ply_el
 }
 
 /* Does the vertex element have a property of @p role? */
-static int ply_has_role(const struct ply_header *h, int role)
+static int ply_has_role(const struct ply_header *h, enum ply_role role)
 {
     for (int e = 0; e < h->elem_count; e++)
         for (int k = 0; strcmp(h->elems[e].name, "vertex") == 0 && k < h->elems[e].prop_count; k++)
-            if (h->elems[e].props[k].role == role)
+            if (h->elems[e].props[k].role == (int)role)
                 return 1;
     return 0;
 }
@@ -269,12 +276,13 @@ static int load_ply(struct sim_mesh *m, const char *path, int need_faces, char *
     }
     m->pos = calloc((size_t)m->vert_count * 3, sizeof(float));
     m->normal = calloc((size_t)m->vert_count * 3, sizeof(float));
-    if (ply_has_role(&h, 4))
+    int has_rgb = ply_has_role(&h, ROLE_RED), has_quality = ply_has_role(&h, ROLE_QUALITY);
+    if (has_rgb)
         m->rgb = calloc((size_t)m->vert_count * 3, 1);
-    if (ply_has_role(&h, 7))
+    if (has_quality)
         m->quality = calloc(m->vert_count, sizeof(float));
-    if (m->pos == NULL || m->normal == NULL || (m->rgb == NULL && ply_has_role(&h, 4)) ||
-        (m->quality == NULL && ply_has_role(&h, 7))) {
+    if (m->pos == NULL || m->normal == NULL || (has_rgb && m->rgb == NULL) ||
+        (has_quality && m->quality == NULL)) {
         rc = -ENOMEM;
         snprintf(err, err_len, "%s: out of memory", path);
         goto out_free;

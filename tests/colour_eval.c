@@ -16,14 +16,12 @@
 #include "config.h"
 #include "frames.h"
 #include "image_io.h"
-#include "ini.h"
 #include "sim_bvh.h"
 #include "sim_mesh.h"
 #include "sim_rig.h"
 #include "storage_posix.h"
 
 #include <errno.h>
-#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -47,13 +45,6 @@ struct rig_views {
 
 /* ---- the scan's rig ---- */
 
-static int read_angle(void *user, const char *section, const char *name, const char *value)
-{
-    if (strcmp(section, "view") == 0 && strcmp(name, "angle_mdeg") == 0)
-        *(long *)user = strtol(value, NULL, 10);
-    return 1;
-}
-
 static int rig_load(struct rig_views *r, const char *scan_dir)
 {
     char path[HAL_MAX_PATH + 64], err[512];
@@ -70,9 +61,9 @@ static int rig_load(struct rig_views *r, const char *scan_dir)
     r->views = r->cfg.views < MAX_VIEWS ? r->cfg.views : MAX_VIEWS;
     vec3 proj_cam = v3_scale(m3_tmul(r->calib.proj_rot, v3_from(r->calib.proj_trans_mm)), -1.0);
     for (uint32_t v = 0; v < r->views; v++) {
-        long angle = LONG_MIN;
+        long angle;
         snprintf(path, sizeof(path), "%s/view_%03u/view.ini", scan_dir, (unsigned)v);
-        if (ini_parse(path, read_angle, &angle) != 0 || angle == LONG_MIN) {
+        if (view_angle_load(path, &angle) != 0) {
             fprintf(stderr, "colour-eval: %s: no [view] angle_mdeg\n", path);
             return -EINVAL;
         }
@@ -122,8 +113,8 @@ static int true_albedo(const struct rig_views *r, vec3 p, double albedo[3])
 {
     if (sim_albedo_at(&r->cfg.sim, r->height_mm, p, albedo))
         return 1;
-    static const double d[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1},
-                                   {0, 0, -1}};
+    static const double d[6][3] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                   {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
     for (int k = 0; k < 6; k++) {
         double other[3];
         vec3 q = v3_add(p, v3_scale(v3(d[k][0], d[k][1], d[k][2]), EDGE_MM));
@@ -179,9 +170,8 @@ static int cloud_load(struct cloud *c, const char *path)
         return -ENOMEM;
     for (uint32_t i = 0; i < c->pts.vert_count; i++) {
         const float *p = &c->pts.pos[3 * i];
-        c->key[i] = cell_key((int64_t)floor(p[0]), (int64_t)floor(p[1]), (int64_t)floor(p[2]))
-                        << 32 |
-                    i;
+        c->key[i] =
+            cell_key((int64_t)floor(p[0]), (int64_t)floor(p[1]), (int64_t)floor(p[2])) << 32 | i;
     }
     qsort(c->key, c->pts.vert_count, sizeof(uint64_t), cmp_u64);
     return 0;
@@ -471,7 +461,8 @@ static int cmd_closeup(const char *scan_dir, const char *out_png, int count, cha
     if (rig_load(&r, scan_dir) != 0)
         return 1;
     snprintf(path, sizeof(path), "%s/truth_mesh.ply", scan_dir);
-    if (sim_mesh_load_ply(&truth, path, err, sizeof(err)) != 0 || sim_bvh_build(&bvh, &truth) != 0) {
+    if (sim_mesh_load_ply(&truth, path, err, sizeof(err)) != 0 ||
+        sim_bvh_build(&bvh, &truth) != 0) {
         fprintf(stderr, "colour-eval: %s\n", err);
         return 1;
     }
