@@ -75,6 +75,22 @@ static int rig_load(struct rig_views *r, const char *scan_dir)
     return 0;
 }
 
+/* The scan's true mesh (truth_mesh.ply) and its BVH. @retval 0 or -errno, said on stderr */
+static int truth_load(const char *scan_dir, struct sim_mesh *truth, struct sim_bvh *bvh)
+{
+    char path[HAL_MAX_PATH + 64], err[512];
+    snprintf(path, sizeof(path), "%s/truth_mesh.ply", scan_dir);
+    int rc = sim_mesh_load_ply(truth, path, err, sizeof(err));
+    if (rc != 0) {
+        fprintf(stderr, "colour-eval: %s\n", err);
+        return rc;
+    }
+    rc = sim_bvh_build(bvh, truth);
+    if (rc != 0)
+        fprintf(stderr, "colour-eval: %s: out of memory for its BVH\n", path);
+    return rc;
+}
+
 static int reaches(const struct sim_bvh *truth, vec3 p, vec3 n, vec3 src)
 {
     vec3 start = v3_add(p, v3_scale(n, 0.05));
@@ -294,14 +310,8 @@ static int cmd_measure(const char *scan_dir, const char *result_dir, const char 
     struct cloud clouds[MAX_VIEWS];
     char path[HAL_MAX_PATH + 64], err[512];
     memset(clouds, 0, sizeof(clouds));
-    if (rig_load(&r, scan_dir) != 0)
+    if (rig_load(&r, scan_dir) != 0 || truth_load(scan_dir, &truth, &bvh) != 0)
         return 1;
-    snprintf(path, sizeof(path), "%s/truth_mesh.ply", scan_dir);
-    if (sim_mesh_load_ply(&truth, path, err, sizeof(err)) != 0 ||
-        sim_bvh_build(&bvh, &truth) != 0) {
-        fprintf(stderr, "colour-eval: %s\n", err);
-        return 1;
-    }
     snprintf(path, sizeof(path), "%s/mesh.ply", result_dir);
     if (sim_mesh_load_ply(&res, path, err, sizeof(err)) != 0 || res.rgb == NULL) {
         fprintf(stderr, "colour-eval: %s: no coloured mesh\n", path);
@@ -458,14 +468,8 @@ static int cmd_closeup(const char *scan_dir, const char *out_png, int count, cha
     struct frame_xform mid;
     double centre[2];
     char path[HAL_MAX_PATH + 64], err[512];
-    if (rig_load(&r, scan_dir) != 0)
+    if (rig_load(&r, scan_dir) != 0 || truth_load(scan_dir, &truth, &bvh) != 0)
         return 1;
-    snprintf(path, sizeof(path), "%s/truth_mesh.ply", scan_dir);
-    if (sim_mesh_load_ply(&truth, path, err, sizeof(err)) != 0 ||
-        sim_bvh_build(&bvh, &truth) != 0) {
-        fprintf(stderr, "colour-eval: %s\n", err);
-        return 1;
-    }
     if (closeup_camera(&r, &truth, &bvh, &mid, centre) != 0) {
         fprintf(stderr, "colour-eval: views 0 and 1 share no boundary the camera sees\n");
         return 1;
