@@ -2,10 +2,29 @@
 #   make              build/scanner (HAL=sim by default; HAL=linux for the appliance)
 #   make test         every unit and integration test (SAN=1: under ASan + UBSan)
 #   make run          a simulated scan with config/sim.ini
-HAL ?= sim
+#   make CROSS_COMPILE=aarch64-linux-gnu-   the appliance for arm64 (build/aarch64-linux-gnu/)
+#   make test-arm64   the unit tests built for arm64, run under qemu-aarch64
 SAN ?= 0
 CC ?= cc
 PKGS := inih libpng cmocka libmodbus libgpiod
+PKG_CONFIG := pkg-config
+DEPS_SET :=
+DEPS_TOOLS := $(CC)
+BUILD := build
+# Cross build with Debian's cross compiler and the target's -dev packages (multiarch): the
+# appliance (HAL=linux) unless told otherwise, in a build directory of its own.
+ifneq ($(CROSS_COMPILE),)
+HAL ?= linux
+CC := $(CROSS_COMPILE)gcc
+CXX := $(CROSS_COMPILE)g++
+AR := $(CROSS_COMPILE)ar
+TRIPLET := $(patsubst %-,%,$(CROSS_COMPILE))
+PKG_CONFIG := PKG_CONFIG_LIBDIR=/usr/lib/$(TRIPLET)/pkgconfig:/usr/share/pkgconfig pkg-config
+DEPS_SET := $(TRIPLET)
+DEPS_TOOLS := $(CC) qemu-$(firstword $(subst -, ,$(TRIPLET)))
+BUILD := build/$(TRIPLET)
+endif
+HAL ?= sim
 
 ifeq ($(HAL),sim)
 else ifeq ($(HAL),linux)
@@ -13,13 +32,12 @@ else
 $(error HAL must be sim or linux, not '$(HAL)')
 endif
 
-BUILD := build
 OPT := -O2
 ifeq ($(SAN),1)
-BUILD := build/san
+BUILD := $(BUILD)/san
 OPT := -O1 -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
 endif
-# HAL=linux objects live apart so that the two builds never mix.
+# HAL=linux objects live apart so that the two builds never mix (also when cross-built).
 ifeq ($(HAL),linux)
 BUILD := $(BUILD)/linux
 endif
@@ -28,8 +46,8 @@ WARN := -std=c11 -Wall -Wextra -Werror
 CFLAGS_COMMON := $(WARN) $(OPT) -g -MMD -MP
 # firmware/ sees the world only through hal/include.
 FW_CFLAGS := $(CFLAGS_COMMON) -Ihal/include -Ifirmware
-PKG_CFLAGS = $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
-PKG_LIBS = $(shell pkg-config --libs inih libpng libmodbus 2>/dev/null) -lpthread
+PKG_CFLAGS = $(shell $(PKG_CONFIG) --cflags $(PKGS) 2>/dev/null)
+PKG_LIBS = $(shell $(PKG_CONFIG) --libs inih libpng libmodbus 2>/dev/null) -lpthread
 HOST_CFLAGS = $(CFLAGS_COMMON) -Ihal/include -Ifirmware -Iapp -Ihal/posix -Ihal/linux -Ihal/modbus -Ihost_sim $(PKG_CFLAGS)
 LDFLAGS_COMMON := $(OPT) -g
 LDLIBS_COMMON = $(PKG_LIBS) -lm
@@ -39,21 +57,28 @@ POSIX_SRC := $(wildcard hal/posix/*.c) $(wildcard hal/modbus/*.c)
 APP_LIB_SRC := app/config.c app/ini_schema.c app/image_io.c app/scan_job.c app/white_cal.c
 SIM_SRC := $(filter-out host_sim/turntable_sim_main.c,$(wildcard host_sim/*.c))
 LINUX_SRC := $(wildcard hal/linux/*.c)
+# The libcamera backend (C++) is built where libcamera is found (Raspberry Pi OS, or Debian's
+# libcamera-dev, which make test installs); without it [camera] backend = libcamera says so.
+HAVE_LIBCAMERA := $(shell $(PKG_CONFIG) --exists libcamera 2>/dev/null && echo 1)
+LIBCAMERA_OBJ = $(if $(HAVE_LIBCAMERA),$(BUILD)/hal/linux/camera_libcamera.o,)
+LIBCAMERA_LIBS = $(if $(HAVE_LIBCAMERA),$(shell $(PKG_CONFIG) --libs libcamera) -lstdc++,)
+HOST_CFLAGS += $(if $(HAVE_LIBCAMERA),-DHAVE_LIBCAMERA,)
 BOARD_SRC := $(if $(filter sim,$(HAL)),$(SIM_SRC),$(LINUX_SRC))
-BOARD_LIBS = $(if $(filter linux,$(HAL)),$(shell pkg-config --libs libgpiod 2>/dev/null),)
+BOARD_LIBS = $(if $(filter linux,$(HAL)),$(shell $(PKG_CONFIG) --libs libgpiod 2>/dev/null) $(LIBCAMERA_LIBS),)
 
 obj = $(patsubst %.c,$(BUILD)/%.o,$(1))
 FW_OBJ := $(call obj,$(FW_SRC))
-HOST_OBJ := $(call obj,$(POSIX_SRC) $(APP_LIB_SRC) $(BOARD_SRC))
+HOST_OBJ := $(call obj,$(POSIX_SRC) $(APP_LIB_SRC) $(BOARD_SRC)) $(if $(filter linux,$(HAL)),$(LIBCAMERA_OBJ),)
 MAIN_OBJ := $(call obj,app/main.c)
 
-.PHONY: all deps test-deps test run clean format docs check-firmware bench measure measure-scan interop-meshlab bench-callgrind eval
+.PHONY: all deps test-deps test test-run linux-build install test-arm64 test-arm64-full arm64-check-elf arm64-run-tests run clean format docs check-firmware bench measure measure-scan interop-meshlab bench-callgrind eval
 SIM_TOOLS := $(if $(filter sim,$(HAL)),$(BUILD)/turntable-sim $(BUILD)/tt-client $(BUILD)/mesh-compare $(BUILD)/colour-eval,)
 all: deps $(BUILD)/scanner $(SIM_TOOLS)
 
 # Install missing Debian packages (fresh Debian 12): only when pkg-config cannot find them.
 deps:
-	@pkg-config --exists $(PKGS) || scripts/install-deps.sh
+	@{ $(PKG_CONFIG) --exists $(PKGS) && command -v $(DEPS_TOOLS); } >/dev/null 2>&1 || \
+		scripts/install-deps.sh $(DEPS_SET)
 
 $(FW_OBJ): $(BUILD)/%.o: %.c | deps
 	@mkdir -p $(dir $@)
@@ -66,8 +91,12 @@ $(BUILD)/%.o: %.c | deps
 	@mkdir -p $(dir $@)
 	$(CC) $(HOST_CFLAGS) -c $< -o $@
 
+$(BUILD)/%.o: %.cpp | deps
+	@mkdir -p $(dir $@)
+	$(CXX) -std=c++17 -Wall -Wextra -Werror $(OPT) -g -MMD -MP -Ihal/include -Ihal/linux $(shell $(PKG_CONFIG) --cflags libcamera 2>/dev/null) -c $< -o $@
+
 $(BUILD)/libfirmware.a: $(FW_OBJ)
-	ar rcs $@ $^
+	$(AR) rcs $@ $^
 
 $(BUILD)/scanner: $(MAIN_OBJ) $(HOST_OBJ) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON) $(BOARD_LIBS)
@@ -88,11 +117,11 @@ $(BUILD)/colour-eval: $(call obj,tests/colour_eval.c tests/colour_metrics.c host
 TEST_SRC := $(filter-out tests/test_util.c,$(wildcard tests/test_*.c))
 TEST_SUPPORT := $(BUILD)/tests/test_util.o $(BUILD)/tests/mesh_compare_lib.o $(BUILD)/tests/colour_metrics.o
 TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
-TEST_LIBS = $(shell pkg-config --libs cmocka libmodbus 2>/dev/null)
+TEST_LIBS = $(shell $(PKG_CONFIG) --libs cmocka libmodbus 2>/dev/null)
 
-# The gpiod backend's pure parts are tested in every build (libgpiod is always installed).
-TEST_EXTRA_OBJ := $(if $(filter sim,$(HAL)),$(call obj,hal/linux/gpio_gpiod.c),)
-TEST_EXTRA_LIBS = $(shell pkg-config --libs libgpiod 2>/dev/null)
+# The appliance backends are tested in every build, without their hardware.
+TEST_EXTRA_OBJ = $(if $(filter sim,$(HAL)),$(call obj,hal/linux/gpio_gpiod.c hal/linux/v4l2_frame.c hal/linux/camera_v4l2.c) $(LIBCAMERA_OBJ),)
+TEST_EXTRA_LIBS = $(shell $(PKG_CONFIG) --libs libgpiod 2>/dev/null) $(LIBCAMERA_LIBS)
 
 $(BUILD)/tests/%: $(BUILD)/tests/%.o $(TEST_SUPPORT) $(HOST_OBJ) $(TEST_EXTRA_OBJ) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(TEST_LIBS) $(LDLIBS_COMMON) $(TEST_EXTRA_LIBS)
@@ -116,11 +145,63 @@ check-firmware: $(FW_OBJ)
 # Test-only packages: Open3D reads our PLY (tests/cli.sh); pymodbus and socat are the Modbus
 # peers of tests/interop.sh.
 test-deps: deps
-	@{ /usr/bin/python3 -c 'import open3d, pymodbus, serial_asyncio' && command -v socat; } \
+	@{ /usr/bin/python3 -c 'import open3d, pymodbus, serial_asyncio' && command -v socat systemd-analyze && pkg-config --exists libcamera; } \
 		>/dev/null 2>&1 || scripts/install-deps.sh test
 
-test: deps test-deps $(BUILD)/scanner $(SIM_TOOLS) $(TEST_BIN) check-firmware
+# A second make, so that what test-deps installed (libcamera-dev) is seen when it starts.
+test: deps test-deps
+	@$(MAKE) --no-print-directory test-run
+test-run: $(BUILD)/scanner $(SIM_TOOLS) $(TEST_BIN) check-firmware linux-build
 	@BUILD=$(BUILD) tests/run.sh $(TEST_BIN) tests/cli.sh tests/interop.sh
+
+# arm64 (a Raspberry Pi 4 or 5 on a 64-bit OS): the appliance's scanner cross-built and checked
+# to be an AArch64 ELF, then every cmocka unit test built for arm64 and run under qemu-aarch64
+# (Debian's qemu-user; the arm64 loader and libraries come with the multiarch -dev packages).
+ARM64 := CROSS_COMPILE=aarch64-linux-gnu-
+# Emulated, the tests that render whole simulated scans take many minutes each: test-arm64 runs
+# the others (every firmware algorithm, config, Modbus, backends); test-arm64-full runs them all.
+ARM64_SLOW := test_colour test_nomalloc test_ply test_safety test_scan test_sim test_view
+ARM64_TESTS = $(filter-out $(addprefix $(BUILD)/tests/,$(ARM64_SLOW)),$(TEST_BIN))
+test-arm64:
+	@$(MAKE) --no-print-directory $(ARM64) HAL=linux deps
+	@$(MAKE) --no-print-directory $(ARM64) HAL=linux arm64-check-elf
+	@$(MAKE) --no-print-directory $(ARM64) HAL=sim arm64-run-tests
+test-arm64-full:
+	@$(MAKE) --no-print-directory $(ARM64) HAL=sim deps
+	@$(MAKE) --no-print-directory $(ARM64) HAL=sim ARM64_SLOW= arm64-run-tests
+arm64-check-elf: $(BUILD)/scanner
+	@$(CROSS_COMPILE)readelf -h $< | grep -q 'Machine: *AArch64' && echo "$<: AArch64 ELF"
+arm64-run-tests: $(TEST_BIN)
+	@RUN_WITH=qemu-aarch64 BUILD=$(BUILD) tests/run.sh $(ARM64_TESTS)
+
+# The appliance, installed: the HAL=linux scanner, the example configs in /etc/scanner (an edited
+# one is kept; the new example goes beside it as .dist), the systemd unit, its user and groups
+# (sysusers.d) and the GPIO group rule (udev). DESTDIR stages it (packaging, tests).
+PREFIX ?= /usr/local
+SYSCONFDIR ?= /etc
+UNITDIR ?= /lib/systemd/system
+DOCDIR ?= $(PREFIX)/share/doc/scanner
+install: linux-build
+	install -D -m 0755 $(LINUX_BUILD)/scanner $(DESTDIR)$(PREFIX)/bin/scanner
+	install -d -m 0755 $(DESTDIR)$(SYSCONFDIR)/scanner
+	@for f in config/pi-v4l2.ini config/pi-libcamera.ini; do \
+		dest=$(DESTDIR)$(SYSCONFDIR)/scanner/$$(basename $$f); \
+		if [ -e $$dest ] && ! cmp -s $$f $$dest; then dest=$$dest.dist; fi; \
+		echo "install -m 0644 $$f $$dest"; install -m 0644 $$f $$dest; \
+	done
+	@mkdir -p $(BUILD)/deploy
+	sed -e 's|@BINDIR@|$(PREFIX)/bin|g' -e 's|@SYSCONFDIR@|$(SYSCONFDIR)|g' -e 's|@DOCDIR@|$(DOCDIR)|g' \
+		'config/deploy/scanner@.service' > '$(BUILD)/deploy/scanner@.service'
+	install -D -m 0644 '$(BUILD)/deploy/scanner@.service' '$(DESTDIR)$(UNITDIR)/scanner@.service'
+	install -D -m 0644 config/deploy/scanner.sysusers $(DESTDIR)/usr/lib/sysusers.d/scanner.conf
+	install -D -m 0644 config/deploy/60-scanner-gpio.rules $(DESTDIR)/usr/lib/udev/rules.d/60-scanner-gpio.rules
+	install -D -m 0644 docs/deploy.md $(DESTDIR)$(DOCDIR)/deploy.md
+	@[ -n "$(DESTDIR)" ] || echo "make install: now run: systemd-sysusers; udevadm control --reload; udevadm trigger; systemctl daemon-reload"
+
+# The appliance's scanner (every backend compiled; tests/cli.sh runs its selftest).
+LINUX_BUILD := $(if $(filter linux,$(HAL)),$(BUILD),$(BUILD)/linux)
+linux-build: deps
+	@$(MAKE) --no-print-directory HAL=linux SAN=$(SAN) $(LINUX_BUILD)/scanner
 
 run: deps $(BUILD)/scanner
 	$(BUILD)/scanner scan --config config/sim.ini
@@ -136,7 +217,7 @@ clean:
 
 .SECONDARY:
 
--include $(shell find $(BUILD) -name '*.d' 2>/dev/null)
+-include $(shell find $(BUILD) -name '*.d' -type f 2>/dev/null)
 
 # Decoding rate, depth error and time per view on the simulator (numbers for the notes).
 $(BUILD)/measure_view: $(BUILD)/tests/measure_view.o $(BUILD)/tests/test_util.o $(HOST_OBJ) $(BUILD)/libfirmware.a
@@ -180,9 +261,9 @@ $(BUILD)/bench/%.o: bench/%.c | deps
 $(BUILD)/bench/opencv_graycode.o: bench/opencv_graycode.cpp
 	@pkg-config --exists opencv4 || scripts/install-deps.sh bench
 	@mkdir -p $(dir $@)
-	$(CXX) -std=c++17 -O2 -Wall -Wextra -Werror $(shell pkg-config --cflags opencv4 2>/dev/null) -c $< -o $@
+	$(CXX) -std=c++17 -O2 -Wall -Wextra -Werror $(shell $(PKG_CONFIG) --cflags opencv4 2>/dev/null) -c $< -o $@
 $(BUILD)/bench_decode: $(BUILD)/bench/bench_decode.o $(BUILD)/bench/opencv_graycode.o $(BUILD)/tests/test_util.o $(HOST_OBJ) $(BUILD)/libfirmware.a
-	$(CXX) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON) $(shell pkg-config --libs opencv4 2>/dev/null)
+	$(CXX) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON) $(shell $(PKG_CONFIG) --libs opencv4 2>/dev/null)
 $(BUILD)/bench/bench_decode.o: bench/bench_decode.c | deps
 	@pkg-config --exists opencv4 || scripts/install-deps.sh bench
 	@mkdir -p $(dir $@)

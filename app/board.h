@@ -23,4 +23,16 @@ int board_write_view_extras(const struct hal *hal, const char *view_dir);
 /** Safe state, then release every device. */
 void board_shutdown(struct hal *hal);
 
+/** One line of the selftest: @p device ("camera", "gpio", "turntable") at @p where, 0 or the
+ *  -errno it failed with, and what was seen or why it failed. */
+typedef void (*board_selftest_row)(void *ctx, const char *device, const char *where, int rc,
+                                   const char *detail);
+
+/** First power-on of a rig: open and try each configured device on its own (a camera frame of
+ *  the configured size, the GPIO lines requested, the turntable's status), releasing each
+ *  before the next, so that nothing stays requested. Reports every device through @p row.
+ *  @retval 0 all work @retval -ENODEV at least one does not */
+int board_selftest(struct hal *hal, const struct app_config *cfg, const struct scan_calib *calib,
+                   board_selftest_row row, void *ctx);
+
 #endif

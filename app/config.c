@@ -34,10 +34,10 @@
     {                                                                                              \
         sec, key, INI_ENUM, C(member), SZ(member), 0, 0, 0, def, choices, doc                      \
     }
-#define GPIO(key, line)                                                                            \
+#define GPIO(key, which)                                                                           \
     {                                                                                              \
-        "gpio", key, INI_I32, C(gpio.line_offset[line]), 0, -1, 1023, 0, "-1", NULL,               \
-            "line offset on the chip; -1 = not wired"                                              \
+        "gpio", key, INI_LINE, C(gpio.line[which]), 0, -1, 1023, 0, "-1", NULL,                    \
+            "line offset on the chip, or the line's name (gpioinfo); -1 = not wired"               \
     }
 
 static const struct ini_key config_keys[] = {
@@ -54,6 +54,12 @@ static const struct ini_key config_keys[] = {
         "fixed analogue gain, 1000 = unity"),
     U32("camera", "drop_frames", camera.drop_frames, 0, 16, "1",
         "stale frames dropped after a light or pattern change"),
+    U32("camera", "frame_timeout_ms", camera.frame_timeout_ms, 10, 600000, "2000",
+        "a capture that gets no frame in this time fails (and is retried)"),
+    U32("camera", "red_gain_milli", camera.red_gain_milli, 100, 16000, "1000",
+        "fixed white-balance gain of red (libcamera; auto white balance is off)"),
+    U32("camera", "blue_gain_milli", camera.blue_gain_milli, 100, 16000, "1000",
+        "fixed white-balance gain of blue (libcamera)"),
     U32("camera", "capture_retries", scan.capture_retries, 0, 10, "2",
         "extra tries of a capture that timed out or came back corrupt"),
     U32("projector", "settle_us", scan.pattern_settle_us, 0, 1000000, "20000",
@@ -182,7 +188,7 @@ static const struct ini_key config_keys[] = {
         "view weights ramp up over this many pixels from the view's edge"),
     F64("fusion", "min_weight", fusion.min_weight, 0, 1, "0.05",
         "pixels weighing less (grazing, far) are not fused"),
-    ENUM("sim", "object", sim.object, "sphere|cylinder|box|torus|mesh", "sphere",
+    ENUM("sim", "object", sim.object, "sphere|cylinder|can|box|torus|mesh", "sphere",
          "simulated object"),
     STR("sim", "mesh_file", sim.mesh_file, "", "PLY mesh for object = mesh, relative to this file"),
     F64("sim", "object_height_mm", sim.object_height_mm, 1, 1000, "150",
@@ -214,6 +220,8 @@ static const struct ini_key config_keys[] = {
         "projector defocus, as a box width in projector pixels"),
     F64("sim", "light_intensity_dn", sim.light_intensity_dn, 0, 10000, "120",
         "like projector_intensity_dn, for each white light"),
+    F64("sim", "light_diffuser_mm", sim.light_diffuser_mm, 0, 1000, "0",
+        "radius of each light's diffuser (softbox); 0: a point light"),
     F64("sim", "reference_distance_mm", sim.reference_distance_mm, 1, 100000, "600",
         "distance at which the intensities above hold (inverse-square falloff)"),
     U32("sim", "reference_exposure_us", sim.reference_exposure_us, 1, 10000000, "10000",

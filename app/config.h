@@ -30,13 +30,13 @@ struct sim_config {
     uint32_t table_angle_error_mdeg;
     double black_offset_dn, ambient_dn, read_noise_dn, electrons_per_dn;
     double projector_intensity_dn, projector_black_level, projector_blur_px;
-    double light_intensity_dn, reference_distance_mm;
+    double light_intensity_dn, light_diffuser_mm, reference_distance_mm;
     uint32_t reference_exposure_us;
 };
 
 struct gpio_config {
     char chip[64];                            /**< gpiochip device or name */
-    int32_t line_offset[HAL_GPIO_LINE_COUNT]; /**< -1 = not wired */
+    struct hal_gpio_line_ref line[HAL_GPIO_LINE_COUNT]; /**< offset or name; -1 and "": not wired */
 };
 
 

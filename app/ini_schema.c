@@ -2,6 +2,8 @@
 #define _POSIX_C_SOURCE 200809L
 #include "ini_schema.h"
 
+#include "hal_gpio.h"
+
 #include <errno.h>
 #include <ini.h>
 #include <math.h>
@@ -76,6 +78,35 @@ static int range_error(const struct ini_key *k, double v, char *msg, size_t len)
     return -1;
 }
 
+/* A GPIO line: an offset in range, or a name of letters, digits, '_' and '-'. */
+static int set_line(const struct ini_key *k, struct hal_gpio_line_ref *ref, const char *value,
+                    char *msg, size_t len)
+{
+    double v;
+    memset(ref, 0, sizeof(*ref));
+    if (parse_double(value, &v) == 0) {
+        if (v != floor(v)) {
+            snprintf(msg, len, "'%s' is not a line offset", value);
+            return -1;
+        }
+        if (range_error(k, v, msg, len))
+            return -1;
+        ref->offset = (int32_t)v;
+        return 0;
+    }
+    size_t n = strlen(value);
+    if (n == 0 || n >= sizeof(ref->name) ||
+        strspn(value, "ABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                      "abcdefghijklmnopqrstuvwxyz"
+                      "0123456789_-") != n) {
+        snprintf(msg, len, "'%s' is neither a line offset nor a line name", value);
+        return -1;
+    }
+    ref->offset = -1;
+    memcpy(ref->name, value, n + 1);
+    return 0;
+}
+
 /* Store @p value for key @p k, or write what is wrong into @p msg. */
 static int set_value(const struct ini_key *k, void *target, const char *value, char *msg,
                      size_t len)
@@ -96,6 +127,8 @@ static int set_value(const struct ini_key *k, void *target, const char *value, c
         else
             *(int32_t *)(void *)dst = (int32_t)v;
         return 0;
+    case INI_LINE:
+        return set_line(k, (struct hal_gpio_line_ref *)(void *)dst, value, msg, len);
     case INI_F64:
         if (parse_double(value, &v) != 0) {
             snprintf(msg, len, "'%s' is not a number", value);
@@ -253,6 +286,8 @@ static const char *type_name(const struct ini_key *k, char *buf, size_t len)
     }
     case INI_VEC:
         return k->size == 3 ? "x, y, z" : "list of numbers";
+    case INI_LINE:
+        return "offset or name";
     }
     return "?";
 }
@@ -270,7 +305,8 @@ void ini_schema_print_doc(const struct ini_key *keys, size_t key_count, FILE *ou
                     section);
         }
         char range[64] = "", type_buf[128];
-        if (k->type == INI_U32 || k->type == INI_I32 || k->type == INI_F64 || k->type == INI_VEC)
+        if (k->type == INI_U32 || k->type == INI_I32 || k->type == INI_F64 || k->type == INI_VEC ||
+            k->type == INI_LINE)
             snprintf(range, sizeof(range), "%.10g .. %.10g%s", k->min, k->max,
                      k->max_is_limit ? " (compiled limit)" : "");
         fprintf(out, "| `%s` | %s | %s | %s | %s |\n", k->name,

@@ -6,7 +6,9 @@
 #include <stddef.h>
 #include <stdio.h>
 
-enum ini_type { INI_U32, INI_I32, INI_F64, INI_STR, INI_ENUM, INI_VEC };
+/* INI_LINE: a GPIO line as a whole number (offset; -1 = not wired) or a name, into a
+ * struct hal_gpio_line_ref. */
+enum ini_type { INI_U32, INI_I32, INI_F64, INI_STR, INI_ENUM, INI_VEC, INI_LINE };
 
 struct ini_key {
     const char *section;

@@ -164,6 +164,34 @@ static int cmd_calibrate_white(const char *config_path, double target_albedo)
     return 0;
 }
 
+static void selftest_row(void *ctx, const char *device, const char *where, int rc,
+                         const char *detail)
+{
+    (void)ctx;
+    printf("%-11s %-32s %-7s %s\n", device, where, rc == 0 ? "ok" : "MISSING", detail);
+}
+
+/* First power-on: each configured device on its own, a table of what works. */
+static int cmd_selftest(const char *config_path)
+{
+    static struct app_config cfg;
+    static struct scan_calib calib;
+    char err[512];
+    if (config_load(&cfg, config_path, err, sizeof(err)) != 0) {
+        fprintf(stderr, "scanner: error: %s\n", err);
+        return 2;
+    }
+    the_hal.log = app_log;
+    printf("%-11s %-32s %-7s %s\n", "device", "where", "status", "detail");
+    /* A new rig has no calibration yet: say so, and try the devices all the same. */
+    int calib_rc = calib_load(&calib, cfg.calibration_file, cfg.light_count, err, sizeof(err));
+    if (calib_rc != 0)
+        calib.light_count = cfg.light_count;
+    selftest_row(NULL, "calibration", cfg.calibration_file, calib_rc, calib_rc ? err : "loaded");
+    int rc = board_selftest(&the_hal, &cfg, &calib, selftest_row, NULL);
+    return rc == 0 && calib_rc == 0 ? 0 : 1;
+}
+
 /* Offline: only storage, a clock and the log; no device is opened. */
 static int cmd_process(const char *scan_dir, const struct scan_job_opts *opts)
 {
@@ -183,6 +211,7 @@ static void usage(FILE *out)
             "its frames\n"
             "       scanner calibrate-white --config FILE [--albedo A]  white reference scales\n"
             "       scanner check-config --config FILE    check a config and its calibration\n"
+            "       scanner selftest --config FILE        try each configured device (new rig)\n"
             "       scanner config-doc                    print the config reference (Markdown)\n"
             "       scanner --version\n");
 }
@@ -248,6 +277,8 @@ int main(int argc, char **argv)
         return cmd_scan(config_path, &opts);
     if (strcmp(argv[1], "calibrate-white") == 0)
         return cmd_calibrate_white(config_path, white_albedo);
+    if (strcmp(argv[1], "selftest") == 0)
+        return cmd_selftest(config_path);
     usage(stderr);
     return 2;
 }

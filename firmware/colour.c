@@ -93,6 +93,17 @@ static double incidence(const struct colour_params *prm, vec3 p, vec3 n, vec3 sr
     return v3_dot(n, v3_scale(to, 1.0 / d));
 }
 
+/* How far a source's mirror reflection at p (normal n) is from the camera, as the weight of
+ * Jost et al., eq. 6: (1 - cos^ke alpha)^ko; 0 in the middle of a highlight, 1 away from it. */
+static double specular_weight(const struct colour_params *prm, vec3 p, vec3 n, vec3 src)
+{
+    vec3 view = v3_norm(v3_scale(p, -1.0)); /* the camera is the origin */
+    vec3 s = v3_norm(v3_sub(src, p));
+    vec3 refl = v3_sub(v3_scale(n, 2.0 * v3_dot(s, n)), s);
+    double cos_a = v3_dot(refl, view);
+    return pow(1.0 - pow(cos_a > 0.0 ? cos_a : 0.0, prm->ke), prm->ko);
+}
+
 /* Albedo 0..1 as the stored byte 0..255, rounded and clamped. */
 static uint8_t albedo_byte(double albedo)
 {
@@ -108,17 +119,18 @@ static void white_balance(const struct colour_params *prm, uint8_t *rgb)
         rgb[k] = albedo_byte(rgb[k] * prm->white_scale[k]);
 }
 
-/* Albedo estimate of valid pixel i: numerator per channel and the denominator (0: none).
- * @p relaxed: the best effort for a pixel without a reliable estimate (grazing or saturated
- * light still used). */
+/* Albedo estimate of valid pixel i: numerator per channel and the denominator (0: none), and
+ * how much the fusion may trust it (@p confidence, 0..; not clamped). @p relaxed: the best
+ * effort for a pixel without a reliable estimate (grazing or saturated light still used). */
 static double pixel_estimate(const struct frame_ctx *f, const struct scan_calib *c, vec3 proj,
                              const uint8_t *white, size_t i, vec3 p, vec3 nn, int relaxed,
-                             double num[3])
+                             double num[3], double *confidence)
 {
     const struct colour_params *prm = f->prm;
     const double min_cos = relaxed ? 0.02 : prm->min_cos;
     double den = 0.0, light[3];
     num[0] = num[1] = num[2] = 0.0;
+    *confidence = 0.0;
     if (prm->method == COLOUR_SINGLE) { /* eq. 4 */
         double fall, ct = incidence(prm, p, nn, proj, &fall);
         int ok = frame_light(f, COLOUR_FRAME_DARK, &white[3 * i], i, light);
@@ -126,14 +138,23 @@ static double pixel_estimate(const struct frame_ctx *f, const struct scan_calib 
             return 0.0;
         for (int k = 0; k < 3; k++)
             num[k] = light[k] * fall;
+        *confidence = ct * specular_weight(prm, p, nn, proj);
         return ct;
     }
     if (prm->method == COLOUR_UNIFORM) { /* method 2 */
         int ok = frame_light(f, COLOUR_FRAME_ALL, &f->frames[COLOUR_FRAME_ALL][3 * i], i, num);
         int lit = (num[0] + num[1] + num[2]) / 3.0 > prm->shadow_dn; /* not every light shadowed */
+        /* the estimate cannot take a highlight out, so a pixel near any light's mirror
+         * direction is trusted less: the fusion takes its colour from another view */
+        *confidence = 1.0;
+        for (uint32_t l = 0; l < c->light_count; l++) {
+            vec3 src = v3_from(c->light_pos_mm[l]);
+            double w = specular_weight(prm, p, nn, src);
+            if (v3_dot(nn, v3_sub(src, p)) > 0.0 && w < *confidence)
+                *confidence = w;
+        }
         return (ok && lit) || relaxed ? 1.0 : 0.0;
     }
-    vec3 view = v3_norm(v3_scale(p, -1.0));
     for (uint32_t l = 0; l < c->light_count; l++) { /* eq. 6, shadowed lights weigh 0 */
         uint32_t k = COLOUR_FRAME_LIGHT0 + l;
         double fall, ct = incidence(prm, p, nn, v3_from(c->light_pos_mm[l]), &fall);
@@ -141,14 +162,12 @@ static double pixel_estimate(const struct frame_ctx *f, const struct scan_calib 
         if ((!ok && !relaxed) || ct < min_cos ||
             (light[0] + light[1] + light[2]) / 3.0 <= prm->shadow_dn)
             continue;
-        vec3 s = v3_norm(v3_sub(v3_from(c->light_pos_mm[l]), p));
-        vec3 refl = v3_sub(v3_scale(nn, 2.0 * v3_dot(s, nn)), s);
-        double cos_a = v3_dot(refl, view);
-        double w = pow(1.0 - pow(cos_a > 0.0 ? cos_a : 0.0, prm->ke), prm->ko);
+        double w = specular_weight(prm, p, nn, v3_from(c->light_pos_mm[l]));
         for (int k = 0; k < 3; k++)
             num[k] += light[k] * fall * w;
         den += ct * w;
     }
+    *confidence = den;
     return den;
 }
 
@@ -181,11 +200,11 @@ int colour_compute(const struct colour_params *prm, const struct scan_calib *c,
             continue;
         vec3 p = v3(r->xyz_mm[3 * i], r->xyz_mm[3 * i + 1], r->xyz_mm[3 * i + 2]);
         vec3 nn = v3(r->normal[3 * i], r->normal[3 * i + 1], r->normal[3 * i + 2]);
-        double num[3], den = pixel_estimate(&f, c, proj, white, i, p, nn, 0, num);
-        float conf = (float)(den > 1.0 ? 1.0 : den);
+        double num[3], trust, den = pixel_estimate(&f, c, proj, white, i, p, nn, 0, num, &trust);
+        float conf = (float)(trust > 1.0 ? 1.0 : trust);
         if (den <= 1e-6) { /* no reliable estimate: a best effort that weighs nothing in the
                               fusion unless no view has better (raw colour is not an albedo) */
-            den = pixel_estimate(&f, c, proj, white, i, p, nn, 1, num);
+            den = pixel_estimate(&f, c, proj, white, i, p, nn, 1, num, &trust);
             conf = 0.0f;
         }
         if (den <= 1e-6)

@@ -99,6 +99,8 @@ int sim_mesh_sphere(struct sim_mesh *m, double r, uint32_t seg)
     return single_grid_mesh(m, seg, seg / 2, sphere_fn, shape);
 }
 
+#define CAN_BODY_V 0.6 /* share of the can's side grid rows on its body */
+
 static vec3 cyl_side_fn(double u, double v, const double *s)
 {
     double phi = 2.0 * M_PI * u;
@@ -120,6 +122,37 @@ int sim_mesh_cylinder(struct sim_mesh *m, double r, double h, uint32_t seg)
     uint32_t vert = 0, tri = 0;
     double side[2] = {r, h}, top[3] = {r, h, 1.0}, bottom[3] = {r, h, 0.0};
     add_grid(m, &vert, &tri, nu, nv, cyl_side_fn, side);
+    add_grid(m, &vert, &tri, nu, nc, cyl_cap_fn, top);
+    add_grid(m, &vert, &tri, nu, nc, cyl_cap_fn, bottom);
+    m->vert_count = vert;
+    m->tri_count = tri;
+    sim_mesh_compute_normals(m);
+    return 0;
+}
+
+/* A spray can's side, body then shoulder, s = {r, h}: the body rises to 0.775 h; the shoulder, a
+ * quarter ellipse, narrows it to a 0.25 r neck at h (vertical where it meets the body, so the
+ * normals run on smoothly). Unlike a plain cylinder's side, the shoulder faces up towards
+ * the camera and the lights, so it shows their highlights. */
+static vec3 can_side_fn(double u, double v, const double *s)
+{
+    double phi = 2.0 * M_PI * u, r = s[0], h = s[1], body = 0.775 * h;
+    if (v <= CAN_BODY_V)
+        return v3(r * cos(phi), r * sin(phi), body * v / CAN_BODY_V);
+    double t = 0.5 * M_PI * (v - CAN_BODY_V) / (1.0 - CAN_BODY_V);
+    double rad = r * (0.25 + 0.75 * cos(t));
+    return v3(rad * cos(phi), rad * sin(phi), body + (h - body) * sin(t));
+}
+
+int sim_mesh_can(struct sim_mesh *m, double r, double h, uint32_t seg)
+{
+    uint32_t nu = seg, nv = seg / 2, nc = seg / 8 + 1;
+    int rc = mesh_alloc(m, grid_verts(nu, nv) + 2 * grid_verts(nu, nc), 2 * nu * (nv + 2 * nc));
+    if (rc != 0)
+        return rc;
+    uint32_t vert = 0, tri = 0;
+    double side[2] = {r, h}, top[3] = {0.25 * r, h, 1.0}, bottom[3] = {r, h, 0.0};
+    add_grid(m, &vert, &tri, nu, nv, can_side_fn, side);
     add_grid(m, &vert, &tri, nu, nc, cyl_cap_fn, top);
     add_grid(m, &vert, &tri, nu, nc, cyl_cap_fn, bottom);
     m->vert_count = vert;

@@ -16,6 +16,8 @@ struct sim_mesh {
 /** @retval 0 ok @retval -ENOMEM */
 int sim_mesh_sphere(struct sim_mesh *m, double radius_mm, uint32_t segments);
 int sim_mesh_cylinder(struct sim_mesh *m, double radius_mm, double height_mm, uint32_t segments);
+/** A spray can: a cylinder of @p radius_mm whose top quarter narrows in a rounded shoulder. */
+int sim_mesh_can(struct sim_mesh *m, double radius_mm, double height_mm, uint32_t segments);
 int sim_mesh_box(struct sim_mesh *m, double sx_mm, double sy_mm, double sz_mm, uint32_t segments);
 int sim_mesh_torus(struct sim_mesh *m, double major_mm, double minor_mm, uint32_t segments);
 /** Load an ASCII or binary little-endian PLY (vertex x y z, uchar red green blue when present,

@@ -68,6 +68,8 @@ static int build_object(struct sim_rig *rig, const char *dir, char *err, size_t 
         rc = sim_mesh_sphere(&rig->mesh, 0.5 * h, c->segments);
     else if (strcmp(c->object, "cylinder") == 0)
         rc = sim_mesh_cylinder(&rig->mesh, 0.3 * h, h, c->segments);
+    else if (strcmp(c->object, "can") == 0)
+        rc = sim_mesh_can(&rig->mesh, 0.3 * h, h, c->segments);
     else if (strcmp(c->object, "box") == 0)
         rc = sim_mesh_box(&rig->mesh, 0.6 * h, 0.45 * h, h, c->segments);
     else if (strcmp(c->object, "torus") == 0) /* lying flat: h is its outer diameter */
@@ -189,6 +191,8 @@ static int occluded(const struct sim_rig *rig, vec3 p_obj, vec3 n_obj, vec3 src_
     vec3 start = v3_add(p_obj, v3_scale(n_obj, 0.01)); /* 10 um off the surface */
     return sim_bvh_occluded(&rig->bvh, start, v3_sub(src_obj, start), 1e-6, 1.0 - 1e-6);
 }
+
+#define DIFFUSER_SAMPLES 32
 
 static double falloff(const struct sim_rig *rig, double dist_mm)
 {
@@ -320,21 +324,32 @@ static double pattern_light(const struct sim_rig *rig, uint32_t pattern, double 
     return black + (1.0 - black) * lit;
 }
 
-/* Light-i radiance at pixel i, computed on the fly (light frames are few). */
+/* Light-i radiance at pixel i, computed on the fly (light frames are few). A light with a
+ * diffuser is a disk of light_diffuser_mm facing the point, sampled at DIFFUSER_SAMPLES points
+ * (a Vogel spiral, the same every frame, so no noise is added); its shadow is the centre's. */
 static void add_light(const struct sim_rig *rig, size_t i, uint32_t li, double sig[3])
 {
     if (!(rig->light_vis[i] & (1u << li)))
         return;
     const float *pc = &rig->truth.pos_cam[3 * i], *nc = &rig->truth.normal_cam[3 * i];
     const float *al = &rig->truth.albedo[3 * i];
-    vec3 p = v3(pc[0], pc[1], pc[2]);
-    vec3 to_light = v3_sub(v3_from(rig->calib.light_pos_mm[li]), p);
-    double albedo[3] = {al[0], al[1], al[2]}, rho[3];
-    sim_material_eval(&rig->material, albedo, v3(nc[0], nc[1], nc[2]), v3_norm(to_light),
-                      v3_norm(v3_scale(p, -1.0)), rho);
-    double e = rig->cfg.light_intensity_dn * falloff(rig, v3_len(to_light));
-    for (int k = 0; k < 3; k++)
-        sig[k] += e * rho[k];
+    vec3 p = v3(pc[0], pc[1], pc[2]), n = v3(nc[0], nc[1], nc[2]);
+    vec3 centre = v3_from(rig->calib.light_pos_mm[li]), view = v3_norm(v3_scale(p, -1.0));
+    double albedo[3] = {al[0], al[1], al[2]}, radius = rig->cfg.light_diffuser_mm;
+    int samples = radius > 0.0 ? DIFFUSER_SAMPLES : 1;
+    vec3 axis = v3_norm(v3_sub(centre, p));
+    vec3 e1 = v3_norm(v3_cross(axis, fabs(axis.x) < 0.9 ? v3(1, 0, 0) : v3(0, 1, 0)));
+    vec3 e2 = v3_cross(axis, e1);
+    for (int j = 0; j < samples; j++) {
+        double r = radius * sqrt((j + 0.5) / samples), phi = j * 2.39996322972865332; /* golden */
+        vec3 src = v3_add(centre, v3_add(v3_scale(e1, r * cos(phi)), v3_scale(e2, r * sin(phi))));
+        vec3 to_light = v3_sub(src, p);
+        double rho[3];
+        sim_material_eval(&rig->material, albedo, n, v3_norm(to_light), view, rho);
+        double e = rig->cfg.light_intensity_dn * falloff(rig, v3_len(to_light)) / samples;
+        for (int k = 0; k < 3; k++)
+            sig[k] += e * rho[k];
+    }
 }
 
 void sim_rig_render(struct sim_rig *rig, const struct sim_sources *src, uint64_t frame_no,

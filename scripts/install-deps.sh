@@ -1,12 +1,28 @@
 #!/bin/sh
 # Installs the Debian 12 packages the scanner builds and tests with (called by make when
 # pkg-config cannot find one of them). Needs root, as on the CI machine and a fresh rig.
-# With the argument "test" it adds what only the tests use (Open3D reads our PLY files), with
-# "bench" what only the benchmarks use (OpenCV to compare with, valgrind).
+# With the argument "test" it adds what only the tests use (Open3D reads our PLY files; the
+# libcamera backend is compiled and tested without a camera), with
+# "bench" what only the benchmarks use (OpenCV to compare with, valgrind), with a target triplet
+# (aarch64-linux-gnu) what cross-building for it needs.
 set -eu
 pkgs="build-essential pkg-config libinih-dev libpng-dev libcmocka-dev libmodbus-dev libgpiod-dev"
 [ "${1:-}" = "bench" ] && pkgs="$pkgs g++ libopencv-dev libopencv-contrib-dev valgrind"
-[ "${1:-}" = "test" ] && pkgs="$pkgs python3 python3-numpy python3-open3d python3-pymodbus python3-serial python3-serial-asyncio socat"
+[ "${1:-}" = "test" ] && pkgs="$pkgs python3 python3-numpy python3-open3d python3-pymodbus python3-serial python3-serial-asyncio socat g++ libcamera-dev systemd"
+# A cross build's target (make CROSS_COMPILE=aarch64-linux-gnu-): its compiler, its -dev
+# packages through Debian's multiarch, and qemu-user to run its tests.
+case "${1:-}" in
+*-linux-gnu*)
+    arch=$(dpkg-architecture -t "$1" -q DEB_HOST_ARCH 2>/dev/null || echo arm64)
+    pkgs="pkg-config gcc-$1 binutils-$1 qemu-user"
+    for p in libinih-dev libpng-dev libcmocka-dev libmodbus-dev libgpiod-dev; do
+        pkgs="$pkgs $p:$arch"
+    done
+    if ! dpkg --print-foreign-architectures | grep -qx "$arch"; then
+        [ "$(id -u)" -eq 0 ] && dpkg --add-architecture "$arch" || sudo dpkg --add-architecture "$arch"
+    fi
+    ;;
+esac
 missing=""
 for p in $pkgs; do
     dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"

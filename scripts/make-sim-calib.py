@@ -4,7 +4,8 @@
 The simulated rig renders with exactly this calibration, so it is also the ground truth.
 Rig, in the turntable frame (origin at the table centre, z up): camera 600 mm out on +x at
 230 mm height, projector at the same radius and height 25 degrees around, both aimed at the
-point 75 mm above the table centre; four white lights around the front half.
+point 75 mm above the table centre; white lights as the layout argument says.
+Usage: make-sim-calib.py [OUT.ini [front|ring]]
 """
 import math, sys
 
@@ -31,10 +32,18 @@ R = matmul(R_pw, transpose(R_cw))
 t = matvec(R_pw, sub(cam, proj))
 axis_pt = matvec(R_cw, sub([0, 0, 0], cam))
 axis_dir = matvec(R_cw, [0, 0, 1])
+# "front" (config/sim-calib.ini): four lights high around the front half.
+# "ring" (tests/eval/ring-calib.ini): eight lights around the camera, above, to the sides and
+# level with the table, so that all lights on is near-uniform light on the side the camera sees
+# (what the constant-illumination method assumes).
+layout = sys.argv[2] if len(sys.argv) > 2 else "front"
+spots = {"front": [(-70, 450, 380.0), (-30, 450, 380.0), (30, 450, 380.0), (70, 450, 380.0)],
+         "ring": [(-40, 500, 420.0), (40, 500, 420.0), (-80, 450, 200.0), (80, 450, 200.0),
+                  (-35, 500, 30.0), (35, 500, 30.0), (-100, 450, 30.0), (100, 450, 30.0)]}[layout]
 lights = []
-for deg in (-70, -30, 30, 70):
+for deg, radius, height in spots:
     b = math.radians(deg)
-    lights.append(matvec(R_cw, sub([450 * math.cos(b), 450 * math.sin(b), 380.0], cam)))
+    lights.append(matvec(R_cw, sub([radius * math.cos(b), radius * math.sin(b), height], cam)))
 
 f = lambda v: ", ".join("%.9f" % x for x in v)
 out = open(sys.argv[1] if len(sys.argv) > 1 else "config/sim-calib.ini", "w")

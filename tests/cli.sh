@@ -22,7 +22,40 @@ check() { # name, then a command that must succeed
 mkdir -p "$out"
 check version sh -c "$bin --version | grep -q 'HAL=sim'"
 check check_config sh -c "$bin check-config --config config/sim.ini | grep -q ': ok'"
+check selftest_sim sh -c "$bin selftest --config config/sim.ini > $out/selftest.txt &&
+    test \$(grep -c ' ok ' $out/selftest.txt) -eq 4"
+# The appliance build on a machine without its devices: each one MISSING with its path and
+# why, and a non-zero exit (issue 5).
+lbin=${BUILD:-build}/linux/scanner
+check selftest_appliance_without_devices sh -c "$lbin selftest --config config/pi-v4l2.ini \
+    > $out/selftest-pi.txt 2>/dev/null; test \$? -eq 1 &&
+    grep -q '^camera .*/dev/video0 .*MISSING camera /dev/video0: open: No such device' $out/selftest-pi.txt &&
+    grep -q '^gpio .*gpiochip0 .*MISSING gpio: cannot open chip' $out/selftest-pi.txt &&
+    grep -q '^turntable .*/dev/ttyUSB0 .*MISSING turntable: cannot connect to /dev/ttyUSB0' $out/selftest-pi.txt &&
+    grep -q '^calibration .*MISSING' $out/selftest-pi.txt"
+check selftest_libcamera_without_camera sh -c "$lbin selftest --config config/pi-libcamera.ini \
+    > $out/selftest-lc.txt 2>/dev/null; test \$? -eq 1 &&
+    grep -Eq '^camera .*MISSING camera libcamera .auto.: (CameraManager::get: no such camera|this scanner was built without)' $out/selftest-lc.txt"
 printf '[camera]\nbackend = sim\nwidth = 1280\nheight = 960\nexposure_us = 10000\nexposur = 1\n' >"$out/bad.ini"
+# make install into a staging tree: every file in place, the unit accepted by systemd, and a
+# config the user edited kept (the new example goes beside it as .dist).
+stage=$PWD/$out/stage
+unit="$stage/lib/systemd/system/scanner@.service"
+check install_tree sh -c "rm -rf $stage && make -s install DESTDIR=$stage PREFIX=/usr >/dev/null &&
+    test -x $stage/usr/bin/scanner && test -f $stage/etc/scanner/pi-v4l2.ini &&
+    test -f $stage/etc/scanner/pi-libcamera.ini && test -f $stage/usr/lib/sysusers.d/scanner.conf &&
+    test -f $stage/usr/lib/udev/rules.d/60-scanner-gpio.rules &&
+    grep -q 'exec /usr/bin/scanner scan --config /etc/scanner/%i.ini' '$unit' &&
+    grep -q '^User=scanner' '$unit' && grep -q '^SupplementaryGroups=video gpio dialout' '$unit' &&
+    grep -q '^NoNewPrivileges=yes' '$unit' && grep -q '^ProtectSystem=strict' '$unit'"
+check install_keeps_edited_config sh -c "echo '; edited' >> $stage/etc/scanner/pi-v4l2.ini &&
+    make -s install DESTDIR=$stage PREFIX=/usr >/dev/null &&
+    tail -n 1 $stage/etc/scanner/pi-v4l2.ini | grep -q '; edited' &&
+    cmp -s config/pi-v4l2.ini $stage/etc/scanner/pi-v4l2.ini.dist"
+check systemd_accepts_unit sh -c "cd '$stage/lib/systemd/system' &&
+    systemd-analyze verify 'scanner@pi-v4l2.service' > $PWD/$out/verify.txt 2>&1; rc=\$?;
+    cat $PWD/$out/verify.txt; test \$rc -eq 0 && ! test -s $PWD/$out/verify.txt &&
+    systemd-sysusers --root=$stage --dry-run >/dev/null"
 check bad_config_names_file_line_key sh -c \
     "$bin scan --config $out/bad.ini 2>&1 | grep -q '$out/bad.ini:6: \[camera\] exposur: unknown key'"
 check bad_config_exit_code sh -c "$bin scan --config $out/bad.ini; test \$? -eq 2"

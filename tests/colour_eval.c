@@ -30,7 +30,9 @@
 #define MAX_VIEWS 64
 #define EDGE_MM 1.5         /* paint within this of a vertex must be one colour */
 #define MATCH_MM 1.0        /* a result vertex farther from the truth is not compared */
-#define HIGHLIGHT_RATIO 1.3 /* luminance / true luminance above this x the median: highlight */
+#define HIGHLIGHT_WHITE 0.3 /* white added, as a share of the diffuse colour: a highlight */
+#define GREY_VARIANCE 0.004 /* paint whose channels vary less is too grey for white_fit() */
+#define MAX_PAINTS 16
 #define CLOSEUP_PX 320
 
 struct rig_views {
@@ -141,11 +143,6 @@ static int true_albedo(const struct rig_views *r, vec3 p, double albedo[3])
     return 0;
 }
 
-static double luminance(const double rgb[3])
-{
-    return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2] + 1e-6;
-}
-
 static void lab_of(const uint8_t rgb[3], double lab[3])
 {
     double lin[3] = {rgb[0] / 255.0, rgb[1] / 255.0, rgb[2] / 255.0};
@@ -199,13 +196,14 @@ static void cloud_free(struct cloud *c)
     free(c->key);
 }
 
-/* The view's colour at @p p: the mean of its points within MATCH_MM (about 50 pixels), so that
- * a step measures what differs between views, not the pixels' noise. @retval 1 found */
-static int cloud_colour(const struct cloud *c, vec3 p, uint8_t rgb[3])
+/* The view's colour at @p p as the fusion takes it: the mean of its points within MATCH_MM
+ * (about 50 pixels) weighted by their confidence, so that a step measures what differs between
+ * views, not the pixels' noise. @retval 1 found */
+static int cloud_colour(const struct cloud *c, vec3 p, uint8_t rgb[3], double *mean_weight)
 {
+    int count = 0;
     int64_t cx = (int64_t)floor(p.x), cy = (int64_t)floor(p.y), cz = (int64_t)floor(p.z);
-    double sum[3] = {0, 0, 0};
-    int found = 0;
+    double sum[3] = {0, 0, 0}, weight = 0.0;
     for (int64_t dz = -1; dz <= 1; dz++)
         for (int64_t dy = -1; dy <= 1; dy++)
             for (int64_t dx = -1; dx <= 1; dx++) {
@@ -224,14 +222,18 @@ static int cloud_colour(const struct cloud *c, vec3 p, uint8_t rgb[3])
                     if (v3_len(v3_sub(p, v3(q[0], q[1], q[2]))) >= MATCH_MM ||
                         (c->pts.quality != NULL && c->pts.quality[i] <= 0.0f))
                         continue; /* no colour estimate there (saturated, every light grazing) */
+                    double w = c->pts.quality != NULL ? c->pts.quality[i] : 1.0;
                     for (int k = 0; k < 3; k++)
-                        sum[k] += c->pts.rgb[3 * i + (size_t)k];
-                    found++;
+                        sum[k] += w * c->pts.rgb[3 * i + (size_t)k];
+                    weight += w;
+                    count++;
                 }
             }
-    for (int k = 0; found > 0 && k < 3; k++)
-        rgb[k] = (uint8_t)(sum[k] / found + 0.5);
-    return found > 0;
+    if (mean_weight != NULL)
+        *mean_weight = count ? weight / count : 0.0;
+    for (int k = 0; weight > 0.0 && k < 3; k++)
+        rgb[k] = (uint8_t)(sum[k] / weight + 0.5);
+    return weight > 0.0;
 }
 
 /* ---- measure ---- */
@@ -240,8 +242,116 @@ struct vertex_eval {
     int usable;     /* compared with the truth */
     int view;       /* dominant view, -1 none */
     vec3 truth_pos; /* closest true point */
+    double albedo[3];
     double lab_true[3], lab_got[3];
 };
+
+/* White light on top of a colour: @p got fitted as a * albedo + b * (1, 1, 1) (least squares).
+ * A shading or white-reference error scales the albedo (a); a highlight adds white, since the
+ * lights are white (b), and so does an offset left in (none keeps Ca). @retval -1 where the
+ * paint is too grey to tell the two apart */
+static int white_fit(const double got[3], const double albedo[3], double *a, double *b)
+{
+    double s_aa = 0.0, s_a = 0.0, s_ag = 0.0, s_g = 0.0;
+    for (int k = 0; k < 3; k++) {
+        s_aa += albedo[k] * albedo[k];
+        s_a += albedo[k];
+        s_ag += albedo[k] * got[k];
+        s_g += got[k];
+    }
+    double det = 3.0 * s_aa - s_a * s_a; /* 9 x the variance of the channels */
+    if (det < 9.0 * GREY_VARIANCE)
+        return -1;
+    *a = (3.0 * s_ag - s_a * s_g) / det;
+    *b = (s_aa * s_g - s_a * s_ag) / det;
+    return 0;
+}
+
+static int cmp_double(const void *a, const void *b);
+
+static double median(double *v, size_t n)
+{
+    qsort(v, n, sizeof(double), cmp_double);
+    return n ? v[n / 2] : NAN;
+}
+
+/* The paint of a vertex, as an index into @p paints (added when new; at most MAX_PAINTS). */
+static int paint_index(double paints[][3], int *count, const double albedo[3])
+{
+    for (int k = 0; k < *count; k++)
+        if (memcmp(paints[k], albedo, sizeof(paints[k])) == 0)
+            return k;
+    if (*count == MAX_PAINTS)
+        return -1;
+    memcpy(paints[*count], albedo, sizeof(paints[0]));
+    return (*count)++;
+}
+
+/* Highlight shares: of the fused vertices, and of the views' own colours at them (each view's
+ * visible surface, weighted by the confidence it gives its colour there, as the fusion is). A
+ * colour carries a highlight where the white in it (white_fit) exceeds the method's usual white for
+ * that paint (its median over the model: an offset such as none's Ca) by HIGHLIGHT_WHITE x the
+ * paint's usual diffuse part. Chromatic paint only. */
+static int highlight_shares(const struct sim_mesh *res, const struct vertex_eval *ve,
+                            const struct cloud *clouds, uint32_t views, double *fused,
+                            double *per_view)
+{
+    double paints[MAX_PAINTS][3], base_b[MAX_PAINTS], unit[MAX_PAINTS];
+    int npaint = 0, *paint = malloc(sizeof(int) * res->vert_count);
+    double *fa = malloc(sizeof(double) * res->vert_count),
+           *fb = malloc(sizeof(double) * res->vert_count);
+    double *tmp = malloc(sizeof(double) * res->vert_count);
+    if (paint == NULL || fa == NULL || fb == NULL || tmp == NULL) {
+        free(paint), free(fa), free(fb), free(tmp);
+        return -ENOMEM;
+    }
+    for (uint32_t i = 0; i < res->vert_count; i++) {
+        double got[3];
+        for (int k = 0; k < 3; k++)
+            got[k] = res->rgb[3 * i + k] / 255.0;
+        paint[i] = -1;
+        if (ve[i].usable && white_fit(got, ve[i].albedo, &fa[i], &fb[i]) == 0)
+            paint[i] = paint_index(paints, &npaint, ve[i].albedo);
+    }
+    for (int p = 0; p < npaint; p++) { /* the paint's usual white and diffuse part */
+        size_t n = 0;
+        for (uint32_t i = 0; i < res->vert_count; i++)
+            if (paint[i] == p)
+                tmp[n++] = fb[i];
+        base_b[p] = median(tmp, n);
+        n = 0;
+        for (uint32_t i = 0; i < res->vert_count; i++)
+            if (paint[i] == p)
+                tmp[n++] = fa[i];
+        unit[p] = median(tmp, n) * (paints[p][0] + paints[p][1] + paints[p][2]) / 3.0;
+    }
+    size_t fn = 0, fh = 0;
+    double vn = 0.0, vh = 0.0;
+    for (uint32_t i = 0; i < res->vert_count; i++) {
+        int p = paint[i];
+        if (p < 0)
+            continue;
+        fn++;
+        fh += fb[i] - base_b[p] > HIGHLIGHT_WHITE * unit[p];
+        const float *q = &res->pos[3 * i];
+        for (uint32_t v = 0; v < views; v++) {
+            uint8_t rgb[3];
+            double got[3], a, b, w;
+            if (!cloud_colour(&clouds[v], v3(q[0], q[1], q[2]), rgb, &w))
+                continue;
+            for (int k = 0; k < 3; k++)
+                got[k] = rgb[k] / 255.0;
+            if (white_fit(got, ve[i].albedo, &a, &b) != 0)
+                continue;
+            vn += w; /* as much as the fusion will take from this view here */
+            vh += w * (b - base_b[p] > HIGHLIGHT_WHITE * unit[p]);
+        }
+    }
+    *fused = fn ? (double)fh / fn : NAN;
+    *per_view = vn > 0.0 ? vh / vn : NAN;
+    free(paint), free(fa), free(fb), free(tmp);
+    return 0;
+}
 
 static int cmp_double(const void *a, const void *b)
 {
@@ -289,8 +399,8 @@ static void boundary_steps(const struct sim_mesh *res, const struct vertex_eval 
             uint8_t ca[3], cb[3];
             const float *p = &res->pos[3 * a];
             vec3 q = v3(p[0], p[1], p[2]);
-            if (cloud_colour(&clouds[ve[a].view], q, ca) &&
-                cloud_colour(&clouds[ve[b].view], q, cb)) {
+            if (cloud_colour(&clouds[ve[a].view], q, ca, NULL) &&
+                cloud_colour(&clouds[ve[b].view], q, cb, NULL)) {
                 double la[3], lb[3];
                 lab_of(ca, la);
                 lab_of(cb, lb);
@@ -324,16 +434,15 @@ static int cmd_measure(const char *scan_dir, const char *result_dir, const char 
     }
     struct vertex_eval *ve = calloc(res.vert_count, sizeof(*ve));
     double *de = calloc(res.vert_count, sizeof(double));
-    double *ratio = calloc(res.vert_count, sizeof(double));
     double mae[3] = {0, 0, 0};
-    size_t used = 0, highlight = 0;
-    for (uint32_t i = 0; ve != NULL && de != NULL && ratio != NULL && i < res.vert_count; i++) {
+    size_t used = 0;
+    for (uint32_t i = 0; ve != NULL && de != NULL && i < res.vert_count; i++) {
         const float *p = &res.pos[3 * i], *n = &res.normal[3 * i];
         vec3 q;
         ve[i].view = -1;
         if (sim_bvh_closest(&bvh, v3(p[0], p[1], p[2]), MATCH_MM, &q) >= MATCH_MM)
             continue;
-        double albedo[3], got[3];
+        double *albedo = ve[i].albedo, got[3];
         ve[i].truth_pos = q;
         ve[i].view = dominant_view(&r, &bvh, q, v3(n[0], n[1], n[2]));
         if (true_albedo(&r, q, albedo) != 0)
@@ -345,7 +454,6 @@ static int cmd_measure(const char *scan_dir, const char *result_dir, const char 
         }
         colour_linear_rgb_to_lab(albedo, ve[i].lab_true);
         colour_linear_rgb_to_lab(got, ve[i].lab_got);
-        ratio[used] = luminance(got) / luminance(albedo);
         de[used++] = colour_ciede2000(ve[i].lab_true, ve[i].lab_got);
     }
     if (used == 0) {
@@ -353,27 +461,17 @@ static int cmd_measure(const char *scan_dir, const char *result_dir, const char 
                 result_dir);
         return 1;
     }
-    /* highlight: brighter than the method's typical brightness for that paint (scale-free, so
-     * an offset or a white-reference error is not counted as highlight) */
     double sum = 0.0;
     for (size_t i = 0; i < used; i++)
         sum += de[i];
-    double *sorted = malloc(sizeof(double) * used);
-    if (sorted == NULL)
-        return 1;
-    memcpy(sorted, ratio, sizeof(double) * used);
-    qsort(sorted, used, sizeof(double), cmp_double);
-    for (size_t i = 0; i < used; i++)
-        highlight += ratio[i] > HIGHLIGHT_RATIO * sorted[used / 2];
-    free(sorted);
-    free(ratio);
     qsort(de, used, sizeof(double), cmp_double);
-    double view_step, fused_step;
+    double view_step, fused_step, hl_fused, hl_views;
     boundary_steps(&res, ve, clouds, &view_step, &fused_step);
-    printf("%s,%zu,%.3f,%.3f,%.4f,%.4f,%.4f,%.3f,%.3f,%.4f,%.4f\n", label, used, sum / used,
+    if (highlight_shares(&res, ve, clouds, r.views, &hl_fused, &hl_views) != 0)
+        return 1;
+    printf("%s,%zu,%.3f,%.3f,%.4f,%.4f,%.4f,%.3f,%.3f,%.4f,%.4f,%.4f\n", label, used, sum / used,
            de[(size_t)(0.95 * (double)(used - 1))], mae[0] / used, mae[1] / used, mae[2] / used,
-           view_step, fused_step, (double)highlight / used,
-           registration_coupling(result_dir, r.views));
+           view_step, fused_step, hl_views, hl_fused, registration_coupling(result_dir, r.views));
     free(ve);
     free(de);
     for (uint32_t v = 0; v < r.views; v++)
@@ -512,7 +610,7 @@ int main(int argc, char **argv)
         return cmd_closeup(argv[2], argv[3], argc - 4, argv + 4);
     if (argc == 2 && strcmp(argv[1], "header") == 0) {
         printf("label,vertices,de2000_mean,de2000_p95,mae_r,mae_g,mae_b,view_step_de2000,"
-               "fused_step_de2000,highlight_share,icp_coupling\n");
+               "fused_step_de2000,highlight_views,highlight_fused,icp_coupling\n");
         return 0;
     }
     fprintf(stderr, "usage: colour-eval header\n"

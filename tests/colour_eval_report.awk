@@ -10,9 +10,9 @@ NR == 1 { next }
     scenes[$1] = 1
     if (!($1 in order)) { order[$1] = ++nscenes; name[nscenes] = $1 }
     de[key] = $4; p95[key] = $5; mae[key] = ($6 + $7 + $8) / 3
-    step[key] = $9; hl[key] = $11; icp[key] = $12
-    row[key] = sprintf("| %s | %s | %d | %.2f | %.2f | %.3f / %.3f / %.3f | %.2f | %.2f | %.2f%% | %.1f%% |",
-                       $1, $2, $3, $4, $5, $6, $7, $8, $9, $10, 100 * $11, 100 * $12)
+    step[key] = $9; hl[key] = $11; hlf[key] = $12; icp[key] = $13
+    row[key] = sprintf("| %s | %s | %d | %.2f | %.2f | %.3f / %.3f / %.3f | %.2f | %.2f | %.2f%% | %.2f%% | %.1f%% |",
+                       $1, $2, $3, $4, $5, $6, $7, $8, $9, $10, 100 * $11, 100 * $12, 100 * $13)
 }
 END {
     split("none single uniform multi", methods, " ")
@@ -26,11 +26,14 @@ END {
     print "0..1); view step: CIEDE2000 between the two views' own colours where the dominant view"
     print "changes (the seam that blending has to hide); fused step: CIEDE2000 across those boundary"
     print "edges in the fused mesh (same true paint on both ends); highlight: share of the surface"
-    print "brighter than 1.3 x the method's median for its paint; ICP coupling: mean coupled share"
-    print "of the overlap of consecutive views (Jost et al. Table 2)."
+    print "whose colour carries white light on top of its paint (the colour fitted as a x albedo +"
+    print "b x white, b above 0.3 x the diffuse part; chromatic paint only, as white on ivory is"
+    print "not told from brightness), in the views' own colours as the fusion takes them (views)"
+    print "and in the fused model (fused); ICP coupling: mean coupled share of the overlap of"
+    print "consecutive views (Jost et al. Table 2)."
     print ""
-    print "| scene | method | vertices | dE00 mean | dE00 p95 | MAE r / g / b | view step dE00 | fused step dE00 | highlight | ICP coupling |"
-    print "|---|---|---|---|---|---|---|---|---|---|"
+    print "| scene | method | vertices | dE00 mean | dE00 p95 | MAE r / g / b | view step dE00 | fused step dE00 | highlight views | highlight fused | ICP coupling |"
+    print "|---|---|---|---|---|---|---|---|---|---|---|"
     for (s = 1; s <= nscenes; s++)
         for (m = 1; m <= 4; m++)
             if ((name[s] "," methods[m]) in row)
@@ -40,7 +43,7 @@ END {
     print ""
     if (("can,multi") in de) {
         check(de["can,multi"] < 3, sprintf("specular can, multi: mean dE00 %.2f < 3", de["can,multi"]))
-        check(hl["can,multi"] < 0.01, sprintf("specular can, multi: highlight %.2f%% < 1%%", 100 * hl["can,multi"]))
+        check(hl["can,multi"] < 0.01 && hlf["can,multi"] < 0.01, sprintf("specular can, multi: highlight %.2f%% (views) and %.2f%% (fused) < 1%%", 100 * hl["can,multi"], 100 * hlf["can,multi"]))
     }
     if (("owl,single") in de) {
         check(de["owl,single"] < 3, sprintf("diffuse owl, single: mean dE00 %.2f < 3", de["owl,single"]))
@@ -55,7 +58,10 @@ END {
             worse = de[n] > de[k] && p95[n] > p95[k] && mae[n] > mae[k] && step[n] > step[k] && icp[n] < icp[k]
             what = sprintf("%s: none worse than %s on dE00 mean, p95, MAE, view step and ICP coupling", sc, methods[m])
             check(worse, what)
-            check(hl[n] >= hl[k], sprintf("%s: highlight none %.2f%% >= %s %.2f%%%s", sc, 100 * hl[n], methods[m], 100 * hl[k], hl[n] >= hl[k] ? "" : " (the fused raw colour keeps little highlight: saturated pixels get no depth, and the views blend)"))
+            # where none shows no highlight (the matte owl) there is none to remove: a method must
+            # then add none (below 0.1%, the noise of the measure)
+            ok = (hl[k] <= hl[n] || hl[k] < 0.001) && (hlf[k] <= hlf[n] || hlf[k] < 0.001)
+            check(ok, sprintf("%s: highlight none %.2f%% (views), %.2f%% (fused) >= %s %.2f%%, %.2f%% (or below 0.1%%)", sc, 100 * hl[n], 100 * hlf[n], methods[m], 100 * hl[k], 100 * hlf[k]))
         }
         for (m = 2; m <= 4; m += 2) {
             k = sc "," methods[m]

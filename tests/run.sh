@@ -1,12 +1,13 @@
 #!/bin/sh
 # Runs every test binary given, and ends with one line: "N passed, N failed".
 # A binary that crashes or exits non-zero without cmocka's summary counts as one failure.
+# RUN_WITH runs each through an emulator (make test-arm64: qemu-aarch64).
 set -u
 cd "$(dirname "$0")/.."
 passed=0
 failed=0
 for t in "$@"; do
-    out=$("$t" 2>&1)
+    out=$(${RUN_WITH:-} "$t" 2>&1)
     rc=$?
     printf '%s\n' "$out"
     p=$(printf '%s\n' "$out" | sed -n 's/^\[  PASSED  \] \([0-9]*\) test.*/\1/p' | tail -n 1)

@@ -57,7 +57,8 @@ static void test_good_config_and_defaults(void **state)
     assert_int_equal(cfg.camera.width, 1280);
     assert_int_equal(cfg.scan.width, 1280);
     assert_int_equal(cfg.scan.min_contrast_dn, 10); /* default */
-    assert_int_equal(cfg.gpio.line_offset[HAL_GPIO_LIGHT_0], -1);
+    assert_int_equal(cfg.gpio.line[HAL_GPIO_LIGHT_0].offset, -1);
+    assert_string_equal(cfg.gpio.line[HAL_GPIO_LIGHT_0].name, "");
     assert_string_equal(cfg.calibration_file, DIR "/../../config/sim-calib.ini");
     struct scan_calib calib;
     assert_int_equal(calib_load(&calib, cfg.calibration_file, 4, err, sizeof(err)), 0);
@@ -90,6 +91,25 @@ static void test_errors_name_file_line_and_key(void **state)
     expect_error("[sim]\nalbedo = 0.5, 0.5\n", "bad.ini:9: [sim] albedo: '0.5, 0.5' is not a list");
     expect_error("[sim]\nseed = 1.5\n", "[sim] seed: '1.5' is not a whole number");
     expect_error("garbage line\n", "bad.ini:8: syntax error");
+}
+
+/* GPIO lines by offset or by the name the chip gives them (issue 5); anything else is refused. */
+static void test_gpio_lines_by_offset_or_name(void **state)
+{
+    (void)state;
+    char text[1024];
+    snprintf(text, sizeof(text), "%s[gpio]\nlight_0 = GPIO17\nlight_1 = 5\nprojector_enable = -1\n",
+             base);
+    assert_int_equal(config_load(&cfg, write_file("lines.ini", text), err, sizeof(err)), 0);
+    assert_string_equal(cfg.gpio.line[HAL_GPIO_LIGHT_0].name, "GPIO17");
+    assert_int_equal(cfg.gpio.line[HAL_GPIO_LIGHT_0].offset, -1);
+    assert_string_equal(cfg.gpio.line[HAL_GPIO_LIGHT_0 + 1].name, "");
+    assert_int_equal(cfg.gpio.line[HAL_GPIO_LIGHT_0 + 1].offset, 5);
+    assert_int_equal(cfg.gpio.line[HAL_GPIO_PROJECTOR_ENABLE].offset, -1);
+    expect_error("[gpio]\nlight_2 = pin 7!\n",
+                 "bad.ini:9: [gpio] light_2: 'pin 7!' is neither a line offset nor a line name");
+    expect_error("[gpio]\nlight_2 = 2000\n", "bad.ini:9: [gpio] light_2: 2000 is out of range");
+    expect_error("[gpio]\nlight_2 = 2.5\n", "[gpio] light_2: '2.5' is not a line offset");
 }
 
 static void test_duplicate_key(void **state)
@@ -187,6 +207,7 @@ int main(void)
         cmocka_unit_test(test_good_config_and_defaults),
         cmocka_unit_test(test_color_spelling),
         cmocka_unit_test(test_errors_name_file_line_and_key),
+        cmocka_unit_test(test_gpio_lines_by_offset_or_name),
         cmocka_unit_test(test_duplicate_key),
         cmocka_unit_test(test_missing_required_key),
         cmocka_unit_test(test_width_over_limit),

@@ -14,11 +14,12 @@ static void test_missing_chip(void **state)
     (void)state;
     struct gpio_gpiod g;
     struct hal_gpio out = {NULL, NULL};
-    int32_t offsets[HAL_GPIO_LINE_COUNT];
+    struct hal_gpio_line_ref lines[HAL_GPIO_LINE_COUNT];
     char err[256];
+    memset(lines, 0, sizeof(lines));
     for (unsigned i = 0; i < HAL_GPIO_LINE_COUNT; i++)
-        offsets[i] = (int32_t)i;
-    int rc = gpio_gpiod_open(&g, "/dev/gpiochip-does-not-exist", offsets, &out, err, sizeof(err));
+        lines[i].offset = (int32_t)i;
+    int rc = gpio_gpiod_open(&g, "/dev/gpiochip-does-not-exist", lines, &out, err, sizeof(err));
     assert_true(rc < 0);
     assert_non_null(strstr(err, "cannot open chip '/dev/gpiochip-does-not-exist'"));
     assert_null(out.ops); /* no device handed to the firmware */

@@ -4,6 +4,8 @@
 
 #include "hal_limits.h"
 
+#include <stdint.h>
+
 /** Logical output lines; the backend maps them to chip lines from the config. */
 enum hal_gpio_line {
     HAL_GPIO_PROJECTOR_ENABLE = 0, /**< projector lamp on (1) / off (0) */
@@ -11,6 +13,15 @@ enum hal_gpio_line {
     HAL_GPIO_PROJECTOR_RESET,      /**< rising edge returns the sequence to pattern 0 */
     HAL_GPIO_LIGHT_0,              /**< first white light; light i is HAL_GPIO_LIGHT_0 + i */
     HAL_GPIO_LINE_COUNT = HAL_GPIO_LIGHT_0 + HAL_MAX_LIGHTS
+};
+
+#define HAL_GPIO_NAME_LEN 32u
+
+/** Where a logical line is wired: a chip line offset, or the line's name as the chip (device
+ *  tree) calls it. Offset -1 and an empty name: not wired. */
+struct hal_gpio_line_ref {
+    int32_t offset;               /**< line offset on the chip; -1 when named or not wired */
+    char name[HAL_GPIO_NAME_LEN]; /**< line name ("GPIO17"); "" when given by offset */
 };
 
 struct hal_gpio_ops {

@@ -17,8 +17,14 @@
 #define HAL_MAX_PROJECTOR_HEIGHT 2048u
 #define HAL_MAX_PATH 512u
 
-_Static_assert(HAL_MAX_WIDTH % 2u == 0u, "YUYV conversion needs an even width");
-_Static_assert(HAL_MAX_PIXELS <= (1u << 23), "pixel indices must fit comfortably in 32 bits");
-_Static_assert(HAL_MAX_PROJECTOR_WIDTH <= 65535u, "projector columns are stored as uint16_t");
+#ifdef __cplusplus /* the libcamera backend is C++ */
+#define HAL_STATIC_ASSERT static_assert
+#else
+#define HAL_STATIC_ASSERT _Static_assert
+#endif
+
+HAL_STATIC_ASSERT(HAL_MAX_WIDTH % 2u == 0u, "YUYV conversion needs an even width");
+HAL_STATIC_ASSERT(HAL_MAX_PIXELS <= (1u << 23), "pixel indices must fit comfortably in 32 bits");
+HAL_STATIC_ASSERT(HAL_MAX_PROJECTOR_WIDTH <= 65535u, "projector columns are stored as uint16_t");
 
 #endif

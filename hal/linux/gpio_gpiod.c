@@ -57,11 +57,27 @@ static const struct hal_gpio_ops gpiod_ops = {
     .safe_state = gpiod_safe_state,
 };
 
-int gpio_gpiod_open(struct gpio_gpiod *g, const char *chip_name,
-                    const int32_t offset[HAL_GPIO_LINE_COUNT], struct hal_gpio *out, char *err,
-                    size_t err_len)
+/* The chip's line for @p ref, by offset or by name; @p where says which, for messages.
+ * @retval NULL with errno set */
+static struct gpiod_line *find_line(struct gpiod_chip *chip, const struct hal_gpio_line_ref *ref,
+                                    char *where, size_t len)
 {
-    char name[32];
+    if (ref->name[0] == '\0') {
+        snprintf(where, len, "line %d", (int)ref->offset);
+        return gpiod_chip_get_line(chip, (unsigned)ref->offset);
+    }
+    snprintf(where, len, "line '%s'", ref->name);
+    struct gpiod_line *line = gpiod_chip_find_line(chip, ref->name);
+    if (line == NULL && errno == ENOENT)
+        errno = ENODEV; /* libgpiod 1.6 says ENOENT when no line of the chip has the name */
+    return line;
+}
+
+int gpio_gpiod_open(struct gpio_gpiod *g, const char *chip_name,
+                    const struct hal_gpio_line_ref lines[HAL_GPIO_LINE_COUNT], struct hal_gpio *out,
+                    char *err, size_t err_len)
+{
+    char name[32], where[HAL_GPIO_NAME_LEN + 16];
     int rc = 0;
     memset(g, 0, sizeof(*g));
     g->chip = gpiod_chip_open_lookup(chip_name);
@@ -71,21 +87,21 @@ int gpio_gpiod_open(struct gpio_gpiod *g, const char *chip_name,
         return rc;
     }
     for (unsigned i = 0; i < HAL_GPIO_LINE_COUNT; i++) {
-        if (offset[i] < 0)
+        if (lines[i].offset < 0 && lines[i].name[0] == '\0')
             continue;
         gpio_line_name((enum hal_gpio_line)i, name, sizeof(name));
-        struct gpiod_line *line = gpiod_chip_get_line(g->chip, (unsigned)offset[i]);
+        struct gpiod_line *line = find_line(g->chip, &lines[i], where, sizeof(where));
         if (line == NULL) {
             rc = -errno;
-            snprintf(err, err_len, "gpio: %s: chip '%s' has no line %d: %s", name, chip_name,
-                     (int)offset[i], strerror(-rc));
+            snprintf(err, err_len, "gpio: %s: chip '%s' has no %s: %s", name, chip_name, where,
+                     strerror(-rc));
             goto out_release;
         }
         if (gpiod_line_request_output(line, "scanner", 0) != 0) {
             rc = -errno;
             const char *user = gpiod_line_consumer(line);
-            snprintf(err, err_len, "gpio: %s: cannot request %s line %d%s%s: %s", name, chip_name,
-                     (int)offset[i], user ? ", in use by " : "", user ? user : "", strerror(-rc));
+            snprintf(err, err_len, "gpio: %s: cannot request %s %s%s%s: %s", name, chip_name, where,
+                     user ? ", in use by " : "", user ? user : "", strerror(-rc));
             goto out_release;
         }
         g->line[i] = line;

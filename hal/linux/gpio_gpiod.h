@@ -15,13 +15,14 @@ struct gpio_gpiod {
     int value[HAL_GPIO_LINE_COUNT];
 };
 
-/** Open @p chip_name and request every wired line (offset >= 0) as an output driven low,
- *  consumer "scanner". On failure nothing stays requested and @p err names chip, line and why.
- *  @retval 0 ok @retval -ENODEV no such chip @retval -EBUSY line used by another program
- *  @retval -errno */
+/** Open @p chip_name and request every wired line (by offset, or by its name on that chip) as
+ *  an output driven low, consumer "scanner". On failure nothing stays requested and @p err
+ *  names chip, line and why.
+ *  @retval 0 ok @retval -ENODEV no such chip or no line of that name @retval -EBUSY line used
+ *  by another program @retval -errno */
 int gpio_gpiod_open(struct gpio_gpiod *g, const char *chip_name,
-                    const int32_t offset[HAL_GPIO_LINE_COUNT], struct hal_gpio *out, char *err,
-                    size_t err_len);
+                    const struct hal_gpio_line_ref lines[HAL_GPIO_LINE_COUNT], struct hal_gpio *out,
+                    char *err, size_t err_len);
 /** Drive every line low, release them and close the chip. */
 void gpio_gpiod_close(struct gpio_gpiod *g);
 /** Name of a logical line as the config writes it ("projector_enable", "light_3"). */

@@ -1,0 +1,155 @@
+/* V4L2 without a device: pixel formats, conversion to the firmware's RGB24, control choice. */
+#define _POSIX_C_SOURCE 200809L
+#include "v4l2_frame.h"
+
+#include <errno.h>
+#include <time.h> /* struct timespec, which videodev2.h uses */
+#include <linux/videodev2.h>
+#include <stdio.h>
+#include <string.h>
+
+uint32_t v4l2_fourcc_of(enum hal_pixel_format format)
+{
+    switch (format) {
+    case HAL_PIX_RGB24:
+        return V4L2_PIX_FMT_RGB24;
+    case HAL_PIX_YUYV:
+        return V4L2_PIX_FMT_YUYV;
+    case HAL_PIX_GREY:
+        return V4L2_PIX_FMT_GREY;
+    }
+    return 0;
+}
+
+const char *v4l2_fourcc_text(uint32_t fourcc, char *buf)
+{
+    for (int k = 0; k < 4; k++) {
+        char c = (char)((fourcc >> (8 * k)) & 0xFFu);
+        buf[k] = c >= 32 && c < 127 ? c : '?';
+    }
+    buf[4] = '\0';
+    return buf;
+}
+
+static uint8_t clamp_u8(int32_t v)
+{
+    return (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : v);
+}
+
+/* BT.601, limited range (Y 16..235, Cb Cr 16..240), in 8.8 fixed point: ITU-R BT.601 as
+ * Microsoft's YUV-to-RGB note writes it (298 = 255/219 x 256, and so on). */
+static void yuv_to_rgb(int32_t y, int32_t u, int32_t v, uint8_t *rgb)
+{
+    int32_t c = 298 * (y - 16) + 128, d = u - 128, e = v - 128;
+    rgb[0] = clamp_u8((c + 409 * e) >> 8);
+    rgb[1] = clamp_u8((c - 100 * d - 208 * e) >> 8);
+    rgb[2] = clamp_u8((c + 516 * d) >> 8);
+}
+
+static uint32_t bytes_per_pixel(uint32_t fourcc)
+{
+    return fourcc == V4L2_PIX_FMT_RGB24 ? 3u : fourcc == V4L2_PIX_FMT_YUYV ? 2u : 1u;
+}
+
+int v4l2_to_rgb(uint32_t fourcc, const uint8_t *src, size_t used, uint32_t bytes_per_line,
+                uint32_t width, uint32_t height, uint8_t *rgb, size_t rgb_cap)
+{
+    if (fourcc != V4L2_PIX_FMT_RGB24 && fourcc != V4L2_PIX_FMT_YUYV && fourcc != V4L2_PIX_FMT_GREY)
+        return -EINVAL;
+    if (fourcc == V4L2_PIX_FMT_YUYV && width % 2u != 0u)
+        return -EINVAL;
+    size_t row = (size_t)width * bytes_per_pixel(fourcc);
+    size_t stride = bytes_per_line > row ? bytes_per_line : row;
+    if ((size_t)width * height * 3u > rgb_cap)
+        return -ENOSPC;
+    if (height == 0 || used < stride * (height - 1u) + row)
+        return -EIO; /* the last row must be complete */
+    for (uint32_t y = 0; y < height; y++) {
+        const uint8_t *s = src + stride * y;
+        uint8_t *d = rgb + (size_t)width * 3u * y;
+        if (fourcc == V4L2_PIX_FMT_RGB24) {
+            memcpy(d, s, row);
+        } else if (fourcc == V4L2_PIX_FMT_GREY) {
+            for (uint32_t x = 0; x < width; x++)
+                d[3 * x] = d[3 * x + 1] = d[3 * x + 2] = s[x];
+        } else {
+            for (uint32_t x = 0; x < width; x += 2, s += 4, d += 6) { /* Y0 U Y1 V */
+                yuv_to_rgb(s[0], s[1], s[3], d);
+                yuv_to_rgb(s[2], s[1], s[3], d + 3);
+            }
+        }
+    }
+    return 0;
+}
+
+static const uint32_t plan_ids[] = {
+    V4L2_CID_EXPOSURE_AUTO,     V4L2_CID_AUTOGAIN,      V4L2_CID_AUTO_WHITE_BALANCE,
+    V4L2_CID_EXPOSURE_ABSOLUTE, V4L2_CID_ANALOGUE_GAIN, V4L2_CID_GAIN,
+};
+
+size_t v4l2_plan_ids(const uint32_t **ids)
+{
+    *ids = plan_ids;
+    return sizeof(plan_ids) / sizeof(plan_ids[0]);
+}
+
+static const struct v4l2_ctrl_info *find(const struct v4l2_ctrl_info *info, size_t n, uint32_t id)
+{
+    for (size_t k = 0; k < n; k++)
+        if (info[k].id == id && info[k].present)
+            return &info[k];
+    return NULL;
+}
+
+static void add(struct v4l2_ctrl_value *out, size_t *count, uint32_t id, int32_t value,
+                const char *name)
+{
+    out[*count].id = id;
+    out[*count].value = value;
+    out[(*count)++].name = name;
+}
+
+int v4l2_plan_controls(const struct v4l2_ctrl_info *info, size_t info_count, uint32_t exposure_us,
+                       uint32_t gain_milli, struct v4l2_ctrl_value out[V4L2_PLAN_MAX],
+                       size_t *out_count, char *err, size_t err_len)
+{
+    const struct v4l2_ctrl_info *c;
+    *out_count = 0;
+    /* Automatics first: while auto exposure is on, most drivers refuse a manual exposure. */
+    if ((c = find(info, info_count, V4L2_CID_EXPOSURE_AUTO)) != NULL)
+        add(out, out_count, c->id, V4L2_EXPOSURE_MANUAL, "exposure_auto");
+    if ((c = find(info, info_count, V4L2_CID_AUTOGAIN)) != NULL)
+        add(out, out_count, c->id, 0, "autogain");
+    if ((c = find(info, info_count, V4L2_CID_AUTO_WHITE_BALANCE)) != NULL)
+        add(out, out_count, c->id, 0, "white_balance_automatic");
+    if ((c = find(info, info_count, V4L2_CID_EXPOSURE_ABSOLUTE)) == NULL) {
+        snprintf(err, err_len, "no manual exposure control (exposure_time_absolute)");
+        return -ENOTSUP;
+    }
+    int64_t units = ((int64_t)exposure_us + 50) / 100; /* the control counts 100 us */
+    if (units < c->minimum || units > c->maximum) {
+        snprintf(err, err_len, "exposure %u us is outside the camera's %d..%d us",
+                 (unsigned)exposure_us, (int)c->minimum * 100, (int)c->maximum * 100);
+        return -ERANGE;
+    }
+    add(out, out_count, c->id, (int32_t)units, "exposure_time_absolute");
+    c = find(info, info_count, V4L2_CID_ANALOGUE_GAIN);
+    if (c == NULL)
+        c = find(info, info_count, V4L2_CID_GAIN);
+    if (c != NULL) {
+        int64_t gain = ((int64_t)c->default_value * gain_milli + 500) / 1000;
+        if (gain < c->minimum || gain > c->maximum) {
+            snprintf(err, err_len,
+                     "gain %u/1000 of the default (%d) is outside the camera's %d..%d",
+                     (unsigned)gain_milli, (int)c->default_value, (int)c->minimum, (int)c->maximum);
+            return -ERANGE;
+        }
+        add(out, out_count, c->id, (int32_t)gain,
+            c->id == V4L2_CID_GAIN ? "gain" : "analogue_gain");
+    } else if (gain_milli != 1000) {
+        snprintf(err, err_len, "gain_milli = %u but the camera has no gain control",
+                 (unsigned)gain_milli);
+        return -ENOTSUP;
+    }
+    return 0;
+}

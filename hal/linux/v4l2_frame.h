@@ -1,0 +1,61 @@
+/* V4L2 without a device: pixel formats, conversion to the firmware's RGB24, control choice. */
+#ifndef V4L2_FRAME_H
+#define V4L2_FRAME_H
+
+#include "hal_camera.h"
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus /* the libcamera backend converts its frames with it too */
+extern "C" {
+#endif
+
+/** The V4L2 fourcc the camera is asked for. @retval 0 for an unknown format */
+uint32_t v4l2_fourcc_of(enum hal_pixel_format format);
+
+/** "YUYV", "RGB3", ... for messages. @p buf holds at least 5 bytes. */
+const char *v4l2_fourcc_text(uint32_t fourcc, char *buf);
+
+/** Convert one frame of @p fourcc (rows @p bytes_per_line apart, @p used bytes delivered) into
+ *  packed RGB24. YUYV is BT.601 limited range, as UVC cameras send it; GREY is replicated.
+ *  @retval 0 ok @retval -EIO short frame (fewer bytes than the mode needs)
+ *  @retval -ENOSPC @p rgb_cap too small @retval -EINVAL unknown format or odd YUYV width */
+int v4l2_to_rgb(uint32_t fourcc, const uint8_t *src, size_t used, uint32_t bytes_per_line,
+                uint32_t width, uint32_t height, uint8_t *rgb, size_t rgb_cap);
+
+/** What the driver said of one control (VIDIOC_QUERYCTRL). */
+struct v4l2_ctrl_info {
+    uint32_t id;
+    int present; /**< 0: the driver has no such control */
+    int32_t minimum, maximum, step, default_value;
+};
+
+/** One control to set (VIDIOC_S_CTRL). */
+struct v4l2_ctrl_value {
+    uint32_t id;
+    int32_t value;
+    const char *name; /**< for messages */
+};
+
+#define V4L2_PLAN_MAX 6
+
+/** The controls that give repeatable frames: auto exposure, auto gain and auto white balance
+ *  off where the driver has them, manual exposure (V4L2_CID_EXPOSURE_ABSOLUTE, 100 us units,
+ *  required) and the gain (analogue gain if present, else gain; @p gain_milli 1000 = the
+ *  driver's default), in the order they must be set.
+ *  @param info  what the driver has, looked up by id (v4l2_plan_ids() lists the ids to query)
+ *  @retval 0 ok @retval -ENOTSUP no manual exposure @retval -ERANGE exposure or gain out of
+ *  the driver's range; @p err says which and the range */
+int v4l2_plan_controls(const struct v4l2_ctrl_info *info, size_t info_count, uint32_t exposure_us,
+                       uint32_t gain_milli, struct v4l2_ctrl_value out[V4L2_PLAN_MAX],
+                       size_t *out_count, char *err, size_t err_len);
+
+/** The control ids v4l2_plan_controls() looks at. @retval their count */
+size_t v4l2_plan_ids(const uint32_t **ids);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif
