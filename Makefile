@@ -45,7 +45,7 @@ endif
 WARN := -std=c11 -Wall -Wextra -Werror
 CFLAGS_COMMON := $(WARN) $(OPT) -g -MMD -MP
 # firmware/ sees the world only through hal/include.
-FW_CFLAGS := $(CFLAGS_COMMON) -Ihal/include -Ifirmware
+FW_CFLAGS := $(CFLAGS_COMMON) -Ihal/include -Ifirmware -fstack-usage
 PKG_CFLAGS = $(shell $(PKG_CONFIG) --cflags $(PKGS) 2>/dev/null)
 PKG_LIBS = $(shell $(PKG_CONFIG) --libs inih libpng libmodbus 2>/dev/null) -lpthread
 HOST_CFLAGS = $(CFLAGS_COMMON) -Ihal/include -Ifirmware -Iapp -Ihal/posix -Ihal/linux -Ihal/modbus -Ihost_sim $(PKG_CFLAGS)
@@ -71,7 +71,7 @@ FW_OBJ := $(call obj,$(FW_SRC))
 HOST_OBJ := $(call obj,$(POSIX_SRC) $(APP_LIB_SRC) $(BOARD_SRC)) $(if $(filter linux,$(HAL)),$(LIBCAMERA_OBJ),)
 MAIN_OBJ := $(call obj,app/main.c)
 
-.PHONY: all deps test-deps test test-run linux-build install test-arm64 test-arm64-full arm64-check-elf arm64-run-tests run clean format docs check-firmware bench measure measure-scan interop-meshlab bench-callgrind eval
+.PHONY: all deps test-deps test test-run linux-build install check-stack size fuzz errors-doc test-arm64 test-arm64-full arm64-check-elf arm64-run-tests run clean format docs check-firmware bench measure measure-scan interop-meshlab bench-callgrind eval
 SIM_TOOLS := $(if $(filter sim,$(HAL)),$(BUILD)/turntable-sim $(BUILD)/tt-client $(BUILD)/mesh-compare $(BUILD)/colour-eval,)
 all: deps $(BUILD)/scanner $(SIM_TOOLS)
 
@@ -80,7 +80,14 @@ deps:
 	@{ $(PKG_CONFIG) --exists $(PKGS) && command -v $(DEPS_TOOLS); } >/dev/null 2>&1 || \
 		scripts/install-deps.sh $(DEPS_SET)
 
-$(FW_OBJ): $(BUILD)/%.o: %.c | deps
+# The firmware's flags in a file that changes only when they do: objects built with other
+# flags (say, before -fstack-usage) are rebuilt.
+FW_FLAGS_STAMP := $(BUILD)/firmware.flags
+$(FW_FLAGS_STAMP): FORCE
+	@mkdir -p $(dir $@); echo '$(FW_CFLAGS)' | cmp -s - $@ || echo '$(FW_CFLAGS)' > $@
+FORCE:
+
+$(FW_OBJ): $(BUILD)/%.o: %.c $(FW_FLAGS_STAMP) | deps
 	@mkdir -p $(dir $@)
 	$(CC) $(FW_CFLAGS) $(FW_EXTRA) -c $< -o $@
 
@@ -142,6 +149,54 @@ check-firmware: $(FW_OBJ)
 	if [ -n "$$bad" ]; then echo "firmware/ includes OS headers: $$bad"; exit 1; fi; \
 	echo "check-firmware: no allocator references and no OS headers in firmware/"
 
+# ---- fuzzing: the parsers of what comes from outside (issue 6) ----
+# make fuzz: each target under libFuzzer (clang, with ASan + UBSan) for FUZZ_SECONDS, seeded by
+# and merged back into tests/fuzz/corpus/<target>/; a crash is written to tests/fuzz/crashes/.
+# make test replays the corpus and every crash kept (fuzz-replay-*, built like the suite).
+FUZZ_TARGETS := config calib view_ini ply
+FUZZ_SECONDS ?= 600
+FUZZ_LIB_SRC := app/config.c app/ini_schema.c host_sim/sim_mesh.c host_sim/sim_ply_read.c
+FUZZ_CFLAGS = -std=c11 -g -O1 -Ihal/include -Ifirmware -Iapp -Ihal/posix -Ihal/linux -Ihal/modbus -Ihost_sim -Itests/fuzz $(PKG_CFLAGS)
+FUZZ_LIBS = $(shell $(PKG_CONFIG) --libs inih 2>/dev/null) -lm
+FUZZ_REPLAY := $(patsubst %,$(BUILD)/tests/fuzz-replay-%,$(FUZZ_TARGETS))
+
+$(BUILD)/tests/fuzz-replay-%: $(call obj,tests/fuzz/replay.c) $(BUILD)/tests/fuzz/fuzz_%.o $(call obj,$(FUZZ_LIB_SRC)) $(BUILD)/libfirmware.a
+	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(FUZZ_LIBS)
+$(BUILD)/tests/fuzz/%.o: tests/fuzz/%.c | deps
+	@mkdir -p $(dir $@)
+	$(CC) $(HOST_CFLAGS) -Itests/fuzz -c $< -o $@
+
+FUZZ_BUILD := build/fuzz
+$(FUZZ_BUILD)/%.o: %.c
+	@mkdir -p $(dir $@)
+	clang $(FUZZ_CFLAGS) -fsanitize=fuzzer-no-link,address,undefined -c $< -o $@
+$(FUZZ_BUILD)/fuzz-%: $(FUZZ_BUILD)/tests/fuzz/fuzz_%.o $(patsubst %.c,$(FUZZ_BUILD)/%.o,$(FUZZ_LIB_SRC) $(FW_SRC))
+	clang -fsanitize=fuzzer,address,undefined -o $@ $^ $(FUZZ_LIBS)
+fuzz: deps
+	@command -v clang >/dev/null && test -d /usr/lib/llvm-14/lib/clang/14.0.6/lib/linux || scripts/install-deps.sh fuzz
+	@$(MAKE) --no-print-directory $(patsubst %,$(FUZZ_BUILD)/fuzz-%,$(FUZZ_TARGETS))
+	@for t in $(FUZZ_TARGETS); do \
+		mkdir -p $(FUZZ_BUILD)/corpus-$$t tests/fuzz/crashes/$$t; \
+		echo "fuzz: $$t for $(FUZZ_SECONDS) s"; \
+		$(FUZZ_BUILD)/fuzz-$$t -max_total_time=$(FUZZ_SECONDS) -print_final_stats=1 \
+			-artifact_prefix=tests/fuzz/crashes/$$t/ $(FUZZ_BUILD)/corpus-$$t tests/fuzz/corpus/$$t \
+			2> $(FUZZ_BUILD)/$$t.log || { tail -n 30 $(FUZZ_BUILD)/$$t.log; exit 1; }; \
+		grep -E '^stat::number_of_executed_units|^#[0-9]+ *DONE' $(FUZZ_BUILD)/$$t.log | tail -n 2; \
+		$(FUZZ_BUILD)/fuzz-$$t -merge=1 tests/fuzz/corpus/$$t $(FUZZ_BUILD)/corpus-$$t 2>/dev/null; \
+	done
+
+# Stack frames of firmware/ bounded (the limit is HAL_STACK_FRAME_MAX in hal/include/hal_limits.h;
+# checked on the plain build: the sanitizers pad frames).
+STACK_LIMIT := $(shell sed -n 's/^\#define HAL_STACK_FRAME_MAX \([0-9]*\)u.*/\1/p' hal/include/hal_limits.h)
+check-stack: $(FW_OBJ)
+	@scripts/check-stack.sh $(STACK_LIMIT) $(FW_OBJ:.o=.su)
+
+# Static memory of the default build: the scanner's sections, and the firmware's buffers.
+size: deps $(BUILD)/scanner $(BUILD)/libfirmware.a
+	@size -A $(BUILD)/scanner | awk '$$1 ~ /^\.(text|rodata|data|bss)$$/ { printf "%-8s %12d bytes\n", $$1, $$2; \
+		if ($$1 != ".text" && $$1 != ".rodata") ram += $$2 } END { printf "static RAM (.data + .bss): %.1f MiB\n", ram / 1048576 }'
+	@bench/static_memory.sh $(BUILD)/libfirmware.a
+
 # Test-only packages: Open3D reads our PLY (tests/cli.sh); pymodbus and socat are the Modbus
 # peers of tests/interop.sh.
 test-deps: deps
@@ -151,8 +206,13 @@ test-deps: deps
 # A second make, so that what test-deps installed (libcamera-dev) is seen when it starts.
 test: deps test-deps
 	@$(MAKE) --no-print-directory test-run
-test-run: $(BUILD)/scanner $(SIM_TOOLS) $(TEST_BIN) check-firmware linux-build
-	@BUILD=$(BUILD) tests/run.sh $(TEST_BIN) tests/cli.sh tests/interop.sh
+test-run: $(BUILD)/scanner $(SIM_TOOLS) $(TEST_BIN) $(FUZZ_REPLAY) check-firmware $(if $(filter 0,$(SAN)),check-stack,) linux-build
+	@RUN_WITH="$(VALGRIND_RUN)" BUILD=$(BUILD) tests/run.sh $(TEST_BIN) tests/cli.sh tests/interop.sh tests/fuzz/replay.sh
+
+# make test VALGRIND=1: every cmocka test under valgrind memcheck; any invalid access,
+# uninitialised use or definite leak fails the test (exit code 99).
+VALGRIND ?= 0
+VALGRIND_RUN = $(if $(filter 1,$(VALGRIND)),valgrind --quiet --error-exitcode=99 --leak-check=full --errors-for-leak-kinds=definite --track-origins=yes,)
 
 # arm64 (a Raspberry Pi 4 or 5 on a 64-bit OS): the appliance's scanner cross-built and checked
 # to be an AArch64 ELF, then every cmocka unit test built for arm64 and run under qemu-aarch64
@@ -208,6 +268,10 @@ run: deps $(BUILD)/scanner
 
 docs: $(BUILD)/scanner
 	$(BUILD)/scanner config-doc > docs/config.md
+
+# docs/errors.md: bad inputs and the messages they get (tests/cli.sh checks it is current).
+errors-doc: deps $(BUILD)/scanner linux-build
+	scripts/errors-table.sh $(BUILD) > docs/errors.md
 
 format:
 	clang-format -i $$(git ls-files '*.c' '*.h')

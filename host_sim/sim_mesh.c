@@ -113,21 +113,29 @@ static vec3 cyl_cap_fn(double u, double v, const double *s)
     return v3(s[0] * (1.0 - v) * cos(phi), s[0] * (1.0 - v) * sin(phi), s[2] > 0.5 ? s[1] : 0.0);
 }
 
-int sim_mesh_cylinder(struct sim_mesh *m, double r, double h, uint32_t seg)
+/* A solid of revolution: its side (@p side_fn of {r, h}, @p nv rows) closed by flat caps of
+ * radius @p top_r at h and r at 0. */
+static int capped_solid(struct sim_mesh *m, grid_fn side_fn, double r, double top_r, double h,
+                        uint32_t seg, uint32_t nv)
 {
-    uint32_t nu = seg, nv = seg / 4, nc = seg / 8 + 1;
+    uint32_t nu = seg, nc = seg / 8 + 1;
     int rc = mesh_alloc(m, grid_verts(nu, nv) + 2 * grid_verts(nu, nc), 2 * nu * (nv + 2 * nc));
     if (rc != 0)
         return rc;
     uint32_t vert = 0, tri = 0;
-    double side[2] = {r, h}, top[3] = {r, h, 1.0}, bottom[3] = {r, h, 0.0};
-    add_grid(m, &vert, &tri, nu, nv, cyl_side_fn, side);
+    double side[2] = {r, h}, top[3] = {top_r, h, 1.0}, bottom[3] = {r, h, 0.0};
+    add_grid(m, &vert, &tri, nu, nv, side_fn, side);
     add_grid(m, &vert, &tri, nu, nc, cyl_cap_fn, top);
     add_grid(m, &vert, &tri, nu, nc, cyl_cap_fn, bottom);
     m->vert_count = vert;
     m->tri_count = tri;
     sim_mesh_compute_normals(m);
     return 0;
+}
+
+int sim_mesh_cylinder(struct sim_mesh *m, double r, double h, uint32_t seg)
+{
+    return capped_solid(m, cyl_side_fn, r, r, h, seg, seg / 4);
 }
 
 /* A spray can's side, body then shoulder, s = {r, h}: the body rises to 0.775 h; the shoulder, a
@@ -146,19 +154,7 @@ static vec3 can_side_fn(double u, double v, const double *s)
 
 int sim_mesh_can(struct sim_mesh *m, double r, double h, uint32_t seg)
 {
-    uint32_t nu = seg, nv = seg / 2, nc = seg / 8 + 1;
-    int rc = mesh_alloc(m, grid_verts(nu, nv) + 2 * grid_verts(nu, nc), 2 * nu * (nv + 2 * nc));
-    if (rc != 0)
-        return rc;
-    uint32_t vert = 0, tri = 0;
-    double side[2] = {r, h}, top[3] = {0.25 * r, h, 1.0}, bottom[3] = {r, h, 0.0};
-    add_grid(m, &vert, &tri, nu, nv, can_side_fn, side);
-    add_grid(m, &vert, &tri, nu, nc, cyl_cap_fn, top);
-    add_grid(m, &vert, &tri, nu, nc, cyl_cap_fn, bottom);
-    m->vert_count = vert;
-    m->tri_count = tri;
-    sim_mesh_compute_normals(m);
-    return 0;
+    return capped_solid(m, can_side_fn, r, 0.25 * r, h, seg, seg / 2);
 }
 
 /* One face of the box: s = {sx, sy, sz, axis, sign}; separate vertices keep the edges sharp. */

@@ -266,12 +266,18 @@ static int load_ply(struct sim_mesh *m, const char *path, int need_faces, char *
     rc = parse_header(f, &h, err, err_len, path);
     if (rc != 0)
         goto out_close;
+    int vertex_elements = 0;
     for (int e = 0; e < h.elem_count; e++)
-        if (strcmp(h.elems[e].name, "vertex") == 0 && h.elems[e].count < (1ul << 26))
+        if (strcmp(h.elems[e].name, "vertex") == 0 && vertex_elements++ == 0 &&
+            h.elems[e].count < (1ul << 26))
             m->vert_count = (uint32_t)h.elems[e].count;
     rc = -EINVAL;
+    if (vertex_elements > 1) { /* which would the faces index? (found by make fuzz) */
+        snprintf(err, err_len, "%s: more than one vertex element", path);
+        goto out_close;
+    }
     if (m->vert_count == 0) {
-        snprintf(err, err_len, "%s: no vertices", path);
+        snprintf(err, err_len, "%s: no vertices (or more than 2^26)", path);
         goto out_close;
     }
     m->pos = calloc((size_t)m->vert_count * 3, sizeof(float));

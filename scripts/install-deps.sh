@@ -8,7 +8,8 @@
 set -eu
 pkgs="build-essential pkg-config libinih-dev libpng-dev libcmocka-dev libmodbus-dev libgpiod-dev"
 [ "${1:-}" = "bench" ] && pkgs="$pkgs g++ libopencv-dev libopencv-contrib-dev valgrind"
-[ "${1:-}" = "test" ] && pkgs="$pkgs python3 python3-numpy python3-open3d python3-pymodbus python3-serial python3-serial-asyncio socat g++ libcamera-dev systemd"
+[ "${1:-}" = "fuzz" ] && pkgs="$pkgs clang libclang-rt-14-dev"
+[ "${1:-}" = "test" ] && pkgs="$pkgs python3 python3-numpy python3-open3d python3-pymodbus python3-serial python3-serial-asyncio socat g++ libcamera-dev systemd valgrind"
 # A cross build's target (make CROSS_COMPILE=aarch64-linux-gnu-): its compiler, its -dev
 # packages through Debian's multiarch, and qemu-user to run its tests.
 case "${1:-}" in

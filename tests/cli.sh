@@ -56,6 +56,8 @@ check systemd_accepts_unit sh -c "cd '$stage/lib/systemd/system' &&
     systemd-analyze verify 'scanner@pi-v4l2.service' > $PWD/$out/verify.txt 2>&1; rc=\$?;
     cat $PWD/$out/verify.txt; test \$rc -eq 0 && ! test -s $PWD/$out/verify.txt &&
     systemd-sysusers --root=$stage --dry-run >/dev/null"
+check errors_doc_is_current sh -c "scripts/errors-table.sh ${BUILD:-build} > $out/errors.md &&
+    diff docs/errors.md $out/errors.md"
 check bad_config_names_file_line_key sh -c \
     "$bin scan --config $out/bad.ini 2>&1 | grep -q '$out/bad.ini:6: \[camera\] exposur: unknown key'"
 check bad_config_exit_code sh -c "$bin scan --config $out/bad.ini; test \$? -eq 2"

@@ -16,6 +16,9 @@
 #define HAL_MAX_PROJECTOR_WIDTH 2048u
 #define HAL_MAX_PROJECTOR_HEIGHT 2048u
 #define HAL_MAX_PATH 512u
+/* Largest stack frame a firmware/ function may have (gcc -fstack-usage, checked by make test:
+ * scripts/check-stack.sh); big state lives in static buffers, never on the stack. */
+#define HAL_STACK_FRAME_MAX 2048u
 
 #ifdef __cplusplus /* the libcamera backend is C++ */
 #define HAL_STATIC_ASSERT static_assert
