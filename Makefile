@@ -131,7 +131,10 @@ TEST_EXTRA_OBJ = $(if $(filter sim,$(HAL)),$(call obj,hal/linux/gpio_gpiod.c hal
 TEST_EXTRA_LIBS = $(shell $(PKG_CONFIG) --libs libgpiod 2>/dev/null) $(LIBCAMERA_LIBS)
 
 $(BUILD)/tests/%: $(BUILD)/tests/%.o $(TEST_SUPPORT) $(HOST_OBJ) $(TEST_EXTRA_OBJ) $(BUILD)/libfirmware.a
-	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(TEST_LIBS) $(LDLIBS_COMMON) $(TEST_EXTRA_LIBS)
+	$(CC) $(LDFLAGS_COMMON) $(TEST_LDFLAGS) -o $@ $^ $(TEST_LIBS) $(LDLIBS_COMMON) $(TEST_EXTRA_LIBS)
+
+# The storage backend's system calls, failed on purpose (tests/test_storage_faults.c).
+$(BUILD)/tests/test_storage_faults: TEST_LDFLAGS = -Wl,--wrap=write,--wrap=fsync,--wrap=rename
 
 $(BUILD)/tests/test_util.o: tests/test_util.c | deps
 	@mkdir -p $(dir $@)
@@ -207,7 +210,7 @@ test-deps: deps
 test: deps test-deps
 	@$(MAKE) --no-print-directory test-run
 test-run: $(BUILD)/scanner $(SIM_TOOLS) $(TEST_BIN) $(FUZZ_REPLAY) check-firmware $(if $(filter 0,$(SAN)),check-stack,) linux-build
-	@RUN_WITH="$(VALGRIND_RUN)" BUILD=$(BUILD) tests/run.sh $(TEST_BIN) tests/cli.sh tests/interop.sh tests/fuzz/replay.sh
+	@RUN_WITH="$(VALGRIND_RUN)" BUILD=$(BUILD) tests/run.sh $(TEST_BIN) tests/cli.sh tests/interop.sh tests/fuzz/replay.sh tests/resume.sh
 
 # make test VALGRIND=1: every cmocka test under valgrind memcheck; any invalid access,
 # uninitialised use or definite leak fails the test (exit code 99).

@@ -203,12 +203,34 @@ static int cmd_process(const char *scan_dir, const struct scan_job_opts *opts)
     return scan_job_process(&hal, scan_dir, opts) == 0 ? 0 : 1;
 }
 
+/* An interrupted scan: take the views it did not finish, then make every result and the model
+ * from the kept frames, as process does (the same model as an uninterrupted scan). */
+static int cmd_resume(const char *scan_dir, const struct scan_job_opts *opts)
+{
+    static struct app_config cfg;
+    static struct scan_calib calib;
+    char err[512];
+    uint32_t first = 0;
+    if (scan_job_load_settings(scan_dir, opts->config_path, &cfg, &calib, err, sizeof(err)) != 0) {
+        fprintf(stderr, "scanner: error: %s\n", err);
+        return 2;
+    }
+    int rc = rig_up(&cfg, &calib);
+    if (rc == 0)
+        rc = scan_job_resume(&the_hal, &cfg, &calib, scan_dir, opts, &first);
+    rig_down();
+    if (rc != 0)
+        return 1;
+    return cmd_process(scan_dir, opts);
+}
+
 static void usage(FILE *out)
 {
     fprintf(out,
             "usage: scanner scan --config FILE [--out DIR] [--json]   take a scan\n"
             "       scanner process DIR [--out DIR2] [--config F] [--json]  recompute a scan from "
             "its frames\n"
+            "       scanner resume DIR [--config F] [--json]  finish an interrupted scan\n"
             "       scanner calibrate-white --config FILE [--albedo A]  white reference scales\n"
             "       scanner check-config --config FILE    check a config and its calibration\n"
             "       scanner selftest --config FILE        try each configured device (new rig)\n"
@@ -226,7 +248,8 @@ int main(int argc, char **argv)
         return 2;
     }
     int first = 2;
-    if (strcmp(argv[1], "process") == 0 && argc > 2 && argv[2][0] != '-') {
+    if ((strcmp(argv[1], "process") == 0 || strcmp(argv[1], "resume") == 0) && argc > 2 &&
+        argv[2][0] != '-') {
         scan_dir = argv[2];
         first = 3;
     }
@@ -260,6 +283,10 @@ int main(int argc, char **argv)
     if (strcmp(argv[1], "process") == 0 && scan_dir != NULL) {
         opts.config_path = config_path; /* optional: other settings for the same frames */
         return cmd_process(scan_dir, &opts);
+    }
+    if (strcmp(argv[1], "resume") == 0 && scan_dir != NULL) {
+        opts.config_path = config_path; /* optional: the scan's config where it was written */
+        return cmd_resume(scan_dir, &opts);
     }
     if (config_path == NULL) {
         usage(stderr);

@@ -368,6 +368,59 @@ int scan_job_live(const struct hal *hal, const struct app_config *cfg,
     return rc;
 }
 
+/* ---- resume ---- */
+
+int scan_job_load_settings(const char *scan_dir, const char *config_path, struct app_config *cfg,
+                           struct scan_calib *calib, char *err, size_t err_len)
+{
+    char path[HAL_MAX_PATH + 32];
+    snprintf(path, sizeof(path), "%s/config.ini", scan_dir);
+    int rc = config_load(cfg, config_path ? config_path : path, err, err_len);
+    if (rc != 0)
+        return rc;
+    /* the calibration is the copy kept with the scan, whatever the config named */
+    snprintf(cfg->calibration_file, sizeof(cfg->calibration_file), "%s/calibration.ini", scan_dir);
+    return calib_load(calib, cfg->calibration_file, cfg->light_count, err, err_len);
+}
+
+/* A view is complete once its view.ini, written last, is on disk and readable. */
+static int view_complete(const char *scan_dir, uint32_t v)
+{
+    char path[HAL_MAX_PATH + 32];
+    long angle;
+    snprintf(path, sizeof(path), "%s/view_%03u/view.ini", scan_dir, (unsigned)v);
+    return view_angle_load(path, &angle) == 0;
+}
+
+int scan_job_resume(const struct hal *hal, const struct app_config *cfg,
+                    const struct scan_calib *calib, const char *scan_dir,
+                    const struct scan_job_opts *opts, uint32_t *first_view)
+{
+    struct job j = {hal,      cfg,        calib,     opts,
+                    scan_dir, cfg->views, wall_ms(), isatty(STDOUT_FILENO) && !opts->json,
+                    ""};
+    char detail[64];
+    uint32_t first = 0;
+    while (first < cfg->views && view_complete(scan_dir, first))
+        first++;
+    *first_view = first;
+    snprintf(detail, sizeof(detail), "%u of %u views kept", (unsigned)first, (unsigned)cfg->views);
+    progress(&j, "resume", -1, first, detail);
+    if (first == cfg->views)
+        return 0;
+    int rc = fusion_begin(&cfg->fusion); /* the model comes from scan_job_process afterwards */
+    icp_reset();
+    if (rc != 0)
+        return rc;
+    progress(&j, "homing", (int)first, first, "");
+    rc = hal_table_home(&hal->turntable);
+    if (rc != 0)
+        hal->log(HAL_LOG_ERROR, "the turntable did not home");
+    for (uint32_t v = first; v < cfg->views && rc == 0; v++)
+        rc = live_view(&j, v);
+    return rc;
+}
+
 /* ---- offline ---- */
 
 static int process_view(struct job *j, uint32_t v, const char *in_view_dir)
@@ -435,14 +488,7 @@ int scan_job_process(const struct hal *hal, const char *scan_dir, const struct s
     static struct app_config cfg;
     static struct scan_calib calib;
     char path[HAL_MAX_PATH + 32], err[512];
-    snprintf(path, sizeof(path), "%s/config.ini", scan_dir);
-    int rc = config_load(&cfg, opts->config_path ? opts->config_path : path, err, sizeof(err));
-    if (rc == 0) {
-        /* the calibration is the copy kept with the scan, whatever the config named */
-        snprintf(cfg.calibration_file, sizeof(cfg.calibration_file), "%s/calibration.ini",
-                 scan_dir);
-        rc = calib_load(&calib, cfg.calibration_file, cfg.light_count, err, sizeof(err));
-    }
+    int rc = scan_job_load_settings(scan_dir, opts->config_path, &cfg, &calib, err, sizeof(err));
     if (rc != 0) {
         hal->log(HAL_LOG_ERROR, "%s", err);
         return rc;

@@ -18,6 +18,21 @@ struct scan_job_opts {
 int scan_job_live(const struct hal *hal, const struct app_config *cfg,
                   const struct scan_calib *calib, const struct scan_job_opts *opts);
 
+/** Load the settings of the interrupted scan in @p scan_dir: its config (or @p config_path,
+ *  when the scan's own names files relative to where it was) and always its kept calibration.
+ *  @retval 0 @retval -errno with the message in @p err */
+int scan_job_load_settings(const char *scan_dir, const char *config_path, struct app_config *cfg,
+                           struct scan_calib *calib, char *err, size_t err_len);
+
+/** Take the views of the scan in @p scan_dir that did not finish (no view.ini: a view is
+ *  complete only once its view.ini is on disk), from the first unfinished one on, homing the
+ *  table first. The model is then made by scan_job_process over all views.
+ *  @param first_view  out: the first view taken (cfg->views: none was missing)
+ *  @retval 0 ok @retval the first error (views finished before it are kept) */
+int scan_job_resume(const struct hal *hal, const struct app_config *cfg,
+                    const struct scan_calib *calib, const char *scan_dir,
+                    const struct scan_job_opts *opts, uint32_t *first_view);
+
 /** Recompute every result of the scan in @p scan_dir from its kept frames alone.
  *  @param hal  storage, clock and log only; no device is touched
  *  @retval 0 ok @retval -errno with the file named in the log */

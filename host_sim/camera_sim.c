@@ -17,6 +17,25 @@ static int camera_sim_open(void *priv, const struct hal_camera_config *cfg)
     return 0;
 }
 
+/* The noise of a frame depends on what it shows (table angle, projector pattern, lights,
+ * exposure) and on how many frames in a row showed the same, not on how many came before: a
+ * scan resumed after an interruption sees the frames an uninterrupted one would. */
+static uint64_t noise_id(struct camera_sim *cam, const struct sim_sources *src)
+{
+    const uint64_t part[] = {(uint64_t)src->projector_on,
+                             src->pattern_index,
+                             src->lights_mask,
+                             src->exposure_us,
+                             src->gain_milli,
+                             (uint32_t)cam->rig->table_angle_mdeg};
+    uint64_t key = 1469598103934665603ull; /* FNV-1a over the parts */
+    for (size_t k = 0; k < sizeof(part) / sizeof(part[0]); k++)
+        key = (key ^ part[k]) * 1099511628211ull;
+    cam->repeat = key == cam->last_key ? cam->repeat + 1 : 0;
+    cam->last_key = key;
+    return key + cam->repeat;
+}
+
 static int camera_sim_capture(void *priv, struct hal_image *img)
 {
     struct camera_sim *cam = priv;
@@ -37,7 +56,7 @@ static int camera_sim_capture(void *priv, struct hal_image *img)
     gpio_sim_sources(cam->gpio, cam->light_count, &src);
     src.exposure_us = cam->cfg.exposure_us;
     src.gain_milli = cam->cfg.gain_milli;
-    sim_rig_render(cam->rig, &src, frame, img->rgb);
+    sim_rig_render(cam->rig, &src, noise_id(cam, &src), img->rgb);
     img->width = cam->rig->width;
     img->height = cam->rig->height;
     img->sequence = frame;

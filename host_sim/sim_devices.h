@@ -27,6 +27,8 @@ struct camera_sim {
     void *table_priv;
     int is_open;
     uint64_t frames; /* captures attempted since open */
+    uint64_t last_key; /* what the last frame showed, and how many in a row did (noise_id) */
+    uint32_t repeat;
     enum sim_cam_fault fault;
     uint64_t fault_first;
     uint32_t fault_count;

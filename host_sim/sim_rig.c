@@ -352,7 +352,7 @@ static void add_light(const struct sim_rig *rig, size_t i, uint32_t li, double s
     }
 }
 
-void sim_rig_render(struct sim_rig *rig, const struct sim_sources *src, uint64_t frame_no,
+void sim_rig_render(struct sim_rig *rig, const struct sim_sources *src, uint64_t noise_id,
                     uint8_t *rgb)
 {
     sim_rig_update(rig);
@@ -362,7 +362,7 @@ void sim_rig_render(struct sim_rig *rig, const struct sim_sources *src, uint64_t
             ensure_light(rig, li);
     const struct sim_config *c = &rig->cfg;
     double gain = (double)src->exposure_us / c->reference_exposure_us * src->gain_milli / 1000.0;
-    uint64_t state = ((uint64_t)c->seed << 32) ^ (frame_no * 0x9E3779B97F4A7C15ull) ^
+    uint64_t state = ((uint64_t)c->seed << 32) ^ (noise_id * 0x9E3779B97F4A7C15ull) ^
                      (uint64_t)(uint32_t)rig->truth_angle_mdeg;
     double var_read = c->read_noise_dn * c->read_noise_dn;
     size_t n = (size_t)rig->width * rig->height;

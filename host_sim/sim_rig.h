@@ -61,8 +61,8 @@ void sim_rig_free(struct sim_rig *rig);
 /** Bring the truth buffers up to date for the current table angle (ray casting). */
 void sim_rig_update(struct sim_rig *rig);
 
-/** Render one RGB24 frame with noise; @p frame_no seeds the noise (deterministic). */
-void sim_rig_render(struct sim_rig *rig, const struct sim_sources *src, uint64_t frame_no,
+/** Render one RGB24 frame with noise; @p noise_id (with the seed and the angle) seeds it. */
+void sim_rig_render(struct sim_rig *rig, const struct sim_sources *src, uint64_t noise_id,
                     uint8_t *rgb);
 
 /** Height of the object as placed on the table (a torus lies flat). */

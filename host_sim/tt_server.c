@@ -131,7 +131,13 @@ void tt_server_run(struct tt_server *s)
             connected = 1;
         }
         int len = modbus_receive(s->ctx, req);
-        if (len > 0) {
+        if (len > 0 && s->is_tcp && s->drop_at_request != 0 &&
+            s->requests + 1 == s->drop_at_request) {
+            s->drop_at_request = 0; /* once: the controller is back for the reconnect */
+            close(modbus_get_socket(s->ctx));
+            modbus_set_socket(s->ctx, -1);
+            connected = 0;
+        } else if (len > 0) {
             answer(s, req, len);
         } else if (len < 0 && errno != ETIMEDOUT && s->is_tcp) {
             close(modbus_get_socket(s->ctx)); /* the client left: wait for the next one */

@@ -25,6 +25,9 @@ struct tt_server {
     int running;
     volatile int stop;
     unsigned long requests; /* requests answered */
+    /* fault injection (tests, TCP): after this many requests in all, drop the client without
+     * answering, as a pulled cable or a rebooting controller does (0: never) */
+    unsigned long drop_at_request;
 };
 
 /** Listen on @p host:@p port (0: any free port, see ->port). @retval 0 or -errno (message in err) */

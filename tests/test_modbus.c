@@ -200,6 +200,25 @@ static void test_no_reply_times_out(void **state)
     assert_non_null(strstr(last_log, "turntable: reading the status failed"));
 }
 
+/* TCP: the connection drops in the middle of a move (cable pulled, controller rebooted) and
+ * comes back: the client reconnects within its retries and the move ends where it should. */
+static void test_connection_drop_reconnects(void **state)
+{
+    (void)state;
+    struct hal_turntable_status st;
+    assert_int_equal(hal_table_home(&table), 0);
+    unsigned long before = client.retries_used;
+    server.drop_at_request = server.requests + 3; /* while polling the move */
+    errors_logged = 0;
+    assert_int_equal(hal_table_move_to(&table, 90000), 0);
+    assert_int_equal(server.drop_at_request, 0); /* the drop happened */
+    assert_true(client.retries_used - before >= 1);
+    assert_int_equal(errors_logged, 0);
+    assert_int_equal(hal_table_get_status(&table, &st), 0);
+    assert_int_equal(st.position_mdeg, 90000);
+    assert_int_equal(tt_server_position(&server), 90000);
+}
+
 /* RTU: a reply with a bad CRC is dropped, flushed and asked again. */
 static void test_rtu_bad_crc_retried(void **state)
 {
@@ -258,6 +277,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_illegal_address_exception, open_tcp, close_all),
         cmocka_unit_test_setup_teardown(test_command_applied_once, open_tcp, close_all),
         cmocka_unit_test_setup_teardown(test_no_reply_times_out, open_tcp, close_all),
+        cmocka_unit_test_setup_teardown(test_connection_drop_reconnects, open_tcp, close_all),
         cmocka_unit_test_setup_teardown(test_home_and_move, open_rtu, close_all),
         cmocka_unit_test_setup_teardown(test_rtu_bad_crc_retried, open_rtu, close_all),
         cmocka_unit_test_setup_teardown(test_rtu_wrong_unit_is_silent, open_rtu, close_all),
