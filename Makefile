@@ -156,11 +156,12 @@ check-firmware: $(FW_OBJ)
 # make fuzz: each target under libFuzzer (clang, with ASan + UBSan) for FUZZ_SECONDS, seeded by
 # and merged back into tests/fuzz/corpus/<target>/; a crash is written to tests/fuzz/crashes/.
 # make test replays the corpus and every crash kept (fuzz-replay-*, built like the suite).
-FUZZ_TARGETS := config calib view_ini ply
+FUZZ_TARGETS := config calib view_ini ply modbus
 FUZZ_SECONDS ?= 600
-FUZZ_LIB_SRC := app/config.c app/ini_schema.c host_sim/sim_mesh.c host_sim/sim_ply_read.c
+FUZZ_LIB_SRC := app/config.c app/ini_schema.c host_sim/sim_mesh.c host_sim/sim_ply_read.c \
+	hal/modbus/turntable_modbus.c host_sim/clock_sim.c
 FUZZ_CFLAGS = -std=c11 -g -O1 -Ihal/include -Ifirmware -Iapp -Ihal/posix -Ihal/linux -Ihal/modbus -Ihost_sim -Itests/fuzz $(PKG_CFLAGS)
-FUZZ_LIBS = $(shell $(PKG_CONFIG) --libs inih 2>/dev/null) -lm
+FUZZ_LIBS = $(shell $(PKG_CONFIG) --libs inih libmodbus 2>/dev/null) -lpthread -lm
 FUZZ_REPLAY := $(patsubst %,$(BUILD)/tests/fuzz-replay-%,$(FUZZ_TARGETS))
 
 $(BUILD)/tests/fuzz-replay-%: $(call obj,tests/fuzz/replay.c) $(BUILD)/tests/fuzz/fuzz_%.o $(call obj,$(FUZZ_LIB_SRC)) $(BUILD)/libfirmware.a

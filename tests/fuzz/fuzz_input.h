@@ -10,7 +10,7 @@
 #include <unistd.h>
 
 /* The path of a file holding exactly @p data; the same file is rewritten for every input. */
-static const char *fuzz_path(const uint8_t *data, size_t size)
+static inline const char *fuzz_path(const uint8_t *data, size_t size)
 {
     static int fd = -1;
     static char path[64];
