@@ -13,11 +13,34 @@ methods="none single uniform multi"
 work=$build/eval
 mkdir -p "$work" "$report"
 
-# White reference: one view of the white sphere gives each method's white_scale.
+# White reference: one view of the white sphere gives each method's white_scale; once more for
+# each variant below, which changes what the white sphere gives.
+variants="falloff=0 ca=pixel"
+with_setting() { # KEY=VALUE FILE: the config with KEY set in its [colour] section
+    sed "/^\[colour\]/a ${1%%=*} = ${1#*=}" "$2"
+}
 "$build/scanner" calibrate-white --config tests/eval/white.ini > "$work/white.txt"
-scale_of() { # method -> its white_scale line's value
+for v in $variants; do
+    with_setting "$v" tests/eval/white.ini > "tests/eval/.white-$v.ini"
+    "$build/scanner" calibrate-white --config "tests/eval/.white-$v.ini" > "$work/white-$v.txt"
+    rm -f "tests/eval/.white-$v.ini"
+done
+scale_of() { # method [variant] -> its white_scale line's value
     awk -v m="$1" '$1 == ";" && $2 == m { getline; sub(/^white_scale = /, ""); print }' \
-        "$work/white.txt"
+        "$work/white${2:+-$2}.txt"
+}
+measure() { # scene method [variant]: process the scan with those settings and measure it
+    name=$2${3:+/$3}
+    dir=$work/$1-$2${3:+-$3}
+    cfg=$dir.ini
+    sed -e "s/^method = .*/method = $2/" -e "s/^white_scale = .*/white_scale = $(scale_of "$2" "${3:-}")/" \
+        -e "s|^calibration = .*|calibration = calibration.ini|" "$work/$1/config.ini" > "$cfg"
+    if [ -n "${3:-}" ]; then
+        with_setting "$3" "$cfg" > "$cfg.tmp" && mv "$cfg.tmp" "$cfg"
+    fi
+    rm -rf "$dir"
+    "$build/scanner" process "$work/$1" --config "$cfg" --out "$dir" --json > "$dir.log"
+    "$build/colour-eval" measure "$work/$1" "$dir" "$1,$name" >> "$csv"
 }
 
 csv=$report/colour-eval.csv
@@ -28,15 +51,15 @@ for scene in $scenes; do
     echo "eval: scanning $scene" >&2
     "$build/scanner" scan --config "tests/eval/$scene.ini" --out "$scan" --json > "$work/$scene.log"
     for m in $methods; do
-        cfg=$work/$scene-$m.ini
-        scale=$(scale_of "$m")
-        sed -e "s/^method = .*/method = $m/" -e "s/^white_scale = .*/white_scale = $scale/" \
-            -e "s|^calibration = .*|calibration = calibration.ini|" "$scan/config.ini" > "$cfg"
-        rm -rf "$work/$scene-$m"
-        "$build/scanner" process "$scan" --config "$cfg" --out "$work/$scene-$m" --json \
-            > "$work/$scene-$m.log"
-        "$build/colour-eval" measure "$scan" "$work/$scene-$m" "$scene,$m" >> "$csv"
+        measure "$scene" "$m"
     done
+    # Does the inverse-square falloff help, and is Ca better per channel or per pixel?
+    if [ "$scene" = owl ] || [ "$scene" = can ]; then
+        for v in $variants; do
+            measure "$scene" single "$v"
+            measure "$scene" multi "$v"
+        done
+    fi
     "$build/colour-eval" closeup "$scan" "$report/closeup-$scene.png" \
         $(for m in $methods; do printf '%s ' "$work/$scene-$m"; done)
 done

@@ -7,6 +7,7 @@ function check(ok, text) {
 NR == 1 { next }
 {
     key = $1 "," $2
+    if ($2 ~ /\//) variant[++nvariant] = key
     scenes[$1] = 1
     if (!($1 in order)) { order[$1] = ++nscenes; name[nscenes] = $1 }
     de[key] = $4; p95[key] = $5; mae[key] = ($6 + $7 + $8) / 3
@@ -38,6 +39,25 @@ END {
         for (m = 1; m <= 4; m++)
             if ((name[s] "," methods[m]) in row)
                 print row[name[s] "," methods[m]]
+    print ""
+    print "### Variants: the inverse-square falloff off, and Ca per pixel"
+    print ""
+    print "The same scans with `[colour] falloff = 0` (no distance compensation) or `ca = pixel` (Ca"
+    print "from the dark frame per pixel rather than one value per channel), each with its own white"
+    print "reference; compare with the single and multi rows above."
+    print ""
+    print "| scene | method | vertices | dE00 mean | dE00 p95 | MAE r / g / b | view step dE00 | fused step dE00 | highlight views | highlight fused | ICP coupling |"
+    print "|---|---|---|---|---|---|---|---|---|---|---|"
+    for (i = 1; i <= nvariant; i++)
+        print row[variant[i]]
+    for (i = 1; i <= nvariant; i++) {
+        split(variant[i], kv, ","); split(kv[2], mv, "/")
+        base = kv[1] "," mv[1]
+        if (mv[2] == "falloff=0")
+            printf "- %s %s: the falloff compensation %s mean dE00 (%.2f with it, %.2f without)\n", kv[1], mv[1], de[base] < de[variant[i]] ? "lowers" : "does not lower", de[base], de[variant[i]]
+        else
+            printf "- %s %s: Ca per pixel gives mean dE00 %.2f, per channel %.2f\n", kv[1], mv[1], de[variant[i]], de[base]
+    }
     print ""
     print "## Issue 4's criteria"
     print ""

@@ -11,7 +11,7 @@ extern "C" {
 struct camera_libcamera {
     void *impl; /* the C++ state, made by camera_libcamera_init */
     void (*log)(enum hal_log_level level, const char *fmt, ...);
-    char error[256]; /* what went wrong last, naming the camera and the call */
+    char error[400]; /* what went wrong last, naming the camera and the call */
 };
 
 /** Fill @p out with the libcamera ops on @p cam; open() starts libcamera's camera manager and

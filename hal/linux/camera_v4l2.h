@@ -18,7 +18,7 @@ struct camera_v4l2 {
     size_t buf_len[CAMERA_V4L2_RING];
     uint32_t buf_count;
     void (*log)(enum hal_log_level level, const char *fmt, ...);
-    char error[256]; /* what went wrong last, naming the device and the ioctl */
+    char error[400]; /* what went wrong last, naming the device and the ioctl */
 };
 
 /** Fill @p out with the V4L2 ops on @p cam (closed); open() then opens cfg->device. */
