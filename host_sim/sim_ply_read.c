@@ -19,6 +19,7 @@ struct ply_prop {
 };
 
 #define PLY_MAX_PROPS 32
+#define PLY_MAX_ROWS (1ul << 31) /* rows of one element; more is a damaged header */
 struct ply_element {
     char name[64];
     unsigned long count;
@@ -148,7 +149,15 @@ static int parse_header(FILE *f, struct ply_header *h, char *err, unsigned err_l
             }
             struct ply_element *el = &h->elems[h->elem_count++];
             snprintf(el->name, sizeof(el->name), "%s", b);
-            el->count = strtoul(c, NULL, 10);
+            char *end;
+            errno = 0;
+            el->count = strtoul(c, &end, 10);
+            /* a count that is not a number, or absurd, would loop for ever over rows of an
+             * element without properties (found by make fuzz) */
+            if (errno != 0 || end == c || *end != '\0' || c[0] == '-' || el->count > PLY_MAX_ROWS) {
+                snprintf(err, err_len, "%s: element '%s' has a bad count '%s'", path, el->name, c);
+                return -EINVAL;
+            }
         } else if (strcmp(a, "property") == 0 && h->elem_count > 0) {
             struct ply_element *el = &h->elems[h->elem_count - 1];
             if (el->prop_count == PLY_MAX_PROPS) {
@@ -205,6 +214,8 @@ static int read_element(FILE *f, const struct ply_header *h, const struct ply_el
                         struct sim_mesh *m, uint32_t *tri_cap)
 {
     int is_vertex = strcmp(el->name, "vertex") == 0;
+    if (el->prop_count == 0)
+        return 0; /* rows of nothing take no bytes */
     for (unsigned long r = 0; r < el->count; r++) {
         for (int k = 0; k < el->prop_count; k++) {
             const struct ply_prop *p = &el->props[k];

@@ -16,7 +16,7 @@ width = 1280
 height = 960
 exposure_us = 10000
 [scan]
-calibration = ../../config/sim-calib.ini
+calibration = '"$PWD/config/sim-calib.ini"'
 '
 cfg() { # name, extra lines: a config of the simulated rig plus the extra lines
     printf '%s%s\n' "$base" "$2" > "$w/$1.ini"
