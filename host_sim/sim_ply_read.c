@@ -251,6 +251,43 @@ static int read_element(FILE *f, const struct ply_header *h, const struct ply_el
     return 0;
 }
 
+/* The fewest bytes a row of @p el can take: binary, the sum of its scalars (a list at least its
+ * count); ASCII, a digit and a separator per property. */
+static size_t min_row_bytes(const struct ply_header *h, const struct ply_element *el)
+{
+    size_t n = 0;
+    for (int k = 0; k < el->prop_count; k++) {
+        const struct ply_prop *p = &el->props[k];
+        n += !h->binary ? 2 : ply_type_size(p->list_count_type != PT_NONE ? p->list_count_type
+                                                                         : p->type);
+    }
+    return n;
+}
+
+/* A header that claims more rows than the file holds is refused before anything is allocated
+ * for them (a tiny file must not cost gigabytes: found by make fuzz). */
+static int check_counts(FILE *f, const struct ply_header *h, const char *path, char *err,
+                        unsigned err_len)
+{
+    long here = ftell(f);
+    if (here < 0 || fseek(f, 0, SEEK_END) != 0)
+        return 0; /* not seekable: the reads will find the end */
+    long end = ftell(f);
+    if (fseek(f, here, SEEK_SET) != 0)
+        return -EIO;
+    double left = (double)(end - here);
+    for (int e = 0; e < h->elem_count; e++) {
+        double need = (double)h->elems[e].count * (double)min_row_bytes(h, &h->elems[e]);
+        if (need > left + 1.0) { /* + 1: ASCII without a final newline */
+            snprintf(err, err_len, "%s: element '%s' claims %lu rows, more than the file holds",
+                     path, h->elems[e].name, h->elems[e].count);
+            return -EINVAL;
+        }
+        left -= need;
+    }
+    return 0;
+}
+
 /* Does the vertex element have a property of @p role? */
 static int ply_has_role(const struct ply_header *h, enum ply_role role)
 {
@@ -275,6 +312,8 @@ static int load_ply(struct sim_mesh *m, const char *path, int need_faces, char *
         return rc;
     }
     rc = parse_header(f, &h, err, err_len, path);
+    if (rc == 0)
+        rc = check_counts(f, &h, path, err, err_len);
     if (rc != 0)
         goto out_close;
     int vertex_elements = 0;

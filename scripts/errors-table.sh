@@ -88,6 +88,11 @@ cfg short '[sim]
 object = mesh
 mesh_file = short.ply'
 row "PLY truncated" "header only" "$sim" scan --config "$w/short.ini" --out "$w/scan-short"
+printf 'ply\nformat binary_little_endian 1.0\nelement vertex 50000000\nproperty float x\nend_header\n' > "$w/huge.ply"
+cfg huge '[sim]
+object = mesh
+mesh_file = huge.ply'
+row "PLY claiming more than it holds" "element vertex 50000000, no data" "$sim" scan --config "$w/huge.ini" --out "$w/scan-huge"
 mkdir -p "$w/not-a-scan"
 row "not a scan directory" "process an empty directory" "$sim" process "$w/not-a-scan"
 row "unknown argument" "scan --colour" "$sim" scan --colour
