@@ -294,7 +294,7 @@ measure: deps $(BUILD)/measure_view
 	$(BUILD)/measure_view config/sim.ini
 
 # Intrinsic colour (issue 4): Jost et al.'s comparison reproduced on the simulator, written to
-# docs/colour-eval/ (table as Markdown and CSV, close-up PNGs of a view boundary). ~6 minutes.
+# docs/colour-eval/ (table as Markdown and CSV, close-up PNGs of a view boundary). About 20 minutes.
 EVAL_DIR ?= docs/colour-eval
 eval: deps $(BUILD)/scanner $(BUILD)/colour-eval
 	tests/colour_eval.sh $(BUILD) $(EVAL_DIR)
