@@ -210,14 +210,13 @@ static int cmd_resume(const char *scan_dir, const struct scan_job_opts *opts)
     static struct app_config cfg;
     static struct scan_calib calib;
     char err[512];
-    uint32_t first = 0;
     if (scan_job_load_settings(scan_dir, opts->config_path, &cfg, &calib, err, sizeof(err)) != 0) {
         fprintf(stderr, "scanner: error: %s\n", err);
         return 2;
     }
     int rc = rig_up(&cfg, &calib);
     if (rc == 0)
-        rc = scan_job_resume(&the_hal, &cfg, &calib, scan_dir, opts, &first);
+        rc = scan_job_resume(&the_hal, &cfg, &calib, scan_dir, opts);
     rig_down();
     if (rc != 0)
         return 1;

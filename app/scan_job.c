@@ -332,6 +332,19 @@ static int live_view(struct job *j, uint32_t v)
     return 0;
 }
 
+/* Home the table, then take views @p first .. the last, each saved before the next move. */
+static int home_and_take_views(struct job *j, uint32_t first)
+{
+    const struct hal *hal = j->hal;
+    progress(j, "homing", (int)first, first, "");
+    int rc = hal_table_home(&hal->turntable);
+    if (rc != 0)
+        hal->log(HAL_LOG_ERROR, "the turntable did not home");
+    for (uint32_t v = first; v < j->cfg->views && rc == 0; v++)
+        rc = live_view(j, v);
+    return rc;
+}
+
 int scan_job_live(const struct hal *hal, const struct app_config *cfg,
                   const struct scan_calib *calib, const struct scan_job_opts *opts)
 {
@@ -353,12 +366,7 @@ int scan_job_live(const struct hal *hal, const struct app_config *cfg,
     if (rc != 0)
         return rc;
     progress(&j, "scan_start", -1, 0, j.out_dir);
-    progress(&j, "homing", 0, 0, "");
-    rc = hal_table_home(&hal->turntable);
-    if (rc != 0)
-        hal->log(HAL_LOG_ERROR, "the turntable did not home");
-    for (uint32_t v = 0; v < cfg->views && rc == 0; v++)
-        rc = live_view(&j, v);
+    rc = home_and_take_views(&j, 0);
     if (rc == 0)
         rc = write_model(&j);
     if (rc == 0)
@@ -394,7 +402,7 @@ static int view_complete(const char *scan_dir, uint32_t v)
 
 int scan_job_resume(const struct hal *hal, const struct app_config *cfg,
                     const struct scan_calib *calib, const char *scan_dir,
-                    const struct scan_job_opts *opts, uint32_t *first_view)
+                    const struct scan_job_opts *opts)
 {
     struct job j = {hal,      cfg,        calib,     opts,
                     scan_dir, cfg->views, wall_ms(), isatty(STDOUT_FILENO) && !opts->json,
@@ -403,22 +411,13 @@ int scan_job_resume(const struct hal *hal, const struct app_config *cfg,
     uint32_t first = 0;
     while (first < cfg->views && view_complete(scan_dir, first))
         first++;
-    *first_view = first;
     snprintf(detail, sizeof(detail), "%u of %u views kept", (unsigned)first, (unsigned)cfg->views);
     progress(&j, "resume", -1, first, detail);
     if (first == cfg->views)
         return 0;
     int rc = fusion_begin(&cfg->fusion); /* the model comes from scan_job_process afterwards */
     icp_reset();
-    if (rc != 0)
-        return rc;
-    progress(&j, "homing", (int)first, first, "");
-    rc = hal_table_home(&hal->turntable);
-    if (rc != 0)
-        hal->log(HAL_LOG_ERROR, "the turntable did not home");
-    for (uint32_t v = first; v < cfg->views && rc == 0; v++)
-        rc = live_view(&j, v);
-    return rc;
+    return rc != 0 ? rc : home_and_take_views(&j, first);
 }
 
 /* ---- offline ---- */

@@ -27,11 +27,10 @@ int scan_job_load_settings(const char *scan_dir, const char *config_path, struct
 /** Take the views of the scan in @p scan_dir that did not finish (no view.ini: a view is
  *  complete only once its view.ini is on disk), from the first unfinished one on, homing the
  *  table first. The model is then made by scan_job_process over all views.
- *  @param first_view  out: the first view taken (cfg->views: none was missing)
  *  @retval 0 ok @retval the first error (views finished before it are kept) */
 int scan_job_resume(const struct hal *hal, const struct app_config *cfg,
                     const struct scan_calib *calib, const char *scan_dir,
-                    const struct scan_job_opts *opts, uint32_t *first_view);
+                    const struct scan_job_opts *opts);
 
 /** Recompute every result of the scan in @p scan_dir from its kept frames alone.
  *  @param hal  storage, clock and log only; no device is touched

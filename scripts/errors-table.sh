@@ -78,21 +78,19 @@ cfg badcalib '' && sed -i "s|^calibration = .*|calibration = calib-vec.ini|" "$w
 row "calibration vector short" "axis_dir = 0, 1" "$sim" check-config --config "$w/badcalib.ini"
 cfg v4l2 '' && sed -i 's/^backend = sim/backend = v4l2/' "$w/v4l2.ini"
 row "backend not built in" "backend = v4l2 (HAL=sim build)" "$sim" scan --config "$w/v4l2.ini" --out "$w/scan-v4l2"
-printf 'ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nelement vertex 1\nproperty float x\nend_header\n1\n2\n3\n' > "$w/two.ply"
-cfg ply '[sim]
+ply_row() { # name, what, input shown, the PLY's content (printf format): a scan of that mesh
+    printf "$4" > "$w/$1.ply"
+    cfg "$1" "[sim]
 object = mesh
-mesh_file = two.ply'
-row "PLY with two vertex elements" "element vertex 2, element vertex 1" "$sim" scan --config "$w/ply.ini" --out "$w/scan-ply"
-printf 'ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n' > "$w/short.ply"
-cfg short '[sim]
-object = mesh
-mesh_file = short.ply'
-row "PLY truncated" "header only" "$sim" scan --config "$w/short.ini" --out "$w/scan-short"
-printf 'ply\nformat binary_little_endian 1.0\nelement vertex 50000000\nproperty float x\nend_header\n' > "$w/huge.ply"
-cfg huge '[sim]
-object = mesh
-mesh_file = huge.ply'
-row "PLY claiming more than it holds" "element vertex 50000000, no data" "$sim" scan --config "$w/huge.ini" --out "$w/scan-huge"
+mesh_file = $1.ply"
+    row "$2" "$3" "$sim" scan --config "$w/$1.ini" --out "$w/scan-$1"
+}
+ply_row two "PLY with two vertex elements" "element vertex 2, element vertex 1" \
+    'ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nelement vertex 1\nproperty float x\nend_header\n1\n2\n3\n'
+ply_row short "PLY truncated" "header only" \
+    'ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n'
+ply_row huge "PLY claiming more than it holds" "element vertex 50000000, no data" \
+    'ply\nformat binary_little_endian 1.0\nelement vertex 50000000\nproperty float x\nend_header\n'
 mkdir -p "$w/not-a-scan"
 row "not a scan directory" "process an empty directory" "$sim" process "$w/not-a-scan"
 row "unknown argument" "scan --colour" "$sim" scan --colour
