@@ -23,6 +23,12 @@ int board_write_view_extras(const struct hal *hal, const char *view_dir);
 /** Safe state, then release every device. */
 void board_shutdown(struct hal *hal);
 
+/** Open the camera with @p cam, capture one frame into a buffer of the configured size, close
+ *  it. @param width @param height  out: the frame's size (0 when none came)
+ *  @retval 0 @retval -ENOMEM @retval what opening or capturing returned */
+int board_grab_frame(const struct hal *hal, const struct hal_camera_config *cam, uint32_t *width,
+                     uint32_t *height);
+
 /** One line of the selftest: @p device ("camera", "gpio", "turntable") at @p where, 0 or the
  *  -errno it failed with, and what was seen or why it failed. */
 typedef void (*board_selftest_row)(void *ctx, const char *device, const char *where, int rc,

@@ -202,24 +202,17 @@ int board_selftest(struct hal *hal, const struct app_config *cfg, const struct s
 {
     char detail[512];
     struct hal_turntable_status st;
-    struct hal_image img = {0};
-    int rc = board_init(hal, cfg, calib, detail, sizeof(detail)), cam_rc = rc, table_rc = rc;
+    uint32_t w, h;
+    int rc = board_init(hal, cfg, calib, detail, sizeof(detail));
     if (rc != 0) {
         row(ctx, "simulated rig", cfg->path, rc, detail);
         return rc;
     }
-    img.capacity = (size_t)cfg->camera.width * cfg->camera.height * 3u;
-    img.rgb = malloc(img.capacity);
-    cam_rc = img.rgb == NULL ? -ENOMEM : hal_cam_open(&hal->camera, &cfg->camera);
-    if (cam_rc == 0)
-        cam_rc = hal_cam_capture(&hal->camera, &img);
-    snprintf(detail, sizeof(detail), "simulated frame %ux%u", (unsigned)img.width,
-             (unsigned)img.height);
+    int cam_rc = board_grab_frame(hal, &cfg->camera, &w, &h);
+    snprintf(detail, sizeof(detail), "simulated frame %ux%u", (unsigned)w, (unsigned)h);
     row(ctx, "camera", "sim", cam_rc, cam_rc == 0 ? detail : strerror(-cam_rc));
-    hal_cam_close(&hal->camera);
-    free(img.rgb);
     row(ctx, "gpio", "sim", 0, "simulated lines");
-    table_rc = hal_table_get_status(&hal->turntable, &st);
+    int table_rc = hal_table_get_status(&hal->turntable, &st);
     snprintf(detail, sizeof(detail), "simulated controller on Modbus %s answers: at %.3f deg",
              cfg->turntable.transport, st.position_mdeg / 1000.0);
     row(ctx, "turntable", cfg->turntable.transport, table_rc,

@@ -126,19 +126,12 @@ static int probe_camera(struct hal *hal, const struct app_config *cfg, char *det
     int rc = camera_init(hal, cfg, detail, len);
     if (rc != 0)
         return rc;
-    struct hal_image img = {0};
-    img.capacity = (size_t)cfg->camera.width * cfg->camera.height * 3u;
-    img.rgb = malloc(img.capacity); /* once, at start: the app may allocate, firmware/ not */
-    rc = img.rgb == NULL ? -ENOMEM : hal_cam_open(&hal->camera, &cfg->camera);
+    uint32_t w, h;
+    rc = board_grab_frame(hal, &cfg->camera, &w, &h);
     if (rc == 0)
-        rc = hal_cam_capture(&hal->camera, &img);
-    if (rc == 0)
-        snprintf(detail, len, "%s frame %ux%u", cfg->camera_backend, (unsigned)img.width,
-                 (unsigned)img.height);
+        snprintf(detail, len, "%s frame %ux%u", cfg->camera_backend, (unsigned)w, (unsigned)h);
     else if (rc != -ENOMEM)
         snprintf(detail, len, "%s", board.camera_error);
-    hal_cam_close(&hal->camera);
-    free(img.rgb);
     camera_free();
     hal->camera.ops = NULL;
     return rc;
