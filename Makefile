@@ -135,6 +135,10 @@ $(BUILD)/tests/%: $(BUILD)/tests/%.o $(TEST_SUPPORT) $(HOST_OBJ) $(TEST_EXTRA_OB
 
 # The storage backend's system calls, failed on purpose (tests/test_storage_faults.c).
 $(BUILD)/tests/test_storage_faults: TEST_LDFLAGS = -Wl,--wrap=write,--wrap=fsync,--wrap=rename
+# libgpiod answered by the test where no GPIO chip exists (a line held by another program).
+GPIOD_WRAPPED := gpiod_chip_open_lookup gpiod_chip_get_line gpiod_line_request_output \
+	gpiod_line_consumer gpiod_line_set_value gpiod_line_release gpiod_chip_close
+$(BUILD)/tests/test_gpiod: TEST_LDFLAGS = $(foreach f,$(GPIOD_WRAPPED),-Wl,--wrap=$(f))
 
 $(BUILD)/tests/test_util.o: tests/test_util.c | deps
 	@mkdir -p $(dir $@)

@@ -63,7 +63,34 @@ int scan_open(const struct hal *hal, const struct hal_camera_config *cam_cfg)
     return rc;
 }
 
-/* Capture into @p buf, retrying faults that a second try can cure (timeout, corrupt frame). */
+/* When the last light or pattern change had settled (HAL clock; 0: the clock cannot tell). */
+static uint64_t settled_us;
+
+/* Wait for a light or pattern change to take effect, and remember when it had. */
+static int settle(const struct hal *hal, const struct scan_params *p)
+{
+    int rc = hal_clock_sleep_us(&hal->clock, p->pattern_settle_us);
+    if (rc == 0 && hal_clock_now_us(&hal->clock, &settled_us) != 0)
+        settled_us = 0;
+    return rc;
+}
+
+/* A frame whose exposure began before the change had settled shows the old pattern or lights
+ * (a camera delivering a frame it had in flight): it is discarded like a corrupt one. */
+static int check_fresh(const struct hal *hal, const struct hal_image *img, uint32_t pattern)
+{
+    if (img->start_us == 0 || settled_us == 0 || img->start_us >= settled_us)
+        return 0;
+    hal->log(HAL_LOG_WARN,
+             "camera: frame %llu for pattern %u began %llu us before the change had settled "
+             "(a stale frame); discarded",
+             (unsigned long long)img->sequence, (unsigned)pattern,
+             (unsigned long long)(settled_us - img->start_us));
+    return -EAGAIN;
+}
+
+/* Capture into @p buf, retrying faults that a second try can cure (timeout, corrupt or stale
+ * frame). */
 static int capture(const struct hal *hal, const struct scan_params *p, uint8_t *buf,
                    uint32_t pattern, struct scan_view_info *info)
 {
@@ -76,12 +103,22 @@ static int capture(const struct hal *hal, const struct scan_params *p, uint8_t *
         if (rc == 0 && (img.width != p->width || img.height != p->height))
             rc = -EIO; /* a frame of the wrong size is as bad as a corrupt one */
         if (rc == 0)
+            rc = check_fresh(hal, &img, pattern);
+        if (rc == 0)
             return 0;
-        hal->log(HAL_LOG_WARN, "camera: capture of pattern %u failed (%s), try %u of %u",
-                 (unsigned)pattern, strerror(-rc), (unsigned)attempt + 1,
-                 (unsigned)p->capture_retries + 1);
+        if (rc != -EAGAIN)
+            hal->log(HAL_LOG_WARN, "camera: capture of pattern %u failed (%s), try %u of %u",
+                     (unsigned)pattern, strerror(-rc), (unsigned)attempt + 1,
+                     (unsigned)p->capture_retries + 1);
         if (rc != -ETIMEDOUT && rc != -EIO && rc != -EAGAIN)
             break;
+    }
+    if (rc == -EAGAIN) {
+        hal->log(HAL_LOG_ERROR,
+                 "camera: giving up on pattern %u: every frame began before the change had "
+                 "settled (raise [camera] drop_frames or [projector] settle_us)",
+                 (unsigned)pattern);
+        return -EIO;
     }
     hal->log(HAL_LOG_ERROR, "camera: giving up on pattern %u: %s", (unsigned)pattern,
              strerror(-rc));
@@ -105,7 +142,7 @@ static int projector_start(const struct hal *hal, const struct scan_params *p, u
     if (rc == 0)
         rc = hal_gpio_pulse(&hal->gpio, &hal->clock, HAL_GPIO_PROJECTOR_RESET, p->trigger_pulse_us);
     if (rc == 0)
-        rc = hal_clock_sleep_us(&hal->clock, p->pattern_settle_us);
+        rc = settle(hal, p);
     return rc;
 }
 
@@ -212,7 +249,7 @@ static int capture_patterns(const struct hal *hal, const struct scan_params *p, 
         rc = hal_gpio_pulse(&hal->gpio, &hal->clock, HAL_GPIO_PROJECTOR_TRIGGER,
                             p->trigger_pulse_us);
         if (rc == 0)
-            rc = hal_clock_sleep_us(&hal->clock, p->pattern_settle_us);
+            rc = settle(hal, p);
         if (rc != 0)
             return rc;
     }
@@ -238,7 +275,7 @@ static int capture_lights(const struct hal *hal, const struct scan_params *p,
             exposure_us = lay.exposure_us[k];
         }
         if (rc == 0)
-            rc = hal_clock_sleep_us(&hal->clock, p->pattern_settle_us);
+            rc = settle(hal, p);
         if (rc == 0 && hal_should_stop(hal))
             rc = -EINTR;
         if (rc == 0)

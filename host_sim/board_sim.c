@@ -104,7 +104,7 @@ int board_init(struct hal *hal, const struct app_config *cfg, const struct scan_
         return rc;
     gpio_sim_init(&sim.gpio, gray_layout_count(&layout), &hal->gpio);
     clock_sim_init(&sim.clock, &hal->clock);
-    camera_sim_init(&sim.camera, &sim.rig, &sim.gpio, calib->light_count, &hal->camera);
+    camera_sim_init(&sim.camera, &sim.rig, &sim.gpio, &sim.clock, calib->light_count, &hal->camera);
     storage_posix_init(&hal->storage);
     sim.ready = 1;
     rc = start_turntable(hal, cfg, err, err_len);

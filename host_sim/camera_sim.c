@@ -14,6 +14,7 @@ static int camera_sim_open(void *priv, const struct hal_camera_config *cfg)
     cam->cfg = *cfg;
     cam->is_open = 1;
     cam->frames = 0;
+    cam->has_shown = 0;
     return 0;
 }
 
@@ -36,14 +37,27 @@ static uint64_t noise_id(struct camera_sim *cam, const struct sim_sources *src)
     return key + cam->repeat;
 }
 
+/* A stale frame: one the camera exposed before the last light or pattern change (it had it
+ * in flight), showing what the previous frame showed, stamped with when that began. */
+static int stale(const struct camera_sim *cam, struct sim_sources *src, uint64_t *start_us)
+{
+    if (!cam->has_shown)
+        return 0; /* nothing was exposed before the first frame */
+    *src = cam->shown;
+    *start_us = cam->shown_start_us;
+    cam->rig->table_angle_mdeg = cam->shown_angle_mdeg;
+    return 1;
+}
+
 static int camera_sim_capture(void *priv, struct hal_image *img)
 {
     struct camera_sim *cam = priv;
     if (!cam->is_open)
         return -EBADF;
     uint64_t frame = cam->frames++;
-    if (cam->fault != SIM_FAULT_NONE && frame >= cam->fault_first &&
-        frame < cam->fault_first + cam->fault_count) {
+    int faulty = cam->fault != SIM_FAULT_NONE && frame >= cam->fault_first &&
+                 frame < cam->fault_first + cam->fault_count;
+    if (faulty && cam->fault != SIM_FAULT_STALE) {
         static const int code[] = {0, -ETIMEDOUT, -EIO, -ENODEV};
         return code[cam->fault];
     }
@@ -56,10 +70,19 @@ static int camera_sim_capture(void *priv, struct hal_image *img)
     gpio_sim_sources(cam->gpio, cam->light_count, &src);
     src.exposure_us = cam->cfg.exposure_us;
     src.gain_milli = cam->cfg.gain_milli;
+    uint64_t start_us = clock_sim_now(cam->clock);
+    if (!(faulty && stale(cam, &src, &start_us))) {
+        cam->shown = src;
+        cam->shown_start_us = start_us;
+        cam->shown_angle_mdeg = cam->rig->table_angle_mdeg;
+        cam->has_shown = 1;
+    }
     sim_rig_render(cam->rig, &src, noise_id(cam, &src), img->rgb);
+    atomic_fetch_add(&cam->clock->now_us, (uint64_t)cam->cfg.exposure_us);
     img->width = cam->rig->width;
     img->height = cam->rig->height;
     img->sequence = frame;
+    img->start_us = start_us;
     return 0;
 }
 
@@ -94,11 +117,12 @@ static const struct hal_camera_ops camera_sim_ops = {
 };
 
 void camera_sim_init(struct camera_sim *cam, struct sim_rig *rig, const struct gpio_sim *gpio,
-                     uint32_t light_count, struct hal_camera *out)
+                     struct clock_sim *clock, uint32_t light_count, struct hal_camera *out)
 {
     memset(cam, 0, sizeof(*cam));
     cam->rig = rig;
     cam->gpio = gpio;
+    cam->clock = clock;
     cam->light_count = light_count;
     out->ops = &camera_sim_ops;
     out->priv = cam;

@@ -11,6 +11,8 @@ enum sim_cam_fault {
     SIM_FAULT_TIMEOUT,   /**< capture answers -ETIMEDOUT */
     SIM_FAULT_CORRUPT,   /**< capture answers -EIO (short or corrupt frame) */
     SIM_FAULT_NO_DEVICE, /**< capture answers -ENODEV (camera unplugged) */
+    SIM_FAULT_STALE,     /**< capture delivers a frame exposed before the last change: what
+                              the previous frame showed, with its start time */
 };
 
 /** Driven value of a GPIO line (0/1). */

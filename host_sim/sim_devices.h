@@ -21,6 +21,7 @@ struct clock_sim {
 struct camera_sim {
     struct sim_rig *rig;
     const struct gpio_sim *gpio;
+    struct clock_sim *clock; /* a frame takes its exposure time */
     uint32_t light_count;
     struct hal_camera_config cfg;
     int32_t (*table_angle)(void *priv); /* where the turntable is, if there is one */
@@ -29,6 +30,10 @@ struct camera_sim {
     uint64_t frames; /* captures attempted since open */
     uint64_t last_key; /* what the last frame showed, and how many in a row did (noise_id) */
     uint32_t repeat;
+    struct sim_sources shown; /* what the last frame showed, when and at what table angle: */
+    uint64_t shown_start_us;  /* what a stale frame shows again */
+    int32_t shown_angle_mdeg;
+    int has_shown;
     enum sim_cam_fault fault;
     uint64_t fault_first;
     uint32_t fault_count;
@@ -40,6 +45,6 @@ void clock_sim_init(struct clock_sim *c, struct hal_clock *out);
 /** Virtual time now, for other threads of the simulator. */
 uint64_t clock_sim_now(void *clock_sim);
 void camera_sim_init(struct camera_sim *cam, struct sim_rig *rig, const struct gpio_sim *gpio,
-                     uint32_t light_count, struct hal_camera *out);
+                     struct clock_sim *clock, uint32_t light_count, struct hal_camera *out);
 
 #endif

@@ -120,6 +120,26 @@ static void test_controls_out_of_range_are_named(void **state)
     assert_non_null(strstr(err, "no manual exposure"));
 }
 
+/* The start of exposure, which the firmware compares with when a pattern had settled: never
+ * later than the truth, and 0 when the stamp's clock is not the HAL's. */
+static void test_frame_start_from_timestamp(void **state)
+{
+    (void)state;
+    const uint32_t mono = V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC;
+    /* start-of-exposure stamp: taken as it is */
+    assert_int_equal(
+        v4l2_frame_start_us(mono | V4L2_BUF_FLAG_TSTAMP_SRC_SOE, 12, 345678, 10000, 33333),
+        12345678u);
+    /* end-of-frame stamp: back by the exposure and one frame's readout */
+    assert_int_equal(
+        v4l2_frame_start_us(mono | V4L2_BUF_FLAG_TSTAMP_SRC_EOF, 12, 345678, 10000, 33333),
+        12345678u - 10000u - 33333u);
+    assert_int_equal(v4l2_frame_start_us(mono, 0, 500, 10000, 0), 1u); /* not "unknown" */
+    /* stamps from another clock cannot be compared with the HAL clock */
+    assert_int_equal(v4l2_frame_start_us(V4L2_BUF_FLAG_TIMESTAMP_COPY, 12, 0, 10000, 0), 0u);
+    assert_int_equal(v4l2_frame_start_us(V4L2_BUF_FLAG_TIMESTAMP_UNKNOWN, 12, 0, 10000, 0), 0u);
+}
+
 static struct hal_camera_config camera_config(const char *device)
 {
     struct hal_camera_config c;
@@ -153,7 +173,7 @@ static void test_v4l2_missing_device(void **state)
     assert_non_null(strstr(cam.error, "camera /dev/null: VIDIOC_QUERYCAP: not a V4L2 device"));
     assert_int_equal(cam.fd, -1);
     assert_int_equal(open_fds(), fds);
-    struct hal_image img = {NULL, 0, 0, 0, 0};
+    struct hal_image img = {.rgb = NULL};
     assert_int_equal(hal_cam_capture(&hc, &img), -ENODEV);
     assert_int_equal(hal_cam_close(&hc), 0);
 }
@@ -170,7 +190,7 @@ static void test_libcamera_missing_camera(void **state)
     print_message("libcamera: %s\n", cam.error);
     assert_true(rc == -ENODEV || rc < 0);
     assert_non_null(strstr(cam.error, "camera libcamera '/base/soc/i2c0mux/i2c@1/imx477@1a'"));
-    struct hal_image img = {NULL, 0, 0, 0, 0};
+    struct hal_image img = {.rgb = NULL};
     assert_int_equal(hal_cam_capture(&hc, &img), -ENODEV);
     camera_libcamera_free(&cam);
 }
@@ -184,6 +204,7 @@ int main(void)
         cmocka_unit_test(test_short_frame_and_small_buffer),
         cmocka_unit_test(test_controls_turn_automatics_off_first),
         cmocka_unit_test(test_controls_out_of_range_are_named),
+        cmocka_unit_test(test_frame_start_from_timestamp),
         cmocka_unit_test(test_v4l2_missing_device),
 #ifdef HAVE_LIBCAMERA
         cmocka_unit_test(test_libcamera_missing_camera),

@@ -77,6 +77,70 @@ static void test_unplugged_camera_not_retried(void **state)
     sim_ctl_inject_camera_fault(SIM_FAULT_NONE, 0, 0);
 }
 
+/* What a clean view at angle 0 gives: its colour, decoded columns and counts. */
+static uint8_t clean_colour[HAL_MAX_PIXELS * 3];
+static uint16_t clean_column[HAL_MAX_PIXELS];
+static struct scan_view_info clean_info;
+
+static void scan_clean_view(void)
+{
+    sim_ctl_inject_camera_fault(SIM_FAULT_NONE, 0, 0);
+    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &clean_info), 0);
+    size_t n = (size_t)t.cfg.scan.width * t.cfg.scan.height;
+    memcpy(clean_colour, scan_view_colour(), n * 3);
+    memcpy(clean_column, decode_get_maps()->column, n * sizeof(clean_column[0]));
+}
+
+/* A view that had stale frames (exposed before the last change) is the clean view exactly. */
+static void assert_view_is_clean(const struct scan_view_info *info)
+{
+    size_t n = (size_t)t.cfg.scan.width * t.cfg.scan.height;
+    assert_int_equal(info->valid_points, clean_info.valid_points);
+    assert_int_equal(info->frames_captured, clean_info.frames_captured);
+    assert_memory_equal(scan_view_colour(), clean_colour, n * 3);
+    assert_memory_equal(decode_get_maps()->column, clean_column, n * sizeof(clean_column[0]));
+}
+
+/* The camera hands over frames it exposed before the pattern or the lights changed: each is
+ * recognised by its start time, discarded and taken again, and the view is as if none came. */
+static void test_stale_frames_are_discarded(void **state)
+{
+    (void)state;
+    struct scan_view_info info;
+    scan_clean_view();
+    /* two in a row on a Gray-code pattern (within capture_retries = 2) */
+    uint64_t start = sim_ctl_frames();
+    sim_ctl_inject_camera_fault(SIM_FAULT_STALE, start + 6, 2);
+    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info), 0);
+    assert_int_equal(info.capture_retries, 2);
+    assert_non_null(strstr(test_last_log, "before the change had settled"));
+    assert_view_is_clean(&info);
+    /* the last colour frame, after its light changed */
+    start = sim_ctl_frames();
+    sim_ctl_inject_camera_fault(SIM_FAULT_STALE, start + clean_info.frames_captured - 1, 1);
+    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info), 0);
+    assert_int_equal(info.capture_retries, 1);
+    assert_view_is_clean(&info);
+    assert_rig_dark();
+    sim_ctl_inject_camera_fault(SIM_FAULT_NONE, 0, 0);
+}
+
+/* A camera that only ever gives old frames: bounded retries, a message that says what to
+ * change, the rig dark, and nothing decoded from the old pattern. */
+static void test_persistent_stale_frames_stop_the_view(void **state)
+{
+    (void)state;
+    struct scan_view_info info;
+    uint64_t start = sim_ctl_frames();
+    sim_ctl_inject_camera_fault(SIM_FAULT_STALE, start + 9, 100);
+    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info), -EIO);
+    assert_int_equal(sim_ctl_frames() - start, 9 + 1 + t.cfg.scan.capture_retries);
+    assert_non_null(strstr(test_last_log, "giving up on pattern 9: every frame began before"));
+    assert_non_null(strstr(test_last_log, "drop_frames"));
+    assert_rig_dark();
+    sim_ctl_inject_camera_fault(SIM_FAULT_NONE, 0, 0);
+}
+
 static int stop_after_frames(void)
 {
     return sim_ctl_frames() >= 10;
@@ -141,6 +205,8 @@ int main(void)
         cmocka_unit_test(test_transient_timeout_is_retried),
         cmocka_unit_test(test_persistent_fault_stops_with_projector_off),
         cmocka_unit_test(test_unplugged_camera_not_retried),
+        cmocka_unit_test(test_stale_frames_are_discarded),
+        cmocka_unit_test(test_persistent_stale_frames_stop_the_view),
         cmocka_unit_test(test_stop_request_leaves_rig_dark),
         cmocka_unit_test(test_safe_state_turns_everything_off),
         cmocka_unit_test(test_projector_sequence),

@@ -33,6 +33,11 @@ struct hal_image {
     uint32_t width;    /**< filled in by capture */
     uint32_t height;   /**< filled in by capture */
     uint64_t sequence; /**< frame counter of the device, filled in by capture */
+    /** When the exposure of the frame's first row began, on the HAL clock (CLOCK_MONOTONIC on
+     *  Linux), or earlier when the device only says roughly; 0 when it cannot tell. The
+     *  firmware discards a frame that began before the last light or pattern change had
+     *  settled: it would show the old pattern. */
+    uint64_t start_us;
 };
 
 struct hal_camera_ops {

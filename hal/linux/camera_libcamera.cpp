@@ -215,6 +215,11 @@ int lc_capture(void *priv, hal_image *img)
     img->width = s->cfg.width;
     img->height = s->cfg.height;
     img->sequence = md.sequence;
+    // FrameMetadata::timestamp is the kernel's buffer stamp in ns of CLOCK_MONOTONIC (the HAL
+    // clock), taken at the start of the frame's readout by the Raspberry Pi's unicam: the
+    // exposure began up to one exposure before it.
+    uint64_t stamp_us = md.timestamp / 1000u;
+    img->start_us = stamp_us > s->cfg.exposure_us ? stamp_us - s->cfg.exposure_us : 0;
     return 0;
 }
 

@@ -99,6 +99,16 @@ static int set_format(struct camera_v4l2 *cam)
     return 0;
 }
 
+/* One frame interval, for the start of exposure of end-of-frame timestamps; optional. */
+static uint32_t frame_interval_us(struct camera_v4l2 *cam)
+{
+    struct v4l2_streamparm parm = {.type = V4L2_BUF_TYPE_VIDEO_CAPTURE};
+    if (xioctl(cam->fd, VIDIOC_G_PARM, &parm) != 0)
+        return 0;
+    const struct v4l2_fract *f = &parm.parm.capture.timeperframe;
+    return f->denominator ? (uint32_t)((uint64_t)f->numerator * 1000000u / f->denominator) : 0;
+}
+
 static int map_buffers(struct camera_v4l2 *cam)
 {
     struct v4l2_requestbuffers req = {
@@ -153,6 +163,7 @@ static int v4l2_open(void *priv, const struct hal_camera_config *cfg)
         (rc = set_controls(cam, cfg->exposure_us, cfg->gain_milli)) != 0 ||
         (rc = map_buffers(cam)) != 0)
         goto out_close;
+    cam->frame_us = frame_interval_us(cam);
     enum v4l2_buf_type type = V4L2_BUF_TYPE_VIDEO_CAPTURE;
     if ((rc = xioctl(cam->fd, VIDIOC_STREAMON, &type)) != 0) {
         fail(cam, rc, "VIDIOC_STREAMON", NULL);
@@ -229,6 +240,9 @@ static int v4l2_capture(void *priv, struct hal_image *img)
     img->width = cam->cfg.width;
     img->height = cam->cfg.height;
     img->sequence = b.sequence;
+    img->start_us =
+        v4l2_frame_start_us(b.flags, (int64_t)b.timestamp.tv_sec, (int64_t)b.timestamp.tv_usec,
+                            cam->cfg.exposure_us, cam->frame_us);
     int rq = requeue(cam, &b);
     return rc != 0 ? rc : rq;
 }
@@ -238,7 +252,12 @@ static int v4l2_set_exposure(void *priv, uint32_t exposure_us, uint32_t gain_mil
     struct camera_v4l2 *cam = priv;
     if (cam->fd < 0)
         return fail(cam, -ENODEV, "set_exposure", "camera not open");
-    return set_controls(cam, exposure_us, gain_milli);
+    int rc = set_controls(cam, exposure_us, gain_milli);
+    if (rc == 0) { /* the start of exposure of the frames that follow depends on it */
+        cam->cfg.exposure_us = exposure_us;
+        cam->cfg.gain_milli = gain_milli;
+    }
+    return rc;
 }
 
 static int v4l2_safe_state(void *priv)

@@ -31,6 +31,19 @@ const char *v4l2_fourcc_text(uint32_t fourcc, char *buf)
     return buf;
 }
 
+uint64_t v4l2_frame_start_us(uint32_t flags, int64_t sec, int64_t usec, uint32_t exposure_us,
+                             uint32_t frame_us)
+{
+    if ((flags & V4L2_BUF_FLAG_TIMESTAMP_MASK) != V4L2_BUF_FLAG_TIMESTAMP_MONOTONIC || sec < 0 ||
+        usec < 0)
+        return 0;
+    uint64_t stamp_us = (uint64_t)sec * 1000000u + (uint64_t)usec;
+    uint64_t back_us = 0;
+    if ((flags & V4L2_BUF_FLAG_TSTAMP_SRC_MASK) != V4L2_BUF_FLAG_TSTAMP_SRC_SOE)
+        back_us = (uint64_t)exposure_us + frame_us;
+    return stamp_us > back_us ? stamp_us - back_us : 1u; /* 0 means "cannot tell" */
+}
+
 static uint8_t clamp_u8(int32_t v)
 {
     return (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : v);

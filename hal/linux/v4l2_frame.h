@@ -24,6 +24,16 @@ const char *v4l2_fourcc_text(uint32_t fourcc, char *buf);
 int v4l2_to_rgb(uint32_t fourcc, const uint8_t *src, size_t used, uint32_t bytes_per_line,
                 uint32_t width, uint32_t height, uint8_t *rgb, size_t rgb_cap);
 
+/** When the exposure of a dequeued frame began, in microseconds of CLOCK_MONOTONIC (the HAL
+ *  clock), from its timestamp. A start-of-exposure stamp is taken as it is; an end-of-frame
+ *  stamp goes back by the exposure and by @p frame_us (the readout of a rolling shutter takes
+ *  up to one frame interval), so that the answer is never later than the truth.
+ *  @param flags the buffer's flags (timestamp type and source)
+ *  @param frame_us one frame interval (VIDIOC_G_PARM), 0 when the driver does not say
+ *  @retval 0 when the stamp is not from CLOCK_MONOTONIC: the start cannot be compared */
+uint64_t v4l2_frame_start_us(uint32_t flags, int64_t sec, int64_t usec, uint32_t exposure_us,
+                             uint32_t frame_us);
+
 /** What the driver said of one control (VIDIOC_QUERYCTRL). */
 struct v4l2_ctrl_info {
     uint32_t id;
