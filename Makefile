@@ -71,7 +71,7 @@ FW_OBJ := $(call obj,$(FW_SRC))
 HOST_OBJ := $(call obj,$(POSIX_SRC) $(APP_LIB_SRC) $(BOARD_SRC)) $(if $(filter linux,$(HAL)),$(LIBCAMERA_OBJ),)
 MAIN_OBJ := $(call obj,app/main.c)
 
-.PHONY: all deps test-deps test test-run linux-build install check-stack size fuzz errors-doc test-arm64 test-arm64-full arm64-check-elf arm64-run-tests run clean format docs check-firmware bench measure measure-scan interop-meshlab bench-callgrind eval
+.PHONY: all deps test-deps test test-run linux-build install check-stack size fuzz errors-doc test-arm64 test-arm64-full test-gpio-chip arm64-check-elf arm64-run-tests run clean format docs check-firmware bench measure measure-scan interop-meshlab bench-callgrind eval
 SIM_TOOLS := $(if $(filter sim,$(HAL)),$(BUILD)/turntable-sim $(BUILD)/tt-client $(BUILD)/mesh-compare $(BUILD)/colour-eval,)
 all: deps $(BUILD)/scanner $(SIM_TOOLS)
 
@@ -237,6 +237,13 @@ test-arm64:
 test-arm64-full:
 	@$(MAKE) --no-print-directory $(ARM64) HAL=sim deps
 	@$(MAKE) --no-print-directory $(ARM64) HAL=sim ARM64_SLOW= arm64-run-tests
+# The GPIO backend against a real kernel GPIO chip (the PL061 of qemu's arm64 "virt" machine),
+# with another program holding one of the lines: tests/gpio_chip.sh. About two minutes.
+test-gpio-chip:
+	@$(MAKE) --no-print-directory $(ARM64) HAL=linux deps
+	@{ command -v qemu-system-aarch64 && command -v cpio; } >/dev/null 2>&1 || scripts/install-deps.sh gpio-chip
+	@$(MAKE) --no-print-directory $(ARM64) HAL=linux all
+	@tests/run.sh tests/gpio_chip.sh
 arm64-check-elf: $(BUILD)/scanner
 	@$(CROSS_COMPILE)readelf -h $< | grep -q 'Machine: *AArch64' && echo "$<: AArch64 ELF"
 arm64-run-tests: $(TEST_BIN)

@@ -1,0 +1,119 @@
+#!/bin/sh
+# The GPIO backend against a real kernel GPIO chip: the arm64 appliance scanner in a virtual
+# machine (qemu-system-aarch64, machine "virt", whose PL061 GPIO controller Debian's arm64
+# kernel drives), where gpioset holds one of the scanner's lines as another program would.
+# Checks: with every line free the selftest requests them all; with one held it names the line
+# and its holder; afterwards the kernel shows no line left requested by the scanner.
+# Run by `make test-gpio-chip` (needs the cross-built scanner: make CROSS_COMPILE=aarch64-linux-gnu- HAL=linux).
+# Ends with cmocka's summary lines so that tests/run.sh counts it.
+set -eu
+cd "$(dirname "$0")/.."
+SCANNER=${SCANNER:-build/aarch64-linux-gnu/linux/scanner}
+WORK=${WORK:-build/gpio-chip}
+TRIPLET=aarch64-linux-gnu
+for tool in qemu-system-aarch64 cpio "$TRIPLET-readelf"; do
+    command -v "$tool" >/dev/null || { echo "gpio_chip: $tool missing (make test-gpio-chip installs it)"; exit 1; }
+done
+rm -rf "$WORK/root" "$WORK/out.log"
+mkdir -p "$WORK/debs" "$WORK/root"
+
+# Debian's arm64 kernel, static busybox and the gpiod tools, unpacked (not installed).
+fetch() { # package name, as apt-get download takes it
+    ls "$WORK/debs/$2"_*.deb >/dev/null 2>&1 && return 0
+    (cd "$WORK/debs" && apt-get download "$1" >/dev/null 2>&1) ||
+        { apt-get update -qq && (cd "$WORK/debs" && apt-get download "$1" >/dev/null); }
+}
+kernel=$(apt-cache depends linux-image-arm64:arm64 | sed -n 's/.*Depends: \(linux-image-[^:]*\).*/\1/p' | head -n 1)
+fetch "$kernel:arm64" "$kernel"
+fetch busybox-static:arm64 busybox-static
+fetch gpiod:arm64 gpiod
+rm -rf "$WORK/unpacked" && mkdir -p "$WORK/unpacked"
+for d in "$WORK"/debs/*.deb; do dpkg-deb -x "$d" "$WORK/unpacked"; done
+IMAGE=$(ls "$WORK"/unpacked/boot/vmlinuz-* | head -n 1)
+
+# The initramfs: busybox, the scanner and gpiod's tools with the shared libraries they need.
+R=$WORK/root
+mkdir -p "$R/bin" "$R/lib/$TRIPLET" "$R/etc/scanner" "$R/proc" "$R/sys" "$R/dev" "$R/tmp"
+cp "$WORK/unpacked/bin/busybox" "$R/bin/"
+cp "$SCANNER" "$R/bin/scanner"
+cp "$WORK/unpacked/usr/bin/gpioset" "$WORK/unpacked/usr/bin/gpioinfo" "$R/bin/"
+libdirs="/usr/lib/$TRIPLET /lib/$TRIPLET $WORK/unpacked/usr/lib/$TRIPLET"
+copy_libs() { # every library an ELF needs, recursively
+    for lib in $("$TRIPLET-readelf" -d "$1" | sed -n 's/.*Shared library: \[\(.*\)\]/\1/p'); do
+        [ -e "$R/lib/$TRIPLET/$lib" ] && continue
+        for d in $libdirs; do
+            if [ -e "$d/$lib" ]; then
+                cp -L "$d/$lib" "$R/lib/$TRIPLET/$lib"
+                copy_libs "$R/lib/$TRIPLET/$lib"
+                break
+            fi
+        done
+        [ -e "$R/lib/$TRIPLET/$lib" ] || { echo "gpio_chip: no $lib for $1" >&2; exit 1; }
+    done
+}
+for elf in "$R/bin/scanner" "$R/bin/gpioset" "$R/bin/gpioinfo"; do copy_libs "$elf"; done
+cp -L "/usr/lib/$TRIPLET/ld-linux-aarch64.so.1" "$R/lib/ld-linux-aarch64.so.1"
+
+# The rig's config with the PL061's eight lines: projector on 0..2, lights on 4..7 (line 3 is
+# the board's power button in the device tree).
+sed -e 's/^chip = .*/chip = gpiochip0/' -e 's/^projector_enable = .*/projector_enable = 0/' \
+    -e 's/^projector_trigger = .*/projector_trigger = 1/' \
+    -e 's/^projector_reset = .*/projector_reset = 2/' -e 's/^light_0 = .*/light_0 = 4/' \
+    -e 's/^light_1 = .*/light_1 = 5/' -e 's/^light_2 = .*/light_2 = 6/' \
+    -e 's/^light_3 = .*/light_3 = 7/' config/pi-v4l2.ini > "$R/etc/scanner/rig.ini"
+
+cat > "$R/init" <<'EOF'
+#!/bin/busybox sh
+/bin/busybox --install -s /bin
+mount -t proc proc /proc; mount -t sysfs sys /sys; mount -t devtmpfs dev /dev
+echo "== gpioinfo"; gpioinfo
+echo "== selftest, lines free"; scanner selftest --config /etc/scanner/rig.ini 2>&1
+gpioset --mode=signal gpiochip0 6=1 & holder=$!
+sleep 1
+echo "== selftest, line 6 held"; scanner selftest --config /etc/scanner/rig.ini 2>&1
+echo "== gpioinfo after"; gpioinfo
+kill $holder
+echo "== done"
+poweroff -f
+EOF
+chmod +x "$R/init"
+(cd "$R" && find . | cpio -o -H newc --quiet | gzip -1) > "$WORK/initramfs.gz"
+
+timeout 600 qemu-system-aarch64 -M virt -cpu cortex-a57 -m 1024 -nographic -no-reboot -nic none \
+    -kernel "$IMAGE" -initrd "$WORK/initramfs.gz" \
+    -append "console=ttyAMA0 panic=-1 quiet" > "$WORK/out.log" 2>&1 || true
+tr -d '\r' < "$WORK/out.log" > "$WORK/vm.log"
+
+passed=0
+failed=0
+check() { # name, then a pattern the VM's log must (or, with !, must not) show in its section
+    name=$1
+    section=$2
+    shift 2
+    body=$(awk -v s="== $section" '$0 == s {on = 1; next} /^== / {on = 0} on' "$WORK/vm.log")
+    ok=1
+    for pat in "$@"; do
+        case $pat in
+        !*) printf '%s\n' "$body" | grep -qE -- "${pat#!}" && ok=0 ;;
+        *) printf '%s\n' "$body" | grep -qE -- "$pat" || ok=0 ;;
+        esac
+    done
+    if [ $ok -eq 1 ]; then
+        echo "[       OK ] gpio_chip: $name"
+        passed=$((passed + 1))
+    else
+        echo "[  FAILED  ] gpio_chip: $name"
+        printf '%s\n' "$body" | sed 's/^/    /'
+        failed=$((failed + 1))
+    fi
+}
+check "the VM found the PL061 chip" "gpioinfo" "^gpiochip0 - 8 lines"
+check "every line free: all requested" "selftest, lines free" \
+    "^gpio +gpiochip0 +ok +7 lines"
+check "a held line: named, with its holder" "selftest, line 6 held" \
+    "^gpio +gpiochip0 +MISSING +gpio: light_2: cannot request gpiochip0 line 6, in use by gpioset: Device or resource busy"
+check "nothing left requested by the scanner" "gpioinfo after" \
+    'line +6: +unnamed +"gpioset" +output' '!"scanner"'
+grep -q "^== done" "$WORK/vm.log" || { echo "gpio_chip: the VM did not finish (see $WORK/vm.log)"; failed=$((failed + 1)); }
+[ $failed -eq 0 ] && echo "[  PASSED  ] $passed test(s)." || echo "[  FAILED  ] $failed test(s)."
+[ $failed -eq 0 ]
