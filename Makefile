@@ -228,7 +228,7 @@ VALGRIND_RUN = $(if $(filter 1,$(VALGRIND)),valgrind --quiet --error-exitcode=99
 ARM64 := CROSS_COMPILE=aarch64-linux-gnu-
 # Emulated, the tests that render whole simulated scans take many minutes each: test-arm64 runs
 # the others (every firmware algorithm, config, Modbus, backends); test-arm64-full runs them all.
-ARM64_SLOW := test_colour test_nomalloc test_ply test_safety test_scan test_sim test_view
+ARM64_SLOW := test_colour test_nomalloc test_ply test_safety test_scan test_scan_faults test_sim test_view
 ARM64_TESTS = $(filter-out $(addprefix $(BUILD)/tests/,$(ARM64_SLOW)),$(TEST_BIN))
 test-arm64:
 	@$(MAKE) --no-print-directory $(ARM64) HAL=linux deps

@@ -229,7 +229,8 @@ static void usage(FILE *out)
             "usage: scanner scan --config FILE [--out DIR] [--json]   take a scan\n"
             "       scanner process DIR [--out DIR2] [--config F] [--json]  recompute a scan from "
             "its frames\n"
-            "       scanner resume DIR [--config F] [--json]  finish an interrupted scan\n"
+            "       scanner resume DIR [--config F] [--json] [--clear-alarm]  finish a stopped\n"
+            "           scan (--clear-alarm: the turntable's alarm, once its cause is fixed)\n"
             "       scanner calibrate-white --config FILE [--albedo A]  white reference scales\n"
             "       scanner check-config --config FILE    check a config and its calibration\n"
             "       scanner selftest --config FILE        try each configured device (new rig)\n"
@@ -240,7 +241,7 @@ static void usage(FILE *out)
 int main(int argc, char **argv)
 {
     const char *config_path = NULL, *scan_dir = NULL;
-    struct scan_job_opts opts = {0, NULL, NULL};
+    struct scan_job_opts opts = {0, NULL, NULL, 0};
     double white_albedo = 0.95; /* a typical white reference target */
     if (argc < 2) {
         usage(stderr);
@@ -259,6 +260,8 @@ int main(int argc, char **argv)
             opts.out_dir = argv[++i];
         else if (strcmp(argv[i], "--json") == 0)
             opts.json = 1;
+        else if (strcmp(argv[i], "--clear-alarm") == 0 && strcmp(argv[1], "resume") == 0)
+            opts.clear_alarm = 1;
         else if (strcmp(argv[i], "--albedo") == 0 && i + 1 < argc)
             white_albedo = atof(argv[++i]);
         else {

@@ -284,6 +284,32 @@ static void set_view_dir(struct job *j, uint32_t view)
 
 /* ---- live ---- */
 
+/* "the N finished views are kept in DIR: scanner resume DIR[ extra] takes the rest" */
+static const char *kept_views(const struct job *j, uint32_t v, const char *extra, char *buf,
+                              size_t len)
+{
+    snprintf(buf, len, "the %u finished views are kept in %s: 'scanner resume %s%s' takes the rest",
+             (unsigned)v, j->out_dir, j->out_dir, extra);
+    return buf;
+}
+
+/* The table did not get to view @p v: say where it is and what the controller reports. */
+static void table_failed(const struct job *j, uint32_t v, int32_t target_mdeg)
+{
+    const struct hal *hal = j->hal;
+    struct hal_turntable_status st;
+    char kept[2 * HAL_MAX_PATH + 96];
+    if (hal_table_get_status(&hal->turntable, &st) == 0 && st.alarm_code != 0)
+        hal->log(HAL_LOG_ERROR,
+                 "view %u: the turntable did not reach %.3f deg: it stopped at %.3f deg with "
+                 "alarm %u; once the table turns freely, %s",
+                 (unsigned)v, target_mdeg / 1000.0, st.position_mdeg / 1000.0,
+                 (unsigned)st.alarm_code, kept_views(j, v, " --clear-alarm", kept, sizeof(kept)));
+    else
+        hal->log(HAL_LOG_ERROR, "view %u: the turntable did not reach %.3f deg; %s", (unsigned)v,
+                 target_mdeg / 1000.0, kept_views(j, v, "", kept, sizeof(kept)));
+}
+
 static int live_view(struct job *j, uint32_t v)
 {
     const struct hal *hal = j->hal;
@@ -296,8 +322,7 @@ static int live_view(struct job *j, uint32_t v)
     if (rc == 0)
         rc = hal_table_get_status(&hal->turntable, &st); /* the angle the controller reports */
     if (rc != 0) {
-        hal->log(HAL_LOG_ERROR, "view %u: the turntable did not reach %.3f deg", (unsigned)v,
-                 target / 1000.0);
+        table_failed(j, v, target);
         return rc;
     }
     set_view_dir(j, v);
@@ -311,8 +336,10 @@ static int live_view(struct job *j, uint32_t v)
     double t0 = wall_ms();
     rc = scan_view(hal, &j->cfg->scan, j->calib, st.position_mdeg, &sink, &info);
     if (rc != 0) {
-        hal->log(HAL_LOG_ERROR, "view %u at %.3f deg failed: %s", (unsigned)v,
-                 st.position_mdeg / 1000.0, rc == -EINTR ? "stopped by request" : strerror(-rc));
+        char kept[2 * HAL_MAX_PATH + 96];
+        hal->log(HAL_LOG_ERROR, "view %u at %.3f deg failed: %s; %s", (unsigned)v,
+                 st.position_mdeg / 1000.0, rc == -EINTR ? "stopped by request" : strerror(-rc),
+                 kept_views(j, v, "", kept, sizeof(kept)));
         return rc;
     }
     progress(j, "saving", (int)v, v, "");
@@ -337,9 +364,12 @@ static int home_and_take_views(struct job *j, uint32_t first)
 {
     const struct hal *hal = j->hal;
     progress(j, "homing", (int)first, first, "");
-    int rc = hal_table_home(&hal->turntable);
-    if (rc != 0)
-        hal->log(HAL_LOG_ERROR, "the turntable did not home");
+    int rc = 0;
+    if (j->opts->clear_alarm && (rc = hal_table_clear_alarm(&hal->turntable)) != 0)
+        hal->log(HAL_LOG_ERROR, "cannot clear the turntable's alarm: %s", strerror(-rc));
+    if (rc == 0 && (rc = hal_table_home(&hal->turntable)) != 0)
+        hal->log(HAL_LOG_ERROR, "the turntable did not home%s",
+                 j->opts->clear_alarm ? "" : " (if it reports an alarm: --clear-alarm)");
     for (uint32_t v = first; v < j->cfg->views && rc == 0; v++)
         rc = live_view(j, v);
     return rc;

@@ -11,6 +11,8 @@ struct scan_job_opts {
     const char *out_dir; /**< results go here (process: default the scan directory itself) */
     const char *config_path; /**< process: settings from this file instead of the scan's own
                                   config.ini (e.g. another [colour] method); NULL: the scan's */
+    int clear_alarm; /**< resume: clear the turntable's alarm before homing (the operator has
+                          fixed its cause: a blocked table, a jammed object) */
 };
 
 /** Home the table and take every configured view, saving each before the next move.

@@ -79,6 +79,11 @@ int hal_table_get_status(const struct hal_turntable *table, struct hal_turntable
     return HAL_CALL(table, get_status, status);
 }
 
+int hal_table_clear_alarm(const struct hal_turntable *table)
+{
+    return HAL_CALL0(table, clear_alarm);
+}
+
 int hal_storage_mkdir_p(const struct hal_storage *st, const char *path)
 {
     return HAL_CALL(st, mkdir_p, path);

@@ -146,6 +146,11 @@ static void test_stall_reported_with_position(void **state)
     pthread_mutex_lock(&server.lock);
     server.ctrl.stall_at_mdeg = INT32_MIN;
     pthread_mutex_unlock(&server.lock);
+    /* the alarm blocks motion until the operator clears it */
+    assert_int_equal(hal_table_move_to(&table, 45000), -EIO);
+    assert_int_equal(hal_table_clear_alarm(&table), 0);
+    assert_int_equal(hal_table_move_to(&table, 45000), 0);
+    assert_int_equal(tt_server_position(&server), 45000);
 }
 
 /* A read-only register written: the controller's exception, reported as such, not retried. */

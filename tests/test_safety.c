@@ -192,6 +192,7 @@ static void test_missing_ops_answer_enosys(void **state)
     struct hal_turntable none = {NULL, NULL};
     struct hal_turntable_status st;
     assert_int_equal(hal_table_home(&none), -ENOSYS);
+    assert_int_equal(hal_table_clear_alarm(&none), -ENOSYS);
     assert_int_equal(hal_table_move_to(&none, 1000), -ENOSYS);
     assert_int_equal(hal_table_get_status(&none, &st), -ENOSYS);
     static const struct hal_camera_ops partial = {0};

@@ -11,6 +11,22 @@
 
 char test_last_log[512];
 int test_error_count;
+static char log_history[16384]; /* warnings and errors since test_log_clear(), one per line */
+static size_t log_history_len;
+
+void test_log_clear(void)
+{
+    log_history[0] = '\0';
+    log_history_len = 0;
+}
+
+int test_log_has(const char *needle)
+{
+    if (strstr(log_history, needle) != NULL)
+        return 1;
+    fprintf(stderr, "not logged: %s\nlogged:\n%s", needle, log_history);
+    return 0;
+}
 
 void test_rig_log(enum hal_log_level level, const char *fmt, ...)
 {
@@ -20,6 +36,11 @@ void test_rig_log(enum hal_log_level level, const char *fmt, ...)
     va_end(ap);
     if (level == HAL_LOG_ERROR)
         test_error_count++;
+    size_t room = sizeof(log_history) - log_history_len;
+    if (level <= HAL_LOG_WARN && room > 1) {
+        int n = snprintf(log_history + log_history_len, room, "%s\n", test_last_log);
+        log_history_len += n > 0 && (size_t)n < room ? (size_t)n : room - 1;
+    }
 }
 
 int test_rig_load(struct test_rig *t, const char *config_path)

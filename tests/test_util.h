@@ -17,7 +17,13 @@ struct test_rig {
 extern char test_last_log[512];
 extern int test_error_count;
 
-/** The quiet logger the test rig uses (records the last message). */
+/** Forget the warnings and errors logged so far. */
+void test_log_clear(void);
+/** @retval 1 when a warning or error since test_log_clear() contains @p needle; 0 after
+ *  printing what was logged instead */
+int test_log_has(const char *needle);
+
+/** The quiet logger the test rig uses (records the last message, and warnings and errors). */
 void test_rig_log(enum hal_log_level level, const char *fmt, ...);
 
 /** Load a config and its calibration. @retval 0 ok (fails the test otherwise) */

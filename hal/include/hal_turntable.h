@@ -22,6 +22,9 @@ struct hal_turntable_ops {
     int (*get_status)(void *priv, struct hal_turntable_status *status);
     /** Stop any motion. Required. */
     int (*safe_state)(void *priv);
+    /** Optional: clear the controller's alarm (a stall, a move before homing), which blocks
+     *  motion until cleared; only once the operator has fixed its cause. @retval 0 ok */
+    int (*clear_alarm)(void *priv);
 };
 
 struct hal_turntable {
@@ -35,5 +38,7 @@ int hal_table_home(const struct hal_turntable *table);
 int hal_table_move_to(const struct hal_turntable *table, int32_t angle_mdeg);
 /** @retval -ENOSYS when the backend lacks the op; otherwise what the op returns. */
 int hal_table_get_status(const struct hal_turntable *table, struct hal_turntable_status *status);
+/** @retval -ENOSYS when the backend lacks the op; otherwise what the op returns. */
+int hal_table_clear_alarm(const struct hal_turntable *table);
 
 #endif

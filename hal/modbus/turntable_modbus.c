@@ -203,11 +203,27 @@ static int tt_safe_state(void *priv)
     return c->ctx != NULL ? send_command(c, TT_CMD_STOP, "stop") : 0;
 }
 
+static int tt_clear_alarm(void *priv)
+{
+    struct tt_client *c = priv;
+    struct hal_turntable_status st;
+    int rc = send_command(c, TT_CMD_CLEAR_ALARM, "clearing the alarm");
+    if (rc == 0)
+        rc = tt_get_status(c, &st);
+    if (rc == 0 && st.alarm_code != 0) {
+        c->log(HAL_LOG_ERROR, "turntable: alarm %u is still raised after clearing it",
+               (unsigned)st.alarm_code);
+        rc = -EIO;
+    }
+    return rc;
+}
+
 static const struct hal_turntable_ops tt_ops = {
     .home = tt_home,
     .move_to = tt_move_to,
     .get_status = tt_get_status,
     .safe_state = tt_safe_state,
+    .clear_alarm = tt_clear_alarm,
 };
 
 static modbus_t *new_context(const struct tt_client_config *cfg)

@@ -1,0 +1,217 @@
+/* Whole scans that fail midway (the table stalls, the camera goes away): a clear error naming
+ * the view and what the controller did, every finished view kept, no view at a wrong angle, and
+ * `resume` finishing the scan with the model an uninterrupted scan gives. */
+#define _POSIX_C_SOURCE 200809L
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <errno.h>
+#include <limits.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "scan_job.h"
+#include "test_util.h"
+#include "tt_server.h"
+
+#define VIEWS 4u /* at 0, 90, 180 and 270 degrees */
+#define OUT "build/test_scan_faults"
+
+static struct test_rig t;
+
+/* The rig of config/sim.ini with a box (quick to render) and four views, in a file: a scan
+ * keeps its config, and resume and process read it back from there. */
+static int setup(void **state)
+{
+    (void)state;
+    if (system("rm -rf " OUT " && mkdir -p " OUT " && sed -e 's/^views = .*/views = 4/' "
+               "-e 's/^object = .*/object = box/' "
+               "-e \"s|^calibration = .*|calibration = $PWD/config/sim-calib.ini|\" "
+               "config/sim.ini > " OUT "/rig.ini && echo 'segments = 16' >> " OUT "/rig.ini") != 0)
+        return -1;
+    if (test_rig_load(&t, OUT "/rig.ini") != 0 || t.cfg.views != VIEWS)
+        return -1;
+    return test_rig_start(&t);
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    test_rig_stop(&t);
+    return 0;
+}
+
+static int scan(const char *dir)
+{
+    struct scan_job_opts opts = {.out_dir = dir};
+    return scan_job_live(&t.hal, &t.cfg, &t.calib, &opts);
+}
+
+static int resume(const char *dir, int clear_alarm)
+{
+    struct scan_job_opts opts = {.clear_alarm = clear_alarm};
+    int rc = scan_job_resume(&t.hal, &t.cfg, &t.calib, dir, &opts);
+    return rc != 0 ? rc : scan_job_process(&t.hal, dir, &opts);
+}
+
+static char *slurp(const char *path, size_t *len)
+{
+    FILE *f = fopen(path, "rb");
+    if (f == NULL)
+        return NULL;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char *buf = malloc((size_t)n + 1);
+    if (buf != NULL && fread(buf, 1, (size_t)n, f) != (size_t)n) {
+        free(buf);
+        buf = NULL;
+    }
+    fclose(f);
+    *len = (size_t)n;
+    return buf;
+}
+
+static void assert_same_file(const char *a, const char *b)
+{
+    size_t la = 0, lb = 0;
+    char *x = slurp(a, &la), *y = slurp(b, &lb);
+    assert_non_null(x);
+    assert_non_null(y);
+    assert_int_equal(la, lb);
+    assert_memory_equal(x, y, la);
+    free(x);
+    free(y);
+}
+
+/* Views 0 .. done-1 complete and at their angles, the others not started. */
+static void assert_views(const char *dir, uint32_t done)
+{
+    char path[256];
+    struct stat st;
+    for (uint32_t v = 0; v < VIEWS; v++) {
+        long angle = LONG_MIN;
+        snprintf(path, sizeof(path), "%s/view_%03u/view.ini", dir, (unsigned)v);
+        if (v < done) {
+            assert_int_equal(view_angle_load(path, &angle), 0);
+            assert_true(labs(angle - (long)(v * 90000u)) <= (long)t.cfg.turntable.tolerance_mdeg);
+        } else {
+            assert_int_not_equal(stat(path, &st), 0);
+        }
+    }
+}
+
+static void assert_rig_dark(void)
+{
+    assert_int_equal(sim_ctl_line(HAL_GPIO_PROJECTOR_ENABLE), 0);
+    for (uint32_t i = 0; i < HAL_MAX_LIGHTS; i++)
+        assert_int_equal(sim_ctl_line((enum hal_gpio_line)(HAL_GPIO_LIGHT_0 + i)), 0);
+}
+
+static void set_stall(int32_t at_mdeg)
+{
+    struct tt_server *server = sim_ctl_turntable();
+    pthread_mutex_lock(&server->lock);
+    server->ctrl.stall_at_mdeg = at_mdeg;
+    pthread_mutex_unlock(&server->lock);
+}
+
+/* The reference: the same scan, nothing going wrong. */
+static void test_reference_scan(void **state)
+{
+    (void)state;
+    assert_int_equal(scan(OUT "/reference"), 0);
+    assert_views(OUT "/reference", VIEWS);
+}
+
+/* The table jams on its way to view 2: the scan stops there and says where the table is and
+ * which alarm it raised; views 0 and 1 stay; a resume without clearing the alarm is refused
+ * and loses nothing; with --clear-alarm it finishes, and the model is the reference's. */
+static void test_stall_stops_scan_then_resume_finishes_it(void **state)
+{
+    (void)state;
+    const char *dir = OUT "/stall";
+    char path[256], ref[256];
+    assert_int_equal(hal_table_home(&t.hal.turntable), 0); /* so that homing passes no stall */
+    set_stall(135000); /* between view 1 (90 deg) and view 2 (180 deg) */
+    test_log_clear();
+    assert_int_equal(scan(dir), -EIO);
+    assert_true(test_log_has("alarm 1 (stall (following error)) at 135.000 deg"));
+    assert_true(test_log_has("view 2: the turntable did not reach 180.000 deg: it stopped at "
+                             "135.000 deg with alarm 1; once the table turns freely, the 2 "
+                             "finished views are kept in build/test_scan_faults/stall: 'scanner "
+                             "resume build/test_scan_faults/stall --clear-alarm' takes the rest"));
+    assert_views(dir, 2);
+    assert_rig_dark();
+    set_stall(INT32_MIN); /* the operator frees the table */
+
+    test_log_clear();
+    assert_int_not_equal(resume(dir, 0), 0); /* the alarm still blocks motion */
+    assert_true(test_log_has("the turntable did not home (if it reports an alarm: --clear-alarm)"));
+    assert_views(dir, 2);
+
+    assert_int_equal(resume(dir, 1), 0);
+    assert_views(dir, VIEWS);
+    snprintf(path, sizeof(path), "%s/mesh.ply", dir);
+    snprintf(ref, sizeof(ref), "%s/mesh.ply", OUT "/reference");
+    assert_same_file(path, ref);
+    for (uint32_t v = 0; v < VIEWS; v++) { /* each view's frames too, e.g. the white one */
+        snprintf(path, sizeof(path), "%s/view_%03u/frame_00.png", dir, (unsigned)v);
+        snprintf(ref, sizeof(ref), "%s/view_%03u/frame_00.png", OUT "/reference", (unsigned)v);
+        assert_same_file(path, ref);
+    }
+    assert_rig_dark();
+}
+
+/* The camera goes away in the middle of view 2: the error names the view and its angle, the
+ * half-taken view is not kept as finished, and resume retakes it whole. */
+static void test_camera_lost_mid_view_then_resume_finishes_it(void **state)
+{
+    (void)state;
+    const char *dir = OUT "/camera";
+    char path[256], ref[256];
+    uint64_t per_view = 0;
+    /* frames per view, from the reference's first view */
+    snprintf(path, sizeof(path), "%s/view_000/view.ini", OUT "/reference");
+    FILE *f = fopen(path, "r");
+    assert_non_null(f);
+    char line[256];
+    while (fgets(line, sizeof(line), f) != NULL)
+        if (sscanf(line, "frames = %lu", (unsigned long *)&per_view) == 1)
+            break;
+    fclose(f);
+    assert_true(per_view > 10);
+    uint64_t start = sim_ctl_frames();
+    sim_ctl_inject_camera_fault(SIM_FAULT_NO_DEVICE, start + 2 * per_view + 7, 1000000);
+    test_log_clear();
+    assert_int_equal(scan(dir), -ENODEV);
+    assert_true(test_log_has("view 2 at 180.000 deg failed: No such device; the 2 finished views "
+                             "are kept in build/test_scan_faults/camera: 'scanner resume "
+                             "build/test_scan_faults/camera' takes the rest"));
+    assert_views(dir, 2);
+    assert_rig_dark();
+    sim_ctl_inject_camera_fault(SIM_FAULT_NONE, 0, 0); /* plugged back in */
+
+    assert_int_equal(resume(dir, 0), 0);
+    assert_views(dir, VIEWS);
+    snprintf(path, sizeof(path), "%s/mesh.ply", dir);
+    snprintf(ref, sizeof(ref), "%s/mesh.ply", OUT "/reference");
+    assert_same_file(path, ref);
+    assert_rig_dark();
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_reference_scan),
+        cmocka_unit_test(test_stall_stops_scan_then_resume_finishes_it),
+        cmocka_unit_test(test_camera_lost_mid_view_then_resume_finishes_it),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
