@@ -31,13 +31,6 @@ static int teardown(void **state)
     return 0;
 }
 
-static void assert_rig_dark(void)
-{
-    assert_int_equal(sim_ctl_line(HAL_GPIO_PROJECTOR_ENABLE), 0);
-    for (uint32_t i = 0; i < HAL_MAX_LIGHTS; i++)
-        assert_int_equal(sim_ctl_line((enum hal_gpio_line)(HAL_GPIO_LIGHT_0 + i)), 0);
-}
-
 static void test_transient_timeout_is_retried(void **state)
 {
     (void)state;
@@ -47,7 +40,7 @@ static void test_transient_timeout_is_retried(void **state)
     assert_int_equal(info.capture_retries, 2);
     assert_int_equal(info.frames_captured, 22);
     assert_true(info.valid_points > 10000);
-    assert_rig_dark();
+    assert_true(test_rig_dark());
 }
 
 static void test_persistent_fault_stops_with_projector_off(void **state)
@@ -61,7 +54,7 @@ static void test_persistent_fault_stops_with_projector_off(void **state)
     /* tried 1 + capture_retries times, then gave up and said which pattern */
     assert_int_equal(sim_ctl_frames() - start, 7 + 1 + t.cfg.scan.capture_retries);
     assert_non_null(strstr(test_last_log, "giving up on pattern 7"));
-    assert_rig_dark();
+    assert_true(test_rig_dark());
     sim_ctl_inject_camera_fault(SIM_FAULT_NONE, 0, 0);
 }
 
@@ -73,7 +66,7 @@ static void test_unplugged_camera_not_retried(void **state)
     sim_ctl_inject_camera_fault(SIM_FAULT_NO_DEVICE, start + 3, 100);
     assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info), -ENODEV);
     assert_int_equal(sim_ctl_frames() - start, 4); /* no retry can bring a camera back */
-    assert_rig_dark();
+    assert_true(test_rig_dark());
     sim_ctl_inject_camera_fault(SIM_FAULT_NONE, 0, 0);
 }
 
@@ -121,7 +114,7 @@ static void test_stale_frames_are_discarded(void **state)
     assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info), 0);
     assert_int_equal(info.capture_retries, 1);
     assert_view_is_clean(&info);
-    assert_rig_dark();
+    assert_true(test_rig_dark());
     sim_ctl_inject_camera_fault(SIM_FAULT_NONE, 0, 0);
 }
 
@@ -137,7 +130,7 @@ static void test_persistent_stale_frames_stop_the_view(void **state)
     assert_int_equal(sim_ctl_frames() - start, 9 + 1 + t.cfg.scan.capture_retries);
     assert_non_null(strstr(test_last_log, "giving up on pattern 9: every frame began before"));
     assert_non_null(strstr(test_last_log, "drop_frames"));
-    assert_rig_dark();
+    assert_true(test_rig_dark());
     sim_ctl_inject_camera_fault(SIM_FAULT_NONE, 0, 0);
 }
 
@@ -155,7 +148,7 @@ static void test_stop_request_leaves_rig_dark(void **state)
     t.hal.stop_requested = NULL;
     assert_int_equal(rc, -EINTR);
     assert_true(info.frames_captured < 22);
-    assert_rig_dark();
+    assert_true(test_rig_dark());
 }
 
 /* Lights on and projector on, then the one shutdown path: everything off. */
@@ -166,7 +159,7 @@ static void test_safe_state_turns_everything_off(void **state)
     assert_int_equal(hal_gpio_set(&t.hal.gpio, HAL_GPIO_LIGHT_0 + 2, 1), 0);
     assert_int_equal(sim_ctl_line(HAL_GPIO_LIGHT_0 + 2), 1);
     assert_int_equal(hal_safe_state(&t.hal), 0);
-    assert_rig_dark();
+    assert_true(test_rig_dark());
 }
 
 /* The projector follows its stored sequence: triggers step, reset returns to pattern 0. */

@@ -16,23 +16,6 @@
 #include "storage_posix.h"
 #include "test_util.h"
 
-static int files_equal(const char *a, const char *b)
-{
-    FILE *fa = fopen(a, "rb"), *fb = fopen(b, "rb");
-    int same = fa != NULL && fb != NULL;
-    while (same) {
-        int ca = fgetc(fa), cb = fgetc(fb);
-        same = ca == cb;
-        if (ca == EOF || cb == EOF)
-            break;
-    }
-    if (fa)
-        fclose(fa);
-    if (fb)
-        fclose(fb);
-    return same;
-}
-
 /* Scan @p object with 8 views over @p transport into @p dir and measure the mesh. */
 static void scan_and_compare(const char *object, const char *transport, const char *dir,
                              struct mesh_comparison *r)
@@ -76,12 +59,12 @@ static void test_bunny_over_tcp_and_process_reproduces(void **state)
     clock_posix_init(&hal.clock);
     struct scan_job_opts opts = {.out_dir = "build/test_scan/bunny_processed"};
     assert_int_equal(scan_job_process(&hal, "build/test_scan/bunny", &opts), 0);
-    assert_true(files_equal("build/test_scan/bunny/mesh.ply",
-                            "build/test_scan/bunny_processed/mesh.ply"));
-    assert_true(files_equal("build/test_scan/bunny/mesh.obj",
-                            "build/test_scan/bunny_processed/mesh.obj"));
-    assert_true(files_equal("build/test_scan/bunny/view_005/cloud.ply",
-                            "build/test_scan/bunny_processed/view_005/cloud.ply"));
+    assert_true(test_files_equal("build/test_scan/bunny/mesh.ply",
+                                 "build/test_scan/bunny_processed/mesh.ply"));
+    assert_true(test_files_equal("build/test_scan/bunny/mesh.obj",
+                                 "build/test_scan/bunny_processed/mesh.obj"));
+    assert_true(test_files_equal("build/test_scan/bunny/view_005/cloud.ply",
+                                 "build/test_scan/bunny_processed/view_005/cloud.ply"));
 }
 
 static void test_cylinder_over_rtu(void **state)

@@ -60,36 +60,6 @@ static int resume(const char *dir, int clear_alarm)
     return rc != 0 ? rc : scan_job_process(&t.hal, dir, &opts);
 }
 
-static char *slurp(const char *path, size_t *len)
-{
-    FILE *f = fopen(path, "rb");
-    if (f == NULL)
-        return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *buf = malloc((size_t)n + 1);
-    if (buf != NULL && fread(buf, 1, (size_t)n, f) != (size_t)n) {
-        free(buf);
-        buf = NULL;
-    }
-    fclose(f);
-    *len = (size_t)n;
-    return buf;
-}
-
-static void assert_same_file(const char *a, const char *b)
-{
-    size_t la = 0, lb = 0;
-    char *x = slurp(a, &la), *y = slurp(b, &lb);
-    assert_non_null(x);
-    assert_non_null(y);
-    assert_int_equal(la, lb);
-    assert_memory_equal(x, y, la);
-    free(x);
-    free(y);
-}
-
 /* Views 0 .. done-1 complete and at their angles, the others not started. */
 static void assert_views(const char *dir, uint32_t done)
 {
@@ -105,13 +75,6 @@ static void assert_views(const char *dir, uint32_t done)
             assert_int_not_equal(stat(path, &st), 0);
         }
     }
-}
-
-static void assert_rig_dark(void)
-{
-    assert_int_equal(sim_ctl_line(HAL_GPIO_PROJECTOR_ENABLE), 0);
-    for (uint32_t i = 0; i < HAL_MAX_LIGHTS; i++)
-        assert_int_equal(sim_ctl_line((enum hal_gpio_line)(HAL_GPIO_LIGHT_0 + i)), 0);
 }
 
 static void set_stall(int32_t at_mdeg)
@@ -148,7 +111,7 @@ static void test_stall_stops_scan_then_resume_finishes_it(void **state)
                              "finished views are kept in build/test_scan_faults/stall: 'scanner "
                              "resume build/test_scan_faults/stall --clear-alarm' takes the rest"));
     assert_views(dir, 2);
-    assert_rig_dark();
+    assert_true(test_rig_dark());
     set_stall(INT32_MIN); /* the operator frees the table */
 
     test_log_clear();
@@ -160,13 +123,13 @@ static void test_stall_stops_scan_then_resume_finishes_it(void **state)
     assert_views(dir, VIEWS);
     snprintf(path, sizeof(path), "%s/mesh.ply", dir);
     snprintf(ref, sizeof(ref), "%s/mesh.ply", OUT "/reference");
-    assert_same_file(path, ref);
+    assert_true(test_files_equal(path, ref));
     for (uint32_t v = 0; v < VIEWS; v++) { /* each view's frames too, e.g. the white one */
         snprintf(path, sizeof(path), "%s/view_%03u/frame_00.png", dir, (unsigned)v);
         snprintf(ref, sizeof(ref), "%s/view_%03u/frame_00.png", OUT "/reference", (unsigned)v);
-        assert_same_file(path, ref);
+        assert_true(test_files_equal(path, ref));
     }
-    assert_rig_dark();
+    assert_true(test_rig_dark());
 }
 
 /* The camera goes away in the middle of view 2: the error names the view and its angle, the
@@ -195,15 +158,15 @@ static void test_camera_lost_mid_view_then_resume_finishes_it(void **state)
                              "are kept in build/test_scan_faults/camera: 'scanner resume "
                              "build/test_scan_faults/camera' takes the rest"));
     assert_views(dir, 2);
-    assert_rig_dark();
+    assert_true(test_rig_dark());
     sim_ctl_inject_camera_fault(SIM_FAULT_NONE, 0, 0); /* plugged back in */
 
     assert_int_equal(resume(dir, 0), 0);
     assert_views(dir, VIEWS);
     snprintf(path, sizeof(path), "%s/mesh.ply", dir);
     snprintf(ref, sizeof(ref), "%s/mesh.ply", OUT "/reference");
-    assert_same_file(path, ref);
-    assert_rig_dark();
+    assert_true(test_files_equal(path, ref));
+    assert_true(test_rig_dark());
 }
 
 int main(void)

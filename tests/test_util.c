@@ -14,6 +14,31 @@ int test_error_count;
 static char log_history[16384]; /* warnings and errors since test_log_clear(), one per line */
 static size_t log_history_len;
 
+int test_files_equal(const char *a, const char *b)
+{
+    FILE *fa = fopen(a, "rb"), *fb = fopen(b, "rb");
+    int same = fa != NULL && fb != NULL;
+    while (same) {
+        int ca = fgetc(fa), cb = fgetc(fb);
+        same = ca == cb;
+        if (ca == EOF || cb == EOF)
+            break;
+    }
+    if (fa)
+        fclose(fa);
+    if (fb)
+        fclose(fb);
+    return same;
+}
+
+int test_rig_dark(void)
+{
+    int lit = sim_ctl_line(HAL_GPIO_PROJECTOR_ENABLE);
+    for (uint32_t i = 0; i < HAL_MAX_LIGHTS; i++)
+        lit |= sim_ctl_line((enum hal_gpio_line)(HAL_GPIO_LIGHT_0 + i));
+    return !lit;
+}
+
 void test_log_clear(void)
 {
     log_history[0] = '\0';

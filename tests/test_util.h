@@ -17,6 +17,11 @@ struct test_rig {
 extern char test_last_log[512];
 extern int test_error_count;
 
+/** @retval 1 when both files exist and hold the same bytes */
+int test_files_equal(const char *a, const char *b);
+/** @retval 1 when the simulated projector and every light are off */
+int test_rig_dark(void);
+
 /** Forget the warnings and errors logged so far. */
 void test_log_clear(void);
 /** @retval 1 when a warning or error since test_log_clear() contains @p needle; 0 after
