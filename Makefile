@@ -37,13 +37,23 @@ ifeq ($(SAN),1)
 BUILD := $(BUILD)/san
 OPT := -O1 -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
 endif
+# Compile-time limits (hal/include/hal_limits.h): default, or small for a board with 512 MB.
+# Every object depends on them, so each set builds in its own directory.
+LIMITS ?= default
+ifeq ($(LIMITS),small)
+BUILD := $(BUILD)/small
+LIMITS_CFLAGS := -DHAL_LIMITS_SMALL
+else ifneq ($(LIMITS),default)
+$(error LIMITS must be default or small, not '$(LIMITS)')
+endif
+
 # HAL=linux objects live apart so that the two builds never mix (also when cross-built).
 ifeq ($(HAL),linux)
 BUILD := $(BUILD)/linux
 endif
 
 WARN := -std=c11 -Wall -Wextra -Werror
-CFLAGS_COMMON := $(WARN) $(OPT) -g -MMD -MP
+CFLAGS_COMMON := $(WARN) $(OPT) $(LIMITS_CFLAGS) -g -MMD -MP
 # firmware/ sees the world only through hal/include.
 FW_CFLAGS := $(CFLAGS_COMMON) -Ihal/include -Ifirmware -fstack-usage
 PKG_CFLAGS = $(shell $(PKG_CONFIG) --cflags $(PKGS) 2>/dev/null)
@@ -71,7 +81,7 @@ FW_OBJ := $(call obj,$(FW_SRC))
 HOST_OBJ := $(call obj,$(POSIX_SRC) $(APP_LIB_SRC) $(BOARD_SRC)) $(if $(filter linux,$(HAL)),$(LIBCAMERA_OBJ),)
 MAIN_OBJ := $(call obj,app/main.c)
 
-.PHONY: all deps test-deps test test-run linux-build install check-stack size fuzz errors-doc test-arm64 test-arm64-full test-gpio-chip arm64-check-elf arm64-run-tests run clean format docs check-firmware bench measure measure-scan interop-meshlab bench-callgrind eval
+.PHONY: all deps test-deps test test-run linux-build small-build install check-stack size fuzz errors-doc test-arm64 test-arm64-full test-gpio-chip arm64-check-elf arm64-run-tests run clean format docs check-firmware bench measure measure-scan interop-meshlab bench-callgrind eval
 SIM_TOOLS := $(if $(filter sim,$(HAL)),$(BUILD)/turntable-sim $(BUILD)/tt-client $(BUILD)/mesh-compare $(BUILD)/colour-eval,)
 all: deps $(BUILD)/scanner $(SIM_TOOLS)
 
@@ -100,7 +110,7 @@ $(BUILD)/%.o: %.c | deps
 
 $(BUILD)/%.o: %.cpp | deps
 	@mkdir -p $(dir $@)
-	$(CXX) -std=c++17 -Wall -Wextra -Werror $(OPT) -g -MMD -MP -Ihal/include -Ihal/linux $(shell $(PKG_CONFIG) --cflags libcamera 2>/dev/null) -c $< -o $@
+	$(CXX) -std=c++17 -Wall -Wextra -Werror $(OPT) $(LIMITS_CFLAGS) -g -MMD -MP -Ihal/include -Ihal/linux $(shell $(PKG_CONFIG) --cflags libcamera 2>/dev/null) -c $< -o $@
 
 $(BUILD)/libfirmware.a: $(FW_OBJ)
 	$(AR) rcs $@ $^
@@ -214,7 +224,7 @@ test-deps: deps
 # A second make, so that what test-deps installed (libcamera-dev) is seen when it starts.
 test: deps test-deps
 	@$(MAKE) --no-print-directory test-run
-test-run: $(BUILD)/scanner $(SIM_TOOLS) $(TEST_BIN) $(FUZZ_REPLAY) check-firmware $(if $(filter 0,$(SAN)),check-stack,) linux-build
+test-run: $(BUILD)/scanner $(SIM_TOOLS) $(TEST_BIN) $(FUZZ_REPLAY) check-firmware $(if $(filter 0,$(SAN)),check-stack,) linux-build small-build
 	@RUN_WITH="$(VALGRIND_RUN)" BUILD=$(BUILD) tests/run.sh $(TEST_BIN) tests/cli.sh tests/interop.sh tests/fuzz/replay.sh tests/resume.sh
 
 # make test VALGRIND=1: every cmocka test under valgrind memcheck; any invalid access,
@@ -238,11 +248,13 @@ test-arm64-full:
 	@$(MAKE) --no-print-directory $(ARM64) HAL=sim deps
 	@$(MAKE) --no-print-directory $(ARM64) HAL=sim ARM64_SLOW= arm64-run-tests
 # The GPIO backend against a real kernel GPIO chip (the PL061 of qemu's arm64 "virt" machine),
-# with another program holding one of the lines: tests/gpio_chip.sh. About two minutes.
+# with another program holding one of the lines; the default build on 1 GB, the LIMITS=small
+# build on 512 MB: tests/gpio_chip.sh. About two minutes.
 test-gpio-chip:
 	@$(MAKE) --no-print-directory $(ARM64) HAL=linux deps
 	@{ command -v qemu-system-aarch64 && command -v cpio; } >/dev/null 2>&1 || scripts/install-deps.sh gpio-chip
 	@$(MAKE) --no-print-directory $(ARM64) HAL=linux all
+	@$(MAKE) --no-print-directory $(ARM64) HAL=linux LIMITS=small all
 	@tests/run.sh tests/gpio_chip.sh
 arm64-check-elf: $(BUILD)/scanner
 	@$(CROSS_COMPILE)readelf -h $< | grep -q 'Machine: *AArch64' && echo "$<: AArch64 ELF"
@@ -277,6 +289,9 @@ install: linux-build
 LINUX_BUILD := $(if $(filter linux,$(HAL)),$(BUILD),$(BUILD)/linux)
 linux-build: deps
 	@$(MAKE) --no-print-directory HAL=linux SAN=$(SAN) $(LINUX_BUILD)/scanner
+# The simulator build with LIMITS=small (a 512 MB board), for tests/cli.sh.
+small-build: deps
+	@$(MAKE) --no-print-directory LIMITS=small SAN=$(SAN) $(BUILD)/small/scanner
 
 run: deps $(BUILD)/scanner
 	$(BUILD)/scanner scan --config config/sim.ini

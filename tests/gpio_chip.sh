@@ -3,18 +3,20 @@
 # machine (qemu-system-aarch64, machine "virt", whose PL061 GPIO controller Debian's arm64
 # kernel drives), where gpioset holds one of the scanner's lines as another program would.
 # Checks: with every line free the selftest requests them all; with one held it names the line
-# and its holder; afterwards the kernel shows no line left requested by the scanner.
-# Run by `make test-gpio-chip` (needs the cross-built scanner: make CROSS_COMPILE=aarch64-linux-gnu- HAL=linux).
+# and its holder; afterwards the kernel shows no line left requested by the scanner. Twice: the
+# default build on a 1 GB machine, the LIMITS=small build on a 512 MB one (where the default
+# build cannot start). Run by `make test-gpio-chip`, which cross-builds both.
 # Ends with cmocka's summary lines so that tests/run.sh counts it.
 set -eu
 cd "$(dirname "$0")/.."
 SCANNER=${SCANNER:-build/aarch64-linux-gnu/linux/scanner}
+SCANNER_SMALL=${SCANNER_SMALL:-build/aarch64-linux-gnu/small/linux/scanner}
 WORK=${WORK:-build/gpio-chip}
 TRIPLET=aarch64-linux-gnu
 for tool in qemu-system-aarch64 cpio "$TRIPLET-readelf"; do
     command -v "$tool" >/dev/null || { echo "gpio_chip: $tool missing (make test-gpio-chip installs it)"; exit 1; }
 done
-rm -rf "$WORK/root" "$WORK/out.log"
+rm -rf "$WORK/root" "$WORK"/vm-*.log
 mkdir -p "$WORK/debs" "$WORK/root"
 
 # Debian's arm64 kernel, static busybox and the gpiod tools, unpacked (not installed).
@@ -35,7 +37,8 @@ IMAGE=$(ls "$WORK"/unpacked/boot/vmlinuz-* | head -n 1)
 R=$WORK/root
 mkdir -p "$R/bin" "$R/lib/$TRIPLET" "$R/etc/scanner" "$R/proc" "$R/sys" "$R/dev" "$R/tmp"
 cp "$WORK/unpacked/bin/busybox" "$R/bin/"
-cp "$SCANNER" "$R/bin/scanner"
+cp "$SCANNER" "$R/bin/scanner-default"
+cp "$SCANNER_SMALL" "$R/bin/scanner-small"
 cp "$WORK/unpacked/usr/bin/gpioset" "$WORK/unpacked/usr/bin/gpioinfo" "$R/bin/"
 libdirs="/usr/lib/$TRIPLET /lib/$TRIPLET $WORK/unpacked/usr/lib/$TRIPLET"
 copy_libs() { # every library an ELF needs, recursively
@@ -51,7 +54,7 @@ copy_libs() { # every library an ELF needs, recursively
         [ -e "$R/lib/$TRIPLET/$lib" ] || { echo "gpio_chip: no $lib for $1" >&2; exit 1; }
     done
 }
-for elf in "$R/bin/scanner" "$R/bin/gpioset" "$R/bin/gpioinfo"; do copy_libs "$elf"; done
+for elf in "$R/bin/scanner-default" "$R/bin/scanner-small" "$R/bin/gpioset" "$R/bin/gpioinfo"; do copy_libs "$elf"; done
 cp -L "/usr/lib/$TRIPLET/ld-linux-aarch64.so.1" "$R/lib/ld-linux-aarch64.so.1"
 
 # The rig's config with the PL061's eight lines: projector on 0..2, lights on 4..7 (line 3 is
@@ -62,10 +65,15 @@ sed -e 's/^chip = .*/chip = gpiochip0/' -e 's/^projector_enable = .*/projector_e
     -e 's/^light_1 = .*/light_1 = 5/' -e 's/^light_2 = .*/light_2 = 6/' \
     -e 's/^light_3 = .*/light_3 = 7/' config/pi-v4l2.ini > "$R/etc/scanner/rig.ini"
 
+# The checks run the build named on the kernel command line (scanner=default or small); the
+# default build's --version shows whether it can start with this much memory.
 cat > "$R/init" <<'EOF'
 #!/bin/busybox sh
 /bin/busybox --install -s /bin
 mount -t proc proc /proc; mount -t sysfs sys /sys; mount -t devtmpfs dev /dev
+build=$(sed -n 's/.*scanner=\([a-z]*\).*/\1/p' /proc/cmdline)
+ln -s /bin/scanner-$build /bin/scanner
+echo "== default build starts"; scanner-default --version 2>&1; echo "exit $?"
 echo "== gpioinfo"; gpioinfo
 echo "== selftest, lines free"; scanner selftest --config /etc/scanner/rig.ini 2>&1
 gpioset --mode=signal gpiochip0 6=1 & holder=$!
@@ -79,18 +87,13 @@ EOF
 chmod +x "$R/init"
 (cd "$R" && find . | cpio -o -H newc --quiet | gzip -1) > "$WORK/initramfs.gz"
 
-timeout 600 qemu-system-aarch64 -M virt -cpu cortex-a57 -m 1024 -nographic -no-reboot -nic none \
-    -kernel "$IMAGE" -initrd "$WORK/initramfs.gz" \
-    -append "console=ttyAMA0 panic=-1 quiet" > "$WORK/out.log" 2>&1 || true
-tr -d '\r' < "$WORK/out.log" > "$WORK/vm.log"
-
 passed=0
 failed=0
-check() { # name, then a pattern the VM's log must (or, with !, must not) show in its section
+check() { # name, section, then patterns the section must (or, with !, must not) show
     name=$1
     section=$2
     shift 2
-    body=$(awk -v s="== $section" '$0 == s {on = 1; next} /^== / {on = 0} on' "$WORK/vm.log")
+    body=$(awk -v s="== $section" '$0 == s {on = 1; next} /^== / {on = 0} on' "$log")
     ok=1
     for pat in "$@"; do
         case $pat in
@@ -99,21 +102,38 @@ check() { # name, then a pattern the VM's log must (or, with !, must not) show i
         esac
     done
     if [ $ok -eq 1 ]; then
-        echo "[       OK ] gpio_chip: $name"
+        echo "[       OK ] gpio_chip ($vm): $name"
         passed=$((passed + 1))
     else
-        echo "[  FAILED  ] gpio_chip: $name"
+        echo "[  FAILED  ] gpio_chip ($vm): $name"
         printf '%s\n' "$body" | sed 's/^/    /'
         failed=$((failed + 1))
     fi
 }
-check "the VM found the PL061 chip" "gpioinfo" "^gpiochip0 - 8 lines"
-check "every line free: all requested" "selftest, lines free" \
-    "^gpio +gpiochip0 +ok +7 lines"
-check "a held line: named, with its holder" "selftest, line 6 held" \
-    "^gpio +gpiochip0 +MISSING +gpio: light_2: cannot request gpiochip0 line 6, in use by gpioset: Device or resource busy"
-check "nothing left requested by the scanner" "gpioinfo after" \
-    'line +6: +unnamed +"gpioset" +output' '!"scanner"'
-grep -q "^== done" "$WORK/vm.log" || { echo "gpio_chip: the VM did not finish (see $WORK/vm.log)"; failed=$((failed + 1)); }
-[ $failed -eq 0 ] && echo "[  PASSED  ] $passed test(s)." || echo "[  FAILED  ] $failed test(s)."
+
+boot() { # memory in MB, the build the checks run
+    vm="$2 build, $1 MB"
+    log=$WORK/vm-$2.log
+    timeout 600 qemu-system-aarch64 -M virt -cpu cortex-a57 -m "$1" -nographic -no-reboot \
+        -nic none -kernel "$IMAGE" -initrd "$WORK/initramfs.gz" \
+        -append "console=ttyAMA0 panic=-1 quiet scanner=$2" 2>&1 | tr -d '\r' > "$log" || true
+    check "the VM found the PL061 chip" "gpioinfo" "^gpiochip0 - 8 lines"
+    check "every line free: all requested" "selftest, lines free" \
+        "^gpio +gpiochip0 +ok +7 lines requested and driven low"
+    check "a held line: named, with its holder" "selftest, line 6 held" \
+        "^gpio +gpiochip0 +MISSING +gpio: light_2: cannot request gpiochip0 line 6, in use by gpioset: Device or resource busy"
+    check "nothing left requested by the scanner" "gpioinfo after" \
+        'line +6: +unnamed +"gpioset" +output' '!"scanner"'
+    if ! grep -q "^== done" "$log"; then
+        echo "[  FAILED  ] gpio_chip ($vm): the VM did not finish (see $log)"
+        failed=$((failed + 1))
+    fi
+}
+
+boot 1024 default
+check "the default build starts" "default build starts" "^scanner .*HAL=linux" "^exit 0$"
+# 512 MB: the default build's 657 MiB of static buffers do not fit; LIMITS=small's do.
+boot 512 small
+check "the default build cannot start" "default build starts" "!^scanner .*HAL=linux" "!^exit 0$"
+if [ $failed -eq 0 ]; then echo "[  PASSED  ] $passed test(s)."; else echo "[  FAILED  ] $failed test(s)."; fi
 [ $failed -eq 0 ]

@@ -6,9 +6,17 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#ifdef HAL_LIMITS_SMALL
+/* make LIMITS=small, for a board with 512 MB (a Pi Zero 2 W, a Pi 3A+): frames up to the Pi
+ * camera v1's 2x2 binned mode, 1296 x 972, and a smaller fusion grid (fusion.h); about 290 MiB
+ * of static buffers instead of 657. */
+#define HAL_MAX_WIDTH 1296u
+#define HAL_MAX_HEIGHT 972u
+#else
 /* The Raspberry Pi HQ camera's 2x2 binned mode is 2028 x 1520; leave room for it. */
 #define HAL_MAX_WIDTH 2048u
 #define HAL_MAX_HEIGHT 1536u
+#endif
 #define HAL_MAX_PIXELS (HAL_MAX_WIDTH * HAL_MAX_HEIGHT)
 /* White lights around the object (Jost et al. method 3 needs several). */
 #define HAL_MAX_LIGHTS 8u
