@@ -43,31 +43,31 @@ static void test_transient_timeout_is_retried(void **state)
     assert_true(test_rig_dark());
 }
 
+/* A fault on every capture from frame @p at of a view on: the view stops with @p want_rc after
+ * @p tries captures of that frame, projector and lights off. */
+static void assert_view_stops(enum sim_cam_fault kind, uint64_t at, int want_rc, uint64_t tries)
+{
+    struct scan_view_info info;
+    uint64_t start = sim_ctl_frames();
+    sim_ctl_inject_camera_fault(kind, start + at, 100);
+    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info), want_rc);
+    assert_int_equal(sim_ctl_frames() - start, at + tries);
+    assert_true(test_rig_dark());
+    sim_ctl_inject_camera_fault(SIM_FAULT_NONE, 0, 0);
+}
+
 static void test_persistent_fault_stops_with_projector_off(void **state)
 {
     (void)state;
-    struct scan_view_info info;
-    uint64_t start = sim_ctl_frames();
-    sim_ctl_inject_camera_fault(SIM_FAULT_CORRUPT, start + 7, 100);
-    int rc = scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info);
-    assert_int_equal(rc, -EIO);
     /* tried 1 + capture_retries times, then gave up and said which pattern */
-    assert_int_equal(sim_ctl_frames() - start, 7 + 1 + t.cfg.scan.capture_retries);
+    assert_view_stops(SIM_FAULT_CORRUPT, 7, -EIO, 1 + t.cfg.scan.capture_retries);
     assert_non_null(strstr(test_last_log, "giving up on pattern 7"));
-    assert_true(test_rig_dark());
-    sim_ctl_inject_camera_fault(SIM_FAULT_NONE, 0, 0);
 }
 
 static void test_unplugged_camera_not_retried(void **state)
 {
     (void)state;
-    struct scan_view_info info;
-    uint64_t start = sim_ctl_frames();
-    sim_ctl_inject_camera_fault(SIM_FAULT_NO_DEVICE, start + 3, 100);
-    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info), -ENODEV);
-    assert_int_equal(sim_ctl_frames() - start, 4); /* no retry can bring a camera back */
-    assert_true(test_rig_dark());
-    sim_ctl_inject_camera_fault(SIM_FAULT_NONE, 0, 0);
+    assert_view_stops(SIM_FAULT_NO_DEVICE, 3, -ENODEV, 1); /* no retry can bring a camera back */
 }
 
 /* What a clean view at angle 0 gives: its colour, decoded columns and counts. */
@@ -123,15 +123,9 @@ static void test_stale_frames_are_discarded(void **state)
 static void test_persistent_stale_frames_stop_the_view(void **state)
 {
     (void)state;
-    struct scan_view_info info;
-    uint64_t start = sim_ctl_frames();
-    sim_ctl_inject_camera_fault(SIM_FAULT_STALE, start + 9, 100);
-    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info), -EIO);
-    assert_int_equal(sim_ctl_frames() - start, 9 + 1 + t.cfg.scan.capture_retries);
+    assert_view_stops(SIM_FAULT_STALE, 9, -EIO, 1 + t.cfg.scan.capture_retries);
     assert_non_null(strstr(test_last_log, "giving up on pattern 9: every frame began before"));
     assert_non_null(strstr(test_last_log, "drop_frames"));
-    assert_true(test_rig_dark());
-    sim_ctl_inject_camera_fault(SIM_FAULT_NONE, 0, 0);
 }
 
 static int stop_after_frames(void)
