@@ -58,7 +58,8 @@ CFLAGS_COMMON := $(WARN) $(OPT) $(LIMITS_CFLAGS) -g -MMD -MP
 FW_CFLAGS := $(CFLAGS_COMMON) -Ihal/include -Ifirmware -fstack-usage
 PKG_CFLAGS = $(shell $(PKG_CONFIG) --cflags $(PKGS) 2>/dev/null)
 PKG_LIBS = $(shell $(PKG_CONFIG) --libs inih libpng libmodbus 2>/dev/null) -lpthread
-HOST_CFLAGS = $(CFLAGS_COMMON) -Ihal/include -Ifirmware -Iapp -Ihal/posix -Ihal/linux -Ihal/modbus -Ihost_sim $(PKG_CFLAGS)
+HOST_INC := -Ihal/include -Ifirmware -Iapp -Ihal/posix -Ihal/linux -Ihal/modbus -Ihost_sim
+HOST_CFLAGS = $(CFLAGS_COMMON) $(HOST_INC) $(PKG_CFLAGS)
 LDFLAGS_COMMON := $(OPT) -g
 LDLIBS_COMMON = $(PKG_LIBS) -lm
 
@@ -174,7 +175,7 @@ FUZZ_TARGETS := config calib view_ini ply modbus
 FUZZ_SECONDS ?= 600
 FUZZ_LIB_SRC := app/config.c app/ini_schema.c host_sim/sim_mesh.c host_sim/sim_ply_read.c \
 	hal/modbus/turntable_modbus.c host_sim/clock_sim.c
-FUZZ_CFLAGS = -std=c11 -g -O1 -Ihal/include -Ifirmware -Iapp -Ihal/posix -Ihal/linux -Ihal/modbus -Ihost_sim -Itests/fuzz $(PKG_CFLAGS)
+FUZZ_CFLAGS = -std=c11 -g -O1 $(HOST_INC) -Itests/fuzz $(PKG_CFLAGS)
 FUZZ_LIBS = $(shell $(PKG_CONFIG) --libs inih libmodbus 2>/dev/null) -lpthread -lm
 FUZZ_REPLAY := $(patsubst %,$(BUILD)/tests/fuzz-replay-%,$(FUZZ_TARGETS))
 
