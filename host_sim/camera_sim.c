@@ -39,7 +39,7 @@ static uint64_t noise_id(struct camera_sim *cam, const struct sim_sources *src)
 
 /* A stale frame: one the camera exposed before the last light or pattern change (it had it
  * in flight), showing what the previous frame showed, stamped with when that began. */
-static int stale(const struct camera_sim *cam, struct sim_sources *src, uint64_t *start_us)
+static int stale(struct camera_sim *cam, struct sim_sources *src, uint64_t *start_us)
 {
     if (!cam->has_shown)
         return 0; /* nothing was exposed before the first frame */
