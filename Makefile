@@ -330,7 +330,7 @@ eval: deps $(BUILD)/scanner $(BUILD)/colour-eval
 measure-scan: deps $(BUILD)/scanner $(BUILD)/mesh-compare
 	@for obj in mesh cylinder sphere; do \
 		sed "s/^object = .*/object = $$obj/" config/sim.ini > $(BUILD)/measure-$$obj.ini; \
-		sed -i "s|^calibration = .*|calibration = $(CURDIR)/config/sim-calib.ini|; s|^mesh_file = ../../|mesh_file = $(CURDIR)/../|" $(BUILD)/measure-$$obj.ini; \
+		sed -i "s|^calibration = .*|calibration = $(CURDIR)/config/sim-calib.ini|; s|^mesh_file = ../|mesh_file = $(CURDIR)/|" $(BUILD)/measure-$$obj.ini; \
 		rm -rf $(BUILD)/measure-scan/$$obj; \
 		$(BUILD)/scanner scan --config $(BUILD)/measure-$$obj.ini --out $(BUILD)/measure-scan/$$obj | tail -n 1; \
 		$(BUILD)/mesh-compare $(BUILD)/measure-scan/$$obj/mesh.ply $(BUILD)/measure-scan/$$obj/truth_mesh.ply $(BUILD)/measure-scan/$$obj; \

@@ -1,4 +1,4 @@
-/* Material models of the simulated object; equations in ../shared/reference/equations.md. */
+/* Material models of the simulated object; equations in docs/equations.md. */
 #define _POSIX_C_SOURCE 200809L
 #include "sim_material.h"
 
@@ -12,7 +12,7 @@ int sim_material_load_abc(struct sim_material *mat, const char *csv_path, const 
     if (f == NULL)
         return -errno;
     char line[512];
-    int rc = -ENOENT;
+    int rc = -ESRCH; /* not -ENOENT: that would read as a missing file */
     while (fgets(line, sizeof(line), f) != NULL) {
         char row_name[64];
         double v[10];

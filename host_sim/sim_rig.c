@@ -109,7 +109,7 @@ static int build_material(struct sim_rig *rig, const char *dir, char *err, size_
         int rc = sim_material_load_abc(&rig->material, path, c->merl_name);
         if (rc != 0) {
             snprintf(err, len, "sim: material '%s' from %s: %s", c->merl_name, path,
-                     rc == -ENOENT ? "not in the table" : strerror(-rc));
+                     rc == -ESRCH ? "not in the table" : strerror(-rc));
             return rc;
         }
     }

@@ -14,13 +14,20 @@
 #include "sim_material.h"
 #include "test_util.h"
 
+/* Load a mesh the test needs, failing with the file's name and the reader's message. */
+static void load_mesh(struct sim_mesh *m, const char *path)
+{
+    char err[256];
+    if (sim_mesh_load_ply(m, path, err, sizeof(err)) != 0)
+        fail_msg("%s", err);
+}
+
 static void test_bunny_ply_loads(void **state)
 {
     (void)state;
     struct sim_mesh m;
     char err[256];
-    assert_int_equal(sim_mesh_load_ply(&m, "../shared/data/bunny/bun_zipper.ply", err, sizeof(err)),
-                     0);
+    load_mesh(&m, "data/bunny/bun_zipper.ply");
     assert_int_equal(m.vert_count, 35947);
     assert_int_equal(m.tri_count, 69451);
     sim_mesh_y_up_to_z_up(&m);
@@ -41,9 +48,7 @@ static void test_bvh_matches_brute_force(void **state)
 {
     (void)state;
     struct sim_mesh m;
-    char err[256];
-    assert_int_equal(
-        sim_mesh_load_ply(&m, "../shared/data/bunny/bun_zipper_res3.ply", err, sizeof(err)), 0);
+        load_mesh(&m, "data/bunny/bun_zipper_res3.ply");
     sim_mesh_place(&m, 150.0);
     struct sim_bvh bvh;
     assert_int_equal(sim_bvh_build(&bvh, &m), 0);
@@ -155,8 +160,10 @@ static void test_merl_material(void **state)
 {
     (void)state;
     struct sim_material mat;
-    const char *csv = "../shared/data/materials/merl_abc_lowetal2012.csv";
-    assert_int_equal(sim_material_load_abc(&mat, csv, "red-plastic"), 0);
+    const char *csv = "data/materials/merl_abc_lowetal2012.csv";
+    int rc = sim_material_load_abc(&mat, csv, "red-plastic");
+    if (rc != 0)
+        fail_msg("%s: %s", csv, strerror(-rc));
     assert_int_not_equal(sim_material_load_abc(&mat, csv, "unobtainium"), 0);
     assert_int_equal(sim_material_load_abc(&mat, csv, "gold-metallic-paint"), 0);
     double albedo[3] = {mat.abc_kd[0], mat.abc_kd[1], mat.abc_kd[2]}, mirror[3], off[3];
