@@ -138,15 +138,16 @@ static int cmd_calibrate_white(const char *config_path, double target_albedo)
         return 2;
     }
     cfg.scan.colour.method = COLOUR_MULTI; /* captures the dark, all-lights and single frames */
+    struct scan_view view;
     struct scan_view_info info;
     struct white_cal wc;
     int rc = rig_up(&cfg, &calib);
     if (rc == 0)
         rc = hal_table_home(&the_hal.turntable);
     if (rc == 0)
-        rc = scan_view(&the_hal, &cfg.scan, &calib, 0, NULL, &info);
+        rc = scan_take_view(&the_hal, &cfg.scan, &calib, 0, NULL, &view, &info);
     if (rc == 0) {
-        rc = white_cal_from_view(&cfg, &calib, target_albedo, &wc);
+        rc = white_cal_from_view(&cfg, &calib, &view, target_albedo, &wc);
         if (rc != 0)
             app_log(HAL_LOG_ERROR, "no usable white pixels: is the target in view, and not "
                                    "saturated (lower [camera] exposure_us)?");

@@ -227,19 +227,19 @@ static int write_registration(struct job *j, const struct icp_report *r)
 
 /* Results of a processed view (its frames, the colour among them, were kept while capturing):
  * its pose (turntable, refined by registration), its point cloud, its part of the fused model. */
-static int save_results(struct job *j, struct icp_report *report)
+static int save_results(struct job *j, const struct scan_view *view, struct icp_report *report)
 {
     char path[HAL_MAX_PATH + 64];
     struct frame_xform pose;
-    scan_view_pose(j->calib, &pose);
-    int rc = scan_register_view(&j->cfg->registration, j->calib, &pose, report);
+    scan_view_pose(j->calib, view, &pose);
+    int rc = scan_register_view(&j->cfg->registration, j->calib, view, &pose, report);
     if (rc == 0)
         rc = write_registration(j, report);
     snprintf(path, sizeof(path), "%s/cloud.ply", j->view_dir);
     if (rc == 0)
-        rc = scan_save_cloud(j->hal, &pose, path);
+        rc = scan_save_cloud(j->hal, view, &pose, path);
     if (rc == 0)
-        rc = scan_fuse_view(j->calib, &pose);
+        rc = scan_fuse_view(j->calib, view, &pose);
     return rc;
 }
 
@@ -332,9 +332,10 @@ static int live_view(struct job *j, uint32_t v)
     utc_now(started, sizeof(started));
     progress(j, "capturing", (int)v, v, "");
     struct scan_frame_sink sink = {save_frame, j};
+    struct scan_view view;
     struct scan_view_info info;
     double t0 = wall_ms();
-    rc = scan_view(hal, &j->cfg->scan, j->calib, st.position_mdeg, &sink, &info);
+    rc = scan_take_view(hal, &j->cfg->scan, j->calib, st.position_mdeg, &sink, &view, &info);
     if (rc != 0) {
         char kept[2 * HAL_MAX_PATH + 96];
         hal->log(HAL_LOG_ERROR, "view %u at %.3f deg failed: %s; %s", (unsigned)v,
@@ -344,7 +345,7 @@ static int live_view(struct job *j, uint32_t v)
     }
     progress(j, "saving", (int)v, v, "");
     struct icp_report reg;
-    rc = save_results(j, &reg);
+    rc = save_results(j, &view, &reg);
     if (rc == 0)
         rc = board_write_view_extras(hal, j->view_dir);
     /* view.ini last: its presence says the view is complete */
@@ -494,16 +495,17 @@ static int process_view(struct job *j, uint32_t v, const char *in_view_dir)
         else
             rc = scan_feed_light_frame(k, pixels);
     }
+    struct scan_view view;
     struct scan_view_info info;
     memset(&info, 0, sizeof(info));
     if (rc == 0)
-        rc = scan_finish_view(j->calib, (int32_t)angle, &info);
+        rc = scan_finish_view(j->calib, (int32_t)angle, &view, &info);
     set_view_dir(j, v);
     if (rc == 0)
         rc = hal_storage_mkdir_p(&hal->storage, j->view_dir);
     struct icp_report reg;
     if (rc == 0)
-        rc = save_results(j, &reg);
+        rc = save_results(j, &view, &reg);
     if (rc == 0) {
         char detail[HAL_MAX_PATH + 160];
         describe(detail, sizeof(detail), &info, &reg, j->view_dir);

@@ -28,7 +28,7 @@ static int channel_median(const uint8_t *rgb, const float *conf, size_t n, int c
 }
 
 int white_cal_from_view(const struct app_config *cfg, const struct scan_calib *calib,
-                        double target_albedo, struct white_cal *out)
+                        struct scan_view *view, double target_albedo, struct white_cal *out)
 {
     memset(out, 0, sizeof(*out));
     size_t n = (size_t)cfg->camera.width * cfg->camera.height;
@@ -38,11 +38,11 @@ int white_cal_from_view(const struct app_config *cfg, const struct scan_calib *c
         /* with this scale the stored byte is half the compensated value in grey levels: colour
          * frames at a shorter exposure are scaled up to the camera's, beyond 255 */
         p.white_scale[0] = p.white_scale[1] = p.white_scale[2] = HALF / 255.0;
-        int rc = scan_recolour(&p, calib);
+        int rc = scan_recolour(&p, calib, view);
         if (rc != 0)
             return rc;
         for (int ch = 0; ch < 3; ch++) {
-            int med = channel_median(scan_view_colour(), scan_view_confidence(), n, ch,
+            int med = channel_median(view->rgb, view->confidence, n, ch,
                                      &out->pixels[m]);
             if (med <= 0 || med >= 255)
                 return -EINVAL; /* nothing confident, or clipped: a dimmer exposure is needed */

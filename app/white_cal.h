@@ -4,6 +4,7 @@
 
 #include "config.h"
 #include "hal.h"
+#include "scan.h"
 
 /** Scale of each compensation method (index enum colour_method; [0] unused), per channel. */
 struct white_cal {
@@ -11,10 +12,11 @@ struct white_cal {
     uint32_t pixels[4]; /**< confident pixels the median came from */
 };
 
-/** From the last view (taken with every colour frame): for each method, the scale that maps the
- *  median compensated colour of the confident pixels to @p target_albedo.
+/** From @p view (taken with every colour frame; recoloured in place by each method in turn):
+ *  for each method, the scale that maps the median compensated colour of the confident pixels
+ *  to @p target_albedo.
  *  @retval 0 @retval -EINVAL no confident pixel for some method */
 int white_cal_from_view(const struct app_config *cfg, const struct scan_calib *calib,
-                        double target_albedo, struct white_cal *out);
+                        struct scan_view *view, double target_albedo, struct white_cal *out);
 
 #endif

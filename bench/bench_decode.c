@@ -57,8 +57,9 @@ static int run(uint32_t width, uint32_t height)
     t.cfg.scan.decode_rows = 1;
     if (test_rig_start(&t) != 0)
         return 1;
+    struct scan_view view;
     struct scan_view_info info;
-    if (scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info) != 0)
+    if (scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info) != 0)
         return 1;
     struct gray_layout layout;
     scan_layout(&t.cfg.scan, &t.calib, &layout);
@@ -72,21 +73,25 @@ static int run(uint32_t width, uint32_t height)
     long bad = opencv_graycode_pattern_mismatches((int)t.calib.proj_width,
                                                   (int)t.calib.proj_height, &cv_count, our_lit,
                                                   &layout);
+    uint8_t *reason = malloc(n);
+    struct decode_maps maps;
+    if (reason == NULL)
+        return 1;
     double floor_ms = 1e9, ours_ms = 1e9, ours_full_ms = 1e9;
     volatile uint64_t sink = 0;
     for (int r = 0; r < 5; r++) {
         double t0 = now_ms();
         sink += read_all(frames + GRAY_PATTERN_FIRST_BIT, patterns, n);
         double t1 = now_ms();
-        decode_pixels();
+        decode_pixels(reason, &maps);
         double t2 = now_ms();
-        decode_finish();
+        decode_finish(reason, &maps);
         double t3 = now_ms();
         floor_ms = t1 - t0 < floor_ms ? t1 - t0 : floor_ms;
         ours_ms = t2 - t1 < ours_ms ? t2 - t1 : ours_ms;
         ours_full_ms = t3 - t2 < ours_full_ms ? t3 - t2 : ours_full_ms;
     }
-    decode_pixels(); /* maps without the neighbour check, as OpenCV's */
+    decode_pixels(reason, &maps); /* maps without the neighbour check, as OpenCV's */
     uint16_t *cv_col = malloc(n * 2), *cv_row = malloc(n * 2);
     uint8_t *cv_ok = malloc(n);
     double cv_ms = opencv_graycode_decode(frames + GRAY_PATTERN_FIRST_BIT, (int)patterns,
@@ -94,7 +99,7 @@ static int run(uint32_t width, uint32_t height)
                                           (int)t.calib.proj_height,
                                           (int)t.cfg.scan.min_bit_diff_dn + 1, cv_col, cv_row,
                                           cv_ok);
-    const struct decode_maps *m = decode_get_maps();
+    const struct decode_maps *m = &maps;
     size_t both = 0, differ = 0, ours_valid = 0, cv_valid = 0;
     for (size_t i = 0; i < n; i++) {
         int mine = m->reason[i] == SCAN_VALID;
@@ -113,6 +118,7 @@ static int run(uint32_t width, uint32_t height)
     free(cv_col);
     free(cv_row);
     free(cv_ok);
+    free(reason);
     test_rig_stop(&t);
     (void)sink;
     return differ != 0 || bad != 0 || cv_count != (int)patterns;

@@ -38,26 +38,31 @@ __attribute__((noinline)) void process_view_once(struct test_rig *t, const uint8
         decode_frame(i, decode_frame_slot(i));
     }
     s[1] = now_ms();
-    const struct decode_maps *maps = decode_get_maps();
-    decode_finish();
+    /* the stages one by one, as scan_finish_view runs them (no colour: grey zero) */
+    static uint8_t reason[HAL_MAX_PIXELS], rgb[HAL_MAX_PIXELS * 3];
+    static float confidence[HAL_MAX_PIXELS];
+    struct scan_view view = {.width = t->cfg.scan.width, .height = t->cfg.scan.height,
+                             .rgb = rgb, .confidence = confidence};
+    decode_finish(reason, &view.maps);
     s[2] = now_ms();
-    refine_columns(maps, (int)t->cfg.scan.refine);
+    refine_columns(&view.maps, (int)t->cfg.scan.refine, &view.column);
     s[3] = now_ms();
-    tri_range_image(&t->calib, maps, refine_get_columns());
+    tri_range_image(&t->calib, view.width, view.height, view.column, reason, &view.range);
     s[4] = now_ms();
-    tri_normals(maps, t->cfg.scan.normal_radius_px, t->cfg.scan.max_depth_jump_mm);
+    tri_normals(&view.range, reason, t->cfg.scan.normal_radius_px,
+                t->cfg.scan.max_depth_jump_mm);
     s[5] = now_ms();
     struct frame_xform pose;
     struct icp_report rep;
-    scan_view_pose(&t->calib, &pose);
+    scan_view_pose(&t->calib, &view, &pose);
     icp_reset();
-    scan_register_view(&t->cfg.registration, &t->calib, &pose, &rep); /* first: kept */
+    scan_register_view(&t->cfg.registration, &t->calib, &view, &pose, &rep); /* first: kept */
     double s_icp = now_ms();
-    scan_register_view(&t->cfg.registration, &t->calib, &pose, &rep); /* against itself */
+    scan_register_view(&t->cfg.registration, &t->calib, &view, &pose, &rep); /* against itself */
     s[6] = now_ms() - (s_icp - s[5]);
-    scan_fuse_view(&t->calib, &pose);
+    scan_fuse_view(&t->calib, &view, &pose);
     s[7] = now_ms() - (s_icp - s[5]);
-    scan_save_cloud_at_turntable_pose(t, "build/bench_view.ply");
+    scan_save_cloud_at_turntable_pose(t, &view, "build/bench_view.ply");
     s[8] = now_ms() - (s_icp - s[5]);
 }
 

@@ -11,7 +11,6 @@
 static uint8_t frame_store[DECODE_MAX_PATTERNS][HAL_MAX_PIXELS];
 static uint16_t column_map[HAL_MAX_PIXELS];
 static uint16_t row_map[HAL_MAX_PIXELS];
-static uint8_t reason_map[HAL_MAX_PIXELS];
 static uint8_t consistent[HAL_MAX_PIXELS];
 
 static struct {
@@ -19,7 +18,6 @@ static struct {
     struct gray_layout layout;
     uint32_t proj_width, proj_height;
     uint32_t next_pattern;
-    struct decode_maps maps;
 } dec;
 
 const char *scan_reason_name(unsigned reason)
@@ -50,11 +48,6 @@ int decode_begin(const struct scan_params *params, const struct gray_layout *lay
     dec.proj_width = proj_width;
     dec.proj_height = proj_height;
     dec.next_pattern = 0;
-    dec.maps.column = column_map;
-    dec.maps.row = layout->row_bits > 0 ? row_map : NULL;
-    dec.maps.reason = reason_map;
-    dec.maps.width = params->width;
-    dec.maps.height = params->height;
     return 0;
 }
 
@@ -129,7 +122,7 @@ static uint8_t classify(const struct scan_params *p, int white, int black, int s
     return out_of_range ? SCAN_INCONSISTENT : SCAN_VALID;
 }
 
-static void decode_block(size_t start, size_t len)
+static void decode_block(size_t start, size_t len, uint8_t *reason)
 {
     static uint16_t code_col[DECODE_BLOCK], code_row[DECODE_BLOCK];
     static uint8_t amb_col[DECODE_BLOCK], amb_row[DECODE_BLOCK], sat[DECODE_BLOCK];
@@ -147,40 +140,45 @@ static void decode_block(size_t start, size_t len)
     for (size_t i = 0; i < len; i++) {
         int out = code_col[i] >= dec.proj_width ||
                   (l->row_bits > 0 && code_row[i] >= dec.proj_height);
-        reason_map[start + i] = classify(&dec.params, white[i], black[i],
+        reason[start + i] = classify(&dec.params, white[i], black[i],
                                          sat[i] == DECODE_SATURATED, amb_col[i], amb_row[i], out);
         column_map[start + i] = code_col[i];
         row_map[start + i] = l->row_bits > 0 ? code_row[i] : 0;
     }
 }
 
-int decode_pixels(void)
+int decode_pixels(uint8_t *reason, struct decode_maps *maps)
 {
     if (dec.next_pattern != gray_layout_count(&dec.layout))
         return -EINVAL;
     size_t n = (size_t)dec.params.width * dec.params.height;
     for (size_t start = 0; start < n; start += DECODE_BLOCK)
-        decode_block(start, n - start < DECODE_BLOCK ? n - start : DECODE_BLOCK);
+        decode_block(start, n - start < DECODE_BLOCK ? n - start : DECODE_BLOCK, reason);
+    maps->column = column_map;
+    maps->row = dec.layout.row_bits > 0 ? row_map : NULL;
+    maps->reason = reason;
+    maps->width = dec.params.width;
+    maps->height = dec.params.height;
     return 0;
 }
 
-static int columns_agree(size_t a, size_t b)
+static int columns_agree(const uint8_t *reason, size_t a, size_t b)
 {
-    if (reason_map[b] != SCAN_VALID)
+    if (reason[b] != SCAN_VALID)
         return 0;
     int d = (int)column_map[a] - (int)column_map[b];
     return d <= (int)dec.params.max_column_jump && d >= -(int)dec.params.max_column_jump;
 }
 
 /* A correct decode agrees with most of its neighbours; a wrong bit makes a lone jump. */
-static void check_neighbours(void)
+static void check_neighbours(uint8_t *reason)
 {
     const uint32_t w = dec.params.width, h = dec.params.height;
     for (uint32_t y = 0; y < h; y++) {
         for (uint32_t x = 0; x < w; x++) {
             size_t i = (size_t)y * w + x;
             consistent[i] = 1;
-            if (reason_map[i] != SCAN_VALID)
+            if (reason[i] != SCAN_VALID)
                 continue;
             uint32_t agree = 0;
             for (int dy = -1; dy <= 1; dy++) {
@@ -188,7 +186,7 @@ static void check_neighbours(void)
                     int nx = (int)x + dx, ny = (int)y + dy;
                     if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= (int)w || ny >= (int)h)
                         continue;
-                    agree += (uint32_t)columns_agree(i, (size_t)ny * w + (size_t)nx);
+                    agree += (uint32_t)columns_agree(reason, i, (size_t)ny * w + (size_t)nx);
                 }
             }
             consistent[i] = agree >= dec.params.min_consistent_neighbours;
@@ -196,21 +194,16 @@ static void check_neighbours(void)
     }
     size_t n = (size_t)w * h;
     for (size_t i = 0; i < n; i++)
-        if (!consistent[i] && reason_map[i] == SCAN_VALID)
-            reason_map[i] = SCAN_INCONSISTENT;
+        if (!consistent[i] && reason[i] == SCAN_VALID)
+            reason[i] = SCAN_INCONSISTENT;
 }
 
-int decode_finish(void)
+int decode_finish(uint8_t *reason, struct decode_maps *maps)
 {
-    int rc = decode_pixels();
+    int rc = decode_pixels(reason, maps);
     if (rc == 0)
-        check_neighbours();
+        check_neighbours(reason);
     return rc;
-}
-
-const struct decode_maps *decode_get_maps(void)
-{
-    return &dec.maps;
 }
 
 /* ---- the plain reference: one pixel at a time, every frame ---- */

@@ -21,11 +21,12 @@ enum scan_reason {
     SCAN_REASON_COUNT
 };
 
-/** Read-only view of the decoder's static maps (row-major, width * height). */
+/** The decoded maps of a view, read-only (row-major, width * height): the decoder's columns and
+ *  rows, and the view's reason map as the stages after decoding left it. */
 struct decode_maps {
     const uint16_t *column; /**< projector column, meaningful where reason == SCAN_VALID */
     const uint16_t *row;    /**< projector row, or NULL when rows are not coded */
-    uint8_t *reason;        /**< enum scan_reason per pixel; later stages add their own */
+    const uint8_t *reason;  /**< enum scan_reason per pixel */
     uint32_t width, height;
 };
 
@@ -54,12 +55,12 @@ uint8_t *decode_frame_slot(uint32_t pattern);
  *  unless it already is the slot). @retval 0 ok @retval -EINVAL out of order */
 int decode_frame(uint32_t pattern, const uint8_t *grey);
 /** Decode every pixel from the kept frames (decode_pixels), then the neighbour check.
+ *  @param reason  out: enum scan_reason per pixel (width * height, the caller's buffer)
+ *  @param maps    out: the decoder's column and row maps, and @p reason
  *  @retval 0 ok @retval -EINVAL frames missing */
-int decode_finish(void);
-/** The per-pixel stage of decode_finish alone (for tests and benchmarks). */
-int decode_pixels(void);
-/** The maps of the last finished view. */
-const struct decode_maps *decode_get_maps(void);
+int decode_finish(uint8_t *reason, struct decode_maps *maps);
+/** The per-pixel stage of decode_finish alone (for tests and benchmarks); same parameters. */
+int decode_pixels(uint8_t *reason, struct decode_maps *maps);
 
 /** The plain per-pixel reference the blocked decoder must match (tests compare them): decode
  *  @p n pixels of @p frames (one pointer per pattern of @p layout) into @p column, @p row

@@ -30,7 +30,7 @@ static void refine_run(const struct decode_maps *m, size_t row, uint32_t x0, uin
     }
 }
 
-int refine_columns(const struct decode_maps *m, int enabled)
+int refine_columns(const struct decode_maps *m, int enabled, const float **columns)
 {
     for (uint32_t y = 0; y < m->height; y++) {
         size_t row = (size_t)y * m->width;
@@ -53,10 +53,6 @@ int refine_columns(const struct decode_maps *m, int enabled)
             x = end + 1;
         }
     }
+    *columns = column_sub;
     return 0;
-}
-
-const float *refine_get_columns(void)
-{
-    return column_sub;
 }

@@ -7,10 +7,10 @@
 /** Fill the continuous column map from the decoded integer columns. Along each camera row a
  *  run of pixels with code c that lies between runs coded c - 1 and c + 1 (either order) spans
  *  the projector interval [c - 0.5, c + 0.5]; each pixel gets its linear position in it. Other
- *  pixels keep c. With @p enabled = 0 every pixel keeps c. @retval 0 */
-int refine_columns(const struct decode_maps *maps, int enabled);
-
-/** The continuous column map (row-major, meaningful where the pixel is valid). */
-const float *refine_get_columns(void);
+ *  pixels keep c. With @p enabled = 0 every pixel keeps c.
+ *  @param columns  out: the continuous column map (the refiner's static buffer, row-major,
+ *                  meaningful where the pixel is valid), until the next call
+ *  @retval 0 */
+int refine_columns(const struct decode_maps *maps, int enabled, const float **columns);
 
 #endif

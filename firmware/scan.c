@@ -20,8 +20,8 @@ static uint8_t light_rgb[COLOUR_MAX_FRAMES][HAL_MAX_PIXELS * 3];
 static int light_present[COLOUR_MAX_FRAMES];
 static uint8_t view_rgb[HAL_MAX_PIXELS * 3]; /* the view's colour: compensated, or raw */
 static float view_confidence[HAL_MAX_PIXELS];
+static uint8_t view_reason[HAL_MAX_PIXELS];  /* decoded, then refined by each later stage */
 static struct scan_params view_params;        /* of the view being fed */
-static int32_t last_angle_mdeg;
 
 int scan_check(const struct scan_params *p, const struct scan_calib *c, char *msg, size_t len)
 {
@@ -202,31 +202,37 @@ int scan_feed_light_frame(uint32_t k, const uint8_t *rgb)
     return 0;
 }
 
-int scan_finish_view(const struct scan_calib *c, int32_t angle_mdeg, struct scan_view_info *info)
+int scan_finish_view(const struct scan_calib *c, int32_t angle_mdeg, struct scan_view *view,
+                     struct scan_view_info *info)
 {
-    const struct decode_maps *maps = decode_get_maps();
-    int rc = decode_finish();
-    if (rc == 0)
-        rc = refine_columns(maps, (int)view_params.refine);
-    if (rc == 0)
-        rc = tri_range_image(c, maps, refine_get_columns());
-    if (rc == 0)
-        rc = tri_normals(maps, view_params.normal_radius_px, view_params.max_depth_jump_mm);
-    const uint8_t *lights[COLOUR_MAX_FRAMES];
+    memset(view, 0, sizeof(*view));
+    view->width = view_params.width;
+    view->height = view_params.height;
+    view->angle_mdeg = angle_mdeg;
+    view->white_rgb = colour_rgb;
     for (uint32_t k = 0; k < COLOUR_MAX_FRAMES; k++)
-        lights[k] = light_present[k] ? light_rgb[k] : NULL;
+        view->lights[k] = light_present[k] ? light_rgb[k] : NULL;
+    view->rgb = view_rgb;
+    view->confidence = view_confidence;
+    int rc = decode_finish(view_reason, &view->maps);
     if (rc == 0)
-        rc = colour_compute(&view_params.colour, c, maps, tri_get_range(), colour_rgb, lights,
-                            view_rgb, view_confidence);
+        rc = refine_columns(&view->maps, (int)view_params.refine, &view->column);
+    if (rc == 0)
+        rc = tri_range_image(c, view->width, view->height, view->column, view_reason,
+                             &view->range);
+    if (rc == 0)
+        rc = tri_normals(&view->range, view_reason, view_params.normal_radius_px,
+                         view_params.max_depth_jump_mm);
+    if (rc == 0)
+        rc = scan_recolour(&view_params.colour, c, view);
     if (rc != 0)
         return rc;
     info->angle_mdeg = angle_mdeg;
     memset(info->reason_count, 0, sizeof(info->reason_count));
-    size_t n = (size_t)maps->width * maps->height;
+    size_t n = (size_t)view->width * view->height;
     for (size_t i = 0; i < n; i++)
-        info->reason_count[maps->reason[i]]++;
+        info->reason_count[view_reason[i]]++;
     info->valid_points = info->reason_count[SCAN_VALID];
-    last_angle_mdeg = angle_mdeg;
     return 0;
 }
 
@@ -298,8 +304,9 @@ static int capture_lights(const struct hal *hal, const struct scan_params *p,
     return rc != 0 ? rc : rc_off;
 }
 
-int scan_view(const struct hal *hal, const struct scan_params *p, const struct scan_calib *c,
-              int32_t angle_mdeg, const struct scan_frame_sink *sink, struct scan_view_info *info)
+int scan_take_view(const struct hal *hal, const struct scan_params *p, const struct scan_calib *c,
+                   int32_t angle_mdeg, const struct scan_frame_sink *sink, struct scan_view *view,
+                   struct scan_view_info *info)
 {
     memset(info, 0, sizeof(*info));
     info->angle_mdeg = angle_mdeg;
@@ -318,36 +325,38 @@ int scan_view(const struct hal *hal, const struct scan_params *p, const struct s
         rc = capture_lights(hal, p, c, count, sink, info);
     if (rc != 0 || rc_off != 0)
         goto out_safe;
-    return scan_finish_view(c, angle_mdeg, info);
+    return scan_finish_view(c, angle_mdeg, view, info);
 out_safe:
     hal->gpio.ops->safe_state(hal->gpio.priv);
     return rc != 0 ? rc : rc_off;
 }
 
-void scan_view_pose(const struct scan_calib *calib, struct frame_xform *obj_from_cam)
+void scan_view_pose(const struct scan_calib *calib, const struct scan_view *view,
+                    struct frame_xform *obj_from_cam)
 {
-    frame_object_from_camera(calib, last_angle_mdeg, obj_from_cam);
+    frame_object_from_camera(calib, view->angle_mdeg, obj_from_cam);
 }
 
 int scan_register_view(const struct icp_params *params, const struct scan_calib *calib,
-                       struct frame_xform *pose, struct icp_report *report)
+                       const struct scan_view *view, struct frame_xform *pose,
+                       struct icp_report *report)
 {
-    return icp_register(params, calib, decode_get_maps(), tri_get_range(), view_rgb, pose,
-                        report);
+    return icp_register(params, calib, &view->maps, &view->range, view->rgb, pose, report);
 }
 
-int scan_fuse_view(const struct scan_calib *calib, const struct frame_xform *obj_from_cam)
+int scan_fuse_view(const struct scan_calib *calib, const struct scan_view *view,
+                   const struct frame_xform *obj_from_cam)
 {
-    return fusion_integrate(calib, obj_from_cam, decode_get_maps(), tri_get_range(), view_rgb,
-                            view_params.colour.method == COLOUR_NONE ? NULL : view_confidence);
+    return fusion_integrate(calib, obj_from_cam, &view->maps, &view->range, view->rgb,
+                            view->colour_method == COLOUR_NONE ? NULL : view->confidence);
 }
 
-int scan_save_cloud(const struct hal *hal, const struct frame_xform *obj_from_cam,
-                    const char *path)
+int scan_save_cloud(const struct hal *hal, const struct scan_view *view,
+                    const struct frame_xform *obj_from_cam, const char *path)
 {
     uint32_t written = 0;
-    int rc = ply_write_cloud(&hal->storage, path, decode_get_maps(), tri_get_range(), view_rgb,
-                             view_confidence, obj_from_cam, &written);
+    int rc = ply_write_cloud(&hal->storage, path, &view->maps, &view->range, view->rgb,
+                             view->confidence, obj_from_cam, &written);
     if (rc != 0)
         hal->log(HAL_LOG_ERROR, "storage: cannot write %s: %s", path, strerror(-rc));
     else
@@ -355,28 +364,12 @@ int scan_save_cloud(const struct hal *hal, const struct frame_xform *obj_from_ca
     return rc;
 }
 
-const uint8_t *scan_colour_frame(void)
+int scan_recolour(const struct colour_params *colour, const struct scan_calib *c,
+                  struct scan_view *view)
 {
-    return colour_rgb;
-}
-
-const uint8_t *scan_view_colour(void)
-{
-    return view_rgb;
-}
-
-const float *scan_view_confidence(void)
-{
-    return view_confidence;
-}
-
-int scan_recolour(const struct colour_params *colour, const struct scan_calib *c)
-{
-    const uint8_t *lights[COLOUR_MAX_FRAMES];
-    for (uint32_t k = 0; k < COLOUR_MAX_FRAMES; k++)
-        lights[k] = light_present[k] ? light_rgb[k] : NULL;
-    return colour_compute(colour, c, decode_get_maps(), tri_get_range(), colour_rgb, lights,
-                          view_rgb, view_confidence);
+    view->colour_method = colour->method;
+    return colour_compute(colour, c, &view->maps, &view->range, view->white_rgb, view->lights,
+                          view->rgb, view->confidence);
 }
 
 void scan_close(const struct hal *hal)

@@ -3,6 +3,7 @@
 #ifndef SCAN_H
 #define SCAN_H
 
+#include "colour.h"
 #include "decode.h"
 #include "hal.h"
 #include "scan_types.h"
@@ -17,6 +18,23 @@ struct scan_view_info {
     uint32_t capture_retries;                 /**< captures that had to be repeated */
     uint32_t valid_points;                    /**< pixels with depth and normal */
     uint32_t reason_count[SCAN_REASON_COUNT]; /**< pixels per reason code */
+};
+
+/** One processed view, as a value: what scan_finish_view hands to the stages after it
+ *  (registration, cloud, fusion, recolouring), each of which takes it as an argument. Its
+ *  pointers lead into the firmware's static buffers (no allocation): valid until the next view
+ *  begins. */
+struct scan_view {
+    uint32_t width, height;              /**< frame size */
+    int32_t angle_mdeg;                  /**< turntable angle it was taken at */
+    struct decode_maps maps;             /**< projector columns (rows), reason per pixel */
+    const float *column;                 /**< continuous projector column (refine.h) */
+    struct tri_range range;              /**< points and normals, camera frame, mm */
+    const uint8_t *white_rgb;            /**< projector-white frame, RGB24 */
+    const uint8_t *lights[COLOUR_MAX_FRAMES]; /**< colour frames (colour.h order); NULL: not taken */
+    uint8_t *rgb;        /**< the view's colour as saved and fused: compensated, else raw */
+    float *confidence;   /**< colour confidence per pixel (0: no estimate) */
+    uint32_t colour_method; /**< enum colour_method the colour was made with */
 };
 
 /** Check parameters and calibration against each other and the compiled limits.
@@ -40,47 +58,51 @@ struct scan_frame_sink {
 /** Capture and process one view at the current turntable angle. On any failure the projector
  *  and lights are off when it returns.
  *  @param sink  keeps every frame as captured (NULL: frames are not kept)
+ *  @param view  out: the processed view
  *  @retval 0 ok @retval -EINTR stop requested @retval capture or processing error */
-int scan_view(const struct hal *hal, const struct scan_params *params,
-              const struct scan_calib *calib, int32_t angle_mdeg,
-              const struct scan_frame_sink *sink, struct scan_view_info *info);
+int scan_take_view(const struct hal *hal, const struct scan_params *params,
+                   const struct scan_calib *calib, int32_t angle_mdeg,
+                   const struct scan_frame_sink *sink, struct scan_view *view,
+                   struct scan_view_info *info);
 
 /** The same processing without a rig, from kept frames (scanner process): begin, feed every
  *  pattern in order (the white frame as RGB, channels 3; the others grey, channels 1, or RGB),
- *  then finish. The live scan runs exactly this path. @retval 0 or -EINVAL */
+ *  then finish with the parameters given to begin. The live scan runs exactly this path.
+ *  @retval 0 or -EINVAL */
 int scan_begin_view(const struct scan_params *params, const struct scan_calib *calib);
 /** The pattern sequence of a view (columns, and rows when params->decode_rows). */
 void scan_layout(const struct scan_params *params, const struct scan_calib *calib,
                  struct gray_layout *layout);
 int scan_feed_frame(uint32_t pattern, const uint8_t *pixels, uint32_t channels,
                     const struct scan_frame_sink *sink);
-int scan_finish_view(const struct scan_calib *calib, int32_t angle_mdeg,
+/** Decode, refine, triangulate, take normals and colour of the frames fed since
+ *  scan_begin_view. @param view  out @param info  out: reasons counted, valid points */
+int scan_finish_view(const struct scan_calib *calib, int32_t angle_mdeg, struct scan_view *view,
                      struct scan_view_info *info);
 
-/** Pose of the last view: camera frame to object frame, from the turntable axis and angle. */
-void scan_view_pose(const struct scan_calib *calib, struct frame_xform *obj_from_cam);
+/** Pose of @p view: camera frame to object frame, from the turntable axis and its angle. */
+void scan_view_pose(const struct scan_calib *calib, const struct scan_view *view,
+                    struct frame_xform *obj_from_cam);
 
-/** Refine @p pose against the previous view (icp.h); the view becomes the next reference. */
+/** Refine @p pose of @p view against the previous view (icp.h); @p view becomes the next
+ *  reference. */
 int scan_register_view(const struct icp_params *params, const struct scan_calib *calib,
-                       struct frame_xform *pose, struct icp_report *report);
+                       const struct scan_view *view, struct frame_xform *pose,
+                       struct icp_report *report);
 
-/** Fuse the last view into the volume (fusion_begin first) seen through @p obj_from_cam. */
-int scan_fuse_view(const struct scan_calib *calib, const struct frame_xform *obj_from_cam);
+/** Fuse @p view into the volume (fusion_begin first) seen through @p obj_from_cam. */
+int scan_fuse_view(const struct scan_calib *calib, const struct scan_view *view,
+                   const struct frame_xform *obj_from_cam);
 
-/** Write the last view's point cloud as binary PLY, through @p obj_from_cam into the object
- *  frame. @retval 0 ok @retval -errno from storage */
-int scan_save_cloud(const struct hal *hal, const struct frame_xform *obj_from_cam,
-                    const char *path);
+/** Write @p view's point cloud as binary PLY, through @p obj_from_cam into the object frame.
+ *  @retval 0 ok @retval -errno from storage */
+int scan_save_cloud(const struct hal *hal, const struct scan_view *view,
+                    const struct frame_xform *obj_from_cam, const char *path);
 
-/** The projector-white frame of the last view, RGB24 (registered with the range image). */
-const uint8_t *scan_colour_frame(void);
-/** The last view's colour as saved and fused: compensated ([colour] method), else raw. */
-const uint8_t *scan_view_colour(void);
-/** Recompute the last view's colour with other colour parameters (same frames, same geometry):
- *  the white calibration compares the methods on one view. @retval 0 or -EINVAL */
-int scan_recolour(const struct colour_params *colour, const struct scan_calib *calib);
-/** The last view's colour confidence per pixel (0: no estimate). */
-const float *scan_view_confidence(void);
+/** Recompute @p view's colour and confidence with other colour parameters (same frames, same
+ *  geometry): the white calibration compares the methods on one view. @retval 0 or -EINVAL */
+int scan_recolour(const struct colour_params *colour, const struct scan_calib *calib,
+                  struct scan_view *view);
 
 /** Colour frames a view takes after its patterns (0 when [colour] method = none). */
 uint32_t scan_light_frame_count(const struct scan_params *params, const struct scan_calib *calib);

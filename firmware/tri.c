@@ -7,26 +7,26 @@
 
 static float xyz_map[HAL_MAX_PIXELS * 3];
 static float normal_map[HAL_MAX_PIXELS * 3];
-static struct tri_range range;
 
-int tri_range_image(const struct scan_calib *c, const struct decode_maps *maps, const float *column)
+int tri_range_image(const struct scan_calib *c, uint32_t width, uint32_t height,
+                    const float *column, uint8_t *reason, struct tri_range *range)
 {
-    if (maps->width != c->cam_width || maps->height != c->cam_height)
+    if (width != c->cam_width || height != c->cam_height)
         return -EINVAL;
     /* Plane of projector column u: n_p = e_x - a e_z with a = (u - cx) / fx, through the
      * projector centre. n_p . (R p + t) = 0  <=>  (R^T n_p) . p + n_p . t = 0, and R^T n_p is
      * linear in a: R^T e_x - a R^T e_z. */
     const vec3 rt_ex = m3_tmul(c->proj_rot, v3(1, 0, 0)), rt_ez = m3_tmul(c->proj_rot, v3(0, 0, 1));
     const vec3 t = v3_from(c->proj_trans_mm);
-    range.xyz_mm = xyz_map;
-    range.normal = normal_map;
-    range.width = maps->width;
-    range.height = maps->height;
-    range.valid_count = 0;
-    for (uint32_t y = 0; y < maps->height; y++) {
-        for (uint32_t x = 0; x < maps->width; x++) {
-            size_t i = (size_t)y * maps->width + x;
-            if (maps->reason[i] != SCAN_VALID)
+    range->xyz_mm = xyz_map;
+    range->normal = normal_map;
+    range->width = width;
+    range->height = height;
+    range->valid_count = 0;
+    for (uint32_t y = 0; y < height; y++) {
+        for (uint32_t x = 0; x < width; x++) {
+            size_t i = (size_t)y * width + x;
+            if (reason[i] != SCAN_VALID)
                 continue;
             vec3 ray = v3(((double)x - c->cam_cx_px) / c->cam_fx_px,
                           ((double)y - c->cam_cy_px) / c->cam_fy_px, 1.0);
@@ -36,13 +36,13 @@ int tri_range_image(const struct scan_calib *c, const struct decode_maps *maps, 
             double s = denom != 0.0 ? -(t.x - a * t.z) / denom : -1.0;
             /* A grazing plane (|denom| tiny) would put the point at infinity. */
             if (s <= 0.0 || denom * denom < 1e-12 * v3_dot(ray, ray)) {
-                maps->reason[i] = SCAN_INCONSISTENT;
+                reason[i] = SCAN_INCONSISTENT;
                 continue;
             }
             xyz_map[3 * i + 0] = (float)(ray.x * s);
             xyz_map[3 * i + 1] = (float)(ray.y * s);
             xyz_map[3 * i + 2] = (float)s;
-            range.valid_count++;
+            range->valid_count++;
         }
     }
     return 0;
@@ -55,14 +55,14 @@ static vec3 point_at(size_t i)
 
 /* How far (in steps of @p step, at most @p max_steps) the surface continues from pixel i: every
  * pixel on the way must be valid and no depth step may exceed max_jump. */
-static uint32_t reach(const struct decode_maps *m, size_t i, long step, uint32_t max_steps,
+static uint32_t reach(const uint8_t *reason, size_t i, long step, uint32_t max_steps,
                       double max_jump)
 {
     uint32_t k = 0;
     size_t cur = i;
     while (k < max_steps) {
         size_t next = (size_t)((long)cur + step);
-        if (m->reason[next] != SCAN_VALID ||
+        if (reason[next] != SCAN_VALID ||
             fabs(xyz_map[3 * next + 2] - xyz_map[3 * cur + 2]) > max_jump)
             break;
         cur = next;
@@ -74,11 +74,11 @@ static uint32_t reach(const struct decode_maps *m, size_t i, long step, uint32_t
 /* Tangent along one image axis between the farthest continuous neighbours on either side.
  * Column quantisation makes the range image a staircase; a wide stencil averages it out.
  * @p before / @p after: how many steps exist in the image on each side. Returns 0 if none. */
-static int tangent(const struct decode_maps *m, size_t i, uint32_t before, uint32_t after,
+static int tangent(const uint8_t *reason, size_t i, uint32_t before, uint32_t after,
                    long step, uint32_t radius, double max_jump, vec3 *out)
 {
-    uint32_t back = reach(m, i, -step, before < radius ? before : radius, max_jump);
-    uint32_t fwd = reach(m, i, step, after < radius ? after : radius, max_jump);
+    uint32_t back = reach(reason, i, -step, before < radius ? before : radius, max_jump);
+    uint32_t fwd = reach(reason, i, step, after < radius ? after : radius, max_jump);
     if (back + fwd == 0)
         return 0;
     *out = v3_sub(point_at((size_t)((long)i + step * (long)fwd)),
@@ -86,19 +86,20 @@ static int tangent(const struct decode_maps *m, size_t i, uint32_t before, uint3
     return 1;
 }
 
-int tri_normals(const struct decode_maps *m, uint32_t radius_px, double max_depth_jump_mm)
+int tri_normals(struct tri_range *range, uint8_t *reason, uint32_t radius_px,
+                double max_depth_jump_mm)
 {
-    const uint32_t w = m->width, h = m->height;
+    const uint32_t w = range->width, h = range->height;
     uint32_t valid = 0;
     for (uint32_t y = 0; y < h; y++) {
         for (uint32_t x = 0; x < w; x++) {
             size_t i = (size_t)y * w + x;
-            if (m->reason[i] != SCAN_VALID)
+            if (reason[i] != SCAN_VALID)
                 continue;
             vec3 du, dv;
-            if (!tangent(m, i, x, w - 1 - x, 1, radius_px, max_depth_jump_mm, &du) ||
-                !tangent(m, i, y, h - 1 - y, (long)w, radius_px, max_depth_jump_mm, &dv)) {
-                m->reason[i] = SCAN_INCONSISTENT;
+            if (!tangent(reason, i, x, w - 1 - x, 1, radius_px, max_depth_jump_mm, &du) ||
+                !tangent(reason, i, y, h - 1 - y, (long)w, radius_px, max_depth_jump_mm, &dv)) {
+                reason[i] = SCAN_INCONSISTENT;
                 continue;
             }
             vec3 n = v3_norm(v3_cross(du, dv));
@@ -110,11 +111,6 @@ int tri_normals(const struct decode_maps *m, uint32_t radius_px, double max_dept
             valid++;
         }
     }
-    range.valid_count = valid;
+    range->valid_count = valid;
     return 0;
-}
-
-const struct tri_range *tri_get_range(void)
-{
-    return &range;
 }

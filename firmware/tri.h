@@ -15,19 +15,21 @@ struct tri_range {
 
 /** Intersect every valid pixel's camera ray with its projector column plane (the plane through
  *  the projector centre and column u_p, x_p / z_p = (u_p - cx_p) / fx_p in the projector frame).
- *  Pixels whose ray misses (parallel, behind a device) become SCAN_INCONSISTENT.
+ *  @param width, height  the frame's size (must be the calibration's)
  *  @param column  continuous projector column per pixel (see refine.h)
+ *  @param reason  in/out: pixels whose ray misses (parallel, behind a device) become
+ *                 SCAN_INCONSISTENT; only SCAN_VALID pixels are triangulated
+ *  @param range   out: the points (the triangulator's static buffers), valid_count
  *  @retval 0 ok @retval -EINVAL calibration does not match the frame size */
-int tri_range_image(const struct scan_calib *calib, const struct decode_maps *maps,
-                    const float *column);
-
+int tri_range_image(const struct scan_calib *calib, uint32_t width, uint32_t height,
+                    const float *column, uint8_t *reason, struct tri_range *range);
 /** Normals from differences across up to @p radius_px pixels each side along both image axes,
  *  stopping where the surface breaks (a depth step above @p max_depth_jump_mm between
- *  neighbours). Pixels with no neighbour on their surface along an axis become SCAN_INCONSISTENT.
+ *  neighbours).
+ *  @param range   in/out: the points of tri_range_image; their normals and valid_count are set
+ *  @param reason  in/out: pixels with no neighbour on their surface along an axis become
+ *                 SCAN_INCONSISTENT
  *  @retval 0 */
-int tri_normals(const struct decode_maps *maps, uint32_t radius_px, double max_depth_jump_mm);
-
-/** The range image of the last view. */
-const struct tri_range *tri_get_range(void);
-
+int tri_normals(struct tri_range *range, uint8_t *reason, uint32_t radius_px,
+                double max_depth_jump_mm);
 #endif

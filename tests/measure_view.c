@@ -34,14 +34,15 @@ int main(int argc, char **argv)
                 t.cfg.scan.refine = (uint32_t)refine;
                 if (test_rig_start(&t) != 0)
                     return 1;
+                struct scan_view view;
                 struct scan_view_info info;
                 double t0 = now_ms();
-                int rc = scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info);
+                int rc = scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info);
                 double ms = now_ms() - t0;
                 if (rc != 0)
                     return 1;
                 struct view_quality q;
-                test_measure_view(sim_ctl_rig(), &q);
+                test_measure_view(sim_ctl_rig(), &view, &q);
                 printf("| %s | %s | %u | %.2f%% | %.2f%% | %u of %u | %u | %.3f | %.3f%% | %.2f | "
                        "%u | "
                        "%.1f | %s | %.0f |\n",

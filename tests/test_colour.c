@@ -46,10 +46,11 @@ static void measure(const char *method, struct colour_stats *out)
     t.cfg.scan.colour.white_scale[0] = t.cfg.scan.colour.white_scale[1] =
         t.cfg.scan.colour.white_scale[2] = 1.0 / 255.0 * 255.0 / 200.0; /* keep values in range */
     assert_int_equal(test_rig_start(&t), 0);
+    struct scan_view view;
     struct scan_view_info info;
-    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info), 0);
-    const struct decode_maps *m = decode_get_maps();
-    const uint8_t *rgb = scan_view_colour();
+    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), 0);
+    const struct decode_maps *m = &view.maps;
+    const uint8_t *rgb = view.rgb;
     const struct sim_rig *rig = sim_ctl_rig();
     vec3 proj = v3_scale(m3_tmul(t.calib.proj_rot, v3_from(t.calib.proj_trans_mm)), -1.0);
     size_t n = (size_t)m->width * m->height, count = 0;
@@ -117,6 +118,7 @@ static void test_white_reference_gives_albedo(void **state)
     (void)state;
     static struct test_rig t;
     struct white_cal wc;
+    struct scan_view view;
     struct scan_view_info info;
     assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
     snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "sphere");
@@ -124,8 +126,8 @@ static void test_white_reference_gives_albedo(void **state)
     t.cfg.sim.albedo[0] = t.cfg.sim.albedo[1] = t.cfg.sim.albedo[2] = 0.95;
     t.cfg.scan.colour.method = COLOUR_MULTI; /* every colour frame */
     assert_int_equal(test_rig_start(&t), 0);
-    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info), 0);
-    assert_int_equal(white_cal_from_view(&t.cfg, &t.calib, 0.95, &wc), 0);
+    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), 0);
+    assert_int_equal(white_cal_from_view(&t.cfg, &t.calib, &view, 0.95, &wc), 0);
     test_rig_stop(&t);
     /* the simulator's intensities are 170 (projector) and 120 (each light) grey levels */
     assert_true(fabs(wc.scale[COLOUR_SINGLE][0] * 170.0 - 1.0) < 0.02);
@@ -137,10 +139,10 @@ static void test_white_reference_gives_albedo(void **state)
         t.cfg.scan.colour.method = method;
         memcpy(t.cfg.scan.colour.white_scale, wc.scale[method], sizeof(wc.scale[method]));
         assert_int_equal(test_rig_start(&t), 0);
-        assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info), 0);
-        const struct decode_maps *m = decode_get_maps();
-        const uint8_t *rgb = scan_view_colour();
-        const float *conf = scan_view_confidence();
+        assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), 0);
+        const struct decode_maps *m = &view.maps;
+        const uint8_t *rgb = view.rgb;
+        const float *conf = view.confidence;
         const struct sim_rig *rig = sim_ctl_rig();
         double err[3] = {0, 0, 0}, de_sum = 0.0;
         size_t n = (size_t)m->width * m->height, count = 0;
@@ -177,15 +179,16 @@ static void test_single_trusts_highlights_less(void **state)
 {
     (void)state;
     static struct test_rig t;
+    struct scan_view view;
     struct scan_view_info info;
     assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
     snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "sphere");
     snprintf(t.cfg.sim.material, sizeof(t.cfg.sim.material), "phong");
     t.cfg.scan.colour.method = COLOUR_SINGLE;
     assert_int_equal(test_rig_start(&t), 0);
-    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info), 0);
-    const struct decode_maps *m = decode_get_maps();
-    const float *conf = scan_view_confidence();
+    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), 0);
+    const struct decode_maps *m = &view.maps;
+    const float *conf = view.confidence;
     const struct sim_rig *rig = sim_ctl_rig();
     vec3 proj = v3_scale(m3_tmul(t.calib.proj_rot, v3_from(t.calib.proj_trans_mm)), -1.0);
     double near_sum = 0.0, far_sum = 0.0; /* confidence / cos(theta): the highlight weight */
@@ -263,6 +266,7 @@ static void test_layout_gives_each_exposure_a_dark_frame(void **state)
 static void uniform_mean(uint32_t all_us, double mean[3])
 {
     static struct test_rig t;
+    struct scan_view view;
     struct scan_view_info info;
     assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
     snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "sphere");
@@ -271,10 +275,10 @@ static void uniform_mean(uint32_t all_us, double mean[3])
     t.cfg.scan.colour.method = COLOUR_UNIFORM;
     t.cfg.scan.colour.all_lights_exposure_us = all_us;
     assert_int_equal(test_rig_start(&t), 0);
-    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info), 0);
-    const struct decode_maps *m = decode_get_maps();
-    const uint8_t *rgb = scan_view_colour();
-    const float *conf = scan_view_confidence();
+    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), 0);
+    const struct decode_maps *m = &view.maps;
+    const uint8_t *rgb = view.rgb;
+    const float *conf = view.confidence;
     size_t n = (size_t)m->width * m->height, count = 0;
     mean[0] = mean[1] = mean[2] = 0.0;
     for (size_t i = 0; i < n; i++) {

@@ -20,11 +20,12 @@ static void test_ply_roundtrip(void **state)
     snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "box");
     t.cfg.sim.segments = 16;
     assert_int_equal(test_rig_start(&t), 0);
+    struct scan_view view;
     struct scan_view_info info;
     const int32_t angle_mdeg = 30000;
     assert_int_equal(hal_table_move_to(&t.hal.turntable, angle_mdeg), 0);
-    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, angle_mdeg, NULL, &info), 0);
-    assert_int_equal(scan_save_cloud_at_turntable_pose(&t, "build/test_ply.ply"), 0);
+    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, angle_mdeg, NULL, &view, &info), 0);
+    assert_int_equal(scan_save_cloud_at_turntable_pose(&t, &view, "build/test_ply.ply"), 0);
 
     FILE *f = fopen("build/test_ply.ply", "rb");
     assert_non_null(f);
@@ -42,9 +43,9 @@ static void test_ply_roundtrip(void **state)
     /* Vertices are in the object frame: rotating back by the angle gives the camera points. */
     struct frame_xform obj;
     frame_object_from_camera(&t.calib, angle_mdeg, &obj);
-    const struct decode_maps *maps = decode_get_maps();
-    const struct tri_range *r = tri_get_range();
-    const uint8_t *rgb = scan_colour_frame();
+    const struct decode_maps *maps = &view.maps;
+    const struct tri_range *r = &view.range;
+    const uint8_t *rgb = view.white_rgb;
     size_t n = (size_t)maps->width * maps->height, seen = 0;
     for (size_t i = 0; i < n; i++) {
         if (maps->reason[i] != SCAN_VALID)
@@ -59,7 +60,7 @@ static void test_ply_roundtrip(void **state)
         assert_memory_equal(rec + 24, rgb + 3 * i, 3);
         float quality;
         memcpy(&quality, rec + 27, sizeof(quality));
-        assert_true(quality == scan_view_confidence()[i]); /* 1 for a valid pixel without method */
+        assert_true(quality == view.confidence[i]); /* 1 for a valid pixel without method */
         assert_true(quality == 1.0f);
         seen++;
     }

@@ -34,9 +34,10 @@ static int teardown(void **state)
 static void test_transient_timeout_is_retried(void **state)
 {
     (void)state;
+    struct scan_view view;
     struct scan_view_info info;
     sim_ctl_inject_camera_fault(SIM_FAULT_TIMEOUT, 5, 2); /* two bad captures, retries = 2 */
-    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info), 0);
+    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), 0);
     assert_int_equal(info.capture_retries, 2);
     assert_int_equal(info.frames_captured, 22);
     assert_true(info.valid_points > 10000);
@@ -47,10 +48,11 @@ static void test_transient_timeout_is_retried(void **state)
  * @p tries captures of that frame, projector and lights off. */
 static void assert_view_stops(enum sim_cam_fault kind, uint64_t at, int want_rc, uint64_t tries)
 {
+    struct scan_view view;
     struct scan_view_info info;
     uint64_t start = sim_ctl_frames();
     sim_ctl_inject_camera_fault(kind, start + at, 100);
-    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info), want_rc);
+    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), want_rc);
     assert_int_equal(sim_ctl_frames() - start, at + tries);
     assert_true(test_rig_dark());
     sim_ctl_inject_camera_fault(SIM_FAULT_NONE, 0, 0);
@@ -74,14 +76,15 @@ static void test_unplugged_camera_not_retried(void **state)
 static uint8_t clean_colour[HAL_MAX_PIXELS * 3];
 static uint16_t clean_column[HAL_MAX_PIXELS];
 static struct scan_view_info clean_info;
+static struct scan_view view; /* the last view taken */
 
 static void scan_clean_view(void)
 {
     sim_ctl_inject_camera_fault(SIM_FAULT_NONE, 0, 0);
-    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &clean_info), 0);
+    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &clean_info), 0);
     size_t n = (size_t)t.cfg.scan.width * t.cfg.scan.height;
-    memcpy(clean_colour, scan_view_colour(), n * 3);
-    memcpy(clean_column, decode_get_maps()->column, n * sizeof(clean_column[0]));
+    memcpy(clean_colour, view.rgb, n * 3);
+    memcpy(clean_column, view.maps.column, n * sizeof(clean_column[0]));
 }
 
 /* A view that had stale frames (exposed before the last change) is the clean view exactly. */
@@ -90,8 +93,8 @@ static void assert_view_is_clean(const struct scan_view_info *info)
     size_t n = (size_t)t.cfg.scan.width * t.cfg.scan.height;
     assert_int_equal(info->valid_points, clean_info.valid_points);
     assert_int_equal(info->frames_captured, clean_info.frames_captured);
-    assert_memory_equal(scan_view_colour(), clean_colour, n * 3);
-    assert_memory_equal(decode_get_maps()->column, clean_column, n * sizeof(clean_column[0]));
+    assert_memory_equal(view.rgb, clean_colour, n * 3);
+    assert_memory_equal(view.maps.column, clean_column, n * sizeof(clean_column[0]));
 }
 
 /* The camera hands over frames it exposed before the pattern or the lights changed: each is
@@ -99,19 +102,20 @@ static void assert_view_is_clean(const struct scan_view_info *info)
 static void test_stale_frames_are_discarded(void **state)
 {
     (void)state;
+    struct scan_view view;
     struct scan_view_info info;
     scan_clean_view();
     /* two in a row on a Gray-code pattern (within capture_retries = 2) */
     uint64_t start = sim_ctl_frames();
     sim_ctl_inject_camera_fault(SIM_FAULT_STALE, start + 6, 2);
-    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info), 0);
+    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), 0);
     assert_int_equal(info.capture_retries, 2);
     assert_non_null(strstr(test_last_log, "before the change had settled"));
     assert_view_is_clean(&info);
     /* the last colour frame, after its light changed */
     start = sim_ctl_frames();
     sim_ctl_inject_camera_fault(SIM_FAULT_STALE, start + clean_info.frames_captured - 1, 1);
-    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info), 0);
+    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), 0);
     assert_int_equal(info.capture_retries, 1);
     assert_view_is_clean(&info);
     assert_true(test_rig_dark());
@@ -136,9 +140,10 @@ static int stop_after_frames(void)
 static void test_stop_request_leaves_rig_dark(void **state)
 {
     (void)state;
+    struct scan_view view;
     struct scan_view_info info;
     t.hal.stop_requested = stop_after_frames;
-    int rc = scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info);
+    int rc = scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info);
     t.hal.stop_requested = NULL;
     assert_int_equal(rc, -EINTR);
     assert_true(info.frames_captured < 22);

@@ -81,19 +81,20 @@ static void test_icp_corrects_a_wrong_angle(void **state)
     static struct test_rig t;
     assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
     assert_int_equal(test_rig_start(&t), 0);
+    struct scan_view view;
     struct scan_view_info info;
     struct icp_report rep;
     struct frame_xform pose, truth;
     icp_reset();
-    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info), 0);
-    scan_view_pose(&t.calib, &pose);
-    assert_int_equal(scan_register_view(&t.cfg.registration, &t.calib, &pose, &rep), 0);
+    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), 0);
+    scan_view_pose(&t.calib, &view, &pose);
+    assert_int_equal(scan_register_view(&t.cfg.registration, &t.calib, &view, &pose, &rep), 0);
     assert_false(rep.has_pair);
     assert_int_equal(hal_table_move_to(&t.hal.turntable, 30000), 0);
-    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 30600, NULL, &info), 0);
+    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 30600, NULL, &view, &info), 0);
     frame_object_from_camera(&t.calib, 30000, &truth);
-    scan_view_pose(&t.calib, &pose); /* from the wrong angle, 30.6 degrees */
-    assert_int_equal(scan_register_view(&t.cfg.registration, &t.calib, &pose, &rep), 0);
+    scan_view_pose(&t.calib, &view, &pose); /* from the wrong angle, 30.6 degrees */
+    assert_int_equal(scan_register_view(&t.cfg.registration, &t.calib, &view, &pose, &rep), 0);
     test_rig_stop(&t);
     /* compare where each pose puts a point on the object, 600 mm in front of the camera */
     vec3 p = v3(0, 0, 600);

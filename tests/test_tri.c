@@ -53,9 +53,11 @@ static void test_points_on_ray_and_plane(void **state)
             column[i] = reason[i] == SCAN_VALID ? (uint16_t)floor(u + 0.5) : 0;
         }
     }
-    assert_int_equal(refine_columns(&maps, 0), 0);
-    assert_int_equal(tri_range_image(&calib, &maps, refine_get_columns()), 0);
-    const struct tri_range *r = tri_get_range();
+    const float *refined;
+    struct tri_range range;
+    assert_int_equal(refine_columns(&maps, 0, &refined), 0);
+    assert_int_equal(tri_range_image(&calib, w, h, refined, reason, &range), 0);
+    const struct tri_range *r = &range;
     uint32_t checked = 0;
     for (size_t i = 0; i < (size_t)w * h; i += 97) {
         if (reason[i] != SCAN_VALID)
@@ -87,10 +89,12 @@ static double plane_normals(int refine)
             column[i] = reason[i] == SCAN_VALID ? (uint16_t)floor(u + 0.5) : 0;
         }
     }
-    assert_int_equal(refine_columns(&maps, refine), 0);
-    assert_int_equal(tri_range_image(&calib, &maps, refine_get_columns()), 0);
-    assert_int_equal(tri_normals(&maps, 4, 3.0), 0);
-    const struct tri_range *r = tri_get_range();
+    const float *refined;
+    struct tri_range range;
+    assert_int_equal(refine_columns(&maps, refine, &refined), 0);
+    assert_int_equal(tri_range_image(&calib, w, h, refined, reason, &range), 0);
+    assert_int_equal(tri_normals(&range, reason, 4, 3.0), 0);
+    const struct tri_range *r = &range;
     vec3 expect = v3_norm(v3(0.2, 0.0, -1.0));
     double sum = 0.0;
     uint32_t n = 0;

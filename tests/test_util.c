@@ -102,17 +102,19 @@ void test_rig_stop(struct test_rig *t)
     board_shutdown(&t->hal);
 }
 
-int scan_save_cloud_at_turntable_pose(struct test_rig *t, const char *path)
+int scan_save_cloud_at_turntable_pose(struct test_rig *t, const struct scan_view *view,
+                                      const char *path)
 {
     struct frame_xform pose;
-    scan_view_pose(&t->calib, &pose);
-    return scan_save_cloud(&t->hal, &pose, path);
+    scan_view_pose(&t->calib, view, &pose);
+    return scan_save_cloud(&t->hal, view, &pose, path);
 }
 
-void test_measure_view(const struct sim_rig *rig, struct view_quality *q)
+void test_measure_view(const struct sim_rig *rig, const struct scan_view *view,
+                       struct view_quality *q)
 {
-    const struct decode_maps *maps = decode_get_maps();
-    const struct tri_range *range = tri_get_range();
+    const struct decode_maps *maps = &view->maps;
+    const struct tri_range *range = &view->range;
     const struct sim_truth *t = &rig->truth;
     size_t n = (size_t)rig->width * rig->height;
     double sum_sq = 0.0, sum_dist = 0.0, sum_angle = 0.0;

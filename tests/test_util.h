@@ -38,8 +38,9 @@ int test_rig_start(struct test_rig *t);
 /** scan_close + board_shutdown. */
 void test_rig_stop(struct test_rig *t);
 
-/** scan_save_cloud with the view's turntable pose. @retval what it returned */
-int scan_save_cloud_at_turntable_pose(struct test_rig *t, const char *path);
+/** scan_save_cloud of @p view with its turntable pose. @retval what it returned */
+int scan_save_cloud_at_turntable_pose(struct test_rig *t, const struct scan_view *view,
+                                      const char *path);
 
 /** How well the last view matches the simulator's ground truth. */
 struct view_quality {
@@ -61,7 +62,8 @@ struct view_quality {
 /** Incidence limit of lit_head_on: beyond 75 degrees the projector's light is a few grey levels. */
 #define TEST_MAX_INCIDENCE_DEG 75.0
 
-/** Compare the firmware's last view with the rig's truth. */
-void test_measure_view(const struct sim_rig *rig, struct view_quality *q);
+/** Compare @p view with the rig's truth. */
+void test_measure_view(const struct sim_rig *rig, const struct scan_view *view,
+                       struct view_quality *q);
 
 #endif

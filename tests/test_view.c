@@ -18,10 +18,11 @@ static void scan_and_measure(const char *object, struct view_quality *q)
     assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
     snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "%s", object);
     assert_int_equal(test_rig_start(&t), 0);
+    struct scan_view view;
     struct scan_view_info info;
-    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info), 0);
+    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), 0);
     assert_int_equal(info.frames_captured, 22);
-    test_measure_view(sim_ctl_rig(), q);
+    test_measure_view(sim_ctl_rig(), &view, q);
     assert_int_equal(info.valid_points, q->valid);
     test_rig_stop(&t);
     print_message("%s: %u lit, %.2f%% right (+-1), %.2f%% head-on right, depth RMS %.3f mm "
@@ -76,16 +77,20 @@ static void test_blocked_decoder_matches_reference(void **state)
     assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
     t.cfg.scan.decode_rows = 1;
     assert_int_equal(test_rig_start(&t), 0);
+    struct scan_view view;
     struct scan_view_info info;
-    assert_int_equal(scan_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info), 0);
+    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), 0);
     assert_int_equal(info.frames_captured, 42);
     struct gray_layout layout;
     scan_layout(&t.cfg.scan, &t.calib, &layout);
     const uint8_t *frames[DECODE_MAX_PATTERNS];
     for (uint32_t p = 0; p < gray_layout_count(&layout); p++)
         frames[p] = decode_frame_slot(p);
-    assert_int_equal(decode_pixels(), 0); /* again, without the neighbour check */
-    const struct decode_maps *m = decode_get_maps();
+    static uint8_t pixel_reason[HAL_MAX_PIXELS];
+    struct decode_maps pixel_maps;
+    /* again, without the neighbour check */
+    assert_int_equal(decode_pixels(pixel_reason, &pixel_maps), 0);
+    const struct decode_maps *m = &pixel_maps;
     size_t n = (size_t)m->width * m->height;
     static uint16_t col[HAL_MAX_PIXELS], row[HAL_MAX_PIXELS];
     static uint8_t reason[HAL_MAX_PIXELS];
