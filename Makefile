@@ -58,16 +58,36 @@ CFLAGS_COMMON := $(WARN) $(OPT) $(LIMITS_CFLAGS) -g -MMD -MP
 FW_CFLAGS := $(CFLAGS_COMMON) -Ihal/include -Ifirmware -fstack-usage
 PKG_CFLAGS = $(shell $(PKG_CONFIG) --cflags $(PKGS) 2>/dev/null)
 PKG_LIBS = $(shell $(PKG_CONFIG) --libs inih libpng libmodbus 2>/dev/null) -lpthread
-HOST_INC := -Ihal/include -Ifirmware -Iapp -Ihal/posix -Ihal/linux -Ihal/modbus -Ihost_sim
-HOST_CFLAGS = $(CFLAGS_COMMON) $(HOST_INC) $(PKG_CFLAGS)
+# Each layer is compiled with only the include paths it may use, so an include that runs back up
+# (hal/ or host_sim/ reaching into app/, board/ into app/) does not compile (docs/architecture.md;
+# tests/layers.sh shows it). Everyone sees hal/include; a layer's paths are INC_<its directory>.
+INC_hal/posix := -Ihal/posix
+INC_hal/modbus := -Ihal/modbus
+INC_hal/linux := -Ihal/linux
+# The simulator agrees with firmware/ on frames, the pattern sequence and the calibration's plain
+# data (frames.h, gray.h, scan_types.h, vec3.h), and with the Modbus client on the register map
+# it serves (hal/modbus/tt_regs.h).
+INC_host_sim := -Ihost_sim -Ifirmware -Ihal/modbus
+# The board composes the backends and the simulator; app/ fills its struct board_config.
+INC_board := -Iboard -Ifirmware -Ihal/posix -Ihal/modbus -Ihal/linux -Ihost_sim
+# The scanner program: the firmware, the board, and the settings structs of the backends and the
+# simulator it reads from a config (turntable_modbus.h, sim_config.h).
+INC_app := -Iapp -Iboard -Ifirmware -Ihal/posix -Ihal/modbus -Ihost_sim
+# Tests, benchmarks and fuzzers see everything.
+HOST_INC := -Ihal/include -Ifirmware -Iapp -Iboard -Ihal/posix -Ihal/linux -Ihal/modbus -Ihost_sim
+INC_tests := $(HOST_INC)
+INC_tests/fuzz := $(HOST_INC)
+INC_bench := $(HOST_INC)
+LAYER_INC = -Ihal/include $(INC_$(patsubst %/,%,$(dir $<)))
+HOST_CFLAGS = $(CFLAGS_COMMON) $(LAYER_INC) $(PKG_CFLAGS)
 LDFLAGS_COMMON := $(OPT) -g
 LDLIBS_COMMON = $(PKG_LIBS) -lm
 
 FW_SRC := $(wildcard firmware/*.c) hal/hal.c
 POSIX_SRC := $(wildcard hal/posix/*.c) $(wildcard hal/modbus/*.c)
-APP_LIB_SRC := app/config.c app/ini_schema.c app/image_io.c app/scan_job.c app/white_cal.c app/board_frame.c
-SIM_SRC := $(filter-out host_sim/turntable_sim_main.c,$(wildcard host_sim/*.c))
-LINUX_SRC := $(wildcard hal/linux/*.c)
+APP_LIB_SRC := app/config.c app/ini_schema.c app/scan_job.c app/white_cal.c board/board_frame.c
+SIM_SRC := $(filter-out host_sim/turntable_sim_main.c,$(wildcard host_sim/*.c)) board/board_sim.c
+LINUX_SRC := $(wildcard hal/linux/*.c) board/board_linux.c
 # The libcamera backend (C++) is built where libcamera is found (Raspberry Pi OS, or Debian's
 # libcamera-dev, which make test installs); without it [camera] backend = libcamera says so.
 HAVE_LIBCAMERA := $(shell $(PKG_CONFIG) --exists libcamera 2>/dev/null && echo 1)
@@ -128,7 +148,7 @@ $(BUILD)/tt-client: $(call obj,tests/tt_client_main.c hal/modbus/turntable_modbu
 $(BUILD)/mesh-compare: $(call obj,tests/mesh_compare.c tests/mesh_compare_lib.c host_sim/sim_bvh.c host_sim/sim_mesh.c host_sim/sim_ply_read.c app/config.c app/ini_schema.c) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON)
 
-$(BUILD)/colour-eval: $(call obj,tests/colour_eval.c tests/colour_metrics.c host_sim/sim_bvh.c host_sim/sim_mesh.c host_sim/sim_ply_read.c host_sim/sim_rig.c host_sim/sim_material.c app/config.c app/ini_schema.c app/image_io.c hal/posix/storage_posix.c) $(BUILD)/libfirmware.a
+$(BUILD)/colour-eval: $(call obj,tests/colour_eval.c tests/colour_metrics.c host_sim/sim_bvh.c host_sim/sim_mesh.c host_sim/sim_ply_read.c host_sim/sim_rig.c host_sim/sim_material.c app/config.c app/ini_schema.c hal/posix/image_io.c hal/posix/storage_posix.c) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON)
 
 # ---- tests ----
@@ -226,7 +246,7 @@ test-deps: deps
 test: deps test-deps
 	@$(MAKE) --no-print-directory test-run
 test-run: $(BUILD)/scanner $(SIM_TOOLS) $(TEST_BIN) $(FUZZ_REPLAY) check-firmware $(if $(filter 0,$(SAN)),check-stack,) linux-build small-build
-	@RUN_WITH="$(VALGRIND_RUN)" BUILD=$(BUILD) tests/run.sh $(TEST_BIN) tests/cli.sh tests/interop.sh tests/fuzz/replay.sh tests/resume.sh
+	@RUN_WITH="$(VALGRIND_RUN)" BUILD=$(BUILD) tests/run.sh $(TEST_BIN) tests/layers.sh tests/cli.sh tests/interop.sh tests/fuzz/replay.sh tests/resume.sh
 
 # make test VALGRIND=1: every cmocka test under valgrind memcheck; any invalid access,
 # uninitialised use or definite leak fails the test (exit code 99).

@@ -424,3 +424,14 @@ int view_angle_load(const char *view_ini, long *angle_mdeg)
     return ini_parse(view_ini, read_angle, angle_mdeg) != 0 || *angle_mdeg == LONG_MIN ? -EINVAL
                                                                                        : 0;
 }
+
+void config_board(const struct app_config *cfg, struct board_config *out)
+{
+    *out = (struct board_config){.config_path = cfg->path,
+                                 .camera_backend = cfg->camera_backend,
+                                 .camera = &cfg->camera,
+                                 .gpio = &cfg->gpio,
+                                 .turntable = &cfg->turntable,
+                                 .scan = &cfg->scan,
+                                 .sim = &cfg->sim};
+}

@@ -3,42 +3,17 @@
 #ifndef CONFIG_H
 #define CONFIG_H
 
+#include "board.h"
 #include "hal.h"
 #include "fusion.h"
 #include "icp.h"
 #include "scan_types.h"
+#include "sim_config.h"
 #include "turntable_modbus.h"
 #include "vec3.h"
 
 #include <stddef.h>
 #include <stdio.h>
-
-/** The simulated rig ([sim]); read in every build so that configs stay portable, used only by
- *  the simulator board. */
-struct sim_config {
-    char object[16]; /**< sphere | cylinder | box | torus | mesh */
-    char mesh_file[HAL_MAX_PATH];
-    double object_height_mm;
-    uint32_t segments; /**< tessellation of analytic shapes */
-    char material[16]; /**< lambert | phong | merl */
-    char merl_file[HAL_MAX_PATH];
-    char merl_name[64];
-    double phong_ks, phong_ke;
-    char albedo_pattern[16]; /**< patches | uniform */
-    double albedo[3];
-    uint32_t seed;
-    uint32_t table_angle_error_mdeg;
-    double black_offset_dn, ambient_dn, read_noise_dn, electrons_per_dn;
-    double projector_intensity_dn, projector_black_level, projector_blur_px;
-    double light_intensity_dn, light_diffuser_mm, reference_distance_mm;
-    uint32_t reference_exposure_us;
-};
-
-struct gpio_config {
-    char chip[64];                            /**< gpiochip device or name */
-    struct hal_gpio_line_ref line[HAL_GPIO_LINE_COUNT]; /**< offset or name; -1 and "": not wired */
-};
-
 
 struct app_config {
     char path[HAL_MAX_PATH];     /**< the file it came from */
@@ -53,7 +28,7 @@ struct app_config {
     double start_angle_deg;
     char calibration_file[HAL_MAX_PATH]; /**< resolved against the config file's directory */
     char output_dir[HAL_MAX_PATH];
-    struct gpio_config gpio;
+    struct hal_gpio_config gpio;
     struct tt_client_config turntable;
     struct fusion_params fusion;
     struct icp_params registration;
@@ -71,6 +46,9 @@ int calib_load(struct scan_calib *calib, const char *path, uint32_t light_count,
 /** The turntable angle a scan directory's view.ini records ([view] angle_mdeg).
  *  @retval 0 ok @retval -EINVAL the file is missing, unreadable or has no angle */
 int view_angle_load(const char *view_ini, long *angle_mdeg);
+
+/** The devices' settings of @p cfg for board_init and board_selftest (pointers into @p cfg). */
+void config_board(const struct app_config *cfg, struct board_config *out);
 
 /** Write the documentation of every key (Markdown) to @p out. */
 void config_print_doc(FILE *out);

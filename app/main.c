@@ -93,7 +93,9 @@ static int rig_up(const struct app_config *cfg, const struct scan_calib *calib)
     the_hal.log = app_log;
     the_hal.stop_requested = app_stop_requested;
     install_signals();
-    int rc = board_init(&the_hal, cfg, calib, err, sizeof(err));
+    struct board_config bc;
+    config_board(cfg, &bc);
+    int rc = board_init(&the_hal, &bc, calib, err, sizeof(err));
     if (rc != 0) {
         fprintf(stderr, "scanner: error: %s\n", err);
         return rc;
@@ -189,7 +191,9 @@ static int cmd_selftest(const char *config_path)
     if (calib_rc != 0)
         calib.light_count = cfg.light_count;
     selftest_row(NULL, "calibration", cfg.calibration_file, calib_rc, calib_rc ? err : "loaded");
-    int rc = board_selftest(&the_hal, &cfg, &calib, selftest_row, NULL);
+    struct board_config bc;
+    config_board(&cfg, &bc);
+    int rc = board_selftest(&the_hal, &bc, &calib, selftest_row, NULL);
     return rc == 0 && calib_rc == 0 ? 0 : 1;
 }
 

@@ -3,7 +3,7 @@
 #ifndef SIM_RIG_H
 #define SIM_RIG_H
 
-#include "config.h"
+#include "sim_config.h"
 #include "gray.h"
 #include "scan_types.h"
 #include "sim_bvh.h"

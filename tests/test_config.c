@@ -175,7 +175,9 @@ static void test_backend_not_built_in(void **state)
     assert_int_equal(calib_load(&calib, cfg.calibration_file, 0, err, sizeof(err)), 0);
     struct hal hal;
     memset(&hal, 0, sizeof(hal));
-    int rc = board_init(&hal, &cfg, &calib, err, sizeof(err));
+    struct board_config bc;
+    config_board(&cfg, &bc);
+    int rc = board_init(&hal, &bc, &calib, err, sizeof(err));
     assert_int_not_equal(rc, 0);
     assert_non_null(strstr(err, "backend = v4l2 is not built in"));
     assert_null(hal.gpio.ops); /* nothing was set up */

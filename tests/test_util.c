@@ -85,7 +85,9 @@ int test_rig_start(struct test_rig *t)
     char err[512];
     t->hal.log = test_rig_log;
     test_error_count = 0;
-    int rc = board_init(&t->hal, &t->cfg, &t->calib, err, sizeof(err));
+    struct board_config bc;
+    config_board(&t->cfg, &bc);
+    int rc = board_init(&t->hal, &bc, &t->calib, err, sizeof(err));
     if (rc != 0) {
         fprintf(stderr, "test_rig_start: %s\n", err);
         return rc;

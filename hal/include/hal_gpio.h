@@ -24,6 +24,12 @@ struct hal_gpio_line_ref {
     char name[HAL_GPIO_NAME_LEN]; /**< line name ("GPIO17"); "" when given by offset */
 };
 
+/** Where the rig's lines are: a chip and a reference per line ([gpio] in a config). */
+struct hal_gpio_config {
+    char chip[64];                                      /**< gpiochip device or name */
+    struct hal_gpio_line_ref line[HAL_GPIO_LINE_COUNT]; /**< offset or name; -1 and "": not wired */
+};
+
 struct hal_gpio_ops {
     /** Drive a line. @retval 0 ok @retval -EINVAL unknown or unmapped line @retval -EIO device
      * error */

@@ -1,17 +1,34 @@
 /* The board: which backends fill the HAL. Exactly one implementation is linked, chosen at build
- * time (HAL=sim: host_sim/board_sim.c, HAL=linux: hal/linux/board_linux.c). */
+ * time (HAL=sim: board/board_sim.c, HAL=linux: board/board_linux.c). The board is the
+ * composition root below app/: it sees the HAL interfaces, the backends and the simulator, never
+ * app/ (its settings come in a struct board_config that app/ fills from the config file). */
 #ifndef BOARD_H
 #define BOARD_H
 
-#include "config.h"
 #include "hal.h"
+#include "scan_types.h"
+
+struct sim_config;       /* host_sim/sim_config.h: read by the simulator board only */
+struct tt_client_config; /* hal/modbus/turntable_modbus.h */
+
+/** The devices' settings, as the config file gave them. */
+struct board_config {
+    const char *config_path; /**< the config file: named in messages; the simulator resolves
+                                  relative paths against its directory */
+    const char *camera_backend;              /**< sim | v4l2 | libcamera */
+    const struct hal_camera_config *camera;
+    const struct hal_gpio_config *gpio;
+    const struct tt_client_config *turntable;
+    const struct scan_params *scan;          /**< the simulator shows the view's patterns */
+    const struct sim_config *sim;
+};
 
 /** "sim" or "linux". */
 const char *board_name(void);
 
 /** Fill every device of @p hal from the config; log and stop_requested stay as the caller set.
  *  @retval 0 ok @retval -errno with @p err saying which device and why; nothing stays requested */
-int board_init(struct hal *hal, const struct app_config *cfg, const struct scan_calib *calib,
+int board_init(struct hal *hal, const struct board_config *cfg, const struct scan_calib *calib,
                char *err, size_t err_len);
 
 /** Extra files for a whole scan (the simulator writes its true mesh). @retval 0 or -errno */
@@ -38,7 +55,7 @@ typedef void (*board_selftest_row)(void *ctx, const char *device, const char *wh
  *  the configured size, the GPIO lines requested, the turntable's status), releasing each
  *  before the next, so that nothing stays requested. Reports every device through @p row.
  *  @retval 0 all work @retval -ENODEV at least one does not */
-int board_selftest(struct hal *hal, const struct app_config *cfg, const struct scan_calib *calib,
-                   board_selftest_row row, void *ctx);
+int board_selftest(struct hal *hal, const struct board_config *cfg,
+                   const struct scan_calib *calib, board_selftest_row row, void *ctx);
 
 #endif

@@ -7,6 +7,7 @@
 #include "image_io.h"
 #include "sim_devices.h"
 #include "pty_link.h"
+#include "sim_config.h"
 #include "storage_posix.h"
 #include "tt_server.h"
 #include "turntable_modbus.h"
@@ -41,10 +42,10 @@ static int32_t table_angle(void *priv)
 }
 
 /* The controller on loopback TCP or on one end of a pty pair, and the client on the other. */
-static int start_turntable(struct hal *hal, const struct app_config *cfg, char *err,
+static int start_turntable(struct hal *hal, const struct board_config *cfg, char *err,
                            size_t err_len)
 {
-    struct tt_client_config cc = cfg->turntable;
+    struct tt_client_config cc = *cfg->turntable;
     int rc;
     if (strcmp(cc.transport, "tcp") == 0) {
         rc = tt_server_open_tcp(&sim.server, cc.host, (int)cc.port, clock_sim_now, &sim.clock,
@@ -63,7 +64,7 @@ static int start_turntable(struct hal *hal, const struct app_config *cfg, char *
     if (rc != 0)
         return rc;
     sim.server_open = 1;
-    sim.server.ctrl.angle_error_mdeg = (int32_t)cfg->sim.table_angle_error_mdeg;
+    sim.server.ctrl.angle_error_mdeg = (int32_t)cfg->sim->table_angle_error_mdeg;
     rc = tt_server_start(&sim.server);
     if (rc == 0)
         rc = tt_client_open(&sim.client, &cc, &hal->clock, hal->log, &hal->turntable, err,
@@ -85,21 +86,21 @@ static void stop_turntable(void)
     sim.server_open = sim.link_open = 0;
 }
 
-int board_init(struct hal *hal, const struct app_config *cfg, const struct scan_calib *calib,
+int board_init(struct hal *hal, const struct board_config *cfg, const struct scan_calib *calib,
                char *err, size_t err_len)
 {
     if (strcmp(cfg->camera_backend, "sim") != 0) {
         snprintf(err, err_len,
                  "%s: [camera] backend = %s is not built in: this scanner was built with HAL=sim "
                  "(rebuild with 'make HAL=linux' for real hardware)",
-                 cfg->path, cfg->camera_backend);
+                 cfg->config_path, cfg->camera_backend);
         return -ENODEV;
     }
     char dir_buf[HAL_MAX_PATH];
-    snprintf(dir_buf, sizeof(dir_buf), "%s", cfg->path);
+    snprintf(dir_buf, sizeof(dir_buf), "%s", cfg->config_path);
     struct gray_layout layout;
-    scan_layout(&cfg->scan, calib, &layout);
-    int rc = sim_rig_init(&sim.rig, &cfg->sim, calib, &layout, dirname(dir_buf), err, err_len);
+    scan_layout(cfg->scan, calib, &layout);
+    int rc = sim_rig_init(&sim.rig, cfg->sim, calib, &layout, dirname(dir_buf), err, err_len);
     if (rc != 0)
         return rc;
     gpio_sim_init(&sim.gpio, gray_layout_count(&layout), &hal->gpio);
@@ -197,7 +198,7 @@ void board_shutdown(struct hal *hal)
 }
 
 /* The simulated rig has its devices only all together: bring it up, try each, take it down. */
-int board_selftest(struct hal *hal, const struct app_config *cfg, const struct scan_calib *calib,
+int board_selftest(struct hal *hal, const struct board_config *cfg, const struct scan_calib *calib,
                    board_selftest_row row, void *ctx)
 {
     char detail[512];
@@ -205,17 +206,17 @@ int board_selftest(struct hal *hal, const struct app_config *cfg, const struct s
     uint32_t w, h;
     int rc = board_init(hal, cfg, calib, detail, sizeof(detail));
     if (rc != 0) {
-        row(ctx, "simulated rig", cfg->path, rc, detail);
+        row(ctx, "simulated rig", cfg->config_path, rc, detail);
         return rc;
     }
-    int cam_rc = board_grab_frame(hal, &cfg->camera, &w, &h);
+    int cam_rc = board_grab_frame(hal, cfg->camera, &w, &h);
     snprintf(detail, sizeof(detail), "simulated frame %ux%u", (unsigned)w, (unsigned)h);
     row(ctx, "camera", "sim", cam_rc, cam_rc == 0 ? detail : strerror(-cam_rc));
     row(ctx, "gpio", "sim", 0, "simulated lines");
     int table_rc = hal_table_get_status(&hal->turntable, &st);
     snprintf(detail, sizeof(detail), "simulated controller on Modbus %s answers: at %.3f deg",
-             cfg->turntable.transport, st.position_mdeg / 1000.0);
-    row(ctx, "turntable", cfg->turntable.transport, table_rc,
+             cfg->turntable->transport, st.position_mdeg / 1000.0);
+    row(ctx, "turntable", cfg->turntable->transport, table_rc,
         table_rc == 0 ? detail : strerror(-table_rc));
     board_shutdown(hal);
     return cam_rc != 0 || table_rc != 0 ? -ENODEV : 0;

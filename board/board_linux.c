@@ -33,7 +33,7 @@ const char *board_name(void)
 }
 
 /* The camera backend's ops (not opened yet: scan_open does that). */
-static int camera_init(struct hal *hal, const struct app_config *cfg, char *err, size_t err_len)
+static int camera_init(struct hal *hal, const struct board_config *cfg, char *err, size_t err_len)
 {
     if (strcmp(cfg->camera_backend, "v4l2") == 0) {
         camera_v4l2_init(&board.v4l2, hal->log, &hal->camera);
@@ -53,12 +53,12 @@ static int camera_init(struct hal *hal, const struct app_config *cfg, char *err,
         snprintf(err, err_len,
                  "%s: [camera] backend = sim is not built in: this scanner was built with "
                  "HAL=linux and drives real hardware only",
-                 cfg->path);
+                 cfg->config_path);
     else
         snprintf(err, err_len,
                  "%s: [camera] backend = %s: this scanner was built without it (libcamera "
                  "was not found at build time; install libcamera-dev and rebuild)",
-                 cfg->path, cfg->camera_backend);
+                 cfg->config_path, cfg->camera_backend);
     return -ENODEV;
 }
 
@@ -69,7 +69,7 @@ static void camera_free(void)
 #endif
 }
 
-int board_init(struct hal *hal, const struct app_config *cfg, const struct scan_calib *calib,
+int board_init(struct hal *hal, const struct board_config *cfg, const struct scan_calib *calib,
                char *err, size_t err_len)
 {
     (void)calib;
@@ -79,10 +79,10 @@ int board_init(struct hal *hal, const struct app_config *cfg, const struct scan_
     int rc = camera_init(hal, cfg, err, err_len);
     if (rc != 0)
         goto out_camera;
-    rc = gpio_gpiod_open(&board.gpio, cfg->gpio.chip, cfg->gpio.line, &hal->gpio, err, err_len);
+    rc = gpio_gpiod_open(&board.gpio, cfg->gpio->chip, cfg->gpio->line, &hal->gpio, err, err_len);
     if (rc != 0)
         goto out_camera;
-    rc = tt_client_open(&board.turntable, &cfg->turntable, &hal->clock, hal->log, &hal->turntable,
+    rc = tt_client_open(&board.turntable, cfg->turntable, &hal->clock, hal->log, &hal->turntable,
                         err, err_len);
     if (rc != 0)
         goto out_gpio;
@@ -121,13 +121,13 @@ void board_shutdown(struct hal *hal)
 
 /* ---- selftest: each device on its own, released before the next ---- */
 
-static int probe_camera(struct hal *hal, const struct app_config *cfg, char *detail, size_t len)
+static int probe_camera(struct hal *hal, const struct board_config *cfg, char *detail, size_t len)
 {
     int rc = camera_init(hal, cfg, detail, len);
     if (rc != 0)
         return rc;
     uint32_t w, h;
-    rc = board_grab_frame(hal, &cfg->camera, &w, &h);
+    rc = board_grab_frame(hal, cfg->camera, &w, &h);
     if (rc == 0)
         snprintf(detail, len, "%s frame %ux%u", cfg->camera_backend, (unsigned)w, (unsigned)h);
     else if (rc != -ENOMEM)
@@ -137,9 +137,9 @@ static int probe_camera(struct hal *hal, const struct app_config *cfg, char *det
     return rc;
 }
 
-static int probe_gpio(struct hal *hal, const struct app_config *cfg, char *detail, size_t len)
+static int probe_gpio(struct hal *hal, const struct board_config *cfg, char *detail, size_t len)
 {
-    int rc = gpio_gpiod_open(&board.gpio, cfg->gpio.chip, cfg->gpio.line, &hal->gpio, detail, len);
+    int rc = gpio_gpiod_open(&board.gpio, cfg->gpio->chip, cfg->gpio->line, &hal->gpio, detail, len);
     if (rc != 0)
         return rc;
     unsigned wired = 0;
@@ -151,10 +151,10 @@ static int probe_gpio(struct hal *hal, const struct app_config *cfg, char *detai
     return 0;
 }
 
-static int probe_turntable(struct hal *hal, const struct app_config *cfg, char *detail, size_t len)
+static int probe_turntable(struct hal *hal, const struct board_config *cfg, char *detail, size_t len)
 {
     struct hal_turntable_status st;
-    int rc = tt_client_open(&board.turntable, &cfg->turntable, &hal->clock, hal->log,
+    int rc = tt_client_open(&board.turntable, cfg->turntable, &hal->clock, hal->log,
                             &hal->turntable, detail, len);
     if (rc != 0)
         return rc;
@@ -170,7 +170,7 @@ static int probe_turntable(struct hal *hal, const struct app_config *cfg, char *
     return rc;
 }
 
-int board_selftest(struct hal *hal, const struct app_config *cfg, const struct scan_calib *calib,
+int board_selftest(struct hal *hal, const struct board_config *cfg, const struct scan_calib *calib,
                    board_selftest_row row, void *ctx)
 {
     char detail[512], where[HAL_MAX_PATH];
@@ -181,17 +181,17 @@ int board_selftest(struct hal *hal, const struct app_config *cfg, const struct s
 
     detail[0] = '\0';
     rc = probe_camera(hal, cfg, detail, sizeof(detail));
-    row(ctx, "camera", cfg->camera.device, rc, detail);
+    row(ctx, "camera", cfg->camera->device, rc, detail);
     failed |= rc != 0;
 
     rc = probe_gpio(hal, cfg, detail, sizeof(detail));
-    row(ctx, "gpio", cfg->gpio.chip, rc, detail);
+    row(ctx, "gpio", cfg->gpio->chip, rc, detail);
     failed |= rc != 0;
 
-    if (strcmp(cfg->turntable.transport, "tcp") == 0)
-        snprintf(where, sizeof(where), "%s:%u", cfg->turntable.host, (unsigned)cfg->turntable.port);
+    if (strcmp(cfg->turntable->transport, "tcp") == 0)
+        snprintf(where, sizeof(where), "%s:%u", cfg->turntable->host, (unsigned)cfg->turntable->port);
     else
-        snprintf(where, sizeof(where), "%s", cfg->turntable.device);
+        snprintf(where, sizeof(where), "%s", cfg->turntable->device);
     rc = probe_turntable(hal, cfg, detail, sizeof(detail));
     row(ctx, "turntable", where, rc, detail);
     failed |= rc != 0;

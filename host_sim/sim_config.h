@@ -1,0 +1,30 @@
+/* The simulated rig's settings ([sim] in a config): what the simulator renders. */
+#ifndef SIM_CONFIG_H
+#define SIM_CONFIG_H
+
+#include "hal_limits.h"
+
+#include <stdint.h>
+
+/** The simulated rig ([sim]); read in every build so that configs stay portable, used only by
+ *  the simulator board. */
+struct sim_config {
+    char object[16]; /**< sphere | cylinder | box | torus | mesh */
+    char mesh_file[HAL_MAX_PATH];
+    double object_height_mm;
+    uint32_t segments; /**< tessellation of analytic shapes */
+    char material[16]; /**< lambert | phong | merl */
+    char merl_file[HAL_MAX_PATH];
+    char merl_name[64];
+    double phong_ks, phong_ke;
+    char albedo_pattern[16]; /**< patches | uniform */
+    double albedo[3];
+    uint32_t seed;
+    uint32_t table_angle_error_mdeg;
+    double black_offset_dn, ambient_dn, read_noise_dn, electrons_per_dn;
+    double projector_intensity_dn, projector_black_level, projector_blur_px;
+    double light_intensity_dn, light_diffuser_mm, reference_distance_mm;
+    uint32_t reference_exposure_us;
+};
+
+#endif
