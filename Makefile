@@ -85,7 +85,7 @@ LDLIBS_COMMON = $(PKG_LIBS) -lm
 
 FW_SRC := $(wildcard firmware/*.c) hal/hal.c
 POSIX_SRC := $(wildcard hal/posix/*.c) $(wildcard hal/modbus/*.c)
-APP_LIB_SRC := app/config.c app/ini_schema.c app/scan_job.c app/white_cal.c board/board_frame.c
+APP_LIB_SRC := app/config.c app/ini_schema.c app/scan_dir.c app/scan_job.c app/white_cal.c board/board_frame.c
 SIM_SRC := $(filter-out host_sim/turntable_sim_main.c,$(wildcard host_sim/*.c)) board/board_sim.c
 LINUX_SRC := $(wildcard hal/linux/*.c) board/board_linux.c
 # The libcamera backend (C++) is built where libcamera is found (Raspberry Pi OS, or Debian's
@@ -145,10 +145,10 @@ $(BUILD)/turntable-sim: $(call obj,host_sim/turntable_sim_main.c host_sim/tt_ser
 $(BUILD)/tt-client: $(call obj,tests/tt_client_main.c hal/modbus/turntable_modbus.c hal/posix/clock_posix.c) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON)
 
-$(BUILD)/mesh-compare: $(call obj,tests/mesh_compare.c tests/mesh_compare_lib.c host_sim/sim_bvh.c host_sim/sim_mesh.c host_sim/sim_ply_read.c app/config.c app/ini_schema.c) $(BUILD)/libfirmware.a
+$(BUILD)/mesh-compare: $(call obj,tests/mesh_compare.c tests/mesh_compare_lib.c host_sim/sim_bvh.c host_sim/sim_mesh.c host_sim/sim_ply_read.c app/config.c app/ini_schema.c app/scan_dir.c hal/posix/image_io.c) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON)
 
-$(BUILD)/colour-eval: $(call obj,tests/colour_eval.c tests/colour_metrics.c host_sim/sim_bvh.c host_sim/sim_mesh.c host_sim/sim_ply_read.c host_sim/sim_rig.c host_sim/sim_material.c app/config.c app/ini_schema.c hal/posix/image_io.c hal/posix/storage_posix.c) $(BUILD)/libfirmware.a
+$(BUILD)/colour-eval: $(call obj,tests/colour_eval.c tests/colour_metrics.c host_sim/sim_bvh.c host_sim/sim_mesh.c host_sim/sim_ply_read.c host_sim/sim_rig.c host_sim/sim_material.c app/config.c app/ini_schema.c app/scan_dir.c hal/posix/image_io.c hal/posix/storage_posix.c) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON)
 
 # ---- tests ----
@@ -193,10 +193,10 @@ check-firmware: $(FW_OBJ)
 # make test replays the corpus and every crash kept (fuzz-replay-*, built like the suite).
 FUZZ_TARGETS := config calib view_ini ply modbus
 FUZZ_SECONDS ?= 600
-FUZZ_LIB_SRC := app/config.c app/ini_schema.c host_sim/sim_mesh.c host_sim/sim_ply_read.c \
-	hal/modbus/turntable_modbus.c host_sim/clock_sim.c
+FUZZ_LIB_SRC := app/config.c app/ini_schema.c app/scan_dir.c hal/posix/image_io.c \
+	host_sim/sim_mesh.c host_sim/sim_ply_read.c hal/modbus/turntable_modbus.c host_sim/clock_sim.c
 FUZZ_CFLAGS = -std=c11 -g -O1 $(HOST_INC) -Itests/fuzz $(PKG_CFLAGS)
-FUZZ_LIBS = $(shell $(PKG_CONFIG) --libs inih libmodbus 2>/dev/null) -lpthread -lm
+FUZZ_LIBS = $(shell $(PKG_CONFIG) --libs inih libmodbus libpng 2>/dev/null) -lpthread -lm
 FUZZ_REPLAY := $(patsubst %,$(BUILD)/tests/fuzz-replay-%,$(FUZZ_TARGETS))
 
 $(BUILD)/tests/fuzz-replay-%: $(call obj,tests/fuzz/replay.c) $(BUILD)/tests/fuzz/fuzz_%.o $(call obj,$(FUZZ_LIB_SRC)) $(BUILD)/libfirmware.a

@@ -411,20 +411,6 @@ void config_print_doc(FILE *out)
     ini_schema_print_doc(calib_keys, sizeof(calib_keys) / sizeof(calib_keys[0]), out);
 }
 
-static int read_angle(void *user, const char *section, const char *name, const char *value)
-{
-    if (strcmp(section, "view") == 0 && strcmp(name, "angle_mdeg") == 0)
-        *(long *)user = strtol(value, NULL, 10);
-    return 1;
-}
-
-int view_angle_load(const char *view_ini, long *angle_mdeg)
-{
-    *angle_mdeg = LONG_MIN;
-    return ini_parse(view_ini, read_angle, angle_mdeg) != 0 || *angle_mdeg == LONG_MIN ? -EINVAL
-                                                                                       : 0;
-}
-
 void config_board(const struct app_config *cfg, struct board_config *out)
 {
     *out = (struct board_config){.config_path = cfg->path,

@@ -43,10 +43,6 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
 int calib_load(struct scan_calib *calib, const char *path, uint32_t light_count, char *err,
                size_t err_len);
 
-/** The turntable angle a scan directory's view.ini records ([view] angle_mdeg).
- *  @retval 0 ok @retval -EINVAL the file is missing, unreadable or has no angle */
-int view_angle_load(const char *view_ini, long *angle_mdeg);
-
 /** The devices' settings of @p cfg for board_init and board_selftest (pointers into @p cfg). */
 void config_board(const struct app_config *cfg, struct board_config *out);
 

@@ -6,8 +6,8 @@
 #include "colour.h"
 #include "fusion.h"
 #include "gray.h"
-#include "image_io.h"
 #include "scan.h"
+#include "scan_dir.h"
 
 #include <errno.h>
 #include <stdarg.h>
@@ -27,7 +27,8 @@ struct job {
     uint32_t views;
     double start_ms;
     int tty;
-    char view_dir[HAL_MAX_PATH + 32];
+    uint32_t view;                      /* the view being taken or processed */
+    char view_dir[SCAN_DIR_PATH_MAX];   /* its directory */
 };
 
 static double wall_ms(void)
@@ -113,116 +114,44 @@ static const char *finished_detail(struct job *j, char *buf, size_t len)
 
 /* ---- the scan directory ---- */
 
+/* A write into the view's directory that failed, said once, naming the file.
+ * @retval @p rc */
+static int write_failed(const struct job *j, const char *name, int rc)
+{
+    if (rc != 0)
+        j->hal->log(HAL_LOG_ERROR, "cannot write %s/%s: %s", j->view_dir, name, strerror(-rc));
+    return rc;
+}
+
 static int save_frame(void *priv, uint32_t pattern, const uint8_t *pixels, uint32_t width,
                       uint32_t height, uint32_t channels)
 {
     struct job *j = priv;
-    char path[HAL_MAX_PATH + 64];
-    snprintf(path, sizeof(path), "%s/frame_%02u.png", j->view_dir, (unsigned)pattern);
-    return image_write_png(&j->hal->storage, path, pixels, width, height, (int)channels);
+    char name[32];
+    snprintf(name, sizeof(name), "frame_%02u.png", (unsigned)pattern);
+    return write_failed(j, name,
+                        scan_dir_write_frame(&j->hal->storage, j->out_dir, j->view, pattern,
+                                             pixels, width, height, channels));
 }
 
-static int copy_file(const struct hal_storage *st, const char *from, const char *to)
+static int write_view_meta(struct job *j, const struct scan_view_info *info, const char *started,
+                           double ms)
 {
-    static char buf[1 << 16]; /* config and calibration files are small */
-    FILE *f = fopen(from, "rb");
-    if (f == NULL)
-        return -errno;
-    size_t n = fread(buf, 1, sizeof(buf), f);
-    int too_big = !feof(f);
-    fclose(f);
-    return too_big ? -EFBIG : hal_storage_write_file(st, to, buf, n);
-}
-
-/* The config and calibration a scan's results came from, kept beside them. */
-static int keep_settings(const struct hal_storage *st, const struct app_config *cfg,
-                         const char *dir)
-{
-    char path[HAL_MAX_PATH + 32];
-    snprintf(path, sizeof(path), "%s/config.ini", dir);
-    int rc = copy_file(st, cfg->path, path);
-    snprintf(path, sizeof(path), "%s/calibration.ini", dir);
-    return rc != 0 ? rc : copy_file(st, cfg->calibration_file, path);
-}
-
-/* A colour frame (colour_layout order): its lights and exposure. */
-static void colour_frame_name(const struct colour_layout *lay, uint32_t k, char *buf, size_t len)
-{
-    unsigned us = (unsigned)lay->exposure_us[k];
-    if (lay->lights_mask[k] == 0)
-        snprintf(buf, len, "dark: projector and lights off, %u us, RGB", us);
-    else if (k == COLOUR_FRAME_ALL)
-        snprintf(buf, len, "all lights on, projector off, %u us, RGB", us);
-    else
-        snprintf(buf, len, "light %u alone, %u us, RGB", (unsigned)(k - COLOUR_FRAME_LIGHT0), us);
-}
-
-static const char *pattern_name(uint32_t pattern, const struct gray_layout *l,
-                                const struct colour_layout *lay, char *buf, size_t len)
-{
-    uint32_t k = (pattern - GRAY_PATTERN_FIRST_BIT) / 2u;
-    if (pattern >= gray_layout_count(l)) /* the colour frames after the patterns */
-        colour_frame_name(lay, pattern - gray_layout_count(l), buf, len);
-    else if (pattern == GRAY_PATTERN_WHITE)
-        snprintf(buf, len, "white, RGB (the view's colour)");
-    else if (pattern == GRAY_PATTERN_BLACK)
-        snprintf(buf, len, "black, grey");
-    else
-        snprintf(buf, len, "%s bit %u of %u%s, grey", k < l->col_bits ? "column" : "row",
-                 (unsigned)(k < l->col_bits ? k : k - l->col_bits),
-                 (unsigned)(k < l->col_bits ? l->col_bits : l->row_bits),
-                 (pattern - GRAY_PATTERN_FIRST_BIT) % 2u ? " inverse" : "");
-    return buf;
-}
-
-static int write_view_meta(struct job *j, uint32_t view, const struct scan_view_info *info,
-                           const char *started, double ms)
-{
-    char text[4096], finished[32], name[64];
-    utc_now(finished, sizeof(finished));
-    struct gray_layout layout;
-    struct colour_layout lay;
-    scan_layout(&j->cfg->scan, j->calib, &layout);
-    colour_layout(&j->cfg->scan.colour, j->calib->light_count, &lay);
-    int len = snprintf(
-        text, sizeof(text),
-        "; one view of a scan: see docs/scan-format.md\n[view]\nindex = %u\nangle_mdeg = %d\n"
-        "started = %s\nfinished = %s\nframes = %u\ncapture_retries = %u\nvalid_points = %u\n"
-        "wall_ms = %.1f\n[capture]\nexposure_us = %u\ngain_milli = %u\n"
-        "; patterns: projector on, lights off; colour frames as named below\n",
-        (unsigned)view, (int)info->angle_mdeg, started, finished, (unsigned)info->frames_captured,
-        (unsigned)info->capture_retries, (unsigned)info->valid_points, ms,
-        (unsigned)j->cfg->camera.exposure_us, (unsigned)j->cfg->camera.gain_milli);
-    uint32_t frames = gray_layout_count(&layout) + lay.count;
-    for (uint32_t p = 0; p < frames && (size_t)len < sizeof(text); p++)
-        len += snprintf(text + len, sizeof(text) - (size_t)len, "frame_%02u = %s\n", (unsigned)p,
-                        pattern_name(p, &layout, &lay, name, sizeof(name)));
-    len += snprintf(text + len, sizeof(text) - (size_t)len, "[pixels]\n");
-    for (unsigned r = 0; r < SCAN_REASON_COUNT && (size_t)len < sizeof(text); r++)
-        len += snprintf(text + len, sizeof(text) - (size_t)len, "%s = %u\n", scan_reason_name(r),
-                        (unsigned)info->reason_count[r]);
-    char path[HAL_MAX_PATH + 64];
-    snprintf(path, sizeof(path), "%s/view.ini", j->view_dir);
-    return hal_storage_write_file(&j->hal->storage, path, text, (size_t)len);
-}
-
-static int write_registration(struct job *j, const struct icp_report *r)
-{
-    char text[1024], path[HAL_MAX_PATH + 64];
-    int len = snprintf(
-        text, sizeof(text),
-        "; registration of this view against the previous one (docs/scan-format.md)\n"
-        "[registration]\nhas_pair = %d\naccepted = %d\noverlap_before = %u\n"
-        "coupled_before = %u\ncoupled_share_before = %.4f\noverlap_after = %u\n"
-        "coupled_after = %u\ncoupled_share_after = %.4f\nrms_before_mm = %.4f\n"
-        "rms_after_mm = %.4f\ncorrection_mm = %.4f\ncorrection_deg = %.4f\n",
-        r->has_pair, r->accepted, (unsigned)r->overlap_before, (unsigned)r->coupled_before,
-        r->overlap_before ? (double)r->coupled_before / r->overlap_before : 0.0,
-        (unsigned)r->overlap_after, (unsigned)r->coupled_after,
-        r->overlap_after ? (double)r->coupled_after / r->overlap_after : 0.0, r->rms_before_mm,
-        r->rms_after_mm, r->correction_mm, r->correction_deg);
-    snprintf(path, sizeof(path), "%s/registration.ini", j->view_dir);
-    return hal_storage_write_file(&j->hal->storage, path, text, (size_t)len);
+    static struct scan_dir_view v; /* large; one view at a time */
+    memset(&v, 0, sizeof(v));
+    v.index = j->view;
+    v.angle_mdeg = info->angle_mdeg;
+    snprintf(v.started, sizeof(v.started), "%s", started);
+    utc_now(v.finished, sizeof(v.finished));
+    v.frames = info->frames_captured;
+    v.capture_retries = info->capture_retries;
+    v.valid_points = info->valid_points;
+    v.wall_ms = ms;
+    v.exposure_us = j->cfg->camera.exposure_us;
+    v.gain_milli = j->cfg->camera.gain_milli;
+    scan_dir_describe_frames(&j->cfg->scan, j->calib, &v);
+    memcpy(v.reason_count, info->reason_count, sizeof(v.reason_count));
+    return write_failed(j, "view.ini", scan_dir_write_view(&j->hal->storage, j->out_dir, j->view, &v));
 }
 
 /* Results of a processed view (its frames, the colour among them, were kept while capturing):
@@ -234,10 +163,13 @@ static int save_results(struct job *j, const struct scan_view *view, struct icp_
     scan_view_pose(j->calib, view, &pose);
     int rc = scan_register_view(&j->cfg->registration, j->calib, view, &pose, report);
     if (rc == 0)
-        rc = write_registration(j, report);
-    snprintf(path, sizeof(path), "%s/cloud.ply", j->view_dir);
+        rc = write_failed(j, "registration.ini",
+                          scan_dir_write_registration(&j->hal->storage, j->out_dir, j->view,
+                                                      report));
     if (rc == 0)
-        rc = scan_save_cloud(j->hal, view, &pose, path);
+        rc = scan_dir_path(path, sizeof(path), j->out_dir, (int)j->view, "cloud.ply");
+    if (rc == 0)
+        rc = scan_save_cloud(j->hal, view, &pose, path); /* says what failed itself */
     if (rc == 0)
         rc = scan_fuse_view(j->calib, view, &pose);
     return rc;
@@ -258,15 +190,16 @@ static void describe(char *buf, size_t len, const struct scan_view_info *info,
 /* The fused model: mesh.ply and mesh.obj in the scan directory. */
 static int write_model(struct job *j)
 {
-    char path[HAL_MAX_PATH + 32], detail[HAL_MAX_PATH + 96];
+    char path[SCAN_DIR_PATH_MAX], detail[HAL_MAX_PATH + 96];
     uint32_t vertices = 0, triangles = 0;
     progress(j, "meshing", -1, j->views, "marching cubes");
-    snprintf(path, sizeof(path), "%s/mesh.ply", j->out_dir);
-    int rc = fusion_write_ply(&j->hal->storage, path, &vertices, &triangles);
-    if (rc == 0) {
-        snprintf(path, sizeof(path), "%s/mesh.obj", j->out_dir);
+    int rc = scan_dir_path(path, sizeof(path), j->out_dir, -1, "mesh.ply");
+    if (rc == 0)
+        rc = fusion_write_ply(&j->hal->storage, path, &vertices, &triangles);
+    if (rc == 0)
+        rc = scan_dir_path(path, sizeof(path), j->out_dir, -1, "mesh.obj");
+    if (rc == 0)
         rc = fusion_write_obj(&j->hal->storage, path);
-    }
     if (rc != 0) {
         j->hal->log(HAL_LOG_ERROR, "cannot write %s: %s", path, strerror(-rc));
         return rc;
@@ -277,9 +210,10 @@ static int write_model(struct job *j)
     return 0;
 }
 
-static void set_view_dir(struct job *j, uint32_t view)
+static void set_view(struct job *j, uint32_t view)
 {
-    snprintf(j->view_dir, sizeof(j->view_dir), "%s/view_%03u", j->out_dir, (unsigned)view);
+    j->view = view;
+    scan_dir_path(j->view_dir, sizeof(j->view_dir), j->out_dir, (int)view, NULL);
 }
 
 /* ---- live ---- */
@@ -293,20 +227,21 @@ static const char *kept_views(const struct job *j, uint32_t v, const char *extra
     return buf;
 }
 
-/* The table did not get to view @p v: say where it is and what the controller reports. */
+/* The table did not get to view @p v. The turntable client has said why (the error, once);
+ * this says what is kept and how to go on, which depends on whether an alarm blocks the table. */
 static void table_failed(const struct job *j, uint32_t v, int32_t target_mdeg)
 {
     const struct hal *hal = j->hal;
     struct hal_turntable_status st;
     char kept[2 * HAL_MAX_PATH + 96];
     if (hal_table_get_status(&hal->turntable, &st) == 0 && st.alarm_code != 0)
-        hal->log(HAL_LOG_ERROR,
-                 "view %u: the turntable did not reach %.3f deg: it stopped at %.3f deg with "
-                 "alarm %u; once the table turns freely, %s",
+        hal->log(HAL_LOG_WARN,
+                 "view %u was not taken at %.3f deg: the table stopped at %.3f deg with alarm %u; "
+                 "once it turns freely, %s",
                  (unsigned)v, target_mdeg / 1000.0, st.position_mdeg / 1000.0,
                  (unsigned)st.alarm_code, kept_views(j, v, " --clear-alarm", kept, sizeof(kept)));
     else
-        hal->log(HAL_LOG_ERROR, "view %u: the turntable did not reach %.3f deg; %s", (unsigned)v,
+        hal->log(HAL_LOG_WARN, "view %u was not taken at %.3f deg; %s", (unsigned)v,
                  target_mdeg / 1000.0, kept_views(j, v, "", kept, sizeof(kept)));
 }
 
@@ -325,10 +260,12 @@ static int live_view(struct job *j, uint32_t v)
         table_failed(j, v, target);
         return rc;
     }
-    set_view_dir(j, v);
+    set_view(j, v);
     rc = hal_storage_mkdir_p(&hal->storage, j->view_dir);
-    if (rc != 0)
+    if (rc != 0) {
+        hal->log(HAL_LOG_ERROR, "cannot make %s: %s", j->view_dir, strerror(-rc));
         return rc;
+    }
     utc_now(started, sizeof(started));
     progress(j, "capturing", (int)v, v, "");
     struct scan_frame_sink sink = {save_frame, j};
@@ -336,9 +273,9 @@ static int live_view(struct job *j, uint32_t v)
     struct scan_view_info info;
     double t0 = wall_ms();
     rc = scan_take_view(hal, &j->cfg->scan, j->calib, st.position_mdeg, &sink, &view, &info);
-    if (rc != 0) {
+    if (rc != 0) { /* the layer that met the fault has said what it was */
         char kept[2 * HAL_MAX_PATH + 96];
-        hal->log(HAL_LOG_ERROR, "view %u at %.3f deg failed: %s; %s", (unsigned)v,
+        hal->log(HAL_LOG_WARN, "view %u at %.3f deg was not finished (%s); %s", (unsigned)v,
                  st.position_mdeg / 1000.0, rc == -EINTR ? "stopped by request" : strerror(-rc),
                  kept_views(j, v, "", kept, sizeof(kept)));
         return rc;
@@ -347,14 +284,12 @@ static int live_view(struct job *j, uint32_t v)
     struct icp_report reg;
     rc = save_results(j, &view, &reg);
     if (rc == 0)
-        rc = board_write_view_extras(hal, j->view_dir);
+        rc = write_failed(j, "(the simulator's truth)", board_write_view_extras(hal, j->view_dir));
     /* view.ini last: its presence says the view is complete */
     if (rc == 0)
-        rc = write_view_meta(j, v, &info, started, wall_ms() - t0);
-    if (rc != 0) {
-        hal->log(HAL_LOG_ERROR, "cannot save %s: %s", j->view_dir, strerror(-rc));
+        rc = write_view_meta(j, &info, started, wall_ms() - t0);
+    if (rc != 0)
         return rc;
-    }
     describe(detail, sizeof(detail), &info, &reg, j->view_dir);
     progress(j, "saved", (int)v, v + 1, detail);
     return 0;
@@ -366,10 +301,11 @@ static int home_and_take_views(struct job *j, uint32_t first)
     const struct hal *hal = j->hal;
     progress(j, "homing", (int)first, first, "");
     int rc = 0;
-    if (j->opts->clear_alarm && (rc = hal_table_clear_alarm(&hal->turntable)) != 0)
-        hal->log(HAL_LOG_ERROR, "cannot clear the turntable's alarm: %s", strerror(-rc));
-    if (rc == 0 && (rc = hal_table_home(&hal->turntable)) != 0)
-        hal->log(HAL_LOG_ERROR, "the turntable did not home%s",
+    if (j->opts->clear_alarm && (rc = hal_table_clear_alarm(&hal->turntable)) == -ENOSYS)
+        hal->log(HAL_LOG_ERROR, "this turntable cannot clear its alarm over its link: clear it "
+                                "at the controller, then resume without --clear-alarm");
+    if (rc == 0 && (rc = hal_table_home(&hal->turntable)) != 0) /* the client said why */
+        hal->log(HAL_LOG_WARN, "the turntable did not home%s",
                  j->opts->clear_alarm ? "" : " (if it reports an alarm: --clear-alarm)");
     for (uint32_t v = first; v < j->cfg->views && rc == 0; v++)
         rc = live_view(j, v);
@@ -380,11 +316,11 @@ int scan_job_live(const struct hal *hal, const struct app_config *cfg,
                   const struct scan_calib *calib, const struct scan_job_opts *opts)
 {
     struct job j = {hal, cfg, calib, opts, opts->out_dir ? opts->out_dir : cfg->output_dir,
-                    cfg->views, wall_ms(), isatty(STDOUT_FILENO) && !opts->json, ""};
+                    cfg->views, wall_ms(), isatty(STDOUT_FILENO) && !opts->json, 0, ""};
     char path[HAL_MAX_PATH + 32];
     int rc = hal_storage_mkdir_p(&hal->storage, j.out_dir);
     if (rc == 0)
-        rc = keep_settings(&hal->storage, cfg, j.out_dir);
+        rc = scan_dir_keep_settings(&hal->storage, cfg->path, cfg->calibration_file, j.out_dir);
     if (rc != 0) {
         hal->log(HAL_LOG_ERROR, "cannot set up the scan directory %s: %s", j.out_dir,
                  strerror(-rc));
@@ -412,23 +348,15 @@ int scan_job_live(const struct hal *hal, const struct app_config *cfg,
 int scan_job_load_settings(const char *scan_dir, const char *config_path, struct app_config *cfg,
                            struct scan_calib *calib, char *err, size_t err_len)
 {
-    char path[HAL_MAX_PATH + 32];
-    snprintf(path, sizeof(path), "%s/config.ini", scan_dir);
-    int rc = config_load(cfg, config_path ? config_path : path, err, err_len);
-    if (rc != 0)
-        return rc;
+    char path[SCAN_DIR_PATH_MAX];
+    int rc = scan_dir_path(path, sizeof(path), scan_dir, -1, "config.ini");
+    if (rc == 0)
+        rc = config_load(cfg, config_path ? config_path : path, err, err_len);
     /* the calibration is the copy kept with the scan, whatever the config named */
-    snprintf(cfg->calibration_file, sizeof(cfg->calibration_file), "%s/calibration.ini", scan_dir);
-    return calib_load(calib, cfg->calibration_file, cfg->light_count, err, err_len);
-}
-
-/* A view is complete once its view.ini, written last, is on disk and readable. */
-static int view_complete(const char *scan_dir, uint32_t v)
-{
-    char path[HAL_MAX_PATH + 32];
-    long angle;
-    snprintf(path, sizeof(path), "%s/view_%03u/view.ini", scan_dir, (unsigned)v);
-    return view_angle_load(path, &angle) == 0;
+    if (rc == 0)
+        rc = scan_dir_path(cfg->calibration_file, sizeof(cfg->calibration_file), scan_dir, -1,
+                           "calibration.ini");
+    return rc != 0 ? rc : calib_load(calib, cfg->calibration_file, cfg->light_count, err, err_len);
 }
 
 int scan_job_resume(const struct hal *hal, const struct app_config *cfg,
@@ -437,10 +365,10 @@ int scan_job_resume(const struct hal *hal, const struct app_config *cfg,
 {
     struct job j = {hal,      cfg,        calib,     opts,
                     scan_dir, cfg->views, wall_ms(), isatty(STDOUT_FILENO) && !opts->json,
-                    ""};
+                     0, ""};
     char detail[64];
     uint32_t first = 0;
-    while (first < cfg->views && view_complete(scan_dir, first))
+    while (first < cfg->views && scan_dir_view_complete(scan_dir, first))
         first++;
     snprintf(detail, sizeof(detail), "%u of %u views kept", (unsigned)first, (unsigned)cfg->views);
     progress(&j, "resume", -1, first, detail);
@@ -453,56 +381,72 @@ int scan_job_resume(const struct hal *hal, const struct app_config *cfg,
 
 /* ---- offline ---- */
 
-static int process_view(struct job *j, uint32_t v, const char *in_view_dir)
+/* The frames the settings need must be the frames the view holds: a config with another
+ * exposure or another number of lights would feed the wrong frame to each step. */
+static int check_frames(const struct job *j, const char *scan_dir, uint32_t v,
+                        const struct scan_dir_view *have, char *err, size_t err_len)
 {
-    static uint8_t pixels[HAL_MAX_PIXELS * 3];
-    const struct hal *hal = j->hal;
-    char path[HAL_MAX_PATH + 64];
-    long angle;
-    snprintf(path, sizeof(path), "%s/view.ini", in_view_dir);
-    if (view_angle_load(path, &angle) != 0) {
-        hal->log(HAL_LOG_ERROR, "%s: missing or without [view] angle_mdeg", path);
+    static struct scan_dir_view want;
+    scan_dir_describe_frames(&j->cfg->scan, j->calib, &want);
+    for (uint32_t f = 0; f < want.frame_count; f++) {
+        if (f < have->frame_count && strcmp(have->frame_name[f], want.frame_name[f]) == 0)
+            continue;
+        snprintf(err, err_len,
+                 "%s/view_%03u/view.ini: frame_%02u is '%s', but these settings need '%s' "
+                 "there (other [scan] or [colour] settings than the scan was taken with?)",
+                 scan_dir, (unsigned)v, (unsigned)f,
+                 f < have->frame_count ? have->frame_name[f] : "(none)", want.frame_name[f]);
         return -EINVAL;
     }
-    int rc = scan_begin_view(&j->cfg->scan, j->calib);
+    return 0;
+}
+
+/* Feed the view's kept frames to the firmware: the patterns, then the colour frames. */
+static int feed_frames(const struct job *j, const char *scan_dir, uint32_t v, char *err,
+                       size_t err_len)
+{
+    static uint8_t pixels[HAL_MAX_PIXELS * 3];
+    const uint32_t width = j->cfg->camera.width, height = j->cfg->camera.height;
     struct gray_layout layout;
     scan_layout(&j->cfg->scan, j->calib, &layout);
     uint32_t count = gray_layout_count(&layout);
-    for (uint32_t p = 0; p < count && rc == 0; p++) {
-        uint32_t w, h;
-        int channels = p == GRAY_PATTERN_WHITE ? 3 : 1;
-        snprintf(path, sizeof(path), "%s/frame_%02u.png", in_view_dir, (unsigned)p);
-        rc = image_read_png(path, pixels, sizeof(pixels), &w, &h, channels);
-        if (rc == 0 && (w != j->cfg->camera.width || h != j->cfg->camera.height))
-            rc = -EINVAL;
-        if (rc != 0)
-            hal->log(HAL_LOG_ERROR, "%s: %s", path,
-                     rc == -EINVAL ? "not a frame of this scan's size" : strerror(-rc));
-        else
-            rc = scan_feed_frame(p, pixels, (uint32_t)channels, NULL);
-    }
     uint32_t lights = scan_light_frame_count(&j->cfg->scan, j->calib);
-    for (uint32_t k = 0; k < lights && rc == 0; k++) {
-        uint32_t w, h;
-        snprintf(path, sizeof(path), "%s/frame_%02u.png", in_view_dir, (unsigned)(count + k));
-        rc = image_read_png(path, pixels, sizeof(pixels), &w, &h, 3);
-        if (rc == 0 && (w != j->cfg->camera.width || h != j->cfg->camera.height))
-            rc = -EINVAL;
-        if (rc != 0)
-            hal->log(HAL_LOG_ERROR, "%s: %s (needed by [colour] method = %s)", path,
-                     rc == -EINVAL ? "not a frame of this scan's size" : strerror(-rc),
-                     j->cfg->colour_method);
-        else
-            rc = scan_feed_light_frame(k, pixels);
+    int rc = scan_begin_view(&j->cfg->scan, j->calib);
+    for (uint32_t f = 0; f < count + lights && rc == 0; f++) {
+        uint32_t channels = f == GRAY_PATTERN_WHITE || f >= count ? 3 : 1;
+        rc = scan_dir_read_frame(scan_dir, v, f, pixels, sizeof(pixels), width, height, channels,
+                                 err, err_len);
+        if (rc == 0)
+            rc = f < count ? scan_feed_frame(f, pixels, channels, NULL)
+                           : scan_feed_light_frame(f - count, pixels);
+    }
+    return rc;
+}
+
+static int process_view(struct job *j, const char *scan_dir, uint32_t v)
+{
+    static struct scan_dir_view meta;
+    const struct hal *hal = j->hal;
+    char err[SCAN_DIR_PATH_MAX + 256];
+    int rc = scan_dir_read_view(scan_dir, v, &meta, err, sizeof(err));
+    if (rc == -ENOENT)
+        snprintf(err, sizeof(err), "%s/view_%03u: the view did not finish (no view.ini); "
+                 "'scanner resume %s' takes it", scan_dir, (unsigned)v, scan_dir);
+    if (rc == 0)
+        rc = check_frames(j, scan_dir, v, &meta, err, sizeof(err));
+    if (rc == 0)
+        rc = feed_frames(j, scan_dir, v, err, sizeof(err));
+    if (rc != 0) {
+        hal->log(HAL_LOG_ERROR, "%s", err);
+        return rc;
     }
     struct scan_view view;
     struct scan_view_info info;
     memset(&info, 0, sizeof(info));
-    if (rc == 0)
-        rc = scan_finish_view(j->calib, (int32_t)angle, &view, &info);
-    set_view_dir(j, v);
-    if (rc == 0)
-        rc = hal_storage_mkdir_p(&hal->storage, j->view_dir);
+    rc = scan_finish_view(j->calib, meta.angle_mdeg, &view, &info);
+    set_view(j, v);
+    if (rc == 0 && (rc = hal_storage_mkdir_p(&hal->storage, j->view_dir)) != 0)
+        hal->log(HAL_LOG_ERROR, "cannot make %s: %s", j->view_dir, strerror(-rc));
     struct icp_report reg;
     if (rc == 0)
         rc = save_results(j, &view, &reg);
@@ -525,19 +469,16 @@ int scan_job_process(const struct hal *hal, const char *scan_dir, const struct s
         return rc;
     }
     struct job j = {hal, &cfg, &calib, opts, opts->out_dir ? opts->out_dir : scan_dir,
-                    cfg.views, wall_ms(), isatty(STDOUT_FILENO) && !opts->json, ""};
+                    cfg.views, wall_ms(), isatty(STDOUT_FILENO) && !opts->json, 0, ""};
     rc = hal_storage_mkdir_p(&hal->storage, j.out_dir);
     if (rc == 0 && opts->out_dir != NULL) /* the results say how they were made */
-        rc = keep_settings(&hal->storage, &cfg, j.out_dir);
+        rc = scan_dir_keep_settings(&hal->storage, cfg.path, cfg.calibration_file, j.out_dir);
     if (rc == 0)
         rc = fusion_begin(&cfg.fusion);
     icp_reset();
     progress(&j, "process_start", -1, 0, scan_dir);
-    for (uint32_t v = 0; v < cfg.views && rc == 0; v++) {
-        char in_dir[HAL_MAX_PATH + 32];
-        snprintf(in_dir, sizeof(in_dir), "%s/view_%03u", scan_dir, (unsigned)v);
-        rc = process_view(&j, v, in_dir);
-    }
+    for (uint32_t v = 0; v < cfg.views && rc == 0; v++)
+        rc = process_view(&j, scan_dir, v);
     if (rc == 0)
         rc = write_model(&j);
     if (rc == 0)

@@ -16,6 +16,7 @@
 #include "config.h"
 #include "frames.h"
 #include "image_io.h"
+#include "scan_dir.h"
 #include "sim_bvh.h"
 #include "sim_mesh.h"
 #include "sim_rig.h"
@@ -50,9 +51,9 @@ struct rig_views {
 static int rig_load(struct rig_views *r, const char *scan_dir)
 {
     char path[HAL_MAX_PATH + 64], err[512];
-    snprintf(path, sizeof(path), "%s/config.ini", scan_dir);
+    scan_dir_path(path, sizeof(path), scan_dir, -1, "config.ini");
     int rc = config_load(&r->cfg, path, err, sizeof(err));
-    snprintf(path, sizeof(path), "%s/calibration.ini", scan_dir);
+    scan_dir_path(path, sizeof(path), scan_dir, -1, "calibration.ini");
     if (rc == 0)
         rc = calib_load(&r->calib, path, r->cfg.light_count, err, sizeof(err));
     if (rc != 0) {
@@ -63,12 +64,13 @@ static int rig_load(struct rig_views *r, const char *scan_dir)
     r->views = r->cfg.views < MAX_VIEWS ? r->cfg.views : MAX_VIEWS;
     vec3 proj_cam = v3_scale(m3_tmul(r->calib.proj_rot, v3_from(r->calib.proj_trans_mm)), -1.0);
     for (uint32_t v = 0; v < r->views; v++) {
-        long angle;
-        snprintf(path, sizeof(path), "%s/view_%03u/view.ini", scan_dir, (unsigned)v);
-        if (view_angle_load(path, &angle) != 0) {
-            fprintf(stderr, "colour-eval: %s: no [view] angle_mdeg\n", path);
-            return -EINVAL;
+        static struct scan_dir_view meta;
+        rc = scan_dir_read_view(scan_dir, v, &meta, err, sizeof(err));
+        if (rc != 0) {
+            fprintf(stderr, "colour-eval: %s\n", err);
+            return rc;
         }
+        int32_t angle = meta.angle_mdeg;
         r->angle_mdeg[v] = angle;
         frame_object_from_camera(&r->calib, (int32_t)angle, &r->obj[v]);
         r->cam_obj[v] = frame_point(&r->obj[v], v3(0, 0, 0));

@@ -4,6 +4,7 @@
 
 #include "config.h"
 #include "frames.h"
+#include "scan_dir.h"
 #include "sim_bvh.h"
 #include "sim_random.h"
 
@@ -197,9 +198,9 @@ int mesh_visibility_from_scan(const char *scan_dir, struct mesh_visibility *vis,
     static struct app_config cfg;
     struct scan_calib calib;
     char path[HAL_MAX_PATH + 32];
-    snprintf(path, sizeof(path), "%s/config.ini", scan_dir);
+    scan_dir_path(path, sizeof(path), scan_dir, -1, "config.ini");
     int rc = config_load(&cfg, path, err, err_len);
-    snprintf(path, sizeof(path), "%s/calibration.ini", scan_dir);
+    scan_dir_path(path, sizeof(path), scan_dir, -1, "calibration.ini");
     if (rc == 0)
         rc = calib_load(&calib, path, cfg.light_count, err, err_len);
     if (rc != 0)

@@ -12,6 +12,7 @@
 
 #include "clock_posix.h"
 #include "mesh_compare.h"
+#include "scan_dir.h"
 #include "scan_job.h"
 #include "storage_posix.h"
 #include "test_util.h"
@@ -32,8 +33,8 @@ static void scan_and_compare(const char *object, const char *transport, const ch
     assert_int_equal(rc, 0);
     char mesh[256], truth[256], err[256];
     struct mesh_visibility vis;
-    snprintf(mesh, sizeof(mesh), "%s/mesh.ply", dir);
-    snprintf(truth, sizeof(truth), "%s/truth_mesh.ply", dir);
+    scan_dir_path(mesh, sizeof(mesh), dir, -1, "mesh.ply");
+    scan_dir_path(truth, sizeof(truth), dir, -1, "truth_mesh.ply");
     assert_int_equal(mesh_visibility_from_scan(dir, &vis, err, sizeof(err)), 0);
     assert_int_equal(mesh_compare_files(mesh, truth, 100000, &vis, r, err, sizeof(err)), 0);
     print_message("%s over %s: result->truth mean %.3f mm; observable surface %.1f%%, within 1 mm "

@@ -16,6 +16,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "scan_dir.h"
 #include "scan_job.h"
 #include "test_util.h"
 #include "tt_server.h"
@@ -66,11 +67,13 @@ static void assert_views(const char *dir, uint32_t done)
     char path[256];
     struct stat st;
     for (uint32_t v = 0; v < VIEWS; v++) {
-        long angle = LONG_MIN;
-        snprintf(path, sizeof(path), "%s/view_%03u/view.ini", dir, (unsigned)v);
+        static struct scan_dir_view meta;
+        char err[512];
+        scan_dir_path(path, sizeof(path), dir, (int)v, "view.ini");
         if (v < done) {
-            assert_int_equal(view_angle_load(path, &angle), 0);
-            assert_true(labs(angle - (long)(v * 90000u)) <= (long)t.cfg.turntable.tolerance_mdeg);
+            assert_int_equal(scan_dir_read_view(dir, v, &meta, err, sizeof(err)), 0);
+            assert_true(labs((long)meta.angle_mdeg - (long)(v * 90000u)) <=
+                        (long)t.cfg.turntable.tolerance_mdeg);
         } else {
             assert_int_not_equal(stat(path, &st), 0);
         }
@@ -109,9 +112,12 @@ static void test_stall_stops_scan_then_resume_finishes_it(void **state)
     set_stall(135000); /* between view 1 (90 deg) and view 2 (180 deg) */
     test_log_clear();
     assert_int_equal(scan(dir), -EIO);
-    assert_true(test_log_has("alarm 1 (stall (following error)) at 135.000 deg"));
-    assert_true(test_log_has("view 2: the turntable did not reach 180.000 deg: it stopped at "
-                             "135.000 deg with alarm 1; once the table turns freely, the 2 "
+    /* one fault, one error, said by the layer that met it; then what is kept and how to go on */
+    assert_true(test_log_one_error(
+        "turntable: move to 180.000 deg: the controller raised alarm 1 (stall (following error)) "
+        "at 135.000 deg"));
+    assert_true(test_log_has("view 2 was not taken at 180.000 deg: the table stopped at "
+                             "135.000 deg with alarm 1; once it turns freely, the 2 "
                              "finished views are kept in build/test_scan_faults/stall: 'scanner "
                              "resume build/test_scan_faults/stall --clear-alarm' takes the rest"));
     assert_views(dir, 2);
@@ -125,12 +131,12 @@ static void test_stall_stops_scan_then_resume_finishes_it(void **state)
 
     assert_int_equal(resume(dir, 1), 0);
     assert_views(dir, VIEWS);
-    snprintf(path, sizeof(path), "%s/mesh.ply", dir);
-    snprintf(ref, sizeof(ref), "%s/mesh.ply", OUT "/reference");
+    scan_dir_path(path, sizeof(path), dir, -1, "mesh.ply");
+    scan_dir_path(ref, sizeof(ref), OUT "/reference", -1, "mesh.ply");
     assert_true(test_files_equal(path, ref));
     for (uint32_t v = 0; v < VIEWS; v++) { /* each view's frames too, e.g. the white one */
-        snprintf(path, sizeof(path), "%s/view_%03u/frame_00.png", dir, (unsigned)v);
-        snprintf(ref, sizeof(ref), "%s/view_%03u/frame_00.png", OUT "/reference", (unsigned)v);
+        scan_dir_frame_path(path, sizeof(path), dir, v, 0);
+        scan_dir_frame_path(ref, sizeof(ref), OUT "/reference", v, 0);
         assert_true(test_files_equal(path, ref));
     }
     assert_true(test_rig_dark());
@@ -149,7 +155,9 @@ static void test_camera_lost_mid_view_then_resume_finishes_it(void **state)
     sim_ctl_inject_camera_fault(SIM_FAULT_NO_DEVICE, start + 2 * per_view + 7, 1000000);
     test_log_clear();
     assert_int_equal(scan(dir), -ENODEV);
-    assert_true(test_log_has("view 2 at 180.000 deg failed: No such device; the 2 finished views "
+    assert_true(test_log_one_error("camera: giving up on pattern 7: No such device"));
+    assert_true(test_log_has("view 2 at 180.000 deg was not finished (No such device); the 2 "
+                             "finished views "
                              "are kept in build/test_scan_faults/camera: 'scanner resume "
                              "build/test_scan_faults/camera' takes the rest"));
     assert_views(dir, 2);
@@ -158,8 +166,8 @@ static void test_camera_lost_mid_view_then_resume_finishes_it(void **state)
 
     assert_int_equal(resume(dir, 0), 0);
     assert_views(dir, VIEWS);
-    snprintf(path, sizeof(path), "%s/mesh.ply", dir);
-    snprintf(ref, sizeof(ref), "%s/mesh.ply", OUT "/reference");
+    scan_dir_path(path, sizeof(path), dir, -1, "mesh.ply");
+    scan_dir_path(ref, sizeof(ref), OUT "/reference", -1, "mesh.ply");
     assert_true(test_files_equal(path, ref));
     assert_true(test_rig_dark());
 }

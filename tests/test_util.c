@@ -13,6 +13,7 @@ char test_last_log[512];
 int test_error_count;
 static char log_history[16384]; /* warnings and errors since test_log_clear(), one per line */
 static size_t log_history_len;
+static char first_error[512]; /* the first error since test_log_clear() */
 
 int test_files_equal(const char *a, const char *b)
 {
@@ -43,6 +44,17 @@ void test_log_clear(void)
 {
     log_history[0] = '\0';
     log_history_len = 0;
+    first_error[0] = '\0';
+    test_error_count = 0;
+}
+
+int test_log_one_error(const char *needle)
+{
+    if (test_error_count == 1 && strstr(first_error, needle) != NULL)
+        return 1;
+    fprintf(stderr, "expected one error naming: %s\n%d errors; logged:\n%s", needle,
+            test_error_count, log_history);
+    return 0;
 }
 
 int test_log_has(const char *needle)
@@ -59,8 +71,8 @@ void test_rig_log(enum hal_log_level level, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(test_last_log, sizeof(test_last_log), fmt, ap);
     va_end(ap);
-    if (level == HAL_LOG_ERROR)
-        test_error_count++;
+    if (level == HAL_LOG_ERROR && test_error_count++ == 0)
+        snprintf(first_error, sizeof(first_error), "%s", test_last_log);
     size_t room = sizeof(log_history) - log_history_len;
     if (level <= HAL_LOG_WARN && room > 1) {
         int n = snprintf(log_history + log_history_len, room, "%s\n", test_last_log);

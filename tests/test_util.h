@@ -22,8 +22,11 @@ int test_files_equal(const char *a, const char *b);
 /** @retval 1 when the simulated projector and every light are off */
 int test_rig_dark(void);
 
-/** Forget the warnings and errors logged so far. */
+/** Forget the warnings and errors logged so far (test_error_count starts again at 0). */
 void test_log_clear(void);
+/** @retval 1 when exactly one error was logged since test_log_clear() and it contains
+ *  @p needle (one fault, one error line, naming its cause); 0 after printing what was logged */
+int test_log_one_error(const char *needle);
 /** @retval 1 when a warning or error since test_log_clear() contains @p needle; 0 after
  *  printing what was logged instead */
 int test_log_has(const char *needle);

@@ -69,25 +69,41 @@ out_png:
 }
 
 int image_read_png(const char *path, uint8_t *pixels, size_t capacity, uint32_t *width,
-                   uint32_t *height, int channels)
+                   uint32_t *height, int channels, char *why, size_t why_len)
 {
     png_image img;
     memset(&img, 0, sizeof(img));
     img.version = PNG_IMAGE_VERSION;
-    if (!png_image_begin_read_from_file(&img, path))
-        return errno == ENOENT ? -ENOENT : -EINVAL;
+    errno = 0;
+    if (!png_image_begin_read_from_file(&img, path)) {
+        int missing = errno == ENOENT;
+        snprintf(why, why_len, "%s", missing ? strerror(ENOENT) : img.message);
+        png_image_free(&img);
+        return missing ? -ENOENT : -EINVAL;
+    }
+    int rc = -EINVAL;
+    if (img.format & PNG_FORMAT_FLAG_LINEAR)
+        snprintf(why, why_len, "a 16-bit PNG; frames are 8-bit");
+    else if (img.format & PNG_FORMAT_FLAG_ALPHA)
+        snprintf(why, why_len, "a PNG with an alpha channel; frames are grey or RGB");
+    else
+        rc = 0;
     img.format = channels == 3 ? PNG_FORMAT_RGB : PNG_FORMAT_GRAY;
-    if (PNG_IMAGE_SIZE(img) > capacity) {
-        png_image_free(&img);
-        return -EINVAL;
+    if (rc == 0 && PNG_IMAGE_SIZE(img) > capacity) {
+        snprintf(why, why_len, "%ux%u, larger than the compiled frame limit", (unsigned)img.width,
+                 (unsigned)img.height);
+        rc = -EINVAL;
     }
-    if (!png_image_finish_read(&img, NULL, pixels, 0, NULL)) {
-        png_image_free(&img);
-        return -EINVAL;
+    if (rc == 0 && !png_image_finish_read(&img, NULL, pixels, 0, NULL)) {
+        snprintf(why, why_len, "%s", img.message); /* libpng's words: truncated, bad CRC, ... */
+        rc = -EINVAL;
     }
-    *width = img.width;
-    *height = img.height;
-    return 0;
+    png_image_free(&img);
+    if (rc == 0) {
+        *width = img.width;
+        *height = img.height;
+    }
+    return rc;
 }
 
 int image_write_pfm(const struct hal_storage *st, const char *path, const float *pixels,

@@ -9,10 +9,13 @@
 /** Write an 8-bit PNG (channels 1 or 3) atomically. @retval 0 ok @retval -errno */
 int image_write_png(const struct hal_storage *st, const char *path, const uint8_t *pixels,
                     uint32_t width, uint32_t height, int channels);
-/** Read an 8-bit PNG into @p pixels (capacity bytes), converting to @p channels (1 or 3).
- *  @retval 0 ok @retval -EINVAL not a PNG or wrong size @retval -errno */
+/** Read an 8-bit PNG without alpha into @p pixels (capacity bytes), converting to @p channels
+ *  (1 or 3). A 16-bit PNG or one with alpha is refused, not converted: a frame never changes
+ *  what it says on the way in.
+ *  @param why  out: what is wrong, in libpng's words for a damaged file
+ *  @retval 0 ok @retval -ENOENT no such file @retval -EINVAL not such a PNG, or too large */
 int image_read_png(const char *path, uint8_t *pixels, size_t capacity, uint32_t *width,
-                   uint32_t *height, int channels);
+                   uint32_t *height, int channels, char *why, size_t why_len);
 /** Write a PFM (channels 1 or 3; NaN allowed) atomically. @retval 0 ok @retval -errno */
 int image_write_pfm(const struct hal_storage *st, const char *path, const float *pixels,
                     uint32_t width, uint32_t height, int channels);

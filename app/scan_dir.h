@@ -1,0 +1,86 @@
+/* The scan directory (docs/scan-format.md): its file names, view.ini and registration.ini, and its
+ * frames. The one place that knows the layout: scan, process, resume and the tests use it. */
+#ifndef SCAN_DIR_H
+#define SCAN_DIR_H
+
+#include "colour.h"
+#include "decode.h"
+#include "hal.h"
+#include "icp.h"
+#include "scan_types.h"
+
+#include <stddef.h>
+#include <stdint.h>
+
+/** Frames a view can hold: the patterns, then the colour frames. */
+#define SCAN_DIR_MAX_FRAMES (DECODE_MAX_PATTERNS + COLOUR_MAX_FRAMES)
+/** Longest description of a frame in view.ini ("light 3 alone, 20000 us, RGB"). */
+#define SCAN_DIR_FRAME_NAME 64u
+/** Room for any path inside a scan directory. */
+#define SCAN_DIR_PATH_MAX (HAL_MAX_PATH + 64u)
+
+/** What a view's view.ini records (written last: its presence means the view is complete). */
+struct scan_dir_view {
+    uint32_t index;
+    int32_t angle_mdeg;                   /**< as the controller reported it after the move */
+    char started[32], finished[32];       /**< UTC, ISO 8601 */
+    uint32_t frames;                      /**< frames captured, retries not counted */
+    uint32_t capture_retries;
+    uint32_t valid_points;
+    double wall_ms;
+    uint32_t exposure_us, gain_milli;     /**< the camera's for the patterns */
+    uint32_t frame_count;                 /**< frames described in frame_name */
+    char frame_name[SCAN_DIR_MAX_FRAMES][SCAN_DIR_FRAME_NAME]; /**< what each frame shows */
+    uint32_t reason_count[SCAN_REASON_COUNT]; /**< pixels per reason code */
+};
+
+/** Path of @p name in the scan directory @p dir (@p view < 0), or in view @p view's directory
+ *  (@p name NULL: that directory). @retval 0 @retval -ENAMETOOLONG */
+int scan_dir_path(char *buf, size_t len, const char *dir, int view, const char *name);
+
+/** Path of frame @p frame of view @p view. @retval 0 @retval -ENAMETOOLONG */
+int scan_dir_frame_path(char *buf, size_t len, const char *dir, uint32_t view, uint32_t frame);
+
+/** Describe every frame a view of @p params and @p calib takes, in order, into
+ *  @p v->frame_name and @p v->frame_count. */
+void scan_dir_describe_frames(const struct scan_params *params, const struct scan_calib *calib,
+                              struct scan_dir_view *v);
+
+/** Write view @p view's view.ini atomically. @retval 0 @retval -errno */
+int scan_dir_write_view(const struct hal_storage *st, const char *dir, uint32_t view,
+                        const struct scan_dir_view *v);
+
+/** Read view @p view's view.ini: every key checked (a number that is not one, a key twice, an
+ *  unknown key, an index that is not the view's) with file, line and key in @p err.
+ *  @retval 0 @retval -ENOENT no view.ini (the view did not finish) @retval -EINVAL */
+int scan_dir_read_view(const char *dir, uint32_t view, struct scan_dir_view *v, char *err,
+                       size_t err_len);
+
+/** scan_dir_read_view of the file at @p path (the fuzzer's way in). */
+int scan_dir_read_view_file(const char *path, uint32_t view, struct scan_dir_view *v, char *err,
+                            size_t err_len);
+
+/** @retval 1 when view @p view finished (its view.ini is there and reads) */
+int scan_dir_view_complete(const char *dir, uint32_t view);
+
+/** Keep frame @p frame of view @p view (8-bit PNG, @p channels 1 or 3), atomically. */
+int scan_dir_write_frame(const struct hal_storage *st, const char *dir, uint32_t view,
+                         uint32_t frame, const uint8_t *pixels, uint32_t width, uint32_t height,
+                         uint32_t channels);
+
+/** Read frame @p frame of view @p view into @p pixels as @p channels (1 or 3); it must be an
+ *  8-bit PNG without alpha of @p width x @p height. @p err names the file and says what is
+ *  wrong (libpng's own words for a damaged file). @retval 0 @retval -ENOENT @retval -EINVAL */
+int scan_dir_read_frame(const char *dir, uint32_t view, uint32_t frame, uint8_t *pixels,
+                        size_t capacity, uint32_t width, uint32_t height, uint32_t channels,
+                        char *err, size_t err_len);
+
+/** Write view @p view's registration.ini (how it was registered to the one before). */
+int scan_dir_write_registration(const struct hal_storage *st, const char *dir, uint32_t view,
+                                const struct icp_report *r);
+
+/** Keep the config and the calibration a scan ran with (config.ini, calibration.ini). */
+int scan_dir_keep_settings(const struct hal_storage *st, const char *config_path,
+                           const char *calibration_path, const char *dir);
+
+#endif

@@ -1,0 +1,290 @@
+/* The scan directory: view.ini written and read back with every key checked, frames refused with
+ * their own reason (libpng's for a damaged file), and `process` refusing frames that are not the
+ * ones its settings need, each fault said in one error line. */
+#define _XOPEN_SOURCE 700
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <errno.h>
+#include <limits.h>
+#include <png.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "clock_posix.h"
+#include "scan_dir.h"
+#include "scan_job.h"
+#include "storage_posix.h"
+#include "test_util.h"
+
+#define DIR "build/test_scan_dir"
+#define W 1280u
+#define H 960u
+
+static struct hal hal;
+static char err[1024];
+
+static int setup(void **state)
+{
+    (void)state;
+    mkdir("build", 0755);
+    mkdir(DIR, 0755);
+    hal.log = test_rig_log;
+    storage_posix_init(&hal.storage);
+    clock_posix_init(&hal.clock);
+    return 0;
+}
+
+static void write_text(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+/* A view directory holding only a view.ini of @p text. */
+static const char *view_with(const char *name, const char *text)
+{
+    static char dir[256];
+    char path[SCAN_DIR_PATH_MAX];
+    snprintf(dir, sizeof(dir), DIR "/%s", name);
+    assert_int_equal(scan_dir_path(path, sizeof(path), dir, 0, NULL), 0);
+    assert_int_equal(hal_storage_mkdir_p(&hal.storage, path), 0);
+    assert_int_equal(scan_dir_path(path, sizeof(path), dir, 0, "view.ini"), 0);
+    write_text(path, text);
+    return dir;
+}
+
+static void expect_view_error(const char *name, const char *text, const char *expect)
+{
+    static struct scan_dir_view v;
+    const char *dir = view_with(name, text);
+    err[0] = '\0';
+    assert_int_equal(scan_dir_read_view(dir, 0, &v, err, sizeof(err)), -EINVAL);
+    if (strstr(err, expect) == NULL)
+        fail_msg("expected '%s' in '%s'", expect, err);
+    assert_false(scan_dir_view_complete(dir, 0));
+}
+
+static void test_view_ini_round_trip(void **state)
+{
+    (void)state;
+    static struct scan_dir_view out, in;
+    struct test_rig t;
+    assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
+    t.cfg.scan.colour.method = COLOUR_MULTI;
+    t.cfg.scan.colour.light_exposure_us = 20000;
+    memset(&out, 0, sizeof(out));
+    out.index = 3;
+    out.angle_mdeg = -135250;
+    snprintf(out.started, sizeof(out.started), "2026-12-01T10:00:00Z");
+    snprintf(out.finished, sizeof(out.finished), "2026-12-01T10:00:02Z");
+    out.frames = 30;
+    out.capture_retries = 2;
+    out.valid_points = 123456;
+    out.wall_ms = 1732.5;
+    out.exposure_us = 10000;
+    out.gain_milli = 1500;
+    scan_dir_describe_frames(&t.cfg.scan, &t.calib, &out);
+    for (unsigned r = 0; r < SCAN_REASON_COUNT; r++)
+        out.reason_count[r] = 1000u * r + 7u;
+    assert_int_equal(out.frame_count, 22u + 1u + 1u + 4u + 1u); /* + a dark at 20000 us */
+    assert_string_equal(out.frame_name[25], "light 1 alone, 20000 us, RGB");
+    assert_int_equal(scan_dir_path(err, sizeof(err), DIR "/round", 3, NULL), 0);
+    assert_int_equal(hal_storage_mkdir_p(&hal.storage, err), 0);
+    assert_int_equal(scan_dir_write_view(&hal.storage, DIR "/round", 3, &out), 0);
+    assert_int_equal(scan_dir_read_view(DIR "/round", 3, &in, err, sizeof(err)), 0);
+    assert_memory_equal(&in, &out, sizeof(in)); /* every field, every frame's name */
+    assert_true(scan_dir_view_complete(DIR "/round", 3));
+    assert_false(scan_dir_view_complete(DIR "/round", 4));
+    static struct scan_dir_view none;
+    assert_int_equal(scan_dir_read_view(DIR "/round", 4, &none, err, sizeof(err)), -ENOENT);
+}
+
+/* Every key is checked: nothing is guessed, and the message names file, line and key. */
+static void test_view_ini_bad_values(void **state)
+{
+    (void)state;
+    const char *head = "[view]\nindex = 0\n";
+    char text[256];
+    snprintf(text, sizeof(text), "%sangle_mdeg = abc\nframes = 22\n", head);
+    expect_view_error("abc", text, "view_000/view.ini:3: [view] angle_mdeg: 'abc' is not a whole number");
+    snprintf(text, sizeof(text), "%sangle_mdeg =\nframes = 22\n", head);
+    expect_view_error("empty", text, "view.ini:3: [view] angle_mdeg: '' is not a whole number");
+    snprintf(text, sizeof(text), "%sframes = 22\n", head);
+    expect_view_error("missing", text, "[view] angle_mdeg: required key is missing");
+    snprintf(text, sizeof(text), "%sangle_mdeg = 0\nframes = 22\nvalid_points = 1.5\n", head);
+    expect_view_error("fraction", text, "view.ini:5: [view] valid_points: '1.5' is not a whole number");
+    snprintf(text, sizeof(text), "%sangle_mdeg = 0\nframes = 22\n[pixels]\nshadow = -4\n", head);
+    expect_view_error("negative", text, "[pixels] shadow: -4");
+    snprintf(text, sizeof(text), "%sangle_mdeg = 0\nangle_mdeg = 5\nframes = 22\n", head);
+    expect_view_error("twice", text, "view.ini:4: [view] angle_mdeg: set twice");
+    snprintf(text, sizeof(text), "%sangle_mdeg = 0\nframes = 22\nangel_mdeg = 5\n", head);
+    expect_view_error("typo", text, "view.ini:5: [view] angel_mdeg: unknown key");
+    expect_view_error("index", "[view]\nindex = 2\nangle_mdeg = 0\nframes = 22\n",
+                      "[view] index: 2, but this is view 0");
+}
+
+/* Write @p bytes as frame 3 of view 0 of @p dir. */
+static void write_frame_bytes(const char *dir, const void *bytes, size_t n)
+{
+    char path[SCAN_DIR_PATH_MAX];
+    assert_int_equal(scan_dir_frame_path(path, sizeof(path), dir, 0, 3), 0);
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    assert_int_equal(fwrite(bytes, 1, n, f), n);
+    fclose(f);
+}
+
+/* Write frame 3 of view 0 of @p dir as a PNG of @p format (libpng's simplified API). */
+static void write_frame_png(const char *dir, uint32_t format, uint32_t w, uint32_t h)
+{
+    char path[SCAN_DIR_PATH_MAX];
+    assert_int_equal(scan_dir_frame_path(path, sizeof(path), dir, 0, 3), 0);
+    png_image img;
+    memset(&img, 0, sizeof(img));
+    img.version = PNG_IMAGE_VERSION;
+    img.width = w;
+    img.height = h;
+    img.format = format;
+    void *pixels = calloc(1, PNG_IMAGE_SIZE(img));
+    assert_non_null(pixels);
+    assert_true(png_image_write_to_file(&img, path, 0, pixels, 0, NULL));
+    free(pixels);
+}
+
+static int read_frame3(const char *dir, uint8_t *buf, size_t cap)
+{
+    err[0] = '\0';
+    return scan_dir_read_frame(dir, 0, 3, buf, cap, W, H, 1, err, sizeof(err));
+}
+
+/* Each kind of bad frame is refused with its own reason, naming the file. */
+static void test_bad_frames_say_why(void **state)
+{
+    (void)state;
+    static uint8_t buf[W * H * 3];
+    const char *dir = view_with("frames", "");
+    assert_int_equal(read_frame3(dir, buf, sizeof(buf)), -ENOENT);
+    assert_non_null(strstr(err, "view_000/frame_03.png: No such file or directory"));
+
+    write_frame_png(dir, PNG_FORMAT_GRAY, W, H);
+    assert_int_equal(read_frame3(dir, buf, sizeof(buf)), 0);
+
+    write_frame_png(dir, PNG_FORMAT_GRAY, 640, 480);
+    assert_int_equal(read_frame3(dir, buf, sizeof(buf)), -EINVAL);
+    assert_non_null(strstr(err, "frame_03.png: 640x480, but this scan's frames are 1280x960"));
+
+    write_frame_png(dir, PNG_FORMAT_LINEAR_Y, W, H); /* 16-bit */
+    assert_int_equal(read_frame3(dir, buf, sizeof(buf)), -EINVAL);
+    assert_non_null(strstr(err, "frame_03.png: a 16-bit PNG; frames are 8-bit"));
+
+    write_frame_png(dir, PNG_FORMAT_RGBA, W, H);
+    assert_int_equal(read_frame3(dir, buf, sizeof(buf)), -EINVAL);
+    assert_non_null(strstr(err, "frame_03.png: a PNG with an alpha channel"));
+
+    uint8_t noise[4096];
+    srand(3);
+    for (size_t i = 0; i < sizeof(noise); i++)
+        noise[i] = (uint8_t)rand();
+    write_frame_bytes(dir, noise, sizeof(noise));
+    assert_int_equal(read_frame3(dir, buf, sizeof(buf)), -EINVAL);
+    assert_non_null(strstr(err, "frame_03.png: "));
+    assert_null(strstr(err, "size")); /* libpng's words, not a guess about the size */
+    print_message("random bytes: %s\n", err);
+
+    /* a real frame cut short: libpng says what it found */
+    write_frame_png(dir, PNG_FORMAT_GRAY, W, H);
+    char path[SCAN_DIR_PATH_MAX];
+    assert_int_equal(scan_dir_frame_path(path, sizeof(path), dir, 0, 3), 0);
+    assert_int_equal(truncate(path, 200), 0);
+    assert_int_equal(read_frame3(dir, buf, sizeof(buf)), -EINVAL);
+    assert_non_null(strstr(err, "frame_03.png: "));
+    print_message("truncated: %s\n", err);
+}
+
+/* A scan directory of one view whose view.ini describes the frames of @p config_text, with
+ * frames 00-02 written (black) and frame 03 as @p frame3 bytes. */
+static void fake_scan(const char *dir, const char *config_text, const void *frame3, size_t n)
+{
+    static struct scan_dir_view v;
+    static uint8_t black[W * H * 3];
+    char path[SCAN_DIR_PATH_MAX], cfg_path[SCAN_DIR_PATH_MAX], calib[PATH_MAX];
+    struct test_rig t;
+    assert_int_equal(scan_dir_path(path, sizeof(path), dir, 0, NULL), 0);
+    assert_int_equal(hal_storage_mkdir_p(&hal.storage, path), 0);
+    snprintf(cfg_path, sizeof(cfg_path), "%s.ini", dir);
+    write_text(cfg_path, config_text);
+    assert_non_null(realpath("config/sim-calib.ini", calib));
+    assert_int_equal(test_rig_load(&t, cfg_path), 0);
+    assert_int_equal(scan_dir_keep_settings(&hal.storage, cfg_path, calib, dir), 0);
+    memset(&v, 0, sizeof(v));
+    scan_dir_describe_frames(&t.cfg.scan, &t.calib, &v);
+    v.frames = v.frame_count;
+    assert_int_equal(scan_dir_write_view(&hal.storage, dir, 0, &v), 0);
+    for (uint32_t f = 0; f < 3; f++)
+        assert_int_equal(scan_dir_write_frame(&hal.storage, dir, 0, f, black, W, H, f ? 1 : 3), 0);
+    write_frame_bytes(dir, frame3, n);
+}
+
+static const char *config_text(const char *colour)
+{
+    static char text[PATH_MAX + 512];
+    char calib[PATH_MAX];
+    assert_non_null(realpath("config/sim-calib.ini", calib));
+    snprintf(text, sizeof(text),
+             "[camera]\nbackend = sim\nwidth = 1280\nheight = 960\nexposure_us = 10000\n"
+             "[lights]\ncount = 4\n[scan]\nviews = 1\ncalibration = %s\n[colour]\n%s", calib,
+             colour);
+    return text;
+}
+
+/* process: a damaged frame is one error naming the file and what libpng found. */
+static void test_process_damaged_frame_one_error(void **state)
+{
+    (void)state;
+    const char noise[] = "\x89PNG\r\n\x1a\n but then not a PNG at all";
+    fake_scan(DIR "/damaged", config_text("method = none\n"), noise, sizeof(noise));
+    struct scan_job_opts opts = {.out_dir = DIR "/damaged_out"};
+    test_log_clear();
+    assert_int_equal(scan_job_process(&hal, DIR "/damaged", &opts), -EINVAL);
+    assert_true(test_log_one_error("build/test_scan_dir/damaged/view_000/frame_03.png: "));
+    assert_null(strstr(test_last_log, "size"));
+}
+
+/* process --config with settings whose colour frames are not the scan's: refused before any
+ * frame is read, naming the first frame that differs (before, frame 25 was taken as what the
+ * config said it was). */
+static void test_process_other_frames_refused(void **state)
+{
+    (void)state;
+    const char png_magic[] = "\x89PNG";
+    fake_scan(DIR "/multi", config_text("method = multi\n"), png_magic, sizeof(png_magic));
+    const char *other = DIR "/multi_longer.ini";
+    write_text(other, config_text("method = multi\nlight_exposure_us = 20000\n"));
+    struct scan_job_opts opts = {.out_dir = DIR "/multi_out", .config_path = other};
+    test_log_clear();
+    assert_int_equal(scan_job_process(&hal, DIR "/multi", &opts), -EINVAL);
+    assert_true(test_log_one_error(
+        "build/test_scan_dir/multi/view_000/view.ini: frame_24 is 'light 0 alone, 10000 us, "
+        "RGB', but these settings need 'light 0 alone, 20000 us, RGB' there"));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_view_ini_round_trip),
+        cmocka_unit_test(test_view_ini_bad_values),
+        cmocka_unit_test(test_bad_frames_say_why),
+        cmocka_unit_test(test_process_damaged_frame_one_error),
+        cmocka_unit_test(test_process_other_frames_refused),
+    };
+    return cmocka_run_group_tests(tests, setup, NULL);
+}
