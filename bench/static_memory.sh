@@ -1,6 +1,6 @@
 #!/bin/sh
 # Static memory of the firmware's buffers (sizes are compiled in: hal/include/hal_limits.h,
-# firmware/fusion.h); only the part a configuration uses is ever touched (BSS is mapped lazily).
+# hal/include/hal_limits.h); only the part a configuration uses is ever touched (BSS is mapped lazily).
 set -eu
 lib=$1
 echo "| buffer (firmware/) | MiB |"

@@ -17,8 +17,10 @@
 #define COLOUR_FRAME_DARK 0u
 #define COLOUR_FRAME_ALL 1u
 #define COLOUR_FRAME_LIGHT0 2u
-/** At most: dark, all lights, every light, and two more dark frames for other exposures. */
-#define COLOUR_MAX_FRAMES (COLOUR_FRAME_LIGHT0 + HAL_MAX_LIGHTS + 2u)
+/* At most COLOUR_MAX_FRAMES (hal_limits.h): dark, all lights, every light, and two more dark
+ * frames for other exposures. */
+HAL_STATIC_ASSERT(COLOUR_MAX_FRAMES == COLOUR_FRAME_LIGHT0 + HAL_MAX_LIGHTS + 2u,
+                  "COLOUR_MAX_FRAMES counts the frames colour_layout() can ask for");
 
 /** What each colour frame shows: its lights, its exposure and the dark frame (Ca) taken at the
  *  same exposure. Frames: dark, all lights, each light alone, then a dark frame for each other

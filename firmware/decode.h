@@ -30,8 +30,7 @@ struct decode_maps {
     uint32_t width, height;
 };
 
-/** Patterns a view can have: white, black, 11 column and 11 row bits with inverses. */
-#define DECODE_MAX_PATTERNS (2u + 2u * 22u)
+/* Patterns a view can have: DECODE_MAX_PATTERNS (hal_limits.h). */
 
 /** Short name of a reason code, for logs and reports. */
 const char *scan_reason_name(unsigned reason);

@@ -8,14 +8,8 @@
 #include "hal.h"
 #include "tri.h"
 
-/* The grid is sized in the config and bounded here: 8 bytes a voxel. */
-#ifdef HAL_LIMITS_SMALL /* make LIMITS=small (hal_limits.h) */
-#define FUSION_MAX_DIM 320u
-#define FUSION_MAX_VOXELS (256u * 256u * 224u)
-#else
-#define FUSION_MAX_DIM 400u
-#define FUSION_MAX_VOXELS (320u * 320u * 280u)
-#endif
+/* The grid is sized in the config and bounded by FUSION_MAX_DIM and FUSION_MAX_VOXELS
+ * (hal_limits.h): 8 bytes a voxel. */
 
 struct fusion_params {
     double voxel_mm;        /**< edge of a voxel */

@@ -1,5 +1,6 @@
-/* Compile-time limits shared by the HAL and the firmware: every static buffer is sized from here.
- */
+/* Every compile-time limit, in one place: the HAL's frame and device sizes and the firmware's
+ * buffers are all sized from here, and checked against each other below. A config beyond them
+ * is refused at start with a message naming the limit (scan_check, fusion_dims, config_load). */
 #ifndef HAL_LIMITS_H
 #define HAL_LIMITS_H
 
@@ -24,6 +25,24 @@
 #define HAL_MAX_PROJECTOR_WIDTH 2048u
 #define HAL_MAX_PROJECTOR_HEIGHT 2048u
 #define HAL_MAX_PATH 512u
+/* Bits of a Gray-coded projector coordinate: enough for HAL_MAX_PROJECTOR_WIDTH and _HEIGHT. */
+#define HAL_MAX_CODE_BITS 11u
+
+/* ---- firmware/ buffers ---- */
+/* Frames a view's decoder keeps: white, black, and every column and row bit with its inverse. */
+#define DECODE_MAX_PATTERNS (2u + 2u * (HAL_MAX_CODE_BITS + HAL_MAX_CODE_BITS))
+/* Colour frames after the patterns (colour.h): dark, all lights, each light alone, and two more
+ * dark frames for other exposures. */
+#define COLOUR_MAX_FRAMES (2u + HAL_MAX_LIGHTS + 2u)
+/* The fusion grid (fusion.h): at most FUSION_MAX_DIM voxels along an axis, FUSION_MAX_VOXELS in
+ * all, 8 bytes each. */
+#ifdef HAL_LIMITS_SMALL
+#define FUSION_MAX_DIM 320u
+#define FUSION_MAX_VOXELS (256u * 256u * 224u)
+#else
+#define FUSION_MAX_DIM 400u
+#define FUSION_MAX_VOXELS (320u * 320u * 280u)
+#endif
 /* Largest stack frame a firmware/ function may have (gcc -fstack-usage, checked by make test:
  * scripts/check-stack.sh); big state lives in static buffers, never on the stack. */
 #define HAL_STACK_FRAME_MAX 2048u
@@ -37,5 +56,14 @@
 HAL_STATIC_ASSERT(HAL_MAX_WIDTH % 2u == 0u, "YUYV conversion needs an even width");
 HAL_STATIC_ASSERT(HAL_MAX_PIXELS <= (1u << 23), "pixel indices must fit comfortably in 32 bits");
 HAL_STATIC_ASSERT(HAL_MAX_PROJECTOR_WIDTH <= 65535u, "projector columns are stored as uint16_t");
+HAL_STATIC_ASSERT((1u << HAL_MAX_CODE_BITS) >= HAL_MAX_PROJECTOR_WIDTH &&
+                      (1u << HAL_MAX_CODE_BITS) >= HAL_MAX_PROJECTOR_HEIGHT,
+                  "every projector column and row must have a code");
+HAL_STATIC_ASSERT(DECODE_MAX_PATTERNS <= 255u, "pattern indices are counted in small integers");
+HAL_STATIC_ASSERT(HAL_MAX_LIGHTS <= 31u, "light masks are 32-bit words");
+HAL_STATIC_ASSERT(FUSION_MAX_VOXELS <= (uint64_t)FUSION_MAX_DIM * FUSION_MAX_DIM * FUSION_MAX_DIM,
+                  "the voxel budget fits in a grid of the largest dimensions");
+HAL_STATIC_ASSERT((uint64_t)FUSION_MAX_VOXELS * 3u < (1ull << 32),
+                  "a mesh vertex per voxel edge (3 a voxel) is numbered in 32 bits");
 
 #endif
