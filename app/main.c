@@ -37,8 +37,16 @@ static void app_log(enum hal_log_level level, const char *fmt, ...)
     fputc('\n', stderr);
 }
 
+/* A stop signal, or standard output that can no longer be written: its reader went away (a
+ * --json consumer that exited: SIGPIPE is ignored, so the write failed with EPIPE), and a scan
+ * nobody can follow stops as it would on a dropped session. */
 static int app_stop_requested(void)
 {
+    if (stop_flag == 0 && ferror(stdout)) {
+        stop_flag = 1;
+        app_log(HAL_LOG_WARN, "standard output cannot be written (its reader went away?): "
+                              "stopping");
+    }
     return stop_flag != 0;
 }
 
@@ -63,8 +71,16 @@ static void install_signals(void)
     memset(&sa, 0, sizeof(sa));
     sa.sa_handler = on_stop_signal;
     sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, NULL);
-    sigaction(SIGTERM, &sa, NULL);
+    /* Each of these ends a scan the same way: between frames, then the one shutdown path that
+     * puts the rig in its safe state. SIGHUP: the session (ssh, terminal) went away; SIGTSTP
+     * (Ctrl-Z) would otherwise freeze the process with the rig lit. */
+    const int stops[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGTSTP};
+    for (size_t i = 0; i < sizeof(stops) / sizeof(stops[0]); i++)
+        sigaction(stops[i], &sa, NULL);
+    /* A closed pipe on stdout is an error of the write (EPIPE, see app_stop_requested), not a
+     * death without the safe state. */
+    sa.sa_handler = SIG_IGN;
+    sigaction(SIGPIPE, &sa, NULL);
     sa.sa_handler = on_fatal_signal;
     sigaction(SIGSEGV, &sa, NULL);
     sigaction(SIGBUS, &sa, NULL);
@@ -203,6 +219,8 @@ static int cmd_process(const char *scan_dir, const struct scan_job_opts *opts)
     struct hal hal;
     memset(&hal, 0, sizeof(hal));
     hal.log = app_log;
+    hal.stop_requested = app_stop_requested; /* also while resume processes */
+    install_signals();
     storage_posix_init(&hal.storage);
     clock_posix_init(&hal.clock);
     return scan_job_process(&hal, scan_dir, opts) == 0 ? 0 : 1;

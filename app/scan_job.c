@@ -477,8 +477,16 @@ int scan_job_process(const struct hal *hal, const char *scan_dir, const struct s
         rc = fusion_begin(&cfg.fusion);
     icp_reset();
     progress(&j, "process_start", -1, 0, scan_dir);
-    for (uint32_t v = 0; v < cfg.views && rc == 0; v++)
+    for (uint32_t v = 0; v < cfg.views && rc == 0; v++) {
+        if (hal_should_stop(hal)) {
+            hal->log(HAL_LOG_WARN, "processing stopped by request before view %u; nothing of %s "
+                                   "is lost: 'scanner process %s' starts it again",
+                     (unsigned)v, scan_dir, scan_dir);
+            rc = -EINTR;
+            break;
+        }
         rc = process_view(&j, scan_dir, v);
+    }
     if (rc == 0)
         rc = write_model(&j);
     if (rc == 0)

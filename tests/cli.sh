@@ -98,19 +98,52 @@ assert events[0] == \"process_start\" and events[-1] == \"process_done\" and \"s
 cp -r "$out/scan" "$out/broken" 2>/dev/null; rm -f "$out/broken/view_000/frame_07.png"
 check process_names_missing_frame sh -c "$bin process $out/broken --out $out/broken_out 2>&1 | \
     grep -q 'view_000/frame_07.png: No such file'; test \$? -eq 0"
-# SIGINT mid-scan: the scan stops between frames, says so, and the rig ends in its safe state.
-sigint_test() {
+# A stop signal mid-scan (Ctrl-C, systemd's SIGTERM, a dropped ssh session's SIGHUP, Ctrl-\,
+# Ctrl-Z): the scan stops between frames, says so, and the rig ends in its safe state; the
+# process neither dies lit nor freezes lit.
+stop_signal_test() {
+    rm -rf "$out/interrupted"
     "$bin" scan --config config/sim.ini --out "$out/interrupted" >"$out/int.log" 2>&1 &
     pid=$!
     sleep 0.4
-    kill -INT "$pid"
+    kill -"$1" "$pid"
     wait "$pid"
     rc=$?
     cat "$out/int.log"
     [ "$rc" -eq 1 ] && grep -q 'stopped by request' "$out/int.log" &&
         grep -q 'safe state: lights and projector off' "$out/int.log"
 }
-check sigint_stops_safely sigint_test
+for sig in INT TERM HUP QUIT TSTP; do
+    check "sig${sig}_stops_safely" stop_signal_test "$sig"
+done
+# The reader of --json goes away (SIGPIPE): the scan stops in the safe state, not killed lit.
+sigpipe_test() {
+    rm -rf "$out/piped"
+    { "$bin" scan --config config/sim.ini --out "$out/piped" --json 2>"$out/pipe.log"
+      echo $? >"$out/pipe.rc"; } | head -n 1 >/dev/null
+    cat "$out/pipe.log"
+    [ "$(cat "$out/pipe.rc")" -eq 1 ] && grep -q 'standard output cannot be written' "$out/pipe.log" &&
+        grep -q 'safe state: lights and projector off' "$out/pipe.log"
+}
+check sigpipe_stops_safely sigpipe_test
+# SIGTERM while resume processes the views it has: honoured there too (it was ignored).
+resume_term_test() {
+    "$bin" resume "$out/interrupted" --config config/sim.ini --json >"$out/resume.json" \
+        2>"$out/resume.log" &
+    pid=$!
+    n=0
+    while ! grep -q process_start "$out/resume.json" && [ $n -lt 1200 ]; do
+        sleep 0.05
+        n=$((n + 1))
+    done
+    kill -TERM "$pid"
+    wait "$pid"
+    rc=$?
+    cat "$out/resume.log"
+    [ "$rc" -eq 1 ] && grep -q 'processing stopped by request before view' "$out/resume.log" &&
+        ! grep -q process_done "$out/resume.json"
+}
+check sigterm_stops_resume_processing resume_term_test
 points=$(sed -n 's/^valid_points = //p' "$out/scan/view_000/view.ini")
 if /usr/bin/python3 -c 'import open3d' 2>/dev/null; then
     check open3d_reads_ply /usr/bin/python3 tests/interop_open3d.py "$out/scan/view_000/cloud.ply" "$points"

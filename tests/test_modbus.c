@@ -153,6 +153,60 @@ static void test_stall_reported_with_position(void **state)
     assert_int_equal(tt_server_position(&server), 45000);
 }
 
+/* The controller restarts between two views (a brown-out, a watchdog): with @p rezeroed it
+ * comes back taking its power-on position as zero and reporting itself homed, no alarm raised;
+ * otherwise it comes back not homed. */
+static void restart_controller(int rezeroed)
+{
+    pthread_mutex_lock(&server.lock);
+    tt_ctrl_init(&server.ctrl, 0, clock_sim_now(&vclock));
+    server.ctrl.homed = rezeroed;
+    pthread_mutex_unlock(&server.lock);
+}
+
+/* A restarted controller is noticed before the next move, which is not made: the view would be
+ * taken at another angle than the one recorded (before: view 2 recorded at 240 deg, taken at 0). */
+static void test_restart_noticed_before_the_move(void **state)
+{
+    (void)state;
+    assert_int_equal(hal_table_home(&table), 0);
+    assert_int_equal(hal_table_move_to(&table, 180000), 0);
+    restart_controller(1);
+    errors_logged = 0;
+    assert_int_equal(hal_table_move_to(&table, 240000), -EIO);
+    assert_int_equal(errors_logged, 1);
+    assert_non_null(strstr(last_log, "turntable: move to 240.000 deg: the controller restarted "
+                                     "(homed, last command 0 where"));
+    assert_int_equal(tt_server_position(&server), 0); /* it did not move */
+    assert_int_equal(hal_table_move_to(&table, 240000), -EIO); /* nor on a second try */
+    int rc = hal_table_home(&table); /* homing again is the way on */
+    if (rc != 0)
+        fail_msg("%s", last_log);
+    assert_int_equal(hal_table_move_to(&table, 240000), 0);
+
+    restart_controller(0);
+    assert_int_equal(hal_table_move_to(&table, 300000), -EIO);
+    assert_non_null(strstr(last_log, "the controller restarted (no longer homed"));
+    assert_int_equal(tt_server_position(&server), 0);
+}
+
+/* The table turned by hand (or re-zeroed, counter kept) between two views: the same. */
+static void test_table_moved_noticed_before_the_move(void **state)
+{
+    (void)state;
+    assert_int_equal(hal_table_home(&table), 0);
+    assert_int_equal(hal_table_move_to(&table, 90000), 0);
+    pthread_mutex_lock(&server.lock);
+    server.ctrl.pos_mdeg = 50000;
+    pthread_mutex_unlock(&server.lock);
+    errors_logged = 0;
+    assert_int_equal(hal_table_move_to(&table, 135000), -EIO);
+    assert_int_equal(errors_logged, 1);
+    assert_non_null(strstr(last_log, "the table is at 50.000 deg, not at 90.000 deg where the "
+                                     "last move left it"));
+    assert_int_equal(tt_server_position(&server), 50000);
+}
+
 /* A read-only register written: the controller's exception, reported as such, not retried. */
 static void test_illegal_address_exception(void **state)
 {
@@ -279,6 +333,9 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_home_and_move, open_tcp, close_all),
         cmocka_unit_test_setup_teardown(test_move_before_home_raises_alarm, open_tcp, close_all),
         cmocka_unit_test_setup_teardown(test_stall_reported_with_position, open_tcp, close_all),
+        cmocka_unit_test_setup_teardown(test_restart_noticed_before_the_move, open_tcp, close_all),
+        cmocka_unit_test_setup_teardown(test_table_moved_noticed_before_the_move, open_tcp,
+                                        close_all),
         cmocka_unit_test_setup_teardown(test_illegal_address_exception, open_tcp, close_all),
         cmocka_unit_test_setup_teardown(test_command_applied_once, open_tcp, close_all),
         cmocka_unit_test_setup_teardown(test_no_reply_times_out, open_tcp, close_all),

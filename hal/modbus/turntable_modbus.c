@@ -87,8 +87,10 @@ static int send_command(struct tt_client *c, uint16_t cmd, const char *what)
     for (uint32_t attempt = 0; attempt <= c->cfg.retries; attempt++) {
         if (attempt > 0)
             c->retries_used++;
-        if (modbus_write_registers(c->ctx, TT_REG_COMMAND, 2, regs) == 2)
+        if (modbus_write_registers(c->ctx, TT_REG_COMMAND, 2, regs) == 2) {
+            c->last_id = id;
             return 0;
+        }
         int e = errno;
         rc = translate(e, msg, sizeof(msg));
         if (!retryable(e))
@@ -98,6 +100,7 @@ static int send_command(struct tt_client *c, uint16_t cmd, const char *what)
         if (modbus_read_registers(c->ctx, TT_REG_LAST_ID, 1, &last) == 1 && last == id) {
             c->log(HAL_LOG_WARN, "turntable: %s: reply lost, but the controller executed it",
                    what);
+            c->last_id = id;
             return 0;
         }
         c->log(HAL_LOG_WARN, "turntable: %s: %s, try %u of %u", what, msg, (unsigned)attempt + 1,
@@ -107,7 +110,8 @@ static int send_command(struct tt_client *c, uint16_t cmd, const char *what)
     return rc;
 }
 
-static int read_status(struct tt_client *c, struct hal_turntable_status *st, uint16_t *raw)
+static int read_status(struct tt_client *c, struct hal_turntable_status *st, uint16_t *raw,
+                       uint16_t *last_id)
 {
     uint16_t r[TT_REG_LAST_ID - TT_REG_ACTUAL_HI + 1];
     int rc = transfer(c, "reading the status", 0, TT_REG_ACTUAL_HI, (int)(sizeof(r) / sizeof(r[0])),
@@ -121,12 +125,14 @@ static int read_status(struct tt_client *c, struct hal_turntable_status *st, uin
     st->alarm_code = (status & TT_STATUS_ALARM) ? r[TT_REG_ALARM - TT_REG_ACTUAL_HI] : 0;
     if (raw != NULL)
         *raw = status;
+    if (last_id != NULL)
+        *last_id = r[TT_REG_LAST_ID - TT_REG_ACTUAL_HI];
     return 0;
 }
 
 static int tt_get_status(void *priv, struct hal_turntable_status *st)
 {
-    return read_status(priv, st, NULL);
+    return read_status(priv, st, NULL, NULL);
 }
 
 /* Poll until the table is idle; an alarm or the move timeout ends the wait with an error. */
@@ -135,7 +141,7 @@ static int wait_idle(struct tt_client *c, const char *what, struct hal_turntable
     uint64_t start, now;
     hal_clock_now_us(c->clock, &start);
     for (;;) {
-        int rc = read_status(c, st, NULL);
+        int rc = read_status(c, st, NULL, NULL);
         if (rc != 0)
             return rc;
         if (st->alarm_code != 0) {
@@ -170,7 +176,48 @@ static int tt_home(void *priv)
         c->log(HAL_LOG_ERROR, "turntable: homing ended without the homed flag");
         rc = -EIO;
     }
+    c->homed = rc == 0;
+    c->lost = 0;
+    c->position_known = rc == 0;
+    c->position_mdeg = st.position_mdeg;
     return rc;
+}
+
+/* Before a move: is the controller still the one we homed, with the table where we left it? A
+ * controller that restarted has forgotten its reference (not homed) or taken its power-on
+ * position as zero, and its command counter starts again; a table turned by hand is elsewhere.
+ * Moving on would take the next view at another angle than the one recorded. */
+static int check_unchanged(struct tt_client *c, const char *what)
+{
+    struct hal_turntable_status st;
+    uint16_t last_id;
+    if (c->lost) {
+        c->log(HAL_LOG_ERROR, "turntable: %s: refused: the table must be homed again first", what);
+        return -EIO;
+    }
+    int rc = read_status(c, &st, NULL, &last_id);
+    if (rc != 0 || !c->homed)
+        return rc;
+    if (!st.homed || last_id != c->last_id) {
+        c->log(HAL_LOG_ERROR,
+               "turntable: %s: the controller restarted (%s, last command %u where %u was "
+               "executed); it was not moved and must be homed again",
+               what, st.homed ? "homed" : "no longer homed", (unsigned)last_id,
+               (unsigned)c->last_id);
+        c->lost = 1;
+        return -EIO;
+    }
+    if (c->position_known &&
+        labs((long)st.position_mdeg - (long)c->position_mdeg) > (long)c->cfg.tolerance_mdeg) {
+        c->log(HAL_LOG_ERROR,
+               "turntable: %s: the table is at %.3f deg, not at %.3f deg where the last move "
+               "left it (turned by hand, or the controller re-zeroed); it was not moved and "
+               "must be homed again",
+               what, st.position_mdeg / 1000.0, c->position_mdeg / 1000.0);
+        c->lost = 1;
+        return -EIO;
+    }
+    return 0;
 }
 
 static int tt_move_to(void *priv, int32_t angle_mdeg)
@@ -181,9 +228,13 @@ static int tt_move_to(void *priv, int32_t angle_mdeg)
     snprintf(what, sizeof(what), "move to %.3f deg", angle_mdeg / 1000.0);
     uint16_t target[2] = {(uint16_t)((uint32_t)angle_mdeg >> 16),
                           (uint16_t)((uint32_t)angle_mdeg & 0xFFFFu)};
-    int rc = transfer(c, "writing the target", 1, TT_REG_TARGET_HI, 2, target);
+    int rc = check_unchanged(c, what);
     if (rc == 0)
+        rc = transfer(c, "writing the target", 1, TT_REG_TARGET_HI, 2, target);
+    if (rc == 0) {
+        c->position_known = 0; /* until the move ends where it should */
         rc = send_command(c, TT_CMD_MOVE, what);
+    }
     if (rc == 0)
         rc = wait_idle(c, what, &st);
     if (rc != 0)
@@ -194,6 +245,8 @@ static int tt_move_to(void *priv, int32_t angle_mdeg)
                st.position_mdeg / 1000.0);
         return -EIO;
     }
+    c->position_known = 1;
+    c->position_mdeg = st.position_mdeg;
     return hal_clock_sleep_us(c->clock, (uint64_t)c->cfg.settle_ms * 1000u);
 }
 

@@ -32,6 +32,13 @@ struct tt_client {
     const struct hal_clock *clock;
     void (*log)(enum hal_log_level level, const char *fmt, ...);
     uint16_t next_id;
+    /* What the controller must still say before a move, once homed (a controller that restarts
+     * forgets its reference and its command counter; a table turned by hand moves): */
+    int homed;                /**< 1 once homed through this client */
+    int lost;                 /**< 1 once a check failed: no move until homed again */
+    uint16_t last_id;         /**< COMMAND_ID of the last command it executed for us */
+    int position_known;       /**< 0 after a move that failed: where it stopped is its own */
+    int32_t position_mdeg;    /**< where the last move (or homing) left it */
     int is_tcp;
     unsigned long retries_used; /**< requests repeated since open (for tests and reports) */
 };
