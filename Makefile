@@ -74,10 +74,11 @@ INC_board := -Iboard -Ifirmware -Ihal/posix -Ihal/modbus -Ihal/linux -Ihost_sim
 # simulator it reads from a config (turntable_modbus.h, sim_config.h).
 INC_app := -Iapp -Iboard -Ifirmware -Ihal/posix -Ihal/modbus -Ihost_sim
 # Tests, benchmarks and fuzzers see everything.
-HOST_INC := -Ihal/include -Ifirmware -Iapp -Iboard -Ihal/posix -Ihal/linux -Ihal/modbus -Ihost_sim
-INC_tests := $(HOST_INC)
-INC_tests/fuzz := $(HOST_INC)
-INC_bench := $(HOST_INC)
+ALL_INC := -Ifirmware -Iapp -Iboard -Ihal/posix -Ihal/linux -Ihal/modbus -Ihost_sim
+HOST_INC := -Ihal/include $(ALL_INC)
+INC_tests := $(ALL_INC)
+INC_tests/fuzz := $(ALL_INC)
+INC_bench := $(ALL_INC)
 LAYER_INC = -Ihal/include $(INC_$(patsubst %/,%,$(dir $<)))
 HOST_CFLAGS = $(CFLAGS_COMMON) $(LAYER_INC) $(PKG_CFLAGS)
 LDFLAGS_COMMON := $(OPT) -g

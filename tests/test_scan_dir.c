@@ -112,22 +112,27 @@ static void test_view_ini_round_trip(void **state)
 static void test_view_ini_bad_values(void **state)
 {
     (void)state;
-    const char *head = "[view]\nindex = 0\n";
-    char text[256];
-    snprintf(text, sizeof(text), "%sangle_mdeg = abc\nframes = 22\n", head);
-    expect_view_error("abc", text, "view_000/view.ini:3: [view] angle_mdeg: 'abc' is not a whole number");
-    snprintf(text, sizeof(text), "%sangle_mdeg =\nframes = 22\n", head);
-    expect_view_error("empty", text, "view.ini:3: [view] angle_mdeg: '' is not a whole number");
-    snprintf(text, sizeof(text), "%sframes = 22\n", head);
-    expect_view_error("missing", text, "[view] angle_mdeg: required key is missing");
-    snprintf(text, sizeof(text), "%sangle_mdeg = 0\nframes = 22\nvalid_points = 1.5\n", head);
-    expect_view_error("fraction", text, "view.ini:5: [view] valid_points: '1.5' is not a whole number");
-    snprintf(text, sizeof(text), "%sangle_mdeg = 0\nframes = 22\n[pixels]\nshadow = -4\n", head);
-    expect_view_error("negative", text, "[pixels] shadow: -4");
-    snprintf(text, sizeof(text), "%sangle_mdeg = 0\nangle_mdeg = 5\nframes = 22\n", head);
-    expect_view_error("twice", text, "view.ini:4: [view] angle_mdeg: set twice");
-    snprintf(text, sizeof(text), "%sangle_mdeg = 0\nframes = 22\nangel_mdeg = 5\n", head);
-    expect_view_error("typo", text, "view.ini:5: [view] angel_mdeg: unknown key");
+#define HEAD "[view]\nindex = 0\n"
+    static const struct {
+        const char *name, *text, *expect;
+    } cases[] = {
+        {"abc", HEAD "angle_mdeg = abc\nframes = 22\n",
+         "view_000/view.ini:3: [view] angle_mdeg: 'abc' is not a whole number"},
+        {"empty", HEAD "angle_mdeg =\nframes = 22\n",
+         "view.ini:3: [view] angle_mdeg: '' is not a whole number"},
+        {"missing", HEAD "frames = 22\n", "[view] angle_mdeg: required key is missing"},
+        {"fraction", HEAD "angle_mdeg = 0\nframes = 22\nvalid_points = 1.5\n",
+         "view.ini:5: [view] valid_points: '1.5' is not a whole number"},
+        {"negative", HEAD "angle_mdeg = 0\nframes = 22\n[pixels]\nshadow = -4\n",
+         "[pixels] shadow: -4"},
+        {"twice", HEAD "angle_mdeg = 0\nangle_mdeg = 5\nframes = 22\n",
+         "view.ini:4: [view] angle_mdeg: set twice"},
+        {"typo", HEAD "angle_mdeg = 0\nframes = 22\nangel_mdeg = 5\n",
+         "view.ini:5: [view] angel_mdeg: unknown key"},
+    };
+#undef HEAD
+    for (size_t k = 0; k < sizeof(cases) / sizeof(cases[0]); k++)
+        expect_view_error(cases[k].name, cases[k].text, cases[k].expect);
     expect_view_error("index", "[view]\nindex = 2\nangle_mdeg = 0\nframes = 22\n",
                       "[view] index: 2, but this is view 0");
 }
@@ -172,6 +177,9 @@ static void test_bad_frames_say_why(void **state)
     (void)state;
     static uint8_t buf[W * H * 3];
     const char *dir = view_with("frames", "");
+    char path[SCAN_DIR_PATH_MAX];
+    assert_int_equal(scan_dir_frame_path(path, sizeof(path), dir, 0, 3), 0);
+    unlink(path); /* from an earlier run */
     assert_int_equal(read_frame3(dir, buf, sizeof(buf)), -ENOENT);
     assert_non_null(strstr(err, "view_000/frame_03.png: No such file or directory"));
 
@@ -202,8 +210,6 @@ static void test_bad_frames_say_why(void **state)
 
     /* a real frame cut short: libpng says what it found */
     write_frame_png(dir, PNG_FORMAT_GRAY, W, H);
-    char path[SCAN_DIR_PATH_MAX];
-    assert_int_equal(scan_dir_frame_path(path, sizeof(path), dir, 0, 3), 0);
     assert_int_equal(truncate(path, 200), 0);
     assert_int_equal(read_frame3(dir, buf, sizeof(buf)), -EINVAL);
     assert_non_null(strstr(err, "frame_03.png: "));
