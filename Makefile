@@ -316,7 +316,7 @@ small-build: deps
 	@$(MAKE) --no-print-directory LIMITS=small SAN=$(SAN) $(BUILD)/small/scanner
 
 run: deps $(BUILD)/scanner
-	$(BUILD)/scanner scan --config config/sim.ini
+	$(BUILD)/scanner scan --config config/sim.ini --replace
 
 docs: $(BUILD)/scanner
 	$(BUILD)/scanner config-doc > docs/config.md

@@ -249,9 +249,10 @@ static int cmd_resume(const char *scan_dir, const struct scan_job_opts *opts)
 static void usage(FILE *out)
 {
     fprintf(out,
-            "usage: scanner scan --config FILE [--out DIR] [--json]   take a scan\n"
-            "       scanner process DIR [--out DIR2] [--config F] [--json]  recompute a scan from "
-            "its frames\n"
+            "usage: scanner scan --config FILE [--out DIR] [--replace] [--json]   take a scan\n"
+            "           (into an empty or new DIR; --replace: replace the scan already there)\n"
+            "       scanner process DIR [--out DIR2 [--replace]] [--config F] [--json]  recompute\n"
+            "           a scan from its frames\n"
             "       scanner resume DIR [--config F] [--json] [--clear-alarm]  finish a stopped\n"
             "           scan (--clear-alarm: the turntable's alarm, once its cause is fixed)\n"
             "       scanner calibrate-white --config FILE [--albedo A]  white reference scales\n"
@@ -264,7 +265,7 @@ static void usage(FILE *out)
 int main(int argc, char **argv)
 {
     const char *config_path = NULL, *scan_dir = NULL;
-    struct scan_job_opts opts = {0, NULL, NULL, 0};
+    struct scan_job_opts opts = {0, NULL, NULL, 0, 0};
     double white_albedo = 0.95; /* a typical white reference target */
     if (argc < 2) {
         usage(stderr);
@@ -285,6 +286,9 @@ int main(int argc, char **argv)
             opts.json = 1;
         else if (strcmp(argv[i], "--clear-alarm") == 0 && strcmp(argv[1], "resume") == 0)
             opts.clear_alarm = 1;
+        else if (strcmp(argv[i], "--replace") == 0 &&
+                 (strcmp(argv[1], "scan") == 0 || strcmp(argv[1], "process") == 0))
+            opts.replace = 1;
         else if (strcmp(argv[i], "--albedo") == 0 && i + 1 < argc)
             white_albedo = atof(argv[++i]);
         else {

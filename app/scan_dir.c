@@ -1,25 +1,30 @@
 /* The scan directory's layout and its small files, read and written in one place. */
-#define _POSIX_C_SOURCE 200809L
+#define _DEFAULT_SOURCE /* flock */
 #include "scan_dir.h"
 
 #include "gray.h"
 #include "image_io.h"
 #include "ini_schema.h"
 
+#include <dirent.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 int scan_dir_path(char *buf, size_t len, const char *dir, int view, const char *name)
 {
     int n;
-    if (view < 0)
-        n = snprintf(buf, len, "%s/%s", dir, name);
-    else if (name == NULL)
+    if (view >= 0 && name != NULL)
+        n = snprintf(buf, len, "%s/view_%03u/%s", dir, (unsigned)view, name);
+    else if (view >= 0)
         n = snprintf(buf, len, "%s/view_%03u", dir, (unsigned)view);
     else
-        n = snprintf(buf, len, "%s/view_%03u/%s", dir, (unsigned)view, name);
+        n = snprintf(buf, len, "%s/%s", dir, name != NULL ? name : "");
     return n < 0 || (size_t)n >= len ? -ENAMETOOLONG : 0;
 }
 
@@ -212,6 +217,18 @@ int scan_dir_read_frame(const char *dir, uint32_t view, uint32_t frame, uint8_t 
     return rc;
 }
 
+int scan_dir_sweep(const struct hal_storage *st, const char *dir, uint32_t views)
+{
+    char path[SCAN_DIR_PATH_MAX];
+    int rc = hal_storage_sweep(st, dir);
+    for (uint32_t v = 0; v < views && (rc == 0 || rc == -ENOSYS); v++) {
+        rc = scan_dir_path(path, sizeof(path), dir, (int)v, NULL);
+        if (rc == 0)
+            rc = hal_storage_sweep(st, path);
+    }
+    return rc == -ENOSYS ? 0 : rc; /* a backend without temporaries has nothing to sweep */
+}
+
 /* ---- the other small files ---- */
 
 int scan_dir_write_registration(const struct hal_storage *st, const char *dir, uint32_t view,
@@ -256,4 +273,153 @@ int scan_dir_keep_settings(const struct hal_storage *st, const char *config_path
     if (rc == 0)
         rc = scan_dir_path(path, sizeof(path), dir, -1, "calibration.ini");
     return rc != 0 ? rc : copy_file(st, calibration_path, path);
+}
+
+/* ---- opening: a lock, and what is already there ---- */
+
+/* @retval 1 when @p name is one of the files a scan writes at the top of its directory
+ * (the simulator's ground truth among them), or a temporary file of one */
+static int scan_file(const char *name)
+{
+    static const char *const names[] = {"config.ini", "calibration.ini", "mesh.ply", "mesh.obj"};
+    for (size_t k = 0; k < sizeof(names) / sizeof(names[0]); k++)
+        if (strcmp(name, names[k]) == 0)
+            return 1;
+    return strncmp(name, "truth_", 6) == 0 || strstr(name, ".tmp.") != NULL;
+}
+
+/* @retval 1 when @p name is a file a view's directory holds */
+static int view_file(const char *name)
+{
+    unsigned frame;
+    char tail[8];
+    if (sscanf(name, "frame_%2u.pn%1s", &frame, tail) == 2 && strcmp(tail, "g") == 0)
+        return 1;
+    return strcmp(name, "view.ini") == 0 || strcmp(name, "cloud.ply") == 0 ||
+           strcmp(name, "registration.ini") == 0 || strncmp(name, "truth_", 6) == 0 ||
+           strstr(name, ".tmp.") != NULL;
+}
+
+/* @retval 1 when @p name is a view's directory: view_NNN */
+static int view_dir(const char *name)
+{
+    unsigned v;
+    char extra;
+    return strlen(name) == 8 && sscanf(name, "view_%3u%c", &v, &extra) == 1;
+}
+
+/* Check (@p remove 0) or remove (1) every entry of @p dir that a scan writes; the first entry
+ * that is not one is named in @p err. @retval 0 @retval -EEXIST @retval -errno */
+static int scan_entries(const char *dir, int in_view, int remove, char *err, size_t err_len)
+{
+    DIR *d = opendir(dir);
+    if (d == NULL)
+        return errno == ENOENT ? 0 : -errno;
+    char path[SCAN_DIR_PATH_MAX];
+    int rc = 0;
+    if (remove && in_view) /* view.ini first: a view cut short here is never taken as finished */
+        unlinkat(dirfd(d), "view.ini", 0);
+    for (struct dirent *e = readdir(d); e != NULL && rc == 0; e = readdir(d)) {
+        if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0)
+            continue;
+        struct stat st;
+        if (fstatat(dirfd(d), e->d_name, &st, AT_SYMLINK_NOFOLLOW) != 0) {
+            rc = -errno;
+            break;
+        }
+        int is_dir = S_ISDIR(st.st_mode);
+        if (!in_view && is_dir && view_dir(e->d_name)) {
+            snprintf(path, sizeof(path), "%s/%s", dir, e->d_name);
+            rc = scan_entries(path, 1, remove, err, err_len);
+            if (rc == 0 && remove && unlinkat(dirfd(d), e->d_name, AT_REMOVEDIR) != 0)
+                rc = -errno;
+        } else if (!is_dir && (in_view ? view_file(e->d_name) : scan_file(e->d_name))) {
+            if (remove && unlinkat(dirfd(d), e->d_name, 0) != 0)
+                rc = -errno;
+        } else {
+            snprintf(err, err_len, "%s/%s is not part of a scan: nothing was replaced", dir,
+                     e->d_name);
+            rc = -EEXIST;
+        }
+    }
+    closedir(d);
+    return rc;
+}
+
+/* @retval 1 when @p dir has no entry but . and .. (or does not exist) */
+static int empty_dir(const char *dir, char *first, size_t len)
+{
+    DIR *d = opendir(dir);
+    if (d == NULL)
+        return 1;
+    int empty = 1;
+    for (struct dirent *e = readdir(d); e != NULL && empty; e = readdir(d))
+        if (strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0) {
+            snprintf(first, len, "%s", e->d_name);
+            empty = 0;
+        }
+    closedir(d);
+    return empty;
+}
+
+int scan_dir_open(const struct hal_storage *st, const char *dir, enum scan_dir_mode mode,
+                  int *lock_fd, char *err, size_t err_len)
+{
+    *lock_fd = -1;
+    int rc = hal_storage_mkdir_p(st, dir);
+    if (rc != 0) {
+        snprintf(err, err_len, "cannot make the scan directory %s: %s", dir, strerror(-rc));
+        return rc;
+    }
+    /* flock on the directory itself: released when the process ends, however it ends */
+    int fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd < 0 || flock(fd, LOCK_EX | LOCK_NB) != 0) {
+        rc = errno == EWOULDBLOCK ? -EBUSY : -errno;
+        snprintf(err, err_len, "%s: %s", dir,
+                 rc == -EBUSY ? "another scanner is using this directory" : strerror(-rc));
+        goto out_close;
+    }
+    char first[256];
+    if (mode == SCAN_DIR_NEW && !empty_dir(dir, first, sizeof(first))) {
+        snprintf(err, err_len,
+                 "%s already holds %s: choose another --out, 'scanner resume %s' to finish the "
+                 "scan there, or --replace to replace it",
+                 dir, first, dir);
+        rc = -EEXIST;
+        goto out_close;
+    }
+    if (mode == SCAN_DIR_REPLACE) { /* check all first: refuse before anything is removed */
+        rc = scan_entries(dir, 0, 0, err, err_len);
+        if (rc == 0)
+            rc = scan_entries(dir, 0, 1, err, err_len);
+        if (rc != 0 && rc != -EEXIST)
+            snprintf(err, err_len, "cannot replace the scan in %s: %s", dir, strerror(-rc));
+        if (rc != 0)
+            goto out_close;
+    }
+    *lock_fd = fd;
+    return 0;
+out_close:
+    if (fd >= 0)
+        close(fd);
+    return rc;
+}
+
+void scan_dir_close(int lock_fd)
+{
+    if (lock_fd >= 0)
+        close(lock_fd); /* and with it the lock */
+}
+
+int scan_dir_begin_view(const struct hal_storage *st, const char *dir, uint32_t view)
+{
+    char path[SCAN_DIR_PATH_MAX];
+    int rc = scan_dir_path(path, sizeof(path), dir, (int)view, NULL);
+    if (rc == 0)
+        rc = hal_storage_mkdir_p(st, path);
+    if (rc == 0)
+        rc = scan_dir_path(path, sizeof(path), dir, (int)view, "view.ini");
+    if (rc == 0 && unlink(path) != 0 && errno != ENOENT)
+        rc = -errno;
+    return rc;
 }

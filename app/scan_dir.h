@@ -35,7 +35,7 @@ struct scan_dir_view {
 };
 
 /** Path of @p name in the scan directory @p dir (@p view < 0), or in view @p view's directory
- *  (@p name NULL: that directory). @retval 0 @retval -ENAMETOOLONG */
+ *  (@p name NULL: that directory itself). @retval 0 @retval -ENAMETOOLONG */
 int scan_dir_path(char *buf, size_t len, const char *dir, int view, const char *name);
 
 /** Path of frame @p frame of view @p view. @retval 0 @retval -ENAMETOOLONG */
@@ -78,6 +78,32 @@ int scan_dir_read_frame(const char *dir, uint32_t view, uint32_t frame, uint8_t 
 /** Write view @p view's registration.ini (how it was registered to the one before). */
 int scan_dir_write_registration(const struct hal_storage *st, const char *dir, uint32_t view,
                                 const struct icp_report *r);
+
+/** How scan_dir_open treats what @p dir already holds. */
+enum scan_dir_mode {
+    SCAN_DIR_EXISTING, /**< a scan to finish or process in place: kept as it is */
+    SCAN_DIR_NEW,      /**< a new scan or new results: the directory must be empty or absent */
+    SCAN_DIR_REPLACE,  /**< the same, but a scan already there is removed first (only a scan's
+                            own files: anything else there is refused, nothing removed) */
+};
+
+/** Make @p dir (and its parents) and lock it for this process, so that a second scanner cannot
+ *  write into it at the same time. @param lock_fd  out: held until scan_dir_close
+ *  @retval 0 @retval -EBUSY another scanner has it @retval -EEXIST not empty (NEW), or holds
+ *  other files than a scan's (REPLACE) @retval -errno; @p err says which and what to do */
+int scan_dir_open(const struct hal_storage *st, const char *dir, enum scan_dir_mode mode,
+                  int *lock_fd, char *err, size_t err_len);
+/** Release the lock of scan_dir_open (-1: none). */
+void scan_dir_close(int lock_fd);
+
+/** Before view @p view's first frame: its directory exists and holds no view.ini, so that a
+ *  view cut short is never taken as finished with frames of another take. @retval 0 @retval
+ *  -errno */
+int scan_dir_begin_view(const struct hal_storage *st, const char *dir, uint32_t view);
+
+/** Remove what interrupted writes (a kill, a power cut) left in the scan directory @p dir and
+ *  in the directories of its views 0 .. @p views - 1. @retval 0 @retval -errno */
+int scan_dir_sweep(const struct hal_storage *st, const char *dir, uint32_t views);
 
 /** Keep the config and the calibration a scan ran with (config.ini, calibration.ini). */
 int scan_dir_keep_settings(const struct hal_storage *st, const char *config_path,

@@ -261,9 +261,9 @@ static int live_view(struct job *j, uint32_t v)
         return rc;
     }
     set_view(j, v);
-    rc = hal_storage_mkdir_p(&hal->storage, j->view_dir);
+    rc = scan_dir_begin_view(&hal->storage, j->out_dir, v); /* no view.ini of an earlier take */
     if (rc != 0) {
-        hal->log(HAL_LOG_ERROR, "cannot make %s: %s", j->view_dir, strerror(-rc));
+        hal->log(HAL_LOG_ERROR, "cannot prepare %s: %s", j->view_dir, strerror(-rc));
         return rc;
     }
     utc_now(started, sizeof(started));
@@ -312,26 +312,45 @@ static int home_and_take_views(struct job *j, uint32_t first)
     return rc;
 }
 
+/* Lock the job's output directory against a second scanner (checking what it holds by
+ * @p mode) and sweep what a kill left there; a refusal is said once. */
+static int open_out(struct job *j, enum scan_dir_mode mode, int *lock_fd)
+{
+    char err[SCAN_DIR_PATH_MAX + 256];
+    int rc = scan_dir_open(&j->hal->storage, j->out_dir, mode, lock_fd, err, sizeof(err));
+    if (rc == 0 && (rc = scan_dir_sweep(&j->hal->storage, j->out_dir, j->views)) != 0)
+        snprintf(err, sizeof(err), "cannot remove the temporary files in %s: %s", j->out_dir,
+                 strerror(-rc));
+    if (rc != 0) {
+        j->hal->log(HAL_LOG_ERROR, "%s", err);
+        scan_dir_close(*lock_fd);
+        *lock_fd = -1;
+    }
+    return rc;
+}
+
 int scan_job_live(const struct hal *hal, const struct app_config *cfg,
                   const struct scan_calib *calib, const struct scan_job_opts *opts)
 {
     struct job j = {hal, cfg, calib, opts, opts->out_dir ? opts->out_dir : cfg->output_dir,
                     cfg->views, wall_ms(), isatty(STDOUT_FILENO) && !opts->json, 0, ""};
     char path[HAL_MAX_PATH + 32];
-    int rc = hal_storage_mkdir_p(&hal->storage, j.out_dir);
-    if (rc == 0)
-        rc = scan_dir_keep_settings(&hal->storage, cfg->path, cfg->calibration_file, j.out_dir);
+    int lock_fd;
+    int rc = open_out(&j, opts->replace ? SCAN_DIR_REPLACE : SCAN_DIR_NEW, &lock_fd);
+    if (rc != 0)
+        return rc;
+    rc = scan_dir_keep_settings(&hal->storage, cfg->path, cfg->calibration_file, j.out_dir);
     if (rc != 0) {
         hal->log(HAL_LOG_ERROR, "cannot set up the scan directory %s: %s", j.out_dir,
                  strerror(-rc));
-        return rc;
+        goto out_unlock;
     }
     rc = fusion_begin(&cfg->fusion);
     icp_reset();
     if (rc == 0)
-        rc = board_write_scan_extras(hal, j.out_dir);
+        rc = write_failed(&j, "(the simulator's truth)", board_write_scan_extras(hal, j.out_dir));
     if (rc != 0)
-        return rc;
+        goto out_unlock;
     progress(&j, "scan_start", -1, 0, j.out_dir);
     rc = home_and_take_views(&j, 0);
     if (rc == 0)
@@ -340,6 +359,8 @@ int scan_job_live(const struct hal *hal, const struct app_config *cfg,
         progress(&j, "scan_done", -1, j.views, finished_detail(&j, path, sizeof(path)));
     else if (opts->json)
         progress(&j, "scan_failed", -1, 0, strerror(-rc));
+out_unlock:
+    scan_dir_close(lock_fd);
     return rc;
 }
 
@@ -367,16 +388,23 @@ int scan_job_resume(const struct hal *hal, const struct app_config *cfg,
                     scan_dir, cfg->views, wall_ms(), isatty(STDOUT_FILENO) && !opts->json,
                      0, ""};
     char detail[64];
+    int lock_fd;
+    int rc = open_out(&j, SCAN_DIR_EXISTING, &lock_fd);
+    if (rc != 0)
+        return rc;
     uint32_t first = 0;
     while (first < cfg->views && scan_dir_view_complete(scan_dir, first))
         first++;
     snprintf(detail, sizeof(detail), "%u of %u views kept", (unsigned)first, (unsigned)cfg->views);
     progress(&j, "resume", -1, first, detail);
-    if (first == cfg->views)
-        return 0;
-    int rc = fusion_begin(&cfg->fusion); /* the model comes from scan_job_process afterwards */
-    icp_reset();
-    return rc != 0 ? rc : home_and_take_views(&j, first);
+    if (first < cfg->views) {
+        rc = fusion_begin(&cfg->fusion); /* the model comes from scan_job_process afterwards */
+        icp_reset();
+        if (rc == 0)
+            rc = home_and_take_views(&j, first);
+    }
+    scan_dir_close(lock_fd);
+    return rc;
 }
 
 /* ---- offline ---- */
@@ -470,9 +498,17 @@ int scan_job_process(const struct hal *hal, const char *scan_dir, const struct s
     }
     struct job j = {hal, &cfg, &calib, opts, opts->out_dir ? opts->out_dir : scan_dir,
                     cfg.views, wall_ms(), isatty(STDOUT_FILENO) && !opts->json, 0, ""};
-    rc = hal_storage_mkdir_p(&hal->storage, j.out_dir);
-    if (rc == 0 && opts->out_dir != NULL) /* the results say how they were made */
-        rc = scan_dir_keep_settings(&hal->storage, cfg.path, cfg.calibration_file, j.out_dir);
+    int elsewhere = opts->out_dir != NULL && strcmp(opts->out_dir, scan_dir) != 0;
+    int lock_fd;
+    rc = open_out(&j, !elsewhere ? SCAN_DIR_EXISTING
+                      : opts->replace ? SCAN_DIR_REPLACE
+                                      : SCAN_DIR_NEW,
+                  &lock_fd);
+    if (rc != 0)
+        return rc;
+    if (elsewhere && (rc = scan_dir_keep_settings(&hal->storage, cfg.path, cfg.calibration_file,
+                                                  j.out_dir)) != 0) /* how they were made */
+        hal->log(HAL_LOG_ERROR, "cannot keep the settings in %s: %s", j.out_dir, strerror(-rc));
     if (rc == 0)
         rc = fusion_begin(&cfg.fusion);
     icp_reset();
@@ -491,5 +527,6 @@ int scan_job_process(const struct hal *hal, const char *scan_dir, const struct s
         rc = write_model(&j);
     if (rc == 0)
         progress(&j, "process_done", -1, j.views, finished_detail(&j, path, sizeof(path)));
+    scan_dir_close(lock_fd);
     return rc;
 }

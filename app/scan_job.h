@@ -13,6 +13,8 @@ struct scan_job_opts {
                                   config.ini (e.g. another [colour] method); NULL: the scan's */
     int clear_alarm; /**< resume: clear the turntable's alarm before homing (the operator has
                           fixed its cause: a blocked table, a jammed object) */
+    int replace;     /**< scan, process --out: a scan already in the output directory is
+                          replaced (without it, a directory that is not empty is refused) */
 };
 
 /** Home the table and take every configured view, saving each before the next move.

@@ -105,6 +105,11 @@ int hal_storage_commit(const struct hal_storage *st, struct hal_file *file)
     return HAL_CALL(st, commit, file);
 }
 
+int hal_storage_sweep(const struct hal_storage *st, const char *dir)
+{
+    return HAL_CALL(st, sweep, dir);
+}
+
 void hal_storage_abort(const struct hal_storage *st, struct hal_file *file)
 {
     if (st != NULL && st->ops != NULL && st->ops->abort != NULL)

@@ -69,10 +69,40 @@ check self_contained sh -c "! git grep -n '[.][.]/shared' -- ':!*.md' && rm -rf 
     git ls-files -z config data | xargs -0 cp --parents -t $clone &&
     sed -i 's/^views = .*/views = 1/' $clone/config/sim.ini &&
     $bin scan --config $clone/config/sim.ini --out $clone/scan | grep -q 'scan finished' &&
+    $bin scan --config $clone/config/sim.ini --out $clone/scan --replace | grep -q 'scan finished' &&
     rm $clone/data/bunny/bun_zipper.ply && ! $bin scan --config $clone/config/sim.ini \
     --out $clone/scan2 2> $clone/err.txt && grep 'data/bunny/bun_zipper.ply: No such file' $clone/err.txt"
 rm -rf "$out/scan" "$out/broken" "$out/broken_out"
 check scan sh -c "$bin scan --config config/sim.ini --out $out/scan | grep -q 'scan finished'"
+# A scan into a directory that holds one: refused, the old scan untouched (it was destroyed, and
+# resume then mixed both); --replace replaces a scan but nothing else; two scanners cannot
+# share a directory.
+check scan_refuses_non_empty_out sh -c "cp $out/scan/mesh.ply $out/mesh.before &&
+    ! $bin scan --config config/sim.ini --out $out/scan 2> $out/nonempty.txt &&
+    grep -q 'already holds .*--replace to replace it' $out/nonempty.txt &&
+    cmp $out/mesh.before $out/scan/mesh.ply && test -f $out/scan/view_007/view.ini"
+check replace_keeps_foreign_files sh -c "rm -rf $out/foreign && mkdir -p $out/foreign/view_000 &&
+    echo notes > $out/foreign/view_000/notes.txt && echo old > $out/foreign/mesh.ply &&
+    ! $bin scan --config config/sim.ini --out $out/foreign --replace 2> $out/foreign.txt &&
+    grep -q 'foreign/view_000/notes.txt is not part of a scan: nothing was replaced' \
+    $out/foreign.txt && grep -q old $out/foreign/mesh.ply"
+two_scanners_test() {
+    rm -rf "$out/together"
+    "$bin" scan --config config/sim.ini --out "$out/together" >/dev/null 2>&1 &
+    pid=$!
+    n=0
+    while [ ! -f "$out/together/config.ini" ] && [ $n -lt 400 ]; do
+        sleep 0.05
+        n=$((n + 1))
+    done
+    "$bin" scan --config config/sim.ini --out "$out/together" --replace >/dev/null 2>"$out/second.txt"
+    rc=$?
+    kill -INT "$pid"
+    wait "$pid"
+    cat "$out/second.txt"
+    [ "$rc" -ne 0 ] && grep -q 'another scanner is using this directory' "$out/second.txt"
+}
+check two_scanners_cannot_share_a_directory two_scanners_test
 check scan_dir_complete sh -c "for f in config.ini calibration.ini view_000/cloud.ply view_000/frame_00.png \
     view_000/frame_21.png view_000/view.ini view_000/truth_depth_mm.pfm view_000/truth_albedo.png; do \
     test -s $out/scan/\$f || exit 1; done"
@@ -89,9 +119,9 @@ esac
 check small_limits_scan_same_model sh -c "$limit $sbin scan --config config/sim.ini \
     --out $out/scan_small >/dev/null 2>&1 && cmp $out/scan/mesh.ply $out/scan_small/mesh.ply"
 rm -rf "$out/processed"
-check process_reproduces_scan sh -c "$bin process $out/scan --out $out/processed >/dev/null && \
+check process_reproduces_scan sh -c "$bin process $out/scan --out $out/processed --replace >/dev/null && \
     cmp $out/scan/view_000/cloud.ply $out/processed/view_000/cloud.ply"
-check json_events sh -c "$bin process $out/scan --out $out/processed --json | /usr/bin/python3 -c '
+check json_events sh -c "$bin process $out/scan --out $out/processed --replace --json | /usr/bin/python3 -c '
 import json, sys
 events = [json.loads(line)[\"event\"] for line in sys.stdin]
 assert events[0] == \"process_start\" and events[-1] == \"process_done\" and \"saved\" in events, events'"

@@ -27,7 +27,7 @@ static void scan_and_compare(const char *object, const char *transport, const ch
     snprintf(t.cfg.turntable.transport, sizeof(t.cfg.turntable.transport), "%s", transport);
     t.cfg.views = 8;
     assert_int_equal(test_rig_start(&t), 0);
-    struct scan_job_opts opts = {.out_dir = dir};
+    struct scan_job_opts opts = {.out_dir = dir, .replace = 1}; /* the last run's scan */
     int rc = scan_job_live(&t.hal, &t.cfg, &t.calib, &opts);
     test_rig_stop(&t);
     assert_int_equal(rc, 0);
@@ -58,7 +58,7 @@ static void test_bunny_over_tcp_and_process_reproduces(void **state)
     hal.log = test_rig_log;
     storage_posix_init(&hal.storage);
     clock_posix_init(&hal.clock);
-    struct scan_job_opts opts = {.out_dir = "build/test_scan/bunny_processed"};
+    struct scan_job_opts opts = {.out_dir = "build/test_scan/bunny_processed", .replace = 1};
     assert_int_equal(scan_job_process(&hal, "build/test_scan/bunny", &opts), 0);
     assert_true(test_files_equal("build/test_scan/bunny/mesh.ply",
                                  "build/test_scan/bunny_processed/mesh.ply"));

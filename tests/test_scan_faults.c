@@ -50,7 +50,7 @@ static int teardown(void **state)
 
 static int scan(const char *dir)
 {
-    struct scan_job_opts opts = {.out_dir = dir};
+    struct scan_job_opts opts = {.out_dir = dir, .replace = 1}; /* the last run's scan */
     return scan_job_live(&t.hal, &t.cfg, &t.calib, &opts);
 }
 

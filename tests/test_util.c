@@ -4,6 +4,7 @@
 
 #include "vec3.h"
 
+#include <dirent.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -30,6 +31,17 @@ int test_files_equal(const char *a, const char *b)
     if (fb)
         fclose(fb);
     return same;
+}
+
+int test_temporaries_in(const char *dir)
+{
+    int n = 0;
+    DIR *d = opendir(dir);
+    for (struct dirent *e = d ? readdir(d) : NULL; e != NULL; e = readdir(d))
+        n += strstr(e->d_name, ".tmp.") != NULL;
+    if (d != NULL)
+        closedir(d);
+    return n;
 }
 
 int test_rig_dark(void)

@@ -19,6 +19,8 @@ extern int test_error_count;
 
 /** @retval 1 when both files exist and hold the same bytes */
 int test_files_equal(const char *a, const char *b);
+/** @retval how many temporary files of an atomic write (NAME.tmp.XXXXXX) are in @p dir */
+int test_temporaries_in(const char *dir);
 /** @retval 1 when the simulated projector and every light are off */
 int test_rig_dark(void);
 

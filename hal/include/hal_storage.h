@@ -25,6 +25,9 @@ struct hal_storage_ops {
     void (*abort)(void *priv, struct hal_file *file);
     /** Nothing to make safe; present so that every device has the op. */
     int (*safe_state)(void *priv);
+    /** Optional: remove the temporary files that interrupted writes left in directory @p dir.
+     *  @retval 0 ok (also when there were none) @retval -errno */
+    int (*sweep)(void *priv, const char *dir);
 };
 
 struct hal_storage {
@@ -43,6 +46,9 @@ int hal_storage_write(const struct hal_storage *st, struct hal_file *file, const
 int hal_storage_commit(const struct hal_storage *st, struct hal_file *file);
 /** Abort an open write; safe on a file that is not open. */
 void hal_storage_abort(const struct hal_storage *st, struct hal_file *file);
+/** Remove what interrupted writes left in @p dir. @retval -ENOSYS when the backend lacks the op;
+ *  otherwise what the op returns. */
+int hal_storage_sweep(const struct hal_storage *st, const char *dir);
 /** Write a whole buffer atomically. @retval 0 ok @retval -errno, and the old file is untouched */
 int hal_storage_write_file(const struct hal_storage *st, const char *path, const void *data,
                            size_t len);

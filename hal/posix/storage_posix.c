@@ -2,12 +2,18 @@
 #define _POSIX_C_SOURCE 200809L
 #include "storage_posix.h"
 
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+
+/* Temporary files are named FILE.tmp.XXXXXX: a name nobody can plant a link at in advance. */
+#define TEMP_SUFFIX ".tmp."
+#define TEMP_RANDOM "XXXXXX"
 
 static int posix_mkdir_p(void *priv, const char *path)
 {
@@ -38,12 +44,24 @@ static int posix_open_atomic(void *priv, struct hal_file *file, const char *path
     (void)priv;
     file->fd = -1;
     int n1 = snprintf(file->final_path, sizeof(file->final_path), "%s", path);
-    int n2 = snprintf(file->temp_path, sizeof(file->temp_path), "%s.tmp", path);
+    int n2 = snprintf(file->temp_path, sizeof(file->temp_path), "%s" TEMP_SUFFIX TEMP_RANDOM,
+                      path);
     if (n1 < 0 || n2 < 0 || (size_t)n2 >= sizeof(file->temp_path))
         return -ENAMETOOLONG;
-    /* O_TRUNC: a temp file left by a crash is simply overwritten. */
-    file->fd = open(file->temp_path, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    return file->fd < 0 ? -errno : 0;
+    /* mkstemp creates a new file of a name of its own (O_CREAT | O_EXCL): a symlink or a file
+     * someone planted in the directory is never followed nor overwritten. What a crash leaves
+     * is removed by posix_sweep at the next start. */
+    file->fd = mkstemp(file->temp_path);
+    if (file->fd < 0)
+        return -errno;
+    if (fcntl(file->fd, F_SETFD, FD_CLOEXEC) != 0 || fchmod(file->fd, 0644) != 0) {
+        int rc = -errno;
+        close(file->fd);
+        file->fd = -1;
+        unlink(file->temp_path);
+        return rc;
+    }
+    return 0;
 }
 
 static int posix_write(void *priv, struct hal_file *file, const void *data, size_t len)
@@ -120,6 +138,29 @@ static int posix_safe_state(void *priv)
     return 0;
 }
 
+/* @retval 1 when @p name is a temporary file of open_atomic: NAME.tmp.XXXXXX */
+static int is_temporary(const char *name)
+{
+    size_t n = strlen(name), tail = strlen(TEMP_SUFFIX TEMP_RANDOM);
+    return n > tail && strncmp(name + n - tail, TEMP_SUFFIX, strlen(TEMP_SUFFIX)) == 0;
+}
+
+static int posix_sweep(void *priv, const char *dir)
+{
+    (void)priv;
+    DIR *d = opendir(dir);
+    if (d == NULL)
+        return errno == ENOENT ? 0 : -errno;
+    int rc = 0;
+    for (struct dirent *e = readdir(d); e != NULL; e = readdir(d)) {
+        /* unlinkat removes a planted symlink itself, never its target */
+        if (is_temporary(e->d_name) && unlinkat(dirfd(d), e->d_name, 0) != 0 && rc == 0)
+            rc = -errno;
+    }
+    closedir(d);
+    return rc;
+}
+
 static const struct hal_storage_ops posix_storage_ops = {
     .mkdir_p = posix_mkdir_p,
     .open_atomic = posix_open_atomic,
@@ -127,6 +168,7 @@ static const struct hal_storage_ops posix_storage_ops = {
     .commit = posix_commit,
     .abort = posix_abort,
     .safe_state = posix_safe_state,
+    .sweep = posix_sweep,
 };
 
 void storage_posix_init(struct hal_storage *st)
