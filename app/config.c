@@ -320,7 +320,7 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
         snprintf(err, err_len,
                  "%s: [fusion] voxel_mm: a %.2f mm grid over radius %.0f mm and heights %.0f..%.0f "
                  "mm exceeds the compiled limit (%u per axis, %u voxels: FUSION_MAX_* in "
-                 "firmware/fusion.h)",
+                 "hal/include/hal_limits.h)",
                  path, cfg->fusion.voxel_mm, cfg->fusion.radius_mm, cfg->fusion.bottom_mm,
                  cfg->fusion.top_mm, FUSION_MAX_DIM, FUSION_MAX_VOXELS);
         return -EINVAL;
@@ -334,6 +334,11 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
         snprintf(err, err_len,
                  "%s: [sim] merl_name: merl_file and merl_name are required when "
                  "material = merl",
+                 path);
+        return -EINVAL;
+    }
+    if (cfg->calibration_file[0] == '\0') {
+        snprintf(err, err_len, "%s: [scan] calibration: empty: name the rig's calibration file",
                  path);
         return -EINVAL;
     }
@@ -376,6 +381,16 @@ int calib_load(struct scan_calib *calib, const char *path, uint32_t light_count,
                 return -EINVAL;
             }
         }
+    }
+    /* Triangulation needs the projector off the camera's centre: a baseline of a few mm or less
+     * gives rays that meet nowhere useful (and 0 gives a scan of no points at all). */
+    double baseline_mm = v3_len(v3_from(calib->proj_trans_mm));
+    if (baseline_mm < 10.0) {
+        snprintf(err, err_len,
+                 "%s: [projector] translation_mm: the projector is %.1f mm from the camera; "
+                 "triangulation needs a baseline (typically 100-300 mm)",
+                 path, baseline_mm);
+        return -EINVAL;
     }
     calib->light_count = light_count;
     for (uint32_t i = 0; i < light_count; i++) {

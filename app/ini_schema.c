@@ -5,11 +5,17 @@
 #include "hal_gpio.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <ini.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+/* A config or calibration is a few kilobytes; anything far larger is not one. */
+#define INI_MAX_FILE_BYTES (1u << 20)
 
 struct parse_state {
     const struct ini_key *keys;
@@ -24,14 +30,52 @@ struct parse_state {
     int failed;
 };
 
-/* inih reads one line per call: counting here gives the line of the key being handled. */
+/* inih reads one line per call: counting here gives the line of the key being handled. A line
+ * longer than inih's buffer would come in pieces, the tail read as a line of its own (a comment's
+ * tail taken for a key): it is refused instead. */
 static char *counting_reader(char *str, int num, void *stream)
 {
     struct parse_state *st = stream;
     char *r = fgets(str, num, st->file);
-    if (r != NULL)
-        st->line++;
+    if (r == NULL || st->failed)
+        return NULL;
+    st->line++;
+    size_t n = strlen(r);
+    if (n + 1 == (size_t)num && r[n - 1] != '\n' && !feof(st->file)) {
+        snprintf(st->err, st->err_len, "%s:%d: line longer than %d characters", st->path,
+                 st->line, num - 2);
+        st->failed = 1;
+        return NULL;
+    }
     return r;
+}
+
+/* Open @p path for reading if it is a regular file of a sensible size (a device such as
+ * /dev/zero, a FIFO or a directory is not a config). @retval 0 @retval -errno, said in @p err */
+static int open_regular(const char *path, FILE **out, char *err, size_t err_len)
+{
+    /* O_NONBLOCK: opening a FIFO must not wait for a writer */
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    struct stat st;
+    int rc = 0;
+    if (fd < 0 || fstat(fd, &st) != 0) {
+        rc = -errno;
+        snprintf(err, err_len, "%s: cannot open: %s", path, strerror(-rc));
+    } else if (!S_ISREG(st.st_mode)) {
+        rc = S_ISDIR(st.st_mode) ? -EISDIR : -EINVAL;
+        snprintf(err, err_len, "%s: not a regular file (%s)", path,
+                 S_ISDIR(st.st_mode) ? "a directory" : "a device, pipe or socket");
+    } else if (st.st_size > (off_t)INI_MAX_FILE_BYTES) {
+        rc = -EFBIG;
+        snprintf(err, err_len, "%s: %lld bytes, too large for a config or calibration (at most "
+                 "%u)", path, (long long)st.st_size, INI_MAX_FILE_BYTES);
+    } else if ((*out = fdopen(fd, "r")) == NULL) {
+        rc = -errno;
+        snprintf(err, err_len, "%s: cannot open: %s", path, strerror(-rc));
+    }
+    if (rc != 0 && fd >= 0)
+        close(fd);
+    return rc;
 }
 
 static int parse_double(const char *s, double *out)
@@ -230,12 +274,9 @@ int ini_schema_load(const struct ini_key *keys, size_t key_count, void *target, 
                  INI_MAX_KEYS);
         return -EINVAL;
     }
-    st.file = fopen(path, "r");
-    if (st.file == NULL) {
-        int e = errno;
-        snprintf(err, err_len, "%s: cannot open: %s", path, strerror(e));
-        return -e;
-    }
+    int rc_open = open_regular(path, &st.file, err, err_len);
+    if (rc_open != 0)
+        return rc_open;
     int rc = ini_parse_stream(counting_reader, &st, handler, &st);
     fclose(st.file);
     if (st.failed)

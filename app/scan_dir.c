@@ -382,8 +382,8 @@ int scan_dir_open(const struct hal_storage *st, const char *dir, enum scan_dir_m
     char first[256];
     if (mode == SCAN_DIR_NEW && !empty_dir(dir, first, sizeof(first))) {
         snprintf(err, err_len,
-                 "%s already holds %s: choose another --out, 'scanner resume %s' to finish the "
-                 "scan there, or --replace to replace it",
+                 "%s already holds %s: choose another --out, or --replace to replace the scan "
+                 "there ('scanner resume %s' finishes a scan that was stopped)",
                  dir, first, dir);
         rc = -EEXIST;
         goto out_close;

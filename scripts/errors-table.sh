@@ -93,6 +93,23 @@ ply_row huge "PLY claiming more than it holds" "element vertex 50000000, no data
     'ply\nformat binary_little_endian 1.0\nelement vertex 50000000\nproperty float x\nend_header\n'
 mkdir -p "$w/not-a-scan"
 row "not a scan directory" "process an empty directory" "$sim" process "$w/not-a-scan"
+row "config not a regular file" "--config /dev/zero" "$sim" check-config --config /dev/zero
+row "config is a directory" "--config config" "$sim" check-config --config config
+cfg long "; $(printf '%0250d' 0) start_angle_deg = 45"
+row "line over the parser's limit" "a 300-character comment" "$sim" check-config --config "$w/long.ini"
+cfg emptycalib '' && sed -i 's|^calibration = .*|calibration =|' "$w/emptycalib.ini"
+row "calibration empty" "calibration =" "$sim" check-config --config "$w/emptycalib.ini"
+sed 's/^translation_mm = .*/translation_mm = 0, 0, 0/' config/sim-calib.ini > "$w/calib-nobase.ini"
+cfg nobase '' && sed -i "s|^calibration = .*|calibration = calib-nobase.ini|" "$w/nobase.ini"
+row "no baseline" "translation_mm = 0, 0, 0" "$sim" check-config --config "$w/nobase.ini"
+mkdir -p "$w/full" && echo notes > "$w/full/notes.txt"
+cfg one '[scan]
+views = 1'
+row "output directory not empty" "scan --out DIR holding notes.txt" "$sim" scan --config "$w/one.ini" --out "$w/full"
+mkdir -p "$w/badview/view_000" && cp "$w/one.ini" "$w/badview/config.ini" &&
+    cp config/sim-calib.ini "$w/badview/calibration.ini" &&
+    printf '[view]\nindex = 0\nangle_mdeg = abc\nframes = 22\n' > "$w/badview/view_000/view.ini"
+PATTERN='error:' row "view.ini value not a number" "angle_mdeg = abc" "$sim" process "$w/badview"
 row "unknown argument" "scan --colour" "$sim" scan --colour
 if [ -x "$dev" ]; then
     PATTERN='^camera' row "camera missing (V4L2)" "/dev/video0 absent" "$dev" selftest --config config/pi-v4l2.ini

@@ -79,7 +79,7 @@ check scan sh -c "$bin scan --config config/sim.ini --out $out/scan | grep -q 's
 # share a directory.
 check scan_refuses_non_empty_out sh -c "cp $out/scan/mesh.ply $out/mesh.before &&
     ! $bin scan --config config/sim.ini --out $out/scan 2> $out/nonempty.txt &&
-    grep -q 'already holds .*--replace to replace it' $out/nonempty.txt &&
+    grep -q 'already holds .*--replace to replace the scan there' $out/nonempty.txt &&
     cmp $out/mesh.before $out/scan/mesh.ply && test -f $out/scan/view_007/view.ini"
 check replace_keeps_foreign_files sh -c "rm -rf $out/foreign && mkdir -p $out/foreign/view_000 &&
     echo notes > $out/foreign/view_000/notes.txt && echo old > $out/foreign/mesh.ply &&

@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "board.h"
 #include "config.h"
@@ -163,6 +164,61 @@ static void test_calibration_errors(void **state)
     assert_int_equal(calib_load(&calib, path, 2, err, sizeof(err)), -EINVAL);
 }
 
+/* A line longer than the parser's buffer is refused; before, the tail of a long comment was
+ * read as a key of its own (start_angle_deg = 45 took effect). */
+static void test_overlong_line_refused(void **state)
+{
+    (void)state;
+    char extra[512];
+    int n = snprintf(extra, sizeof(extra), "; ");
+    while (n < 250)
+        extra[n++] = 'x';
+    snprintf(extra + n, sizeof(extra) - (size_t)n, " start_angle_deg = 45\nviews = 8\n");
+    expect_error(extra, "bad.ini:8: line longer than 198 characters");
+}
+
+/* Only a regular file of a sensible size is a config: /dev/zero, a FIFO and a directory each
+ * get their own message at once (before, /dev/zero spun forever at 100% CPU, a directory was
+ * "required key is missing"). */
+static void test_not_a_regular_file(void **state)
+{
+    (void)state;
+    err[0] = '\0';
+    assert_int_equal(config_load(&cfg, "/dev/zero", err, sizeof(err)), -EINVAL);
+    assert_non_null(strstr(err, "/dev/zero: not a regular file (a device, pipe or socket)"));
+    assert_int_equal(config_load(&cfg, DIR, err, sizeof(err)), -EISDIR);
+    assert_non_null(strstr(err, DIR ": not a regular file (a directory)"));
+    unlink(DIR "/fifo");
+    assert_int_equal(mkfifo(DIR "/fifo", 0600), 0);
+    assert_int_equal(config_load(&cfg, DIR "/fifo", err, sizeof(err)), -EINVAL);
+    assert_non_null(strstr(err, "fifo: not a regular file"));
+    struct scan_calib calib;
+    assert_int_equal(calib_load(&calib, "/dev/urandom", 0, err, sizeof(err)), -EINVAL);
+    assert_non_null(strstr(err, "/dev/urandom: not a regular file"));
+}
+
+/* An empty calibration name, and a calibration whose projector sits on the camera (a scan of
+ * it "finished" with 0 points): each refused with its key. */
+static void test_empty_calibration_and_zero_baseline(void **state)
+{
+    (void)state;
+    const char *path = write_file(
+        "empty-calib.ini", "[camera]\nbackend = sim\nwidth = 1280\nheight = 960\n"
+                           "exposure_us = 10000\n[scan]\ncalibration =\n");
+    assert_int_equal(config_load(&cfg, path, err, sizeof(err)), -EINVAL);
+    assert_non_null(strstr(err, "[scan] calibration: empty"));
+    struct scan_calib calib;
+    path = write_file(
+        "no-baseline.ini",
+        "[camera]\nfx_px = 100\nfy_px = 100\ncx_px = 1\ncy_px = 1\nwidth = 64\nheight = 64\n"
+        "[projector]\nfx_px = 100\nfy_px = 100\ncx_px = 1\ncy_px = 1\nwidth = 64\n"
+        "height = 64\nrotation = 1, 0, 0, 0, 1, 0, 0, 0, 1\ntranslation_mm = 0, 0, 0\n"
+        "[turntable]\naxis_point_mm = 0, 0, 500\naxis_dir = 0, -1, 0\n");
+    assert_int_equal(calib_load(&calib, path, 0, err, sizeof(err)), -EINVAL);
+    assert_non_null(strstr(err, "[projector] translation_mm: the projector is 0.0 mm from the "
+                                "camera"));
+}
+
 /* A HAL=sim build refuses a real-hardware backend rather than faking it. */
 static void test_backend_not_built_in(void **state)
 {
@@ -216,6 +272,9 @@ int main(void)
         cmocka_unit_test(test_calibration_errors),
         cmocka_unit_test(test_backend_not_built_in),
         cmocka_unit_test(test_docs_cover_every_key),
+        cmocka_unit_test(test_overlong_line_refused),
+        cmocka_unit_test(test_not_a_regular_file),
+        cmocka_unit_test(test_empty_calibration_and_zero_baseline),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
