@@ -64,8 +64,15 @@ static void start_move(struct tt_ctrl *c, double target, uint64_t now_us)
     c->moving = 1;
 }
 
+static void execute(struct tt_ctrl *c, uint16_t cmd, uint64_t now_us);
+
 void tt_ctrl_update(struct tt_ctrl *c, uint64_t now_us)
 {
+    if (c->pending && now_us >= c->pending_due_us) { /* a slow controller gets round to it */
+        c->pending = 0;
+        c->last_id = c->pending_id;
+        execute(c, c->pending_cmd, c->pending_due_us);
+    }
     if (c->moving) {
         double t = (double)(now_us - c->start_us) / 1e6;
         double d = fabs(c->target_mdeg - c->start_mdeg);
@@ -160,7 +167,13 @@ void tt_ctrl_after_write(struct tt_ctrl *c, uint64_t now_us)
 {
     tt_ctrl_update(c, now_us);
     uint16_t id = c->regs[TT_REG_COMMAND_ID];
-    if (id != c->last_id) { /* a new command; the same id again is a repeat and does nothing */
+    if (c->command_delay_us != 0 && id != c->last_id && !(c->pending && id == c->pending_id)) {
+        c->pending = 1; /* acted on later, in tt_ctrl_update */
+        c->pending_cmd = c->regs[TT_REG_COMMAND];
+        c->pending_id = id;
+        c->pending_due_us = now_us + c->command_delay_us;
+    } else if (c->command_delay_us == 0 && id != c->last_id) {
+        /* a new command; the same id again is a repeat and does nothing */
         c->last_id = id;
         execute(c, c->regs[TT_REG_COMMAND], now_us);
     }

@@ -25,6 +25,12 @@ struct tt_ctrl {
     int32_t angle_error_mdeg;
     uint32_t moves;
     double physical_offset_mdeg;
+    /* fault injection (tests): a controller that acts on a command only this long after it
+     * came, reporting idle and the previous LAST_ID meanwhile (0: at once) */
+    uint32_t command_delay_us;
+    int pending;              /* a command received, not yet executed */
+    uint16_t pending_cmd, pending_id;
+    uint64_t pending_due_us;
 };
 
 /** Power-on state: not homed, at a random-ish position @p power_on_mdeg, idle. */

@@ -94,6 +94,13 @@ static void answer(struct tt_server *s, const uint8_t *req, int len)
     pthread_mutex_lock(&s->lock);
     uint64_t now = s->now(s->now_priv);
     tt_ctrl_update(&s->ctrl, now);
+    if (s->busy_replies > 0) {
+        s->busy_replies--;
+        s->requests++;
+        pthread_mutex_unlock(&s->lock);
+        modbus_reply_exception(s->ctx, req, MODBUS_EXCEPTION_SLAVE_OR_SERVER_BUSY);
+        return;
+    }
     if ((function == 0x06 || function == 0x10) && tt_ctrl_check_write(&s->ctrl, addr, count)) {
         pthread_mutex_unlock(&s->lock);
         modbus_reply_exception(s->ctx, req, MODBUS_EXCEPTION_ILLEGAL_DATA_ADDRESS);

@@ -28,6 +28,9 @@ struct tt_server {
     /* fault injection (tests, TCP): after this many requests in all, drop the client without
      * answering, as a pulled cable or a rebooting controller does (0: never) */
     unsigned long drop_at_request;
+    /* fault injection (tests): answer the next this many requests with exception 6, "server
+     * busy", as a controller does while it is occupied */
+    unsigned long busy_replies;
 };
 
 /** Listen on @p host:@p port (0: any free port, see ->port). @retval 0 or -errno (message in err) */

@@ -207,6 +207,47 @@ static void test_table_moved_noticed_before_the_move(void **state)
     assert_int_equal(tt_server_position(&server), 50000);
 }
 
+/* "Server busy" (exception 6) asks to be asked again: retried within the same bounds (before,
+ * one busy reply stopped the scan); a controller that stays busy is one error. */
+static void test_busy_controller_asked_again(void **state)
+{
+    (void)state;
+    assert_int_equal(hal_table_home(&table), 0);
+    pthread_mutex_lock(&server.lock);
+    server.busy_replies = 2; /* within retries = 2 */
+    pthread_mutex_unlock(&server.lock);
+    errors_logged = 0;
+    assert_int_equal(hal_table_move_to(&table, 30000), 0);
+    assert_int_equal(errors_logged, 0);
+    assert_int_equal(tt_server_position(&server), 30000);
+    pthread_mutex_lock(&server.lock);
+    server.busy_replies = 1000;
+    pthread_mutex_unlock(&server.lock);
+    assert_int_equal(hal_table_move_to(&table, 60000), -EIO);
+    assert_int_equal(errors_logged, 1);
+    assert_non_null(strstr(last_log, "exception 6"));
+    pthread_mutex_lock(&server.lock);
+    server.busy_replies = 0;
+    pthread_mutex_unlock(&server.lock);
+}
+
+/* A controller that takes a while to act on a command reports idle meanwhile: the move is over
+ * only once it has taken this command (LAST_ID) and is idle again (before: "did not reach"). */
+static void test_slow_controller_move_waits_for_its_command(void **state)
+{
+    (void)state;
+    assert_int_equal(hal_table_home(&table), 0);
+    pthread_mutex_lock(&server.lock);
+    server.ctrl.command_delay_us = 300000; /* six polls */
+    pthread_mutex_unlock(&server.lock);
+    errors_logged = 0;
+    assert_int_equal(hal_table_move_to(&table, 120000), 0);
+    assert_int_equal(errors_logged, 0);
+    assert_int_equal(tt_server_position(&server), 120000);
+    assert_int_equal(hal_table_move_to(&table, 0), 0);
+    assert_int_equal(tt_server_position(&server), 0);
+}
+
 /* A read-only register written: the controller's exception, reported as such, not retried. */
 static void test_illegal_address_exception(void **state)
 {
@@ -335,6 +376,9 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_stall_reported_with_position, open_tcp, close_all),
         cmocka_unit_test_setup_teardown(test_restart_noticed_before_the_move, open_tcp, close_all),
         cmocka_unit_test_setup_teardown(test_table_moved_noticed_before_the_move, open_tcp,
+                                        close_all),
+        cmocka_unit_test_setup_teardown(test_busy_controller_asked_again, open_tcp, close_all),
+        cmocka_unit_test_setup_teardown(test_slow_controller_move_waits_for_its_command, open_tcp,
                                         close_all),
         cmocka_unit_test_setup_teardown(test_illegal_address_exception, open_tcp, close_all),
         cmocka_unit_test_setup_teardown(test_command_applied_once, open_tcp, close_all),

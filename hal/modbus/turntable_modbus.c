@@ -31,10 +31,11 @@ static int translate(int e, char *msg, size_t len)
     return -e;
 }
 
-/* Retry only what a second try can cure; an exception is the controller's final word. */
+/* Retry only what a second try can cure: an exception is the controller's final word, except
+ * "busy" and "acknowledge" (working on it), which ask to be asked again. */
 static int retryable(int e)
 {
-    return !(e >= EMBXILFUN && e <= EMBXGTAR);
+    return !(e >= EMBXILFUN && e <= EMBXGTAR) || e == EMBXSBUSY || e == EMBXACK;
 }
 
 static void recover(struct tt_client *c, int e)
@@ -141,7 +142,8 @@ static int wait_idle(struct tt_client *c, const char *what, struct hal_turntable
     uint64_t start, now;
     hal_clock_now_us(c->clock, &start);
     for (;;) {
-        int rc = read_status(c, st, NULL, NULL);
+        uint16_t last_id;
+        int rc = read_status(c, st, NULL, &last_id);
         if (rc != 0)
             return rc;
         if (st->alarm_code != 0) {
@@ -150,7 +152,9 @@ static int wait_idle(struct tt_client *c, const char *what, struct hal_turntable
                    st->position_mdeg / 1000.0);
             return -EIO;
         }
-        if (!st->busy)
+        /* Done once the controller has taken this command (LAST_ID) and is idle again: idle
+         * before it took it means it has not started, not that it has arrived. */
+        if (!st->busy && last_id == c->last_id)
             return 0;
         hal_clock_now_us(c->clock, &now);
         if (now - start > (uint64_t)c->cfg.move_timeout_ms * 1000u) {
