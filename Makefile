@@ -154,7 +154,8 @@ $(BUILD)/colour-eval: $(call obj,tests/colour_eval.c tests/colour_metrics.c host
 
 # ---- tests ----
 TEST_SRC := $(filter-out tests/test_util.c,$(wildcard tests/test_*.c))
-TEST_SUPPORT := $(BUILD)/tests/test_util.o $(BUILD)/tests/mesh_compare_lib.o $(BUILD)/tests/colour_metrics.o
+TEST_SUPPORT := $(BUILD)/tests/test_util.o $(BUILD)/tests/mesh_compare_lib.o $(BUILD)/tests/colour_metrics.o \
+	$(BUILD)/tests/tcp_relay.o
 TEST_BIN := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 TEST_LIBS = $(shell $(PKG_CONFIG) --libs cmocka libmodbus 2>/dev/null)
 

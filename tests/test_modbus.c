@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "pty_link.h"
+#include "tcp_relay.h"
 #include "sim_devices.h"
 #include "tt_server.h"
 #include "turntable_modbus.h"
@@ -85,6 +86,80 @@ static int open_rtu(void **state)
     snprintf(c.transport, sizeof(c.transport), "rtu");
     snprintf(c.device, sizeof(c.device), "%s", link.path[0]);
     return tt_client_open(&client, &c, &vhal_clock, log_capture, &table, err, sizeof(err));
+}
+
+/* TCP through the hostile relay. */
+static struct tcp_relay relay;
+static int open_tcp_relay(void **state)
+{
+    (void)state;
+    char err[256];
+    errors_logged = 0;
+    last_log[0] = '\0';
+    clock_sim_init(&vclock, &vhal_clock);
+    if (tt_server_open_tcp(&server, "127.0.0.1", 0, clock_sim_now, &vclock, err, sizeof(err)) ||
+        tt_server_start(&server) || tcp_relay_start(&relay, server.port))
+        return -1;
+    struct tt_client_config c = base_config();
+    c.port = (uint32_t)relay.port;
+    return tt_client_open(&client, &c, &vhal_clock, log_capture, &table, err, sizeof(err));
+}
+
+static int close_relay(void **state)
+{
+    tt_client_close(&client);
+    tcp_relay_stop(&relay);
+    tt_server_close(&server);
+    (void)state;
+    return 0;
+}
+
+/* Five moves there and back, each checked where the controller says the table is. */
+static void moves_arrive(void)
+{
+    for (int k = 1; k <= 5; k++) {
+        int32_t to = (k % 2) ? 10000 * k : 0;
+        assert_int_equal(hal_table_move_to(&table, to), 0);
+        assert_int_equal(tt_server_position(&server), to);
+    }
+}
+
+/* One reply held back past the timeout, then delivered: before, every later request read the
+ * reply of the one before ("Invalid data" to the end of the scan) and the final STOP failed.
+ * Now the late reply is left behind with its connection and every later move arrives. */
+static void test_late_reply_does_not_desynchronise(void **state)
+{
+    (void)state;
+    assert_int_equal(hal_table_home(&table), 0);
+    unsigned long before = tcp_relay_connections(&relay);
+    tcp_relay_delay(&relay, 2, 350); /* past the 200 ms response timeout */
+    errors_logged = 0;
+    moves_arrive();
+    assert_int_equal(errors_logged, 0);
+    assert_true(tcp_relay_connections(&relay) > before); /* left behind with its connection */
+    /* and the STOP of the safe state reaches the controller */
+    assert_int_equal(table.ops->safe_state(table.priv), 0);
+    pthread_mutex_lock(&server.lock);
+    uint16_t last = server.ctrl.last_id, cmd = server.ctrl.regs[TT_REG_COMMAND];
+    pthread_mutex_unlock(&server.lock);
+    assert_int_equal(last, client.last_id);
+    assert_int_equal(cmd, TT_CMD_STOP);
+}
+
+/* One reply sent twice: the spare copy answers nobody. */
+static void test_duplicated_reply_does_not_desynchronise(void **state)
+{
+    (void)state;
+    assert_int_equal(hal_table_home(&table), 0);
+    tcp_relay_duplicate(&relay, 2);
+    errors_logged = 0;
+    moves_arrive();
+    assert_int_equal(errors_logged, 0);
+    assert_int_equal(table.ops->safe_state(table.priv), 0);
+    pthread_mutex_lock(&server.lock);
+    uint16_t last = server.ctrl.last_id;
+    pthread_mutex_unlock(&server.lock);
+    assert_int_equal(last, client.last_id);
 }
 
 static int close_all(void **state)
@@ -380,6 +455,10 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_busy_controller_asked_again, open_tcp, close_all),
         cmocka_unit_test_setup_teardown(test_slow_controller_move_waits_for_its_command, open_tcp,
                                         close_all),
+        cmocka_unit_test_setup_teardown(test_late_reply_does_not_desynchronise, open_tcp_relay,
+                                        close_relay),
+        cmocka_unit_test_setup_teardown(test_duplicated_reply_does_not_desynchronise,
+                                        open_tcp_relay, close_relay),
         cmocka_unit_test_setup_teardown(test_illegal_address_exception, open_tcp, close_all),
         cmocka_unit_test_setup_teardown(test_command_applied_once, open_tcp, close_all),
         cmocka_unit_test_setup_teardown(test_no_reply_times_out, open_tcp, close_all),

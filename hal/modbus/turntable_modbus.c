@@ -38,15 +38,20 @@ static int retryable(int e)
     return !(e >= EMBXILFUN && e <= EMBXGTAR) || e == EMBXSBUSY || e == EMBXACK;
 }
 
+/* Before a retry. On TCP a reply that came late, twice or garbled may still be on its way, and a
+ * flush cannot know when it has all gone: the next request would read it as its own answer
+ * (libmodbus refuses its transaction id, and so on for the rest of the scan). A new connection
+ * leaves it behind. An exception was a matched reply, so nothing is left to drop. */
 static void recover(struct tt_client *c, int e)
 {
-    modbus_flush(c->ctx);
-    if (c->is_tcp && (e == ECONNRESET || e == EPIPE || e == ENOTCONN || e == EBADF ||
-                      e == ECONNREFUSED)) {
+    int exception = e >= EMBXILFUN && e <= EMBXGTAR;
+    if (c->is_tcp && !exception) {
         modbus_close(c->ctx);
         if (modbus_connect(c->ctx) != 0)
             c->log(HAL_LOG_WARN, "turntable: reconnect to %s:%u failed: %s", c->cfg.host,
                    (unsigned)c->cfg.port, modbus_strerror(errno));
+    } else {
+        modbus_flush(c->ctx);
     }
     hal_clock_sleep_us(c->clock, (uint64_t)c->cfg.poll_interval_ms * 1000u);
 }
