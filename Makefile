@@ -193,7 +193,7 @@ check-firmware: $(FW_OBJ)
 # make fuzz: each target under libFuzzer (clang, with ASan + UBSan) for FUZZ_SECONDS, seeded by
 # and merged back into tests/fuzz/corpus/<target>/; a crash is written to tests/fuzz/crashes/.
 # make test replays the corpus and every crash kept (fuzz-replay-*, built like the suite).
-FUZZ_TARGETS := config calib view_ini ply modbus
+FUZZ_TARGETS := config calib view_ini scan_dir ply modbus
 FUZZ_SECONDS ?= 600
 FUZZ_LIB_SRC := app/config.c app/ini_schema.c app/scan_dir.c hal/posix/image_io.c \
 	host_sim/sim_mesh.c host_sim/sim_ply_read.c hal/modbus/turntable_modbus.c host_sim/clock_sim.c

@@ -5,7 +5,7 @@ set -u
 cd "$(dirname "$0")/../.."
 pass=0
 fail=0
-for t in config calib view_ini ply modbus; do
+for t in config calib view_ini scan_dir ply modbus; do
     if "${BUILD:-build}/tests/fuzz-replay-$t" "tests/fuzz/corpus/$t" "tests/fuzz/crashes/$t"; then
         pass=$((pass + 1))
     else
