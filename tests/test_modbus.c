@@ -55,19 +55,32 @@ static struct tt_client_config base_config(void)
     return c;
 }
 
-static int open_tcp(void **state)
+/* The controller on TCP, the client talking to it directly or through the hostile relay. */
+static struct tcp_relay relay;
+static int start_tcp(int via_relay)
 {
-    (void)state;
     char err[256];
     errors_logged = 0;
     last_log[0] = '\0';
     clock_sim_init(&vclock, &vhal_clock);
     if (tt_server_open_tcp(&server, "127.0.0.1", 0, clock_sim_now, &vclock, err, sizeof(err)) ||
-        tt_server_start(&server))
+        tt_server_start(&server) || (via_relay && tcp_relay_start(&relay, server.port)))
         return -1;
     struct tt_client_config c = base_config();
-    c.port = (uint32_t)server.port;
+    c.port = (uint32_t)(via_relay ? relay.port : server.port);
     return tt_client_open(&client, &c, &vhal_clock, log_capture, &table, err, sizeof(err));
+}
+
+static int open_tcp(void **state)
+{
+    (void)state;
+    return start_tcp(0);
+}
+
+static int open_tcp_relay(void **state)
+{
+    (void)state;
+    return start_tcp(1);
 }
 
 static int open_rtu(void **state)
@@ -85,23 +98,6 @@ static int open_rtu(void **state)
     struct tt_client_config c = base_config();
     snprintf(c.transport, sizeof(c.transport), "rtu");
     snprintf(c.device, sizeof(c.device), "%s", link.path[0]);
-    return tt_client_open(&client, &c, &vhal_clock, log_capture, &table, err, sizeof(err));
-}
-
-/* TCP through the hostile relay. */
-static struct tcp_relay relay;
-static int open_tcp_relay(void **state)
-{
-    (void)state;
-    char err[256];
-    errors_logged = 0;
-    last_log[0] = '\0';
-    clock_sim_init(&vclock, &vhal_clock);
-    if (tt_server_open_tcp(&server, "127.0.0.1", 0, clock_sim_now, &vclock, err, sizeof(err)) ||
-        tt_server_start(&server) || tcp_relay_start(&relay, server.port))
-        return -1;
-    struct tt_client_config c = base_config();
-    c.port = (uint32_t)relay.port;
     return tt_client_open(&client, &c, &vhal_clock, log_capture, &table, err, sizeof(err));
 }
 
