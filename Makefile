@@ -6,7 +6,7 @@
 #   make test-arm64   the unit tests built for arm64, run under qemu-aarch64
 SAN ?= 0
 CC ?= cc
-PKGS := inih libpng cmocka libmodbus libgpiod
+PKGS := inih libpng cmocka libmodbus libgpiod libseccomp
 PKG_CONFIG := pkg-config
 DEPS_SET :=
 DEPS_TOOLS := $(CC)
@@ -103,7 +103,7 @@ FW_OBJ := $(call obj,$(FW_SRC))
 HOST_OBJ := $(call obj,$(POSIX_SRC) $(APP_LIB_SRC) $(BOARD_SRC)) $(if $(filter linux,$(HAL)),$(LIBCAMERA_OBJ),)
 MAIN_OBJ := $(call obj,app/main.c)
 
-.PHONY: all deps test-deps test test-run linux-build small-build install check-stack size fuzz errors-doc test-arm64 test-arm64-full test-gpio-chip arm64-check-elf arm64-run-tests run clean format docs check-firmware bench measure measure-scan interop-meshlab bench-callgrind eval
+.PHONY: seccomp-tool all deps test-deps test test-run linux-build small-build install check-stack size fuzz errors-doc test-arm64 test-arm64-full test-gpio-chip arm64-check-elf arm64-run-tests run clean format docs check-firmware bench measure measure-scan interop-meshlab bench-callgrind eval
 SIM_TOOLS := $(if $(filter sim,$(HAL)),$(BUILD)/turntable-sim $(BUILD)/tt-client $(BUILD)/mesh-compare $(BUILD)/colour-eval,)
 all: deps $(BUILD)/scanner $(SIM_TOOLS)
 
@@ -145,6 +145,12 @@ $(BUILD)/turntable-sim: $(call obj,host_sim/turntable_sim_main.c host_sim/tt_ser
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON)
 $(BUILD)/tt-client: $(call obj,tests/tt_client_main.c hal/modbus/turntable_modbus.c hal/posix/clock_posix.c) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON)
+
+# Runs a command under a system-call allow-list as the systemd unit's filter does (tests only).
+$(BUILD)/seccomp-run: tests/seccomp_run.c | deps
+	@mkdir -p $(dir $@)
+	$(CC) $(WARN) $(OPT) -g -o $@ $< $(shell $(PKG_CONFIG) --libs libseccomp 2>/dev/null)
+seccomp-tool: $(BUILD)/seccomp-run
 
 $(BUILD)/mesh-compare: $(call obj,tests/mesh_compare.c tests/mesh_compare_lib.c host_sim/sim_bvh.c host_sim/sim_mesh.c host_sim/sim_ply_read.c app/config.c app/ini_schema.c app/scan_dir.c hal/posix/image_io.c) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON)
@@ -247,7 +253,7 @@ test-deps: deps
 # A second make, so that what test-deps installed (libcamera-dev) is seen when it starts.
 test: deps test-deps
 	@$(MAKE) --no-print-directory test-run
-test-run: $(BUILD)/scanner $(SIM_TOOLS) $(TEST_BIN) $(FUZZ_REPLAY) check-firmware $(if $(filter 0,$(SAN)),check-stack,) linux-build small-build
+test-run: $(BUILD)/scanner $(SIM_TOOLS) $(BUILD)/seccomp-run $(TEST_BIN) $(FUZZ_REPLAY) check-firmware $(if $(filter 0,$(SAN)),check-stack,) linux-build small-build
 	@RUN_WITH="$(VALGRIND_RUN)" BUILD=$(BUILD) tests/run.sh $(TEST_BIN) tests/layers.sh tests/cli.sh tests/interop.sh tests/fuzz/replay.sh tests/resume.sh
 
 # make test VALGRIND=1: every cmocka test under valgrind memcheck; any invalid access,
@@ -275,9 +281,10 @@ test-arm64-full:
 # build on 512 MB: tests/gpio_chip.sh. About two minutes.
 test-gpio-chip:
 	@$(MAKE) --no-print-directory $(ARM64) HAL=linux deps
-	@{ command -v qemu-system-aarch64 && command -v cpio; } >/dev/null 2>&1 || scripts/install-deps.sh gpio-chip
+	@{ command -v qemu-system-aarch64 && command -v cpio && command -v systemd-analyze; } >/dev/null 2>&1 || scripts/install-deps.sh gpio-chip
 	@$(MAKE) --no-print-directory $(ARM64) HAL=linux all
 	@$(MAKE) --no-print-directory $(ARM64) HAL=linux LIMITS=small all
+	@$(MAKE) --no-print-directory $(ARM64) HAL=linux seccomp-tool
 	@tests/run.sh tests/gpio_chip.sh
 arm64-check-elf: $(BUILD)/scanner
 	@$(CROSS_COMPILE)readelf -h $< | grep -q 'Machine: *AArch64' && echo "$<: AArch64 ELF"

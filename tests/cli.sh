@@ -56,6 +56,19 @@ check systemd_accepts_unit sh -c "cd '$stage/lib/systemd/system' &&
     systemd-analyze verify 'scanner@pi-v4l2.service' > $PWD/$out/verify.txt 2>&1; rc=\$?;
     cat $PWD/$out/verify.txt; test \$rc -eq 0 && ! test -s $PWD/$out/verify.txt &&
     systemd-sysusers --root=$stage --dry-run >/dev/null"
+# The unit's exposure (systemd-analyze security, offline): at most 2.0 (it was 3.5).
+check unit_exposure_at_most_2 sh -c "cd '$stage/lib/systemd/system' &&
+    systemd-analyze security --offline=true 'scanner@pi-v4l2.service' > $PWD/$out/exposure.txt 2>&1;
+    tail -n 1 $PWD/$out/exposure.txt; awk '/Overall exposure level/ { found = 1; if (\$(NF - 2) + 0 > 2.0) exit 1 }
+    END { exit !found }' $PWD/$out/exposure.txt"
+# The scanner works under exactly the unit's system-call filter (a call outside it kills the
+# process here, where the unit would answer EPERM): a whole simulated scan.
+check scan_under_unit_syscall_filter sh -c "scripts/syscall-list.sh config/deploy/scanner@.service \
+    > $out/syscalls.txt && rm -rf $out/filtered && ${BUILD:-build}/seccomp-run $out/syscalls.txt -- \
+    $bin scan --config config/sim.ini --out $out/filtered | grep -q 'scan finished'"
+# ... and the runner does enforce it: without write(2) even --version is killed (SIGSYS).
+check seccomp_run_enforces sh -c "grep -vx write $out/syscalls.txt > $out/nowrite.txt;
+    ${BUILD:-build}/seccomp-run $out/nowrite.txt -- $bin --version; test \$? -eq 159"
 check errors_doc_is_current sh -c "scripts/errors-table.sh ${BUILD:-build} > $out/errors.md &&
     diff docs/errors.md $out/errors.md"
 check bad_config_names_file_line_key sh -c \

@@ -11,6 +11,7 @@ set -eu
 cd "$(dirname "$0")/.."
 SCANNER=${SCANNER:-build/aarch64-linux-gnu/linux/scanner}
 SCANNER_SMALL=${SCANNER_SMALL:-build/aarch64-linux-gnu/small/linux/scanner}
+SECCOMP_RUN=${SECCOMP_RUN:-build/aarch64-linux-gnu/linux/seccomp-run}
 WORK=${WORK:-build/gpio-chip}
 TRIPLET=aarch64-linux-gnu
 for tool in qemu-system-aarch64 cpio "$TRIPLET-readelf"; do
@@ -40,6 +41,9 @@ cp "$WORK/unpacked/bin/busybox" "$R/bin/"
 cp "$SCANNER" "$R/bin/scanner-default"
 cp "$SCANNER_SMALL" "$R/bin/scanner-small"
 cp "$WORK/unpacked/usr/bin/gpioset" "$WORK/unpacked/usr/bin/gpioinfo" "$R/bin/"
+# The installed unit's system-call filter, and a runner that enforces it (tests/seccomp_run.c).
+cp "$SECCOMP_RUN" "$R/bin/seccomp-run"
+scripts/syscall-list.sh config/deploy/scanner@.service > "$R/etc/scanner/syscalls"
 libdirs="/usr/lib/$TRIPLET /lib/$TRIPLET $WORK/unpacked/usr/lib/$TRIPLET"
 copy_libs() { # every library an ELF needs, recursively
     for lib in $("$TRIPLET-readelf" -d "$1" | sed -n 's/.*Shared library: \[\(.*\)\]/\1/p'); do
@@ -54,7 +58,8 @@ copy_libs() { # every library an ELF needs, recursively
         [ -e "$R/lib/$TRIPLET/$lib" ] || { echo "gpio_chip: no $lib for $1" >&2; exit 1; }
     done
 }
-for elf in "$R/bin/scanner-default" "$R/bin/scanner-small" "$R/bin/gpioset" "$R/bin/gpioinfo"; do copy_libs "$elf"; done
+for elf in "$R/bin/scanner-default" "$R/bin/scanner-small" "$R/bin/gpioset" "$R/bin/gpioinfo" \
+    "$R/bin/seccomp-run"; do copy_libs "$elf"; done
 cp -L "/usr/lib/$TRIPLET/ld-linux-aarch64.so.1" "$R/lib/ld-linux-aarch64.so.1"
 
 # The rig's config with the PL061's eight lines: projector on 0..2, lights on 4..7 (line 3 is
@@ -76,6 +81,9 @@ ln -s /bin/scanner-$build /bin/scanner
 echo "== default build starts"; scanner-default --version 2>&1; echo "exit $?"
 echo "== gpioinfo"; gpioinfo
 echo "== selftest, lines free"; scanner selftest --config /etc/scanner/rig.ini 2>&1
+echo "== selftest under the unit's system-call filter"
+seccomp-run /etc/scanner/syscalls -- scanner selftest --config /etc/scanner/rig.ini 2>&1
+echo "exit $?"
 gpioset --mode=signal gpiochip0 6=1 & holder=$!
 sleep 1
 echo "== selftest, line 6 held"; scanner selftest --config /etc/scanner/rig.ini 2>&1
@@ -120,6 +128,9 @@ boot() { # memory in MB, the build the checks run
     check "the VM found the PL061 chip" "gpioinfo" "^gpiochip0 - 8 lines"
     check "every line free: all requested" "selftest, lines free" \
         "^gpio +gpiochip0 +ok +7 lines requested and driven low"
+    check "the selftest under the unit's system-call filter" \
+        "selftest under the unit's system-call filter" \
+        "^gpio +gpiochip0 +ok +7 lines requested and driven low" "^exit 1$"
     check "a held line: named, with its holder" "selftest, line 6 held" \
         "^gpio +gpiochip0 +MISSING +gpio: light_2: cannot request gpiochip0 line 6, in use by gpioset: Device or resource busy"
     check "nothing left requested by the scanner" "gpioinfo after" \
