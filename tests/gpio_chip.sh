@@ -30,13 +30,20 @@ kernel=$(apt-cache depends linux-image-arm64:arm64 | sed -n 's/.*Depends: \(linu
 fetch "$kernel:arm64" "$kernel"
 fetch busybox-static:arm64 busybox-static
 fetch gpiod:arm64 gpiod
+# udevadm, to run the installed GPIO rule on the kernel's own chip, and what it links to.
+for p in udev libsystemd-shared libkmod2 libacl1 libblkid1 libcap2 libselinux1 libcrypt1 \
+    libgcrypt20 libgpg-error0 libip4tc2 liblz4-1 libmount1 libssl3 libpam0g libzstd1 liblzma5 \
+    libpcre2-8-0 libaudit1 libcap-ng0; do
+    fetch "$p:arm64" "$p"
+done
 rm -rf "$WORK/unpacked" && mkdir -p "$WORK/unpacked"
 for d in "$WORK"/debs/*.deb; do dpkg-deb -x "$d" "$WORK/unpacked"; done
 IMAGE=$(ls "$WORK"/unpacked/boot/vmlinuz-* | head -n 1)
 
 # The initramfs: busybox, the scanner and gpiod's tools with the shared libraries they need.
 R=$WORK/root
-mkdir -p "$R/bin" "$R/lib/$TRIPLET" "$R/etc/scanner" "$R/proc" "$R/sys" "$R/dev" "$R/tmp"
+mkdir -p "$R/bin" "$R/lib/$TRIPLET" "$R/etc/scanner" "$R/proc" "$R/sys" "$R/dev" "$R/tmp" \
+    "$R/run" "$R/etc/udev/rules.d" "$R/usr/lib/$TRIPLET/systemd"
 cp "$WORK/unpacked/bin/busybox" "$R/bin/"
 cp "$SCANNER" "$R/bin/scanner-default"
 cp "$SCANNER_SMALL" "$R/bin/scanner-small"
@@ -44,10 +51,19 @@ cp "$WORK/unpacked/usr/bin/gpioset" "$WORK/unpacked/usr/bin/gpioinfo" "$R/bin/"
 # The installed unit's system-call filter, and a runner that enforces it (tests/seccomp_run.c).
 cp "$SECCOMP_RUN" "$R/bin/seccomp-run"
 scripts/syscall-list.sh config/deploy/scanner@.service > "$R/etc/scanner/syscalls"
-libdirs="/usr/lib/$TRIPLET /lib/$TRIPLET $WORK/unpacked/usr/lib/$TRIPLET"
+libdirs="/usr/lib/$TRIPLET /lib/$TRIPLET $WORK/unpacked/usr/lib/$TRIPLET $WORK/unpacked/lib/$TRIPLET"
+cp "$WORK/unpacked/bin/udevadm" "$R/bin/"
+cp -L "$WORK"/unpacked/usr/lib/$TRIPLET/systemd/libsystemd-shared-*.so "$R/usr/lib/$TRIPLET/systemd/"
+# The installed rule as it is, and the same rule with this board's chip (the PL061) added, as a
+# person with another board would.
+cp config/deploy/60-scanner-gpio.rules "$R/etc/scanner/"
+sed 's/|raspberrypi,rp1-gpio"/|raspberrypi,rp1-gpio|arm,pl061"/' config/deploy/60-scanner-gpio.rules \
+    > "$R/etc/scanner/60-scanner-gpio-pl061.rules"
+printf 'root:x:0:\ngpio:x:997:\n' > "$R/etc/group"
 copy_libs() { # every library an ELF needs, recursively
     for lib in $("$TRIPLET-readelf" -d "$1" | sed -n 's/.*Shared library: \[\(.*\)\]/\1/p'); do
         [ -e "$R/lib/$TRIPLET/$lib" ] && continue
+    [ -e "$R/usr/lib/$TRIPLET/systemd/$lib" ] && continue
         for d in $libdirs; do
             if [ -e "$d/$lib" ]; then
                 cp -L "$d/$lib" "$R/lib/$TRIPLET/$lib"
@@ -59,7 +75,9 @@ copy_libs() { # every library an ELF needs, recursively
     done
 }
 for elf in "$R/bin/scanner-default" "$R/bin/scanner-small" "$R/bin/gpioset" "$R/bin/gpioinfo" \
-    "$R/bin/seccomp-run"; do copy_libs "$elf"; done
+    "$R/bin/seccomp-run" "$R/bin/udevadm" "$R"/usr/lib/$TRIPLET/systemd/libsystemd-shared-*.so; do
+    copy_libs "$elf"
+done
 cp -L "/usr/lib/$TRIPLET/ld-linux-aarch64.so.1" "$R/lib/ld-linux-aarch64.so.1"
 
 # The rig's config with the PL061's eight lines: projector on 0..2, lights on 4..7 (line 3 is
@@ -80,6 +98,13 @@ build=$(sed -n 's/.*scanner=\([a-z]*\).*/\1/p' /proc/cmdline)
 ln -s /bin/scanner-$build /bin/scanner
 echo "== default build starts"; scanner-default --version 2>&1; echo "exit $?"
 echo "== gpioinfo"; gpioinfo
+udev() { # the rule file to run on the chip
+    rm -f /etc/udev/rules.d/*; cp "$1" /etc/udev/rules.d/
+    udevadm test --action=add /sys/bus/gpio/devices/gpiochip0 2>&1 |
+        grep -E 'Reading rules file|Setting permissions'
+}
+echo "== udev, the installed rule"; udev /etc/scanner/60-scanner-gpio.rules
+echo "== udev, the rule with this board's chip"; udev /etc/scanner/60-scanner-gpio-pl061.rules
 echo "== selftest, lines free"; scanner selftest --config /etc/scanner/rig.ini 2>&1
 echo "== selftest under the unit's system-call filter"
 seccomp-run /etc/scanner/syscalls -- scanner selftest --config /etc/scanner/rig.ini 2>&1
@@ -126,6 +151,11 @@ boot() { # memory in MB, the build the checks run
         -nic none -kernel "$IMAGE" -initrd "$WORK/initramfs.gz" \
         -append "console=ttyAMA0 panic=-1 quiet scanner=$2" 2>&1 | tr -d '\r' > "$log" || true
     check "the VM found the PL061 chip" "gpioinfo" "^gpiochip0 - 8 lines"
+    check "the installed udev rule leaves another board's chip alone" \
+        "udev, the installed rule" "Reading rules file: .*60-scanner-gpio.rules" \
+        "!Setting permissions"
+    check "with the board's chip added, the rule gives it to the gpio group" \
+        "udev, the rule with this board's chip" "/dev/gpiochip0, uid=0, gid=997, mode=0660"
     check "every line free: all requested" "selftest, lines free" \
         "^gpio +gpiochip0 +ok +7 lines requested and driven low"
     check "the selftest under the unit's system-call filter" \
