@@ -136,15 +136,30 @@ static void view_keys_complete(void)
     if (done)
         return;
     for (unsigned r = 0; r < SCAN_REASON_COUNT; r++)
-        view_keys[10 + r] = (struct ini_key){"pixels", scan_reason_name(r), INI_U32,
-                                             V(reason_count) + r * sizeof(uint32_t), 0, 0,
-                                             HAL_MAX_PIXELS, 0, "0", NULL, "pixels"};
+        view_keys[10 + r] = (struct ini_key){"pixels",
+                                             scan_reason_name(r),
+                                             INI_U32,
+                                             V(reason_count) + r * sizeof(uint32_t),
+                                             0,
+                                             0,
+                                             HAL_MAX_PIXELS,
+                                             0,
+                                             "0",
+                                             NULL,
+                                             "pixels"};
     for (unsigned f = 0; f < SCAN_DIR_MAX_FRAMES; f++) {
         snprintf(frame_keys[f], sizeof(frame_keys[f]), "frame_%02u", f);
-        view_keys[VIEW_FIXED_KEYS + f] =
-            (struct ini_key){"capture", frame_keys[f], INI_STR,
-                             V(frame_name) + f * SCAN_DIR_FRAME_NAME, SCAN_DIR_FRAME_NAME, 0, 0,
-                             0, "", NULL, "what the frame shows"};
+        view_keys[VIEW_FIXED_KEYS + f] = (struct ini_key){"capture",
+                                                          frame_keys[f],
+                                                          INI_STR,
+                                                          V(frame_name) + f * SCAN_DIR_FRAME_NAME,
+                                                          SCAN_DIR_FRAME_NAME,
+                                                          0,
+                                                          0,
+                                                          0,
+                                                          "",
+                                                          NULL,
+                                                          "what the frame shows"};
     }
     done = 1;
 }
@@ -166,8 +181,8 @@ int scan_dir_read_view_file(const char *path, uint32_t view, struct scan_dir_vie
 {
     view_keys_complete();
     memset(v, 0, sizeof(*v));
-    int rc = ini_schema_load(view_keys, sizeof(view_keys) / sizeof(view_keys[0]), v, path, err,
-                         err_len);
+    int rc =
+        ini_schema_load(view_keys, sizeof(view_keys) / sizeof(view_keys[0]), v, path, err, err_len);
     if (rc == 0 && v->index != view) {
         snprintf(err, err_len, "%s: [view] index: %u, but this is view %u", path,
                  (unsigned)v->index, (unsigned)view);
@@ -235,18 +250,18 @@ int scan_dir_write_registration(const struct hal_storage *st, const char *dir, u
                                 const struct icp_report *r)
 {
     char text[1024], path[SCAN_DIR_PATH_MAX];
-    int len = snprintf(
-        text, sizeof(text),
-        "; registration of this view against the previous one (docs/scan-format.md)\n"
-        "[registration]\nhas_pair = %d\naccepted = %d\noverlap_before = %u\n"
-        "coupled_before = %u\ncoupled_share_before = %.4f\noverlap_after = %u\n"
-        "coupled_after = %u\ncoupled_share_after = %.4f\nrms_before_mm = %.4f\n"
-        "rms_after_mm = %.4f\ncorrection_mm = %.4f\ncorrection_deg = %.4f\n",
-        r->has_pair, r->accepted, (unsigned)r->overlap_before, (unsigned)r->coupled_before,
-        r->overlap_before ? (double)r->coupled_before / r->overlap_before : 0.0,
-        (unsigned)r->overlap_after, (unsigned)r->coupled_after,
-        r->overlap_after ? (double)r->coupled_after / r->overlap_after : 0.0, r->rms_before_mm,
-        r->rms_after_mm, r->correction_mm, r->correction_deg);
+    int len =
+        snprintf(text, sizeof(text),
+                 "; registration of this view against the previous one (docs/scan-format.md)\n"
+                 "[registration]\nhas_pair = %d\naccepted = %d\noverlap_before = %u\n"
+                 "coupled_before = %u\ncoupled_share_before = %.4f\noverlap_after = %u\n"
+                 "coupled_after = %u\ncoupled_share_after = %.4f\nrms_before_mm = %.4f\n"
+                 "rms_after_mm = %.4f\ncorrection_mm = %.4f\ncorrection_deg = %.4f\n",
+                 r->has_pair, r->accepted, (unsigned)r->overlap_before, (unsigned)r->coupled_before,
+                 r->overlap_before ? (double)r->coupled_before / r->overlap_before : 0.0,
+                 (unsigned)r->overlap_after, (unsigned)r->coupled_after,
+                 r->overlap_after ? (double)r->coupled_after / r->overlap_after : 0.0,
+                 r->rms_before_mm, r->rms_after_mm, r->correction_mm, r->correction_deg);
     int rc = scan_dir_path(path, sizeof(path), dir, (int)view, "registration.ini");
     return rc != 0 ? rc : hal_storage_write_file(st, path, text, (size_t)len);
 }

@@ -22,16 +22,16 @@
 /** What a view's view.ini records (written last: its presence means the view is complete). */
 struct scan_dir_view {
     uint32_t index;
-    int32_t angle_mdeg;                   /**< as the controller reported it after the move */
-    char started[32], finished[32];       /**< UTC, ISO 8601 */
-    uint32_t frames;                      /**< frames captured, retries not counted */
+    int32_t angle_mdeg;             /**< as the controller reported it after the move */
+    char started[32], finished[32]; /**< UTC, ISO 8601 */
+    uint32_t frames;                /**< frames captured, retries not counted */
     uint32_t capture_retries;
     uint32_t valid_points;
     double wall_ms;
-    uint32_t exposure_us, gain_milli;     /**< the camera's for the patterns */
-    uint32_t frame_count;                 /**< frames described in frame_name */
+    uint32_t exposure_us, gain_milli; /**< the camera's for the patterns */
+    uint32_t frame_count;             /**< frames described in frame_name */
     char frame_name[SCAN_DIR_MAX_FRAMES][SCAN_DIR_FRAME_NAME]; /**< what each frame shows */
-    uint32_t reason_count[SCAN_REASON_COUNT]; /**< pixels per reason code */
+    uint32_t reason_count[SCAN_REASON_COUNT];                  /**< pixels per reason code */
 };
 
 /** Path of @p name in the scan directory @p dir (@p view < 0), or in view @p view's directory

@@ -11,7 +11,7 @@ struct tcp_relay {
     int upstream_port; /**< the controller */
     pthread_t thread;
     volatile int stop;
-    pthread_mutex_t lock; /* guards the counters and faults below */
+    pthread_mutex_t lock;          /* guards the counters and faults below */
     unsigned long replies;         /**< replies passed on so far */
     unsigned long connections;     /**< client connections accepted so far */
     unsigned long delay_reply;     /**< hold reply number N (counting from 1) back ... */

@@ -247,8 +247,8 @@ static const char *config_text(const char *colour)
     assert_non_null(realpath("config/sim-calib.ini", calib));
     snprintf(text, sizeof(text),
              "[camera]\nbackend = sim\nwidth = 1280\nheight = 960\nexposure_us = 10000\n"
-             "[lights]\ncount = 4\n[scan]\nviews = 1\ncalibration = %s\n[colour]\n%s", calib,
-             colour);
+             "[lights]\ncount = 4\n[scan]\nviews = 1\ncalibration = %s\n[colour]\n%s",
+             calib, colour);
     return text;
 }
 
