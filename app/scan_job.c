@@ -27,8 +27,8 @@ struct job {
     uint32_t views;
     double start_ms;
     int tty;
-    uint32_t view;                      /* the view being taken or processed */
-    char view_dir[SCAN_DIR_PATH_MAX];   /* its directory */
+    uint32_t view;                    /* the view being taken or processed */
+    char view_dir[SCAN_DIR_PATH_MAX]; /* its directory */
 };
 
 static double wall_ms(void)
@@ -36,6 +36,20 @@ static double wall_ms(void)
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
+}
+
+static void job_init(struct job *j, const struct hal *hal, const struct app_config *cfg,
+                     const struct scan_calib *calib, const struct scan_job_opts *opts,
+                     const char *out_dir)
+{
+    *j = (struct job){.hal = hal,
+                      .cfg = cfg,
+                      .calib = calib,
+                      .opts = opts,
+                      .out_dir = out_dir,
+                      .views = cfg->views,
+                      .start_ms = wall_ms(),
+                      .tty = isatty(STDOUT_FILENO) && !opts->json};
 }
 
 static void utc_now(char *buf, size_t len)
@@ -130,8 +144,8 @@ static int save_frame(void *priv, uint32_t pattern, const uint8_t *pixels, uint3
     char name[32];
     snprintf(name, sizeof(name), "frame_%02u.png", (unsigned)pattern);
     return write_failed(j, name,
-                        scan_dir_write_frame(&j->hal->storage, j->out_dir, j->view, pattern,
-                                             pixels, width, height, channels));
+                        scan_dir_write_frame(&j->hal->storage, j->out_dir, j->view, pattern, pixels,
+                                             width, height, channels));
 }
 
 static int write_view_meta(struct job *j, const struct scan_view_info *info, const char *started,
@@ -151,7 +165,8 @@ static int write_view_meta(struct job *j, const struct scan_view_info *info, con
     v.gain_milli = j->cfg->camera.gain_milli;
     scan_dir_describe_frames(&j->cfg->scan, j->calib, &v);
     memcpy(v.reason_count, info->reason_count, sizeof(v.reason_count));
-    return write_failed(j, "view.ini", scan_dir_write_view(&j->hal->storage, j->out_dir, j->view, &v));
+    return write_failed(j, "view.ini",
+                        scan_dir_write_view(&j->hal->storage, j->out_dir, j->view, &v));
 }
 
 /* Results of a processed view (its frames, the colour among them, were kept while capturing):
@@ -163,9 +178,9 @@ static int save_results(struct job *j, const struct scan_view *view, struct icp_
     scan_view_pose(j->calib, view, &pose);
     int rc = scan_register_view(&j->cfg->registration, j->calib, view, &pose, report);
     if (rc == 0)
-        rc = write_failed(j, "registration.ini",
-                          scan_dir_write_registration(&j->hal->storage, j->out_dir, j->view,
-                                                      report));
+        rc = write_failed(
+            j, "registration.ini",
+            scan_dir_write_registration(&j->hal->storage, j->out_dir, j->view, report));
     if (rc == 0)
         rc = scan_dir_path(path, sizeof(path), j->out_dir, (int)j->view, "cloud.ply");
     if (rc == 0)
@@ -332,8 +347,8 @@ static int open_out(struct job *j, enum scan_dir_mode mode, int *lock_fd)
 int scan_job_live(const struct hal *hal, const struct app_config *cfg,
                   const struct scan_calib *calib, const struct scan_job_opts *opts)
 {
-    struct job j = {hal, cfg, calib, opts, opts->out_dir ? opts->out_dir : cfg->output_dir,
-                    cfg->views, wall_ms(), isatty(STDOUT_FILENO) && !opts->json, 0, ""};
+    struct job j;
+    job_init(&j, hal, cfg, calib, opts, opts->out_dir ? opts->out_dir : cfg->output_dir);
     char path[HAL_MAX_PATH + 32];
     int lock_fd;
     int rc = open_out(&j, opts->replace ? SCAN_DIR_REPLACE : SCAN_DIR_NEW, &lock_fd);
@@ -384,9 +399,8 @@ int scan_job_resume(const struct hal *hal, const struct app_config *cfg,
                     const struct scan_calib *calib, const char *scan_dir,
                     const struct scan_job_opts *opts)
 {
-    struct job j = {hal,      cfg,        calib,     opts,
-                    scan_dir, cfg->views, wall_ms(), isatty(STDOUT_FILENO) && !opts->json,
-                     0, ""};
+    struct job j;
+    job_init(&j, hal, cfg, calib, opts, scan_dir);
     char detail[64];
     int lock_fd;
     int rc = open_out(&j, SCAN_DIR_EXISTING, &lock_fd);
@@ -458,8 +472,10 @@ static int process_view(struct job *j, const char *scan_dir, uint32_t v)
     char err[SCAN_DIR_PATH_MAX + 256];
     int rc = scan_dir_read_view(scan_dir, v, &meta, err, sizeof(err));
     if (rc == -ENOENT)
-        snprintf(err, sizeof(err), "%s/view_%03u: the view did not finish (no view.ini); "
-                 "'scanner resume %s' takes it", scan_dir, (unsigned)v, scan_dir);
+        snprintf(err, sizeof(err),
+                 "%s/view_%03u: the view did not finish (no view.ini); "
+                 "'scanner resume %s' takes it",
+                 scan_dir, (unsigned)v, scan_dir);
     if (rc == 0)
         rc = check_frames(j, scan_dir, v, &meta, err, sizeof(err));
     if (rc == 0)
@@ -496,13 +512,14 @@ int scan_job_process(const struct hal *hal, const char *scan_dir, const struct s
         hal->log(HAL_LOG_ERROR, "%s", err);
         return rc;
     }
-    struct job j = {hal, &cfg, &calib, opts, opts->out_dir ? opts->out_dir : scan_dir,
-                    cfg.views, wall_ms(), isatty(STDOUT_FILENO) && !opts->json, 0, ""};
+    struct job j;
+    job_init(&j, hal, &cfg, &calib, opts, opts->out_dir ? opts->out_dir : scan_dir);
     int elsewhere = opts->out_dir != NULL && strcmp(opts->out_dir, scan_dir) != 0;
     int lock_fd;
-    rc = open_out(&j, !elsewhere ? SCAN_DIR_EXISTING
-                      : opts->replace ? SCAN_DIR_REPLACE
-                                      : SCAN_DIR_NEW,
+    rc = open_out(&j,
+                  !elsewhere      ? SCAN_DIR_EXISTING
+                  : opts->replace ? SCAN_DIR_REPLACE
+                                  : SCAN_DIR_NEW,
                   &lock_fd);
     if (rc != 0)
         return rc;
@@ -515,8 +532,9 @@ int scan_job_process(const struct hal *hal, const char *scan_dir, const struct s
     progress(&j, "process_start", -1, 0, scan_dir);
     for (uint32_t v = 0; v < cfg.views && rc == 0; v++) {
         if (hal_should_stop(hal)) {
-            hal->log(HAL_LOG_WARN, "processing stopped by request before view %u; nothing of %s "
-                                   "is lost: 'scanner process %s' starts it again",
+            hal->log(HAL_LOG_WARN,
+                     "processing stopped by request before view %u; nothing of %s "
+                     "is lost: 'scanner process %s' starts it again",
                      (unsigned)v, scan_dir, scan_dir);
             rc = -EINTR;
             break;

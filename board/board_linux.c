@@ -139,7 +139,8 @@ static int probe_camera(struct hal *hal, const struct board_config *cfg, char *d
 
 static int probe_gpio(struct hal *hal, const struct board_config *cfg, char *detail, size_t len)
 {
-    int rc = gpio_gpiod_open(&board.gpio, cfg->gpio->chip, cfg->gpio->line, &hal->gpio, detail, len);
+    int rc =
+        gpio_gpiod_open(&board.gpio, cfg->gpio->chip, cfg->gpio->line, &hal->gpio, detail, len);
     if (rc != 0)
         return rc;
     unsigned wired = 0;
@@ -151,7 +152,8 @@ static int probe_gpio(struct hal *hal, const struct board_config *cfg, char *det
     return 0;
 }
 
-static int probe_turntable(struct hal *hal, const struct board_config *cfg, char *detail, size_t len)
+static int probe_turntable(struct hal *hal, const struct board_config *cfg, char *detail,
+                           size_t len)
 {
     struct hal_turntable_status st;
     int rc = tt_client_open(&board.turntable, cfg->turntable, &hal->clock, hal->log,
@@ -189,7 +191,8 @@ int board_selftest(struct hal *hal, const struct board_config *cfg, const struct
     failed |= rc != 0;
 
     if (strcmp(cfg->turntable->transport, "tcp") == 0)
-        snprintf(where, sizeof(where), "%s:%u", cfg->turntable->host, (unsigned)cfg->turntable->port);
+        snprintf(where, sizeof(where), "%s:%u", cfg->turntable->host,
+                 (unsigned)cfg->turntable->port);
     else
         snprintf(where, sizeof(where), "%s", cfg->turntable->device);
     rc = probe_turntable(hal, cfg, detail, sizeof(detail));

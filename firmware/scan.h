@@ -25,15 +25,16 @@ struct scan_view_info {
  *  pointers lead into the firmware's static buffers (no allocation): valid until the next view
  *  begins. */
 struct scan_view {
-    uint32_t width, height;              /**< frame size */
-    int32_t angle_mdeg;                  /**< turntable angle it was taken at */
-    struct decode_maps maps;             /**< projector columns (rows), reason per pixel */
-    const float *column;                 /**< continuous projector column (refine.h) */
-    struct tri_range range;              /**< points and normals, camera frame, mm */
-    const uint8_t *white_rgb;            /**< projector-white frame, RGB24 */
-    const uint8_t *lights[COLOUR_MAX_FRAMES]; /**< colour frames (colour.h order); NULL: not taken */
-    uint8_t *rgb;        /**< the view's colour as saved and fused: compensated, else raw */
-    float *confidence;   /**< colour confidence per pixel (0: no estimate) */
+    uint32_t width, height;   /**< frame size */
+    int32_t angle_mdeg;       /**< turntable angle it was taken at */
+    struct decode_maps maps;  /**< projector columns (rows), reason per pixel */
+    const float *column;      /**< continuous projector column (refine.h) */
+    struct tri_range range;   /**< points and normals, camera frame, mm */
+    const uint8_t *white_rgb; /**< projector-white frame, RGB24 */
+    const uint8_t
+        *lights[COLOUR_MAX_FRAMES]; /**< colour frames (colour.h order); NULL: not taken */
+    uint8_t *rgb;           /**< the view's colour as saved and fused: compensated, else raw */
+    float *confidence;      /**< colour confidence per pixel (0: no estimate) */
     uint32_t colour_method; /**< enum colour_method the colour was made with */
 };
 

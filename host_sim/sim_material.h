@@ -18,7 +18,8 @@ struct sim_material {
 };
 
 /** Load material @p name from the MERL/ABC table (CSV: name,kd_r,kd_g,kd_b,A_r,A_g,A_b,B,C,ior).
- *  @retval 0 ok @retval -ESRCH no such material in the table @retval -errno the file (-ENOENT: missing) */
+ *  @retval 0 ok @retval -ESRCH no such material in the table @retval -errno the file (-ENOENT:
+ * missing) */
 int sim_material_load_abc(struct sim_material *mat, const char *csv_path, const char *name);
 
 /** Reflected fraction per channel, as camera counts per unit source irradiance at normal incidence:

@@ -248,9 +248,9 @@ static void test_restart_noticed_before_the_move(void **state)
     assert_int_equal(errors_logged, 1);
     assert_non_null(strstr(last_log, "turntable: move to 240.000 deg: the controller restarted "
                                      "(homed, last command 0 where"));
-    assert_int_equal(tt_server_position(&server), 0); /* it did not move */
+    assert_int_equal(tt_server_position(&server), 0);          /* it did not move */
     assert_int_equal(hal_table_move_to(&table, 240000), -EIO); /* nor on a second try */
-    int rc = hal_table_home(&table); /* homing again is the way on */
+    int rc = hal_table_home(&table);                           /* homing again is the way on */
     if (rc != 0)
         fail_msg("%s", last_log);
     assert_int_equal(hal_table_move_to(&table, 240000), 0);

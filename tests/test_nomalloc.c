@@ -98,7 +98,8 @@ static void test_no_allocation_during_a_view(void **state)
     alloc_calls = 0;
     counting = 1;
     int rc = scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info);
-    int rc_save = rc == 0 ? scan_save_cloud_at_turntable_pose(&t, &view, "build/test_nomalloc.ply") : rc;
+    int rc_save =
+        rc == 0 ? scan_save_cloud_at_turntable_pose(&t, &view, "build/test_nomalloc.ply") : rc;
     counting = 0;
     assert_int_equal(rc, 0);
     assert_int_equal(rc_save, 0);
