@@ -386,6 +386,14 @@ int scan_job_load_settings(const char *scan_dir, const char *config_path, struct
 {
     char path[SCAN_DIR_PATH_MAX];
     int rc = scan_dir_path(path, sizeof(path), scan_dir, -1, "config.ini");
+    if (rc == 0 && config_path == NULL && access(path, F_OK) != 0) {
+        snprintf(err, err_len,
+                 "%s holds no scan (no config.ini; a scan stopped before its first file has "
+                 "nothing to go on with: take it again with 'scanner scan --config F --out %s "
+                 "--replace')",
+                 scan_dir, scan_dir);
+        return -ENOENT;
+    }
     if (rc == 0)
         rc = config_load(cfg, config_path ? config_path : path, err, err_len);
     /* the calibration is the copy kept with the scan, whatever the config named */
