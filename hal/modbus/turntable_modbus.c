@@ -10,6 +10,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* @retval 1 when @p e is an exception the controller answered (a matched reply) */
+static int is_exception(int e)
+{
+    return e >= EMBXILFUN && e <= EMBXGTAR;
+}
+
 /* Translate a libmodbus failure (errno) into an errno-style code and a sentence. */
 static int translate(int e, char *msg, size_t len)
 {
@@ -17,7 +23,7 @@ static int translate(int e, char *msg, size_t len)
         snprintf(msg, len, "no reply from the controller");
         return -ETIMEDOUT;
     }
-    if (e >= EMBXILFUN && e <= EMBXGTAR) {
+    if (is_exception(e)) {
         snprintf(msg, len, "the controller answered exception %d (%s)", e - MODBUS_ENOBASE,
                  modbus_strerror(e));
         return -EIO;
@@ -35,7 +41,7 @@ static int translate(int e, char *msg, size_t len)
  * "busy" and "acknowledge" (working on it), which ask to be asked again. */
 static int retryable(int e)
 {
-    return !(e >= EMBXILFUN && e <= EMBXGTAR) || e == EMBXSBUSY || e == EMBXACK;
+    return !is_exception(e) || e == EMBXSBUSY || e == EMBXACK;
 }
 
 /* Before a retry. On TCP a reply that came late, twice or garbled may still be on its way, and a
@@ -44,8 +50,7 @@ static int retryable(int e)
  * leaves it behind. An exception was a matched reply, so nothing is left to drop. */
 static void recover(struct tt_client *c, int e)
 {
-    int exception = e >= EMBXILFUN && e <= EMBXGTAR;
-    if (c->is_tcp && !exception) {
+    if (c->is_tcp && !is_exception(e)) {
         modbus_close(c->ctx);
         if (modbus_connect(c->ctx) != 0)
             c->log(HAL_LOG_WARN, "turntable: reconnect to %s:%u failed: %s", c->cfg.host,
@@ -116,8 +121,8 @@ static int send_command(struct tt_client *c, uint16_t cmd, const char *what)
     return rc;
 }
 
-static int read_status(struct tt_client *c, struct hal_turntable_status *st, uint16_t *raw,
-                       uint16_t *last_id)
+/* STATUS, ACTUAL and ALARM into @p st, and LAST_ID (may be NULL), in one request. */
+static int read_status(struct tt_client *c, struct hal_turntable_status *st, uint16_t *last_id)
 {
     uint16_t r[TT_REG_LAST_ID - TT_REG_ACTUAL_HI + 1];
     int rc = transfer(c, "reading the status", 0, TT_REG_ACTUAL_HI, (int)(sizeof(r) / sizeof(r[0])),
@@ -129,8 +134,6 @@ static int read_status(struct tt_client *c, struct hal_turntable_status *st, uin
     st->busy = (status & TT_STATUS_BUSY) != 0;
     st->homed = (status & TT_STATUS_HOMED) != 0;
     st->alarm_code = (status & TT_STATUS_ALARM) ? r[TT_REG_ALARM - TT_REG_ACTUAL_HI] : 0;
-    if (raw != NULL)
-        *raw = status;
     if (last_id != NULL)
         *last_id = r[TT_REG_LAST_ID - TT_REG_ACTUAL_HI];
     return 0;
@@ -138,7 +141,7 @@ static int read_status(struct tt_client *c, struct hal_turntable_status *st, uin
 
 static int tt_get_status(void *priv, struct hal_turntable_status *st)
 {
-    return read_status(priv, st, NULL, NULL);
+    return read_status(priv, st, NULL);
 }
 
 /* Poll until the table is idle; an alarm or the move timeout ends the wait with an error. */
@@ -148,7 +151,7 @@ static int wait_idle(struct tt_client *c, const char *what, struct hal_turntable
     hal_clock_now_us(c->clock, &start);
     for (;;) {
         uint16_t last_id;
-        int rc = read_status(c, st, NULL, &last_id);
+        int rc = read_status(c, st, &last_id);
         if (rc != 0)
             return rc;
         if (st->alarm_code != 0) {
@@ -188,7 +191,8 @@ static int tt_home(void *priv)
     c->homed = rc == 0;
     c->lost = 0;
     c->position_known = rc == 0;
-    c->position_mdeg = st.position_mdeg;
+    if (rc == 0)
+        c->position_mdeg = st.position_mdeg;
     return rc;
 }
 
@@ -204,7 +208,7 @@ static int check_unchanged(struct tt_client *c, const char *what)
         c->log(HAL_LOG_ERROR, "turntable: %s: refused: the table must be homed again first", what);
         return -EIO;
     }
-    int rc = read_status(c, &st, NULL, &last_id);
+    int rc = read_status(c, &st, &last_id);
     if (rc != 0 || !c->homed)
         return rc;
     if (!st.homed || last_id != c->last_id) {
