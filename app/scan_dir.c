@@ -293,14 +293,14 @@ int scan_dir_keep_settings(const struct hal_storage *st, const char *config_path
 /* ---- opening: a lock, and what is already there ---- */
 
 /* @retval 1 when @p name is one of the files a scan writes at the top of its directory
- * (the simulator's ground truth among them), or a temporary file of one */
+ * (the simulator's ground truth among them) */
 static int scan_file(const char *name)
 {
     static const char *const names[] = {"config.ini", "calibration.ini", "mesh.ply", "mesh.obj"};
     for (size_t k = 0; k < sizeof(names) / sizeof(names[0]); k++)
         if (strcmp(name, names[k]) == 0)
             return 1;
-    return strncmp(name, "truth_", 6) == 0 || strstr(name, ".tmp.") != NULL;
+    return strncmp(name, "truth_", 6) == 0;
 }
 
 /* @retval 1 when @p name is a file a view's directory holds */
@@ -311,8 +311,7 @@ static int view_file(const char *name)
     if (sscanf(name, "frame_%2u.pn%1s", &frame, tail) == 2 && strcmp(tail, "g") == 0)
         return 1;
     return strcmp(name, "view.ini") == 0 || strcmp(name, "cloud.ply") == 0 ||
-           strcmp(name, "registration.ini") == 0 || strncmp(name, "truth_", 6) == 0 ||
-           strstr(name, ".tmp.") != NULL;
+           strcmp(name, "registration.ini") == 0 || strncmp(name, "truth_", 6) == 0;
 }
 
 /* @retval 1 when @p name is a view's directory: view_NNN */
@@ -324,9 +323,14 @@ static int view_dir(const char *name)
 }
 
 /* Check (@p remove 0) or remove (1) every entry of @p dir that a scan writes; the first entry
- * that is not one is named in @p err. @retval 0 @retval -EEXIST @retval -errno */
-static int scan_entries(const char *dir, int in_view, int remove, char *err, size_t err_len)
+ * that is not one is named in @p err. What interrupted writes left is swept first: the storage
+ * backend knows its temporary files. @retval 0 @retval -EEXIST @retval -errno */
+static int scan_entries(const struct hal_storage *storage, const char *dir, int in_view,
+                        int remove, char *err, size_t err_len)
 {
+    int rc_sweep = hal_storage_sweep(storage, dir);
+    if (rc_sweep != 0 && rc_sweep != -ENOSYS)
+        return rc_sweep;
     DIR *d = opendir(dir);
     if (d == NULL)
         return errno == ENOENT ? 0 : -errno;
@@ -345,7 +349,7 @@ static int scan_entries(const char *dir, int in_view, int remove, char *err, siz
         int is_dir = S_ISDIR(st.st_mode);
         if (!in_view && is_dir && view_dir(e->d_name)) {
             snprintf(path, sizeof(path), "%s/%s", dir, e->d_name);
-            rc = scan_entries(path, 1, remove, err, err_len);
+            rc = scan_entries(storage, path, 1, remove, err, err_len);
             if (rc == 0 && remove && unlinkat(dirfd(d), e->d_name, AT_REMOVEDIR) != 0)
                 rc = -errno;
         } else if (!is_dir && (in_view ? view_file(e->d_name) : scan_file(e->d_name))) {
@@ -404,9 +408,9 @@ int scan_dir_open(const struct hal_storage *st, const char *dir, enum scan_dir_m
         goto out_close;
     }
     if (mode == SCAN_DIR_REPLACE) { /* check all first: refuse before anything is removed */
-        rc = scan_entries(dir, 0, 0, err, err_len);
+        rc = scan_entries(st, dir, 0, 0, err, err_len);
         if (rc == 0)
-            rc = scan_entries(dir, 0, 1, err, err_len);
+            rc = scan_entries(st, dir, 0, 1, err, err_len);
         if (rc != 0 && rc != -EEXIST)
             snprintf(err, err_len, "cannot replace the scan in %s: %s", dir, strerror(-rc));
         if (rc != 0)
