@@ -191,6 +191,9 @@ static const struct ini_key config_keys[] = {
     ENUM("sim", "object", sim.object, "sphere|cylinder|can|box|torus|mesh", "sphere",
          "simulated object"),
     STR("sim", "mesh_file", sim.mesh_file, "", "PLY mesh for object = mesh, relative to this file"),
+    STR("sim", "rig", sim.rig_file, "",
+        "the true rig the simulator renders with (a calibration file, relative to this file); "
+        "empty: the scan's calibration, so the firmware knows the rig exactly"),
     F64("sim", "object_height_mm", sim.object_height_mm, 1, 1000, "150",
         "object height after scaling (sphere: diameter)"),
     U32("sim", "segments", sim.segments, 8, 4096, "384", "tessellation of analytic shapes"),
@@ -254,12 +257,16 @@ static const struct ini_key calib_keys[] = {
     CF("camera", "cy_px", cam_cy_px, -1e5, 1e5, "principal point y"),
     CU("camera", "width", cam_width, HAL_MAX_WIDTH, "image width the intrinsics belong to"),
     CU("camera", "height", cam_height, HAL_MAX_HEIGHT, "image height"),
+    CV("camera", "distortion", cam_dist, 5, -100, 100, "0, 0, 0, 0, 0",
+       "lens distortion k1, k2, p1, p2, k3 (Brown-Conrady, OpenCV's order; 0: a pinhole)"),
     CF("projector", "fx_px", proj_fx_px, 1, 1e6, "focal length x"),
     CF("projector", "fy_px", proj_fy_px, 1, 1e6, "focal length y"),
     CF("projector", "cx_px", proj_cx_px, -1e5, 1e5, "principal point x"),
     CF("projector", "cy_px", proj_cy_px, -1e5, 1e5, "principal point y"),
     CU("projector", "width", proj_width, HAL_MAX_PROJECTOR_WIDTH, "projector columns"),
     CU("projector", "height", proj_height, HAL_MAX_PROJECTOR_HEIGHT, "projector rows"),
+    CV("projector", "distortion", proj_dist, 5, -100, 100, "0, 0, 0, 0, 0",
+       "lens distortion k1, k2, p1, p2, k3, as for the camera"),
     CV("projector", "rotation", proj_rot, 9, -1, 1, NULL,
        "rotation camera -> projector, row-major 3x3 (p_proj = R p_cam + t)"),
     CV("projector", "translation_mm", proj_trans_mm, 3, -1e5, 1e5, NULL,
@@ -284,6 +291,28 @@ static enum hal_pixel_format pixel_format_of(const char *s)
     return strcmp(s, "yuyv") == 0   ? HAL_PIX_YUYV
            : strcmp(s, "grey") == 0 ? HAL_PIX_GREY
                                     : HAL_PIX_RGB24;
+}
+
+/* [sim] rig: the geometry the simulator renders with, loaded now so that a bad file is named at
+ * start like the calibration is. */
+static int load_sim_rig(struct app_config *cfg, const char *path, char *err, size_t err_len)
+{
+    if (cfg->sim.rig_file[0] == '\0')
+        return 0;
+    char dir_buf[HAL_MAX_PATH], joined[HAL_MAX_PATH * 2 + 2];
+    snprintf(dir_buf, sizeof(dir_buf), "%s", path);
+    if (cfg->sim.rig_file[0] == '/')
+        snprintf(joined, sizeof(joined), "%s", cfg->sim.rig_file);
+    else
+        snprintf(joined, sizeof(joined), "%s/%s", dirname(dir_buf), cfg->sim.rig_file);
+    char why[512];
+    int rc = calib_load(&cfg->sim.rig, joined, cfg->light_count, why, sizeof(why));
+    if (rc != 0) {
+        snprintf(err, err_len, "%s: [sim] rig: %s", path, why);
+        return rc;
+    }
+    cfg->sim.has_rig = 1;
+    return 0;
 }
 
 int config_load(struct app_config *cfg, const char *path, char *err, size_t err_len)
@@ -353,7 +382,7 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
         }
         memcpy(cfg->calibration_file, joined, strlen(joined) + 1);
     }
-    return 0;
+    return load_sim_rig(cfg, path, err, err_len);
 }
 
 int calib_load(struct scan_calib *calib, const char *path, uint32_t light_count, char *err,

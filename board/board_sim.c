@@ -100,7 +100,20 @@ int board_init(struct hal *hal, const struct board_config *cfg, const struct sca
     snprintf(dir_buf, sizeof(dir_buf), "%s", cfg->config_path);
     struct gray_layout layout;
     scan_layout(cfg->scan, calib, &layout);
-    int rc = sim_rig_init(&sim.rig, cfg->sim, calib, &layout, dirname(dir_buf), err, err_len);
+    /* The simulator renders the true rig: the config's [sim] rig, or else the calibration. */
+    const struct scan_calib *truth = cfg->sim->has_rig ? &cfg->sim->rig : calib;
+    if (truth->cam_width != calib->cam_width || truth->cam_height != calib->cam_height ||
+        truth->proj_width != calib->proj_width || truth->proj_height != calib->proj_height) {
+        snprintf(err, err_len,
+                 "%s: [sim] rig: a %ux%u camera and %ux%u projector, but the calibration's are "
+                 "%ux%u and %ux%u (the same devices must be described)",
+                 cfg->config_path, (unsigned)truth->cam_width, (unsigned)truth->cam_height,
+                 (unsigned)truth->proj_width, (unsigned)truth->proj_height,
+                 (unsigned)calib->cam_width, (unsigned)calib->cam_height,
+                 (unsigned)calib->proj_width, (unsigned)calib->proj_height);
+        return -EINVAL;
+    }
+    int rc = sim_rig_init(&sim.rig, cfg->sim, truth, &layout, dirname(dir_buf), err, err_len);
     if (rc != 0)
         return rc;
     gpio_sim_init(&sim.gpio, gray_layout_count(&layout), &hal->gpio);

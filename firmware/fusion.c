@@ -1,6 +1,8 @@
 /* Truncated signed distance fusion in a static voxel grid, and marching cubes over it. */
 #include "fusion.h"
 
+#include "camray.h"
+#include "lens.h"
 #include "mc_table.h"
 #include "vec3.h"
 
@@ -114,8 +116,7 @@ static void pixel_weights(const struct scan_calib *c, const struct decode_maps *
             weight_map[i] = 0.0f;
             if (m->reason[i] != SCAN_VALID)
                 continue;
-            vec3 ray = v3_norm(
-                v3((x - c->cam_cx_px) / c->cam_fx_px, (y - c->cam_cy_px) / c->cam_fy_px, 1.0));
+            vec3 ray = v3_norm(camray_at(c, x, y));
             vec3 n = v3(r->normal[3 * i], r->normal[3 * i + 1], r->normal[3 * i + 2]);
             double head_on = -v3_dot(n, ray), z = r->xyz_mm[3 * i + 2];
             double w = head_on * (600.0 / z) * (600.0 / z) * fmin(1.0, edge_dist[i] / fade);
@@ -191,6 +192,7 @@ int fusion_integrate(const struct scan_calib *c, const struct frame_xform *obj_f
 {
     pixel_weights(c, m, r);
     const double trunc = fz.p.truncation_mm, vox = fz.p.voxel_mm;
+    const int pinhole = lens_is_pinhole(c->cam_dist); /* the voxel loop's common case, inline */
     const vec3 step_x = m3_tmul(obj_from_cam->rot, v3(vox, 0, 0));
     uint32_t lo[3], hi[3];
     if (!view_box(obj_from_cam, m, r, lo, hi))
@@ -204,6 +206,8 @@ int fusion_integrate(const struct scan_calib *c, const struct frame_xform *obj_f
                     continue;
                 double a = p.x / p.z, b = p.y / p.z;
                 double fu = c->cam_fx_px * a + c->cam_cx_px, fv = c->cam_fy_px * b + c->cam_cy_px;
+                if (!pinhole)
+                    camray_project(c, p, &fu, &fv);
                 if (fu < -0.5 || fv < -0.5)
                     continue;
                 /* nearest pixel; a cast rounds correctly once the value is known >= -0.5, and

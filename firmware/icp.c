@@ -1,6 +1,7 @@
 /* Pairwise point-to-plane ICP with projective association, in static buffers. */
 #include "icp.h"
 
+#include "camray.h"
 #include "vec3.h"
 
 #include <string.h>
@@ -105,8 +106,9 @@ static void accumulate(const struct icp_params *prm, const struct scan_calib *c,
                                           r->normal[3 * i + 2]));
             if (p.z <= 1.0)
                 continue;
-            long u = lround((c->cam_fx_px * p.x / p.z + c->cam_cx_px) / ICP_STRIDE);
-            long v = lround((c->cam_fy_px * p.y / p.z + c->cam_cy_px) / ICP_STRIDE);
+            double fu, fv;
+            camray_project(c, p, &fu, &fv);
+            long u = lround(fu / ICP_STRIDE), v = lround(fv / ICP_STRIDE);
             if (u < 0 || v < 0 || u >= (long)ref.w || v >= (long)ref.h)
                 continue;
             size_t j = (size_t)v * ref.w + (size_t)u;

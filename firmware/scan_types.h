@@ -10,8 +10,10 @@
 struct scan_calib {
     double cam_fx_px, cam_fy_px, cam_cx_px, cam_cy_px; /**< camera pinhole intrinsics */
     uint32_t cam_width, cam_height;                    /**< image size the intrinsics belong to */
+    double cam_dist[5]; /**< camera lens distortion k1, k2, p1, p2, k3 (firmware/lens.h) */
     double proj_fx_px, proj_fy_px, proj_cx_px, proj_cy_px; /**< projector pinhole intrinsics */
     uint32_t proj_width, proj_height;                      /**< projector resolution */
+    double proj_dist[5]; /**< projector lens distortion k1, k2, p1, p2, k3 */
     double proj_rot[9];      /**< rotation camera -> projector, row-major: p_proj = R p_cam + t */
     double proj_trans_mm[3]; /**< translation camera -> projector */
     double axis_point_mm[3]; /**< a point on the turntable axis, on the table surface */

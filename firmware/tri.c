@@ -1,6 +1,8 @@
 /* Camera-ray / projector-plane triangulation and range-image normals, in static buffers. */
 #include "tri.h"
 
+#include "camray.h"
+#include "lens.h"
 #include "vec3.h"
 
 #include <errno.h>
@@ -8,11 +10,47 @@
 static float xyz_map[HAL_MAX_PIXELS * 3];
 static float normal_map[HAL_MAX_PIXELS * 3];
 
+/* Depth s along camera ray d (z = 1) where the projector's distorted column is @p col_n
+ * (normalised: (u - cx) / fx). The point s d lands at q = s R d + t in the projector frame, at
+ * normalised (q.x / q.z, q.y / q.z), distorted by lens_distort; Newton's method on s from the
+ * pinhole plane's answer @p s0. This is the "distorted column surface": only the column is
+ * needed, so the refined sub-pixel columns keep their precision and no rows are decoded.
+ * @retval 1 converged to s > 0 @retval 0 not */
+static int distorted_column_depth(const struct scan_calib *c, vec3 d, double col_n, double s0,
+                                  double *s_out)
+{
+    const vec3 a = m3_mul(c->proj_rot, d), t = v3_from(c->proj_trans_mm);
+    double s = s0;
+    for (int it = 0; it < 12; it++) {
+        vec3 q = v3_add(v3_scale(a, s), t);
+        if (q.z <= 0.0)
+            return 0;
+        double xn = q.x / q.z, yn = q.y / q.z, xd, yd, j[4];
+        lens_distort(c->proj_dist, xn, yn, &xd, &yd);
+        lens_jacobian(c->proj_dist, xn, yn, j);
+        double dxn = (a.x * q.z - q.x * a.z) / (q.z * q.z), dyn = (a.y * q.z - q.y * a.z) / (q.z * q.z);
+        double deriv = j[0] * dxn + j[1] * dyn;
+        if (deriv == 0.0)
+            return 0;
+        double step = (xd - col_n) / deriv;
+        s -= step;
+        if (fabs(step) < 1e-7) { /* mm */
+            *s_out = s;
+            return s > 0.0;
+        }
+    }
+    return 0;
+}
+
 int tri_range_image(const struct scan_calib *c, uint32_t width, uint32_t height,
                     const float *column, uint8_t *reason, struct tri_range *range)
 {
     if (width != c->cam_width || height != c->cam_height)
         return -EINVAL;
+    int rc = camray_prepare(c);
+    if (rc != 0)
+        return rc;
+    const int proj_pinhole = lens_is_pinhole(c->proj_dist);
     /* Plane of projector column u: n_p = e_x - a e_z with a = (u - cx) / fx, through the
      * projector centre. n_p . (R p + t) = 0  <=>  (R^T n_p) . p + n_p . t = 0, and R^T n_p is
      * linear in a: R^T e_x - a R^T e_z. */
@@ -28,14 +66,14 @@ int tri_range_image(const struct scan_calib *c, uint32_t width, uint32_t height,
             size_t i = (size_t)y * width + x;
             if (reason[i] != SCAN_VALID)
                 continue;
-            vec3 ray = v3(((double)x - c->cam_cx_px) / c->cam_fx_px,
-                          ((double)y - c->cam_cy_px) / c->cam_fy_px, 1.0);
+            vec3 ray = camray_at(c, x, y);
             double a = ((double)column[i] - c->proj_cx_px) / c->proj_fx_px;
             vec3 normal = v3_sub(rt_ex, v3_scale(rt_ez, a));
             double denom = v3_dot(normal, ray);
             double s = denom != 0.0 ? -(t.x - a * t.z) / denom : -1.0;
             /* A grazing plane (|denom| tiny) would put the point at infinity. */
-            if (s <= 0.0 || denom * denom < 1e-12 * v3_dot(ray, ray)) {
+            if (s <= 0.0 || denom * denom < 1e-12 * v3_dot(ray, ray) ||
+                (!proj_pinhole && !distorted_column_depth(c, ray, a, s, &s))) {
                 reason[i] = SCAN_INCONSISTENT;
                 continue;
             }

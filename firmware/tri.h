@@ -13,14 +13,17 @@ struct tri_range {
     uint32_t valid_count; /**< pixels left valid after triangulation and normals */
 };
 
-/** Intersect every valid pixel's camera ray with its projector column plane (the plane through
- *  the projector centre and column u_p, x_p / z_p = (u_p - cx_p) / fx_p in the projector frame).
+/** Intersect every valid pixel's camera ray (camray.h: through the camera's lens model) with
+ *  its projector column: for a pinhole projector the plane through the projector centre and
+ *  column u_p, x_p / z_p = (u_p - cx_p) / fx_p in the projector frame; with projector distortion
+ *  the surface of points whose distorted column is u_p (found along the ray by Newton's method).
  *  @param width, height  the frame's size (must be the calibration's)
  *  @param column  continuous projector column per pixel (see refine.h)
  *  @param reason  in/out: pixels whose ray misses (parallel, behind a device) become
  *                 SCAN_INCONSISTENT; only SCAN_VALID pixels are triangulated
  *  @param range   out: the points (the triangulator's static buffers), valid_count
- *  @retval 0 ok @retval -EINVAL calibration does not match the frame size */
+ *  @retval 0 ok @retval -EINVAL calibration does not match the frame size
+ *  @retval -EDOM the camera's distortion folds over inside the image */
 int tri_range_image(const struct scan_calib *calib, uint32_t width, uint32_t height,
                     const float *column, uint8_t *reason, struct tri_range *range);
 /** Normals from differences across up to @p radius_px pixels each side along both image axes,

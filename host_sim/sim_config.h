@@ -3,6 +3,7 @@
 #define SIM_CONFIG_H
 
 #include "hal_limits.h"
+#include "scan_types.h"
 
 #include <stdint.h>
 
@@ -25,6 +26,9 @@ struct sim_config {
     double projector_intensity_dn, projector_black_level, projector_blur_px;
     double light_intensity_dn, light_diffuser_mm, reference_distance_mm;
     uint32_t reference_exposure_us;
+    char rig_file[HAL_MAX_PATH]; /**< the true rig's geometry ("": the scan's calibration) */
+    uint32_t has_rig;            /**< 1: rig holds the rig_file, loaded with the config */
+    struct scan_calib rig;       /**< what the simulator renders with when has_rig */
 };
 
 #endif

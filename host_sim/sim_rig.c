@@ -5,6 +5,7 @@
 
 #include "frames.h"
 #include "gray.h"
+#include "lens.h"
 #include "sim_random.h"
 
 #include <errno.h>
@@ -209,13 +210,17 @@ static void update_pixel(struct sim_rig *rig, const struct frame_xform *obj, vec
     size_t i = (size_t)y * rig->width + x;
     vec3 d_cam = v3(((double)x - c->cam_cx_px) / c->cam_fx_px,
                     ((double)y - c->cam_cy_px) / c->cam_fy_px, 1.0);
-    struct sim_hit hit;
-    t->hit[i] =
-        (uint8_t)sim_bvh_intersect(&rig->bvh, cam_obj, frame_dir(obj, d_cam), 1e-6, 1e9, &hit);
+    t->hit[i] = 0;
     t->proj_lit[i] = 0;
     t->dark[i] = 0;
     for (int k = 0; k < 3; k++)
         rig->proj_radiance[3 * i + k] = 0.0f;
+    if (!lens_is_pinhole(c->cam_dist) &&
+        lens_undistort(c->cam_dist, d_cam.x, d_cam.y, &d_cam.x, &d_cam.y) != 0)
+        return; /* beyond where the lens model holds: no light reaches this pixel */
+    struct sim_hit hit;
+    t->hit[i] =
+        (uint8_t)sim_bvh_intersect(&rig->bvh, cam_obj, frame_dir(obj, d_cam), 1e-6, 1e9, &hit);
     if (!t->hit[i])
         return;
     const struct sim_mesh *m = &rig->mesh;
@@ -244,6 +249,12 @@ static void update_pixel(struct sim_rig *rig, const struct frame_xform *obj, vec
         return;
     double u = c->proj_fx_px * pp.x / pp.z + c->proj_cx_px;
     double v = c->proj_fy_px * pp.y / pp.z + c->proj_cy_px;
+    if (!lens_is_pinhole(c->proj_dist)) {
+        double xd, yd;
+        lens_distort(c->proj_dist, pp.x / pp.z, pp.y / pp.z, &xd, &yd);
+        u = c->proj_fx_px * xd + c->proj_cx_px;
+        v = c->proj_fy_px * yd + c->proj_cy_px;
+    }
     t->proj_u[i] = (float)u;
     t->proj_v[i] = (float)v;
     vec3 to_proj = v3_sub(proj_cam, p_cam);
