@@ -96,6 +96,13 @@ LIBCAMERA_OBJ = $(if $(HAVE_LIBCAMERA),$(BUILD)/hal/linux/camera_libcamera.o,)
 LIBCAMERA_LIBS = $(if $(HAVE_LIBCAMERA),$(shell $(PKG_CONFIG) --libs libcamera) -lstdc++,)
 HOST_CFLAGS += $(if $(HAVE_LIBCAMERA),-DHAVE_LIBCAMERA,)
 BOARD_SRC := $(if $(filter sim,$(HAL)),$(SIM_SRC),$(LINUX_SRC))
+# The calibration (scanner calibrate) is its own program, scanner-calibrate, built where OpenCV
+# 4 is found (Debian's libopencv-contrib-dev, which make test installs): a scan never loads
+# OpenCV. scanner execs it for 'scanner calibrate'.
+HAVE_OPENCV := $(shell $(PKG_CONFIG) --exists opencv4 2>/dev/null && echo 1)
+CALIB_SRC := app/calibrate.c app/calib_solve.c app/calib_files.c
+OPENCV_LIBS := -lopencv_aruco -lopencv_calib3d -lopencv_imgproc -lopencv_core
+CALIB_TOOL := $(if $(HAVE_OPENCV),$(BUILD)/scanner-calibrate,)
 BOARD_LIBS = $(if $(filter linux,$(HAL)),$(shell $(PKG_CONFIG) --libs libgpiod 2>/dev/null) $(LIBCAMERA_LIBS),)
 
 obj = $(patsubst %.c,$(BUILD)/%.o,$(1))
@@ -105,7 +112,7 @@ MAIN_OBJ := $(call obj,app/main.c)
 
 .PHONY: seccomp-tool all deps test-deps test test-run linux-build small-build install check-stack size fuzz errors-doc test-arm64 test-arm64-full test-gpio-chip arm64-check-elf arm64-run-tests run clean format docs check-firmware bench measure measure-scan interop-meshlab bench-callgrind eval
 SIM_TOOLS := $(if $(filter sim,$(HAL)),$(BUILD)/turntable-sim $(BUILD)/tt-client $(BUILD)/mesh-compare $(BUILD)/colour-eval,)
-all: deps $(BUILD)/scanner $(SIM_TOOLS)
+all: deps $(BUILD)/scanner $(CALIB_TOOL) $(SIM_TOOLS)
 
 # Install missing Debian packages (fresh Debian 12): only when pkg-config cannot find them.
 deps:
@@ -140,6 +147,15 @@ $(BUILD)/libfirmware.a: $(FW_OBJ)
 $(BUILD)/scanner: $(MAIN_OBJ) $(HOST_OBJ) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON) $(BOARD_LIBS)
 
+$(BUILD)/app/main_calibrate.o: app/main.c | deps
+	@mkdir -p $(dir $@)
+	$(CC) $(HOST_CFLAGS) -DSCANNER_CALIBRATE -c $< -o $@
+$(BUILD)/app/calib_cv.o: app/calib_cv.cpp app/calib_cv.h | deps
+	@mkdir -p $(dir $@)
+	$(CXX) -std=c++17 -Wall -Wextra -Werror $(OPT) -g -MMD -MP -Iapp $(shell $(PKG_CONFIG) --cflags opencv4 2>/dev/null) -c $< -o $@
+$(BUILD)/scanner-calibrate: $(BUILD)/app/main_calibrate.o $(call obj,$(CALIB_SRC)) $(BUILD)/app/calib_cv.o $(HOST_OBJ) $(BUILD)/libfirmware.a
+	$(CXX) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON) $(BOARD_LIBS) $(OPENCV_LIBS)
+
 # The simulated controller as its own program, and the client as a command (interop tests).
 $(BUILD)/turntable-sim: $(call obj,host_sim/turntable_sim_main.c host_sim/tt_server.c host_sim/tt_ctrl.c)
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON)
@@ -155,7 +171,7 @@ seccomp-tool: $(BUILD)/seccomp-run
 $(BUILD)/mesh-compare: $(call obj,tests/mesh_compare.c tests/mesh_compare_lib.c host_sim/sim_bvh.c host_sim/sim_mesh.c host_sim/sim_ply_read.c app/config.c app/ini_schema.c app/scan_dir.c hal/posix/image_io.c) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON)
 
-$(BUILD)/colour-eval: $(call obj,tests/colour_eval.c tests/colour_metrics.c host_sim/sim_bvh.c host_sim/sim_mesh.c host_sim/sim_ply_read.c host_sim/sim_rig.c host_sim/sim_material.c app/config.c app/ini_schema.c app/scan_dir.c hal/posix/image_io.c hal/posix/storage_posix.c) $(BUILD)/libfirmware.a
+$(BUILD)/colour-eval: $(call obj,tests/colour_eval.c tests/colour_metrics.c host_sim/sim_bvh.c host_sim/sim_mesh.c host_sim/sim_ply_read.c host_sim/sim_rig.c host_sim/sim_target.c host_sim/sim_material.c app/config.c app/ini_schema.c app/scan_dir.c hal/posix/image_io.c hal/posix/storage_posix.c) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON)
 
 # ---- tests ----
@@ -374,6 +390,10 @@ interop-meshlab: deps $(BUILD)/scanner
 	rm -rf $(BUILD)/meshlab-scan
 	$(BUILD)/scanner scan --config config/sim.ini --out $(BUILD)/meshlab-scan > /dev/null
 	tests/interop_meshlab.sh $(BUILD)/meshlab-scan
+
+# The calibration's accuracy (tests/measure_calib.c): a calibration against the true rig.
+$(BUILD)/measure-calib: $(call obj,tests/measure_calib.c app/config.c app/ini_schema.c) $(BUILD)/libfirmware.a
+	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON)
 
 # Time per view, split between the simulated capture and the firmware's processing.
 $(BUILD)/bench_view: $(BUILD)/bench/bench_view.o $(BUILD)/tests/test_util.o $(HOST_OBJ) $(BUILD)/libfirmware.a

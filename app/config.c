@@ -229,6 +229,44 @@ static const struct ini_key config_keys[] = {
         "distance at which the intensities above hold (inverse-square falloff)"),
     U32("sim", "reference_exposure_us", sim.reference_exposure_us, 1, 10000000, "10000",
         "exposure at which the intensities above hold"),
+    ENUM("calibrate", "board", calibrate.board, "chessboard|charuco", "charuco",
+         "the printed board: a plain chessboard (seen whole) or ChArUco (seen in part)"),
+    U32("calibrate", "squares_x", calibrate.squares_x, 3, 33, "9", "squares across the board"),
+    U32("calibrate", "squares_y", calibrate.squares_y, 3, 33, "7", "squares down the board"),
+    F64("calibrate", "square_mm", calibrate.square_mm, 1, 500, "20",
+        "side of a square as printed (measure it: the scale of every result)"),
+    F64("calibrate", "marker_mm", calibrate.marker_mm, 1, 500, "15",
+        "ChArUco: side of a marker, smaller than a square"),
+    ENUM("calibrate", "dictionary", calibrate.dictionary, "4x4_50|4x4_100|5x5_50|5x5_100|6x6_250",
+         "5x5_100", "ChArUco: the ArUco dictionary of the markers"),
+    F64("calibrate", "margin_mm", calibrate.margin_mm, 0, 200, "10",
+        "white border around the squares; the sheet's bottom edge sits on the plate's"),
+    F64("calibrate", "board_thickness_mm", calibrate.board_thickness_mm, 0, 100, "3",
+        "plate the sheet is glued to (the table's height is found from the board's bottom edge)"),
+    STR("calibrate", "placements", calibrate.placements, "0, 35, -25, 0@75, 0@-75, 25@75, 25@-75",
+        "the board's placements, comma-separated: each a tilt from upright in degrees (leaning "
+        "back; 90: lying flat), optionally @ an offset in mm to the camera's right ('0@70')"),
+    U32("calibrate", "turns", calibrate.turns, 1, 32, "5", "table angles per board placement"),
+    F64("calibrate", "turn_step_deg", calibrate.turn_step_deg, 0, 90, "15",
+        "between those angles, centred on 0 (the board must stay in view)"),
+    F64("calibrate", "sphere_diameter_mm", calibrate.sphere_diameter_mm, 1, 500, "60",
+        "the matte white sphere (lights) and the verification ball"),
+    F64("calibrate", "sphere_offset_mm", calibrate.sphere_offset_mm, 0, 300, "50",
+        "how far from the table's centre the sphere is placed"),
+    U32("calibrate", "sphere_turns", calibrate.sphere_turns, 0, 32, "6",
+        "table angles of the sphere, evenly round (0: lights are not calibrated)"),
+    U32("calibrate", "projector_width", calibrate.projector_width, 1, HAL_MAX_PROJECTOR_WIDTH,
+        "1024", "projector columns, when no calibration file exists yet"),
+    U32("calibrate", "projector_height", calibrate.projector_height, 1,
+        HAL_MAX_PROJECTOR_HEIGHT, "768", "projector rows, when no calibration file exists yet"),
+    U32("calibrate", "min_corners", calibrate.min_corners, 6, 1024, "12",
+        "fewer corners found in an image: the image is not used"),
+    U32("calibrate", "fix_k3", calibrate.fix_k3, 0, 1, "1",
+        "1: the sixth-order radial term stays 0 (ordinary lenses; avoids over-fitting)"),
+    F64("calibrate", "max_camera_rms_px", calibrate.max_camera_rms_px, 0.01, 100, "0.5",
+        "a camera reprojection RMS above this refuses the calibration"),
+    F64("calibrate", "max_projector_rms_px", calibrate.max_projector_rms_px, 0.01, 100, "1",
+        "a projector reprojection RMS above this refuses the calibration"),
 };
 
 #undef C
@@ -291,6 +329,51 @@ static enum hal_pixel_format pixel_format_of(const char *s)
     return strcmp(s, "yuyv") == 0   ? HAL_PIX_YUYV
            : strcmp(s, "grey") == 0 ? HAL_PIX_GREY
                                     : HAL_PIX_RGB24;
+}
+
+/* [calibrate] placements: the board's tilts, comma-separated. */
+static int parse_placements(struct calib_settings *c, const char *path, char *err, size_t len)
+{
+    const char *p = c->placements;
+    c->placement_count = 0;
+    while (*p != '\0') {
+        char *end;
+        double tilt = strtod(p, &end);
+        if (end == p || tilt < -60.0 || tilt > 90.0) {
+            snprintf(err, len,
+                     "%s: [calibrate] placements: '%s': each placement is a tilt from upright "
+                     "in degrees, -60..90",
+                     path, c->placements);
+            return -EINVAL;
+        }
+        if (c->placement_count == CALIB_MAX_PLACEMENTS) {
+            snprintf(err, len, "%s: [calibrate] placements: more than %u", path,
+                     (unsigned)CALIB_MAX_PLACEMENTS);
+            return -EINVAL;
+        }
+        double offset = 0.0;
+        p = end + strspn(end, " \t");
+        if (*p == '@') {
+            offset = strtod(p + 1, &end);
+            if (end == p + 1 || fabs(offset) > 300.0) {
+                snprintf(err, len,
+                         "%s: [calibrate] placements: '%s': after '@' an offset in mm, -300..300",
+                         path, c->placements);
+                return -EINVAL;
+            }
+            p = end + strspn(end, " \t");
+        }
+        c->offset_mm[c->placement_count] = offset;
+        c->tilt_deg[c->placement_count++] = tilt;
+        if (*p == ',')
+            p++;
+        else if (*p != '\0') {
+            snprintf(err, len, "%s: [calibrate] placements: '%s': numbers separated by commas",
+                     path, c->placements);
+            return -EINVAL;
+        }
+    }
+    return 0;
 }
 
 /* [sim] rig: the geometry the simulator renders with, loaded now so that a bad file is named at
@@ -382,6 +465,9 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
         }
         memcpy(cfg->calibration_file, joined, strlen(joined) + 1);
     }
+    rc = parse_placements(&cfg->calibrate, path, err, err_len);
+    if (rc != 0)
+        return rc;
     return load_sim_rig(cfg, path, err, err_len);
 }
 
@@ -430,6 +516,53 @@ int calib_load(struct scan_calib *calib, const char *path, uint32_t light_count,
         }
     }
     return 0;
+}
+
+/* "a, b, c" to 12 significant digits (1e-12: far below any calibration's uncertainty; the
+ * loader refuses lines over 198 characters) */
+static int put_vec(char *buf, size_t len, const char *key, const double *v, int n)
+{
+    int w = snprintf(buf, len, "%s = ", key);
+    for (int i = 0; i < n && w > 0 && (size_t)w < len; i++)
+        w += snprintf(buf + w, len - (size_t)w, "%s%.12g", i > 0 ? ", " : "", v[i]);
+    if (w > 0 && (size_t)w < len)
+        w += snprintf(buf + w, len - (size_t)w, "\n");
+    return w;
+}
+
+int calib_save(const struct hal_storage *st, const char *path, const struct scan_calib *c,
+               const char *comment)
+{
+    static char buf[16384];
+    size_t n = 0;
+#define PUT(...) n += (size_t)snprintf(buf + n, n < sizeof(buf) ? sizeof(buf) - n : 0, __VA_ARGS__)
+#define VEC(key, v, k) n += (size_t)put_vec(buf + n, n < sizeof(buf) ? sizeof(buf) - n : 0, key, v, k)
+    if (comment != NULL)
+        PUT("%s", comment);
+    PUT("[camera]\nfx_px = %.12g\nfy_px = %.12g\ncx_px = %.12g\ncy_px = %.12g\nwidth = %u\n"
+        "height = %u\n", c->cam_fx_px, c->cam_fy_px, c->cam_cx_px, c->cam_cy_px,
+        (unsigned)c->cam_width, (unsigned)c->cam_height);
+    VEC("distortion", c->cam_dist, 5);
+    PUT("\n[projector]\nfx_px = %.12g\nfy_px = %.12g\ncx_px = %.12g\ncy_px = %.12g\n"
+        "width = %u\nheight = %u\n", c->proj_fx_px, c->proj_fy_px, c->proj_cx_px, c->proj_cy_px,
+        (unsigned)c->proj_width, (unsigned)c->proj_height);
+    VEC("distortion", c->proj_dist, 5);
+    VEC("rotation", c->proj_rot, 9);
+    VEC("translation_mm", c->proj_trans_mm, 3);
+    PUT("\n[turntable]\n");
+    VEC("axis_point_mm", c->axis_point_mm, 3);
+    VEC("axis_dir", c->axis_dir, 3);
+    PUT("\n[lights]\n");
+    for (uint32_t i = 0; i < c->light_count && i < HAL_MAX_LIGHTS; i++) {
+        char key[32];
+        snprintf(key, sizeof(key), "light_%u_mm", (unsigned)i);
+        VEC(key, c->light_pos_mm[i], 3);
+    }
+#undef PUT
+#undef VEC
+    if (n >= sizeof(buf))
+        return -EFBIG;
+    return hal_storage_write_file(st, path, buf, n);
 }
 
 void config_print_doc(FILE *out)

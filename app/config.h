@@ -4,6 +4,7 @@
 #define CONFIG_H
 
 #include "board.h"
+#include "calibrate.h"
 #include "hal.h"
 #include "fusion.h"
 #include "icp.h"
@@ -33,6 +34,7 @@ struct app_config {
     struct fusion_params fusion;
     struct icp_params registration;
     struct sim_config sim;
+    struct calib_settings calibrate;
 };
 
 /** Parse and check @p path. On error @p err says file, line and key.
@@ -42,6 +44,12 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
 /** Parse and check a calibration file. @retval 0 ok, otherwise @p err says file, line and key */
 int calib_load(struct scan_calib *calib, const char *path, uint32_t light_count, char *err,
                size_t err_len);
+
+/** Write @p calib as a calibration file calib_load reads back, durably (temp, fsync, rename),
+ *  under the comment lines @p comment (each line starts "; "; may be NULL).
+ *  @retval 0 @retval -errno */
+int calib_save(const struct hal_storage *st, const char *path, const struct scan_calib *calib,
+               const char *comment);
 
 /** The devices' settings of @p cfg for board_init and board_selftest (pointers into @p cfg). */
 void config_board(const struct app_config *cfg, struct board_config *out);

@@ -23,7 +23,7 @@ struct ini_key {
     const char *doc;     /**< one sentence for docs/config.md */
 };
 
-#define INI_MAX_KEYS 128
+#define INI_MAX_KEYS 192
 
 /** Parse @p path against @p keys into @p target. Unknown sections and keys, duplicates, bad
  *  values and missing required keys are errors naming file, line and key.

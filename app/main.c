@@ -1,6 +1,7 @@
 /* The scanner command-line program: config, board, one scan, and a safe rig on every exit. */
 #define _POSIX_C_SOURCE 200809L
 #include "board.h"
+#include "calibrate.h"
 #include "config.h"
 #include "scan.h"
 #include "scan_job.h"
@@ -15,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #ifndef SCANNER_VERSION
 #define SCANNER_VERSION "0.1.0"
@@ -246,6 +248,101 @@ static int cmd_resume(const char *scan_dir, const struct scan_job_opts *opts)
     return cmd_process(scan_dir, opts);
 }
 
+#ifdef SCANNER_CALIBRATE
+/* scanner calibrate [verify | board] --config F [--out P] [--dir D | --from D] */
+static int cmd_calibrate(int argc, char **argv)
+{
+    static struct app_config cfg;
+    static struct scan_calib calib;
+    const char *config_path = NULL, *out = NULL, *dir = NULL, *from = NULL, *what = "";
+    int first = 2;
+    if (argc > 2 && (strcmp(argv[2], "verify") == 0 || strcmp(argv[2], "board") == 0))
+        what = argv[first++];
+    for (int i = first; i < argc; i++) {
+        if (strcmp(argv[i], "--config") == 0 && i + 1 < argc)
+            config_path = argv[++i];
+        else if (strcmp(argv[i], "--out") == 0 && i + 1 < argc)
+            out = argv[++i];
+        else if (strcmp(argv[i], "--dir") == 0 && i + 1 < argc)
+            dir = argv[++i];
+        else if (strcmp(argv[i], "--from") == 0 && i + 1 < argc)
+            from = argv[++i];
+        else {
+            fprintf(stderr, "scanner: calibrate: unknown argument '%s'\n", argv[i]);
+            return 2;
+        }
+    }
+    char err[512];
+    if (config_path == NULL || (what[0] != 'v' && out == NULL)) {
+        fprintf(stderr, "scanner: calibrate: --config FILE%s is required\n",
+                what[0] == 'v' ? "" : " and --out FILE");
+        return 2;
+    }
+    if (config_load(&cfg, config_path, err, sizeof(err)) != 0) {
+        fprintf(stderr, "scanner: error: %s\n", err);
+        return 2;
+    }
+    struct hal_storage st;
+    storage_posix_init(&st);
+    if (strcmp(what, "board") == 0)
+        return calibrate_print_board(&st, &cfg, out) == 0 ? 0 : 1;
+    if (from != NULL)
+        return calibrate_solve(&st, &cfg, from, out) == 0 ? 0 : 1;
+    int rc = calib_load(&calib, cfg.calibration_file, cfg.light_count, err, sizeof(err));
+    if (rc == -ENOENT && what[0] != 'v') {
+        calibrate_guess(&cfg, &calib); /* a new rig: nothing calibrated yet */
+        rc = 0;
+    }
+    if (rc == 0)
+        rc = scan_check(&cfg.scan, &calib, err, sizeof(err));
+    if (rc != 0) {
+        fprintf(stderr, "scanner: error: %s\n", err);
+        return 2;
+    }
+    if (what[0] != 'v') /* the projector's sequence is the calibration's: rows too */
+        calib_capture_params(&cfg, &cfg.scan);
+    char dir_buf[HAL_MAX_PATH];
+    if (dir == NULL && out != NULL) { /* CAL.ini -> CAL-captures */
+        size_t l = strlen(out);
+        snprintf(dir_buf, sizeof(dir_buf), "%.*s-captures",
+                 (int)(l > 4 && strcmp(out + l - 4, ".ini") == 0 ? l - 4 : l), out);
+        dir = dir_buf;
+    }
+    rc = rig_up(&cfg, &calib);
+    if (rc == 0)
+        rc = what[0] == 'v' ? calibrate_verify(&the_hal, &cfg, &calib)
+                            : calibrate_capture(&the_hal, &cfg, &calib, dir);
+    rig_down();
+    if (rc == 0 && what[0] != 'v')
+        rc = calibrate_solve(&st, &cfg, dir, out);
+    return rc == 0 ? 0 : 1;
+}
+#else
+/* The calibration (OpenCV) is its own program beside this one, so that a scan never loads it. */
+static int cmd_calibrate(int argc, char **argv)
+{
+    (void)argc;
+    char self[HAL_MAX_PATH], path[HAL_MAX_PATH + 32];
+    ssize_t n = readlink("/proc/self/exe", self, sizeof(self) - 1);
+    if (n <= 0) {
+        fprintf(stderr, "scanner: error: cannot find my own program: %s\n", strerror(errno));
+        return 1;
+    }
+    self[n] = '\0';
+    char *slash = strrchr(self, '/');
+    if (slash != NULL)
+        *slash = '\0';
+    snprintf(path, sizeof(path), "%s/scanner-calibrate", self);
+    argv[0] = path;
+    execv(path, argv);
+    fprintf(stderr,
+            "scanner: error: cannot run %s: %s (the calibration needs OpenCV: install Debian's "
+            "libopencv-contrib-dev and rebuild)\n",
+            path, strerror(errno));
+    return 1;
+}
+#endif
+
 static void usage(FILE *out)
 {
     fprintf(out,
@@ -255,6 +352,12 @@ static void usage(FILE *out)
             "           a scan from its frames\n"
             "       scanner resume DIR [--config F] [--json] [--clear-alarm]  finish a stopped\n"
             "           scan (--clear-alarm: the turntable's alarm, once its cause is fixed)\n"
+            "       scanner calibrate --config FILE --out CAL.ini [--dir DIR]  calibrate the rig\n"
+            "           (step by step; every capture kept in DIR, default CAL-captures)\n"
+            "       scanner calibrate --config FILE --from DIR --out CAL.ini  from kept captures\n"
+            "       scanner calibrate verify --config FILE   scan the sphere, print the errors\n"
+            "       scanner calibrate board --config FILE --out BASE  the board to print\n"
+            "           (BASE.png at 300 dpi, BASE.svg at true size)\n"
             "       scanner calibrate-white --config FILE [--albedo A]  white reference scales\n"
             "       scanner check-config --config FILE    check a config and its calibration\n"
             "       scanner selftest --config FILE        try each configured device (new rig)\n"
@@ -271,6 +374,8 @@ int main(int argc, char **argv)
         usage(stderr);
         return 2;
     }
+    if (strcmp(argv[1], "calibrate") == 0)
+        return cmd_calibrate(argc, argv);
     int first = 2;
     if ((strcmp(argv[1], "process") == 0 || strcmp(argv[1], "resume") == 0) && argc > 2 &&
         argv[2][0] != '-') {

@@ -266,7 +266,7 @@ int scan_dir_write_registration(const struct hal_storage *st, const char *dir, u
     return rc != 0 ? rc : hal_storage_write_file(st, path, text, (size_t)len);
 }
 
-static int copy_file(const struct hal_storage *st, const char *from, const char *to)
+int scan_dir_copy_file(const struct hal_storage *st, const char *from, const char *to)
 {
     static char buf[1 << 16]; /* config and calibration files are small */
     FILE *f = fopen(from, "rb");
@@ -284,10 +284,10 @@ int scan_dir_keep_settings(const struct hal_storage *st, const char *config_path
     char path[SCAN_DIR_PATH_MAX];
     int rc = scan_dir_path(path, sizeof(path), dir, -1, "config.ini");
     if (rc == 0)
-        rc = copy_file(st, config_path, path);
+        rc = scan_dir_copy_file(st, config_path, path);
     if (rc == 0)
         rc = scan_dir_path(path, sizeof(path), dir, -1, "calibration.ini");
-    return rc != 0 ? rc : copy_file(st, calibration_path, path);
+    return rc != 0 ? rc : scan_dir_copy_file(st, calibration_path, path);
 }
 
 /* ---- opening: a lock, and what is already there ---- */
@@ -311,6 +311,7 @@ static int view_file(const char *name)
     if (sscanf(name, "frame_%2u.pn%1s", &frame, tail) == 2 && strcmp(tail, "g") == 0)
         return 1;
     return strcmp(name, "view.ini") == 0 || strcmp(name, "cloud.ply") == 0 ||
+           strcmp(name, "target.ini") == 0 ||
            strcmp(name, "registration.ini") == 0 || strncmp(name, "truth_", 6) == 0;
 }
 

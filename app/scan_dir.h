@@ -106,6 +106,10 @@ int scan_dir_begin_view(const struct hal_storage *st, const char *dir, uint32_t 
 int scan_dir_sweep(const struct hal_storage *st, const char *dir, uint32_t views);
 
 /** Keep the config and the calibration a scan ran with (config.ini, calibration.ini). */
+/** Copy a small file (config, calibration: up to 64 KiB) durably. @retval 0 @retval -errno
+ *  @retval -EFBIG larger */
+int scan_dir_copy_file(const struct hal_storage *st, const char *from, const char *to);
+
 int scan_dir_keep_settings(const struct hal_storage *st, const char *config_path,
                            const char *calibration_path, const char *dir);
 

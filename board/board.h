@@ -37,6 +37,25 @@ int board_write_scan_extras(const struct hal *hal, const char *scan_dir);
 /** Extra files for a finished view (the simulator writes its ground truth). @retval 0 or -errno */
 int board_write_view_extras(const struct hal *hal, const char *view_dir);
 
+/** What the person puts on the turntable for a calibration step. */
+enum board_target_kind { BOARD_TARGET_OBJECT = 0, BOARD_TARGET_BOARD, BOARD_TARGET_SPHERE };
+struct board_target {
+    uint32_t kind;                      /**< enum board_target_kind */
+    const uint8_t *sheet;               /**< board: the printed sheet, grey, row-major */
+    uint32_t sheet_width, sheet_height; /**< pixels */
+    double sheet_px_per_mm;
+    double thickness_mm; /**< board: the plate under the sheet */
+    double tilt_deg;     /**< board: from upright (facing the camera), leaning back; 90 flat */
+    double diameter_mm;  /**< sphere */
+    double position_mm[2]; /**< on the table at angle 0 (x towards the camera, y to its right) */
+};
+
+/** The person's part of a calibration step. The simulator places the target itself; on a rig
+ *  the person must be asked. @retval 0 placed @retval -ENOSYS ask the person
+ *  @retval -errno (with @p err) */
+int board_place_target(struct hal *hal, const struct board_target *target, char *err,
+                       size_t err_len);
+
 /** Safe state, then release every device. */
 void board_shutdown(struct hal *hal);
 

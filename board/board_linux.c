@@ -200,3 +200,12 @@ int board_selftest(struct hal *hal, const struct board_config *cfg, const struct
     failed |= rc != 0;
     return failed ? -ENODEV : 0;
 }
+
+int board_place_target(struct hal *hal, const struct board_target *t, char *err, size_t len)
+{
+    (void)hal;
+    (void)t;
+    (void)err;
+    (void)len;
+    return -ENOSYS; /* a person places it: the calibration asks them */
+}

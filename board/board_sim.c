@@ -127,6 +127,25 @@ int board_init(struct hal *hal, const struct board_config *cfg, const struct sca
     return rc;
 }
 
+int board_place_target(struct hal *hal, const struct board_target *t, char *err, size_t len)
+{
+    (void)hal;
+    struct sim_target st = {
+        .kind = t->kind == BOARD_TARGET_BOARD    ? SIM_TARGET_BOARD
+                : t->kind == BOARD_TARGET_SPHERE ? SIM_TARGET_SPHERE
+                                                 : SIM_TARGET_OBJECT,
+        .sheet = t->sheet,
+        .sheet_width = t->sheet_width,
+        .sheet_height = t->sheet_height,
+        .sheet_px_per_mm = t->sheet_px_per_mm,
+        .thickness_mm = t->thickness_mm,
+        .tilt_deg = t->tilt_deg,
+        .diameter_mm = t->diameter_mm,
+        .position_mm = {t->position_mm[0], t->position_mm[1]},
+    };
+    return sim_rig_set_target(&sim.rig, &st, err, len);
+}
+
 static int write_truth(const struct hal *hal, const char *dir)
 {
     struct sim_rig *rig = &sim.rig;

@@ -126,6 +126,7 @@ int sim_rig_init(struct sim_rig *rig, const struct sim_config *cfg, const struct
     rig->width = calib->cam_width;
     rig->height = calib->cam_height;
     rig->layout = *layout;
+    snprintf(rig->dir, sizeof(rig->dir), "%s", dir);
     rig->table_angle_mdeg = 0; /* the turntable, when there is one, sets it per frame */
     int rc = build_object(rig, dir, err, len);
     if (rc == 0)
@@ -177,7 +178,64 @@ void sim_rig_free(struct sim_rig *rig)
     free(rig->gauss);
     sim_bvh_free(&rig->bvh);
     sim_mesh_free(&rig->mesh);
+    free(rig->sheet_pixels);
     memset(rig, 0, sizeof(*rig));
+}
+
+int sim_rig_set_target(struct sim_rig *rig, const struct sim_target *t, char *err, size_t len)
+{
+    struct sim_mesh mesh;
+    struct sim_bvh bvh;
+    struct sim_sheet_frame sheet;
+    uint8_t *pixels = NULL;
+    int rc;
+    memset(&sheet, 0, sizeof(sheet));
+    if (t->kind == SIM_TARGET_OBJECT) {
+        struct sim_mesh old = rig->mesh;
+        rc = build_object(rig, rig->dir, err, len);
+        if (rc != 0) {
+            rig->mesh = old;
+            return rc;
+        }
+        mesh = rig->mesh;
+        rig->mesh = old;
+    } else if ((rc = sim_target_mesh(t, &mesh, &sheet)) != 0) {
+        snprintf(err, len, "sim: cannot build the calibration target: %s", strerror(-rc));
+        return rc;
+    }
+    if (t->kind == SIM_TARGET_BOARD) {
+        size_t n = (size_t)t->sheet_width * t->sheet_height;
+        pixels = malloc(n);
+        if (pixels == NULL) {
+            sim_mesh_free(&mesh);
+            snprintf(err, len, "sim: out of memory for the board's sheet");
+            return -ENOMEM;
+        }
+        memcpy(pixels, t->sheet, n);
+    }
+    if ((rc = sim_bvh_build(&bvh, &mesh)) != 0) {
+        free(pixels);
+        sim_mesh_free(&mesh);
+        snprintf(err, len, "sim: cannot build the target's ray-casting tree: %s", strerror(-rc));
+        return rc;
+    }
+    sim_bvh_free(&rig->bvh);
+    sim_mesh_free(&rig->mesh);
+    free(rig->sheet_pixels);
+    rig->mesh = mesh;
+    rig->bvh = bvh;
+    rig->bvh.mesh = &rig->mesh; /* it was built over the local copy */
+    rig->sheet = sheet;
+    rig->sheet_pixels = pixels;
+    rig->target = *t;
+    rig->target.sheet = pixels;
+    /* Targets are matte; the object keeps its configured material. */
+    if (t->kind == SIM_TARGET_OBJECT)
+        rc = build_material(rig, rig->dir, err, len);
+    else
+        memset(&rig->material, 0, sizeof(rig->material)); /* SIM_MAT_LAMBERT */
+    rig->truth_valid = 0;
+    return rc;
 }
 
 static vec3 projector_centre_cam(const struct scan_calib *c)
@@ -199,6 +257,44 @@ static double falloff(const struct sim_rig *rig, double dist_mm)
 {
     double r = rig->cfg.reference_distance_mm / dist_mm;
     return r * r; /* inverse-square law, 1 at the reference distance */
+}
+
+#define SHEET_SAMPLES 8 /* per pixel side: a camera pixel integrates the print over its area */
+
+/* Albedo of a calibration target at p_obj. On the board's face, the sheet averaged over the
+ * pixel's footprint: sub-pixel rays (the lens linearised about the pixel's ray) meet the face's
+ * plane; a single ray per pixel would put every printed edge on the pixel grid. */
+static void target_albedo(const struct sim_rig *rig, const struct frame_xform *obj, vec3 cam_obj,
+                          vec3 d_cam, vec3 p_obj, double albedo[3])
+{
+    const struct scan_calib *c = &rig->calib;
+    const struct sim_sheet_frame *f = &rig->sheet;
+    double a = 0.9; /* the matte white sphere, the plate's edges */
+    if (rig->target.kind == SIM_TARGET_BOARD && fabs(v3_dot(v3_sub(p_obj, f->origin), f->n)) < 0.01) {
+        double j[4] = {1, 0, 0, 1}, inv[4];
+        if (!lens_is_pinhole(c->cam_dist))
+            lens_jacobian(c->cam_dist, d_cam.x, d_cam.y, j);
+        double det = j[0] * j[3] - j[1] * j[2];
+        inv[0] = j[3] / det, inv[1] = -j[1] / det, inv[2] = -j[2] / det, inv[3] = j[0] / det;
+        vec3 pts[SHEET_SAMPLES * SHEET_SAMPLES];
+        uint32_t n = 0;
+        for (int sy = 0; sy < SHEET_SAMPLES; sy++) {
+            for (int sx = 0; sx < SHEET_SAMPLES; sx++) {
+                double dx = ((sx + 0.5) / SHEET_SAMPLES - 0.5) / c->cam_fx_px;
+                double dy = ((sy + 0.5) / SHEET_SAMPLES - 0.5) / c->cam_fy_px;
+                vec3 d = v3(d_cam.x + inv[0] * dx + inv[1] * dy, d_cam.y + inv[2] * dx + inv[3] * dy,
+                            1.0);
+                vec3 dir = frame_dir(obj, d);
+                double den = v3_dot(dir, f->n);
+                if (den == 0.0)
+                    continue;
+                double s = v3_dot(v3_sub(f->origin, cam_obj), f->n) / den;
+                pts[n++] = v3_add(cam_obj, v3_scale(dir, s));
+            }
+        }
+        a = n > 0 ? sim_target_sheet_albedo(&rig->target, f, pts, n) : a;
+    }
+    albedo[0] = albedo[1] = albedo[2] = a;
 }
 
 /* Cast the camera ray of pixel (x, y); fill truth and the projector's reflected light. */
@@ -237,7 +333,10 @@ static void update_pixel(struct sim_rig *rig, const struct frame_xform *obj, vec
     vec3 p_cam = v3_scale(d_cam, hit.t);
     vec3 n_cam = frame_dir_inv(obj, n_obj);
     double albedo[3];
-    t->dark[i] = (uint8_t)sim_albedo_at(&rig->cfg, rig->object_height_mm, p_obj, albedo);
+    if (rig->target.kind == SIM_TARGET_OBJECT)
+        t->dark[i] = (uint8_t)sim_albedo_at(&rig->cfg, rig->object_height_mm, p_obj, albedo);
+    else
+        target_albedo(rig, obj, cam_obj, d_cam, p_obj, albedo);
     for (int k = 0; k < 3; k++) {
         t->albedo[3 * i + k] = (float)albedo[k];
         t->pos_cam[3 * i + k] = (float)(k == 0 ? p_cam.x : k == 1 ? p_cam.y : p_cam.z);

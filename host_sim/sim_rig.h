@@ -9,6 +9,7 @@
 #include "sim_bvh.h"
 #include "sim_material.h"
 #include "sim_mesh.h"
+#include "sim_target.h"
 
 /** What lights the object while a frame is taken. */
 struct sim_sources {
@@ -48,6 +49,10 @@ struct sim_rig {
     uint8_t *light_vis;   /**< bit i: light i reaches the point */
     uint32_t lights_done; /**< lights whose visibility is computed for truth_angle_mdeg */
     float *gauss;         /**< table of standard normal samples for the noise */
+    struct sim_target target;      /**< what stands on the table (SIM_TARGET_OBJECT: the object) */
+    struct sim_sheet_frame sheet;  /**< a board's printed sheet, object frame */
+    uint8_t *sheet_pixels;         /**< the rig's copy of the sheet */
+    char dir[HAL_MAX_PATH];        /**< where relative paths of the config are resolved */
 };
 
 /** Build the object, material and buffers. Allocates; nothing allocates after this.
@@ -57,6 +62,12 @@ int sim_rig_init(struct sim_rig *rig, const struct sim_config *cfg, const struct
                  const struct gray_layout *layout, const char *config_dir, char *err,
                  size_t err_len);
 void sim_rig_free(struct sim_rig *rig);
+
+/** Put a calibration target on the table in place of the object (the simulated person's part
+ *  of `scanner calibrate`); SIM_TARGET_OBJECT puts the object back. Allocates (a setup step).
+ *  @retval 0 @retval -errno, with @p err saying what */
+int sim_rig_set_target(struct sim_rig *rig, const struct sim_target *target, char *err,
+                       size_t err_len);
 
 /** Bring the truth buffers up to date for the current table angle (ray casting). */
 void sim_rig_update(struct sim_rig *rig);

@@ -1,0 +1,302 @@
+// OpenCV 4.6 (Debian libopencv-contrib-dev) for calibration, behind app/calib_cv.h: board
+// drawing and detection (chessboard, ChArUco), calibrateCamera, stereoCalibrate, solvePnP.
+#include "calib_cv.h"
+
+#include <opencv2/aruco/charuco.hpp>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <vector>
+
+namespace {
+
+cv::Ptr<cv::aruco::CharucoBoard> charuco(const calcv_board *b)
+{
+    cv::Ptr<cv::aruco::Dictionary> dict = cv::aruco::getPredefinedDictionary(b->dictionary);
+    return cv::aruco::CharucoBoard::create(b->squares_x, b->squares_y, (float)b->square_mm,
+                                           (float)b->marker_mm, dict);
+}
+
+bool board_ok(const calcv_board *b)
+{
+    return b->squares_x >= 3 && b->squares_y >= 3 && b->square_mm > 0.0 &&
+           (b->squares_x - 1) * (b->squares_y - 1) <= CALCV_MAX_CORNERS &&
+           (b->kind == CALCV_CHESSBOARD ||
+            (b->kind == CALCV_CHARUCO && b->marker_mm > 0.0 && b->marker_mm < b->square_mm));
+}
+
+cv::Matx33d camera_matrix(const calcv_lens *l)
+{
+    return cv::Matx33d(l->fx, 0, l->cx, 0, l->fy, l->cy, 0, 0, 1);
+}
+
+void lens_from(const cv::Mat &k, const cv::Mat &d, calcv_lens *l)
+{
+    l->fx = k.at<double>(0, 0);
+    l->fy = k.at<double>(1, 1);
+    l->cx = k.at<double>(0, 2);
+    l->cy = k.at<double>(1, 2);
+    for (int i = 0; i < 5; i++)
+        l->dist[i] = i < (int)d.total() ? d.at<double>(i) : 0.0;
+}
+
+void split(const calcv_corners &v, std::vector<cv::Point3f> &obj, std::vector<cv::Point2f> &img)
+{
+    obj.clear();
+    img.clear();
+    for (int i = 0; i < v.count; i++) {
+        obj.emplace_back((float)v.sheet[i][0], (float)v.sheet[i][1], 0.0f);
+        img.emplace_back((float)v.image[i][0], (float)v.image[i][1]);
+    }
+}
+
+// Why a board was not found: what the image itself shows.
+void explain(const cv::Mat &img, int found, int need, char *why, size_t len)
+{
+    double lo, hi;
+    cv::Mat small;
+    cv::resize(img, small, cv::Size(), 0.25, 0.25, cv::INTER_AREA);
+    cv::minMaxLoc(small, &lo, &hi);
+    int saturated = cv::countNonZero(img >= 250);
+    if (hi - lo < 40.0)
+        snprintf(why, len, "too dark or too flat: the brightest and darkest areas differ by %.0f "
+                 "grey levels (light the board, or raise the exposure)", hi - lo);
+    else if (saturated > (int)(img.total() / 50))
+        snprintf(why, len, "glare: %.1f%% of the image is saturated (tilt the board away from the "
+                 "light, or lower the exposure)", 100.0 * saturated / (double)img.total());
+    else if (found > 0)
+        snprintf(why, len, "too few corners: %d of the %d needed (is the board partly out of "
+                 "view, or covered?)", found, need);
+    else
+        snprintf(why, len, "no board in view (is it partly out of view, too steep, or another "
+                 "board than the config describes?)");
+}
+
+} // namespace
+
+extern "C" int calcv_board_corner_count(const calcv_board *b)
+{
+    return (b->squares_x - 1) * (b->squares_y - 1);
+}
+
+extern "C" void calcv_board_size_mm(const calcv_board *b, double *w, double *h)
+{
+    *w = b->squares_x * b->square_mm + 2.0 * b->margin_mm;
+    *h = b->squares_y * b->square_mm + 2.0 * b->margin_mm;
+}
+
+extern "C" int calcv_board_image(const calcv_board *b, double px_per_mm, uint8_t **grey,
+                                 int *width, int *height)
+{
+    if (!board_ok(b) || px_per_mm <= 0.0)
+        return -EINVAL;
+    const int sq = (int)std::lround(b->square_mm * px_per_mm);
+    const int margin = (int)std::lround(b->margin_mm * px_per_mm);
+    const int w = b->squares_x * sq + 2 * margin, h = b->squares_y * sq + 2 * margin;
+    cv::Mat img(h, w, CV_8UC1, cv::Scalar(255));
+    if (b->kind == CALCV_CHARUCO) {
+        // The board exactly fills the area inside the margin: squares of sq pixels.
+        cv::Mat inner;
+        charuco(b)->draw(cv::Size(w - 2 * margin, h - 2 * margin), inner, 0, 1);
+        inner.copyTo(img(cv::Rect(margin, margin, inner.cols, inner.rows)));
+    } else {
+        // A chessboard whose top-left square is black, as OpenCV's pattern generator draws it.
+        for (int y = 0; y < b->squares_y; y++)
+            for (int x = 0; x < b->squares_x; x++)
+                if ((x + y) % 2 == 0)
+                    img(cv::Rect(margin + x * sq, margin + y * sq, sq, sq)).setTo(0);
+    }
+    *grey = (uint8_t *)malloc((size_t)w * h);
+    if (*grey == nullptr)
+        return -ENOMEM;
+    memcpy(*grey, img.data, (size_t)w * h);
+    *width = w;
+    *height = h;
+    return 0;
+}
+
+extern "C" int calcv_find_corners(const calcv_board *b, const uint8_t *grey, int width,
+                                  int height, int min_corners, calcv_corners *out, char *why,
+                                  size_t why_len)
+{
+    if (!board_ok(b))
+        return -EINVAL;
+    cv::Mat img(height, width, CV_8UC1, const_cast<uint8_t *>(grey));
+    out->count = 0;
+    const int nx = b->squares_x - 1, ny = b->squares_y - 1;
+    std::vector<cv::Point2f> pts;
+    std::vector<int> ids;
+    if (b->kind == CALCV_CHESSBOARD) {
+        if (!cv::findChessboardCornersSB(img, cv::Size(nx, ny), pts,
+                                         cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_EXHAUSTIVE |
+                                             cv::CALIB_CB_ACCURACY)) {
+            explain(img, 0, nx * ny, why, why_len);
+            return -ENOENT;
+        }
+        // A symmetric board reads the same turned by 180 degrees: take the reading whose first
+        // corner is the higher one, so that every view numbers the corners alike.
+        if (pts.front().y > pts.back().y)
+            std::reverse(pts.begin(), pts.end());
+        // Seen from the front, the sheet's x (along a row) turned into its y (down the rows) is
+        // clockwise in the image; a reading the other way round is the board's mirror image.
+        cv::Point2f ax = pts[nx - 1] - pts[0], ay = pts[(size_t)nx * (ny - 1)] - pts[0];
+        if (ax.x * ay.y - ax.y * ay.x < 0.0f)
+            for (int y = 0; y < ny; y++)
+                std::reverse(pts.begin() + y * nx, pts.begin() + (y + 1) * nx);
+        for (int i = 0; i < nx * ny; i++)
+            ids.push_back(i);
+    } else {
+        cv::Ptr<cv::aruco::CharucoBoard> board = charuco(b);
+        std::vector<int> marker_ids;
+        std::vector<std::vector<cv::Point2f>> markers;
+        cv::Ptr<cv::aruco::DetectorParameters> params = cv::aruco::DetectorParameters::create();
+        params->cornerRefinementMethod = cv::aruco::CORNER_REFINE_SUBPIX;
+        cv::aruco::detectMarkers(img, board->dictionary, markers, marker_ids, params);
+        if (!marker_ids.empty())
+            cv::aruco::interpolateCornersCharuco(markers, marker_ids, img, board, pts, ids);
+        if ((int)ids.size() < min_corners) {
+            explain(img, (int)ids.size(), min_corners, why, why_len);
+            return -ENOENT;
+        }
+    }
+    if ((int)ids.size() < min_corners) {
+        explain(img, (int)ids.size(), min_corners, why, why_len);
+        return -ENOENT;
+    }
+    for (size_t i = 0; i < ids.size() && i < CALCV_MAX_CORNERS; i++) {
+        int id = ids[i];
+        out->id[i] = id;
+        out->image[i][0] = pts[i].x;
+        out->image[i][1] = pts[i].y;
+        // Corner id runs row-major over the inner corners; corner (1, 1) of the squares is id 0.
+        out->sheet[i][0] = b->margin_mm + (1 + id % nx) * b->square_mm;
+        out->sheet[i][1] = b->margin_mm + (1 + id / nx) * b->square_mm;
+        out->sheet[i][2] = 0.0;
+        out->count = (int)i + 1;
+    }
+    return 0;
+}
+
+extern "C" int calcv_calibrate(const calcv_corners *views, int n, int width, int height,
+                               int fix_k3, calcv_lens *lens, double *rvec, double *tvec,
+                               double *view_rms, double *rms)
+{
+    if (n < 3)
+        return -EINVAL;
+    std::vector<std::vector<cv::Point3f>> obj(n);
+    std::vector<std::vector<cv::Point2f>> img(n);
+    for (int v = 0; v < n; v++) {
+        if (views[v].count < 6)
+            return -EINVAL;
+        split(views[v], obj[v], img[v]);
+    }
+    cv::Mat k, d, per_view, sd_in, sd_ex;
+    std::vector<cv::Mat> rv, tv;
+    try {
+        *rms = cv::calibrateCamera(obj, img, cv::Size(width, height), k, d, rv, tv, sd_in, sd_ex,
+                                   per_view, fix_k3 ? cv::CALIB_FIX_K3 : 0,
+                                   cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
+                                                    100, 1e-12));
+    } catch (const cv::Exception &e) {
+        fprintf(stderr, "calibrate: OpenCV: %s\n", e.what());
+        return -EDOM;
+    }
+    lens_from(k, d, lens);
+    for (int v = 0; v < n; v++) {
+        for (int i = 0; i < 3; i++) {
+            rvec[3 * v + i] = rv[v].at<double>(i);
+            tvec[3 * v + i] = tv[v].at<double>(i);
+        }
+        view_rms[v] = per_view.at<double>(v);
+    }
+    return 0;
+}
+
+extern "C" int calcv_stereo(const calcv_corners *cam, const calcv_corners *proj, int n, int fix_k3,
+                            calcv_lens *cam_lens, calcv_lens *proj_lens, double rot[9],
+                            double trans[3], double *rms)
+{
+    std::vector<std::vector<cv::Point3f>> obj(n), obj2(n);
+    std::vector<std::vector<cv::Point2f>> img1(n), img2(n);
+    for (int v = 0; v < n; v++) {
+        split(cam[v], obj[v], img1[v]);
+        split(proj[v], obj2[v], img2[v]);
+    }
+    cv::Mat k1(camera_matrix(cam_lens)), k2(camera_matrix(proj_lens));
+    cv::Mat d1(1, 5, CV_64F, cam_lens->dist), d2(1, 5, CV_64F, proj_lens->dist);
+    d1 = d1.clone();
+    d2 = d2.clone();
+    cv::Mat r, t, e, f;
+    try {
+        *rms = cv::stereoCalibrate(obj, img1, img2, k1, d1, k2, d2, cv::Size(1, 1), r, t, e, f,
+                                   cv::CALIB_USE_INTRINSIC_GUESS | (fix_k3 ? cv::CALIB_FIX_K3 : 0),
+                                   cv::TermCriteria(cv::TermCriteria::COUNT |
+                                                        cv::TermCriteria::EPS,
+                                                    200, 1e-12));
+    } catch (const cv::Exception &ex) {
+        fprintf(stderr, "calibrate: OpenCV: %s\n", ex.what());
+        return -EDOM;
+    }
+    lens_from(k1, d1, cam_lens);
+    lens_from(k2, d2, proj_lens);
+    for (int i = 0; i < 9; i++)
+        rot[i] = r.at<double>(i / 3, i % 3);
+    for (int i = 0; i < 3; i++)
+        trans[i] = t.at<double>(i);
+    return 0;
+}
+
+extern "C" void calcv_rodrigues(const double rvec[3], double rot[9])
+{
+    cv::Mat r;
+    cv::Rodrigues(cv::Vec3d(rvec[0], rvec[1], rvec[2]), r);
+    for (int i = 0; i < 9; i++)
+        rot[i] = r.at<double>(i / 3, i % 3);
+}
+
+extern "C" double calcv_reprojection_rms(const calcv_corners *v, const calcv_lens *lens,
+                                         const double rvec[3], const double tvec[3])
+{
+    std::vector<cv::Point3f> obj;
+    std::vector<cv::Point2f> img, proj;
+    split(*v, obj, img);
+    if (obj.empty())
+        return 0.0;
+    cv::Mat d(1, 5, CV_64F, const_cast<double *>(lens->dist));
+    cv::projectPoints(obj, cv::Vec3d(rvec[0], rvec[1], rvec[2]),
+                      cv::Vec3d(tvec[0], tvec[1], tvec[2]), camera_matrix(lens), d, proj);
+    double sum = 0.0;
+    for (size_t i = 0; i < img.size(); i++) {
+        cv::Point2f e = img[i] - proj[i];
+        sum += e.dot(e);
+    }
+    return std::sqrt(sum / (double)img.size());
+}
+
+extern "C" int calcv_pose(const calcv_corners *v, const calcv_lens *lens, double rvec[3],
+                          double tvec[3], double *rms)
+{
+    std::vector<cv::Point3f> obj;
+    std::vector<cv::Point2f> img;
+    split(*v, obj, img);
+    cv::Mat d(1, 5, CV_64F, const_cast<double *>(lens->dist));
+    cv::Vec3d r, t;
+    try {
+        if (!cv::solvePnP(obj, img, camera_matrix(lens), d, r, t, false, cv::SOLVEPNP_ITERATIVE))
+            return -EDOM;
+    } catch (const cv::Exception &e) {
+        fprintf(stderr, "calibrate: OpenCV: %s\n", e.what());
+        return -EDOM;
+    }
+    for (int i = 0; i < 3; i++) {
+        rvec[i] = r[i];
+        tvec[i] = t[i];
+    }
+    *rms = calcv_reprojection_rms(v, lens, rvec, tvec);
+    return 0;
+}

@@ -1,0 +1,986 @@
+/* The calibration computed from the captures of a calibration directory: camera and projector
+ * lenses and pose (OpenCV, app/calib_cv.cpp), the turntable axis, the lights; the file and its
+ * report (docs/calibration.md). A setup step: it allocates. */
+#define _POSIX_C_SOURCE 200809L
+#include "calib_priv.h"
+
+#include "decode.h"
+#include "lens.h"
+#include "scan.h"
+#include "scan_dir.h"
+#include "vec3.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+
+/* Half the side of the window the projector's coordinates are interpolated over at a corner. */
+#define CORNER_WINDOW_PX 12
+
+struct board_view {
+    uint32_t view;
+    struct calib_target_info ti;
+    struct calcv_corners cam;  /* every corner found */
+    struct calcv_corners camp; /* the corners the projector's coordinates are known at */
+    struct calcv_corners proj; /* those corners in projector pixels */
+    double rvec[3], tvec[3], rms;
+    int found, has_proj;
+};
+
+struct solve {
+    const struct app_config *cfg;
+    const char *dir;
+    struct scan_calib start; /* the calibration the captures were taken with */
+    struct scan_calib out;
+    struct scan_params params;
+    struct calcv_board board;
+    struct board_view *views;
+    uint32_t view_count;
+    uint32_t sphere_views[CALIB_MAX_VIEWS];
+    uint32_t sphere_count;
+    char *report;
+    size_t report_len, report_cap;
+    double cam_rms, proj_rms, stereo_rms;
+    int camera_only;
+};
+
+static void say(struct solve *s, const char *fmt, ...)
+{
+    va_list ap;
+    char line[1024];
+    va_start(ap, fmt);
+    int n = vsnprintf(line, sizeof(line), fmt, ap);
+    va_end(ap);
+    if (n < 0)
+        return;
+    if ((size_t)n >= sizeof(line))
+        n = (int)sizeof(line) - 1;
+    if (s->report_len + (size_t)n + 1 > s->report_cap) {
+        size_t cap = 2 * s->report_cap + (size_t)n + 1024;
+        char *r = realloc(s->report, cap);
+        if (r == NULL)
+            return;
+        s->report = r;
+        s->report_cap = cap;
+    }
+    memcpy(s->report + s->report_len, line, (size_t)n + 1);
+    s->report_len += (size_t)n;
+}
+
+static int frame_exists(const char *dir, uint32_t view, uint32_t frame)
+{
+    char path[SCAN_DIR_PATH_MAX];
+    struct stat sb;
+    return scan_dir_frame_path(path, sizeof(path), dir, view, frame) == 0 &&
+           stat(path, &sb) == 0;
+}
+
+/* Feed a capture's pattern frames to the decoder. @retval 0 @retval -ENOENT not all there */
+static int feed_patterns(struct solve *s, uint32_t v, const struct scan_calib *calib)
+{
+    static uint8_t pixels[HAL_MAX_PIXELS * 3];
+    struct gray_layout layout;
+    char err[SCAN_DIR_PATH_MAX + 256];
+    scan_layout(&s->params, calib, &layout);
+    uint32_t count = gray_layout_count(&layout);
+    if (!frame_exists(s->dir, v, count - 1))
+        return -ENOENT;
+    int rc = scan_begin_view(&s->params, calib);
+    for (uint32_t f = 0; f < count && rc == 0; f++) {
+        uint32_t ch = f == GRAY_PATTERN_WHITE ? 3 : 1;
+        rc = scan_dir_read_frame(s->dir, v, f, pixels, sizeof(pixels), calib->cam_width,
+                                 calib->cam_height, ch, err, sizeof(err));
+        if (rc != 0)
+            fprintf(stderr, "scanner: error: %s\n", err);
+        else
+            rc = scan_feed_frame(f, pixels, ch, NULL);
+    }
+    return rc;
+}
+
+/* Solve the n x n system a x = b (row-major), Gauss-Jordan with partial pivoting; a and b are
+ * destroyed. @retval 0 singular */
+static int solve_n(double *a, double *b, double *x, int n)
+{
+    for (int c = 0; c < n; c++) {
+        int p = c;
+        for (int k = c + 1; k < n; k++)
+            if (fabs(a[k * n + c]) > fabs(a[p * n + c]))
+                p = k;
+        if (fabs(a[p * n + c]) < 1e-30)
+            return 0;
+        for (int k = 0; k < n; k++) {
+            double t = a[c * n + k];
+            a[c * n + k] = a[p * n + k];
+            a[p * n + k] = t;
+        }
+        double t = b[c];
+        b[c] = b[p];
+        b[p] = t;
+        for (int k = 0; k < n; k++) {
+            if (k == c)
+                continue;
+            double f = a[k * n + c] / a[c * n + c];
+            for (int j = c; j < n; j++)
+                a[k * n + j] -= f * a[c * n + j];
+            b[k] -= f * b[c];
+        }
+    }
+    for (int k = 0; k < n; k++)
+        x[k] = b[k] / a[k * n + k];
+    return 1;
+}
+
+/* The projector's column and row at camera point (x, y): a plane fitted by least squares to
+ * the decoded integer codes of the valid pixels within CORNER_WINDOW_PX (each coordinate on its
+ * own: a linear interpolation of the decoded maps, not a homography between the images),
+ * evaluated at the point; twice, the second fit without the codes more than 1.5 off the first.
+ * The stair-steps of the codes average out over the window; the black squares (too dark to
+ * decode) leave holes in it, which a plane bridges. Over a window of a few millimetres the
+ * curvature of the map (perspective, the projector's lens) is far below a hundredth of a pixel. @retval 1 known @retval 0 too few decoded pixels around */
+#define NB 3 /* the plane's coefficients: 1, dx, dy */
+static int projector_at(const struct decode_maps *m, double x, double y, double *u, double *v)
+{
+    const int r = CORNER_WINDOW_PX;
+    double out[2];
+    for (int which = 0; which < 2; which++) {
+        const uint16_t *code = which == 0 ? m->column : m->row;
+        double first[NB] = {0};
+        for (int pass = 0; pass < 2; pass++) {
+            double a[NB][NB + 1];
+            memset(a, 0, sizeof(a));
+            int n = 0;
+            for (int dy = -r; dy <= r; dy++) {
+                for (int dx = -r; dx <= r; dx++) {
+                    long px = lround(x) + dx, py = lround(y) + dy;
+                    if (px < 0 || py < 0 || px >= (long)m->width || py >= (long)m->height)
+                        continue;
+                    size_t i = (size_t)py * m->width + (size_t)px;
+                    if (m->reason[i] != SCAN_VALID)
+                        continue;
+                    double ex = (double)px - x, ey = (double)py - y;
+                    double b[NB] = {1, ex, ey};
+                    double val = code[i];
+                    if (pass == 1) {
+                        double pred = 0;
+                        for (int k = 0; k < NB; k++)
+                            pred += first[k] * b[k];
+                        if (fabs(pred - val) > 1.5)
+                            continue;
+                    }
+                    for (int j = 0; j < NB; j++) {
+                        for (int k = 0; k < NB; k++)
+                            a[j][k] += b[j] * b[k];
+                        a[j][NB] += b[j] * val;
+                    }
+                    n++;
+                }
+            }
+            if (n < (2 * r + 1) * (2 * r + 1) / 4)
+                return 0;
+            double m[NB * NB], rhs[NB];
+            for (int j = 0; j < NB; j++) {
+                for (int k = 0; k < NB; k++)
+                    m[NB * j + k] = a[j][k];
+                rhs[j] = a[j][NB];
+            }
+            if (!solve_n(m, rhs, first, NB))
+                return 0;
+        }
+        out[which] = first[0];
+    }
+    *u = out[0];
+    *v = out[1];
+    return 1;
+}
+
+/* A board capture: its corners, and where the projector's coordinates are known, those. */
+static int load_board_view(struct solve *s, struct board_view *bv)
+{
+    static uint8_t rgb[HAL_MAX_PIXELS * 3], grey[HAL_MAX_PIXELS];
+    static uint8_t reason[HAL_MAX_PIXELS];
+    char err[SCAN_DIR_PATH_MAX + 256], why[256];
+    const uint32_t w = s->start.cam_width, h = s->start.cam_height;
+    int rc = scan_dir_read_frame(s->dir, bv->view, 0, rgb, sizeof(rgb), w, h, 3, err, sizeof(err));
+    if (rc != 0) {
+        fprintf(stderr, "scanner: error: %s\n", err);
+        return rc;
+    }
+    decode_rgb_to_grey(rgb, grey, (size_t)w * h, 256);
+    if (calcv_find_corners(&s->board, grey, (int)w, (int)h, (int)s->cfg->calibrate.min_corners,
+                           &bv->cam, why, sizeof(why)) != 0) {
+        say(s, "view_%03u: rejected: board not found: %s\n", (unsigned)bv->view, why);
+        return 0;
+    }
+    bv->found = 1;
+    if (frame_exists(s->dir, bv->view, 1) == 0) {
+        say(s, "view_%03u: %d corners (white frame only: camera alone)\n", (unsigned)bv->view,
+            bv->cam.count);
+        return 0;
+    }
+    if ((rc = feed_patterns(s, bv->view, &s->start)) != 0) {
+        say(s, "view_%03u: %d corners; the pattern frames are incomplete: camera only\n",
+            (unsigned)bv->view, bv->cam.count);
+        return rc == -ENOENT ? 0 : rc;
+    }
+    struct decode_maps maps;
+    if ((rc = decode_finish(reason, &maps)) != 0)
+        return rc;
+    if (maps.row == NULL) {
+        say(s, "view_%03u: no projector rows were captured: camera only\n", (unsigned)bv->view);
+        return 0;
+    }
+    for (int i = 0; i < bv->cam.count; i++) {
+        double u, v;
+        if (!projector_at(&maps, bv->cam.image[i][0], bv->cam.image[i][1], &u, &v))
+            continue;
+        int k = bv->camp.count++;
+        bv->camp.id[k] = bv->proj.id[k] = bv->cam.id[i];
+        memcpy(bv->camp.image[k], bv->cam.image[i], sizeof(bv->cam.image[i]));
+        memcpy(bv->camp.sheet[k], bv->cam.sheet[i], sizeof(bv->cam.sheet[i]));
+        memcpy(bv->proj.sheet[k], bv->cam.sheet[i], sizeof(bv->cam.sheet[i]));
+        bv->proj.image[k][0] = u;
+        bv->proj.image[k][1] = v;
+        bv->proj.count = k + 1;
+    }
+    bv->has_proj = bv->proj.count >= (int)s->cfg->calibrate.min_corners;
+    say(s, "view_%03u: %d corners, %d with projector coordinates%s\n", (unsigned)bv->view,
+        bv->cam.count, bv->proj.count, bv->has_proj ? "" : " (too few: camera only)");
+    return 0;
+}
+
+static int load_views(struct solve *s)
+{
+    for (uint32_t v = 0; v < CALIB_MAX_VIEWS; v++) {
+        if (!frame_exists(s->dir, v, 0))
+            continue;
+        struct calib_target_info ti;
+        char err[SCAN_DIR_PATH_MAX + 256];
+        int rc = calib_read_target(s->dir, v, &ti, err, sizeof(err));
+        if (rc != 0) {
+            fprintf(stderr, "scanner: error: %s\n", err);
+            return rc;
+        }
+        if (ti.kind == CALIB_TARGET_SPHERE) {
+            s->sphere_views[s->sphere_count++] = v;
+            continue;
+        }
+        struct board_view *bv = &s->views[s->view_count];
+        memset(bv, 0, sizeof(*bv));
+        bv->view = v;
+        bv->ti = ti;
+        if ((rc = load_board_view(s, bv)) != 0)
+            return rc;
+        s->view_count++;
+    }
+    return 0;
+}
+
+/* The largest angle between two boards' normals, degrees: Zhang's method needs the board in
+ * several orientations; one orientation (however many images) cannot give the focal length. */
+static double orientation_spread_deg(const struct solve *s)
+{
+    double worst = 0.0;
+    for (uint32_t i = 0; i < s->view_count; i++) {
+        for (uint32_t j = i + 1; j < s->view_count; j++) {
+            const struct board_view *a = &s->views[i], *b = &s->views[j];
+            if (!a->found || !b->found)
+                continue;
+            double ra[9], rb[9];
+            calcv_rodrigues(a->rvec, ra);
+            calcv_rodrigues(b->rvec, rb);
+            double c = ra[2] * rb[2] + ra[5] * rb[5] + ra[8] * rb[8];
+            worst = fmax(worst, acos(fmin(1.0, fmax(-1.0, c))) * 180.0 / M_PI);
+        }
+    }
+    return worst;
+}
+
+static void lens_to_calib(const struct calcv_lens *l, int projector, struct scan_calib *c)
+{
+    if (projector) {
+        c->proj_fx_px = l->fx, c->proj_fy_px = l->fy, c->proj_cx_px = l->cx, c->proj_cy_px = l->cy;
+        memcpy(c->proj_dist, l->dist, sizeof(c->proj_dist));
+    } else {
+        c->cam_fx_px = l->fx, c->cam_fy_px = l->fy, c->cam_cx_px = l->cx, c->cam_cy_px = l->cy;
+        memcpy(c->cam_dist, l->dist, sizeof(c->cam_dist));
+    }
+}
+
+static void calib_to_lens(const struct scan_calib *c, int projector, struct calcv_lens *l)
+{
+    if (projector) {
+        l->fx = c->proj_fx_px, l->fy = c->proj_fy_px, l->cx = c->proj_cx_px, l->cy = c->proj_cy_px;
+        memcpy(l->dist, c->proj_dist, sizeof(l->dist));
+    } else {
+        l->fx = c->cam_fx_px, l->fy = c->cam_fy_px, l->cx = c->cam_cx_px, l->cy = c->cam_cy_px;
+        memcpy(l->dist, c->cam_dist, sizeof(l->dist));
+    }
+}
+
+/* Zhang's method on every board found; an image far worse than the rest is dropped once. */
+static int solve_camera(struct solve *s)
+{
+    const struct calib_settings *cs = &s->cfg->calibrate;
+    static struct calcv_corners sel[CALIB_MAX_VIEWS];
+    static double rv[CALIB_MAX_VIEWS * 3], tv[CALIB_MAX_VIEWS * 3], vr[CALIB_MAX_VIEWS];
+    uint32_t idx[CALIB_MAX_VIEWS];
+    struct calcv_lens lens;
+    for (int attempt = 0; attempt < 2; attempt++) {
+        int n = 0;
+        for (uint32_t i = 0; i < s->view_count; i++)
+            if (s->views[i].found) {
+                idx[n] = i;
+                sel[n++] = s->views[i].cam;
+            }
+        if (n < 3) {
+            say(s, "refused: too few views: the board was found in %d image%s; at least 3 in "
+                "different orientations are needed (10 or more give a good calibration)\n", n,
+                n == 1 ? "" : "s");
+            return -EINVAL;
+        }
+        int rc = calcv_calibrate(sel, n, (int)s->start.cam_width, (int)s->start.cam_height,
+                                 (int)cs->fix_k3, &lens, rv, tv, vr, &s->cam_rms);
+        if (rc != 0) {
+            say(s, "refused: the camera calibration did not converge (OpenCV: see above)\n");
+            return -EINVAL;
+        }
+        double sorted[CALIB_MAX_VIEWS], median;
+        memcpy(sorted, vr, sizeof(double) * (size_t)n);
+        for (int a = 1; a < n; a++)
+            for (int b = a; b > 0 && sorted[b] < sorted[b - 1]; b--) {
+                double t = sorted[b];
+                sorted[b] = sorted[b - 1];
+                sorted[b - 1] = t;
+            }
+        median = sorted[n / 2];
+        int dropped = 0;
+        for (int k = 0; k < n; k++) {
+            struct board_view *bv = &s->views[idx[k]];
+            memcpy(bv->rvec, &rv[3 * k], sizeof(bv->rvec));
+            memcpy(bv->tvec, &tv[3 * k], sizeof(bv->tvec));
+            bv->rms = vr[k];
+            if (attempt == 0 && vr[k] > 3.0 * median && vr[k] > 0.3) {
+                say(s, "view_%03u: rejected: reprojection RMS %.3f px, over 3x the median %.3f "
+                    "(blurred, or the board moved during the capture?)\n", (unsigned)bv->view,
+                    vr[k], median);
+                bv->found = bv->has_proj = 0;
+                dropped++;
+            }
+        }
+        if (dropped == 0)
+            break;
+    }
+    double spread = orientation_spread_deg(s);
+    if (spread < 5.0) {
+        say(s, "refused: degenerate placements: every board faces the same way (the normals "
+            "differ by %.1f deg at most); turn the table or tilt the board between captures\n",
+            spread);
+        return -EINVAL;
+    }
+    lens_to_calib(&lens, 0, &s->out);
+    say(s, "camera: reprojection RMS %.4f px over the boards found; orientations spread over "
+        "%.0f deg\n", s->cam_rms, spread);
+    if (s->cam_rms > cs->max_camera_rms_px) {
+        say(s, "refused: the camera's reprojection RMS %.3f px is above [calibrate] "
+            "max_camera_rms_px = %.3f (blurred or moving captures, a board that is not flat, or "
+            "square_mm wrong?)\n", s->cam_rms, cs->max_camera_rms_px);
+        return -EINVAL;
+    }
+    return 0;
+}
+
+/* The projector as an inverse camera (Zhang's method on the corners' projector coordinates),
+ * then camera and projector refined together with the pose between them (stereoCalibrate). */
+static int solve_projector(struct solve *s)
+{
+    const struct calib_settings *cs = &s->cfg->calibrate;
+    static struct calcv_corners cam[CALIB_MAX_VIEWS], proj[CALIB_MAX_VIEWS];
+    static double rv[CALIB_MAX_VIEWS * 3], tv[CALIB_MAX_VIEWS * 3], vr[CALIB_MAX_VIEWS];
+    int n = 0;
+    for (uint32_t i = 0; i < s->view_count; i++)
+        if (s->views[i].found && s->views[i].has_proj) {
+            cam[n] = s->views[i].camp;
+            proj[n++] = s->views[i].proj;
+        }
+    if (n == 0) {
+        s->camera_only = 1;
+        say(s, "projector: no capture has its patterns: the camera alone is calibrated (the "
+            "projector, the axis and the lights stay as the starting file has them)\n");
+        return 0;
+    }
+    if (n < 3) {
+        say(s, "refused: too few views with projector coordinates: %d (at least 3)\n", n);
+        return -EINVAL;
+    }
+    struct calcv_lens pl, cl;
+    if (calcv_calibrate(proj, n, (int)s->start.proj_width, (int)s->start.proj_height,
+                        (int)cs->fix_k3, &pl, rv, tv, vr, &s->proj_rms) != 0) {
+        say(s, "refused: the projector calibration did not converge\n");
+        return -EINVAL;
+    }
+    say(s, "projector alone: RMS %.4f px, f %.1f %.1f c %.1f %.1f k1 %.4f k2 %.4f\n", s->proj_rms,
+        pl.fx, pl.fy, pl.cx, pl.cy, pl.dist[0], pl.dist[1]);
+    calib_to_lens(&s->out, 0, &cl);
+    if (calcv_stereo(cam, proj, n, (int)cs->fix_k3, &cl, &pl, s->out.proj_rot,
+                     s->out.proj_trans_mm, &s->stereo_rms) != 0) {
+        say(s, "refused: the joint camera-projector calibration did not converge\n");
+        return -EINVAL;
+    }
+    lens_to_calib(&cl, 0, &s->out);
+    lens_to_calib(&pl, 1, &s->out);
+    /* The projector's own RMS, with the joint lenses: each view's board pose from the camera,
+     * carried into the projector by the stereo pose. */
+    double sum = 0.0;
+    int count = 0;
+    for (uint32_t i = 0; i < s->view_count; i++) {
+        struct board_view *bv = &s->views[i];
+        if (!bv->found || !bv->has_proj)
+            continue;
+        double rvec[3], tvec[3], rms, r[9];
+        if (calcv_pose(&bv->camp, &cl, rvec, tvec, &rms) != 0)
+            continue;
+        calcv_rodrigues(rvec, r);
+        /* board -> projector: Rs (R X + t) + ts */
+        double rp[9], tp[3];
+        for (int a = 0; a < 3; a++) {
+            for (int b = 0; b < 3; b++) {
+                rp[3 * a + b] = 0;
+                for (int k = 0; k < 3; k++)
+                    rp[3 * a + b] += s->out.proj_rot[3 * a + k] * r[3 * k + b];
+            }
+            tp[a] = s->out.proj_trans_mm[a];
+            for (int k = 0; k < 3; k++)
+                tp[a] += s->out.proj_rot[3 * a + k] * tvec[k];
+        }
+        /* back to a rotation vector through the camera of calib_cv: Rodrigues is its own
+         * inverse there, so use the axis-angle formula */
+        double ang = acos(fmin(1.0, fmax(-1.0, 0.5 * (rp[0] + rp[4] + rp[8] - 1.0))));
+        double rvp[3] = {0, 0, 0};
+        if (ang > 1e-12) {
+            double f = ang / (2.0 * sin(ang));
+            rvp[0] = f * (rp[7] - rp[5]);
+            rvp[1] = f * (rp[2] - rp[6]);
+            rvp[2] = f * (rp[3] - rp[1]);
+        }
+        double e = calcv_reprojection_rms(&bv->proj, &pl, rvp, tp);
+        say(s, "view_%03u: camera %.3f px, projector %.3f px\n", (unsigned)bv->view, rms, e);
+        sum += e * e * bv->proj.count;
+        count += bv->proj.count;
+    }
+    s->proj_rms = count > 0 ? sqrt(sum / count) : 0.0;
+    say(s, "projector: reprojection RMS %.4f px (joint RMS %.4f px over %d views)\n", s->proj_rms,
+        s->stereo_rms, n);
+    if (s->proj_rms > cs->max_projector_rms_px) {
+        say(s, "refused: the projector's reprojection RMS %.3f px is above [calibrate] "
+            "max_projector_rms_px = %.3f (patterns out of focus, or the board moved?)\n",
+            s->proj_rms, cs->max_projector_rms_px);
+        return -EINVAL;
+    }
+    return 0;
+}
+
+/* Solve the symmetric 3x3 system a x = b (Cramer's rule). @retval 0 singular */
+static int solve3(const double a[9], const double b[3], double x[3])
+{
+    double det = a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) +
+                 a[2] * (a[3] * a[7] - a[4] * a[6]);
+    if (fabs(det) < 1e-30)
+        return 0;
+    for (int k = 0; k < 3; k++) {
+        double m[9];
+        memcpy(m, a, sizeof(m));
+        for (int r = 0; r < 3; r++)
+            m[3 * r + k] = b[r];
+        x[k] = (m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +
+                m[2] * (m[3] * m[7] - m[4] * m[6])) / det;
+    }
+    return 1;
+}
+
+/* The turntable axis from the board's poses: two captures of one placement differ by a turn
+ * about the axis, X_j = R_ij X_i + t_ij with R_ij = R_j R_i^T, t_ij = t_j - R_ij t_i. The turn's
+ * axis (the skew part of R_ij, signed by the table's angle step) gives the direction; every
+ * point c of the axis stays put, (I - R_ij) c = t_ij, stacked over all pairs by least squares.
+ * The table's surface: each board's plate stands on it, so the sheet's bottom edge, less the
+ * plate's thickness along the sheet's normal, lies on it. */
+static int solve_axis(struct solve *s)
+{
+    double dir[3] = {0, 0, 0}, ata[9] = {0}, atb[3] = {0};
+    int pairs = 0;
+    double r[CALIB_MAX_VIEWS][9];
+    for (uint32_t i = 0; i < s->view_count; i++) {
+        struct board_view *bv = &s->views[i];
+        if (bv->found) {
+            struct calcv_lens cl;
+            double rms;
+            calib_to_lens(&s->out, 0, &cl);
+            if (calcv_pose(&bv->cam, &cl, bv->rvec, bv->tvec, &rms) != 0)
+                bv->found = 0;
+            calcv_rodrigues(bv->rvec, r[i]);
+        }
+    }
+    for (int pass = 0; pass < 2; pass++) {
+        for (uint32_t i = 0; i < s->view_count; i++) {
+            for (uint32_t j = i + 1; j < s->view_count; j++) {
+                const struct board_view *a = &s->views[i], *b = &s->views[j];
+                if (!a->found || !b->found || !a->ti.has_angle || !b->ti.has_angle ||
+                    a->ti.placement != b->ti.placement || a->ti.angle_mdeg == b->ti.angle_mdeg)
+                    continue;
+                double rij[9], tij[3];
+                for (int x = 0; x < 3; x++)
+                    for (int y = 0; y < 3; y++) {
+                        rij[3 * x + y] = 0;
+                        for (int k = 0; k < 3; k++)
+                            rij[3 * x + y] += r[j][3 * x + k] * r[i][3 * y + k];
+                    }
+                for (int x = 0; x < 3; x++) {
+                    tij[x] = b->tvec[x];
+                    for (int k = 0; k < 3; k++)
+                        tij[x] -= rij[3 * x + k] * a->tvec[k];
+                }
+                if (pass == 0) {
+                    double sgn = b->ti.angle_mdeg > a->ti.angle_mdeg ? 1.0 : -1.0;
+                    dir[0] += sgn * (rij[7] - rij[5]);
+                    dir[1] += sgn * (rij[2] - rij[6]);
+                    dir[2] += sgn * (rij[3] - rij[1]);
+                    pairs++;
+                    continue;
+                }
+                double m[9];
+                for (int k = 0; k < 9; k++)
+                    m[k] = (k % 4 == 0 ? 1.0 : 0.0) - rij[k];
+                for (int x = 0; x < 3; x++) {
+                    for (int y = 0; y < 3; y++)
+                        for (int k = 0; k < 3; k++)
+                            ata[3 * x + y] += m[3 * k + x] * m[3 * k + y];
+                    for (int k = 0; k < 3; k++)
+                        atb[x] += m[3 * k + x] * tij[k];
+                }
+            }
+        }
+        if (pass == 0) {
+            if (pairs == 0) {
+                say(s, "turntable: no placement was seen at two table angles: the axis stays as "
+                    "the starting file has it\n");
+                return 0;
+            }
+            vec3 a = v3_norm(v3(dir[0], dir[1], dir[2]));
+            dir[0] = a.x, dir[1] = a.y, dir[2] = a.z;
+        }
+    }
+    /* (I - R) has the axis as its null space: pin the point's component along it to 0. */
+    for (int x = 0; x < 3; x++)
+        for (int y = 0; y < 3; y++)
+            ata[3 * x + y] += dir[x] * dir[y];
+    double c[3];
+    if (!solve3(ata, atb, c)) {
+        say(s, "refused: the axis cannot be located (the table turned too little?)\n");
+        return -EINVAL;
+    }
+    const vec3 a = v3(dir[0], dir[1], dir[2]);
+    double wmm, hmm, along = 0.0;
+    int n = 0;
+    calcv_board_size_mm(&s->board, &wmm, &hmm);
+    for (uint32_t i = 0; i < s->view_count; i++) {
+        const struct board_view *bv = &s->views[i];
+        if (!bv->found)
+            continue;
+        /* bottom-edge centre of the sheet, and the face's outward normal (-z of the sheet) */
+        vec3 m = v3_add(m3_mul(r[i], v3(0.5 * wmm, hmm, 0.0)), v3_from(bv->tvec));
+        vec3 nrm = v3(-r[i][2], -r[i][5], -r[i][8]);
+        vec3 base = v3_sub(m, v3_scale(nrm, s->cfg->calibrate.board_thickness_mm));
+        along += v3_dot(v3_sub(base, v3(c[0], c[1], c[2])), a);
+        n++;
+    }
+    along /= n;
+    vec3 point = v3_add(v3(c[0], c[1], c[2]), v3_scale(a, along));
+    if (a.y > 0.0)
+        say(s, "warning: the axis points down in the image: the table turns clockwise seen "
+            "from above for rising angles, which the scanner does not expect\n");
+    memcpy(s->out.axis_dir, dir, sizeof(dir));
+    s->out.axis_point_mm[0] = point.x;
+    s->out.axis_point_mm[1] = point.y;
+    s->out.axis_point_mm[2] = point.z;
+    /* how well one axis explains every pair: the turn of each pair against the table's */
+    double worst_deg = 0.0;
+    for (uint32_t i = 0; i < s->view_count; i++)
+        for (uint32_t j = i + 1; j < s->view_count; j++) {
+            const struct board_view *p = &s->views[i], *q = &s->views[j];
+            if (!p->found || !q->found || !p->ti.has_angle || !q->ti.has_angle ||
+                p->ti.placement != q->ti.placement)
+                continue;
+            double tr = 0;
+            for (int x = 0; x < 3; x++)
+                for (int k = 0; k < 3; k++)
+                    tr += r[j][3 * x + k] * r[i][3 * x + k];
+            double turn = acos(fmin(1.0, fmax(-1.0, 0.5 * (tr - 1.0)))) * 180.0 / M_PI;
+            double table = fabs((double)(q->ti.angle_mdeg - p->ti.angle_mdeg)) / 1000.0;
+            worst_deg = fmax(worst_deg, fabs(turn - table));
+        }
+    say(s, "turntable: axis from %d pairs of captures; the boards turned by the table's angles "
+        "within %.3f deg; the table's surface from %d board edges\n", pairs, worst_deg, n);
+    return 0;
+}
+
+/* ---- lights: the matte white sphere's shading ---- */
+
+struct shade_sample {
+    float p[3], n[3]; /* surface point and normal (camera frame) */
+    float signal[HAL_MAX_LIGHTS]; /* each light's frame less the dark frame, grey levels */
+};
+
+double calib_fit_sphere(const float *xyz, const uint8_t *reason, size_t n, int fit_radius,
+                        double *radius, vec3 *centre, uint32_t *used)
+{
+    vec3 c = v3(0, 0, 0);
+    uint32_t count = 0;
+    for (size_t i = 0; i < n; i++)
+        if (reason[i] == SCAN_VALID) {
+            c = v3_add(c, v3(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]));
+            count++;
+        }
+    *used = count;
+    if (count < 100)
+        return -1.0;
+    double r = *radius;
+    c = v3_scale(c, 1.0 / count);
+    c = v3_add(c, v3_scale(v3_norm(c), r)); /* the visible cap's centroid, pushed back */
+    double rms = 0.0;
+    const int np = fit_radius ? 4 : 3;
+    for (int it = 0; it < 50; it++) {
+        double a[16] = {0}, b[4] = {0}, sum = 0.0;
+        for (size_t i = 0; i < n; i++) {
+            if (reason[i] != SCAN_VALID)
+                continue;
+            vec3 d = v3_sub(v3(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]), c);
+            double len = v3_len(d), res = len - r;
+            double g[4] = {-d.x / len, -d.y / len, -d.z / len, -1.0}; /* d(res)/d(c, r) */
+            for (int x = 0; x < np; x++) {
+                for (int y = 0; y < np; y++)
+                    a[4 * x + y] += g[x] * g[y];
+                b[x] -= g[x] * res;
+            }
+            sum += res * res;
+        }
+        rms = sqrt(sum / count);
+        double step[4] = {0, 0, 0, 0};
+        if (np == 3) {
+            double a3[9] = {a[0], a[1], a[2], a[4], a[5], a[6], a[8], a[9], a[10]};
+            if (!solve3(a3, b, step))
+                return -1.0;
+        } else if (!solve_n(a, b, step, 4)) {
+            return -1.0;
+        }
+        c = v3_add(c, v3(step[0], step[1], step[2]));
+        r += step[3];
+        if (fabs(step[0]) + fabs(step[1]) + fabs(step[2]) + fabs(step[3]) < 1e-8)
+            break;
+    }
+    *centre = c;
+    *radius = r;
+    return rms;
+}
+
+/* I = k max(0, n.(L - p)) / |L - p|^3: Lambert's cosine and the inverse-square law, as the
+ * colour methods assume (docs/colour.md). */
+static double shade(vec3 l, vec3 p, vec3 n)
+{
+    vec3 d = v3_sub(l, p);
+    double len = v3_len(d), c = v3_dot(n, d);
+    return c > 0.0 ? c / (len * len * len) : 0.0;
+}
+
+/* Light @p li's position (and intensity k) from every sample: Levenberg-Marquardt on the four
+ * unknowns, numeric derivatives, from the starting file's position. @retval RMS residual */
+static double fit_light(const struct shade_sample *smp, size_t n, uint32_t li, vec3 *light,
+                        double *k_out)
+{
+    vec3 l = *light;
+    double lambda = 1e-3, k = 0.0, cost = 0.0;
+    for (int it = 0; it < 60; it++) {
+        /* k for this l in closed form, then the step in l */
+        double num = 0.0, den = 0.0;
+        for (size_t i = 0; i < n; i++) {
+            vec3 p = v3(smp[i].p[0], smp[i].p[1], smp[i].p[2]);
+            vec3 nn = v3(smp[i].n[0], smp[i].n[1], smp[i].n[2]);
+            double g = shade(l, p, nn);
+            num += g * smp[i].signal[li];
+            den += g * g;
+        }
+        if (den <= 0.0)
+            return -1.0;
+        k = num / den;
+        double a[9] = {0}, b[3] = {0};
+        cost = 0.0;
+        const double h = 0.01; /* mm */
+        for (size_t i = 0; i < n; i++) {
+            vec3 p = v3(smp[i].p[0], smp[i].p[1], smp[i].p[2]);
+            vec3 nn = v3(smp[i].n[0], smp[i].n[1], smp[i].n[2]);
+            double f0 = k * shade(l, p, nn), res = smp[i].signal[li] - f0, jv[3];
+            jv[0] = k * (shade(v3_add(l, v3(h, 0, 0)), p, nn) - f0 / k) / h;
+            jv[1] = k * (shade(v3_add(l, v3(0, h, 0)), p, nn) - f0 / k) / h;
+            jv[2] = k * (shade(v3_add(l, v3(0, 0, h)), p, nn) - f0 / k) / h;
+            for (int x = 0; x < 3; x++) {
+                for (int y = 0; y < 3; y++)
+                    a[3 * x + y] += jv[x] * jv[y];
+                b[x] += jv[x] * res;
+            }
+            cost += res * res;
+        }
+        for (int x = 0; x < 3; x++)
+            a[4 * x] *= 1.0 + lambda;
+        double step[3];
+        if (!solve3(a, b, step))
+            break;
+        vec3 cand = v3_add(l, v3(step[0], step[1], step[2]));
+        double cand_cost = 0.0;
+        for (size_t i = 0; i < n; i++) {
+            vec3 p = v3(smp[i].p[0], smp[i].p[1], smp[i].p[2]);
+            vec3 nn = v3(smp[i].n[0], smp[i].n[1], smp[i].n[2]);
+            double res = smp[i].signal[li] - k * shade(cand, p, nn);
+            cand_cost += res * res;
+        }
+        if (cand_cost < cost) {
+            l = cand;
+            lambda *= 0.3;
+            if (v3_len(v3(step[0], step[1], step[2])) < 1e-4)
+                break;
+        } else {
+            lambda *= 10.0;
+        }
+    }
+    *light = l;
+    *k_out = k;
+    return sqrt(cost / n);
+}
+
+/* Each sphere capture triangulated with the new geometry, its centre fitted (the diameter is
+ * known), and each light's frame sampled over the sphere. */
+static int solve_lights(struct solve *s)
+{
+    const uint32_t lights = s->start.light_count;
+    if (s->sphere_count == 0 || lights == 0 || s->camera_only) {
+        say(s, "lights: no sphere captures: the lights stay as the starting file has them\n");
+        return 0;
+    }
+    static uint8_t dark[HAL_MAX_PIXELS * 3], lit[HAL_MAX_PIXELS * 3];
+    const size_t npix = (size_t)s->out.cam_width * s->out.cam_height;
+    const size_t cap = npix / 4 * s->sphere_count + 1;
+    struct shade_sample *smp = calloc(cap, sizeof(*smp));
+    if (smp == NULL)
+        return -ENOMEM;
+    size_t n = 0;
+    const double radius = 0.5 * s->cfg->calibrate.sphere_diameter_mm;
+    struct gray_layout layout;
+    scan_layout(&s->params, &s->out, &layout);
+    const uint32_t patterns = gray_layout_count(&layout);
+    char err[SCAN_DIR_PATH_MAX + 256];
+    int rc = 0;
+    for (uint32_t k = 0; k < s->sphere_count && rc == 0; k++) {
+        uint32_t v = s->sphere_views[k];
+        struct scan_view view;
+        struct scan_view_info info;
+        if ((rc = feed_patterns(s, v, &s->out)) != 0 ||
+            (rc = scan_finish_view(&s->out, 0, &view, &info)) != 0)
+            break;
+        vec3 centre;
+        uint32_t used;
+        double r = radius;
+        double rms = calib_fit_sphere(view.range.xyz_mm, view.maps.reason, npix, 0, &r, &centre,
+                                      &used);
+        if (rms < 0.0) {
+            say(s, "view_%03u: sphere not seen (%u points): not used\n", (unsigned)v,
+                (unsigned)used);
+            continue;
+        }
+        say(s, "view_%03u: sphere centre (%.2f, %.2f, %.2f) mm from %u points, fit RMS %.3f mm\n",
+            (unsigned)v, centre.x, centre.y, centre.z, (unsigned)used, rms);
+        /* frames after the patterns: dark, all lights, then each light (colour.h) */
+        rc = scan_dir_read_frame(s->dir, v, patterns + COLOUR_FRAME_DARK, dark, sizeof(dark),
+                                 s->out.cam_width, s->out.cam_height, 3, err, sizeof(err));
+        size_t first = n;
+        for (uint32_t li = 0; li < lights && rc == 0; li++) {
+            rc = scan_dir_read_frame(s->dir, v, patterns + COLOUR_FRAME_LIGHT0 + li, lit,
+                                     sizeof(lit), s->out.cam_width, s->out.cam_height, 3, err,
+                                     sizeof(err));
+            if (rc != 0)
+                break;
+            n = first;
+            for (size_t i = 0; i < npix && n < cap; i += 2) {
+                if (view.maps.reason[i] != SCAN_VALID || (i / s->out.cam_width) % 2 != 0)
+                    continue;
+                vec3 p = v3(view.range.xyz_mm[3 * i], view.range.xyz_mm[3 * i + 1],
+                            view.range.xyz_mm[3 * i + 2]);
+                vec3 nn = v3_norm(v3_sub(p, centre));
+                p = v3_add(centre, v3_scale(nn, radius)); /* on the fitted sphere */
+                double sig = 0.0;
+                int saturated = 0;
+                for (int ch = 0; ch < 3; ch++) {
+                    saturated |= lit[3 * i + (size_t)ch] >= s->params.saturation_dn;
+                    sig += ((double)lit[3 * i + (size_t)ch] - dark[3 * i + (size_t)ch]) / 3.0;
+                }
+                struct shade_sample *q = &smp[n++];
+                if (li == 0) {
+                    q->p[0] = (float)p.x, q->p[1] = (float)p.y, q->p[2] = (float)p.z;
+                    q->n[0] = (float)nn.x, q->n[1] = (float)nn.y, q->n[2] = (float)nn.z;
+                }
+                q->signal[li] = saturated ? -1.0f : (float)sig;
+            }
+        }
+        if (rc != 0)
+            fprintf(stderr, "scanner: error: %s\n", err);
+    }
+    if (rc == 0 && n < 1000) {
+        say(s, "refused: the sphere was seen in too few captures (%zu samples)\n", n);
+        rc = -EINVAL;
+    }
+    /* Per light: samples saturated, or in its shadow and so at the noise (signal <= 4 grey
+     * levels), say nothing about it. */
+    struct shade_sample *use = rc == 0 ? calloc(n, sizeof(*use)) : NULL;
+    if (rc == 0 && use == NULL)
+        rc = -ENOMEM;
+    for (uint32_t li = 0; li < lights && rc == 0; li++) {
+        size_t m = 0;
+        for (size_t i = 0; i < n; i++)
+            if (smp[i].signal[li] > 4.0f) {
+                use[m] = smp[i];
+                use[m].signal[0] = smp[i].signal[li];
+                m++;
+            }
+        vec3 l = v3_from(s->out.light_pos_mm[li]);
+        double k, res = m > 100 ? fit_light(use, m, 0, &l, &k) : -1.0;
+        if (res < 0.0) {
+            say(s, "refused: light %u lights too little of the sphere (%zu samples)\n",
+                (unsigned)li, m);
+            rc = -EINVAL;
+            break;
+        }
+        s->out.light_pos_mm[li][0] = l.x;
+        s->out.light_pos_mm[li][1] = l.y;
+        s->out.light_pos_mm[li][2] = l.z;
+        say(s, "light %u: (%.2f, %.2f, %.2f) mm from %zu samples, shading RMS %.2f grey levels, "
+            "intensity %.4g (grey levels at 1 m, head-on)\n", (unsigned)li, l.x, l.y, l.z, m,
+            res, k * 1e-6);
+    }
+    free(use);
+    free(smp);
+    return rc;
+}
+
+/* ---- the file ---- */
+
+/* An existing file is kept beside the new one, named by when it was replaced. */
+static int keep_old(const char *path, char *kept, size_t len)
+{
+    struct stat sb;
+    kept[0] = '\0';
+    if (stat(path, &sb) != 0)
+        return 0;
+    char stamp[32];
+    time_t now = time(NULL);
+    struct tm tm;
+    gmtime_r(&now, &tm);
+    strftime(stamp, sizeof(stamp), "%Y%m%dT%H%M%SZ", &tm);
+    snprintf(kept, len, "%s.%s", path, stamp);
+    if (rename(path, kept) != 0) {
+        int e = errno;
+        fprintf(stderr, "scanner: error: cannot keep the old %s as %s: %s\n", path, kept,
+                strerror(e));
+        return -e;
+    }
+    return 0;
+}
+
+static int write_outputs(struct solve *s, const struct hal_storage *st, const char *out_path)
+{
+    char comment[1024], kept[HAL_MAX_PATH + 40], report_path[HAL_MAX_PATH + 16];
+    snprintf(comment, sizeof(comment),
+             "; written by scanner calibrate from %s\n"
+             "; quality: camera_rms_px = %.4f, projector_rms_px = %.4f, boards = %u\n"
+             "; camera frame: x right, y down, z forward; millimetres\n",
+             s->dir, s->cam_rms, s->proj_rms, (unsigned)s->view_count);
+    int rc = keep_old(out_path, kept, sizeof(kept));
+    if (rc == 0)
+        rc = calib_save(st, out_path, &s->out, comment);
+    if (rc != 0) {
+        fprintf(stderr, "scanner: error: cannot write %s: %s\n", out_path, strerror(-rc));
+        return rc;
+    }
+    /* what calib_load accepts is the test of what was written */
+    struct scan_calib back;
+    char err[512];
+    if ((rc = calib_load(&back, out_path, s->out.light_count, err, sizeof(err))) != 0) {
+        fprintf(stderr, "scanner: error: the calibration written does not load: %s\n", err);
+        return rc;
+    }
+    size_t l = strlen(out_path);
+    snprintf(report_path, sizeof(report_path), "%.*s.report.txt",
+             (int)(l > 4 && strcmp(out_path + l - 4, ".ini") == 0 ? l - 4 : l), out_path);
+    rc = hal_storage_write_file(st, report_path, s->report, s->report_len);
+    if (rc != 0)
+        fprintf(stderr, "scanner: error: cannot write %s: %s\n", report_path, strerror(-rc));
+    printf("calibration written: %s (report: %s)%s%s\n", out_path, report_path,
+           kept[0] ? "; the previous file is kept as " : "", kept);
+    return rc;
+}
+
+int calibrate_solve(const struct hal_storage *st, const struct app_config *cfg, const char *dir,
+                    const char *out_path)
+{
+    struct solve s;
+    memset(&s, 0, sizeof(s));
+    s.cfg = cfg;
+    s.dir = dir;
+    char path[SCAN_DIR_PATH_MAX], err[512];
+    scan_dir_path(path, sizeof(path), dir, -1, "calibration.ini");
+    int rc = calib_load(&s.start, path, cfg->light_count, err, sizeof(err));
+    if (rc == -ENOENT) {
+        calibrate_guess(cfg, &s.start); /* captures made elsewhere */
+        rc = 0;
+    } else if (rc != 0) {
+        fprintf(stderr, "scanner: error: %s\n", err);
+        return rc;
+    }
+    s.out = s.start;
+    calib_capture_params(cfg, &s.params);
+    s.params.colour.method = COLOUR_NONE; /* the light frames are read here, not compensated */
+    if (calib_board_from_settings(&cfg->calibrate, &s.board) != 0) {
+        fprintf(stderr, "scanner: error: %s: [calibrate] marker_mm must be below square_mm\n",
+                cfg->path);
+        return -EINVAL;
+    }
+    s.views = calloc(CALIB_MAX_VIEWS, sizeof(*s.views));
+    if (s.views == NULL)
+        return -ENOMEM;
+    say(&s, "calibration from %s (board: %s, %ux%u squares of %.2f mm)\n", dir,
+        cfg->calibrate.board, (unsigned)cfg->calibrate.squares_x,
+        (unsigned)cfg->calibrate.squares_y, cfg->calibrate.square_mm);
+    rc = load_views(&s);
+    if (rc == 0 && s.view_count == 0 && s.sphere_count == 0) {
+        say(&s, "refused: %s holds no captures (view_NNN/frame_00.png)\n", dir);
+        rc = -EINVAL;
+    }
+    if (rc == 0)
+        rc = solve_camera(&s);
+    if (rc == 0)
+        rc = solve_projector(&s);
+    if (rc == 0 && !s.camera_only)
+        rc = solve_axis(&s);
+    if (rc == 0)
+        rc = solve_lights(&s);
+    fputs(s.report != NULL ? s.report : "", stdout);
+    if (rc == 0)
+        rc = write_outputs(&s, st, out_path);
+    else if (rc == -EINVAL)
+        fprintf(stderr, "scanner: error: calibration refused (see above); %s is unchanged\n",
+                out_path);
+    free(s.report);
+    free(s.views);
+    return rc;
+}

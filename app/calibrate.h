@@ -1,0 +1,67 @@
+/* `scanner calibrate`: lead a person through capturing a board and a sphere on the turntable,
+ * keep every capture, and compute the rig's calibration file from them (docs/calibration.md). */
+#ifndef CALIBRATE_H
+#define CALIBRATE_H
+
+#include "hal.h"
+#include "scan_types.h"
+
+#include <stddef.h>
+#include <stdint.h>
+
+#define CALIB_MAX_PLACEMENTS 8 /**< board placements one procedure lists */
+#define CALIB_MAX_VIEWS 96     /**< captures one calibration directory holds */
+
+/** [calibrate] of a config: the board, the procedure, and what is accepted. */
+struct calib_settings {
+    char board[16];      /**< chessboard | charuco */
+    uint32_t squares_x, squares_y;
+    double square_mm, marker_mm, margin_mm, board_thickness_mm;
+    char dictionary[16]; /**< ChArUco dictionary, e.g. 5x5_100 */
+    char placements[160]; /**< board placements, comma-separated: tilt from upright in degrees
+                               (90: flat), optionally @ sideways offset in mm ("20@-70") */
+    uint32_t placement_count;                /**< parsed from placements */
+    double tilt_deg[CALIB_MAX_PLACEMENTS];   /**< parsed from placements */
+    double offset_mm[CALIB_MAX_PLACEMENTS];  /**< to the camera's right of the table's centre */
+    uint32_t turns;       /**< table angles per placement */
+    double turn_step_deg; /**< between them, centred on 0 */
+    double sphere_diameter_mm, sphere_offset_mm;
+    uint32_t sphere_turns; /**< table angles of the sphere (0: lights not calibrated) */
+    uint32_t projector_width, projector_height; /**< used when no calibration exists yet */
+    uint32_t min_corners;
+    uint32_t fix_k3;
+    double max_camera_rms_px, max_projector_rms_px;
+};
+
+struct app_config;
+
+/** The scan parameters every calibration capture is taken and decoded with (rows as well as
+ *  columns; every light's frame): the projector must store this sequence. */
+void calib_capture_params(const struct app_config *cfg, struct scan_params *p);
+
+/** A first guess of the rig for the captures when no calibration file exists: the camera's
+ *  size from [camera], the projector's from [calibrate], nominal optics and pose. */
+void calibrate_guess(const struct app_config *cfg, struct scan_calib *guess);
+
+/** Capture every step into @p dir (new, or an unfinished calibration directory: the steps
+ *  already there are kept), telling the person what to do; the simulator places the targets.
+ *  @retval 0 @retval -EINTR stopped (captures kept) @retval -errno (said) */
+int calibrate_capture(struct hal *hal, const struct app_config *cfg,
+                      const struct scan_calib *guess, const char *dir);
+
+/** Compute the calibration from the captures in @p dir and write @p out_path (an existing file
+ *  is kept beside it) with its report. @param cfg  the config (board, limits, light count)
+ *  @retval 0 @retval -EINVAL refused (said why) @retval -errno */
+int calibrate_solve(const struct hal_storage *st, const struct app_config *cfg, const char *dir,
+                    const char *out_path);
+
+/** Scan the sphere of [calibrate] sphere_diameter_mm once and print the diameter error and the
+ *  sphere fit's RMS, with the calibration's reprojection RMS. @retval 0 @retval -errno */
+int calibrate_verify(struct hal *hal, const struct app_config *cfg, const struct scan_calib *calib);
+
+/** Write the board to print: PNG at 300 dpi and SVG at true size (@p base.png, @p base.svg).
+ *  @retval 0 @retval -errno */
+int calibrate_print_board(const struct hal_storage *st, const struct app_config *cfg,
+                          const char *base);
+
+#endif
