@@ -424,8 +424,6 @@ static int solve_projector(struct solve *s)
         say(s, "refused: the projector calibration did not converge\n");
         return -EINVAL;
     }
-    say(s, "projector alone: RMS %.4f px, f %.1f %.1f c %.1f %.1f k1 %.4f k2 %.4f\n", s->proj_rms,
-        pl.fx, pl.fy, pl.cx, pl.cy, pl.dist[0], pl.dist[1]);
     calib_to_lens(&s->out, 0, &cl);
     if (calcv_stereo(cam, proj, n, (int)cs->fix_k3, &cl, &pl, s->out.proj_rot,
                      s->out.proj_trans_mm, &s->stereo_rms) != 0) {
@@ -696,67 +694,84 @@ static double shade(vec3 l, vec3 p, vec3 n)
     return c > 0.0 ? c / (len * len * len) : 0.0;
 }
 
-/* Light @p li's position (and intensity k) from every sample: Levenberg-Marquardt on the four
- * unknowns, numeric derivatives, from the starting file's position. @retval RMS residual */
+/* Light @p li's position L and intensity k from every sample: Levenberg-Marquardt on the four
+ * unknowns together (k and the distance are strongly coupled: alternating between them crawls
+ * along that valley), analytic derivatives: f = k g, df/dk = g,
+ * df/dL = k (n / |d|^3 - 3 (n.d) d / |d|^5) with d = L - p. From the starting file's position.
+ * @retval RMS residual, grey levels @retval -1 no solution */
 static double fit_light(const struct shade_sample *smp, size_t n, uint32_t li, vec3 *light,
                         double *k_out)
 {
-    vec3 l = *light;
-    double lambda = 1e-3, k = 0.0, cost = 0.0;
-    for (int it = 0; it < 60; it++) {
-        /* k for this l in closed form, then the step in l */
-        double num = 0.0, den = 0.0;
-        for (size_t i = 0; i < n; i++) {
-            vec3 p = v3(smp[i].p[0], smp[i].p[1], smp[i].p[2]);
-            vec3 nn = v3(smp[i].n[0], smp[i].n[1], smp[i].n[2]);
-            double g = shade(l, p, nn);
-            num += g * smp[i].signal[li];
-            den += g * g;
-        }
-        if (den <= 0.0)
-            return -1.0;
-        k = num / den;
-        double a[9] = {0}, b[3] = {0};
-        cost = 0.0;
-        const double h = 0.01; /* mm */
-        for (size_t i = 0; i < n; i++) {
-            vec3 p = v3(smp[i].p[0], smp[i].p[1], smp[i].p[2]);
-            vec3 nn = v3(smp[i].n[0], smp[i].n[1], smp[i].n[2]);
-            double f0 = k * shade(l, p, nn), res = smp[i].signal[li] - f0, jv[3];
-            jv[0] = k * (shade(v3_add(l, v3(h, 0, 0)), p, nn) - f0 / k) / h;
-            jv[1] = k * (shade(v3_add(l, v3(0, h, 0)), p, nn) - f0 / k) / h;
-            jv[2] = k * (shade(v3_add(l, v3(0, 0, h)), p, nn) - f0 / k) / h;
-            for (int x = 0; x < 3; x++) {
-                for (int y = 0; y < 3; y++)
-                    a[3 * x + y] += jv[x] * jv[y];
-                b[x] += jv[x] * res;
-            }
-            cost += res * res;
-        }
-        for (int x = 0; x < 3; x++)
-            a[4 * x] *= 1.0 + lambda;
-        double step[3];
-        if (!solve3(a, b, step))
-            break;
-        vec3 cand = v3_add(l, v3(step[0], step[1], step[2]));
-        double cand_cost = 0.0;
-        for (size_t i = 0; i < n; i++) {
-            vec3 p = v3(smp[i].p[0], smp[i].p[1], smp[i].p[2]);
-            vec3 nn = v3(smp[i].n[0], smp[i].n[1], smp[i].n[2]);
-            double res = smp[i].signal[li] - k * shade(cand, p, nn);
-            cand_cost += res * res;
-        }
-        if (cand_cost < cost) {
-            l = cand;
-            lambda *= 0.3;
-            if (v3_len(v3(step[0], step[1], step[2])) < 1e-4)
-                break;
-        } else {
-            lambda *= 10.0;
-        }
+    double x[4] = {light->x, light->y, light->z, 0.0};
+    double num = 0.0, den = 0.0;
+    for (size_t i = 0; i < n; i++) { /* k for the starting position, in closed form */
+        double g = shade(*light, v3(smp[i].p[0], smp[i].p[1], smp[i].p[2]),
+                         v3(smp[i].n[0], smp[i].n[1], smp[i].n[2]));
+        num += g * smp[i].signal[li];
+        den += g * g;
     }
-    *light = l;
-    *k_out = k;
+    if (den <= 0.0)
+        return -1.0;
+    x[3] = num / den;
+    double lambda = 1e-3, cost = -1.0;
+    for (int it = 0; it < 200; it++) {
+        double a[16] = {0}, b[4] = {0}, c = 0.0;
+        vec3 l = v3(x[0], x[1], x[2]);
+        for (size_t i = 0; i < n; i++) {
+            vec3 p = v3(smp[i].p[0], smp[i].p[1], smp[i].p[2]);
+            vec3 nn = v3(smp[i].n[0], smp[i].n[1], smp[i].n[2]);
+            vec3 d = v3_sub(l, p);
+            double len = v3_len(d), nd = v3_dot(nn, d), g = nd > 0.0 ? nd / (len * len * len) : 0.0;
+            double res = smp[i].signal[li] - x[3] * g, jv[4] = {0, 0, 0, g};
+            if (nd > 0.0) {
+                double l3 = len * len * len, l5 = l3 * len * len;
+                jv[0] = x[3] * (nn.x / l3 - 3.0 * nd * d.x / l5);
+                jv[1] = x[3] * (nn.y / l3 - 3.0 * nd * d.y / l5);
+                jv[2] = x[3] * (nn.z / l3 - 3.0 * nd * d.z / l5);
+            }
+            for (int r = 0; r < 4; r++) {
+                for (int q = 0; q < 4; q++)
+                    a[4 * r + q] += jv[r] * jv[q];
+                b[r] += jv[r] * res;
+            }
+            c += res * res;
+        }
+        cost = c;
+        double step[4];
+        int accepted = 0;
+        for (int tries = 0; tries < 20 && !accepted; tries++) {
+            double m[16], rhs[4];
+            memcpy(m, a, sizeof(m));
+            memcpy(rhs, b, sizeof(rhs));
+            for (int r = 0; r < 4; r++)
+                m[5 * r] *= 1.0 + lambda;
+            if (!solve_n(m, rhs, step, 4))
+                break;
+            double cand[4] = {x[0] + step[0], x[1] + step[1], x[2] + step[2], x[3] + step[3]};
+            double cc = 0.0;
+            vec3 lc = v3(cand[0], cand[1], cand[2]);
+            for (size_t i = 0; i < n; i++) {
+                double res = smp[i].signal[li] -
+                             cand[3] * shade(lc, v3(smp[i].p[0], smp[i].p[1], smp[i].p[2]),
+                                             v3(smp[i].n[0], smp[i].n[1], smp[i].n[2]));
+                cc += res * res;
+            }
+            if (cc <= cost) {
+                memcpy(x, cand, sizeof(x));
+                lambda = fmax(lambda * 0.3, 1e-12);
+                accepted = 1;
+                if (cost - cc <= 1e-13 * cost)
+                    it = 200; /* converged */
+                cost = cc;
+            } else {
+                lambda *= 10.0;
+            }
+        }
+        if (!accepted)
+            break;
+    }
+    *light = v3(x[0], x[1], x[2]);
+    *k_out = x[3];
     return sqrt(cost / n);
 }
 
@@ -830,7 +845,7 @@ static int solve_lights(struct solve *s)
                     q->p[0] = (float)p.x, q->p[1] = (float)p.y, q->p[2] = (float)p.z;
                     q->n[0] = (float)nn.x, q->n[1] = (float)nn.y, q->n[2] = (float)nn.z;
                 }
-                q->signal[li] = saturated ? -1.0f : (float)sig;
+                q->signal[li] = saturated ? -1.0f : (float)fmax(sig, -0.99);
             }
         }
         if (rc != 0)
@@ -840,21 +855,22 @@ static int solve_lights(struct solve *s)
         say(s, "refused: the sphere was seen in too few captures (%zu samples)\n", n);
         rc = -EINVAL;
     }
-    /* Per light: samples saturated, or in its shadow and so at the noise (signal <= 4 grey
-     * levels), say nothing about it. */
+    /* Per light: every sample that is not saturated, those in its shadow too (the model says 0
+     * there; leaving out the samples at the noise would keep only the terminator's positive
+     * noise and pull the light outwards). */
     struct shade_sample *use = rc == 0 ? calloc(n, sizeof(*use)) : NULL;
     if (rc == 0 && use == NULL)
         rc = -ENOMEM;
     for (uint32_t li = 0; li < lights && rc == 0; li++) {
         size_t m = 0;
         for (size_t i = 0; i < n; i++)
-            if (smp[i].signal[li] > 4.0f) {
+            if (smp[i].signal[li] > -1.0f) {
                 use[m] = smp[i];
                 use[m].signal[0] = smp[i].signal[li];
                 m++;
             }
         vec3 l = v3_from(s->out.light_pos_mm[li]);
-        double k, res = m > 100 ? fit_light(use, m, 0, &l, &k) : -1.0;
+        double k = 0.0, res = m > 100 ? fit_light(use, m, 0, &l, &k) : -1.0;
         if (res < 0.0) {
             say(s, "refused: light %u lights too little of the sphere (%zu samples)\n",
                 (unsigned)li, m);

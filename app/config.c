@@ -229,7 +229,7 @@ static const struct ini_key config_keys[] = {
         "distance at which the intensities above hold (inverse-square falloff)"),
     U32("sim", "reference_exposure_us", sim.reference_exposure_us, 1, 10000000, "10000",
         "exposure at which the intensities above hold"),
-    ENUM("calibrate", "board", calibrate.board, "chessboard|charuco", "charuco",
+    ENUM("calibrate", "board", calibrate.board, "chessboard|charuco", "chessboard",
          "the printed board: a plain chessboard (seen whole) or ChArUco (seen in part)"),
     U32("calibrate", "squares_x", calibrate.squares_x, 3, 33, "9", "squares across the board"),
     U32("calibrate", "squares_y", calibrate.squares_y, 3, 33, "7", "squares down the board"),
