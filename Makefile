@@ -110,7 +110,7 @@ FW_OBJ := $(call obj,$(FW_SRC))
 HOST_OBJ := $(call obj,$(POSIX_SRC) $(APP_LIB_SRC) $(BOARD_SRC)) $(if $(filter linux,$(HAL)),$(LIBCAMERA_OBJ),)
 MAIN_OBJ := $(call obj,app/main.c)
 
-.PHONY: seccomp-tool all deps test-deps test test-run linux-build small-build install check-stack size fuzz errors-doc test-arm64 test-arm64-full test-gpio-chip arm64-check-elf arm64-run-tests run clean format docs check-firmware bench measure measure-scan interop-meshlab bench-callgrind eval
+.PHONY: seccomp-tool all deps test-deps test test-run linux-build small-build install check-stack size fuzz errors-doc test-arm64 test-arm64-full test-gpio-chip arm64-check-elf arm64-run-tests run clean format docs check-firmware bench measure measure-scan interop-meshlab bench-callgrind eval calibrate-demo measure-calib
 SIM_TOOLS := $(if $(filter sim,$(HAL)),$(BUILD)/turntable-sim $(BUILD)/tt-client $(BUILD)/mesh-compare $(BUILD)/colour-eval,)
 all: deps $(BUILD)/scanner $(CALIB_TOOL) $(SIM_TOOLS)
 
@@ -261,16 +261,16 @@ size: deps $(BUILD)/scanner $(BUILD)/libfirmware.a
 	@bench/static_memory.sh $(BUILD)/libfirmware.a
 
 # Test-only packages: Open3D reads our PLY (tests/cli.sh); pymodbus and socat are the Modbus
-# peers of tests/interop.sh.
+# peers of tests/interop.sh; OpenCV builds scanner-calibrate (tests/calibrate.sh).
 test-deps: deps
-	@{ /usr/bin/python3 -c 'import open3d, pymodbus, serial_asyncio' && command -v socat systemd-analyze && pkg-config --exists libcamera; } \
+	@{ /usr/bin/python3 -c 'import open3d, pymodbus, serial_asyncio' && command -v socat systemd-analyze && pkg-config --exists libcamera opencv4; } \
 		>/dev/null 2>&1 || scripts/install-deps.sh test
 
 # A second make, so that what test-deps installed (libcamera-dev) is seen when it starts.
 test: deps test-deps
 	@$(MAKE) --no-print-directory test-run
-test-run: $(BUILD)/scanner $(SIM_TOOLS) $(BUILD)/seccomp-run $(TEST_BIN) $(FUZZ_REPLAY) check-firmware $(if $(filter 0,$(SAN)),check-stack,) linux-build small-build
-	@RUN_WITH="$(VALGRIND_RUN)" BUILD=$(BUILD) tests/run.sh $(TEST_BIN) tests/layers.sh tests/cli.sh tests/interop.sh tests/fuzz/replay.sh tests/resume.sh
+test-run: $(BUILD)/scanner $(CALIB_TOOL) $(SIM_TOOLS) $(BUILD)/seccomp-run $(TEST_BIN) $(FUZZ_REPLAY) check-firmware $(if $(filter 0,$(SAN)),check-stack,) linux-build small-build
+	@RUN_WITH="$(VALGRIND_RUN)" BUILD=$(BUILD) tests/run.sh $(TEST_BIN) tests/layers.sh tests/cli.sh tests/calibrate.sh tests/interop.sh tests/fuzz/replay.sh tests/resume.sh
 
 # make test VALGRIND=1: every cmocka test under valgrind memcheck; any invalid access,
 # uninitialised use or definite leak fails the test (exit code 99).
@@ -394,6 +394,15 @@ interop-meshlab: deps $(BUILD)/scanner
 # The calibration's accuracy (tests/measure_calib.c): a calibration against the true rig.
 $(BUILD)/measure-calib: $(call obj,tests/measure_calib.c app/config.c app/ini_schema.c) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON)
+
+# Calibration of the simulated demo rig from scratch (scans/calib-demo/), and how close it is:
+# make calibrate-demo prints the table parameter | true | nominal | recovered | error and scans
+# the bunny with the result; make measure-calib also scans with the true and the nominal file.
+# A few minutes each (docs/calibration.md).
+calibrate-demo: deps $(BUILD)/scanner $(BUILD)/scanner-calibrate $(BUILD)/mesh-compare $(BUILD)/measure-calib
+	scripts/measure-calib.sh $(BUILD)
+measure-calib: deps $(BUILD)/scanner $(BUILD)/scanner-calibrate $(BUILD)/mesh-compare $(BUILD)/measure-calib
+	scripts/measure-calib.sh $(BUILD) measure
 
 # Time per view, split between the simulated capture and the firmware's processing.
 $(BUILD)/bench_view: $(BUILD)/bench/bench_view.o $(BUILD)/tests/test_util.o $(HOST_OBJ) $(BUILD)/libfirmware.a

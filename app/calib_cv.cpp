@@ -96,7 +96,8 @@ extern "C" int calcv_board_image(const calcv_board *b, double px_per_mm, uint8_t
     if (!board_ok(b) || px_per_mm <= 0.0)
         return -EINVAL;
     const int sq = (int)std::lround(b->square_mm * px_per_mm);
-    const int margin = (int)std::lround(b->margin_mm * px_per_mm);
+    // the margin at the squares' own scale, so that the whole sheet has one resolution
+    const int margin = (int)std::lround(b->margin_mm * sq / b->square_mm);
     const int w = b->squares_x * sq + 2 * margin, h = b->squares_y * sq + 2 * margin;
     cv::Mat img(h, w, CV_8UC1, cv::Scalar(255));
     if (b->kind == CALCV_CHARUCO) {

@@ -104,12 +104,11 @@ int calib_write_guess(const struct hal_storage *st, const char *dir, const struc
     return rc;
 }
 
-int calib_write_svg(const struct hal_storage *st, const char *base, const struct calcv_board *b,
-                    const char *png_path)
+int calib_write_svg(const struct hal_storage *st, const char *base, const char *png_path,
+                    int width, int height, double px_per_mm)
 {
     char path[HAL_MAX_PATH + 8], buf[1024];
-    double w, h;
-    calcv_board_size_mm(b, &w, &h);
+    double w = width / px_per_mm, h = height / px_per_mm;
     const char *name = strrchr(png_path, '/');
     name = name != NULL ? name + 1 : png_path;
     int n = snprintf(buf, sizeof(buf),

@@ -41,9 +41,10 @@ int calib_write_file(const struct hal_storage *st, const char *dir, const char *
 /** The calibration the captures were taken with (its sizes), as dir/calibration.ini. */
 int calib_write_guess(const struct hal_storage *st, const char *dir, const struct scan_calib *g);
 
-/** An SVG of the board at true size that shows @p png_path. @retval 0 @retval -errno */
-int calib_write_svg(const struct hal_storage *st, const char *base, const struct calcv_board *b,
-                    const char *png_path);
+/** An SVG at true size showing the @p width x @p height picture @p png_path of the board, drawn
+ *  at @p px_per_mm. @retval 0 @retval -errno */
+int calib_write_svg(const struct hal_storage *st, const char *base, const char *png_path,
+                    int width, int height, double px_per_mm);
 
 /** A sphere through the valid points of a range image: Gauss-Newton on sum (|p - c| - r)^2 from
  *  the visible cap's centroid pushed back by r. @param fit_radius  0: @p radius is known

@@ -327,6 +327,32 @@ static void calib_to_lens(const struct scan_calib *c, int projector, struct calc
 static int solve_camera(struct solve *s)
 {
     const struct calib_settings *cs = &s->cfg->calibrate;
+    /* Zhang's method needs the board in several orientations: judged first from poses through
+     * the starting lens (rough, but orientations differ by far more than its error). */
+    struct calcv_lens start;
+    calib_to_lens(&s->start, 0, &start);
+    int found = 0;
+    for (uint32_t i = 0; i < s->view_count; i++)
+        found += s->views[i].found;
+    if (found < 3) {
+        say(s, "refused: too few views: the board was found in %d image%s; at least 3 in "
+            "different orientations are needed (10 or more give a good calibration)\n", found,
+            found == 1 ? "" : "s");
+        return -EINVAL;
+    }
+    for (uint32_t i = 0; i < s->view_count; i++) {
+        struct board_view *bv = &s->views[i];
+        double rms;
+        if (bv->found && calcv_pose(&bv->cam, &start, bv->rvec, bv->tvec, &rms) != 0)
+            bv->found = 0;
+    }
+    double spread = orientation_spread_deg(s);
+    if (spread < 5.0) {
+        say(s, "refused: degenerate placements: every board faces the same way (the normals "
+            "differ by %.1f deg at most); turn the table or tilt the board between captures\n",
+            spread);
+        return -EINVAL;
+    }
     static struct calcv_corners sel[CALIB_MAX_VIEWS];
     static double rv[CALIB_MAX_VIEWS * 3], tv[CALIB_MAX_VIEWS * 3], vr[CALIB_MAX_VIEWS];
     uint32_t idx[CALIB_MAX_VIEWS];
@@ -375,13 +401,6 @@ static int solve_camera(struct solve *s)
         }
         if (dropped == 0)
             break;
-    }
-    double spread = orientation_spread_deg(s);
-    if (spread < 5.0) {
-        say(s, "refused: degenerate placements: every board faces the same way (the normals "
-            "differ by %.1f deg at most); turn the table or tilt the board between captures\n",
-            spread);
-        return -EINVAL;
     }
     lens_to_calib(&lens, 0, &s->out);
     say(s, "camera: reprojection RMS %.4f px over the boards found; orientations spread over "
@@ -956,9 +975,16 @@ int calibrate_solve(const struct hal_storage *st, const struct app_config *cfg, 
     char path[SCAN_DIR_PATH_MAX], err[512];
     scan_dir_path(path, sizeof(path), dir, -1, "calibration.ini");
     int rc = calib_load(&s.start, path, cfg->light_count, err, sizeof(err));
-    if (rc == -ENOENT) {
-        calibrate_guess(cfg, &s.start); /* captures made elsewhere */
-        rc = 0;
+    if (rc == -ENOENT) { /* captures made elsewhere: the config's calibration, or a guess */
+        rc = calib_load(&s.start, cfg->calibration_file, cfg->light_count, err, sizeof(err));
+        if (rc == -ENOENT)
+            calibrate_guess(cfg, &s.start);
+        if (rc == -ENOENT || rc == 0)
+            rc = 0;
+        else
+            fprintf(stderr, "scanner: error: %s\n", err);
+        if (rc != 0)
+            return rc;
     } else if (rc != 0) {
         fprintf(stderr, "scanner: error: %s\n", err);
         return rc;

@@ -331,23 +331,22 @@ int calibrate_print_board(const struct hal_storage *st, const struct app_config 
     char path[HAL_MAX_PATH + 8];
     snprintf(path, sizeof(path), "%s.png", base);
     rc = image_write_png(st, path, grey, (uint32_t)w, (uint32_t)h, 1);
-    if (rc == 0) {
-        /* SVG at true size: one rectangle per black run of each pixel row at 300 dpi would be
-         * large; the picture is embedded instead, scaled to the board's size in mm. */
-        rc = calib_write_svg(st, base, &b, path);
-    }
+    /* whole pixels per square: the picture's true scale is its squares' */
+    const double px_per_mm = lround(b.square_mm * dpi / 25.4) / b.square_mm;
+    if (rc == 0) /* the SVG shows the picture at that scale: true size on any printer */
+        rc = calib_write_svg(st, base, path, w, h, px_per_mm);
     free(grey);
     if (rc != 0) {
         fprintf(stderr, "scanner: error: cannot write %s: %s\n", path, strerror(-rc));
         return rc;
     }
-    double wmm, hmm;
-    calcv_board_size_mm(&b, &wmm, &hmm);
-    printf("%s.png (300 dpi) and %s.svg: a %s board of %ux%u squares of %.1f mm, %.0f x %.0f mm. "
-           "Print at 100%% (no fit-to-page), measure a square, and glue it flat on a rigid plate "
+    const double wmm = w / px_per_mm, hmm = h / px_per_mm;
+    printf("%s.svg (true size, %.0f x %.0f mm) and %s.png (%dx%d, true size at %.2f dpi): a %s "
+           "of %ux%u squares of %.1f mm. Print at 100%% (no fit-to-page), measure a square (and "
+           "put what you measure in [calibrate] square_mm), and glue it flat on a rigid plate "
            "with the sheet's bottom edge on the plate's.\n",
-           base, base, cfg->calibrate.board, (unsigned)b.squares_x, (unsigned)b.squares_y,
-           b.square_mm, wmm, hmm);
+           base, wmm, hmm, base, w, h, px_per_mm * 25.4, cfg->calibrate.board,
+           (unsigned)b.squares_x, (unsigned)b.squares_y, b.square_mm);
     return 0;
 }
 

@@ -2,7 +2,8 @@
 # Installs the Debian 12 packages the scanner builds and tests with (called by make when
 # pkg-config cannot find one of them). Needs root, as on the CI machine and a fresh rig.
 # With the argument "test" it adds what only the tests use (Open3D reads our PLY files; the
-# libcamera backend is compiled and tested without a camera), with
+# libcamera backend is compiled and tested without a camera; OpenCV builds the calibration
+# program), with
 # "bench" what only the benchmarks use (OpenCV to compare with, valgrind), with "gpio-chip" the
 # virtual machine of tests/gpio_chip.sh, with a target triplet
 # (aarch64-linux-gnu) what cross-building for it needs.
@@ -11,7 +12,7 @@ pkgs="build-essential pkg-config libinih-dev libpng-dev libcmocka-dev libmodbus-
 [ "${1:-}" = "bench" ] && pkgs="$pkgs g++ libopencv-dev libopencv-contrib-dev valgrind"
 [ "${1:-}" = "fuzz" ] && pkgs="$pkgs clang libclang-rt-14-dev"
 [ "${1:-}" = "gpio-chip" ] && pkgs="qemu-system-arm cpio systemd"
-[ "${1:-}" = "test" ] && pkgs="$pkgs python3 python3-numpy python3-open3d python3-pymodbus python3-serial python3-serial-asyncio socat g++ libcamera-dev systemd valgrind"
+[ "${1:-}" = "test" ] && pkgs="$pkgs python3 python3-numpy python3-open3d python3-pymodbus python3-serial python3-serial-asyncio socat g++ libcamera-dev libopencv-contrib-dev systemd valgrind"
 # A cross build's target (make CROSS_COMPILE=aarch64-linux-gnu-): its compiler, its -dev
 # packages through Debian's multiarch, and qemu-user to run its tests.
 case "${1:-}" in

@@ -1,0 +1,167 @@
+#!/bin/sh
+# scanner calibrate as a person meets it, on the simulated demo rig (config/demo-rig.ini, which
+# the scanner is not told): the whole procedure, a kill during it and --from after, the refusals
+# (too few views, every board facing one way, a residual above the limit, a board not found),
+# the camera alone from white frames, the board to print, and the verification scan.
+# Prints cmocka-style PASSED/FAILED lines for tests/run.sh.
+set -u
+cd "$(dirname "$0")/.."
+bin=${BUILD:-build}/scanner
+out=${BUILD:-build}/calibrate-test
+cfg=tests/calibrate.ini
+pass=0
+fail=0
+check() { # name, then a command that must succeed
+    name=$1
+    shift
+    if "$@" >"$out.log" 2>&1; then
+        echo "[       OK ] $name"
+        pass=$((pass + 1))
+    else
+        echo "[  FAILED  ] $name"
+        sed 's/^/    /' "$out.log"
+        fail=$((fail + 1))
+    fi
+}
+if [ ! -x "${BUILD:-build}/scanner-calibrate" ]; then
+    echo "[  FAILED  ] calibrate: ${BUILD:-build}/scanner-calibrate was not built (OpenCV 4 missing:"
+    echo "             scripts/install-deps.sh test installs libopencv-contrib-dev)"
+    exit 1
+fi
+rm -rf "$out"
+mkdir -p "$out"
+# a value of the calibration file $1: section $2, key $3, field $4 (1-based)
+value() {
+    awk -v s="[$2]" -v k="$3" -v f="$4" '$0 == s { in_s = 1; next } /^\[/ { in_s = 0 }
+        in_s && $1 == k { sub(/^[^=]*= */, ""); split($0, v, /, */); print v[f]; exit }' "$1"
+}
+# |a - b| <= tol
+near() { awk -v a="$1" -v b="$2" -v t="$3" 'BEGIN { d = a - b; if (d < 0) d = -d; exit !(d <= t) }'; }
+
+# The whole procedure: every capture kept, the board found in each, a calibration written that
+# the scanner accepts, close to the true rig (fx 2436 px, baseline to the projector, light 0).
+full_test() {
+    "$bin" calibrate --config $cfg --out "$out/cal.ini" >"$out/full.txt" 2>&1 || { cat "$out/full.txt"; return 1; }
+    cat "$out/full.txt"
+    test "$(grep -c 'board found, [0-9]* corners' "$out/full.txt")" -eq 6 &&
+        test -f "$out/cal-captures/view_007/view.ini" && test -f "$out/cal-captures/view_007/target.ini" &&
+        test -f "$out/cal.report.txt" && grep -q '^camera: reprojection RMS' "$out/cal.report.txt" &&
+        near "$(value "$out/cal.ini" camera fx_px 1)" 2436 12 &&
+        near "$(value "$out/cal.ini" projector translation_mm 1)" -250.59 2 &&
+        near "$(value "$out/cal.ini" lights light_0_mm 1)" -414.86 15 &&
+        sed "s|^calibration = .*|calibration = $PWD/$out/cal.ini|; s|^rig = ../|rig = $PWD/|" $cfg >"$out/calibrated.ini" &&
+        "$bin" check-config --config "$out/calibrated.ini"
+}
+check calibrate_whole_procedure full_test
+# Killed after three captures: the finished ones are kept, nothing is written; --from finishes.
+kill_test() {
+    "$bin" calibrate --config $cfg --out "$out/killed.ini" >"$out/killed.txt" 2>&1 &
+    pid=$!
+    n=0
+    while [ ! -f "$out/killed-captures/view_002/view.ini" ] && [ $n -lt 2400 ]; do
+        sleep 0.05
+        n=$((n + 1))
+    done
+    kill -TERM "$pid"
+    wait "$pid"
+    rc=$?
+    cat "$out/killed.txt"
+    [ "$rc" -eq 1 ] && ! test -e "$out/killed.ini" &&
+        grep -q 'calibration captures stopped (stopped by request).*--from' "$out/killed.txt" &&
+        grep -q 'safe state: lights and projector off' "$out/killed.txt" &&
+        "$bin" calibrate --config $cfg --from "$out/killed-captures" --out "$out/killed.ini" &&
+        test -f "$out/killed.ini"
+}
+check calibrate_kill_keeps_captures_and_from_finishes kill_test
+# A copy of some captures of the whole procedure, each its own placement (only their white
+# frames with $3 = white).
+copy_views() { # dest, "views", [white]
+    rm -rf "$1" && mkdir -p "$1"
+    i=0
+    for v in $2; do
+        d=$(printf '%s/view_%03d' "$1" $i)
+        mkdir -p "$d"
+        if [ "${3:-}" = white ]; then
+            cp "$out/cal-captures/view_00$v/frame_00.png" "$d/"
+        else
+            cp "$out/cal-captures/view_00$v/"* "$d/" && cp "$out/cal-captures/calibration.ini" "$1/"
+            sed -i "s/^placement = .*/placement = $i/" "$d/target.ini"
+        fi
+        i=$((i + 1))
+    done
+}
+too_few_test() {
+    copy_views "$out/few" "0 1"
+    ! "$bin" calibrate --config $cfg --from "$out/few" --out "$out/few.ini" >"$out/few.txt" 2>&1
+    rc=$?
+    cat "$out/few.txt"
+    [ $rc -eq 0 ] && grep -q 'refused: too few views: the board was found in 2 images' "$out/few.txt" &&
+        grep -q "calibration refused (see above); $out/few.ini is unchanged" "$out/few.txt" &&
+        ! test -e "$out/few.ini"
+}
+check too_few_views_refused too_few_test
+# Three captures of one board at one angle: Zhang's method cannot tell the focal length.
+degenerate_test() {
+    copy_views "$out/same" "0 0 0 0"
+    ! "$bin" calibrate --config $cfg --from "$out/same" --out "$out/same.ini" >"$out/same.txt" 2>&1
+    rc=$?
+    cat "$out/same.txt"
+    [ $rc -eq 0 ] && grep -q 'refused: degenerate placements: every board faces the same way' \
+        "$out/same.txt" && ! test -e "$out/same.ini"
+}
+check degenerate_placements_refused degenerate_test
+# A residual above [calibrate] max_camera_rms_px: refused, the file there kept as it was.
+residual_test() {
+    sed 's/^\[calibrate\]/[calibrate]\nmax_camera_rms_px = 0.01/' $cfg >"$out/strict.ini"
+    sed -i "s|= \.\./|= $PWD/|" "$out/strict.ini"
+    echo '; the old calibration' >"$out/strict-cal.ini"
+    ! "$bin" calibrate --config "$out/strict.ini" --from "$out/cal-captures" --out "$out/strict-cal.ini" \
+        >"$out/strict.txt" 2>&1
+    rc=$?
+    cat "$out/strict.txt"
+    [ $rc -eq 0 ] && grep -q "is above \[calibrate\] max_camera_rms_px = 0.010" "$out/strict.txt" &&
+        test "$(cat "$out/strict-cal.ini")" = '; the old calibration' &&
+        test "$(ls "$out" | grep -c '^strict-cal.ini')" -eq 1
+}
+check residual_too_large_refused residual_test
+# A capture where the board is not in view (the sphere's): rejected with why, the rest used.
+not_found_test() {
+    copy_views "$out/missing" "0 1 2 3 6"
+    cp "$out/cal-captures/view_006/frame_00.png" "$out/missing/view_004/frame_00.png"
+    sed -i 's/^target = .*/target = board/' "$out/missing/view_004/target.ini"
+    "$bin" calibrate --config $cfg --from "$out/missing" --out "$out/missing.ini" >"$out/missing.txt" 2>&1
+    rc=$?
+    cat "$out/missing.txt"
+    [ $rc -eq 0 ] && grep -q '^view_004: rejected: board not found: ' "$out/missing.txt" &&
+        test -f "$out/missing.ini"
+}
+check board_not_found_said_and_skipped not_found_test
+# Only a white frame per board pose (a printed board and any camera): the camera alone, the
+# rest as the config's calibration file has it; and a file already there is kept beside it.
+camera_only_test() {
+    copy_views "$out/white" "0 1 2 3 4 5" white
+    cp config/sim-calib.ini "$out/white.ini"
+    "$bin" calibrate --config $cfg --from "$out/white" --out "$out/white.ini" >"$out/white.txt" 2>&1
+    rc=$?
+    cat "$out/white.txt"
+    kept=$(ls "$out" | grep '^white.ini.20' | head -n 1)
+    [ $rc -eq 0 ] && grep -q 'the camera alone is calibrated' "$out/white.txt" &&
+        near "$(value "$out/white.ini" camera fx_px 1)" 2436 12 &&
+        test "$(value "$out/white.ini" projector fx_px 1)" = 1900 &&
+        test -n "$kept" && cmp -s config/sim-calib.ini "$out/$kept" &&
+        grep -q "the previous file is kept as $out/$kept" "$out/white.txt"
+}
+check camera_alone_from_white_frames camera_only_test
+# The board to print: PNG near 300 dpi with whole pixels per square (236 for 20 mm: 2360 x
+# 1888), SVG at true size.
+check board_to_print sh -c "$bin calibrate board --config $cfg --out $out/board &&
+    test \"\$(od -An -tu1 -j16 -N8 $out/board.png | awk '{ print \$3 * 256 + \$4, \$7 * 256 + \$8 }')\" = '2360 1888' &&
+    grep -q 'width=\"200.000mm\" height=\"160.000mm\"' $out/board.svg"
+# The verification scan with the calibration found: the sphere's diameter within 0.3 mm.
+check verify_sphere sh -c "$bin calibrate verify --config $out/calibrated.ini > $out/verify.txt &&
+    cat $out/verify.txt && awk '/^diameter:/ { e = \$9 + 0; if (e < 0) e = -e; ok = e <= 0.3 }
+    END { exit !ok }' $out/verify.txt && grep -q '^sphere fit RMS' $out/verify.txt &&
+    grep -q '^reprojection RMS (from the calibration): camera' $out/verify.txt"
+echo "[  PASSED  ] $pass test(s)."
+[ "$fail" -eq 0 ] || echo "[  FAILED  ] $fail test(s)"
+[ "$fail" -eq 0 ]
