@@ -17,7 +17,7 @@ mkdir -p "$out"
 scan_with() {
     sed -e "s|^calibration = .*|calibration = $1|" -e "s|^rig = .*|rig = $top/config/demo-rig.ini|" \
         -e "s|^mesh_file = ../|mesh_file = $top/|" config/calib-demo.ini > "$2.ini"
-    "$build/scanner" scan --config "$2.ini" --out "$2" --replace | tail -n 1
+    "$build/scanner" scan --config "$2.ini" --out "$2" --replace > "$2.log" && tail -n 1 "$2.log" >&2
     "$build/mesh-compare" "$2/mesh.ply" "$2/truth_mesh.ply" > "$2.compare"
     sed -n 's/^result -> truth: mean \([0-9.]*\) mm.*/\1/p' "$2.compare"
 }

@@ -70,10 +70,22 @@ int main(int argc, char **argv)
         fprintf(stderr, "measure-calib: %s\n", err);
         return 1;
     }
+    /* the residuals scanner calibrate recorded in the file's quality comment */
+    double cam_rms = -1.0, proj_rms = -1.0;
+    char line[256];
+    FILE *f = fopen(argv[3], "r");
+    while (f != NULL && fgets(line, sizeof(line), f) != NULL)
+        if (sscanf(line, "; quality: camera_rms_px = %lf, projector_rms_px = %lf", &cam_rms,
+                   &proj_rms) == 2)
+            break;
+    if (f != NULL)
+        fclose(f);
     printf("| %-34s | %12s | %12s | %12s | %14s |\n", "parameter", "true", "nominal", "recovered",
            "error");
     printf("|%s|%s|%s|%s|%s|\n", "------------------------------------",
            "--------------", "--------------", "--------------", "----------------");
+    row("camera reprojection RMS (px)", "px", 0.0, 0.0, cam_rms, cam_rms);
+    row("projector reprojection RMS (px)", "px", 0.0, 0.0, proj_rms, proj_rms);
     row("camera fx (px)", "%", t.cam_fx_px, n.cam_fx_px, r.cam_fx_px,
         100.0 * (r.cam_fx_px - t.cam_fx_px) / t.cam_fx_px);
     row("camera fy (px)", "%", t.cam_fy_px, n.cam_fy_px, r.cam_fy_px,
