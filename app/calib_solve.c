@@ -877,6 +877,7 @@ static int solve_lights(struct solve *s)
     /* Per light: every sample that is not saturated, those in its shadow too (the model says 0
      * there; leaving out the samples at the noise would keep only the terminator's positive
      * noise and pull the light outwards). */
+    double intensity[HAL_MAX_LIGHTS], mean = 0.0;
     struct shade_sample *use = rc == 0 ? calloc(n, sizeof(*use)) : NULL;
     if (rc == 0 && use == NULL)
         rc = -ENOMEM;
@@ -899,9 +900,16 @@ static int solve_lights(struct solve *s)
         s->out.light_pos_mm[li][0] = l.x;
         s->out.light_pos_mm[li][1] = l.y;
         s->out.light_pos_mm[li][2] = l.z;
+        intensity[li] = k;
+        mean += k / lights;
         say(s, "light %u: (%.2f, %.2f, %.2f) mm from %zu samples, shading RMS %.2f grey levels, "
             "intensity %.4g (grey levels at 1 m, head-on)\n", (unsigned)li, l.x, l.y, l.z, m,
             res, k * 1e-6);
+    }
+    for (uint32_t li = 0; li < lights && rc == 0; li++) {
+        s->out.light_gain[li] = intensity[li] / mean;
+        say(s, "light %u: gain %.4f (its intensity over the lights' mean)\n", (unsigned)li,
+            s->out.light_gain[li]);
     }
     free(use);
     free(smp);

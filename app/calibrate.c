@@ -45,6 +45,7 @@ void calibrate_guess(const struct app_config *cfg, struct scan_calib *g)
         g->light_pos_mm[i][0] = 100.0 * i - 150.0;
         g->light_pos_mm[i][1] = -200.0;
         g->light_pos_mm[i][2] = 300.0;
+        g->light_gain[i] = 1.0;
     }
 }
 

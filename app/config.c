@@ -286,7 +286,9 @@ static const struct ini_key config_keys[] = {
     }
 #define LIGHT(i)                                                                                   \
     CV("lights", "light_" #i "_mm", light_pos_mm[i], 3, -1e5, 1e5, "0, 0, 0",                      \
-       "position of light " #i " (camera frame)")
+       "position of light " #i " (camera frame)"),                                                 \
+    {"lights", "light_" #i "_gain", INI_F64, K(light_gain[i]), 0, 0.01, 100, 0, "1", NULL,          \
+     "intensity of light " #i " relative to the lights' mean (scanner calibrate measures it)"}
 
 static const struct ini_key calib_keys[] = {
     CF("camera", "fx_px", cam_fx_px, 1, 1e6, "focal length x"),
@@ -557,6 +559,7 @@ int calib_save(const struct hal_storage *st, const char *path, const struct scan
         char key[32];
         snprintf(key, sizeof(key), "light_%u_mm", (unsigned)i);
         VEC(key, c->light_pos_mm[i], 3);
+        PUT("light_%u_gain = %.6f\n", (unsigned)i, c->light_gain[i]);
     }
 #undef PUT
 #undef VEC

@@ -163,8 +163,10 @@ static double pixel_estimate(const struct frame_ctx *f, const struct scan_calib 
             (light[0] + light[1] + light[2]) / 3.0 <= prm->shadow_dn)
             continue;
         double w = specular_weight(prm, p, nn, v3_from(c->light_pos_mm[l]));
+        /* a brighter light gives more signal for the same albedo: its gain takes that out */
+        double gain = c->light_gain[l] > 0.0 ? c->light_gain[l] : 1.0;
         for (int k = 0; k < 3; k++)
-            num[k] += light[k] * fall * w;
+            num[k] += light[k] * fall * w / gain;
         den += ct * w;
     }
     *confidence = den;

@@ -20,6 +20,8 @@ struct scan_calib {
     double axis_dir[3];      /**< unit direction of the axis, pointing up */
     uint32_t light_count;    /**< number of white lights */
     double light_pos_mm[HAL_MAX_LIGHTS][3]; /**< light positions */
+    double light_gain[HAL_MAX_LIGHTS]; /**< each light's intensity relative to their mean (1:
+                                            equal lights); the multi method divides by it */
 };
 
 enum colour_method { COLOUR_NONE = 0, COLOUR_SINGLE, COLOUR_UNIFORM, COLOUR_MULTI };

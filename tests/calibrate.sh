@@ -9,20 +9,7 @@ cd "$(dirname "$0")/.."
 bin=${BUILD:-build}/scanner
 out=${BUILD:-build}/calibrate-test
 cfg=tests/calibrate.ini
-pass=0
-fail=0
-check() { # name, then a command that must succeed
-    name=$1
-    shift
-    if "$@" >"$out.log" 2>&1; then
-        echo "[       OK ] $name"
-        pass=$((pass + 1))
-    else
-        echo "[  FAILED  ] $name"
-        sed 's/^/    /' "$out.log"
-        fail=$((fail + 1))
-    fi
-}
+. tests/check.sh
 if [ ! -x "${BUILD:-build}/scanner-calibrate" ]; then
     echo "[  FAILED  ] calibrate: ${BUILD:-build}/scanner-calibrate was not built (OpenCV 4 missing:"
     echo "             scripts/install-deps.sh test installs libopencv-contrib-dev)"
@@ -162,6 +149,4 @@ check verify_sphere sh -c "$bin calibrate verify --config $out/calibrated.ini > 
     cat $out/verify.txt && awk '/^diameter:/ { e = \$9 + 0; if (e < 0) e = -e; ok = e <= 0.3 }
     END { exit !ok }' $out/verify.txt && grep -q '^sphere fit RMS' $out/verify.txt &&
     grep -q '^reprojection RMS (from the calibration): camera' $out/verify.txt"
-echo "[  PASSED  ] $pass test(s)."
-[ "$fail" -eq 0 ] || echo "[  FAILED  ] $fail test(s)"
-[ "$fail" -eq 0 ]
+check_summary

@@ -5,20 +5,7 @@ set -u
 cd "$(dirname "$0")/.."
 bin=${BUILD:-build}/scanner
 out=${BUILD:-build}/cli
-pass=0
-fail=0
-check() { # name, then a command that must succeed
-    name=$1
-    shift
-    if "$@" >"$out.log" 2>&1; then
-        echo "[       OK ] $name"
-        pass=$((pass + 1))
-    else
-        echo "[  FAILED  ] $name"
-        sed 's/^/    /' "$out.log"
-        fail=$((fail + 1))
-    fi
-}
+. tests/check.sh
 mkdir -p "$out"
 check version sh -c "$bin --version | grep -q 'HAL=sim'"
 check check_config sh -c "$bin check-config --config config/sim.ini | grep -q ': ok'"
@@ -232,6 +219,4 @@ else
     echo "[  FAILED  ] open3d_reads_ply: python3-open3d missing (scripts/install-deps.sh test)"
     fail=$((fail + 1))
 fi
-echo "[  PASSED  ] $pass test(s)."
-[ "$fail" -eq 0 ] || echo "[  FAILED  ] $fail test(s)"
-[ "$fail" -eq 0 ]
+check_summary

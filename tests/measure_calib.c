@@ -131,6 +131,9 @@ int main(int argc, char **argv)
         char name[40];
         snprintf(name, sizeof(name), "light %u (mm)", (unsigned)i);
         row3(name, t.light_pos_mm[i], n.light_pos_mm[i], r.light_pos_mm[i], "mm");
+        snprintf(name, sizeof(name), "light %u gain (relative intensity)", (unsigned)i);
+        row(name, "", t.light_gain[i], n.light_gain[i], r.light_gain[i],
+            r.light_gain[i] - t.light_gain[i]);
     }
     return 0;
 }

@@ -1,0 +1,23 @@
+# Sourced by the shell tests (tests/cli.sh, tests/calibrate.sh): check NAME COMMAND... runs a
+# command that must succeed and prints a cmocka-style line for tests/run.sh, with the command's
+# output indented when it fails; check_summary prints the totals and is the script's status.
+# Needs $out (the test's output directory).
+pass=0
+fail=0
+check() { # name, then a command that must succeed
+    name=$1
+    shift
+    if "$@" >"$out.log" 2>&1; then
+        echo "[       OK ] $name"
+        pass=$((pass + 1))
+    else
+        echo "[  FAILED  ] $name"
+        sed 's/^/    /' "$out.log"
+        fail=$((fail + 1))
+    fi
+}
+check_summary() {
+    echo "[  PASSED  ] $pass test(s)."
+    [ "$fail" -eq 0 ] || echo "[  FAILED  ] $fail test(s)"
+    [ "$fail" -eq 0 ]
+}
