@@ -1001,8 +1001,8 @@ int calibrate_solve(const struct hal_storage *st, const struct app_config *cfg, 
     calib_capture_params(cfg, &s.params);
     s.params.colour.method = COLOUR_NONE; /* the light frames are read here, not compensated */
     if (calib_board_from_settings(&cfg->calibrate, &s.board) != 0) {
-        fprintf(stderr, "scanner: error: %s: [calibrate] marker_mm must be below square_mm\n",
-                cfg->path);
+        fprintf(stderr, "scanner: error: %s: [calibrate]: marker_mm must be below square_mm, and "
+                "a chessboard's squares_x and squares_y must differ\n", cfg->path);
         return -EINVAL;
     }
     s.views = calloc(CALIB_MAX_VIEWS, sizeof(*s.views));

@@ -68,6 +68,9 @@ int calib_board_from_settings(const struct calib_settings *s, struct calcv_board
             b->dictionary = dicts[i].id;
     if (b->kind == CALCV_CHARUCO && b->marker_mm >= b->square_mm)
         return -EINVAL;
+    /* a square chessboard reads the same turned by 90 degrees: views would disagree */
+    if (b->kind == CALCV_CHESSBOARD && b->squares_x == b->squares_y)
+        return -EINVAL;
     return 0;
 }
 
@@ -279,7 +282,8 @@ int calibrate_capture(struct hal *hal, const struct app_config *cfg,
         rc = calcv_board_image(&c.board, CALIB_SHEET_PX_PER_MM, &c.sheet, &c.sheet_w, &c.sheet_h);
     if (rc != 0) {
         hal->log(HAL_LOG_ERROR, "%s: [calibrate]: the board cannot be drawn (marker_mm must be "
-                 "below square_mm)", cfg->path);
+                 "below square_mm; a chessboard's squares_x and squares_y must differ)",
+                 cfg->path);
         return -EINVAL;
     }
     rc = scan_dir_open(&hal->storage, dir, SCAN_DIR_NEW, &lock_fd, err, sizeof(err));
@@ -326,7 +330,8 @@ int calibrate_print_board(const struct hal_storage *st, const struct app_config 
         rc = calcv_board_image(&b, dpi / 25.4, &grey, &w, &h);
     if (rc != 0) {
         fprintf(stderr, "scanner: error: %s: [calibrate]: the board cannot be drawn (marker_mm "
-                "must be below square_mm)\n", cfg->path);
+                "must be below square_mm; a chessboard's squares_x and squares_y must differ)\n",
+                cfg->path);
         return -EINVAL;
     }
     char path[HAL_MAX_PATH + 8];
