@@ -45,6 +45,7 @@ struct solve {
     uint32_t sphere_count;
     char *report;
     size_t report_len, report_cap;
+    char refusal[512]; /* the last "refused: ..." line, for the error message */
     double cam_rms, proj_rms, stereo_rms;
     int camera_only;
 };
@@ -70,6 +71,9 @@ static void say(struct solve *s, const char *fmt, ...)
     }
     memcpy(s->report + s->report_len, line, (size_t)n + 1);
     s->report_len += (size_t)n;
+    if (strncmp(line, "refused: ", 9) == 0)
+        snprintf(s->refusal, sizeof(s->refusal), "%.*s", (int)strcspn(line + 9, "\n"),
+                 line + 9);
 }
 
 static int frame_exists(const char *dir, uint32_t view, uint32_t frame)
@@ -1028,8 +1032,8 @@ int calibrate_solve(const struct hal_storage *st, const struct app_config *cfg, 
     if (rc == 0)
         rc = write_outputs(&s, st, out_path);
     else if (rc == -EINVAL)
-        fprintf(stderr, "scanner: error: calibration refused (see above); %s is unchanged\n",
-                out_path);
+        fprintf(stderr, "scanner: error: calibration refused: %s; %s is unchanged\n",
+                s.refusal[0] ? s.refusal : "see above", out_path);
     free(s.report);
     free(s.views);
     return rc;

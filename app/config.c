@@ -470,6 +470,19 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
     rc = parse_placements(&cfg->calibrate, path, err, err_len);
     if (rc != 0)
         return rc;
+    const struct calib_settings *cb = &cfg->calibrate;
+    if (strcmp(cb->board, "chessboard") == 0 && cb->squares_x == cb->squares_y) {
+        snprintf(err, err_len,
+                 "%s: [calibrate] squares_y: a chessboard's squares_x and squares_y must differ "
+                 "(a square one reads the same turned by 90 degrees)",
+                 path);
+        return -EINVAL;
+    }
+    if (strcmp(cb->board, "charuco") == 0 && cb->marker_mm >= cb->square_mm) {
+        snprintf(err, err_len, "%s: [calibrate] marker_mm: %g must be below square_mm %g", path,
+                 cb->marker_mm, cb->square_mm);
+        return -EINVAL;
+    }
     return load_sim_rig(cfg, path, err, err_len);
 }
 

@@ -111,6 +111,15 @@ mkdir -p "$w/badview/view_000" && cp "$w/one.ini" "$w/badview/config.ini" &&
     printf '[view]\nindex = 0\nangle_mdeg = abc\nframes = 22\n' > "$w/badview/view_000/view.ini"
 PATTERN='error:' row "view.ini value not a number" "angle_mdeg = abc" "$sim" process "$w/badview"
 row "unknown argument" "scan --colour" "$sim" scan --colour
+cfg placements '[calibrate]
+placements = 0, upright'
+row "calibration placements not numbers" "placements = 0, upright" "$sim" check-config --config "$w/placements.ini"
+cfg squareboard '[calibrate]
+squares_x = 8
+squares_y = 8'
+row "square chessboard" "squares_x = squares_y = 8" "$sim" check-config --config "$w/squareboard.ini"
+mkdir -p "$w/nocaptures"
+row "calibration from no captures" "calibrate --from an empty directory" "$sim" calibrate --config "$w/one.ini" --from "$w/nocaptures" --out "$w/cal.ini"
 if [ -x "$dev" ]; then
     PATTERN='^camera' row "camera missing (V4L2)" "/dev/video0 absent" "$dev" selftest --config config/pi-v4l2.ini
     PATTERN='^gpio' row "GPIO chip missing" "gpiochip0 absent" "$dev" selftest --config config/pi-v4l2.ini
