@@ -98,6 +98,8 @@ struct capture {
     struct calcv_board board;
     uint8_t *sheet; /* the board as printed, for the simulated person */
     int sheet_w, sheet_h;
+    int person;      /* 1: a person places the targets (a rig), and may take a view again */
+    int board_found; /* the last board capture showed the board */
 };
 
 static int save_frame(void *priv, uint32_t pattern, const uint8_t *pixels, uint32_t width,
@@ -127,12 +129,28 @@ static int place(struct capture *c, const struct board_target *t, const char *wh
         c->hal->log(HAL_LOG_ERROR, "%s", err);
         return rc;
     }
+    c->person = 1;
     printf("    Press Enter when it is done (Ctrl-D stops; the captures so far are kept).\n");
     fflush(stdout);
     char line[64];
     if (fgets(line, sizeof(line), stdin) == NULL || c->hal->stop_requested())
         return -EINTR;
     return 0;
+}
+
+/* After a capture whose board was not found, a person may put it right and take it again.
+ * @retval 1 again @retval 0 go on @retval -EINTR stop */
+static int ask_again(struct capture *c)
+{
+    if (!c->person || c->board_found)
+        return 0;
+    printf("    Put it right and press Enter to take this view again, or type s and Enter to "
+           "go on without it.\n");
+    fflush(stdout);
+    char line[64];
+    if (fgets(line, sizeof(line), stdin) == NULL || c->hal->stop_requested())
+        return -EINTR;
+    return line[0] == 's' || line[0] == 'S' ? 0 : 1;
 }
 
 /* One capture: the table to @p angle_mdeg, the frames, target.ini and view.ini; then the board
@@ -182,9 +200,10 @@ static int capture_one(struct capture *c, const struct calib_target_info *ti)
         static uint8_t grey[HAL_MAX_PIXELS];
         char why[256];
         decode_rgb_to_grey(view.white_rgb, grey, (size_t)view.width * view.height, 256);
-        if (calcv_find_corners(&c->board, grey, (int)view.width, (int)view.height,
-                               (int)c->cfg->calibrate.min_corners, &corners, why,
-                               sizeof(why)) == 0)
+        c->board_found = calcv_find_corners(&c->board, grey, (int)view.width, (int)view.height,
+                                            (int)c->cfg->calibrate.min_corners, &corners, why,
+                                            sizeof(why)) == 0;
+        if (c->board_found)
             printf("    view_%03u at %7.2f deg: board found, %d corners\n", (unsigned)c->view,
                    st.position_mdeg / 1000.0, corners.count);
         else
@@ -195,7 +214,6 @@ static int capture_one(struct capture *c, const struct calib_target_info *ti)
                st.position_mdeg / 1000.0, (unsigned)info.valid_points);
     }
     fflush(stdout);
-    c->view++;
     return 0;
 }
 
@@ -239,7 +257,11 @@ static int board_steps(struct capture *c)
                 .tilt_deg = tilt,
                 .angle_mdeg = (int32_t)lround(((double)k - 0.5 * (s->turns - 1.0)) *
                                               s->turn_step_deg * 1000.0)};
-            rc = capture_one(c, &ti);
+            int again = 1;
+            while (rc == 0 && again == 1) /* the same view again, at the same index */
+                if ((rc = capture_one(c, &ti)) == 0 && (again = ask_again(c)) < 0)
+                    rc = again;
+            c->view += rc == 0;
         }
     }
     return rc;
@@ -266,6 +288,7 @@ static int sphere_steps(struct capture *c)
             .placement = s->placement_count,
             .angle_mdeg = (int32_t)lround(360000.0 * k / s->sphere_turns)};
         rc = capture_one(c, &ti);
+        c->view += rc == 0;
     }
     return rc;
 }
