@@ -196,6 +196,9 @@ static const struct ini_key config_keys[] = {
         "empty: the scan's calibration, so the firmware knows the rig exactly"),
     F64("sim", "object_height_mm", sim.object_height_mm, 1, 1000, "150",
         "object height after scaling (sphere: diameter)"),
+    {"sim", "object_pose", INI_VEC, C(sim.object_pose_deg), 3, -360, 360, 0, "0, 0, 0", NULL,
+     "the object turned by these angles (degrees, about x, then y, then z) before it is stood on "
+     "the table at its lowest point: 90, 0, 0 lays an upright object on its side (a second pass)"},
     U32("sim", "segments", sim.segments, 8, 4096, "384", "tessellation of analytic shapes"),
     ENUM("sim", "material", sim.material, "lambert|phong|merl", "lambert", "reflectance model"),
     STR("sim", "merl_file", sim.merl_file, "", "MERL/ABC table (CSV), relative to this file"),

@@ -13,6 +13,8 @@ struct sim_config {
     char object[16]; /**< sphere | cylinder | box | torus | mesh */
     char mesh_file[HAL_MAX_PATH];
     double object_height_mm;
+    double object_pose_deg[3]; /**< turned about x, then y, then z before it is stood on the
+                                    table (90, 0, 0: an upright object on its side) */
     uint32_t segments; /**< tessellation of analytic shapes */
     char material[16]; /**< lambert | phong | merl */
     char merl_file[HAL_MAX_PATH];

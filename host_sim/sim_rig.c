@@ -60,6 +60,44 @@ double sim_rig_placed_height(const struct sim_config *cfg)
     return strcmp(cfg->object, "torus") == 0 ? 0.28 * cfg->object_height_mm : cfg->object_height_mm;
 }
 
+/* [sim] object_pose: turn the standing object (R = Rz Ry Rx), then stand it on the table again,
+ * centred on the axis at its lowest point; the paint stays on the object (sim_albedo_at is
+ * asked in the standing frame, q = R^T (p - shift)). */
+static void pose_object(struct sim_rig *rig)
+{
+    const double *d = rig->cfg.object_pose_deg;
+    double a = d[0] * M_PI / 180.0, b = d[1] * M_PI / 180.0, g = d[2] * M_PI / 180.0;
+    double rx[9] = {1, 0, 0, 0, cos(a), -sin(a), 0, sin(a), cos(a)};
+    double ry[9] = {cos(b), 0, sin(b), 0, 1, 0, -sin(b), 0, cos(b)};
+    double rz[9] = {cos(g), -sin(g), 0, sin(g), cos(g), 0, 0, 0, 1};
+    double t[9], *r = rig->pose_rot;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            t[3 * i + j] = ry[3 * i] * rx[j] + ry[3 * i + 1] * rx[3 + j] + ry[3 * i + 2] * rx[6 + j];
+        }
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            r[3 * i + j] = rz[3 * i] * t[j] + rz[3 * i + 1] * t[3 + j] + rz[3 * i + 2] * t[6 + j];
+    rig->pose_shift = v3(0, 0, 0);
+    if (d[0] == 0.0 && d[1] == 0.0 && d[2] == 0.0)
+        return; /* standing as it is: the mesh is not touched */
+    struct sim_mesh *m = &rig->mesh;
+    vec3 lo = v3(1e30, 1e30, 1e30), hi = v3(-1e30, -1e30, -1e30);
+    for (uint32_t i = 0; i < m->vert_count; i++) {
+        float *p = &m->pos[3 * i];
+        vec3 q = m3_mul(r, v3(p[0], p[1], p[2]));
+        lo = v3(fmin(lo.x, q.x), fmin(lo.y, q.y), fmin(lo.z, q.z));
+        hi = v3(fmax(hi.x, q.x), fmax(hi.y, q.y), fmax(hi.z, q.z));
+    }
+    rig->pose_shift = v3(-0.5 * (lo.x + hi.x), -0.5 * (lo.y + hi.y), -lo.z);
+    for (uint32_t i = 0; i < m->vert_count; i++) {
+        float *p = &m->pos[3 * i];
+        vec3 q = v3_add(m3_mul(r, v3(p[0], p[1], p[2])), rig->pose_shift);
+        p[0] = (float)q.x, p[1] = (float)q.y, p[2] = (float)q.z;
+    }
+    sim_mesh_compute_normals(m);
+}
+
 static int build_object(struct sim_rig *rig, const char *dir, char *err, size_t len)
 {
     const struct sim_config *c = &rig->cfg;
@@ -90,6 +128,7 @@ static int build_object(struct sim_rig *rig, const char *dir, char *err, size_t 
     }
     rig->object_height_mm = sim_rig_placed_height(c);
     sim_mesh_place(&rig->mesh, rig->object_height_mm);
+    pose_object(rig);
     return 0;
 }
 
@@ -333,8 +372,10 @@ static void update_pixel(struct sim_rig *rig, const struct frame_xform *obj, vec
     vec3 p_cam = v3_scale(d_cam, hit.t);
     vec3 n_cam = frame_dir_inv(obj, n_obj);
     double albedo[3];
-    if (rig->target.kind == SIM_TARGET_OBJECT)
-        t->dark[i] = (uint8_t)sim_albedo_at(&rig->cfg, rig->object_height_mm, p_obj, albedo);
+    if (rig->target.kind == SIM_TARGET_OBJECT) /* the paint, in the object's standing frame */
+        t->dark[i] = (uint8_t)sim_albedo_at(&rig->cfg, rig->object_height_mm,
+                                            m3_tmul(rig->pose_rot, v3_sub(p_obj, rig->pose_shift)),
+                                            albedo);
     else
         target_albedo(rig, obj, cam_obj, d_cam, p_obj, albedo);
     for (int k = 0; k < 3; k++) {

@@ -40,7 +40,9 @@ struct sim_rig {
     struct sim_material material;
     uint32_t width, height;
     struct gray_layout layout; /**< the projector's stored pattern sequence */
-    double object_height_mm;  /**< height of the placed object */
+    double object_height_mm;  /**< height of the object standing (its paint is laid out by it) */
+    double pose_rot[9];       /**< [sim] object_pose: standing -> as placed, p = R q + shift */
+    vec3 pose_shift;
     int32_t table_angle_mdeg; /**< where the turntable is; the camera renders at this angle */
     int32_t truth_angle_mdeg; /**< angle the truth buffers belong to */
     int truth_valid;

@@ -155,6 +155,56 @@ static void test_deterministic_noise_and_black_level(void **state)
     test_rig_stop(&t);
 }
 
+/* Dark-paint and object pixels of the rig at @p angle_mdeg, with the object posed as @p pose. */
+static void posed_counts(const double pose[3], int32_t angle_mdeg, size_t *hit, size_t *dark,
+                         double *height_mm)
+{
+    static struct test_rig t;
+    assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
+    snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "box");
+    t.cfg.sim.segments = 16;
+    memcpy(t.cfg.sim.object_pose_deg, pose, 3 * sizeof(double));
+    assert_int_equal(test_rig_start(&t), 0);
+    struct sim_rig *rig = sim_ctl_rig();
+    rig->table_angle_mdeg = angle_mdeg;
+    sim_rig_update(rig);
+    *hit = *dark = 0;
+    for (size_t i = 0; i < (size_t)rig->width * rig->height; i++) {
+        *hit += rig->truth.hit[i];
+        *dark += rig->truth.dark[i];
+    }
+    float lo = 1e30f, hi = -1e30f;
+    for (uint32_t v = 0; v < rig->mesh.vert_count; v++) {
+        lo = fminf(lo, rig->mesh.pos[3 * v + 2]);
+        hi = fmaxf(hi, rig->mesh.pos[3 * v + 2]);
+    }
+    assert_true(fabsf(lo) < 1e-3f); /* stood on the table */
+    *height_mm = hi - lo;
+    test_rig_stop(&t);
+}
+
+/* [sim] object_pose: the box (0.6 h x 0.45 h x h) laid on its side is 0.45 h tall; turned a
+ * quarter about the vertical and seen with the table a quarter back, it is the unturned box,
+ * its paint (the dark stripe) included: the paint stays on the object. */
+static void test_object_pose(void **state)
+{
+    (void)state;
+    const double none[3] = {0, 0, 0}, side[3] = {90, 0, 0}, turned[3] = {0, 0, 90};
+    size_t hit0, dark0, hit1, dark1, hit2, dark2;
+    double h0, h1, h2;
+    posed_counts(none, 0, &hit0, &dark0, &h0);
+    posed_counts(side, 0, &hit1, &dark1, &h1);
+    posed_counts(turned, -90000, &hit2, &dark2, &h2);
+    print_message("standing %.1f mm, on its side %.1f mm; pixels %zu / %zu, dark %zu / %zu\n",
+                  h0, h1, hit0, hit2, dark0, dark2);
+    assert_true(fabs(h0 - 150.0) < 0.01 && fabs(h1 - 0.45 * 150.0) < 0.01);
+    assert_true(fabs(h2 - 150.0) < 0.01);
+    assert_true(dark0 > 1000);
+    assert_true(labs((long)hit2 - (long)hit0) <= (long)(hit0 / 1000));
+    assert_true(labs((long)dark2 - (long)dark0) <= (long)(dark0 / 100) + 5);
+    assert_true(hit1 != hit0);
+}
+
 /* The ABC model of a measured material reflects more near the mirror direction. */
 static void test_merl_material(void **state)
 {
@@ -183,6 +233,7 @@ int main(void)
         cmocka_unit_test(test_closed_shapes_have_outward_normals),
         cmocka_unit_test(test_deterministic_noise_and_black_level),
         cmocka_unit_test(test_merl_material),
+        cmocka_unit_test(test_object_pose),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
