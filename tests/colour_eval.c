@@ -60,6 +60,13 @@ static int rig_load(struct rig_views *r, const char *scan_dir)
         fprintf(stderr, "colour-eval: %s\n", err);
         return rc;
     }
+    const double *pose = r->cfg.sim.object_pose_deg;
+    if (pose[0] != 0.0 || pose[1] != 0.0 || pose[2] != 0.0 || r->cfg.sim.has_rig) {
+        /* its truth is looked up in the standing object's frame and the scan's calibration */
+        fprintf(stderr, "colour-eval: %s: [sim] object_pose and rig are not supported here\n",
+                scan_dir);
+        return -EINVAL;
+    }
     r->height_mm = sim_rig_placed_height(&r->cfg.sim);
     r->views = r->cfg.views < MAX_VIEWS ? r->cfg.views : MAX_VIEWS;
     vec3 proj_cam = v3_scale(m3_tmul(r->calib.proj_rot, v3_from(r->calib.proj_trans_mm)), -1.0);
