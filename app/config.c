@@ -474,6 +474,15 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
     if (rc != 0)
         return rc;
     const struct calib_settings *cb = &cfg->calibrate;
+    uint32_t captures = cb->placement_count * cb->turns + cb->sphere_turns;
+    if (captures > CALIB_MAX_VIEWS) {
+        snprintf(err, err_len,
+                 "%s: [calibrate] turns: %u placements x %u turns + %u sphere turns are %u "
+                 "captures, more than the %u a calibration directory holds (CALIB_MAX_VIEWS)",
+                 path, (unsigned)cb->placement_count, (unsigned)cb->turns,
+                 (unsigned)cb->sphere_turns, (unsigned)captures, (unsigned)CALIB_MAX_VIEWS);
+        return -EINVAL;
+    }
     if (strcmp(cb->board, "chessboard") == 0 && cb->squares_x == cb->squares_y) {
         snprintf(err, err_len,
                  "%s: [calibrate] squares_y: a chessboard's squares_x and squares_y must differ "
