@@ -44,11 +44,7 @@ check calibrate_whole_procedure full_test
 kill_test() {
     "$bin" calibrate --config $cfg --out "$out/killed.ini" >"$out/killed.txt" 2>&1 &
     pid=$!
-    n=0
-    while [ ! -f "$out/killed-captures/view_002/view.ini" ] && [ $n -lt 2400 ]; do
-        sleep 0.05
-        n=$((n + 1))
-    done
+    wait_for "$out/killed-captures/view_002/view.ini" 2400
     kill -TERM "$pid"
     wait "$pid"
     rc=$?

@@ -127,11 +127,7 @@ two_scanners_test() {
     rm -rf "$out/together"
     "$bin" scan --config config/sim.ini --out "$out/together" >/dev/null 2>&1 &
     pid=$!
-    n=0
-    while [ ! -f "$out/together/config.ini" ] && [ $n -lt 400 ]; do
-        sleep 0.05
-        n=$((n + 1))
-    done
+    wait_for "$out/together/config.ini" 400
     "$bin" scan --config config/sim.ini --out "$out/together" --replace >/dev/null 2>"$out/second.txt"
     rc=$?
     kill -INT "$pid"
