@@ -247,9 +247,9 @@ int scan_dir_sweep(const struct hal_storage *st, const char *dir, uint32_t views
 /* ---- the other small files ---- */
 
 int scan_dir_write_registration(const struct hal_storage *st, const char *dir, uint32_t view,
-                                const struct icp_report *r)
+                                const struct icp_report *r, const struct frame_xform *pose)
 {
-    char text[1024], path[SCAN_DIR_PATH_MAX];
+    char text[1536], path[SCAN_DIR_PATH_MAX];
     int len =
         snprintf(text, sizeof(text),
                  "; registration of this view against the previous one (docs/scan-format.md)\n"
@@ -262,6 +262,16 @@ int scan_dir_write_registration(const struct hal_storage *st, const char *dir, u
                  (unsigned)r->overlap_after, (unsigned)r->coupled_after,
                  r->overlap_after ? (double)r->coupled_after / r->overlap_after : 0.0,
                  r->rms_before_mm, r->rms_after_mm, r->correction_mm, r->correction_deg);
+    const double *m = pose->rot;
+    if (len > 0 && (size_t)len < sizeof(text))
+        len += snprintf(text + len, sizeof(text) - (size_t)len,
+                        "; the pose the view was fused with: p_object = rotation (p_camera - "
+                        "origin)\npose_rotation = %.9f, %.9f, %.9f, %.9f, %.9f, %.9f, %.9f, %.9f, "
+                        "%.9f\npose_origin_mm = %.6f, %.6f, %.6f\n",
+                        m[0], m[1], m[2], m[3], m[4], m[5], m[6], m[7], m[8], pose->origin.x,
+                        pose->origin.y, pose->origin.z);
+    if (len < 0 || (size_t)len >= sizeof(text))
+        return -ENAMETOOLONG;
     int rc = scan_dir_path(path, sizeof(path), dir, (int)view, "registration.ini");
     return rc != 0 ? rc : hal_storage_write_file(st, path, text, (size_t)len);
 }

@@ -180,7 +180,7 @@ static int save_results(struct job *j, const struct scan_view *view, struct icp_
     if (rc == 0)
         rc = write_failed(
             j, "registration.ini",
-            scan_dir_write_registration(&j->hal->storage, j->out_dir, j->view, report));
+            scan_dir_write_registration(&j->hal->storage, j->out_dir, j->view, report, &pose));
     if (rc == 0)
         rc = scan_dir_path(path, sizeof(path), j->out_dir, (int)j->view, "cloud.ply");
     if (rc == 0)

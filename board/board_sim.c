@@ -179,6 +179,14 @@ static int write_truth(const struct hal *hal, const char *dir)
         img8[i] = (uint8_t)(t->proj_lit[i] ? 255 : 0);
     snprintf(path, sizeof(path), "%s/truth_projector_lit.png", dir);
     rc = image_write_png(&hal->storage, path, img8, rig->width, rig->height, 1);
+    if (rc != 0)
+        goto out_free;
+    /* where the table really stood (a table with [sim] table_angle_error_mdeg misses) */
+    char text[128];
+    int len = snprintf(text, sizeof(text), "; the table's true angle for this view\n[truth]\n"
+                       "angle_mdeg = %d\n", (int)rig->truth_angle_mdeg);
+    snprintf(path, sizeof(path), "%s/truth_angle.ini", dir);
+    rc = hal_storage_write_file(&hal->storage, path, text, (size_t)len);
 out_free:
     free(depth);
     free(img8);

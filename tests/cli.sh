@@ -137,10 +137,12 @@ two_scanners_test() {
 }
 check two_scanners_cannot_share_a_directory two_scanners_test
 check scan_dir_complete sh -c "for f in config.ini calibration.ini view_000/cloud.ply view_000/frame_00.png \
-    view_000/frame_21.png view_000/view.ini view_000/truth_depth_mm.pfm view_000/truth_albedo.png; do \
-    test -s $out/scan/\$f || exit 1; done"
+    view_000/frame_21.png view_000/view.ini view_000/truth_depth_mm.pfm view_000/truth_albedo.png \
+    view_000/truth_angle.ini view_000/registration.ini; do test -s $out/scan/\$f || exit 1; done &&
+    grep -q '^pose_rotation = ' $out/scan/view_003/registration.ini &&
+    grep -q '^angle_mdeg = 135000' $out/scan/view_003/truth_angle.ini"
 # make LIMITS=small, for a board with 512 MB: under a 512 MiB address-space limit the default
-# build cannot even start (657 MiB of static buffers), the small one takes the same scan and
+# build cannot even start (672 MiB of static buffers), the small one takes the same scan and
 # gives the same model. (ASan reserves terabytes of address space: no limit under SAN=1.)
 sbin=${BUILD:-build}/small/scanner
 rm -rf "$out/scan_small"
