@@ -267,6 +267,19 @@ extern "C" void calcv_rodrigues(const double rvec[3], double rot[9])
         rot[i] = r.at<double>(i / 3, i % 3);
 }
 
+extern "C" void calcv_pose_through(const double rvec[3], const double tvec[3],
+                                   const double rot[9], const double trans[3], double rvec_out[3],
+                                   double tvec_out[3])
+{
+    cv::Vec3d r2, r3, t3;
+    cv::Rodrigues(cv::Matx33d(rot), r2);
+    cv::composeRT(cv::Vec3d(rvec), cv::Vec3d(tvec), r2, cv::Vec3d(trans), r3, t3);
+    for (int i = 0; i < 3; i++) {
+        rvec_out[i] = r3[i];
+        tvec_out[i] = t3[i];
+    }
+}
+
 extern "C" double calcv_reprojection_rms(const calcv_corners *v, const calcv_lens *lens,
                                          const double rvec[3], const double tvec[3])
 {

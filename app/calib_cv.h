@@ -81,6 +81,11 @@ int calcv_pose(const struct calcv_corners *v, const struct calcv_lens *lens, dou
 /** Rotation vector to matrix (row-major). */
 void calcv_rodrigues(const double rvec[3], double rot[9]);
 
+/** A pose carried through a rigid motion (composeRT): the board -> camera pose (@p rvec,
+ *  @p tvec) followed by p' = @p rot p + @p trans, as a rotation vector and translation. */
+void calcv_pose_through(const double rvec[3], const double tvec[3], const double rot[9],
+                        const double trans[3], double rvec_out[3], double tvec_out[3]);
+
 /** Reprojection RMS of @p v through @p lens at pose (rvec, tvec), px. */
 double calcv_reprojection_rms(const struct calcv_corners *v, const struct calcv_lens *lens,
                               const double rvec[3], const double tvec[3]);

@@ -463,32 +463,11 @@ static int solve_projector(struct solve *s)
         struct board_view *bv = &s->views[i];
         if (!bv->found || !bv->has_proj)
             continue;
-        double rvec[3], tvec[3], rms, r[9];
+        double rvec[3], tvec[3], rms, rvp[3], tp[3];
         if (calcv_pose(&bv->camp, &cl, rvec, tvec, &rms) != 0)
             continue;
-        calcv_rodrigues(rvec, r);
-        /* board -> projector: Rs (R X + t) + ts */
-        double rp[9], tp[3];
-        for (int a = 0; a < 3; a++) {
-            for (int b = 0; b < 3; b++) {
-                rp[3 * a + b] = 0;
-                for (int k = 0; k < 3; k++)
-                    rp[3 * a + b] += s->out.proj_rot[3 * a + k] * r[3 * k + b];
-            }
-            tp[a] = s->out.proj_trans_mm[a];
-            for (int k = 0; k < 3; k++)
-                tp[a] += s->out.proj_rot[3 * a + k] * tvec[k];
-        }
-        /* back to a rotation vector through the camera of calib_cv: Rodrigues is its own
-         * inverse there, so use the axis-angle formula */
-        double ang = acos(fmin(1.0, fmax(-1.0, 0.5 * (rp[0] + rp[4] + rp[8] - 1.0))));
-        double rvp[3] = {0, 0, 0};
-        if (ang > 1e-12) {
-            double f = ang / (2.0 * sin(ang));
-            rvp[0] = f * (rp[7] - rp[5]);
-            rvp[1] = f * (rp[2] - rp[6]);
-            rvp[2] = f * (rp[3] - rp[1]);
-        }
+        /* board -> projector: the camera's pose carried through the stereo pose */
+        calcv_pose_through(rvec, tvec, s->out.proj_rot, s->out.proj_trans_mm, rvp, tp);
         double e = calcv_reprojection_rms(&bv->proj, &pl, rvp, tp);
         say(s, "view_%03u: camera %.3f px, projector %.3f px\n", (unsigned)bv->view, rms, e);
         sum += e * e * bv->proj.count;
