@@ -485,24 +485,6 @@ static int solve_projector(struct solve *s)
     return 0;
 }
 
-/* Solve the symmetric 3x3 system a x = b (Cramer's rule). @retval 0 singular */
-static int solve3(const double a[9], const double b[3], double x[3])
-{
-    double det = a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) +
-                 a[2] * (a[3] * a[7] - a[4] * a[6]);
-    if (fabs(det) < 1e-30)
-        return 0;
-    for (int k = 0; k < 3; k++) {
-        double m[9];
-        memcpy(m, a, sizeof(m));
-        for (int r = 0; r < 3; r++)
-            m[3 * r + k] = b[r];
-        x[k] = (m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +
-                m[2] * (m[3] * m[7] - m[4] * m[6])) / det;
-    }
-    return 1;
-}
-
 /* The turntable axis from the board's poses: two captures of one placement differ by a turn
  * about the axis, X_j = R_ij X_i + t_ij with R_ij = R_j R_i^T, t_ij = t_j - R_ij t_i. The turn's
  * axis (the skew part of R_ij, signed by the table's angle step) gives the direction; every
@@ -579,7 +561,7 @@ static int solve_axis(struct solve *s)
         for (int y = 0; y < 3; y++)
             ata[3 * x + y] += dir[x] * dir[y];
     double c[3];
-    if (!solve3(ata, atb, c)) {
+    if (!solve_n(ata, atb, c, 3)) {
         say(s, "refused: the axis cannot be located (the table turned too little?)\n");
         return -EINVAL;
     }
@@ -663,20 +645,15 @@ double calib_fit_sphere(const float *xyz, const uint8_t *reason, size_t n, int f
             double g[4] = {-d.x / len, -d.y / len, -d.z / len, -1.0}; /* d(res)/d(c, r) */
             for (int x = 0; x < np; x++) {
                 for (int y = 0; y < np; y++)
-                    a[4 * x + y] += g[x] * g[y];
+                    a[np * x + y] += g[x] * g[y];
                 b[x] -= g[x] * res;
             }
             sum += res * res;
         }
         rms = sqrt(sum / count);
         double step[4] = {0, 0, 0, 0};
-        if (np == 3) {
-            double a3[9] = {a[0], a[1], a[2], a[4], a[5], a[6], a[8], a[9], a[10]};
-            if (!solve3(a3, b, step))
-                return -1.0;
-        } else if (!solve_n(a, b, step, 4)) {
+        if (!solve_n(a, b, step, np))
             return -1.0;
-        }
         c = v3_add(c, v3(step[0], step[1], step[2]));
         r += step[3];
         if (fabs(step[0]) + fabs(step[1]) + fabs(step[2]) + fabs(step[3]) < 1e-8)
