@@ -161,21 +161,18 @@ extern "C" int calcv_find_corners(const calcv_board *b, const uint8_t *grey, int
         cv::aruco::detectMarkers(img, board->dictionary, markers, marker_ids, params);
         if (!marker_ids.empty())
             cv::aruco::interpolateCornersCharuco(markers, marker_ids, img, board, pts, ids);
-        if ((int)ids.size() < min_corners) {
-            explain(img, (int)ids.size(), min_corners, why, why_len);
-            return -ENOENT;
-        }
-        // interpolateCornersCharuco refines over a window wide enough to take in the markers'
-        // edges, which pulls the corners (0.1% in focal length, a pixel in the principal point,
-        // measured on the simulator); refine again over a window within the white borders.
-        cv::cornerSubPix(img, pts, cv::Size(4, 4), cv::Size(-1, -1),
-                         cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 50,
-                                          1e-4));
     }
     if ((int)ids.size() < min_corners) {
         explain(img, (int)ids.size(), min_corners, why, why_len);
         return -ENOENT;
     }
+    // interpolateCornersCharuco refines over a window wide enough to take in the markers' edges,
+    // which pulls the corners (0.1% in focal length, a pixel in the principal point, measured on
+    // the simulator); refine again over a window within the white borders.
+    if (b->kind == CALCV_CHARUCO)
+        cv::cornerSubPix(img, pts, cv::Size(4, 4), cv::Size(-1, -1),
+                         cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 50,
+                                          1e-4));
     for (size_t i = 0; i < ids.size() && i < CALCV_MAX_CORNERS; i++) {
         int id = ids[i];
         out->id[i] = id;

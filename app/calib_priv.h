@@ -22,8 +22,9 @@ struct calib_target_info {
     uint32_t has_angle; /**< 0: captures made elsewhere, no table angle known */
 };
 
-/** The board of [calibrate]. @retval 0 @retval -EINVAL */
-int calib_board_from_settings(const struct calib_settings *s, struct calcv_board *b);
+/** The board of [calibrate] (config_load has checked it: a ChArUco marker below its square, a
+ *  chessboard that is not square). */
+void calib_board_from_settings(const struct calib_settings *s, struct calcv_board *b);
 
 /** Write view @p view's target.ini durably. @retval 0 @retval -errno (logged) */
 int calib_write_target(const struct hal_storage *st, const char *dir, uint32_t view,

@@ -960,11 +960,7 @@ int calibrate_solve(const struct hal_storage *st, const struct app_config *cfg, 
     s.out = s.start;
     calib_capture_params(cfg, &s.params);
     s.params.colour.method = COLOUR_NONE; /* the light frames are read here, not compensated */
-    if (calib_board_from_settings(&cfg->calibrate, &s.board) != 0) {
-        fprintf(stderr, "scanner: error: %s: [calibrate]: marker_mm must be below square_mm, and "
-                "a chessboard's squares_x and squares_y must differ\n", cfg->path);
-        return -EINVAL;
-    }
+    calib_board_from_settings(&cfg->calibrate, &s.board);
     s.views = calloc(CALIB_MAX_VIEWS, sizeof(*s.views));
     if (s.views == NULL)
         return -ENOMEM;

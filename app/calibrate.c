@@ -49,7 +49,7 @@ void calibrate_guess(const struct app_config *cfg, struct scan_calib *g)
     }
 }
 
-int calib_board_from_settings(const struct calib_settings *s, struct calcv_board *b)
+void calib_board_from_settings(const struct calib_settings *s, struct calcv_board *b)
 {
     static const struct {
         const char *name;
@@ -66,12 +66,6 @@ int calib_board_from_settings(const struct calib_settings *s, struct calcv_board
     for (size_t i = 0; i < sizeof(dicts) / sizeof(dicts[0]); i++)
         if (strcmp(s->dictionary, dicts[i].name) == 0)
             b->dictionary = dicts[i].id;
-    if (b->kind == CALCV_CHARUCO && b->marker_mm >= b->square_mm)
-        return -EINVAL;
-    /* a square chessboard reads the same turned by 90 degrees: views would disagree */
-    if (b->kind == CALCV_CHESSBOARD && b->squares_x == b->squares_y)
-        return -EINVAL;
-    return 0;
 }
 
 /* The scan parameters of a calibration capture: columns and rows (the projector's coordinates
@@ -300,14 +294,11 @@ int calibrate_capture(struct hal *hal, const struct app_config *cfg,
     calib_capture_params(cfg, &c.params);
     char err[HAL_MAX_PATH + 256];
     int lock_fd = -1;
-    int rc = calib_board_from_settings(&cfg->calibrate, &c.board);
-    if (rc == 0)
-        rc = calcv_board_image(&c.board, CALIB_SHEET_PX_PER_MM, &c.sheet, &c.sheet_w, &c.sheet_h);
+    calib_board_from_settings(&cfg->calibrate, &c.board);
+    int rc = calcv_board_image(&c.board, CALIB_SHEET_PX_PER_MM, &c.sheet, &c.sheet_w, &c.sheet_h);
     if (rc != 0) {
-        hal->log(HAL_LOG_ERROR, "%s: [calibrate]: the board cannot be drawn (marker_mm must be "
-                 "below square_mm; a chessboard's squares_x and squares_y must differ)",
-                 cfg->path);
-        return -EINVAL;
+        hal->log(HAL_LOG_ERROR, "cannot draw the board: %s", strerror(-rc));
+        return rc;
     }
     rc = scan_dir_open(&hal->storage, dir, SCAN_DIR_NEW, &lock_fd, err, sizeof(err));
     if (rc != 0) {
@@ -348,14 +339,11 @@ int calibrate_print_board(const struct hal_storage *st, const struct app_config 
     uint8_t *grey = NULL;
     int w, h;
     const double dpi = 300.0;
-    int rc = calib_board_from_settings(&cfg->calibrate, &b);
-    if (rc == 0)
-        rc = calcv_board_image(&b, dpi / 25.4, &grey, &w, &h);
+    calib_board_from_settings(&cfg->calibrate, &b);
+    int rc = calcv_board_image(&b, dpi / 25.4, &grey, &w, &h);
     if (rc != 0) {
-        fprintf(stderr, "scanner: error: %s: [calibrate]: the board cannot be drawn (marker_mm "
-                "must be below square_mm; a chessboard's squares_x and squares_y must differ)\n",
-                cfg->path);
-        return -EINVAL;
+        fprintf(stderr, "scanner: error: cannot draw the board: %s\n", strerror(-rc));
+        return rc;
     }
     char path[HAL_MAX_PATH + 8];
     snprintf(path, sizeof(path), "%s.png", base);
