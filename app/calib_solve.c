@@ -903,6 +903,7 @@ static int keep_old(const char *path, char *kept, size_t len)
 static int write_outputs(struct solve *s, const struct hal_storage *st, const char *out_path)
 {
     char comment[1024], kept[HAL_MAX_PATH + 40], report_path[HAL_MAX_PATH + 16];
+    /* the quality line is read back by calib_read_quality (verify, measure-calib) */
     snprintf(comment, sizeof(comment),
              "; written by scanner calibrate from %s\n"
              "; quality: camera_rms_px = %.4f, projector_rms_px = %.4f, boards = %u\n"

@@ -369,20 +369,6 @@ int calibrate_print_board(const struct hal_storage *st, const struct app_config 
 
 /* ---- verification: a sphere of known diameter ---- */
 
-/* The reprojection RMS the calibration file records in its quality comment, or -1. */
-static void recorded_rms(const char *path, double *cam, double *proj)
-{
-    char line[256];
-    *cam = *proj = -1.0;
-    FILE *f = fopen(path, "r");
-    while (f != NULL && fgets(line, sizeof(line), f) != NULL)
-        if (sscanf(line, "; quality: camera_rms_px = %lf, projector_rms_px = %lf", cam, proj) ==
-            2)
-            break;
-    if (f != NULL)
-        fclose(f);
-}
-
 int calibrate_verify(struct hal *hal, const struct app_config *cfg, const struct scan_calib *calib)
 {
     const struct calib_settings *s = &cfg->calibrate;
@@ -415,7 +401,7 @@ int calibrate_verify(struct hal *hal, const struct app_config *cfg, const struct
         return -ENODATA;
     }
     double cam_rms, proj_rms;
-    recorded_rms(cfg->calibration_file, &cam_rms, &proj_rms);
+    calib_read_quality(cfg->calibration_file, &cam_rms, &proj_rms);
     printf("sphere: %u points, centre (%.2f, %.2f, %.2f) mm\n", (unsigned)used, centre.x, centre.y,
            centre.z);
     printf("diameter: %.3f mm measured, %.3f mm true: error %+.3f mm (%+.3f%%)\n", 2.0 * radius,

@@ -545,6 +545,19 @@ int calib_load(struct scan_calib *calib, const char *path, uint32_t light_count,
     return 0;
 }
 
+void calib_read_quality(const char *path, double *camera_rms_px, double *projector_rms_px)
+{
+    char line[256];
+    *camera_rms_px = *projector_rms_px = -1.0;
+    FILE *f = fopen(path, "r");
+    while (f != NULL && fgets(line, sizeof(line), f) != NULL)
+        if (sscanf(line, "; quality: camera_rms_px = %lf, projector_rms_px = %lf", camera_rms_px,
+                   projector_rms_px) == 2)
+            break;
+    if (f != NULL)
+        fclose(f);
+}
+
 /* "a, b, c" to 12 significant digits (1e-12: far below any calibration's uncertainty; the
  * loader refuses lines over 198 characters) */
 static int put_vec(char *buf, size_t len, const char *key, const double *v, int n)

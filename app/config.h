@@ -51,6 +51,11 @@ int calib_load(struct scan_calib *calib, const char *path, uint32_t light_count,
 int calib_save(const struct hal_storage *st, const char *path, const struct scan_calib *calib,
                const char *comment);
 
+/** The reprojection RMS scanner calibrate recorded in a calibration file's comment
+ *  ("; quality: camera_rms_px = C, projector_rms_px = P", written by calib_solve.c), px; -1 for
+ *  each when the file has none. */
+void calib_read_quality(const char *path, double *camera_rms_px, double *projector_rms_px);
+
 /** The devices' settings of @p cfg for board_init and board_selftest (pointers into @p cfg). */
 void config_board(const struct app_config *cfg, struct board_config *out);
 

@@ -70,16 +70,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "measure-calib: %s\n", err);
         return 1;
     }
-    /* the residuals scanner calibrate recorded in the file's quality comment */
-    double cam_rms = -1.0, proj_rms = -1.0;
-    char line[256];
-    FILE *f = fopen(argv[3], "r");
-    while (f != NULL && fgets(line, sizeof(line), f) != NULL)
-        if (sscanf(line, "; quality: camera_rms_px = %lf, projector_rms_px = %lf", &cam_rms,
-                   &proj_rms) == 2)
-            break;
-    if (f != NULL)
-        fclose(f);
+    double cam_rms, proj_rms; /* what scanner calibrate recorded in the file */
+    calib_read_quality(argv[3], &cam_rms, &proj_rms);
     printf("| %-34s | %12s | %12s | %12s | %14s |\n", "parameter", "true", "nominal", "recovered",
            "error");
     printf("|%s|%s|%s|%s|%s|\n", "------------------------------------",
