@@ -78,6 +78,14 @@ int calib_read_target(const char *dir, uint32_t view, struct calib_target_info *
     return 0;
 }
 
+void calibrate_path_beside(const char *cal_path, const char *suffix, char *buf, size_t len)
+{
+    size_t l = strlen(cal_path);
+    if (l > 4 && strcmp(cal_path + l - 4, ".ini") == 0)
+        l -= 4;
+    snprintf(buf, len, "%.*s%s", (int)l, cal_path, suffix);
+}
+
 int calib_write_file(const struct hal_storage *st, const char *dir, const char *name,
                      const char *from)
 {

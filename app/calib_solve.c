@@ -923,9 +923,7 @@ static int write_outputs(struct solve *s, const struct hal_storage *st, const ch
         fprintf(stderr, "scanner: error: the calibration written does not load: %s\n", err);
         return rc;
     }
-    size_t l = strlen(out_path);
-    snprintf(report_path, sizeof(report_path), "%.*s.report.txt",
-             (int)(l > 4 && strcmp(out_path + l - 4, ".ini") == 0 ? l - 4 : l), out_path);
+    calibrate_path_beside(out_path, ".report.txt", report_path, sizeof(report_path));
     rc = hal_storage_write_file(st, report_path, s->report, s->report_len);
     if (rc != 0)
         fprintf(stderr, "scanner: error: cannot write %s: %s\n", report_path, strerror(-rc));

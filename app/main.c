@@ -302,10 +302,8 @@ static int cmd_calibrate(int argc, char **argv)
     if (what[0] != 'v') /* the projector's sequence is the calibration's: rows too */
         calib_capture_params(&cfg, &cfg.scan);
     char dir_buf[HAL_MAX_PATH];
-    if (dir == NULL && out != NULL) { /* CAL.ini -> CAL-captures */
-        size_t l = strlen(out);
-        snprintf(dir_buf, sizeof(dir_buf), "%.*s-captures",
-                 (int)(l > 4 && strcmp(out + l - 4, ".ini") == 0 ? l - 4 : l), out);
+    if (dir == NULL && out != NULL) {
+        calibrate_path_beside(out, "-captures", dir_buf, sizeof(dir_buf));
         dir = dir_buf;
     }
     rc = rig_up(&cfg, &calib);
