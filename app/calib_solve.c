@@ -8,6 +8,7 @@
 #include "lens.h"
 #include "scan.h"
 #include "scan_dir.h"
+#include "scan_job.h"
 #include "vec3.h"
 
 #include <errno.h>
@@ -87,23 +88,14 @@ static int frame_exists(const char *dir, uint32_t view, uint32_t frame)
 /* Feed a capture's pattern frames to the decoder. @retval 0 @retval -ENOENT not all there */
 static int feed_patterns(struct solve *s, uint32_t v, const struct scan_calib *calib)
 {
-    static uint8_t pixels[HAL_MAX_PIXELS * 3];
     struct gray_layout layout;
     char err[SCAN_DIR_PATH_MAX + 256];
     scan_layout(&s->params, calib, &layout);
-    uint32_t count = gray_layout_count(&layout);
-    if (!frame_exists(s->dir, v, count - 1))
+    if (!frame_exists(s->dir, v, gray_layout_count(&layout) - 1))
         return -ENOENT;
-    int rc = scan_begin_view(&s->params, calib);
-    for (uint32_t f = 0; f < count && rc == 0; f++) {
-        uint32_t ch = f == GRAY_PATTERN_WHITE ? 3 : 1;
-        rc = scan_dir_read_frame(s->dir, v, f, pixels, sizeof(pixels), calib->cam_width,
-                                 calib->cam_height, ch, err, sizeof(err));
-        if (rc != 0)
-            fprintf(stderr, "scanner: error: %s\n", err);
-        else
-            rc = scan_feed_frame(f, pixels, ch, NULL);
-    }
+    int rc = scan_job_feed_view(s->dir, v, &s->params, calib, err, sizeof(err));
+    if (rc != 0)
+        fprintf(stderr, "scanner: error: %s\n", err);
     return rc;
 }
 

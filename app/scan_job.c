@@ -451,21 +451,19 @@ static int check_frames(const struct job *j, const char *scan_dir, uint32_t v,
     return 0;
 }
 
-/* Feed the view's kept frames to the firmware: the patterns, then the colour frames. */
-static int feed_frames(const struct job *j, const char *scan_dir, uint32_t v, char *err,
-                       size_t err_len)
+int scan_job_feed_view(const char *scan_dir, uint32_t v, const struct scan_params *params,
+                       const struct scan_calib *calib, char *err, size_t err_len)
 {
     static uint8_t pixels[HAL_MAX_PIXELS * 3];
-    const uint32_t width = j->cfg->camera.width, height = j->cfg->camera.height;
     struct gray_layout layout;
-    scan_layout(&j->cfg->scan, j->calib, &layout);
+    scan_layout(params, calib, &layout);
     uint32_t count = gray_layout_count(&layout);
-    uint32_t lights = scan_light_frame_count(&j->cfg->scan, j->calib);
-    int rc = scan_begin_view(&j->cfg->scan, j->calib);
+    uint32_t lights = scan_light_frame_count(params, calib);
+    int rc = scan_begin_view(params, calib);
     for (uint32_t f = 0; f < count + lights && rc == 0; f++) {
         uint32_t channels = f == GRAY_PATTERN_WHITE || f >= count ? 3 : 1;
-        rc = scan_dir_read_frame(scan_dir, v, f, pixels, sizeof(pixels), width, height, channels,
-                                 err, err_len);
+        rc = scan_dir_read_frame(scan_dir, v, f, pixels, sizeof(pixels), params->width,
+                                 params->height, channels, err, err_len);
         if (rc == 0)
             rc = f < count ? scan_feed_frame(f, pixels, channels, NULL)
                            : scan_feed_light_frame(f - count, pixels);
@@ -487,7 +485,7 @@ static int process_view(struct job *j, const char *scan_dir, uint32_t v)
     if (rc == 0)
         rc = check_frames(j, scan_dir, v, &meta, err, sizeof(err));
     if (rc == 0)
-        rc = feed_frames(j, scan_dir, v, err, sizeof(err));
+        rc = scan_job_feed_view(scan_dir, v, &j->cfg->scan, j->calib, err, sizeof(err));
     if (rc != 0) {
         hal->log(HAL_LOG_ERROR, "%s", err);
         return rc;

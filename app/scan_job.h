@@ -39,6 +39,13 @@ int scan_job_resume(const struct hal *hal, const struct app_config *cfg,
 /** Recompute every result of the scan in @p scan_dir from its kept frames alone.
  *  @param hal  storage, clock and log only; no device is touched
  *  @retval 0 ok @retval -errno with the file named in the log */
+/** Feed view @p v's kept frames in @p scan_dir to the firmware as the live view fed them: the
+ *  patterns of @p params, then its colour frames (scan_begin_view first; finish with
+ *  scan_finish_view or decode_finish). @p err names a frame that is missing or wrong.
+ *  @retval 0 @retval -ENOENT @retval -EINVAL */
+int scan_job_feed_view(const char *scan_dir, uint32_t v, const struct scan_params *params,
+                       const struct scan_calib *calib, char *err, size_t err_len);
+
 int scan_job_process(const struct hal *hal, const char *scan_dir, const struct scan_job_opts *opts);
 
 #endif
