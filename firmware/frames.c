@@ -24,18 +24,8 @@ void frame_object_from_camera(const struct scan_calib *calib, int32_t angle_mdeg
     double a = (double)angle_mdeg * (M_PI / 180000.0);
     double c = cos(a), s = sin(a);
     double rz[9] = {c, s, 0, -s, c, 0, 0, 0, 1};
-    for (int r = 0; r < 3; r++)
-        for (int k = 0; k < 3; k++)
-            o->rot[r * 3 + k] = rz[r * 3 + 0] * t.rot[0 * 3 + k] +
-                                rz[r * 3 + 1] * t.rot[1 * 3 + k] + rz[r * 3 + 2] * t.rot[2 * 3 + k];
+    m3_mul_m3(rz, t.rot, o->rot);
     o->origin = t.origin;
-}
-
-static void m3_mul_m3(const double a[9], const double b[9], double out[9])
-{
-    for (int r = 0; r < 3; r++)
-        for (int c = 0; c < 3; c++)
-            out[r * 3 + c] = a[r * 3] * b[c] + a[r * 3 + 1] * b[3 + c] + a[r * 3 + 2] * b[6 + c];
 }
 
 void frame_compose(const struct frame_xform *a, const struct frame_xform *b,

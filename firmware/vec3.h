@@ -56,6 +56,13 @@ static inline vec3 m3_mul(const double m[9], vec3 v)
     return v3(m[0] * v.x + m[1] * v.y + m[2] * v.z, m[3] * v.x + m[4] * v.y + m[5] * v.z,
               m[6] * v.x + m[7] * v.y + m[8] * v.z);
 }
+/** out = a b (3x3, row-major); @p out may alias neither input. */
+static inline void m3_mul_m3(const double a[9], const double b[9], double out[9])
+{
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++)
+            out[r * 3 + c] = a[r * 3] * b[c] + a[r * 3 + 1] * b[3 + c] + a[r * 3 + 2] * b[6 + c];
+}
 /** transpose(m) times v. */
 static inline vec3 m3_tmul(const double m[9], vec3 v)
 {

@@ -71,13 +71,8 @@ static void pose_object(struct sim_rig *rig)
     double ry[9] = {cos(b), 0, sin(b), 0, 1, 0, -sin(b), 0, cos(b)};
     double rz[9] = {cos(g), -sin(g), 0, sin(g), cos(g), 0, 0, 0, 1};
     double t[9], *r = rig->pose_rot;
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++) {
-            t[3 * i + j] = ry[3 * i] * rx[j] + ry[3 * i + 1] * rx[3 + j] + ry[3 * i + 2] * rx[6 + j];
-        }
-    for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            r[3 * i + j] = rz[3 * i] * t[j] + rz[3 * i + 1] * t[3 + j] + rz[3 * i + 2] * t[6 + j];
+    m3_mul_m3(ry, rx, t);
+    m3_mul_m3(rz, t, r);
     rig->pose_shift = v3(0, 0, 0);
     if (d[0] == 0.0 && d[1] == 0.0 && d[2] == 0.0)
         return; /* standing as it is: the mesh is not touched */
