@@ -381,20 +381,29 @@ static int parse_placements(struct calib_settings *c, const char *path, char *er
     return 0;
 }
 
+/* @p name as the config file @p config_path names it: relative to its directory unless
+ * absolute. @retval 0 @retval -ENAMETOOLONG */
+static int path_beside(const char *config_path, const char *name, char *out, size_t len)
+{
+    char dir_buf[HAL_MAX_PATH];
+    snprintf(dir_buf, sizeof(dir_buf), "%s", config_path);
+    int n = name[0] == '/' ? snprintf(out, len, "%s", name)
+                           : snprintf(out, len, "%s/%s", dirname(dir_buf), name);
+    return n < 0 || (size_t)n >= len ? -ENAMETOOLONG : 0;
+}
+
 /* [sim] rig: the geometry the simulator renders with, loaded now so that a bad file is named at
  * start like the calibration is. */
 static int load_sim_rig(struct app_config *cfg, const char *path, char *err, size_t err_len)
 {
     if (cfg->sim.rig_file[0] == '\0')
         return 0;
-    char dir_buf[HAL_MAX_PATH], joined[HAL_MAX_PATH * 2 + 2];
-    snprintf(dir_buf, sizeof(dir_buf), "%s", path);
-    if (cfg->sim.rig_file[0] == '/')
-        snprintf(joined, sizeof(joined), "%s", cfg->sim.rig_file);
+    char joined[HAL_MAX_PATH * 2 + 2], why[512];
+    int rc = path_beside(path, cfg->sim.rig_file, joined, sizeof(joined));
+    if (rc == 0)
+        rc = calib_load(&cfg->sim.rig, joined, cfg->light_count, why, sizeof(why));
     else
-        snprintf(joined, sizeof(joined), "%s/%s", dirname(dir_buf), cfg->sim.rig_file);
-    char why[512];
-    int rc = calib_load(&cfg->sim.rig, joined, cfg->light_count, why, sizeof(why));
+        snprintf(why, sizeof(why), "path too long");
     if (rc != 0) {
         snprintf(err, err_len, "%s: [sim] rig: %s", path, why);
         return rc;
@@ -460,16 +469,12 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
         return -EINVAL;
     }
     /* The calibration file is named relative to the config file. */
-    if (cfg->calibration_file[0] != '/') {
-        char dir_buf[HAL_MAX_PATH], joined[HAL_MAX_PATH * 2];
-        snprintf(dir_buf, sizeof(dir_buf), "%s", path);
-        snprintf(joined, sizeof(joined), "%s/%s", dirname(dir_buf), cfg->calibration_file);
-        if (strlen(joined) >= sizeof(cfg->calibration_file)) {
-            snprintf(err, err_len, "%s: [scan] calibration: path too long", path);
-            return -EINVAL;
-        }
-        memcpy(cfg->calibration_file, joined, strlen(joined) + 1);
+    char joined[sizeof(cfg->calibration_file)];
+    if (path_beside(path, cfg->calibration_file, joined, sizeof(joined)) != 0) {
+        snprintf(err, err_len, "%s: [scan] calibration: path too long", path);
+        return -EINVAL;
     }
+    memcpy(cfg->calibration_file, joined, sizeof(joined));
     rc = parse_placements(&cfg->calibrate, path, err, err_len);
     if (rc != 0)
         return rc;
