@@ -11,6 +11,7 @@
 #include "image_io.h"
 #include "scan.h"
 #include "scan_dir.h"
+#include "scan_job.h"
 
 #include <errno.h>
 #include <math.h>
@@ -174,16 +175,7 @@ static int capture_one(struct capture *c, const struct calib_target_info *ti)
     if ((rc = calib_write_target(&hal->storage, c->dir, c->view, &done)) != 0)
         return rc;
     static struct scan_dir_view meta;
-    memset(&meta, 0, sizeof(meta));
-    meta.index = c->view;
-    meta.angle_mdeg = st.position_mdeg;
-    meta.frames = info.frames_captured;
-    meta.capture_retries = info.capture_retries;
-    meta.valid_points = info.valid_points;
-    meta.exposure_us = c->cfg->camera.exposure_us;
-    meta.gain_milli = c->cfg->camera.gain_milli;
-    scan_dir_describe_frames(&c->params, c->guess, &meta);
-    memcpy(meta.reason_count, info.reason_count, sizeof(meta.reason_count));
+    scan_job_view_meta(c->cfg, &c->params, c->guess, c->view, &info, &meta);
     if ((rc = scan_dir_write_view(&hal->storage, c->dir, c->view, &meta)) != 0) {
         hal->log(HAL_LOG_ERROR, "cannot write %s/view_%03u/view.ini: %s", c->dir,
                  (unsigned)c->view, strerror(-rc));

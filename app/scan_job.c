@@ -148,23 +148,30 @@ static int save_frame(void *priv, uint32_t pattern, const uint8_t *pixels, uint3
                                              width, height, channels));
 }
 
+void scan_job_view_meta(const struct app_config *cfg, const struct scan_params *params,
+                        const struct scan_calib *calib, uint32_t view,
+                        const struct scan_view_info *info, struct scan_dir_view *v)
+{
+    memset(v, 0, sizeof(*v));
+    v->index = view;
+    v->angle_mdeg = info->angle_mdeg;
+    v->frames = info->frames_captured;
+    v->capture_retries = info->capture_retries;
+    v->valid_points = info->valid_points;
+    v->exposure_us = cfg->camera.exposure_us;
+    v->gain_milli = cfg->camera.gain_milli;
+    scan_dir_describe_frames(params, calib, v);
+    memcpy(v->reason_count, info->reason_count, sizeof(v->reason_count));
+}
+
 static int write_view_meta(struct job *j, const struct scan_view_info *info, const char *started,
                            double ms)
 {
     static struct scan_dir_view v; /* large; one view at a time */
-    memset(&v, 0, sizeof(v));
-    v.index = j->view;
-    v.angle_mdeg = info->angle_mdeg;
+    scan_job_view_meta(j->cfg, &j->cfg->scan, j->calib, j->view, info, &v);
     snprintf(v.started, sizeof(v.started), "%s", started);
     utc_now(v.finished, sizeof(v.finished));
-    v.frames = info->frames_captured;
-    v.capture_retries = info->capture_retries;
-    v.valid_points = info->valid_points;
     v.wall_ms = ms;
-    v.exposure_us = j->cfg->camera.exposure_us;
-    v.gain_milli = j->cfg->camera.gain_milli;
-    scan_dir_describe_frames(&j->cfg->scan, j->calib, &v);
-    memcpy(v.reason_count, info->reason_count, sizeof(v.reason_count));
     return write_failed(j, "view.ini",
                         scan_dir_write_view(&j->hal->storage, j->out_dir, j->view, &v));
 }

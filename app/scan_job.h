@@ -5,6 +5,8 @@
 
 #include "config.h"
 #include "hal.h"
+#include "scan.h"
+#include "scan_dir.h"
 
 struct scan_job_opts {
     int json;           /**< one JSON status line per event instead of the terminal display */
@@ -39,6 +41,12 @@ int scan_job_resume(const struct hal *hal, const struct app_config *cfg,
 /** Recompute every result of the scan in @p scan_dir from its kept frames alone.
  *  @param hal  storage, clock and log only; no device is touched
  *  @retval 0 ok @retval -errno with the file named in the log */
+/** What view.ini records of a view just taken with @p params (started, finished and wall_ms are
+ *  the caller's to set). */
+void scan_job_view_meta(const struct app_config *cfg, const struct scan_params *params,
+                        const struct scan_calib *calib, uint32_t view,
+                        const struct scan_view_info *info, struct scan_dir_view *v);
+
 /** Feed view @p v's kept frames in @p scan_dir to the firmware as the live view fed them: the
  *  patterns of @p params, then its colour frames (scan_begin_view first; finish with
  *  scan_finish_view or decode_finish). @p err names a frame that is missing or wrong.
