@@ -375,25 +375,7 @@ eval: deps $(BUILD)/scanner $(BUILD)/colour-eval
 # angle by up to 1 and 2 degrees (each view's angle as reported, registered and true), and peak
 # memory for 8 and 24 views.
 measure-scan: deps $(BUILD)/scanner $(BUILD)/mesh-compare $(BUILD)/measure-registration
-	@for obj in mesh cylinder sphere; do \
-		sed "s/^object = .*/object = $$obj/" config/sim.ini > $(BUILD)/measure-$$obj.ini; \
-		sed -i "s|^calibration = .*|calibration = $(CURDIR)/config/sim-calib.ini|; s|^mesh_file = ../|mesh_file = $(CURDIR)/|" $(BUILD)/measure-$$obj.ini; \
-		rm -rf $(BUILD)/measure-scan/$$obj; \
-		$(BUILD)/scanner scan --config $(BUILD)/measure-$$obj.ini --out $(BUILD)/measure-scan/$$obj | tail -n 1; \
-		$(BUILD)/mesh-compare $(BUILD)/measure-scan/$$obj/mesh.ply $(BUILD)/measure-scan/$$obj/truth_mesh.ply $(BUILD)/measure-scan/$$obj; \
-	done
-	@for err in 1000 2000; do \
-		{ cat $(BUILD)/measure-mesh.ini; printf 'table_angle_error_mdeg = %s\n' $$err; } > $(BUILD)/measure-table-$$err.ini; \
-		rm -rf $(BUILD)/measure-scan/table-$$err; \
-		echo "== bunny, the table up to $$err mdeg off the angle it reports (issue 15)"; \
-		$(BUILD)/scanner scan --config $(BUILD)/measure-table-$$err.ini --out $(BUILD)/measure-scan/table-$$err | tail -n 1; \
-		$(BUILD)/mesh-compare $(BUILD)/measure-scan/table-$$err/mesh.ply $(BUILD)/measure-scan/table-$$err/truth_mesh.ply | sed -n 2p; \
-		$(BUILD)/measure-registration $(BUILD)/measure-scan/table-$$err; \
-	done
-	@sed "s/^views = .*/views = 24/" $(BUILD)/measure-mesh.ini > $(BUILD)/measure-24.ini; \
-		rm -rf $(BUILD)/measure-scan/bunny24; \
-		$(BUILD)/scanner scan --config $(BUILD)/measure-24.ini --out $(BUILD)/measure-scan/bunny24 | tail -n 1; \
-		$(BUILD)/mesh-compare $(BUILD)/measure-scan/bunny24/mesh.ply $(BUILD)/measure-scan/bunny24/truth_mesh.ply $(BUILD)/measure-scan/bunny24
+	scripts/measure-scan.sh $(BUILD)
 
 # MeshLab opens a scan's mesh (installs MeshLab and Xvfb when missing: large, so not in test).
 interop-meshlab: deps $(BUILD)/scanner

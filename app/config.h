@@ -7,7 +7,7 @@
 #include "calibrate.h"
 #include "hal.h"
 #include "fusion.h"
-#include "icp.h"
+#include "reg.h"
 #include "scan_types.h"
 #include "sim_config.h"
 #include "turntable_modbus.h"
@@ -32,7 +32,7 @@ struct app_config {
     struct hal_gpio_config gpio;
     struct tt_client_config turntable;
     struct fusion_params fusion;
-    struct icp_params registration;
+    struct reg_params registration;
     struct sim_config sim;
     struct calib_settings calibrate;
 };

@@ -247,21 +247,24 @@ int scan_dir_sweep(const struct hal_storage *st, const char *dir, uint32_t views
 /* ---- the other small files ---- */
 
 int scan_dir_write_registration(const struct hal_storage *st, const char *dir, uint32_t view,
-                                const struct icp_report *r, const struct frame_xform *pose)
+                                const struct reg_report *r, const struct reg_view *v,
+                                const struct frame_xform *pose)
 {
-    char text[1536], path[SCAN_DIR_PATH_MAX];
-    int len =
-        snprintf(text, sizeof(text),
-                 "; registration of this view against the previous one (docs/scan-format.md)\n"
-                 "[registration]\nhas_pair = %d\naccepted = %d\noverlap_before = %u\n"
-                 "coupled_before = %u\ncoupled_share_before = %.4f\noverlap_after = %u\n"
-                 "coupled_after = %u\ncoupled_share_after = %.4f\nrms_before_mm = %.4f\n"
-                 "rms_after_mm = %.4f\ncorrection_mm = %.4f\ncorrection_deg = %.4f\n",
-                 r->has_pair, r->accepted, (unsigned)r->overlap_before, (unsigned)r->coupled_before,
-                 r->overlap_before ? (double)r->coupled_before / r->overlap_before : 0.0,
-                 (unsigned)r->overlap_after, (unsigned)r->coupled_after,
-                 r->overlap_after ? (double)r->coupled_after / r->overlap_after : 0.0,
-                 r->rms_before_mm, r->rms_after_mm, r->correction_mm, r->correction_deg);
+    char text[2048], path[SCAN_DIR_PATH_MAX];
+    int len = snprintf(
+        text, sizeof(text),
+        "; the joint registration of the scan's views, and this view's part (docs/scan-format.md)\n"
+        "[registration]\nsolved = %d\naccepted = %d\nrefused = %s\nstride_px = %u\n"
+        "iterations = %u\nscore_before_mm = %.4f\nscore_after_mm = %.4f\nrms_mm = %.4f\n"
+        "loop_closure_rms_mm = %.4f\naxis_shift_mm = %.4f\naxis_tilt_deg = %.4f\n"
+        "worst_view = %u\nworst_rms_mm = %.4f\n"
+        "[view]\nreported_angle_deg = %.3f\nangle_deg = %.4f\ncorrection_deg = %.4f\n"
+        "overlap = %u\ncoupled = %u\ncoupled_share = %.4f\nview_rms_mm = %.4f\n",
+        r->solved, r->accepted, r->refused, (unsigned)r->stride, (unsigned)r->iterations,
+        r->score_before_mm, r->score_after_mm, r->rms_mm, r->loop_rms_mm, r->axis_shift_mm,
+        r->axis_tilt_deg, (unsigned)r->worst_view, r->worst_rms_mm, v->reported_mdeg / 1000.0,
+        v->angle_deg, v->correction_deg, (unsigned)v->overlap, (unsigned)v->coupled,
+        v->overlap ? (double)v->coupled / v->overlap : 0.0, v->rms_mm);
     const double *m = pose->rot;
     if (len > 0 && (size_t)len < sizeof(text))
         len += snprintf(text + len, sizeof(text) - (size_t)len,

@@ -6,7 +6,7 @@
 #include "colour.h"
 #include "decode.h"
 #include "hal.h"
-#include "icp.h"
+#include "reg.h"
 #include "scan_types.h"
 
 #include <stddef.h>
@@ -75,10 +75,12 @@ int scan_dir_read_frame(const char *dir, uint32_t view, uint32_t frame, uint8_t 
                         size_t capacity, uint32_t width, uint32_t height, uint32_t channels,
                         char *err, size_t err_len);
 
-/** Write view @p view's registration.ini: how it was registered to the one before, and @p pose,
- *  the camera-to-object pose it was fused with. @retval 0 @retval -errno */
+/** Write view @p view's registration.ini: the scan's joint registration @p r, this view's part
+ *  of it @p v, and @p pose, the camera-to-object pose it was fused with.
+ *  @retval 0 @retval -errno */
 int scan_dir_write_registration(const struct hal_storage *st, const char *dir, uint32_t view,
-                                const struct icp_report *r, const struct frame_xform *pose);
+                                const struct reg_report *r, const struct reg_view *v,
+                                const struct frame_xform *pose);
 
 /** How scan_dir_open treats what @p dir already holds. */
 enum scan_dir_mode {

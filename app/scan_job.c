@@ -31,11 +31,23 @@ struct job {
     char view_dir[SCAN_DIR_PATH_MAX]; /* its directory */
 };
 
+static int load_view(struct job *j, const char *scan_dir, uint32_t v, struct scan_view *view,
+                     struct scan_view_info *info);
+static int stopped_offline(struct job *j, const char *scan_dir, uint32_t v);
+
 static double wall_ms(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
+}
+
+/* CPU time of this thread: what a stage costs, whatever else the machine does. */
+static double cpu_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec / 1e9;
 }
 
 static void job_init(struct job *j, const struct hal *hal, const struct app_config *cfg,
@@ -176,18 +188,18 @@ static int write_view_meta(struct job *j, const struct scan_view_info *info, con
                         scan_dir_write_view(&j->hal->storage, j->out_dir, j->view, &v));
 }
 
-/* Results of a processed view (its frames, the colour among them, were kept while capturing):
- * its pose (turntable, refined by registration), its point cloud, its part of the fused model. */
-static int save_results(struct job *j, const struct scan_view *view, struct icp_report *report)
+/* Results of a processed view once the scan is registered: its registration.ini, its point
+ * cloud and its part of the fused model, all at the registered pose. */
+static int save_results(struct job *j, const struct scan_view *view, const struct reg_report *rep)
 {
     char path[HAL_MAX_PATH + 64];
     struct frame_xform pose;
-    scan_view_pose(j->calib, view, &pose);
-    int rc = scan_register_view(&j->cfg->registration, j->calib, view, &pose, report);
+    struct reg_view rv;
+    int rc = reg_view_pose(j->view, &pose, &rv);
     if (rc == 0)
-        rc = write_failed(
-            j, "registration.ini",
-            scan_dir_write_registration(&j->hal->storage, j->out_dir, j->view, report, &pose));
+        rc = write_failed(j, "registration.ini",
+                          scan_dir_write_registration(&j->hal->storage, j->out_dir, j->view, rep,
+                                                      &rv, &pose));
     if (rc == 0)
         rc = scan_dir_path(path, sizeof(path), j->out_dir, (int)j->view, "cloud.ply");
     if (rc == 0)
@@ -197,16 +209,16 @@ static int save_results(struct job *j, const struct scan_view *view, struct icp_
     return rc;
 }
 
-static void describe(char *buf, size_t len, const struct scan_view_info *info,
-                     const struct icp_report *r, const char *dir)
+static void describe(char *buf, size_t len, const struct scan_view_info *info, const char *dir)
 {
-    int n = snprintf(buf, len, "%u points at %.1f deg", (unsigned)info->valid_points,
-                     info->angle_mdeg / 1000.0);
-    if (r->has_pair && r->overlap_before > 0 && r->overlap_after > 0)
-        n += snprintf(buf + n, len - (size_t)n, ", coupled %.1f%% -> %.1f%% of the overlap",
-                      100.0 * r->coupled_before / r->overlap_before,
-                      100.0 * r->coupled_after / r->overlap_after);
-    snprintf(buf + n, len - (size_t)n, " -> %s/cloud.ply", dir);
+    snprintf(buf, len, "%u points at %.1f deg -> %s", (unsigned)info->valid_points,
+             info->angle_mdeg / 1000.0, dir);
+}
+
+static void set_view(struct job *j, uint32_t view)
+{
+    j->view = view;
+    scan_dir_path(j->view_dir, sizeof(j->view_dir), j->out_dir, (int)view, NULL);
 }
 
 /* The fused model: mesh.ply and mesh.obj in the scan directory. */
@@ -232,10 +244,73 @@ static int write_model(struct job *j)
     return 0;
 }
 
-static void set_view(struct job *j, uint32_t view)
+/* Before the first view: the registration sized for the scan's views. */
+static int begin_model(struct job *j)
 {
-    j->view = view;
-    scan_dir_path(j->view_dir, sizeof(j->view_dir), j->out_dir, (int)view, NULL);
+    int rc = reg_begin(&j->cfg->registration, j->calib, j->cfg->views, j->cfg->scan.width,
+                       j->cfg->scan.height);
+    if (rc != 0)
+        j->hal->log(HAL_LOG_ERROR, "registration: %u views exceed the compiled limit %u",
+                    (unsigned)j->cfg->views, REG_MAX_VIEWS);
+    return rc;
+}
+
+/* The registration's one quality line, and a refused or failed one said plainly. */
+static int report_registration(struct job *j, const struct reg_report *r, double cpu_seconds,
+                               const char *scan_dir)
+{
+    char detail[512];
+    if (!r->solved)
+        snprintf(detail, sizeof(detail), "turntable angles kept ([registration] icp = 0 or one "
+                                         "view)");
+    else
+        snprintf(detail, sizeof(detail),
+                 "%s: residual %.3f mm, loop closure %.3f mm, worst view %u (%.3f mm); axis moved "
+                 "%.2f mm, tilted %.3f deg; %.2f s CPU%s%s",
+                 r->accepted ? "registered" : "turntable angles kept", r->rms_mm, r->loop_rms_mm,
+                 (unsigned)r->worst_view, r->worst_rms_mm, r->axis_shift_mm, r->axis_tilt_deg,
+                 cpu_seconds, r->accepted ? "" : ": ", r->refused);
+    progress(j, "registration", -1, j->views, detail);
+    if (!r->solved || r->failed_view < 0)
+        return 0;
+    j->hal->log(HAL_LOG_ERROR,
+                "registration failed: view %d does not match view %d (%.0f%% of their overlap "
+                "couples, at least %.0f%% needed): did the object move on the table? No model "
+                "was made; the views are kept in %s. Scan again, or fuse them at the turntable's "
+                "angles with 'scanner process %s --config F' where F has [registration] icp = 0",
+                r->failed_view, r->failed_against, 100.0 * r->failed_share,
+                100.0 * j->cfg->registration.min_coupled_share, scan_dir, scan_dir);
+    return -EPROTO;
+}
+
+/* Once every view is in: register them jointly, then fuse each at its registered pose. The
+ * fusion must wait for the registration, and the views' range images are not kept in memory
+ * (a view's are 40 MB), so each view is decoded again from its kept frames in @p scan_dir. */
+static int make_model(struct job *j, const char *scan_dir)
+{
+    struct reg_report rep;
+    double t0 = cpu_s();
+    reg_solve(&rep);
+    int rc = report_registration(j, &rep, cpu_s() - t0, scan_dir);
+    if (rc == 0)
+        rc = fusion_begin(&j->cfg->fusion);
+    for (uint32_t v = 0; v < j->views && rc == 0; v++) {
+        struct scan_view view;
+        struct scan_view_info info;
+        rc = stopped_offline(j, scan_dir, v);
+        if (rc == 0)
+            rc = load_view(j, scan_dir, v, &view, &info);
+        if (rc == 0 && (rc = hal_storage_mkdir_p(&j->hal->storage, j->view_dir)) != 0)
+            j->hal->log(HAL_LOG_ERROR, "cannot make %s: %s", j->view_dir, strerror(-rc));
+        if (rc == 0)
+            rc = save_results(j, &view, &rep);
+        if (rc == 0) {
+            char detail[HAL_MAX_PATH + 160];
+            describe(detail, sizeof(detail), &info, j->view_dir);
+            progress(j, "fused", (int)v, v + 1, detail);
+        }
+    }
+    return rc == 0 ? write_model(j) : rc;
 }
 
 /* ---- live ---- */
@@ -303,8 +378,7 @@ static int live_view(struct job *j, uint32_t v)
         return rc;
     }
     progress(j, "saving", (int)v, v, "");
-    struct icp_report reg;
-    rc = save_results(j, &view, &reg);
+    rc = scan_keep_for_registration(v, &view); /* the model is made once every view is in */
     if (rc == 0)
         rc = write_failed(j, "(the simulator's truth)", board_write_view_extras(hal, j->view_dir));
     /* view.ini last: its presence says the view is complete */
@@ -312,7 +386,7 @@ static int live_view(struct job *j, uint32_t v)
         rc = write_view_meta(j, &info, started, wall_ms() - t0);
     if (rc != 0)
         return rc;
-    describe(detail, sizeof(detail), &info, &reg, j->view_dir);
+    describe(detail, sizeof(detail), &info, j->view_dir);
     progress(j, "saved", (int)v, v + 1, detail);
     return 0;
 }
@@ -367,8 +441,7 @@ int scan_job_live(const struct hal *hal, const struct app_config *cfg,
                  strerror(-rc));
         goto out_unlock;
     }
-    rc = fusion_begin(&cfg->fusion);
-    icp_reset();
+    rc = begin_model(&j);
     if (rc == 0)
         rc = write_failed(&j, "(the simulator's truth)", board_write_scan_extras(hal, j.out_dir));
     if (rc != 0)
@@ -376,7 +449,7 @@ int scan_job_live(const struct hal *hal, const struct app_config *cfg,
     progress(&j, "scan_start", -1, 0, j.out_dir);
     rc = home_and_take_views(&j, 0);
     if (rc == 0)
-        rc = write_model(&j);
+        rc = make_model(&j, j.out_dir);
     if (rc == 0)
         progress(&j, "scan_done", -1, j.views, finished_detail(&j, path, sizeof(path)));
     else if (opts->json)
@@ -427,8 +500,7 @@ int scan_job_resume(const struct hal *hal, const struct app_config *cfg,
     snprintf(detail, sizeof(detail), "%u of %u views kept", (unsigned)first, (unsigned)cfg->views);
     progress(&j, "resume", -1, first, detail);
     if (first < cfg->views) {
-        rc = fusion_begin(&cfg->fusion); /* the model comes from scan_job_process afterwards */
-        icp_reset();
+        rc = begin_model(&j); /* the model comes from scan_job_process afterwards */
         if (rc == 0)
             rc = home_and_take_views(&j, first);
     }
@@ -478,7 +550,9 @@ int scan_job_feed_view(const char *scan_dir, uint32_t v, const struct scan_param
     return rc;
 }
 
-static int process_view(struct job *j, const char *scan_dir, uint32_t v)
+/* Decode view @p v of @p scan_dir from its kept frames, as it was decoded live. */
+static int load_view(struct job *j, const char *scan_dir, uint32_t v, struct scan_view *view,
+                     struct scan_view_info *info)
 {
     static struct scan_dir_view meta;
     const struct hal *hal = j->hal;
@@ -497,22 +571,21 @@ static int process_view(struct job *j, const char *scan_dir, uint32_t v)
         hal->log(HAL_LOG_ERROR, "%s", err);
         return rc;
     }
-    struct scan_view view;
-    struct scan_view_info info;
-    memset(&info, 0, sizeof(info));
-    rc = scan_finish_view(j->calib, meta.angle_mdeg, &view, &info);
+    memset(info, 0, sizeof(*info));
     set_view(j, v);
-    if (rc == 0 && (rc = hal_storage_mkdir_p(&hal->storage, j->view_dir)) != 0)
-        hal->log(HAL_LOG_ERROR, "cannot make %s: %s", j->view_dir, strerror(-rc));
-    struct icp_report reg;
-    if (rc == 0)
-        rc = save_results(j, &view, &reg);
-    if (rc == 0) {
-        char detail[HAL_MAX_PATH + 160];
-        describe(detail, sizeof(detail), &info, &reg, j->view_dir);
-        progress(j, "saved", (int)v, v + 1, detail);
-    }
-    return rc;
+    return scan_finish_view(j->calib, meta.angle_mdeg, view, info);
+}
+
+/* Stopped by request between views of the offline work: nothing is lost. */
+static int stopped_offline(struct job *j, const char *scan_dir, uint32_t v)
+{
+    if (!hal_should_stop(j->hal))
+        return 0;
+    j->hal->log(HAL_LOG_WARN,
+                "processing stopped by request before view %u; nothing of %s "
+                "is lost: 'scanner process %s' starts it again",
+                (unsigned)v, scan_dir, scan_dir);
+    return -EINTR;
 }
 
 int scan_job_process(const struct hal *hal, const char *scan_dir, const struct scan_job_opts *opts)
@@ -540,22 +613,24 @@ int scan_job_process(const struct hal *hal, const char *scan_dir, const struct s
                                                   j.out_dir)) != 0) /* how they were made */
         hal->log(HAL_LOG_ERROR, "cannot keep the settings in %s: %s", j.out_dir, strerror(-rc));
     if (rc == 0)
-        rc = fusion_begin(&cfg.fusion);
-    icp_reset();
+        rc = begin_model(&j);
     progress(&j, "process_start", -1, 0, scan_dir);
     for (uint32_t v = 0; v < cfg.views && rc == 0; v++) {
-        if (hal_should_stop(hal)) {
-            hal->log(HAL_LOG_WARN,
-                     "processing stopped by request before view %u; nothing of %s "
-                     "is lost: 'scanner process %s' starts it again",
-                     (unsigned)v, scan_dir, scan_dir);
-            rc = -EINTR;
-            break;
+        struct scan_view view;
+        struct scan_view_info info;
+        rc = stopped_offline(&j, scan_dir, v);
+        if (rc == 0)
+            rc = load_view(&j, scan_dir, v, &view, &info);
+        if (rc == 0)
+            rc = scan_keep_for_registration(v, &view);
+        if (rc == 0) {
+            char detail[HAL_MAX_PATH + 160];
+            describe(detail, sizeof(detail), &info, j.view_dir);
+            progress(&j, "decoded", (int)v, v + 1, detail);
         }
-        rc = process_view(&j, scan_dir, v);
     }
     if (rc == 0)
-        rc = write_model(&j);
+        rc = make_model(&j, scan_dir);
     if (rc == 0)
         progress(&j, "process_done", -1, j.views, finished_detail(&j, path, sizeof(path)));
     scan_dir_close(lock_fd);

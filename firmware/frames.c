@@ -18,14 +18,34 @@ void frame_table_from_camera(const struct scan_calib *calib, struct frame_xform 
 void frame_object_from_camera(const struct scan_calib *calib, int32_t angle_mdeg,
                               struct frame_xform *o)
 {
+    frame_object_from_camera_rad(calib, (double)angle_mdeg * (M_PI / 180000.0), o);
+}
+
+void frame_object_from_camera_rad(const struct scan_calib *calib, double angle_rad,
+                                  struct frame_xform *o)
+{
     struct frame_xform t;
     frame_table_from_camera(calib, &t);
     /* The table turned the object by +angle; undo it: Rz(-angle) * table_from_cam. */
-    double a = (double)angle_mdeg * (M_PI / 180000.0);
-    double c = cos(a), s = sin(a);
+    double c = cos(angle_rad), s = sin(angle_rad);
     double rz[9] = {c, s, 0, -s, c, 0, 0, 0, 1};
     m3_mul_m3(rz, t.rot, o->rot);
     o->origin = t.origin;
+}
+
+void frame_from_small_motion(const double x[6], struct frame_xform *d)
+{
+    vec3 w = v3(x[0], x[1], x[2]);
+    double th = v3_len(w);
+    vec3 k = th > 0.0 ? v3_scale(w, 1.0 / th) : v3(1, 0, 0);
+    double s = sin(th), c1 = 1.0 - cos(th);
+    /* Rodrigues: R = I + sin(th) K + (1 - cos(th)) K^2 */
+    double kx[9] = {0, -k.z, k.y, k.z, 0, -k.x, -k.y, k.x, 0}, kk[9];
+    m3_mul_m3(kx, kx, kk);
+    for (int e = 0; e < 9; e++)
+        d->rot[e] = (e % 4 == 0 ? 1.0 : 0.0) + s * kx[e] + c1 * kk[e];
+    /* p' = R p + t = R (p - origin) with origin = -R^T t */
+    d->origin = v3_scale(m3_tmul(d->rot, v3(x[3], x[4], x[5])), -1.0);
 }
 
 void frame_compose(const struct frame_xform *a, const struct frame_xform *b,

@@ -21,6 +21,14 @@ void frame_table_from_camera(const struct scan_calib *calib, struct frame_xform 
 void frame_object_from_camera(const struct scan_calib *calib, int32_t angle_mdeg,
                               struct frame_xform *obj_from_cam);
 
+/** The same for an angle in radians (a registered angle is not a whole millidegree). */
+void frame_object_from_camera_rad(const struct scan_calib *calib, double angle_rad,
+                                  struct frame_xform *obj_from_cam);
+
+/** The rigid motion p' = R p + t of a small rotation vector x[0..2] (rad) and translation
+ *  x[3..5]: the step of a linearised point-to-plane solve (Low 2004). */
+void frame_from_small_motion(const double x[6], struct frame_xform *out);
+
 /** Apply to a point. */
 static inline vec3 frame_point(const struct frame_xform *x, vec3 p)
 {

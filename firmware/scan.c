@@ -337,11 +337,9 @@ void scan_view_pose(const struct scan_calib *calib, const struct scan_view *view
     frame_object_from_camera(calib, view->angle_mdeg, obj_from_cam);
 }
 
-int scan_register_view(const struct icp_params *params, const struct scan_calib *calib,
-                       const struct scan_view *view, struct frame_xform *pose,
-                       struct icp_report *report)
+int scan_keep_for_registration(uint32_t index, const struct scan_view *view)
 {
-    return icp_register(params, calib, &view->maps, &view->range, view->rgb, pose, report);
+    return reg_add_view(index, view->angle_mdeg, &view->maps, &view->range, view->rgb);
 }
 
 int scan_fuse_view(const struct scan_calib *calib, const struct scan_view *view,

@@ -8,7 +8,7 @@
 #include "hal.h"
 #include "scan_types.h"
 #include "frames.h"
-#include "icp.h"
+#include "reg.h"
 #include "tri.h"
 
 /** What one view produced. */
@@ -85,11 +85,8 @@ int scan_finish_view(const struct scan_calib *calib, int32_t angle_mdeg, struct 
 void scan_view_pose(const struct scan_calib *calib, const struct scan_view *view,
                     struct frame_xform *obj_from_cam);
 
-/** Refine @p pose of @p view against the previous view (icp.h); @p view becomes the next
- *  reference. */
-int scan_register_view(const struct icp_params *params, const struct scan_calib *calib,
-                       const struct scan_view *view, struct frame_xform *pose,
-                       struct icp_report *report);
+/** Keep samples of @p view as view @p index of the joint registration (reg_begin first). */
+int scan_keep_for_registration(uint32_t index, const struct scan_view *view);
 
 /** Fuse @p view into the volume (fusion_begin first) seen through @p obj_from_cam. */
 int scan_fuse_view(const struct scan_calib *calib, const struct scan_view *view,

@@ -15,6 +15,8 @@ struct sim_config {
     double object_height_mm;
     double object_pose_deg[3]; /**< turned about x, then y, then z before it is stood on the
                                     table (90, 0, 0: an upright object on its side) */
+    double slip_mm[3];   /**< the object slips on the table by this (object frame) ... */
+    double slip_at_deg;  /**< ... from this table angle on */
     uint32_t segments; /**< tessellation of analytic shapes */
     char material[16]; /**< lambert | phong | merl */
     char merl_file[HAL_MAX_PATH];

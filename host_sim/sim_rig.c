@@ -405,12 +405,21 @@ static void update_pixel(struct sim_rig *rig, const struct frame_xform *obj, vec
         rig->proj_radiance[3 * i + k] = (float)(e * rho[k]);
 }
 
+/* Camera frame to object frame at table angle @p angle_mdeg: the turntable's, and the object
+ * moved on the table by [sim] slip_mm once the table has reached slip_at_deg. */
+static void object_frame(const struct sim_rig *rig, int32_t angle_mdeg, struct frame_xform *obj)
+{
+    frame_object_from_camera(&rig->calib, angle_mdeg, obj);
+    if (angle_mdeg >= rig->cfg.slip_at_deg * 1000.0) /* p_obj = R (p - o) - s */
+        obj->origin = v3_add(obj->origin, m3_tmul(obj->rot, v3_from(rig->cfg.slip_mm)));
+}
+
 void sim_rig_update(struct sim_rig *rig)
 {
     if (rig->truth_valid && rig->truth_angle_mdeg == rig->table_angle_mdeg)
         return;
     struct frame_xform obj;
-    frame_object_from_camera(&rig->calib, rig->table_angle_mdeg, &obj);
+    object_frame(rig, rig->table_angle_mdeg, &obj);
     vec3 cam_obj = frame_point(&obj, v3(0, 0, 0));
     vec3 proj_cam = projector_centre_cam(&rig->calib);
     vec3 proj_obj = frame_point(&obj, proj_cam);
@@ -428,7 +437,7 @@ static void ensure_light(struct sim_rig *rig, uint32_t li)
     if (rig->lights_done & (1u << li))
         return;
     struct frame_xform obj;
-    frame_object_from_camera(&rig->calib, rig->truth_angle_mdeg, &obj);
+    object_frame(rig, rig->truth_angle_mdeg, &obj);
     vec3 light_obj = frame_point(&obj, v3_from(rig->calib.light_pos_mm[li]));
     size_t n = (size_t)rig->width * rig->height;
     for (size_t i = 0; i < n; i++) {

@@ -159,7 +159,8 @@ check process_reproduces_scan sh -c "$bin process $out/scan --out $out/processed
 check json_events sh -c "$bin process $out/scan --out $out/processed --replace --json | /usr/bin/python3 -c '
 import json, sys
 events = [json.loads(line)[\"event\"] for line in sys.stdin]
-assert events[0] == \"process_start\" and events[-1] == \"process_done\" and \"saved\" in events, events'"
+assert events[0] == \"process_start\" and events[-1] == \"process_done\", events
+assert \"registration\" in events and events.count(\"fused\") == 8, events'"
 cp -r "$out/scan" "$out/broken" 2>/dev/null; rm -f "$out/broken/view_000/frame_07.png"
 check process_names_missing_frame sh -c "$bin process $out/broken --out $out/broken_out 2>&1 | \
     grep -q 'view_000/frame_07.png: No such file'; test \$? -eq 0"

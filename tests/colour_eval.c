@@ -378,7 +378,7 @@ static double registration_coupling(const char *result_dir, uint32_t views)
         FILE *f = fopen(path, "r");
         double share;
         while (f != NULL && fgets(line, sizeof(line), f) != NULL)
-            if (sscanf(line, "coupled_share_after = %lf", &share) == 1) {
+            if (sscanf(line, "coupled_share = %lf", &share) == 1) {
                 sum += share;
                 pairs++;
             }

@@ -29,12 +29,17 @@ struct mesh_comparison {
     double truth_observable_within_1mm; /**< of the observable surface, share within 1 mm */
     double truth_observable_to_result_mean_mm;
     double symmetric_observable_mean_mm; /**< result->truth and observable truth->result */
+    int aligned;                /**< the result was first moved onto the truth (rigid ICP) */
+    double align_deg, align_mm; /**< how far that moved it (rotation; a point 100 mm out) */
 };
 
-/** @retval 0 ok, or -errno with @p err saying which file */
+/** @param align  1: first move the result rigidly onto the truth (point-to-plane ICP against
+ *  the closest true points): a scan's frame is its first view's, and a table that missed that
+ *  view's angle turns the whole model, which says nothing of its shape
+ *  @retval 0 ok, or -errno with @p err saying which file */
 int mesh_compare_files(const char *result_ply, const char *truth_ply, uint32_t samples,
-                       const struct mesh_visibility *vis, struct mesh_comparison *out, char *err,
-                       size_t err_len);
+                       const struct mesh_visibility *vis, int align, struct mesh_comparison *out,
+                       char *err, size_t err_len);
 /** The rig of a scan directory (calibration.ini, config.ini views). @retval 0 or -errno */
 int mesh_visibility_from_scan(const char *scan_dir, struct mesh_visibility *vis, char *err,
                               size_t err_len);

@@ -4,6 +4,7 @@
 
 #include "config.h"
 #include "frames.h"
+#include "lsq.h"
 #include "scan_dir.h"
 #include "sim_bvh.h"
 #include "sim_random.h"
@@ -86,6 +87,47 @@ static int sample_distances(const struct sim_mesh *from, const struct sim_bvh *t
     return 0;
 }
 
+/* Move @p m rigidly onto the surface of @p truth: point-to-plane ICP of its vertices against
+ * their closest true points (the plane through the closest point, across p - q), pairs over
+ * 3 mm left out (a fringe, a fragment). @p deg, @p mm: how far it moved. */
+static void align_to_truth(struct sim_mesh *m, const struct sim_bvh *truth, double *deg,
+                           double *mm)
+{
+    uint32_t step = m->vert_count / 20000u + 1u;
+    struct frame_xform total = {{1, 0, 0, 0, 1, 0, 0, 0, 1}, {0, 0, 0}};
+    for (int it = 0; it < 30; it++) {
+        double a[36] = {0}, b[6] = {0}, x[6];
+        for (uint32_t i = 0; i < m->vert_count; i += step) {
+            vec3 p = v3(m->pos[3 * i], m->pos[3 * i + 1], m->pos[3 * i + 2]), q;
+            double d = sim_bvh_closest(truth, p, 3.0, &q);
+            if (d > 3.0 || d < 1e-9)
+                continue;
+            vec3 n = v3_scale(v3_sub(p, q), 1.0 / d), pxn = v3_cross(p, n);
+            double jac[6] = {pxn.x, pxn.y, pxn.z, n.x, n.y, n.z};
+            for (int r = 0; r < 6; r++) {
+                for (int c = 0; c < 6; c++)
+                    a[r * 6 + c] += jac[r] * jac[c];
+                b[r] -= jac[r] * d;
+            }
+        }
+        if (lsq_solve(6, a, b, x) != 0)
+            break;
+        struct frame_xform step_x, moved;
+        frame_from_small_motion(x, &step_x);
+        for (uint32_t i = 0; i < m->vert_count; i++) {
+            vec3 p = frame_point(&step_x, v3(m->pos[3 * i], m->pos[3 * i + 1], m->pos[3 * i + 2]));
+            m->pos[3 * i] = (float)p.x, m->pos[3 * i + 1] = (float)p.y, m->pos[3 * i + 2] = (float)p.z;
+        }
+        frame_compose(&step_x, &total, &moved);
+        total = moved;
+        if (v3_len(v3(x[0], x[1], x[2])) < 1e-8 && v3_len(v3(x[3], x[4], x[5])) < 1e-6)
+            break;
+    }
+    double tr = total.rot[0] + total.rot[4] + total.rot[8], c = 0.5 * (tr - 1.0);
+    *deg = acos(c > 1.0 ? 1.0 : c) * 180.0 / M_PI;
+    *mm = v3_len(v3_sub(frame_point(&total, v3(100, 0, 50)), v3(100, 0, 50)));
+}
+
 static int cmp_double(const void *a, const void *b)
 {
     double x = *(const double *)a, y = *(const double *)b;
@@ -93,8 +135,8 @@ static int cmp_double(const void *a, const void *b)
 }
 
 int mesh_compare_files(const char *result_ply, const char *truth_ply, uint32_t n,
-                       const struct mesh_visibility *vis, struct mesh_comparison *out, char *err,
-                       size_t err_len)
+                       const struct mesh_visibility *vis, int align, struct mesh_comparison *out,
+                       char *err, size_t err_len)
 {
     struct sim_mesh res, tru;
     struct sim_bvh res_bvh, tru_bvh;
@@ -110,17 +152,23 @@ int mesh_compare_files(const char *result_ply, const char *truth_ply, uint32_t n
     double *z1 = malloc(sizeof(double) * n), *z2 = malloc(sizeof(double) * n);
     uint8_t *observed = vis != NULL ? malloc(n) : NULL;
     rc = -1;
-    if (d1 && d2 && z1 && z2 && sim_bvh_build(&res_bvh, &res) == 0) {
-        if (sim_bvh_build(&tru_bvh, &tru) == 0) {
+    double align_deg = 0.0, align_mm = 0.0;
+    if (d1 && d2 && z1 && z2 && sim_bvh_build(&tru_bvh, &tru) == 0) {
+        if (align)
+            align_to_truth(&res, &tru_bvh, &align_deg, &align_mm);
+        if (sim_bvh_build(&res_bvh, &res) == 0) {
             rc = sample_distances(&res, &tru_bvh, n, d1, z1, NULL, NULL, NULL);
             if (rc == 0)
                 rc = sample_distances(&tru, &res_bvh, n, d2, z2, vis, &tru_bvh, observed);
-            sim_bvh_free(&tru_bvh);
+            sim_bvh_free(&res_bvh);
         }
-        sim_bvh_free(&res_bvh);
+        sim_bvh_free(&tru_bvh);
     }
     if (rc == 0) {
         memset(out, 0, sizeof(*out));
+        out->aligned = align;
+        out->align_deg = align_deg;
+        out->align_mm = align_mm;
         out->result_triangles = res.tri_count;
         double s1 = 0, s2 = 0, s2_seen = 0;
         uint32_t within = 0, seen = 0, seen_within = 0;
@@ -175,6 +223,9 @@ int mesh_compare_files(const char *result_ply, const char *truth_ply, uint32_t n
 
 void mesh_compare_print(const struct mesh_comparison *r, FILE *out)
 {
+    if (r->aligned)
+        fprintf(out, "aligned to the truth first: turned %.3f deg, moved %.3f mm\n", r->align_deg,
+                r->align_mm);
     fprintf(out,
             "result triangles: %u\n"
             "result -> truth: mean %.3f mm, 95%% %.3f mm, max %.3f mm\n"

@@ -43,6 +43,15 @@
 #define FUSION_MAX_DIM 400u
 #define FUSION_MAX_VOXELS (320u * 320u * 280u)
 #endif
+/* Joint registration (reg.h): the views of one scan (as many as [scan] views allows), and the
+ * samples kept of all of them together, 28 bytes each; a scan of many views keeps every n-th
+ * pixel with a larger n. */
+#define REG_MAX_VIEWS 360u
+#ifdef HAL_LIMITS_SMALL /* 8 views of 1280 x 960 at every 4th pixel, as the default build */
+#define REG_MAX_CELLS (640u * 1024u)
+#else
+#define REG_MAX_CELLS (1u << 20)
+#endif
 /* Largest stack frame a firmware/ function may have (gcc -fstack-usage, checked by make test:
  * scripts/check-stack.sh); big state lives in static buffers, never on the stack. */
 #define HAL_STACK_FRAME_MAX 2048u
@@ -63,6 +72,7 @@ HAL_STATIC_ASSERT(DECODE_MAX_PATTERNS <= 255u, "pattern indices are counted in s
 HAL_STATIC_ASSERT(HAL_MAX_LIGHTS <= 31u, "light masks are 32-bit words");
 HAL_STATIC_ASSERT(FUSION_MAX_VOXELS <= (uint64_t)FUSION_MAX_DIM * FUSION_MAX_DIM * FUSION_MAX_DIM,
                   "the voxel budget fits in a grid of the largest dimensions");
+HAL_STATIC_ASSERT(REG_MAX_CELLS / REG_MAX_VIEWS >= 64u, "every view keeps some samples");
 HAL_STATIC_ASSERT((uint64_t)FUSION_MAX_VOXELS * 3u < (1ull << 32),
                   "a mesh vertex per voxel edge (3 a voxel) is numbered in 32 bits");
 

@@ -1,0 +1,56 @@
+/* Gaussian elimination for the registrations' normal equations. */
+#include "lsq.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stddef.h>
+
+int lsq_solve(uint32_t n, double *a, double *b, double *x)
+{
+    double scale = 0.0;
+    for (uint32_t i = 0; i < n; i++)
+        scale = fmax(scale, fabs(a[(size_t)i * n + i]));
+    if (scale <= 0.0)
+        return -EDOM;
+    uint32_t rank = 0;
+    for (uint32_t c = 0; c < n; c++) {
+        uint32_t piv = c;
+        for (uint32_t r = c + 1; r < n; r++)
+            if (fabs(a[(size_t)r * n + c]) > fabs(a[(size_t)piv * n + c]))
+                piv = r;
+        for (uint32_t k = 0; k < n && piv != c; k++) {
+            double t = a[(size_t)c * n + k];
+            a[(size_t)c * n + k] = a[(size_t)piv * n + k];
+            a[(size_t)piv * n + k] = t;
+        }
+        double t = b[c];
+        b[c] = b[piv];
+        b[piv] = t;
+        double d = a[(size_t)c * n + c];
+        if (fabs(d) < 1e-12 * scale) { /* undetermined: leave this unknown at 0 */
+            a[(size_t)c * n + c] = 0.0;
+            continue;
+        }
+        rank++;
+        for (uint32_t r = c + 1; r < n; r++) {
+            double f = a[(size_t)r * n + c] / d;
+            if (f == 0.0)
+                continue;
+            for (uint32_t k = c; k < n; k++)
+                a[(size_t)r * n + k] -= f * a[(size_t)c * n + k];
+            b[r] -= f * b[c];
+        }
+    }
+    for (uint32_t r = n; r-- > 0;) {
+        double d = a[(size_t)r * n + r];
+        if (d == 0.0) {
+            x[r] = 0.0;
+            continue;
+        }
+        double s = b[r];
+        for (uint32_t k = r + 1; k < n; k++)
+            s -= a[(size_t)r * n + k] * x[k];
+        x[r] = s / d;
+    }
+    return rank > 0 ? 0 : -EDOM;
+}

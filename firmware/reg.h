@@ -1,0 +1,75 @@
+/* Joint registration of all views of a turntable scan: the views as turns about one axis, the
+ * axis re-estimated from the scan's own data and each view's angle free, every neighbouring pair
+ * of views (the last back to the first: the loop closure) pulled together by point-to-plane
+ * residuals at once, in static memory. */
+#ifndef REG_H
+#define REG_H
+
+#include "decode.h"
+#include "frames.h"
+#include "tri.h"
+
+struct reg_params {
+    uint32_t enabled;          /**< 0: keep the turntable poses */
+    uint32_t sample_stride;    /**< keep every n-th pixel of a view in x and y (at least) */
+    uint32_t iterations;       /**< Gauss-Newton steps, each with new pairs */
+    double max_pair_mm;        /**< a pair farther apart does not couple */
+    double max_normal_deg;     /**< nor one whose normals differ more */
+    uint32_t use_colour;       /**< 1: colours must agree too (multi-feature matching) */
+    double max_colour_dn;      /**< largest per-channel colour difference of a pair */
+    double max_correction_deg; /**< a view's angle may move this far from the reported one */
+    double max_axis_shift_mm;  /**< the axis may move this far from the calibrated one */
+    double max_axis_tilt_deg;  /**< and tilt this far */
+    double min_coupled_share;  /**< two neighbouring views coupling less of their overlap do
+                                    not match: the registration fails and names the view */
+};
+
+/** One view after registration. */
+struct reg_view {
+    int present;               /**< 0: never added */
+    int32_t reported_mdeg;     /**< the angle the table reported */
+    double angle_deg;          /**< the angle it is fused at */
+    double correction_deg;     /**< angle_deg - reported, relative to view 0's correction */
+    uint32_t overlap, coupled; /**< with its neighbours, at the final poses */
+    double rms_mm;             /**< point-to-plane residual of its coupled pairs */
+};
+
+/** The whole scan's registration. */
+struct reg_report {
+    uint32_t views, stride;    /**< views added; pixel stride of the kept samples */
+    int solved;                /**< 1: the joint adjustment ran (icp = 1, two views or more) */
+    int accepted;              /**< 1: its poses are used; 0: the turntable's */
+    uint32_t iterations;       /**< steps taken */
+    double score_before_mm, score_after_mm; /**< truncated residual over every overlap: the
+                                                 square root of mean(min(r, max_pair)^2) */
+    double rms_mm;             /**< point-to-plane residual of all coupled pairs, final */
+    double loop_rms_mm;        /**< of the closing pair (last view back to the first) */
+    double axis_shift_mm, axis_tilt_deg;   /**< the axis against the calibrated one */
+    uint32_t worst_view;       /**< the view with the largest residual */
+    double worst_rms_mm;
+    int failed_view;           /**< -1, or a view that does not match the one before it */
+    int failed_against;        /**< the view it was compared with */
+    double failed_share;       /**< the share of their overlap that coupled */
+    char refused[160];         /**< why a solved adjustment was not accepted ("" when it was) */
+};
+
+/** Forget every view and size the samples for @p views views of @p width x @p height: the
+ *  stride grows beyond params->sample_stride until they fit REG_MAX_CELLS.
+ *  @retval 0 @retval -E2BIG more views than REG_MAX_VIEWS */
+int reg_begin(const struct reg_params *params, const struct scan_calib *calib, uint32_t views,
+              uint32_t width, uint32_t height);
+
+/** Keep samples of view @p index (camera frame) taken at the reported @p angle_mdeg.
+ *  @retval 0 @retval -EINVAL index or size outside what reg_begin was given */
+int reg_add_view(uint32_t index, int32_t angle_mdeg, const struct decode_maps *maps,
+                 const struct tri_range *range, const uint8_t *rgb);
+
+/** Register every added view jointly. @param report out
+ *  @retval 0 (a failed match is reported in report->failed_view, not as an error) */
+int reg_solve(struct reg_report *report);
+
+/** View @p index after reg_solve: its pose (camera frame to object frame) and numbers.
+ *  @retval 0 @retval -EINVAL not added */
+int reg_view_pose(uint32_t index, struct frame_xform *obj_from_cam, struct reg_view *view);
+
+#endif
