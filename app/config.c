@@ -95,6 +95,9 @@ static const struct ini_key config_keys[] = {
     STR("scan", "calibration", calibration_file, NULL,
         "calibration file, relative to this config file"),
     STR("output", "dir", output_dir, "scans/latest", "scan directory (created if missing)"),
+    F64("output", "min_fragment_share", min_fragment_share, 0, 1, "0.01",
+        "floating pieces of the mesh with fewer triangles than this share of the largest piece "
+        "are left out of every output (0: keep every piece)"),
     STR("gpio", "chip", gpio.chip, "gpiochip0", "GPIO chip name or path"),
     GPIO("projector_enable", HAL_GPIO_PROJECTOR_ENABLE),
     GPIO("projector_trigger", HAL_GPIO_PROJECTOR_TRIGGER),

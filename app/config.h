@@ -29,6 +29,7 @@ struct app_config {
     double start_angle_deg;
     char calibration_file[HAL_MAX_PATH]; /**< resolved against the config file's directory */
     char output_dir[HAL_MAX_PATH];
+    double min_fragment_share; /**< [output]: smaller floating pieces are left out of the mesh */
     struct hal_gpio_config gpio;
     struct tt_client_config turntable;
     struct fusion_params fusion;

@@ -109,9 +109,9 @@ static void progress(struct job *j, const char *event, int view, uint32_t done, 
         if (left_s >= 0)
             printf(" (~%.0f s left)", left_s);
         printf("  %s %.*s", event, shown, detail);
-        if (strcmp(event, "saved") == 0)
+        if (strcmp(event, "saved") == 0 || strcmp(event, "fused") == 0)
             printf("\n");
-    } else if (view >= 0 && strcmp(event, "saved") == 0) {
+    } else if (view >= 0 && (strcmp(event, "saved") == 0 || strcmp(event, "fused") == 0)) {
         printf("view %d of %u: %s\n", view + 1, (unsigned)j->views, detail);
     } else if (view < 0) {
         static const char *const human[][2] = {{"scan_start", "scanning into"},
@@ -133,7 +133,7 @@ static const char *finished_detail(struct job *j, char *buf, size_t len)
 {
     struct rusage ru;
     getrusage(RUSAGE_SELF, &ru);
-    snprintf(buf, len, "%s (mesh: %s/mesh.ply, mesh.obj; peak memory %.1f MB)", j->out_dir,
+    snprintf(buf, len, "%s (mesh: %s/mesh.ply, mesh.obj, mesh.stl; peak memory %.1f MB)", j->out_dir,
              j->out_dir, ru.ru_maxrss / 1024.0);
     return buf;
 }
@@ -221,25 +221,42 @@ static void set_view(struct job *j, uint32_t view)
     scan_dir_path(j->view_dir, sizeof(j->view_dir), j->out_dir, (int)view, NULL);
 }
 
-/* The fused model: mesh.ply and mesh.obj in the scan directory. */
+/* The fused model: mesh.ply, mesh.obj and mesh.stl in the scan directory, without floating
+ * fragments. */
 static int write_model(struct job *j)
 {
-    char path[SCAN_DIR_PATH_MAX], detail[HAL_MAX_PATH + 96];
-    uint32_t vertices = 0, triangles = 0;
+    static const char *const names[] = {"mesh.ply", "mesh.obj", "mesh.stl"};
+    int (*const writers[])(const struct hal_storage *, const char *) = {
+        fusion_write_ply, fusion_write_obj, fusion_write_stl};
+    char path[SCAN_DIR_PATH_MAX], detail[HAL_MAX_PATH + 160];
+    struct mesh_summary ms;
     progress(j, "meshing", -1, j->views, "marching cubes");
-    int rc = scan_dir_path(path, sizeof(path), j->out_dir, -1, "mesh.ply");
-    if (rc == 0)
-        rc = fusion_write_ply(&j->hal->storage, path, &vertices, &triangles);
-    if (rc == 0)
-        rc = scan_dir_path(path, sizeof(path), j->out_dir, -1, "mesh.obj");
-    if (rc == 0)
-        rc = fusion_write_obj(&j->hal->storage, path);
-    if (rc != 0) {
-        j->hal->log(HAL_LOG_ERROR, "cannot write %s: %s", path, strerror(-rc));
+    int rc = fusion_mesh_prepare(j->cfg->min_fragment_share, &ms);
+    int fits = rc == 0;
+    if (rc == -E2BIG)
+        j->hal->log(HAL_LOG_WARN,
+                    "the mesh has %u vertices, more than MESH_MAX_VERTICES (%u): it is written "
+                    "whole, fragments and all, and without mesh.stl (a larger [fusion] voxel_mm "
+                    "makes a smaller mesh)",
+                    (unsigned)ms.vertices, MESH_MAX_VERTICES);
+    else if (rc != 0)
         return rc;
+    rc = 0;
+    for (size_t k = 0; k < sizeof(names) / sizeof(names[0]) && rc == 0; k++) {
+        if (!fits && writers[k] == fusion_write_stl)
+            continue;
+        rc = scan_dir_path(path, sizeof(path), j->out_dir, -1, names[k]);
+        if (rc == 0 && (rc = writers[k](&j->hal->storage, path)) != 0)
+            j->hal->log(HAL_LOG_ERROR, "cannot write %s: %s", path, strerror(-rc));
     }
-    snprintf(detail, sizeof(detail), "%u vertices, %u triangles -> %s/mesh.ply and mesh.obj",
-             (unsigned)vertices, (unsigned)triangles, j->out_dir);
+    if (rc != 0)
+        return rc;
+    snprintf(detail, sizeof(detail),
+             "%u vertices, %u triangles (%u floating fragments of %u pieces left out) -> "
+             "%s/mesh.ply, mesh.obj%s",
+             (unsigned)ms.kept_vertices, (unsigned)ms.kept_triangles,
+             (unsigned)ms.removed_pieces, (unsigned)ms.pieces, j->out_dir,
+             fits ? " and mesh.stl" : "");
     progress(j, "mesh", -1, j->views, detail);
     return 0;
 }
@@ -304,9 +321,11 @@ static int make_model(struct job *j, const char *scan_dir)
             j->hal->log(HAL_LOG_ERROR, "cannot make %s: %s", j->view_dir, strerror(-rc));
         if (rc == 0)
             rc = save_results(j, &view, &rep);
-        if (rc == 0) {
+        struct reg_view rv;
+        if (rc == 0 && reg_view_pose(v, NULL, &rv) == 0) {
             char detail[HAL_MAX_PATH + 160];
-            describe(detail, sizeof(detail), &info, j->view_dir);
+            snprintf(detail, sizeof(detail), "fused at %.3f deg (%+.3f deg from the table's) -> %s",
+                     rv.angle_deg, rv.correction_deg, j->view_dir);
             progress(j, "fused", (int)v, v + 1, detail);
         }
     }

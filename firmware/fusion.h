@@ -52,10 +52,27 @@ struct mesh_sink {
  *  @retval 0 or what the sink returned */
 int fusion_extract(const struct mesh_sink *sink);
 
-/** Write the mesh as binary PLY (vertex x y z nx ny nz red green blue, faces) and as OBJ (with
- *  vertex colours and normals), atomically. @retval 0 or -errno */
-int fusion_write_ply(const struct hal_storage *st, const char *path, uint32_t *vertices,
-                     uint32_t *triangles);
+/** What fusion_mesh_prepare found. */
+struct mesh_summary {
+    uint32_t vertices, triangles;           /**< the whole marching-cubes mesh */
+    uint32_t kept_vertices, kept_triangles; /**< what the writers write */
+    uint32_t pieces, removed_pieces;        /**< connected pieces; those left out */
+};
+
+/** Run marching cubes once to find the mesh's connected pieces: the writers then leave out
+ *  floating fragments, pieces with fewer than @p min_fragment_share of the largest piece's
+ *  triangles (0: keep every piece). Must come before the writers, after the last fusion.
+ *  @param summary  out
+ *  @retval 0 @retval -E2BIG more vertices than MESH_MAX_VERTICES: the writers keep every piece
+ *  and no STL can be written (PLY and OBJ still can) */
+int fusion_mesh_prepare(double min_fragment_share, struct mesh_summary *summary);
+
+/** Write the prepared mesh as binary PLY (vertex x y z nx ny nz red green blue, faces), as OBJ
+ *  (with vertex colours and normals) or as binary STL (for printing: triangles only), atomically,
+ *  in millimetres. @retval 0 @retval -EINVAL not prepared @retval -E2BIG (STL) the mesh did not
+ *  fit MESH_MAX_VERTICES @retval -errno from storage */
+int fusion_write_ply(const struct hal_storage *st, const char *path);
 int fusion_write_obj(const struct hal_storage *st, const char *path);
+int fusion_write_stl(const struct hal_storage *st, const char *path);
 
 #endif

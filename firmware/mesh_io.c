@@ -1,29 +1,153 @@
-/* The fused mesh as binary PLY and OBJ. PLY needs its counts first and its vertices before its
- * faces, so marching cubes runs three times (count, vertices, faces); it is deterministic. */
+/* The fused mesh as binary PLY, OBJ and binary STL, without its floating fragments.
+ *
+ * Marching cubes is deterministic, so the mesh is not stored: fusion_mesh_prepare runs it once to
+ * find the connected pieces (union-find over vertex numbers) and keep each vertex's position
+ * (STL repeats them per triangle), and each writer runs it again, renumbering the vertices it
+ * keeps. Without room for every vertex (more than MESH_MAX_VERTICES) nothing is left out and
+ * no STL is written; PLY and OBJ stream as before. */
 #include "fusion.h"
 #include "outbuf.h"
 #include "ply.h"
 
-struct mesh_count {
-    uint32_t vertices, triangles;
-};
+#include <errno.h>
+#include <string.h>
 
-static int count_vertex(void *priv, const float p[3], const float n[3], const uint8_t rgb[3])
+#define DROPPED 0xFFFFFFFFu
+
+static float mesh_pos[MESH_MAX_VERTICES * 3];
+/* Union-find parent of each vertex; after prepare, the vertex's new number or DROPPED. */
+static uint32_t mesh_index[MESH_MAX_VERTICES];
+static uint32_t mesh_tris[MESH_MAX_VERTICES]; /* triangles of the piece rooted here */
+
+static struct {
+    int prepared, fits; /* fits: every vertex had room (else nothing is dropped) */
+    struct mesh_summary s;
+} mp;
+
+static uint32_t find_root(uint32_t v)
 {
-    (void)p;
+    while (mesh_index[v] != v) {
+        mesh_index[v] = mesh_index[mesh_index[v]]; /* path halving */
+        v = mesh_index[v];
+    }
+    return v;
+}
+
+static void join(uint32_t a, uint32_t b)
+{
+    a = find_root(a);
+    b = find_root(b);
+    if (a != b) /* the larger number under the smaller: deterministic */
+        mesh_index[a > b ? a : b] = a < b ? a : b;
+}
+
+static int note_vertex(void *priv, const float p[3], const float n[3], const uint8_t rgb[3])
+{
+    (void)priv;
     (void)n;
     (void)rgb;
-    ((struct mesh_count *)priv)->vertices++;
+    uint32_t v = mp.s.vertices++;
+    if (v < MESH_MAX_VERTICES) {
+        memcpy(&mesh_pos[3 * (size_t)v], p, 3 * sizeof(float));
+        mesh_index[v] = v;
+    }
     return 0;
 }
 
-static int count_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
+static int note_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
 {
-    (void)a;
+    (void)priv;
+    mp.s.triangles++;
+    if (mp.s.vertices <= MESH_MAX_VERTICES) {
+        join(a, b);
+        join(b, c);
+    }
+    return 0;
+}
+
+static int count_piece(void *priv, uint32_t a, uint32_t b, uint32_t c)
+{
+    (void)priv;
     (void)b;
     (void)c;
-    ((struct mesh_count *)priv)->triangles++;
+    mesh_tris[find_root(a)]++;
     return 0;
+}
+
+int fusion_mesh_prepare(double min_fragment_share, struct mesh_summary *out)
+{
+    memset(&mp, 0, sizeof(mp));
+    struct mesh_sink pass1 = {note_vertex, note_triangle, NULL};
+    int rc = fusion_extract(&pass1);
+    if (rc != 0)
+        return rc;
+    mp.fits = mp.s.vertices <= MESH_MAX_VERTICES;
+    mp.s.kept_vertices = mp.s.vertices;
+    mp.s.kept_triangles = mp.s.triangles;
+    if (mp.fits) {
+        uint32_t n = mp.s.vertices, largest = 0, next = 0;
+        memset(mesh_tris, 0, n * sizeof(uint32_t));
+        struct mesh_sink pass2 = {NULL, count_piece, NULL};
+        fusion_extract(&pass2);
+        for (uint32_t v = 0; v < n; v++)
+            mesh_index[v] = find_root(v); /* every vertex straight to its root */
+        for (uint32_t v = 0; v < n; v++)
+            if (mesh_index[v] == v && mesh_tris[v] > largest)
+                largest = mesh_tris[v];
+        double keep_from = min_fragment_share * largest;
+        mp.s.kept_triangles = 0;
+        for (uint32_t v = 0; v < n; v++) {
+            uint32_t root = mesh_index[v], tris = mesh_tris[root];
+            int keep = tris > 0 && tris >= keep_from;
+            if (root == v) {
+                mp.s.pieces++;
+                mp.s.removed_pieces += !keep;
+                mp.s.kept_triangles += keep ? tris : 0;
+            }
+            mesh_index[v] = keep ? next++ : DROPPED; /* its root's entry is read before: root <= v */
+        }
+        mp.s.kept_vertices = next;
+    }
+    mp.prepared = 1;
+    *out = mp.s;
+    return mp.fits ? 0 : -E2BIG;
+}
+
+/* A writer's sink behind the filter: vertices renumbered, dropped ones and their triangles
+ * left out. */
+struct filtered {
+    const struct mesh_sink *to;
+    uint32_t next_vertex;
+};
+
+static int filter_vertex(void *priv, const float p[3], const float n[3], const uint8_t rgb[3])
+{
+    struct filtered *f = priv;
+    uint32_t v = f->next_vertex++;
+    if (mp.fits && mesh_index[v] == DROPPED)
+        return 0;
+    return f->to->vertex(f->to->priv, p, n, rgb);
+}
+
+static int filter_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
+{
+    struct filtered *f = priv;
+    if (!mp.fits)
+        return f->to->triangle(f->to->priv, a, b, c);
+    if (mesh_index[a] == DROPPED)
+        return 0;
+    return f->to->triangle(f->to->priv, mesh_index[a], mesh_index[b], mesh_index[c]);
+}
+
+/* Run marching cubes into @p sink through the filter. */
+static int extract_kept(const struct mesh_sink *sink)
+{
+    if (!mp.prepared)
+        return -EINVAL;
+    struct filtered f = {sink, 0};
+    struct mesh_sink through = {sink->vertex ? filter_vertex : NULL,
+                                sink->triangle ? filter_triangle : NULL, &f};
+    return fusion_extract(&through);
 }
 
 static int ply_vertex(void *priv, const float p[3], const float n[3], const uint8_t rgb[3])
@@ -44,28 +168,20 @@ static int ply_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
     return o->rc;
 }
 
-int fusion_write_ply(const struct hal_storage *st, const char *path, uint32_t *vertices,
-                     uint32_t *triangles)
+int fusion_write_ply(const struct hal_storage *st, const char *path)
 {
-    struct mesh_count count = {0, 0};
-    struct mesh_sink counter = {count_vertex, count_triangle, &count};
-    int rc = fusion_extract(&counter);
-    if (rc != 0)
-        return rc;
     struct outbuf o;
+    if (!mp.prepared)
+        return -EINVAL;
     if (outbuf_open(&o, st, path) != 0)
         return o.rc;
-    ply_put_header(&o, "fused mesh", count.vertices, count.triangles, 0);
+    /* PLY wants its counts first and its vertices before its faces: two more runs */
+    ply_put_header(&o, "fused mesh", mp.s.kept_vertices, mp.s.kept_triangles, 0);
     struct mesh_sink vertex_pass = {ply_vertex, NULL, &o};
     struct mesh_sink face_pass = {NULL, ply_triangle, &o};
-    fusion_extract(&vertex_pass);
-    fusion_extract(&face_pass);
-    rc = outbuf_close(&o);
-    if (rc == 0) {
-        *vertices = count.vertices;
-        *triangles = count.triangles;
-    }
-    return rc;
+    extract_kept(&vertex_pass);
+    extract_kept(&face_pass);
+    return outbuf_close(&o);
 }
 
 static int obj_vertex(void *priv, const float p[3], const float n[3], const uint8_t rgb[3])
@@ -87,10 +203,59 @@ static int obj_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
 int fusion_write_obj(const struct hal_storage *st, const char *path)
 {
     struct outbuf o;
+    if (!mp.prepared)
+        return -EINVAL;
     if (outbuf_open(&o, st, path) != 0)
         return o.rc;
     outbuf_printf(&o, "# turntable colour scanner: fused mesh; units: millimetres\n");
     struct mesh_sink sink = {obj_vertex, obj_triangle, &o};
-    fusion_extract(&sink);
+    extract_kept(&sink);
+    return outbuf_close(&o);
+}
+
+/* One STL facet: its normal (right-handed from the vertex order), then the three corners. The
+ * triangle callback gets the vertex numbers before renumbering: positions are looked up there. */
+static int stl_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
+{
+    struct outbuf *o = priv;
+    const float *p[3] = {&mesh_pos[3 * (size_t)a], &mesh_pos[3 * (size_t)b],
+                         &mesh_pos[3 * (size_t)c]};
+    vec3 e1 = v3(p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]);
+    vec3 e2 = v3(p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]);
+    vec3 n = v3_cross(e1, e2);
+    double len = v3_len(n);
+    n = len > 0.0 ? v3_scale(n, 1.0 / len) : v3(0, 0, 0);
+    outbuf_f32le(o, (float)n.x);
+    outbuf_f32le(o, (float)n.y);
+    outbuf_f32le(o, (float)n.z);
+    for (int k = 0; k < 3; k++)
+        for (int d = 0; d < 3; d++)
+            outbuf_f32le(o, p[k][d]);
+    static const uint8_t no_attribute[2] = {0, 0};
+    outbuf_put(o, no_attribute, 2);
+    return o->rc;
+}
+
+static int stl_kept_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
+{
+    return mesh_index[a] == DROPPED ? 0 : stl_triangle(priv, a, b, c);
+}
+
+int fusion_write_stl(const struct hal_storage *st, const char *path)
+{
+    struct outbuf o;
+    if (!mp.prepared)
+        return -EINVAL;
+    if (!mp.fits)
+        return -E2BIG;
+    if (outbuf_open(&o, st, path) != 0)
+        return o.rc;
+    char header[80]; /* must not begin with "solid": readers would take it for ASCII STL */
+    memset(header, 0, sizeof(header));
+    strncpy(header, "turntable colour scanner: fused mesh, units millimetres", sizeof(header) - 1);
+    outbuf_put(&o, header, sizeof(header));
+    outbuf_u32le(&o, mp.s.kept_triangles);
+    struct mesh_sink sink = {NULL, stl_kept_triangle, &o};
+    fusion_extract(&sink); /* the original vertex numbers: mesh_pos is indexed by them */
     return outbuf_close(&o);
 }

@@ -19,6 +19,7 @@ struct mesh_visibility {
 
 struct mesh_comparison {
     uint32_t result_triangles;
+    uint32_t result_pieces;     /**< connected pieces of the result (1: no floating fragment) */
     double result_to_truth_mean_mm, result_to_truth_p95_mm, result_to_truth_max_mm;
     double truth_to_result_mean_mm;
     double truth_within_1mm;          /**< share of the true surface within 1 mm of the result */

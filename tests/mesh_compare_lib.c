@@ -128,6 +128,39 @@ static void align_to_truth(struct sim_mesh *m, const struct sim_bvh *truth, doub
     *mm = v3_len(v3_sub(frame_point(&total, v3(100, 0, 50)), v3(100, 0, 50)));
 }
 
+static uint32_t root_of(uint32_t *parent, uint32_t v)
+{
+    while (parent[v] != v)
+        v = parent[v] = parent[parent[v]];
+    return v;
+}
+
+/* Connected pieces of @p m (vertices joined by its triangles; unused vertices not counted). */
+static uint32_t count_pieces(const struct sim_mesh *m)
+{
+    uint32_t *parent = malloc(sizeof(uint32_t) * m->vert_count), pieces = 0;
+    uint8_t *used = calloc(m->vert_count, 1);
+    if (parent == NULL || used == NULL) {
+        free(parent);
+        free(used);
+        return 0;
+    }
+    for (uint32_t v = 0; v < m->vert_count; v++)
+        parent[v] = v;
+    for (uint32_t t = 0; t < m->tri_count; t++)
+        for (int k = 0; k < 3; k++) {
+            uint32_t a = root_of(parent, m->tri[3 * t + k]);
+            uint32_t b = root_of(parent, m->tri[3 * t + (k + 1) % 3]);
+            parent[a] = b;
+            used[m->tri[3 * t + k]] = 1;
+        }
+    for (uint32_t v = 0; v < m->vert_count; v++)
+        pieces += used[v] && root_of(parent, v) == v;
+    free(parent);
+    free(used);
+    return pieces;
+}
+
 static int cmp_double(const void *a, const void *b)
 {
     double x = *(const double *)a, y = *(const double *)b;
@@ -170,6 +203,7 @@ int mesh_compare_files(const char *result_ply, const char *truth_ply, uint32_t n
         out->align_deg = align_deg;
         out->align_mm = align_mm;
         out->result_triangles = res.tri_count;
+        out->result_pieces = count_pieces(&res);
         double s1 = 0, s2 = 0, s2_seen = 0;
         uint32_t within = 0, seen = 0, seen_within = 0;
         for (uint32_t i = 0; i < n; i++) {
@@ -227,7 +261,7 @@ void mesh_compare_print(const struct mesh_comparison *r, FILE *out)
         fprintf(out, "aligned to the truth first: turned %.3f deg, moved %.3f mm\n", r->align_deg,
                 r->align_mm);
     fprintf(out,
-            "result triangles: %u\n"
+            "result triangles: %u in %u connected pieces\n"
             "result -> truth: mean %.3f mm, 95%% %.3f mm, max %.3f mm\n"
             "truth -> result: mean %.3f mm, within 1 mm %.2f%%\n"
             "truth above the table (z >= 1 mm) -> result: mean %.3f mm, within 1 mm %.2f%%\n"
@@ -235,7 +269,7 @@ void mesh_compare_print(const struct mesh_comparison *r, FILE *out)
             "observable true surface: %.2f%% of it; within 1 mm of the result %.2f%%, mean "
             "distance %.3f mm\n"
             "symmetric mean surface distance over the observable surface: %.3f mm\n",
-            (unsigned)r->result_triangles, r->result_to_truth_mean_mm, r->result_to_truth_p95_mm,
+            (unsigned)r->result_triangles, (unsigned)r->result_pieces, r->result_to_truth_mean_mm, r->result_to_truth_p95_mm,
             r->result_to_truth_max_mm, r->truth_to_result_mean_mm, 100.0 * r->truth_within_1mm,
             r->truth_seen_to_result_mean_mm, 100.0 * r->truth_seen_within_1mm,
             r->symmetric_mean_mm, 100.0 * r->observable_share,

@@ -6,11 +6,13 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "fusion.h"
 #include "mc_table.h"
+#include "storage_posix.h"
 
 struct collected {
     float *pos;
@@ -169,6 +171,77 @@ static void test_random_blobs_stay_closed(void **state)
     free(c.tri);
 }
 
+/* A sphere and a crumb floating beside it (what a stray reflection leaves in a scan). */
+static double sphere_and_crumb(vec3 p, void *ctx)
+{
+    (void)ctx;
+    double crumb = v3_len(v3_sub(p, v3(25.0, 0.0, 52.0))) - 2.5;
+    return fmin(sphere(p, NULL), crumb);
+}
+
+/* "element NAME N" from a PLY header. */
+static long ply_count(const char *path, const char *name)
+{
+    char line[128], want[64];
+    long n = -1;
+    snprintf(want, sizeof(want), "element %s %%ld", name);
+    FILE *f = fopen(path, "rb");
+    while (f != NULL && fgets(line, sizeof(line), f) != NULL && strncmp(line, "end_header", 10))
+        if (sscanf(line, want, &n) == 1)
+            break;
+    if (f != NULL)
+        fclose(f);
+    return n;
+}
+
+/* The crumb is left out of every output; the STL holds the sphere's triangles, outward. */
+static void test_fragments_left_out_and_stl(void **state)
+{
+    (void)state;
+    struct collected whole;
+    extract(sphere_and_crumb, NULL, &whole);
+    struct mesh_summary ms;
+    assert_int_equal(fusion_mesh_prepare(0.05, &ms), 0);
+    assert_int_equal(ms.vertices, whole.nv);
+    assert_int_equal(ms.triangles, whole.nt);
+    assert_int_equal(ms.pieces, 2);
+    assert_int_equal(ms.removed_pieces, 1);
+    assert_true(ms.kept_triangles < ms.triangles && ms.kept_triangles > 0.9 * ms.triangles);
+    struct hal_storage st;
+    storage_posix_init(&st);
+    assert_int_equal(system("mkdir -p build/test_fusion"), 0);
+    assert_int_equal(fusion_write_ply(&st, "build/test_fusion/mesh.ply"), 0);
+    assert_int_equal(fusion_write_stl(&st, "build/test_fusion/mesh.stl"), 0);
+    assert_int_equal(ply_count("build/test_fusion/mesh.ply", "vertex"), ms.kept_vertices);
+    assert_int_equal(ply_count("build/test_fusion/mesh.ply", "face"), ms.kept_triangles);
+    FILE *f = fopen("build/test_fusion/mesh.stl", "rb");
+    assert_non_null(f);
+    char header[80];
+    uint32_t count = 0;
+    assert_int_equal(fread(header, 1, 80, f), 80);
+    assert_true(strncmp(header, "solid", 5) != 0); /* not mistaken for ASCII STL */
+    assert_int_equal(fread(&count, 4, 1, f), 1);   /* little-endian host */
+    assert_int_equal(count, ms.kept_triangles);
+    for (uint32_t t = 0; t < count; t++) {
+        float v[12];
+        uint16_t attr;
+        assert_int_equal(fread(v, sizeof(float), 12, f), 12);
+        assert_int_equal(fread(&attr, 2, 1, f), 1);
+        vec3 n = v3(v[0], v[1], v[2]), a = v3(v[3], v[4], v[5]);
+        assert_true(fabs(v3_len(n) - 1.0) < 1e-4);
+        for (int k = 0; k < 3; k++) /* on the sphere, none on the crumb */
+            assert_true(fabs(sphere(v3(v[3 + 3 * k], v[4 + 3 * k], v[5 + 3 * k]), NULL)) < 0.05);
+        assert_true(v3_dot(n, v3_sub(a, v3(0.3, -0.2, 30.1))) > 0.0);
+    }
+    assert_int_equal(fgetc(f), EOF);
+    fclose(f);
+    assert_int_equal(fusion_mesh_prepare(0.0, &ms), 0); /* 0: every piece kept */
+    assert_int_equal(ms.removed_pieces, 0);
+    assert_int_equal(ms.kept_triangles, whole.nt);
+    free(whole.pos);
+    free(whole.tri);
+}
+
 /* The generated table: complementary cases mirror each other, and every case's triangles are
  * edges of the cube where the sign changes. */
 static void test_table_properties(void **state)
@@ -197,6 +270,7 @@ int main(void)
         cmocka_unit_test(test_sphere_is_closed_genus_0),
         cmocka_unit_test(test_torus_is_closed_genus_1),
         cmocka_unit_test(test_random_blobs_stay_closed),
+        cmocka_unit_test(test_fragments_left_out_and_stl),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -44,10 +44,11 @@ static void scan_and_compare(const char *object, const char *transport, uint32_t
     scan_dir_path(truth, sizeof(truth), dir, -1, "truth_mesh.ply");
     assert_int_equal(mesh_visibility_from_scan(dir, &vis, err, sizeof(err)), 0);
     assert_int_equal(mesh_compare_files(mesh, truth, 100000, &vis, align, r, err, sizeof(err)), 0);
-    print_message("%s over %s, table error up to %u mdeg: result->truth mean %.3f mm%s; "
+    print_message("%s over %s, table error up to %u mdeg: %u piece(s), result->truth mean %.3f mm%s; "
                   "observable surface %.1f%%, within 1 mm %.2f%%; symmetric mean %.3f mm (all of "
                   "the truth: within 1 mm %.1f%%)\n",
-                  object, transport, (unsigned)table_error_mdeg, r->result_to_truth_mean_mm,
+                  object, transport, (unsigned)table_error_mdeg, (unsigned)r->result_pieces,
+                  r->result_to_truth_mean_mm,
                   align ? " (aligned)" : "", 100.0 * r->observable_share,
                   100.0 * r->truth_observable_within_1mm, r->symmetric_observable_mean_mm,
                   100.0 * r->truth_within_1mm);
@@ -55,6 +56,7 @@ static void scan_and_compare(const char *object, const char *transport, uint32_t
     assert_true(r->symmetric_observable_mean_mm < 0.3);
     assert_true(r->truth_observable_within_1mm >= 0.95);
     assert_true(r->observable_share > 0.7); /* the measure must not hide a blind rig */
+    assert_int_equal(r->result_pieces, 1);  /* floating fragments left out */
 }
 
 /* "key = number" from an INI file. */
