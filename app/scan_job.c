@@ -118,6 +118,7 @@ static void progress(struct job *j, const char *event, int view, uint32_t done, 
                                                {"scan_done", "scan finished:"},
                                                {"scan_failed", "scan failed:"},
                                                {"process_start", "processing"},
+                                               {"registration", "registration:"},
                                                {"process_done", "process finished:"}};
         const char *text = event;
         for (size_t k = 0; k < sizeof(human) / sizeof(human[0]); k++)
@@ -282,11 +283,12 @@ static int report_registration(struct job *j, const struct reg_report *r, double
                                          "view)");
     else
         snprintf(detail, sizeof(detail),
-                 "%s: residual %.3f mm, loop closure %.3f mm, worst view %u (%.3f mm); axis moved "
-                 "%.2f mm, tilted %.3f deg; %.2f s CPU%s%s",
-                 r->accepted ? "registered" : "turntable angles kept", r->rms_mm, r->loop_rms_mm,
-                 (unsigned)r->worst_view, r->worst_rms_mm, r->axis_shift_mm, r->axis_tilt_deg,
-                 cpu_seconds, r->accepted ? "" : ": ", r->refused);
+                 "residual %.3f mm, loop closure %.3f mm, worst view %u (%.3f mm); axis moved "
+                 "%.2f mm, tilted %.3f deg; %.2f s CPU; %s%s",
+                 r->rms_mm, r->loop_rms_mm, (unsigned)r->worst_view, r->worst_rms_mm,
+                 r->axis_shift_mm, r->axis_tilt_deg, cpu_seconds,
+                 r->accepted ? "the views' angles corrected" : "turntable angles kept: ",
+                 r->accepted ? "" : r->refused);
     progress(j, "registration", -1, j->views, detail);
     if (!r->solved || r->failed_view < 0)
         return 0;
