@@ -95,6 +95,12 @@ static const struct ini_key config_keys[] = {
     STR("scan", "calibration", calibration_file, NULL,
         "calibration file, relative to this config file"),
     STR("output", "dir", output_dir, "scans/latest", "scan directory (created if missing)"),
+    F64("output", "max_hole_mm", max_hole_mm, 0, 100, "0",
+        "holes in the model up to this wide are filled (in the volume, from the surface around "
+        "them; the filling also extends open edges by half this); 0: none, nothing invented"),
+    U32("output", "watertight", watertight, 0, 1, "0",
+        "1: close the model for printing: at the table plane, and what no camera saw under a "
+        "surface or behind a hole up to max_hole_mm is solid (needs max_hole_mm > 0)"),
     F64("output", "min_fragment_share", min_fragment_share, 0, 1, "0.01",
         "floating pieces of the mesh with fewer triangles than this share of the largest piece "
         "are left out of every output (0: keep every piece)"),
@@ -515,6 +521,13 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
     if (strcmp(cb->board, "charuco") == 0 && cb->marker_mm >= cb->square_mm) {
         snprintf(err, err_len, "%s: [calibrate] marker_mm: %g must be below square_mm %g", path,
                  cb->marker_mm, cb->square_mm);
+        return -EINVAL;
+    }
+    if (cfg->watertight && cfg->max_hole_mm <= 0.0) {
+        snprintf(err, err_len,
+                 "%s: [output] watertight: a closed model needs max_hole_mm > 0, the widest hole "
+                 "to close (e.g. 10)",
+                 path);
         return -EINVAL;
     }
     return load_sim_rig(cfg, path, err, err_len);

@@ -30,6 +30,8 @@ struct app_config {
     char calibration_file[HAL_MAX_PATH]; /**< resolved against the config file's directory */
     char output_dir[HAL_MAX_PATH];
     double min_fragment_share; /**< [output]: smaller floating pieces are left out of the mesh */
+    double max_hole_mm;        /**< [output]: holes up to this wide are filled */
+    uint32_t watertight;       /**< [output]: 1: the model is closed */
     struct hal_gpio_config gpio;
     struct tt_client_config turntable;
     struct fusion_params fusion;

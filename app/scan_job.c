@@ -231,8 +231,13 @@ static int write_model(struct job *j)
         fusion_write_ply, fusion_write_obj, fusion_write_stl};
     char path[SCAN_DIR_PATH_MAX], detail[HAL_MAX_PATH + 160];
     struct mesh_summary ms;
+    uint32_t filled = 0, inside = 0;
     progress(j, "meshing", -1, j->views, "marching cubes");
-    int rc = fusion_mesh_prepare(j->cfg->min_fragment_share, &ms);
+    int rc = fusion_fill_holes(j->cfg->max_hole_mm, &filled);
+    if (rc == 0 && j->cfg->watertight)
+        rc = fusion_close_watertight(j->cfg->max_hole_mm, &inside);
+    if (rc == 0)
+        rc = fusion_mesh_prepare(j->cfg->min_fragment_share, &ms);
     int fits = rc == 0;
     if (rc == -E2BIG)
         j->hal->log(HAL_LOG_WARN,
@@ -253,10 +258,11 @@ static int write_model(struct job *j)
     if (rc != 0)
         return rc;
     snprintf(detail, sizeof(detail),
-             "%u vertices, %u triangles (%u floating fragments of %u pieces left out) -> "
-             "%s/mesh.ply, mesh.obj%s",
+             "%u vertices, %u triangles (%u floating fragments of %u pieces left out; %u voxels "
+             "filled holes%s) -> %s/mesh.ply, mesh.obj%s",
              (unsigned)ms.kept_vertices, (unsigned)ms.kept_triangles,
-             (unsigned)ms.removed_pieces, (unsigned)ms.pieces, j->out_dir,
+             (unsigned)ms.removed_pieces, (unsigned)ms.pieces, (unsigned)filled,
+             j->cfg->watertight ? ", closed watertight" : "", j->out_dir,
              fits ? " and mesh.stl" : "");
     progress(j, "mesh", -1, j->views, detail);
     return 0;

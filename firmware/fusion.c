@@ -1,5 +1,6 @@
 /* Truncated signed distance fusion in a static voxel grid, and marching cubes over it. */
 #include "fusion.h"
+#include "fusion_grid.h"
 
 #include "camray.h"
 #include "lens.h"
@@ -10,19 +11,7 @@
 #include <stdio.h>
 #include <string.h>
 
-/* 8 bytes: distance in units of truncation / 32767, weight in thousandths, colour, and the
- * colour's own weight in 1/32 (it saturates at ~8: a voxel's colour stops changing once about
- * eight good views agree). The colour has its own weight because a colour estimate can be
- * unreliable (a highlight, a grazing light) where the geometry is fine. */
-struct voxel {
-    int16_t sdf;
-    uint16_t weight;
-    uint8_t rgb[3];
-    uint8_t colour_weight;
-};
-_Static_assert(sizeof(struct voxel) == 8, "voxel layout");
-
-static struct voxel grid[FUSION_MAX_VOXELS];
+struct voxel fusion_grid[FUSION_MAX_VOXELS];
 static float weight_map[HAL_MAX_PIXELS];
 static uint16_t edge_dist[HAL_MAX_PIXELS];
 /* vertex numbers of the grid edges of two sample planes (x, y edges) and between them (z) */
@@ -30,15 +19,9 @@ static uint32_t edge_vertex_x[2][FUSION_MAX_DIM * FUSION_MAX_DIM];
 static uint32_t edge_vertex_y[2][FUSION_MAX_DIM * FUSION_MAX_DIM];
 static uint32_t edge_vertex_z[FUSION_MAX_DIM * FUSION_MAX_DIM];
 
-static struct {
-    struct fusion_params p;
-    uint32_t dims[3];
-    vec3 origin; /* object-frame position of voxel (0, 0, 0) */
-} fz;
+struct fusion_state fusion_vol;
 
 #define NO_VERTEX 0xFFFFFFFFu
-#define WEIGHT_SCALE 1000.0
-#define COLOUR_WEIGHT_SCALE 32.0
 
 int fusion_dims(const struct fusion_params *p, uint32_t dims[3])
 {
@@ -57,20 +40,16 @@ int fusion_dims(const struct fusion_params *p, uint32_t dims[3])
 
 int fusion_begin(const struct fusion_params *p)
 {
-    int rc = fusion_dims(p, fz.dims);
+    int rc = fusion_dims(p, fusion_vol.dims);
     if (rc != 0)
         return rc;
-    fz.p = *p;
-    fz.origin = v3(-p->radius_mm, -p->radius_mm, p->bottom_mm);
-    memset(grid, 0, (size_t)fz.dims[0] * fz.dims[1] * fz.dims[2] * sizeof(grid[0]));
+    fusion_vol.p = *p;
+    fusion_vol.origin = v3(-p->radius_mm, -p->radius_mm, p->bottom_mm);
+    memset(fusion_grid, 0, (size_t)fusion_vol.dims[0] * fusion_vol.dims[1] * fusion_vol.dims[2] * sizeof(fusion_grid[0]));
     mc_table_build();
     return 0;
 }
 
-static size_t vidx(uint32_t x, uint32_t y, uint32_t z)
-{
-    return ((size_t)z * fz.dims[1] + y) * fz.dims[0] + x;
-}
 
 /* City-block distance of each valid pixel to the nearest invalid one (two passes), capped. */
 static void distance_to_edge(const struct decode_maps *m, uint16_t cap)
@@ -108,8 +87,8 @@ static void distance_to_edge(const struct decode_maps *m, uint16_t cap)
 static void pixel_weights(const struct scan_calib *c, const struct decode_maps *m,
                           const struct tri_range *r)
 {
-    const double fade = fz.p.edge_fade_px > 0 ? (double)fz.p.edge_fade_px : 1.0;
-    distance_to_edge(m, (uint16_t)(fz.p.edge_fade_px > 0 ? fz.p.edge_fade_px : 1));
+    const double fade = fusion_vol.p.edge_fade_px > 0 ? (double)fusion_vol.p.edge_fade_px : 1.0;
+    distance_to_edge(m, (uint16_t)(fusion_vol.p.edge_fade_px > 0 ? fusion_vol.p.edge_fade_px : 1));
     for (uint32_t y = 0; y < m->height; y++) {
         for (uint32_t x = 0; x < m->width; x++) {
             size_t i = (size_t)y * m->width + x;
@@ -120,7 +99,7 @@ static void pixel_weights(const struct scan_calib *c, const struct decode_maps *
             vec3 n = v3(r->normal[3 * i], r->normal[3 * i + 1], r->normal[3 * i + 2]);
             double head_on = -v3_dot(n, ray), z = r->xyz_mm[3 * i + 2];
             double w = head_on * (600.0 / z) * (600.0 / z) * fmin(1.0, edge_dist[i] / fade);
-            weight_map[i] = w >= fz.p.min_weight ? (float)w : 0.0f;
+            weight_map[i] = w >= fusion_vol.p.min_weight ? (float)w : 0.0f;
         }
     }
 }
@@ -142,7 +121,7 @@ static void fuse_colour(struct voxel *vx, double cw, const uint8_t *rgb)
 
 static void fuse_voxel(struct voxel *vx, double sdf, double w, double cw, const uint8_t *rgb)
 {
-    double trunc = fz.p.truncation_mm;
+    double trunc = fusion_vol.p.truncation_mm;
     if (sdf > trunc)
         sdf = trunc;
     double old_w = vx->weight / WEIGHT_SCALE, old_s = vx->sdf / 32767.0 * trunc;
@@ -151,7 +130,7 @@ static void fuse_voxel(struct voxel *vx, double sdf, double w, double cw, const 
     if (fabs(sdf) < trunc) /* colour comes from near the surface only */
         fuse_colour(vx, cw, rgb);
     vx->sdf = (int16_t)lround(s / trunc * 32767.0);
-    vx->weight = (uint16_t)lround(fmin(new_w, fz.p.max_weight) * WEIGHT_SCALE);
+    vx->weight = (uint16_t)lround(fmin(new_w, fusion_vol.p.max_weight) * WEIGHT_SCALE);
 }
 
 /* Voxels this view can change: those within the truncation band of its fused points. Voxels
@@ -168,19 +147,19 @@ static int view_box(const struct frame_xform *obj_from_cam, const struct decode_
             continue;
         vec3 p = frame_point(obj_from_cam, v3(r->xyz_mm[3 * i], r->xyz_mm[3 * i + 1],
                                               r->xyz_mm[3 * i + 2]));
-        double pa[3] = {p.x, p.y, p.z}, oa[3] = {fz.origin.x, fz.origin.y, fz.origin.z};
+        double pa[3] = {p.x, p.y, p.z}, oa[3] = {fusion_vol.origin.x, fusion_vol.origin.y, fusion_vol.origin.z};
         for (int a = 0; a < 3; a++) {
-            double g = (pa[a] - oa[a]) / fz.p.voxel_mm;
+            double g = (pa[a] - oa[a]) / fusion_vol.p.voxel_mm;
             mn[a] = g < mn[a] ? g : mn[a];
             mx[a] = g > mx[a] ? g : mx[a];
         }
         any = 1;
     }
-    double margin = fz.p.truncation_mm / fz.p.voxel_mm + 1.0;
+    double margin = fusion_vol.p.truncation_mm / fusion_vol.p.voxel_mm + 1.0;
     for (int a = 0; a < 3 && any; a++) {
         double l = floor(mn[a] - margin), h = ceil(mx[a] + margin);
         lo[a] = l < 0.0 ? 0u : (uint32_t)l;
-        hi[a] = h > fz.dims[a] - 1.0 ? fz.dims[a] - 1u : (uint32_t)h;
+        hi[a] = h > fusion_vol.dims[a] - 1.0 ? fusion_vol.dims[a] - 1u : (uint32_t)h;
         any = lo[a] <= hi[a];
     }
     return any;
@@ -191,7 +170,7 @@ int fusion_integrate(const struct scan_calib *c, const struct frame_xform *obj_f
                      const float *confidence)
 {
     pixel_weights(c, m, r);
-    const double trunc = fz.p.truncation_mm, vox = fz.p.voxel_mm;
+    const double trunc = fusion_vol.p.truncation_mm, vox = fusion_vol.p.voxel_mm;
     const int pinhole = lens_is_pinhole(c->cam_dist); /* the voxel loop's common case, inline */
     const vec3 step_x = m3_tmul(obj_from_cam->rot, v3(vox, 0, 0));
     uint32_t lo[3], hi[3];
@@ -199,7 +178,7 @@ int fusion_integrate(const struct scan_calib *c, const struct frame_xform *obj_f
         return 0;
     for (uint32_t z = lo[2]; z <= hi[2]; z++) {
         for (uint32_t y = lo[1]; y <= hi[1]; y++) {
-            vec3 p_obj = v3_add(fz.origin, v3(lo[0] * vox, y * vox, z * vox));
+            vec3 p_obj = v3_add(fusion_vol.origin, v3(lo[0] * vox, y * vox, z * vox));
             vec3 p = frame_point_inv(obj_from_cam, p_obj); /* camera frame */
             for (uint32_t x = lo[0]; x <= hi[0]; x++, p = v3_add(p, step_x)) {
                 if (p.z <= 1.0)
@@ -223,7 +202,7 @@ int fusion_integrate(const struct scan_calib *c, const struct frame_xform *obj_f
                 if (sdf < -trunc)
                     continue; /* hidden behind the surface: this view knows nothing of it */
                 double w = weight_map[i], cw = confidence != NULL ? w * confidence[i] : w;
-                fuse_voxel(&grid[vidx(x, y, z)], sdf, w, cw, rgb + 3 * i);
+                fuse_voxel(&fusion_grid[vidx(x, y, z)], sdf, w, cw, rgb + 3 * i);
             }
         }
     }
@@ -232,13 +211,17 @@ int fusion_integrate(const struct scan_calib *c, const struct frame_xform *obj_f
 
 int fusion_fill(double (*sdf_mm)(vec3 p, void *ctx), void *ctx)
 {
-    for (uint32_t z = 0; z < fz.dims[2]; z++)
-        for (uint32_t y = 0; y < fz.dims[1]; y++)
-            for (uint32_t x = 0; x < fz.dims[0]; x++) {
-                struct voxel *v = &grid[vidx(x, y, z)];
-                double d = sdf_mm(v3_add(fz.origin, v3_scale(v3(x, y, z), fz.p.voxel_mm)), ctx);
-                d = fmax(-fz.p.truncation_mm, fmin(fz.p.truncation_mm, d));
-                v->sdf = (int16_t)lround(d / fz.p.truncation_mm * 32767.0);
+    for (uint32_t z = 0; z < fusion_vol.dims[2]; z++)
+        for (uint32_t y = 0; y < fusion_vol.dims[1]; y++)
+            for (uint32_t x = 0; x < fusion_vol.dims[0]; x++) {
+                struct voxel *v = &fusion_grid[vidx(x, y, z)];
+                double d = sdf_mm(v3_add(fusion_vol.origin, v3_scale(v3(x, y, z), fusion_vol.p.voxel_mm)), ctx);
+                if (isnan(d)) { /* never observed */
+                    memset(v, 0, sizeof(*v));
+                    continue;
+                }
+                d = fmax(-fusion_vol.p.truncation_mm, fmin(fusion_vol.p.truncation_mm, d));
+                v->sdf = (int16_t)lround(d / fusion_vol.p.truncation_mm * 32767.0);
                 v->weight = (uint16_t)WEIGHT_SCALE;
                 v->rgb[0] = v->rgb[1] = v->rgb[2] = 128;
                 v->colour_weight = (uint8_t)COLOUR_WEIGHT_SCALE;
@@ -250,15 +233,15 @@ int fusion_fill(double (*sdf_mm)(vec3 p, void *ctx), void *ctx)
 
 static double sdf_at(uint32_t x, uint32_t y, uint32_t z)
 {
-    return grid[vidx(x, y, z)].sdf / 32767.0 * fz.p.truncation_mm;
+    return fusion_grid[vidx(x, y, z)].sdf / 32767.0 * fusion_vol.p.truncation_mm;
 }
 
 /* Distance gradient at a sample (central differences, one-sided at the border): it points out. */
 static vec3 gradient(uint32_t x, uint32_t y, uint32_t z)
 {
     uint32_t lo[3] = {x ? x - 1 : x, y ? y - 1 : y, z ? z - 1 : z};
-    uint32_t hi[3] = {x + 1 < fz.dims[0] ? x + 1 : x, y + 1 < fz.dims[1] ? y + 1 : y,
-                      z + 1 < fz.dims[2] ? z + 1 : z};
+    uint32_t hi[3] = {x + 1 < fusion_vol.dims[0] ? x + 1 : x, y + 1 < fusion_vol.dims[1] ? y + 1 : y,
+                      z + 1 < fusion_vol.dims[2] ? z + 1 : z};
     return v3((sdf_at(hi[0], y, z) - sdf_at(lo[0], y, z)) / (double)(hi[0] - lo[0] + (hi[0] == lo[0])),
               (sdf_at(x, hi[1], z) - sdf_at(x, lo[1], z)) / (double)(hi[1] - lo[1] + (hi[1] == lo[1])),
               (sdf_at(x, y, hi[2]) - sdf_at(x, y, lo[2])) / (double)(hi[2] - lo[2] + (hi[2] == lo[2])));
@@ -279,16 +262,16 @@ static int edge_vertex(struct extract_state *st, const uint32_t s[3], int axis, 
     }
     uint32_t t[3] = {s[0], s[1], s[2]};
     t[axis]++;
-    const struct voxel *va = &grid[vidx(s[0], s[1], s[2])], *vb = &grid[vidx(t[0], t[1], t[2])];
+    const struct voxel *va = &fusion_grid[vidx(s[0], s[1], s[2])], *vb = &fusion_grid[vidx(t[0], t[1], t[2])];
     double da = sdf_at(s[0], s[1], s[2]), db = sdf_at(t[0], t[1], t[2]);
     /* Strictly inside the edge: a zero distance at a sample would otherwise put the vertices of
      * several edges on the same point (degenerate triangles, non-manifold fans). */
     double f = fmin(fmax(da / (da - db), 1e-3), 1.0 - 1e-3);
     vec3 ga = gradient(s[0], s[1], s[2]), gb = gradient(t[0], t[1], t[2]);
     vec3 n = v3_norm(v3_add(v3_scale(ga, 1.0 - f), v3_scale(gb, f)));
-    vec3 pos = v3_add(fz.origin, v3_scale(v3(s[0], s[1], s[2]), fz.p.voxel_mm));
+    vec3 pos = v3_add(fusion_vol.origin, v3_scale(v3(s[0], s[1], s[2]), fusion_vol.p.voxel_mm));
     double shift[3] = {0, 0, 0};
-    shift[axis] = f * fz.p.voxel_mm;
+    shift[axis] = f * fusion_vol.p.voxel_mm;
     pos = v3_add(pos, v3(shift[0], shift[1], shift[2]));
     float fp[3] = {(float)pos.x, (float)pos.y, (float)pos.z};
     float fn[3] = {(float)n.x, (float)n.y, (float)n.z};
@@ -304,7 +287,7 @@ static uint32_t *edge_slot(uint32_t x, uint32_t y, uint32_t z, int e)
 {
     unsigned a = mc_edge_corner[e][0]; /* the lower corner of the edge */
     uint32_t sx = x + (a & 1u), sy = y + ((a >> 1) & 1u), sz = z + (a >> 2);
-    size_t i = (size_t)sy * fz.dims[0] + sx;
+    size_t i = (size_t)sy * fusion_vol.dims[0] + sx;
     if (e < 4)
         return &edge_vertex_x[sz & 1u][i];
     if (e < 8)
@@ -316,7 +299,7 @@ static int extract_cell(struct extract_state *st, uint32_t x, uint32_t y, uint32
 {
     unsigned pattern = 0;
     for (unsigned c = 0; c < 8; c++) {
-        const struct voxel *v = &grid[vidx(x + (c & 1u), y + ((c >> 1) & 1u), z + (c >> 2))];
+        const struct voxel *v = &fusion_grid[vidx(x + (c & 1u), y + ((c >> 1) & 1u), z + (c >> 2))];
         if (v->weight == 0)
             return 0; /* a corner no view has seen: no surface can be claimed here */
         pattern |= (v->sdf < 0 ? 1u : 0u) << c;
@@ -344,16 +327,16 @@ static int extract_cell(struct extract_state *st, uint32_t x, uint32_t y, uint32
 int fusion_extract(const struct mesh_sink *sink)
 {
     struct extract_state st = {sink, 0};
-    size_t plane = (size_t)fz.dims[0] * fz.dims[1];
+    size_t plane = (size_t)fusion_vol.dims[0] * fusion_vol.dims[1];
     memset(edge_vertex_x[0], 0xFF, plane * sizeof(uint32_t));
     memset(edge_vertex_y[0], 0xFF, plane * sizeof(uint32_t));
-    for (uint32_t z = 0; z + 1 < fz.dims[2]; z++) {
+    for (uint32_t z = 0; z + 1 < fusion_vol.dims[2]; z++) {
         /* plane z+1 starts empty; plane z keeps what the layer below made */
         memset(edge_vertex_x[(z + 1) & 1u], 0xFF, plane * sizeof(uint32_t));
         memset(edge_vertex_y[(z + 1) & 1u], 0xFF, plane * sizeof(uint32_t));
         memset(edge_vertex_z, 0xFF, plane * sizeof(uint32_t));
-        for (uint32_t y = 0; y + 1 < fz.dims[1]; y++) {
-            for (uint32_t x = 0; x + 1 < fz.dims[0]; x++) {
+        for (uint32_t y = 0; y + 1 < fusion_vol.dims[1]; y++) {
+            for (uint32_t x = 0; x + 1 < fusion_vol.dims[0]; x++) {
                 int rc = extract_cell(&st, x, y, z);
                 if (rc != 0)
                     return rc;

@@ -37,8 +37,21 @@ int fusion_integrate(const struct scan_calib *calib, const struct frame_xform *o
                      const uint8_t *rgb, const float *confidence);
 
 /** Set every voxel from a signed distance function of the object-frame position (mm), weight 1
- *  and grey colour: synthetic objects and tests of the extraction. @retval 0 */
+ *  and grey colour (NAN: never observed): synthetic objects and tests of the extraction.
+ *  @retval 0 */
 int fusion_fill(double (*sdf_mm)(vec3 p, void *ctx), void *ctx);
+
+/** Fill holes up to @p max_hole_mm across: the signed distance diffused into unobserved voxels
+ *  from their observed neighbours, a voxel layer a pass (fusion_close.c). After the last
+ *  fusion, before the mesh. @param filled  out: voxels filled @retval 0 @retval -EINVAL no grid */
+int fusion_fill_holes(double max_hole_mm, uint32_t *filled);
+
+/** Decide every voxel still unobserved, so that the mesh is closed: outside when reachable from
+ *  the grid's sides or top, sideways or down, through passages wider than @p max_hole_mm,
+ *  without crossing the object's observed inside or the table plane (object frame z = 0);
+ *  inside otherwise; at and below the table plane, outside (the object is closed there).
+ *  @param inside  out: voxels decided inside @retval 0 @retval -EINVAL no grid */
+int fusion_close_watertight(double max_hole_mm, uint32_t *inside);
 
 /** Receives the mesh: vertices are numbered from 0 in the order given. */
 struct mesh_sink {
@@ -66,6 +79,10 @@ struct mesh_summary {
  *  @retval 0 @retval -E2BIG more vertices than MESH_MAX_VERTICES: the writers keep every piece
  *  and no STL can be written (PLY and OBJ still can) */
 int fusion_mesh_prepare(double min_fragment_share, struct mesh_summary *summary);
+
+/** Marching cubes into @p sink as the writers see it: the pieces fusion_mesh_prepare left out
+ *  are not given, the vertices renumbered. @retval 0 @retval -EINVAL not prepared */
+int fusion_extract_prepared(const struct mesh_sink *sink);
 
 /** Write the prepared mesh as binary PLY (vertex x y z nx ny nz red green blue, faces), as OBJ
  *  (with vertex colours and normals) or as binary STL (for printing: triangles only), atomically,

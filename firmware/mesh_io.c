@@ -139,8 +139,7 @@ static int filter_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
     return f->to->triangle(f->to->priv, mesh_index[a], mesh_index[b], mesh_index[c]);
 }
 
-/* Run marching cubes into @p sink through the filter. */
-static int extract_kept(const struct mesh_sink *sink)
+int fusion_extract_prepared(const struct mesh_sink *sink)
 {
     if (!mp.prepared)
         return -EINVAL;
@@ -179,8 +178,8 @@ int fusion_write_ply(const struct hal_storage *st, const char *path)
     ply_put_header(&o, "fused mesh", mp.s.kept_vertices, mp.s.kept_triangles, 0);
     struct mesh_sink vertex_pass = {ply_vertex, NULL, &o};
     struct mesh_sink face_pass = {NULL, ply_triangle, &o};
-    extract_kept(&vertex_pass);
-    extract_kept(&face_pass);
+    fusion_extract_prepared(&vertex_pass);
+    fusion_extract_prepared(&face_pass);
     return outbuf_close(&o);
 }
 
@@ -209,7 +208,7 @@ int fusion_write_obj(const struct hal_storage *st, const char *path)
         return o.rc;
     outbuf_printf(&o, "# turntable colour scanner: fused mesh; units: millimetres\n");
     struct mesh_sink sink = {obj_vertex, obj_triangle, &o};
-    extract_kept(&sink);
+    fusion_extract_prepared(&sink);
     return outbuf_close(&o);
 }
 

@@ -161,6 +161,75 @@ static uint32_t count_pieces(const struct sim_mesh *m)
     return pieces;
 }
 
+static int cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* Holes of @p m: its boundary edges (used by one triangle) joined into pieces, each measured
+ * by the diagonal of its bounding box; edges used by more than two triangles counted apart. */
+static void count_holes(const struct sim_mesh *m, struct mesh_comparison *out)
+{
+    size_t ne = 3 * (size_t)m->tri_count;
+    uint64_t *edge = malloc(sizeof(uint64_t) * (ne > 0 ? ne : 1));
+    uint32_t *parent = malloc(sizeof(uint32_t) * (m->vert_count > 0 ? m->vert_count : 1));
+    double *box = malloc(sizeof(double) * 6 * (m->vert_count > 0 ? m->vert_count : 1));
+    uint8_t *on_hole = calloc(m->vert_count > 0 ? m->vert_count : 1, 1);
+    if (edge == NULL || parent == NULL || box == NULL || on_hole == NULL)
+        goto out_free;
+    for (uint32_t t = 0; t < m->tri_count; t++)
+        for (int k = 0; k < 3; k++) {
+            uint64_t a = m->tri[3 * t + k], b = m->tri[3 * t + (k + 1) % 3];
+            edge[3 * (size_t)t + k] = a < b ? a << 32 | b : b << 32 | a;
+        }
+    qsort(edge, ne, sizeof(uint64_t), cmp_u64);
+    for (uint32_t v = 0; v < m->vert_count; v++)
+        parent[v] = v;
+    for (size_t i = 0; i < ne;) {
+        size_t j = i;
+        while (j < ne && edge[j] == edge[i])
+            j++;
+        uint32_t a = (uint32_t)(edge[i] >> 32), b = (uint32_t)edge[i];
+        if (j - i == 1) {
+            out->boundary_edges++;
+            on_hole[a] = on_hole[b] = 1;
+            parent[root_of(parent, a)] = root_of(parent, b);
+        } else if (j - i > 2) {
+            out->nonmanifold_edges++;
+        }
+        i = j;
+    }
+    for (uint32_t v = 0; v < m->vert_count; v++) {
+        double *bx = &box[6 * (size_t)v];
+        bx[0] = bx[1] = bx[2] = 1e30;
+        bx[3] = bx[4] = bx[5] = -1e30;
+    }
+    for (uint32_t v = 0; v < m->vert_count; v++) {
+        if (!on_hole[v])
+            continue;
+        double *bx = &box[6 * (size_t)root_of(parent, v)];
+        for (int k = 0; k < 3; k++) {
+            bx[k] = fmin(bx[k], m->pos[3 * v + k]);
+            bx[3 + k] = fmax(bx[3 + k], m->pos[3 * v + k]);
+        }
+    }
+    for (uint32_t v = 0; v < m->vert_count; v++) {
+        if (!on_hole[v] || root_of(parent, v) != v)
+            continue;
+        const double *bx = &box[6 * (size_t)v];
+        double size = v3_len(v3(bx[3] - bx[0], bx[4] - bx[1], bx[5] - bx[2]));
+        out->holes++;
+        out->holes_under_10mm += size < 10.0;
+        out->largest_hole_mm = fmax(out->largest_hole_mm, size);
+    }
+out_free:
+    free(edge);
+    free(parent);
+    free(box);
+    free(on_hole);
+}
+
 static int cmp_double(const void *a, const void *b)
 {
     double x = *(const double *)a, y = *(const double *)b;
@@ -204,6 +273,7 @@ int mesh_compare_files(const char *result_ply, const char *truth_ply, uint32_t n
         out->align_mm = align_mm;
         out->result_triangles = res.tri_count;
         out->result_pieces = count_pieces(&res);
+        count_holes(&res, out);
         double s1 = 0, s2 = 0, s2_seen = 0;
         uint32_t within = 0, seen = 0, seen_within = 0;
         for (uint32_t i = 0; i < n; i++) {
@@ -262,6 +332,8 @@ void mesh_compare_print(const struct mesh_comparison *r, FILE *out)
                 r->align_mm);
     fprintf(out,
             "result triangles: %u in %u connected pieces\n"
+            "result holes: %u (%u under 10 mm across, the largest %.1f mm); %u boundary edges, "
+            "%u edges of more than two triangles (watertight: both 0)\n"
             "result -> truth: mean %.3f mm, 95%% %.3f mm, max %.3f mm\n"
             "truth -> result: mean %.3f mm, within 1 mm %.2f%%\n"
             "truth above the table (z >= 1 mm) -> result: mean %.3f mm, within 1 mm %.2f%%\n"
@@ -269,7 +341,9 @@ void mesh_compare_print(const struct mesh_comparison *r, FILE *out)
             "observable true surface: %.2f%% of it; within 1 mm of the result %.2f%%, mean "
             "distance %.3f mm\n"
             "symmetric mean surface distance over the observable surface: %.3f mm\n",
-            (unsigned)r->result_triangles, (unsigned)r->result_pieces, r->result_to_truth_mean_mm, r->result_to_truth_p95_mm,
+            (unsigned)r->result_triangles, (unsigned)r->result_pieces, (unsigned)r->holes,
+            (unsigned)r->holes_under_10mm, r->largest_hole_mm, (unsigned)r->boundary_edges,
+            (unsigned)r->nonmanifold_edges, r->result_to_truth_mean_mm, r->result_to_truth_p95_mm,
             r->result_to_truth_max_mm, r->truth_to_result_mean_mm, 100.0 * r->truth_within_1mm,
             r->truth_seen_to_result_mean_mm, 100.0 * r->truth_seen_within_1mm,
             r->symmetric_mean_mm, 100.0 * r->observable_share,

@@ -6,6 +6,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -242,6 +243,75 @@ static void test_fragments_left_out_and_stl(void **state)
     free(whole.tri);
 }
 
+/* The sphere as a scan sees it: observed near its surface only (within the truncation, as
+ * the fusion observes), with an unobserved patch 8 mm across on its side; with @p ctx, also
+ * nothing below 6 mm (the rig's cameras look down) and standing on the table. */
+static double scanned_sphere(vec3 p, void *ctx)
+{
+    vec3 c = ctx != NULL ? v3(0, 0, 20) : v3(0.3, -0.2, 30.1);
+    double d = v3_len(v3_sub(p, c)) - 20.0;
+    vec3 patch = v3_add(c, v3(20, 0, 0));
+    if (fabs(d) > 2.5 || v3_len(v3_sub(p, patch)) < 4.0 || (ctx != NULL && p.z < 6.0))
+        return NAN;
+    return d;
+}
+
+/* A hole of 8 mm is filled with max_hole_mm = 10: the surface closes. */
+static void test_small_hole_filled(void **state)
+{
+    (void)state;
+    struct collected c;
+    uint32_t filled;
+    extract(scanned_sphere, NULL, &c); /* with the hole: must not be closed */
+    struct mesh_summary ms;
+    assert_int_equal(fusion_mesh_prepare(0.0, &ms), 0);
+    free(c.pos);
+    free(c.tri);
+    assert_int_equal(fusion_fill_holes(10.0, &filled), 0);
+    assert_true(filled > 0);
+    memset(&c, 0, sizeof(c));
+    struct mesh_sink sink = {on_vertex, on_triangle, &c};
+    assert_int_equal(fusion_extract(&sink), 0);
+    assert_true(c.nt > ms.triangles);
+    assert_int_equal(check_closed(&c), 2);
+    free(c.pos);
+    free(c.tri);
+}
+
+/* Standing on the table, unseen below 6 mm and inside: closed watertight, solid (one surface,
+ * no inner wall), nothing below the table. */
+static void test_watertight_closes_at_the_table(void **state)
+{
+    (void)state;
+    struct collected c;
+    uint32_t filled, inside;
+    int standing = 1;
+    struct fusion_params p = grid_params();
+    p.bottom_mm = -3;
+    assert_int_equal(fusion_begin(&p), 0);
+    assert_int_equal(fusion_fill(scanned_sphere, &standing), 0);
+    assert_int_equal(fusion_fill_holes(10.0, &filled), 0);
+    assert_int_equal(fusion_close_watertight(10.0, &inside), 0);
+    /* the core no filling reached (radius 20 - 2.5 observed - 5 filled) is decided solid */
+    assert_true(inside > 0.8 * 4.0 / 3.0 * M_PI * 12.5 * 12.5 * 12.5);
+    struct mesh_summary ms; /* crumbs the opening leaves beside the surface are fragments */
+    assert_int_equal(fusion_mesh_prepare(0.01, &ms), 0);
+    memset(&c, 0, sizeof(c));
+    struct mesh_sink sink = {on_vertex, on_triangle, &c};
+    assert_int_equal(fusion_extract_prepared(&sink), 0);
+    assert_int_equal(c.nt, ms.kept_triangles);
+    assert_int_equal(check_closed(&c), 2); /* one closed surface: no hollow inside */
+    for (uint32_t v = 0; v < c.nv; v++) {
+        vec3 q = v3(c.pos[3 * v], c.pos[3 * v + 1], c.pos[3 * v + 2]);
+        assert_true(q.z > -0.01);
+        int patch = v3_len(v3_sub(q, v3(20, 0, 20))) < 6.0; /* filled flat: off by < 1 mm */
+        if (q.z > 12.0) /* above the unseen band and its closure: the sphere itself */
+            assert_true(fabs(v3_len(v3_sub(q, v3(0, 0, 20))) - 20.0) < (patch ? 1.0 : 0.3));
+    }
+    free(c.pos);
+    free(c.tri);
+}
+
 /* The generated table: complementary cases mirror each other, and every case's triangles are
  * edges of the cube where the sign changes. */
 static void test_table_properties(void **state)
@@ -271,6 +341,8 @@ int main(void)
         cmocka_unit_test(test_torus_is_closed_genus_1),
         cmocka_unit_test(test_random_blobs_stay_closed),
         cmocka_unit_test(test_fragments_left_out_and_stl),
+        cmocka_unit_test(test_small_hole_filled),
+        cmocka_unit_test(test_watertight_closes_at_the_table),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
