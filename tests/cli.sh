@@ -141,8 +141,26 @@ check scan_dir_complete sh -c "for f in config.ini calibration.ini view_000/clou
     view_000/truth_angle.ini view_000/registration.ini; do test -s $out/scan/\$f || exit 1; done &&
     grep -q '^pose_rotation = ' $out/scan/view_003/registration.ini &&
     grep -q '^angle_mdeg = 135000' $out/scan/view_003/truth_angle.ini"
+# The scan's mesh files, the STL among them, and the one registration line.
+check scan_writes_stl_and_registration_line sh -c "test -s $out/scan/mesh.stl &&
+    test \$(stat -c %s $out/scan/mesh.stl) -gt 84 &&
+    grep -q '^angle_deg = ' $out/scan/view_003/registration.ini &&
+    grep -q '^loop_closure_rms_mm = ' $out/scan/view_003/registration.ini"
+# The object slips on the table between two views: the scan fails, names the view, writes no
+# model and keeps every view.
+sed -e 's/^views = .*/views = 4/' -e "s|^calibration = .*|calibration = $PWD/config/sim-calib.ini|" \
+    -e "s|^mesh_file = ../|mesh_file = $PWD/|" config/sim.ini > "$out/slip.ini"
+printf 'slip_mm = 6, 0, 0\nslip_at_deg = 170\n' >> "$out/slip.ini"
+rm -rf "$out/slip"
+check slipped_object_names_the_view sh -c "! $bin scan --config $out/slip.ini --out $out/slip \
+    > $out/slip.log 2>&1 && grep -q 'registration failed: view 2 does not match view 1' \
+    $out/slip.log && test -s $out/slip/view_003/view.ini && test ! -e $out/slip/mesh.ply"
+# A closed model needs the widest hole to close.
+printf '[output]\nwatertight = 1\n' | cat config/sim.ini - > "$out/watertight.ini"
+check watertight_needs_max_hole sh -c "$bin check-config --config $out/watertight.ini 2>&1 |
+    grep -q 'watertight: a closed model needs max_hole_mm > 0'"
 # make LIMITS=small, for a board with 512 MB: under a 512 MiB address-space limit the default
-# build cannot even start (672 MiB of static buffers), the small one takes the same scan and
+# build cannot even start (729 MiB of static buffers), the small one takes the same scan and
 # gives the same model. (ASan reserves terabytes of address space: no limit under SAN=1.)
 sbin=${BUILD:-build}/small/scanner
 rm -rf "$out/scan_small"
