@@ -110,7 +110,7 @@ FW_OBJ := $(call obj,$(FW_SRC))
 HOST_OBJ := $(call obj,$(POSIX_SRC) $(APP_LIB_SRC) $(BOARD_SRC)) $(if $(filter linux,$(HAL)),$(LIBCAMERA_OBJ),)
 MAIN_OBJ := $(call obj,app/main.c)
 
-.PHONY: seccomp-tool all deps test-deps test test-run linux-build small-build install check-stack size fuzz errors-doc test-arm64 test-arm64-full test-gpio-chip arm64-check-elf arm64-run-tests run clean format docs check-firmware bench measure measure-scan interop-meshlab bench-callgrind eval calibrate-demo measure-calib
+.PHONY: seccomp-tool all deps test-deps test test-run run-complete linux-build small-build install check-stack size fuzz errors-doc test-arm64 test-arm64-full test-gpio-chip arm64-check-elf arm64-run-tests run clean format docs check-firmware bench measure measure-scan interop-meshlab bench-callgrind eval calibrate-demo measure-calib
 SIM_TOOLS := $(if $(filter sim,$(HAL)),$(BUILD)/turntable-sim $(BUILD)/tt-client $(BUILD)/mesh-compare $(BUILD)/colour-eval,)
 all: deps $(BUILD)/scanner $(CALIB_TOOL) $(SIM_TOOLS)
 
@@ -341,6 +341,11 @@ small-build: deps
 
 run: deps $(BUILD)/scanner
 	$(BUILD)/scanner scan --config config/sim.ini --replace
+
+# The bunny in two passes (upright, then on its side), one model: scans/sim-complete/.
+run-complete: deps $(BUILD)/scanner $(BUILD)/mesh-compare
+	$(BUILD)/scanner scan --config config/sim-complete.ini --replace
+	$(BUILD)/mesh-compare --align scans/sim-complete/mesh.ply scans/sim-complete/truth_mesh.ply
 
 docs: $(BUILD)/scanner
 	$(BUILD)/scanner config-doc > docs/config.md

@@ -68,7 +68,11 @@ static const struct ini_key config_keys[] = {
         "width of the trigger and reset pulses"),
     LIM("lights", "count", light_count, 0, HAL_MAX_LIGHTS, "0",
         "white lights wired to light_0 .. light_N-1"),
-    U32("scan", "views", views, 1, 360, "1", "views per scan"),
+    U32("scan", "views", views, 1, 360, "1", "views per pass (a turn of the table)"),
+    U32("scan", "passes", passes, 1, 2, "1",
+        "2: after the first turn the person lays the object another way (on its side) and the "
+        "table turns again; the second pass is found in the first and both make one model (the "
+        "parts one pass cannot see: the underside, deep folds)"),
     F64("scan", "start_angle_deg", start_angle_deg, -360, 360, "0", "turntable angle of view 0"),
     U32("scan", "min_contrast_dn", scan.min_contrast_dn, 1, 255, "10",
         "white minus black (grey levels) below this: too dark to decode, flagged 'dark'"),
@@ -214,6 +218,10 @@ static const struct ini_key config_keys[] = {
         "empty: the scan's calibration, so the firmware knows the rig exactly"),
     F64("sim", "object_height_mm", sim.object_height_mm, 1, 1000, "150",
         "object height after scaling (sphere: diameter)"),
+    {"sim", "second_pass_pose", INI_VEC, C(sim.second_pass_pose_deg), 3, -360, 360, 0,
+     "90, 0, 30", NULL,
+     "[scan] passes = 2: how the simulated person lays the object for the second pass, as "
+     "object_pose (degrees about x, then y, then z, then stood on the table)"},
     {"sim", "object_pose", INI_VEC, C(sim.object_pose_deg), 3, -360, 360, 0, "0, 0, 0", NULL,
      "the object turned by these angles (degrees, about x, then y, then z) before it is stood on "
      "the table at its lowest point: 90, 0, 0 lays an upright object on its side (a second pass)"},
@@ -521,6 +529,12 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
     if (strcmp(cb->board, "charuco") == 0 && cb->marker_mm >= cb->square_mm) {
         snprintf(err, err_len, "%s: [calibrate] marker_mm: %g must be below square_mm %g", path,
                  cb->marker_mm, cb->square_mm);
+        return -EINVAL;
+    }
+    if (cfg->views * cfg->passes > REG_MAX_VIEWS) {
+        snprintf(err, err_len, "%s: [scan] views: %u views x %u passes exceed the %u a scan holds "
+                 "(REG_MAX_VIEWS)", path, (unsigned)cfg->views, (unsigned)cfg->passes,
+                 (unsigned)REG_MAX_VIEWS);
         return -EINVAL;
     }
     if (cfg->watertight && cfg->max_hole_mm <= 0.0) {

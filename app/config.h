@@ -25,7 +25,8 @@ struct app_config {
     struct hal_camera_config camera;
     uint32_t light_count;
     struct scan_params scan;
-    uint32_t views;
+    uint32_t views;  /**< per pass */
+    uint32_t passes; /**< 1, or 2: the object laid another way for a second turn */
     double start_angle_deg;
     char calibration_file[HAL_MAX_PATH]; /**< resolved against the config file's directory */
     char output_dir[HAL_MAX_PATH];

@@ -59,7 +59,7 @@ static void job_init(struct job *j, const struct hal *hal, const struct app_conf
                       .calib = calib,
                       .opts = opts,
                       .out_dir = out_dir,
-                      .views = cfg->views,
+                      .views = cfg->views * cfg->passes, /* every pass's */
                       .start_ms = wall_ms(),
                       .tty = isatty(STDOUT_FILENO) && !opts->json};
 }
@@ -119,6 +119,7 @@ static void progress(struct job *j, const char *event, int view, uint32_t done, 
                                                {"scan_failed", "scan failed:"},
                                                {"process_start", "processing"},
                                                {"registration", "registration:"},
+                                               {"place_object", ">>>"},
                                                {"process_done", "process finished:"}};
         const char *text = event;
         for (size_t k = 0; k < sizeof(human) / sizeof(human[0]); k++)
@@ -235,7 +236,7 @@ static int write_model(struct job *j)
     progress(j, "meshing", -1, j->views, "marching cubes");
     int rc = fusion_fill_holes(j->cfg->max_hole_mm, &filled);
     if (rc == 0 && j->cfg->watertight)
-        rc = fusion_close_watertight(j->cfg->max_hole_mm, &inside);
+        rc = fusion_close_watertight(j->cfg->max_hole_mm, j->cfg->passes == 1, &inside);
     if (rc == 0)
         rc = fusion_mesh_prepare(j->cfg->min_fragment_share, &ms);
     int fits = rc == 0;
@@ -271,11 +272,11 @@ static int write_model(struct job *j)
 /* Before the first view: the registration sized for the scan's views. */
 static int begin_model(struct job *j)
 {
-    int rc = reg_begin(&j->cfg->registration, j->calib, j->cfg->views, j->cfg->scan.width,
-                       j->cfg->scan.height);
+    int rc = reg_begin(&j->cfg->registration, j->calib, j->views, j->cfg->passes,
+                       j->cfg->scan.width, j->cfg->scan.height);
     if (rc != 0)
         j->hal->log(HAL_LOG_ERROR, "registration: %u views exceed the compiled limit %u",
-                    (unsigned)j->cfg->views, REG_MAX_VIEWS);
+                    (unsigned)j->views, REG_MAX_VIEWS);
     return rc;
 }
 
@@ -295,7 +296,22 @@ static int report_registration(struct job *j, const struct reg_report *r, double
                  r->axis_shift_mm, r->axis_tilt_deg, cpu_seconds,
                  r->accepted ? "the views' angles corrected" : "turntable angles kept: ",
                  r->accepted ? "" : r->refused);
+    if (j->cfg->passes == 2 && r->failed_view < 0) {
+        size_t n = strlen(detail);
+        snprintf(detail + n, sizeof(detail) - n,
+                 "; second pass found turned %.1f deg, residual %.3f mm over %u pairs",
+                 r->second_turned_deg, r->second_rms_mm, (unsigned)r->second_coupled);
+    }
     progress(j, "registration", -1, j->views, detail);
+    if (r->failed_view >= 0 && r->failed_against < 0) {
+        j->hal->log(HAL_LOG_ERROR,
+                    "registration failed: the second pass (from view %d) matches nothing of the "
+                    "first (%.0f%% of its points paired, at least %.0f%% needed): was it the same "
+                    "object? No model was made; the views are kept in %s",
+                    r->failed_view, 100.0 * r->failed_share,
+                    100.0 * j->cfg->registration.min_coupled_share, scan_dir);
+        return -EPROTO;
+    }
     if (!r->solved || r->failed_view < 0)
         return 0;
     j->hal->log(HAL_LOG_ERROR,
@@ -372,7 +388,8 @@ static void table_failed(const struct job *j, uint32_t v, int32_t target_mdeg)
 static int live_view(struct job *j, uint32_t v)
 {
     const struct hal *hal = j->hal;
-    int32_t target = (int32_t)((j->cfg->start_angle_deg + 360.0 * v / j->views) * 1000.0);
+    uint32_t k = v % j->cfg->views; /* the view's place in its pass */
+    int32_t target = (int32_t)((j->cfg->start_angle_deg + 360.0 * k / j->cfg->views) * 1000.0);
     char detail[HAL_MAX_PATH + 160], started[32];
     snprintf(detail, sizeof(detail), "to %.1f deg", target / 1000.0);
     progress(j, "moving", (int)v, v, detail);
@@ -418,20 +435,55 @@ static int live_view(struct job *j, uint32_t v)
     return 0;
 }
 
-/* Home the table, then take views @p first .. the last, each saved before the next move. */
+/* The person lays the object as pass @p pass asks (the simulated person does it at once).
+ * @retval 0 @retval -EINTR the person stopped (Ctrl-D) @retval -errno */
+static int ask_for_pass(struct job *j, uint32_t pass)
+{
+    char err[256], detail[160];
+    struct board_target t = {.kind = BOARD_TARGET_OBJECT, .pass = pass};
+    snprintf(detail, sizeof(detail),
+             pass == 2 ? "pass 2 of 2: lay the object on its side (another way than before), "
+                         "near the middle of the table"
+                       : "pass 1 of 2: stand the object upright in the middle of the table");
+    progress(j, "place_object", -1, 0, detail);
+    int rc = board_place_target((struct hal *)j->hal, &t, err, sizeof(err));
+    if (rc == 0)
+        return 0;
+    if (rc != -ENOSYS) {
+        j->hal->log(HAL_LOG_ERROR, "%s", err);
+        return rc;
+    }
+    printf("%s; press Enter when it is done (Ctrl-D stops; the views so far are kept).\n", detail);
+    fflush(stdout);
+    char line[64];
+    return fgets(line, sizeof(line), stdin) == NULL || hal_should_stop(j->hal) ? -EINTR : 0;
+}
+
+/* Home the table, then take views @p first .. the last, each saved before the next move; a
+ * two-pass scan asks for the object to be laid for the second pass, and homes again. */
 static int home_and_take_views(struct job *j, uint32_t first)
 {
     const struct hal *hal = j->hal;
-    progress(j, "homing", (int)first, first, "");
     int rc = 0;
-    if (j->opts->clear_alarm && (rc = hal_table_clear_alarm(&hal->turntable)) == -ENOSYS)
+    if (j->cfg->passes == 2 && first >= j->cfg->views) /* resumed in the second pass */
+        rc = ask_for_pass(j, 2);
+    if (rc == 0)
+        progress(j, "homing", (int)first, first, "");
+    if (rc == 0 && j->opts->clear_alarm && (rc = hal_table_clear_alarm(&hal->turntable)) == -ENOSYS)
         hal->log(HAL_LOG_ERROR, "this turntable cannot clear its alarm over its link: clear it "
                                 "at the controller, then resume without --clear-alarm");
     if (rc == 0 && (rc = hal_table_home(&hal->turntable)) != 0) /* the client said why */
         hal->log(HAL_LOG_WARN, "the turntable did not home%s",
                  j->opts->clear_alarm ? "" : " (if it reports an alarm: --clear-alarm)");
-    for (uint32_t v = first; v < j->cfg->views && rc == 0; v++)
-        rc = live_view(j, v);
+    for (uint32_t v = first; v < j->views && rc == 0; v++) {
+        if (v == j->cfg->views && v != first) { /* the second pass begins */
+            rc = ask_for_pass(j, 2);
+            if (rc == 0 && (rc = hal_table_home(&hal->turntable)) != 0)
+                hal->log(HAL_LOG_WARN, "the turntable did not home for the second pass");
+        }
+        if (rc == 0)
+            rc = live_view(j, v);
+    }
     return rc;
 }
 
@@ -522,11 +574,11 @@ int scan_job_resume(const struct hal *hal, const struct app_config *cfg,
     if (rc != 0)
         return rc;
     uint32_t first = 0;
-    while (first < cfg->views && scan_dir_view_complete(scan_dir, first))
+    while (first < j.views && scan_dir_view_complete(scan_dir, first))
         first++;
-    snprintf(detail, sizeof(detail), "%u of %u views kept", (unsigned)first, (unsigned)cfg->views);
+    snprintf(detail, sizeof(detail), "%u of %u views kept", (unsigned)first, (unsigned)j.views);
     progress(&j, "resume", -1, first, detail);
-    if (first < cfg->views) {
+    if (first < j.views) {
         rc = begin_model(&j); /* the model comes from scan_job_process afterwards */
         if (rc == 0)
             rc = home_and_take_views(&j, first);
@@ -642,7 +694,7 @@ int scan_job_process(const struct hal *hal, const char *scan_dir, const struct s
     if (rc == 0)
         rc = begin_model(&j);
     progress(&j, "process_start", -1, 0, scan_dir);
-    for (uint32_t v = 0; v < cfg.views && rc == 0; v++) {
+    for (uint32_t v = 0; v < j.views && rc == 0; v++) {
         struct scan_view view;
         struct scan_view_info info;
         rc = stopped_offline(&j, scan_dir, v);

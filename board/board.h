@@ -48,10 +48,12 @@ struct board_target {
     double tilt_deg;     /**< board: from upright (facing the camera), leaning back; 90 flat */
     double diameter_mm;  /**< sphere */
     double position_mm[2]; /**< on the table at angle 0 (x towards the camera, y to its right) */
+    uint32_t pass;       /**< object: the scan's pass (1: as it stands; 2: laid another way,
+                              which the simulator does by [sim] second_pass_pose) */
 };
 
-/** The person's part of a calibration step. The simulator places the target itself; on a rig
- *  the person must be asked. @retval 0 placed @retval -ENOSYS ask the person
+/** The person's part of a calibration step, or of a scan's second pass. The simulator places
+ *  the target itself; on a rig the person must be asked. @retval 0 placed @retval -ENOSYS ask the person
  *  @retval -errno (with @p err) */
 int board_place_target(struct hal *hal, const struct board_target *target, char *err,
                        size_t err_len);

@@ -143,6 +143,15 @@ int board_place_target(struct hal *hal, const struct board_target *t, char *err,
         .diameter_mm = t->diameter_mm,
         .position_mm = {t->position_mm[0], t->position_mm[1]},
     };
+    if (t->kind == BOARD_TARGET_OBJECT) { /* the person lays the object as the pass asks */
+        static double first_pose[3];
+        static int kept;
+        if (!kept)
+            memcpy(first_pose, sim.rig.cfg.object_pose_deg, sizeof(first_pose));
+        kept = 1;
+        memcpy(sim.rig.cfg.object_pose_deg,
+               t->pass == 2 ? sim.rig.cfg.second_pass_pose_deg : first_pose, sizeof(first_pose));
+    }
     return sim_rig_set_target(&sim.rig, &st, err, len);
 }
 

@@ -47,11 +47,12 @@ int fusion_fill(double (*sdf_mm)(vec3 p, void *ctx), void *ctx);
 int fusion_fill_holes(double max_hole_mm, uint32_t *filled);
 
 /** Decide every voxel still unobserved, so that the mesh is closed: outside when reachable from
- *  the grid's sides or top, sideways or down, through passages wider than @p max_hole_mm,
+ *  the grid's sides or top (sideways or down only when @p one_pass: what its cameras did not
+ *  see under a surface is solid) through passages wider than @p max_hole_mm,
  *  without crossing the object's observed inside or the table plane (object frame z = 0);
  *  inside otherwise; at and below the table plane, outside (the object is closed there).
  *  @param inside  out: voxels decided inside @retval 0 @retval -EINVAL no grid */
-int fusion_close_watertight(double max_hole_mm, uint32_t *inside);
+int fusion_close_watertight(double max_hole_mm, int one_pass, uint32_t *inside);
 
 /** Receives the mesh: vertices are numbered from 0 in the order given. */
 struct mesh_sink {

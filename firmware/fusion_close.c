@@ -184,12 +184,13 @@ static void box_3d(uint8_t *map, uint32_t r, int erode)
     memcpy(map, scratch_b, (grid_voxels() + 7) / 8);
 }
 
-/* Flood @p flood from the grid's sides and top through the voxels set in @p through, by moves
- * sideways or down, never up: the cameras of a turntable rig look down on the object, so what
- * no camera saw under a surface (a belly between the legs, the inside of an upturned cup) is
- * taken as solid, while a pocket open to the side or the top is outside. Sweeps in both
- * directions until nothing changes (no queue: the memory stays one bit a voxel). */
-static void flood_from_outside(const uint8_t *through, uint8_t *flood)
+/* Flood @p flood from the grid's sides and top through the voxels set in @p through. With
+ * @p down_only, by moves sideways or down, never up: the cameras of a one-pass scan look down
+ * on the object, so what no camera saw under a surface (a belly between the legs, the inside of
+ * an upturned cup) is taken as solid, while a pocket open to the side or the top is outside; a
+ * second pass has seen the underside, so every direction. Sweeps in both directions until
+ * nothing changes (no queue: the memory stays one bit a voxel). */
+static void flood_from_outside(const uint8_t *through, uint8_t *flood, int down_only)
 {
     const uint32_t *d = fusion_vol.dims;
     memset(flood, 0, (grid_voxels() + 7) / 8);
@@ -214,7 +215,8 @@ static void flood_from_outside(const uint8_t *through, uint8_t *flood)
                             continue;
                         int n = neighbours(x, y, z, nb);
                         for (int q = 0; q < n; q++)
-                            if (bit(flood, nb[q]) && !(z > 0 && nb[q] == vidx(x, y, z - 1))) {
+                            if (bit(flood, nb[q]) &&
+                                !(down_only && z > 0 && nb[q] == vidx(x, y, z - 1))) {
                                 set_bit(flood, i, 1);
                                 changed = 1;
                                 break;
@@ -228,7 +230,7 @@ static void flood_from_outside(const uint8_t *through, uint8_t *flood)
 /* The outside, in mark: the flood from outside through the passable voxels opened by
  * @p r voxels (eroded, flooded, dilated back), so that it cannot leak into the object through
  * a hole narrower than 2 r + 1 voxels. */
-static void find_outside(uint32_t r)
+static void find_outside(uint32_t r, int down_only)
 {
     const uint32_t *d = fusion_vol.dims;
     for (uint32_t z = 0; z < d[2]; z++)
@@ -237,7 +239,7 @@ static void find_outside(uint32_t r)
                 set_bit(mark, vidx(x, y, z), passable(vidx(x, y, z), z));
     memcpy(scratch_a, mark, (grid_voxels() + 7) / 8);
     box_3d(scratch_a, r, 1);
-    flood_from_outside(scratch_a, scratch_b);
+    flood_from_outside(scratch_a, scratch_b, down_only);
     memcpy(scratch_a, scratch_b, (grid_voxels() + 7) / 8);
     box_3d(scratch_a, r, 0);
     size_t n = grid_voxels();
@@ -245,14 +247,14 @@ static void find_outside(uint32_t r)
         mark[i] &= scratch_a[i];
 }
 
-int fusion_close_watertight(double max_hole_mm, uint32_t *inside)
+int fusion_close_watertight(double max_hole_mm, int one_pass, uint32_t *inside)
 {
     const uint32_t *d = fusion_vol.dims;
     const int16_t out_sdf = 32767, in_sdf = -32767;
     *inside = 0;
     if (d[0] == 0)
         return -EINVAL;
-    find_outside((uint32_t)ceil(0.5 * max_hole_mm / fusion_vol.p.voxel_mm));
+    find_outside((uint32_t)ceil(0.5 * max_hole_mm / fusion_vol.p.voxel_mm), one_pass);
     for (uint32_t z = 0; z < d[2]; z++)
         for (uint32_t y = 0; y < d[1]; y++)
             for (uint32_t x = 0; x < d[0]; x++) {

@@ -13,6 +13,7 @@
  *     dp'/d(tilt of d about e)  = e x R (p - a) - R (e x (p - a))   (R' = Q R Q^T, Q about e). */
 #include "reg.h"
 
+#include "align.h"
 #include "camray.h"
 #include "lsq.h"
 #include "vec3.h"
@@ -45,7 +46,7 @@ struct edge_stats {
 static struct {
     struct reg_params p;
     struct scan_calib calib;
-    uint32_t views, stride, gw, gh;
+    uint32_t views, passes, per_pass, stride, gw, gh;
     int32_t reported_mdeg[REG_MAX_VIEWS];
     uint8_t present[REG_MAX_VIEWS];
     double theta[REG_MAX_VIEWS]; /* radians */
@@ -53,6 +54,8 @@ static struct {
     int use_solution;            /* poses from theta, a, d rather than the turntable's */
     uint32_t edges, edge_from[REG_EDGES], edge_to[REG_EDGES];
     struct edge_stats stats[REG_EDGES];
+    int second_aligned;          /* the second pass's views go through first_from_second */
+    struct frame_xform first_from_second;
 } rg;
 
 static size_t cell_count(void)
@@ -66,14 +69,17 @@ static struct reg_cell *view_cells(uint32_t v)
 }
 
 int reg_begin(const struct reg_params *p, const struct scan_calib *c, uint32_t views,
-              uint32_t width, uint32_t height)
+              uint32_t passes, uint32_t width, uint32_t height)
 {
-    if (views == 0 || views > REG_MAX_VIEWS || width == 0 || height == 0)
+    if (views == 0 || views > REG_MAX_VIEWS || width == 0 || height == 0 || passes == 0 ||
+        passes > 2 || views % passes != 0)
         return -E2BIG;
     memset(&rg, 0, sizeof(rg));
     rg.p = *p;
     rg.calib = *c;
     rg.views = views;
+    rg.passes = passes;
+    rg.per_pass = views / passes;
     rg.stride = p->sample_stride > 0 ? p->sample_stride : 1;
     for (;;) {
         rg.gw = (width + rg.stride - 1) / rg.stride;
@@ -109,21 +115,23 @@ int reg_add_view(uint32_t index, int32_t angle_mdeg, const struct decode_maps *m
     return 0;
 }
 
-/* Neighbouring views: each with the next, the last with the first (when the views go round). */
+/* Neighbouring views of each pass: each with the next, the last with the first (the views of
+ * a pass go round). */
 static void make_edges(void)
 {
     rg.edges = 0;
-    uint32_t n = rg.views;
-    for (uint32_t i = 0; i < n && n >= 2; i++) {
-        uint32_t j = (i + 1) % n;
-        if (n == 2 && i == 1)
-            break; /* two views: one pair */
-        if (!rg.present[i] || !rg.present[j])
-            continue;
-        rg.edge_from[rg.edges] = i;
-        rg.edge_to[rg.edges] = j;
-        rg.edges++;
-    }
+    uint32_t n = rg.per_pass;
+    for (uint32_t pass = 0; pass < rg.passes; pass++)
+        for (uint32_t k = 0; k < n && n >= 2; k++) {
+            uint32_t i = pass * n + k, j = pass * n + (k + 1) % n;
+            if (n == 2 && k == 1)
+                break; /* two views: one pair */
+            if (!rg.present[i] || !rg.present[j])
+                continue;
+            rg.edge_from[rg.edges] = i;
+            rg.edge_to[rg.edges] = j;
+            rg.edges++;
+        }
 }
 
 /* R(d, angle) as a row-major matrix. */
@@ -143,13 +151,20 @@ static void across(vec3 d, vec3 *e1, vec3 *e2)
     *e2 = v3_cross(d, *e1);
 }
 
-/* Unknowns: angle of view v >= 1 at v - 1 (view 0 is the gauge), then the axis. */
-static uint32_t n_params(void)
+/* Unknowns: the angle of each view but the first of its pass (the gauge of that pass's frame),
+ * then the axis. @retval the unknown of view @p v's angle, -1 for a first view */
+static int angle_param(uint32_t v)
 {
-    return rg.views - 1 + 4;
+    uint32_t pass = v / rg.per_pass;
+    return v % rg.per_pass == 0 ? -1 : (int)(v - 1 - pass);
 }
 
-/* Add one residual with @p jac entries at @p idx (negative: view 0, fixed) to the equations. */
+static uint32_t n_params(void)
+{
+    return rg.views - rg.passes + 4;
+}
+
+/* Add one residual with @p jac entries at @p idx (negative: a fixed angle) to the equations. */
 static void add_residual(const int idx[6], const double jac[6], double res, double weight)
 {
     const uint32_t n = n_params();
@@ -175,8 +190,8 @@ static void pair_views(uint32_t src, uint32_t dst, double gate_mm, int solve,
     vec3 e1, e2;
     across(rg.d, &e1, &e2);
     vec3 r_e1 = m3_mul(rot, e1), r_e2 = m3_mul(rot, e2);
-    int idx[6] = {(int)src - 1, (int)dst - 1, (int)rg.views - 1, (int)rg.views,
-                  (int)rg.views + 1, (int)rg.views + 2};
+    const int axis = (int)(rg.views - rg.passes);
+    int idx[6] = {angle_param(src), angle_param(dst), axis, axis + 1, axis + 2, axis + 3};
     const struct reg_cell *from = view_cells(src), *to = view_cells(dst);
     for (size_t k = 0; k < cell_count(); k++) {
         const struct reg_cell *cp = &from[k];
@@ -272,13 +287,15 @@ static double gauss_newton_step(void)
     if (lsq_solve(n, normal_a, normal_b, step_x) != 0)
         return 0.0;
     double largest = 0.0;
-    for (uint32_t v = 1; v < rg.views; v++) {
-        rg.theta[v] += step_x[v - 1];
-        largest = fmax(largest, fabs(step_x[v - 1]));
+    for (uint32_t v = 0; v < rg.views; v++) {
+        if (angle_param(v) < 0)
+            continue;
+        rg.theta[v] += step_x[angle_param(v)];
+        largest = fmax(largest, fabs(step_x[angle_param(v)]));
     }
     vec3 e1, e2;
     across(rg.d, &e1, &e2);
-    const double *ax = &step_x[rg.views - 1];
+    const double *ax = &step_x[rg.views - rg.passes];
     rg.a = v3_add(rg.a, v3_add(v3_scale(e1, ax[0]), v3_scale(e2, ax[1])));
     rg.d = v3_norm(v3_add(rg.d, v3_cross(v3_add(v3_scale(e1, ax[2]), v3_scale(e2, ax[3])), rg.d)));
     return fmax(largest, fmax(fabs(ax[2]), fabs(ax[3])));
@@ -327,8 +344,8 @@ static void check_bounds(struct reg_report *rep)
  * from the last pass. */
 static void summarise(struct reg_report *rep)
 {
-    uint64_t coupled = 0;
-    double sq = 0.0;
+    uint64_t coupled = 0, loop_coupled = 0;
+    double sq = 0.0, loop_sq = 0.0;
     rep->failed_view = rep->failed_against = -1;
     for (uint32_t e = 0; e < rg.edges; e++) {
         const struct edge_stats *st = &rg.stats[e];
@@ -340,9 +357,12 @@ static void summarise(struct reg_report *rep)
             rep->failed_against = (int)rg.edge_from[e];
             rep->failed_share = share;
         }
-        if (rg.edge_to[e] == 0 && rg.views > 2)
-            rep->loop_rms_mm = st->coupled > 0 ? sqrt(st->sq / st->coupled) : 0.0;
+        if (rg.edge_to[e] % rg.per_pass == 0 && rg.per_pass > 2) { /* a closing pair */
+            loop_sq += st->sq;
+            loop_coupled += st->coupled;
+        }
     }
+    rep->loop_rms_mm = loop_coupled > 0 ? sqrt(loop_sq / (double)loop_coupled) : 0.0;
     rep->rms_mm = coupled > 0 ? sqrt(sq / (double)coupled) : 0.0;
     rep->worst_rms_mm = -1.0;
     for (uint32_t v = 0; v < rg.views; v++) {
@@ -356,6 +376,128 @@ static void summarise(struct reg_report *rep)
         rep->worst_rms_mm = 0.0;
 }
 
+/* A cell's point and normal in its pass's object frame through @p pose. */
+static void cell_in_object(const struct reg_cell *cl, const struct frame_xform *pose, vec3 *p,
+                           vec3 *n)
+{
+    *p = frame_point(pose, v3(cl->xyz[0], cl->xyz[1], cl->xyz[2]));
+    *n = frame_dir(pose, v3(cl->normal[0], cl->normal[1], cl->normal[2]));
+}
+
+/* Hand both passes' samples (object frames) to the alignment, spread to fit ALIGN_MAX_POINTS. */
+static void feed_alignment(void)
+{
+    uint64_t valid[2] = {0, 0};
+    for (uint32_t v = 0; v < rg.views; v++)
+        for (size_t k = 0; k < cell_count() && rg.present[v]; k++)
+            valid[v / rg.per_pass] += view_cells(v)[k].valid;
+    align_begin();
+    for (uint32_t v = 0; v < rg.views; v++) {
+        uint32_t pass = v / rg.per_pass;
+        uint64_t step = valid[pass] / ALIGN_MAX_POINTS + 1, seen = 0;
+        struct frame_xform pose;
+        struct reg_view rv;
+        if (reg_view_pose(v, &pose, &rv) != 0)
+            continue;
+        for (size_t k = 0; k < cell_count(); k++) {
+            const struct reg_cell *cl = &view_cells(v)[k];
+            if (!cl->valid || seen++ % step != 0)
+                continue;
+            vec3 p, n;
+            cell_in_object(cl, &pose, &p, &n);
+            align_add_point(pass, p, n);
+        }
+    }
+}
+
+/* The second pass's samples against the first pass's views, projectively, as the views of a
+ * pass are paired: one point-to-plane step of first_from_second per call (object frame 1).
+ * @retval pairs coupled; @p rms their residual */
+static uint32_t refine_second_step(double gate_mm, double *rms)
+{
+    const double min_cos = cos(rg.p.max_normal_deg * M_PI / 180.0);
+    double a[36] = {0}, b[6] = {0}, x[6], sq = 0.0;
+    uint32_t coupled = 0;
+    static struct frame_xform first[REG_MAX_VIEWS], cam_of[REG_MAX_VIEWS]; /* too big for a stack */
+    struct reg_view rv;
+    for (uint32_t j = 0; j < rg.per_pass; j++)
+        if (reg_view_pose(j, &first[j], &rv) == 0)
+            frame_invert(&first[j], &cam_of[j]);
+    for (uint32_t v = rg.per_pass; v < rg.views; v++) {
+        struct frame_xform pose;
+        if (reg_view_pose(v, &pose, &rv) != 0)
+            continue;
+        for (size_t k = 0; k < cell_count(); k += 2) {
+            const struct reg_cell *cl = &view_cells(v)[k];
+            if (!cl->valid)
+                continue;
+            vec3 p, n;
+            cell_in_object(cl, &pose, &p, &n);
+            for (uint32_t j = 0; j < rg.per_pass; j++) {
+                if (!rg.present[j])
+                    continue;
+                vec3 c = frame_point(&cam_of[j], p);
+                if (c.z <= 1.0 || v3_dot(frame_dir(&cam_of[j], n), c) >= 0.0)
+                    continue; /* behind the camera, or facing away from it */
+                double fu, fv;
+                camray_project(&rg.calib, c, &fu, &fv);
+                long u = lround(fu / rg.stride), w = lround(fv / rg.stride);
+                if (u < 0 || w < 0 || u >= (long)rg.gw || w >= (long)rg.gh)
+                    continue;
+                const struct reg_cell *cq = &view_cells(j)[(size_t)w * rg.gw + (size_t)u];
+                if (!cq->valid)
+                    continue;
+                vec3 q, nq;
+                cell_in_object(cq, &first[j], &q, &nq);
+                if (v3_len(v3_sub(p, q)) > gate_mm || v3_dot(n, nq) < min_cos)
+                    continue;
+                double res = v3_dot(v3_sub(p, q), nq);
+                vec3 pxn = v3_cross(p, nq);
+                double jac[6] = {pxn.x, pxn.y, pxn.z, nq.x, nq.y, nq.z};
+                for (int r = 0; r < 6; r++) {
+                    for (int s = 0; s < 6; s++)
+                        a[r * 6 + s] += jac[r] * jac[s];
+                    b[r] -= jac[r] * res;
+                }
+                sq += res * res;
+                coupled++;
+                break; /* one pair a point: the first view that sees it */
+            }
+        }
+    }
+    *rms = coupled > 0 ? sqrt(sq / coupled) : 0.0;
+    if (coupled >= 6 && lsq_solve(6, a, b, x) == 0) {
+        struct frame_xform s, moved;
+        frame_from_small_motion(x, &s);
+        frame_compose(&s, &rg.first_from_second, &moved);
+        rg.first_from_second = moved;
+    }
+    return coupled;
+}
+
+/* Two passes: the second found in the first (align.h), then refined against the first pass's
+ * views; a second pass that matches nothing fails the registration at its first view. */
+static void align_second_pass(struct reg_report *rep)
+{
+    struct align_params ap = {rg.p.max_pair_mm, rg.p.max_normal_deg, rg.p.min_coupled_share};
+    struct align_report ar;
+    rg.second_aligned = 0; /* the second pass's points in its own frame */
+    feed_alignment();
+    if (align_solve(&ap, &rg.first_from_second, &ar) != 0 || !ar.found) {
+        rep->failed_view = (int)rg.per_pass;
+        rep->failed_against = -1;
+        rep->failed_share = ar.coupled_share;
+        return;
+    }
+    rg.second_aligned = 1;
+    double rms = 0.0;
+    for (int it = 0; it < 15; it++)
+        rep->second_coupled = refine_second_step(rg.p.max_pair_mm, &rms);
+    rep->second_rms_mm = rms;
+    rep->second_turned_deg = ar.turned_deg;
+    rep->second_share = ar.coupled_share;
+}
+
 int reg_solve(struct reg_report *rep)
 {
     memset(rep, 0, sizeof(*rep));
@@ -367,7 +509,7 @@ int reg_solve(struct reg_report *rep)
     rg.use_solution = 0;
     pass(rg.p.max_pair_mm, 0);
     rep->score_before_mm = rep->score_after_mm = score();
-    if (rg.p.enabled && rg.edges > 0 && rg.present[0]) {
+    if (rg.p.enabled && rg.edges > 0 && rg.present[0] && rg.present[rg.views - rg.per_pass]) {
         rep->solved = 1;
         for (uint32_t it = 0; it < rg.p.iterations; it++) {
             /* wide pairs first, to reach errors of a degree or two, then the working gate */
@@ -392,6 +534,8 @@ int reg_solve(struct reg_report *rep)
         rg.use_solution = rep->accepted;
     }
     summarise(rep);
+    if (rg.passes == 2)
+        align_second_pass(rep);
     return 0;
 }
 
@@ -421,6 +565,10 @@ int reg_view_pose(uint32_t v, struct frame_xform *obj_from_cam, struct reg_view 
             c.axis_dir[0] = rg.d.x, c.axis_dir[1] = rg.d.y, c.axis_dir[2] = rg.d.z;
         }
         frame_object_from_camera_rad(&c, theta, obj_from_cam);
+        if (v >= rg.per_pass && rg.second_aligned) { /* into the first pass's object frame */
+            struct frame_xform in_second = *obj_from_cam;
+            frame_compose(&rg.first_from_second, &in_second, obj_from_cam);
+        }
     }
     return 0;
 }

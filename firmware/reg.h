@@ -47,17 +47,24 @@ struct reg_report {
     double axis_shift_mm, axis_tilt_deg;   /**< the axis against the calibrated one */
     uint32_t worst_view;       /**< the view with the largest residual */
     double worst_rms_mm;
-    int failed_view;           /**< -1, or a view that does not match the one before it */
-    int failed_against;        /**< the view it was compared with */
+    int failed_view;           /**< -1, or a view that does not match the one before it (or
+                                    the first view of a second pass that matches nothing) */
+    int failed_against;        /**< the view it was compared with (-1: the first pass) */
     double failed_share;       /**< the share of their overlap that coupled */
     char refused[160];         /**< why a solved adjustment was not accepted ("" when it was) */
+    double second_turned_deg;  /**< two passes: how far the object was turned between them */
+    double second_share;       /**< the share of the second pass's points the search paired */
+    uint32_t second_coupled;   /**< pairs of the final refinement against the first pass */
+    double second_rms_mm;      /**< and their residual */
 };
 
-/** Forget every view and size the samples for @p views views of @p width x @p height: the
- *  stride grows beyond params->sample_stride until they fit REG_MAX_CELLS.
- *  @retval 0 @retval -E2BIG more views than REG_MAX_VIEWS */
+/** Forget every view and size the samples for @p views views of @p width x @p height in
+ *  @p passes passes (1, or 2: the object laid another way for the second half of the views,
+ *  which is found in the first without a starting pose, align.h): the stride grows beyond
+ *  params->sample_stride until they fit REG_MAX_CELLS.
+ *  @retval 0 @retval -E2BIG more views than REG_MAX_VIEWS, or not passes x views per pass */
 int reg_begin(const struct reg_params *params, const struct scan_calib *calib, uint32_t views,
-              uint32_t width, uint32_t height);
+              uint32_t passes, uint32_t width, uint32_t height);
 
 /** Keep samples of view @p index (camera frame) taken at the reported @p angle_mdeg.
  *  @retval 0 @retval -EINVAL index or size outside what reg_begin was given */

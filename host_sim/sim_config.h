@@ -13,6 +13,7 @@ struct sim_config {
     char object[16]; /**< sphere | cylinder | box | torus | mesh */
     char mesh_file[HAL_MAX_PATH];
     double object_height_mm;
+    double second_pass_pose_deg[3]; /**< the object_pose of a scan's second pass */
     double object_pose_deg[3]; /**< turned about x, then y, then z before it is stood on the
                                     table (90, 0, 0: an upright object on its side) */
     double slip_mm[3];   /**< the object slips on the table by this (object frame) ... */

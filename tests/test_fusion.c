@@ -291,7 +291,7 @@ static void test_watertight_closes_at_the_table(void **state)
     assert_int_equal(fusion_begin(&p), 0);
     assert_int_equal(fusion_fill(scanned_sphere, &standing), 0);
     assert_int_equal(fusion_fill_holes(10.0, &filled), 0);
-    assert_int_equal(fusion_close_watertight(10.0, &inside), 0);
+    assert_int_equal(fusion_close_watertight(10.0, 1, &inside), 0);
     /* the core no filling reached (radius 20 - 2.5 observed - 5 filled) is decided solid */
     assert_true(inside > 0.8 * 4.0 / 3.0 * M_PI * 12.5 * 12.5 * 12.5);
     struct mesh_summary ms; /* crumbs the opening leaves beside the surface are fragments */

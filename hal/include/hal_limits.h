@@ -59,6 +59,15 @@
 #else
 #define REG_MAX_CELLS (1u << 20)
 #endif
+/* A second pass aligned to the first (align.h): points kept of each pass, 24 bytes each, and
+ * the cells of the first pass's nearest-point field, 4 bytes each. */
+#ifdef HAL_LIMITS_SMALL
+#define ALIGN_MAX_POINTS 75000u
+#define ALIGN_MAX_CELLS (1u << 20)
+#else
+#define ALIGN_MAX_POINTS 150000u
+#define ALIGN_MAX_CELLS (1u << 21)
+#endif
 /* Largest stack frame a firmware/ function may have (gcc -fstack-usage, checked by make test:
  * scripts/check-stack.sh); big state lives in static buffers, never on the stack. */
 #define HAL_STACK_FRAME_MAX 2048u
