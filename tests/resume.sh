@@ -61,4 +61,21 @@ if [ -d "$out/killed" ]; then # the last interrupted scan, resumed to its end
     finished=$((finished + 1))
 fi
 echo "[       OK ] sigkill_and_resume: $done_kills kills, $finished scans finished, each model identical"
-echo "[  PASSED  ] 1 test(s)."
+# A two-pass scan killed in its second pass: resume asks for the object laid as the second pass
+# wants (the simulated person lays it), takes the rest and gives the uninterrupted model.
+two=tests/resume-two-pass.ini
+"$bin" scan --config $two --out "$out/two-reference" >"$out/two-reference.log" 2>&1 ||
+    fail "two-pass reference scan: $(tail -n 1 "$out/two-reference.log")"
+"$bin" scan --config $two --out "$out/two" >"$out/two.log" 2>&1 &
+pid=$!
+while kill -0 "$pid" 2>/dev/null && [ ! -f "$out/two/view_005/view.ini" ]; do sleep 0.2; done
+kill -KILL "$pid" 2>/dev/null
+wait "$pid" 2>/dev/null
+[ -f "$out/two/view_005/view.ini" ] && [ ! -f "$out/two/mesh.ply" ] ||
+    fail "the two-pass scan was not stopped in its second pass"
+"$bin" resume "$out/two" --config $two >>"$out/two.log" 2>&1 || fail "two-pass resume: $(tail -n 3 "$out/two.log")"
+grep -q '>>> pass 2 of 2' "$out/two.log" || fail "resume in the second pass did not ask for the object"
+cmp -s "$out/two/mesh.ply" "$out/two-reference/mesh.ply" ||
+    fail "the two-pass model after a kill in its second pass differs from the uninterrupted one"
+echo "[       OK ] two_pass_killed_in_second_pass_resumes"
+echo "[  PASSED  ] 2 test(s)."
