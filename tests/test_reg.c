@@ -26,6 +26,16 @@ static struct scan_calib calib;
 static uint8_t reason[HAL_MAX_PIXELS], rgb[HAL_MAX_PIXELS * 3];
 static float xyz[HAL_MAX_PIXELS * 3], normal[HAL_MAX_PIXELS * 3];
 
+/* How the object lies: its spheres at rot c + shift (object frame). */
+static double placed_rot[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+static vec3 placed_shift;
+static double radius_scale = 1.0; /* another object altogether */
+
+static vec3 sphere_centre(int k)
+{
+    return v3_add(m3_mul(placed_rot, v3_from(sphere_c[k])), placed_shift);
+}
+
 /* Render the view at true angle @p angle_deg, the object slipped by @p slip_mm (object frame),
  * and add it to the registration as view @p v reported at @p reported_deg. */
 static void add_view(uint32_t v, double angle_deg, double reported_deg, vec3 slip_mm)
@@ -42,9 +52,10 @@ static void add_view(uint32_t v, double angle_deg, double reported_deg, vec3 sli
             double best = 1e30;
             int hit = -1;
             for (int k = 0; k < SPHERES; k++) { /* |eye + t dir - c|^2 = r^2 */
-                vec3 oc = v3_sub(eye, v3_from(sphere_c[k]));
+                vec3 oc = v3_sub(eye, sphere_centre(k));
                 double a = v3_dot(dir, dir), b = v3_dot(oc, dir);
-                double disc = b * b - a * (v3_dot(oc, oc) - sphere_r[k] * sphere_r[k]);
+                double r = sphere_r[k] * radius_scale;
+                double disc = b * b - a * (v3_dot(oc, oc) - r * r);
                 double t = disc >= 0.0 ? (-b - sqrt(disc)) / a : -1.0;
                 if (t > 0.0 && t < best) {
                     best = t;
@@ -55,7 +66,7 @@ static void add_view(uint32_t v, double angle_deg, double reported_deg, vec3 sli
                 continue;
             size_t i = (size_t)y * w + x;
             vec3 p_obj = v3_add(eye, v3_scale(dir, best));
-            vec3 n_cam = frame_dir_inv(&obj, v3_norm(v3_sub(p_obj, v3_from(sphere_c[hit]))));
+            vec3 n_cam = frame_dir_inv(&obj, v3_norm(v3_sub(p_obj, sphere_centre(hit))));
             vec3 p_cam = v3_scale(ray, best);
             if (v3_dot(n_cam, v3_norm(p_cam)) > -0.2)
                 continue; /* grazing: a scanner would not keep it */
@@ -112,7 +123,7 @@ static void test_table_errors_are_found(void **state)
     static const double err_deg[VIEWS] = {0.7, -1.9, 1.2, 0.4, -0.8, 2.0, -1.3, 1.6};
     double truth[VIEWS];
     struct reg_params p = params();
-    assert_int_equal(reg_begin(&p, &calib, VIEWS, calib.cam_width, calib.cam_height), 0);
+    assert_int_equal(reg_begin(&p, &calib, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
     for (uint32_t v = 0; v < VIEWS; v++) {
         truth[v] = 45.0 * v + err_deg[v];
         add_view(v, truth[v], 45.0 * v, v3(0, 0, 0));
@@ -141,7 +152,7 @@ static void test_axis_is_reestimated(void **state)
     d = v3_norm(v3_add(d, v3(0.007, 0, 0))); /* 0.4 degrees */
     wrong.axis_dir[0] = d.x, wrong.axis_dir[1] = d.y, wrong.axis_dir[2] = d.z;
     struct reg_params p = params();
-    assert_int_equal(reg_begin(&p, &wrong, VIEWS, calib.cam_width, calib.cam_height), 0);
+    assert_int_equal(reg_begin(&p, &wrong, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
     for (uint32_t v = 0; v < VIEWS; v++) {
         truth[v] = 45.0 * v;
         add_view(v, truth[v], truth[v], v3(0, 0, 0)); /* rendered with the true axis */
@@ -164,7 +175,7 @@ static void test_slip_names_the_view_and_bounds_refuse(void **state)
 {
     (void)state;
     struct reg_params p = params();
-    assert_int_equal(reg_begin(&p, &calib, VIEWS, calib.cam_width, calib.cam_height), 0);
+    assert_int_equal(reg_begin(&p, &calib, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
     for (uint32_t v = 0; v < VIEWS; v++)
         add_view(v, 45.0 * v, 45.0 * v, v >= 4 ? v3(6, 0, 0) : v3(0, 0, 0));
     struct reg_report rep;
@@ -176,7 +187,7 @@ static void test_slip_names_the_view_and_bounds_refuse(void **state)
     assert_true(rep.failed_share < p.min_coupled_share);
 
     p.max_correction_deg = 0.5; /* the table below misses by 1.5 degrees */
-    assert_int_equal(reg_begin(&p, &calib, VIEWS, calib.cam_width, calib.cam_height), 0);
+    assert_int_equal(reg_begin(&p, &calib, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
     for (uint32_t v = 0; v < VIEWS; v++)
         add_view(v, 45.0 * v + (v == 5 ? 1.5 : 0.0), 45.0 * v, v3(0, 0, 0));
     assert_int_equal(reg_solve(&rep), 0);
@@ -188,18 +199,78 @@ static void test_slip_names_the_view_and_bounds_refuse(void **state)
     assert_true(fabs(rv.angle_deg - 225.0) < 1e-9); /* refused: the table's own angle */
 }
 
+/* Two passes: the object laid on its side and turned for the second; found without a starting
+ * pose, every second-pass view's pose puts the object where the first pass has it. */
+static void test_second_pass_found(void **state)
+{
+    (void)state;
+    struct reg_params p = params();
+    const double ax = M_PI / 2.0, az = M_PI / 6.0; /* Rz(30) Rx(90), as [sim] second_pass_pose */
+    double rx[9] = {1, 0, 0, 0, cos(ax), -sin(ax), 0, sin(ax), cos(ax)};
+    double rz[9] = {cos(az), -sin(az), 0, sin(az), cos(az), 0, 0, 0, 1};
+    assert_int_equal(reg_begin(&p, &calib, 2 * VIEWS, 2, calib.cam_width, calib.cam_height), 0);
+    for (uint32_t v = 0; v < VIEWS; v++)
+        add_view(v, 45.0 * v, 45.0 * v, v3(0, 0, 0));
+    m3_mul_m3(rz, rx, placed_rot);
+    placed_shift = v3(4.0, -3.0, 45.0);
+    for (uint32_t v = 0; v < VIEWS; v++) /* and the table misses a little, as ever */
+        add_view(VIEWS + v, 45.0 * v + 0.3 * (v % 3), 45.0 * v, v3(0, 0, 0));
+    struct reg_report rep;
+    assert_int_equal(reg_solve(&rep), 0);
+    double worst = 0.0;
+    for (uint32_t v = VIEWS; v < 2 * VIEWS; v++) {
+        struct frame_xform pose, truth;
+        struct reg_view rv;
+        assert_int_equal(reg_view_pose(v, &pose, &rv), 0);
+        frame_object_from_camera_rad(&calib, (45.0 * (v - VIEWS) + 0.3 * ((v - VIEWS) % 3)) *
+                                                 M_PI / 180.0, &truth);
+        for (int k = 0; k < SPHERES; k++) { /* a centre as this view's camera has it */
+            vec3 cam = frame_point_inv(&truth, sphere_centre(k));
+            worst = fmax(worst, v3_len(v3_sub(frame_point(&pose, cam), v3_from(sphere_c[k]))));
+        }
+    }
+    memcpy(placed_rot, (double[9]){1, 0, 0, 0, 1, 0, 0, 0, 1}, sizeof(placed_rot));
+    placed_shift = v3(0, 0, 0);
+    print_message("second pass: turned %.2f deg (true %.2f), residual %.3f mm over %u pairs; "
+                  "worst sphere centre %.3f mm off\n",
+                  rep.second_turned_deg, acos((cos(az) - 1.0) / 2.0) * 180.0 / M_PI,
+                  rep.second_rms_mm, (unsigned)rep.second_coupled, worst);
+    assert_int_equal(rep.failed_view, -1);
+    assert_true(fabs(rep.second_turned_deg - acos((cos(az) - 1.0) / 2.0) * 180.0 / M_PI) < 0.2);
+    assert_true(worst < 0.1);
+}
+
+/* A second pass of another object: nothing of it matches, the registration says so. */
+static void test_second_pass_of_another_object_fails(void **state)
+{
+    (void)state;
+    struct reg_params p = params();
+    assert_int_equal(reg_begin(&p, &calib, 2 * VIEWS, 2, calib.cam_width, calib.cam_height), 0);
+    for (uint32_t v = 0; v < VIEWS; v++)
+        add_view(v, 45.0 * v, 45.0 * v, v3(0, 0, 0));
+    radius_scale = 1.5;
+    for (uint32_t v = 0; v < VIEWS; v++)
+        add_view(VIEWS + v, 45.0 * v, 45.0 * v, v3(0, 0, 0));
+    radius_scale = 1.0;
+    struct reg_report rep;
+    assert_int_equal(reg_solve(&rep), 0);
+    print_message("another object: %.0f%% of the second pass paired\n", 100.0 * rep.failed_share);
+    assert_int_equal(rep.failed_view, (int)VIEWS);
+    assert_int_equal(rep.failed_against, -1);
+}
+
 /* More views than fit at the configured stride keep every n-th pixel with a larger n. */
 static void test_many_views_fit_in_the_cells(void **state)
 {
     (void)state;
     struct reg_params p = params();
     struct reg_report rep;
-    assert_int_equal(reg_begin(&p, &calib, REG_MAX_VIEWS, 2048, 1536), 0);
+    assert_int_equal(reg_begin(&p, &calib, REG_MAX_VIEWS, 1, 2048, 1536), 0);
     assert_int_equal(reg_solve(&rep), 0);
     uint64_t cells = (uint64_t)((2048 + rep.stride - 1) / rep.stride) *
                      ((1536 + rep.stride - 1) / rep.stride) * REG_MAX_VIEWS;
     assert_true(rep.stride > 4 && cells <= REG_MAX_CELLS);
-    assert_int_equal(reg_begin(&p, &calib, REG_MAX_VIEWS + 1, 2048, 1536), -E2BIG);
+    assert_int_equal(reg_begin(&p, &calib, REG_MAX_VIEWS + 1, 1, 2048, 1536), -E2BIG);
 }
 
 int main(void)
@@ -208,6 +279,8 @@ int main(void)
         cmocka_unit_test(test_table_errors_are_found),
         cmocka_unit_test(test_axis_is_reestimated),
         cmocka_unit_test(test_slip_names_the_view_and_bounds_refuse),
+        cmocka_unit_test(test_second_pass_found),
+        cmocka_unit_test(test_second_pass_of_another_object_fails),
         cmocka_unit_test(test_many_views_fit_in_the_cells),
     };
     return cmocka_run_group_tests(tests, setup, NULL);
