@@ -61,21 +61,29 @@ if [ -d "$out/killed" ]; then # the last interrupted scan, resumed to its end
     finished=$((finished + 1))
 fi
 echo "[       OK ] sigkill_and_resume: $done_kills kills, $finished scans finished, each model identical"
-# A two-pass scan killed in its second pass: resume asks for the object laid as the second pass
-# wants (the simulated person lays it), takes the rest and gives the uninterrupted model.
-two=tests/resume-two-pass.ini
-"$bin" scan --config $two --out "$out/two-reference" >"$out/two-reference.log" 2>&1 ||
-    fail "two-pass reference scan: $(tail -n 1 "$out/two-reference.log")"
-"$bin" scan --config $two --out "$out/two" >"$out/two.log" 2>&1 &
-pid=$!
-while kill -0 "$pid" 2>/dev/null && [ ! -f "$out/two/view_005/view.ini" ]; do sleep 0.2; done
-kill -KILL "$pid" 2>/dev/null
-wait "$pid" 2>/dev/null
-[ -f "$out/two/view_005/view.ini" ] && [ ! -f "$out/two/mesh.ply" ] ||
-    fail "the two-pass scan was not stopped in its second pass"
-"$bin" resume "$out/two" --config $two >>"$out/two.log" 2>&1 || fail "two-pass resume: $(tail -n 3 "$out/two.log")"
-grep -q '>>> pass 2 of 2' "$out/two.log" || fail "resume in the second pass did not ask for the object"
-cmp -s "$out/two/mesh.ply" "$out/two-reference/mesh.ply" ||
-    fail "the two-pass model after a kill in its second pass differs from the uninterrupted one"
+# A two-pass scan stopped in its second pass (its last three views unfinished: no view.ini),
+# the table up to 1 degree off: resume asks for the object laid as the second pass wants (the
+# simulated person lays it), takes the rest, and the model is whole and accurate. The scan is
+# test_scan's when it has run (the same settings), else made here. (Not byte for byte: the
+# simulated table misses each resumed move by another amount.)
+ref=${BUILD:-build}/test_scan/two-pass
+sed -e "s|^calibration = .*|calibration = $PWD/config/sim-calib.ini|" \
+    -e "s|^mesh_file = ../|mesh_file = $PWD/|" config/sim-complete.ini > "$out/two.ini"
+echo "table_angle_error_mdeg = 1000" >> "$out/two.ini"
+if [ ! -f "$ref/view_015/view.ini" ]; then
+    ref=$out/two-reference
+    "$bin" scan --config "$out/two.ini" --out "$ref" >"$out/two-reference.log" 2>&1 ||
+        fail "two-pass reference scan: $(tail -n 1 "$out/two-reference.log")"
+fi
+cp -r "$ref" "$out/two"
+rm -f "$out/two/mesh.ply" "$out/two/mesh.obj" "$out/two/mesh.stl" "$out/two"/view_01[345]/view.ini
+"$bin" resume "$out/two" --config "$out/two.ini" >"$out/two.log" 2>&1 ||
+    fail "two-pass resume: $(tail -n 3 "$out/two.log")"
+grep -q '13 of 16 views kept' "$out/two.log" && grep -q '>>> pass 2 of 2' "$out/two.log" ||
+    fail "resume in the second pass did not take the last views with the object laid again"
+"${BUILD:-build}/mesh-compare" --align "$out/two/mesh.ply" "$out/two/truth_mesh.ply" > "$out/two.compare"
+awk '/^result -> truth: mean/ { a = $5 } /^truth -> result: mean/ { b = $5; w = $10 }
+     END { exit !(w + 0 >= 98 && (a + b) / 2 < 0.1) }' "$out/two.compare" ||
+    fail "the two-pass model resumed in its second pass is not whole: $(sed -n 4,5p "$out/two.compare")"
 echo "[       OK ] two_pass_killed_in_second_pass_resumes"
 echo "[  PASSED  ] 2 test(s)."
