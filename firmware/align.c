@@ -168,34 +168,23 @@ static void icp(struct motion *m, uint32_t step, int iterations, double gate0_mm
     const double min_cos = cos(max_normal_deg * M_PI / 180.0);
     for (int it = 0; it < iterations; it++) {
         double gate = fmax(gate1_mm, gate0_mm * pow(0.8, it));
-        double a[36] = {0}, b[6] = {0}, x[6], sq = 0.0;
-        uint32_t n = 0;
+        struct lsq_rigid eq;
+        lsq_rigid_clear(&eq);
         for (uint32_t i = 0; i < npts[1]; i += step) {
             vec3 p = apply(m, point(1, i));
             long k = nearest_to(p);
             if (k < 0)
                 continue;
             vec3 q = point(0, (uint32_t)k), nq = normal(0, (uint32_t)k);
-            if (v3_len(v3_sub(p, q)) > gate || v3_dot(m3_mul(m->r, normal(1, i)), nq) < min_cos)
-                continue;
-            double res = v3_dot(v3_sub(p, q), nq);
-            vec3 pxn = v3_cross(p, nq);
-            double jac[6] = {pxn.x, pxn.y, pxn.z, nq.x, nq.y, nq.z};
-            for (int r = 0; r < 6; r++) {
-                for (int c = 0; c < 6; c++)
-                    a[r * 6 + c] += jac[r] * jac[c];
-                b[r] -= jac[r] * res;
-            }
-            sq += res * res;
-            n++;
+            if (v3_len(v3_sub(p, q)) <= gate && v3_dot(m3_mul(m->r, normal(1, i)), nq) >= min_cos)
+                lsq_rigid_add(&eq, p, q, nq);
         }
-        *coupled = n;
-        *rms = n > 0 ? sqrt(sq / n) : 0.0;
-        if (n < 6 || lsq_solve(6, a, b, x) != 0)
-            return;
+        *coupled = eq.pairs;
+        *rms = eq.pairs > 0 ? sqrt(eq.sq / eq.pairs) : 0.0;
         struct frame_xform s;
-        frame_from_small_motion(x, &s); /* p'' = Rs p' + ts, ts = -Rs origin */
-        vec3 ts = v3_scale(m3_mul(s.rot, s.origin), -1.0);
+        if (lsq_rigid_step(&eq, &s) != 0)
+            return;
+        vec3 ts = v3_scale(m3_mul(s.rot, s.origin), -1.0); /* p'' = Rs p' + ts */
         double r[9];
         m3_mul_m3(s.rot, m->r, r);
         memcpy(m->r, r, sizeof(r));

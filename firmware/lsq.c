@@ -4,6 +4,7 @@
 #include <errno.h>
 #include <math.h>
 #include <stddef.h>
+#include <string.h>
 
 int lsq_solve(uint32_t n, double *a, double *b, double *x)
 {
@@ -53,4 +54,32 @@ int lsq_solve(uint32_t n, double *a, double *b, double *x)
         x[r] = s / d;
     }
     return rank > 0 ? 0 : -EDOM;
+}
+
+void lsq_rigid_clear(struct lsq_rigid *eq)
+{
+    memset(eq, 0, sizeof(*eq));
+}
+
+void lsq_rigid_add(struct lsq_rigid *eq, vec3 p, vec3 q, vec3 n)
+{
+    double res = v3_dot(v3_sub(p, q), n);
+    vec3 pxn = v3_cross(p, n);
+    const double jac[6] = {pxn.x, pxn.y, pxn.z, n.x, n.y, n.z};
+    for (int r = 0; r < 6; r++) {
+        for (int c = 0; c < 6; c++)
+            eq->a[r * 6 + c] += jac[r] * jac[c];
+        eq->b[r] -= jac[r] * res;
+    }
+    eq->sq += res * res;
+    eq->pairs++;
+}
+
+int lsq_rigid_step(struct lsq_rigid *eq, struct frame_xform *step)
+{
+    double x[6];
+    if (eq->pairs < 6 || lsq_solve(6, eq->a, eq->b, x) != 0)
+        return -EDOM;
+    frame_from_small_motion(x, step);
+    return 0;
 }

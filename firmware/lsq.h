@@ -5,10 +5,32 @@
 
 #include <stdint.h>
 
+#include "frames.h"
+#include "vec3.h"
+
 /** Solve a x = b for symmetric positive semi-definite @p a (n x n, row-major) by Gaussian
  *  elimination with partial pivoting; @p a and @p b are consumed. A direction the equations
  *  do not determine (a pivot below 1e-12 of the largest) gets x = 0 there.
  *  @retval 0 @retval -EDOM nothing determined at all */
 int lsq_solve(uint32_t n, double *a, double *b, double *x);
+
+/** Normal equations of point-to-plane rigid registration (Chen and Medioni 1992; Low 2004):
+ *  the small motion x = (omega, t) that moves points p towards the planes (q, n), linearised:
+ *  r = (p - q) . n + omega . (p x n) + t . n. */
+struct lsq_rigid {
+    double a[36], b[6];
+    double sq;      /**< sum of the squared residuals added */
+    uint32_t pairs; /**< pairs added */
+};
+
+/** Empty equations. */
+void lsq_rigid_clear(struct lsq_rigid *eq);
+
+/** Add the pair of point @p p and the plane through @p q with unit normal @p n. */
+void lsq_rigid_add(struct lsq_rigid *eq, vec3 p, vec3 q, vec3 n);
+
+/** Solve (consumes @p eq) for the step that moves the points: out(p) = R p + t.
+ *  @retval 0 @retval -EDOM fewer than 6 pairs or nothing determined */
+int lsq_rigid_step(struct lsq_rigid *eq, struct frame_xform *step);
 
 #endif

@@ -416,8 +416,8 @@ static void feed_alignment(void)
 static uint32_t refine_second_step(double gate_mm, double *rms)
 {
     const double min_cos = cos(rg.p.max_normal_deg * M_PI / 180.0);
-    double a[36] = {0}, b[6] = {0}, x[6], sq = 0.0;
-    uint32_t coupled = 0;
+    struct lsq_rigid eq;
+    lsq_rigid_clear(&eq);
     static struct frame_xform first[REG_MAX_VIEWS], cam_of[REG_MAX_VIEWS]; /* too big for a stack */
     struct reg_view rv;
     for (uint32_t j = 0; j < rg.per_pass; j++)
@@ -451,24 +451,15 @@ static uint32_t refine_second_step(double gate_mm, double *rms)
                 cell_in_object(cq, &first[j], &q, &nq);
                 if (v3_len(v3_sub(p, q)) > gate_mm || v3_dot(n, nq) < min_cos)
                     continue;
-                double res = v3_dot(v3_sub(p, q), nq);
-                vec3 pxn = v3_cross(p, nq);
-                double jac[6] = {pxn.x, pxn.y, pxn.z, nq.x, nq.y, nq.z};
-                for (int r = 0; r < 6; r++) {
-                    for (int s = 0; s < 6; s++)
-                        a[r * 6 + s] += jac[r] * jac[s];
-                    b[r] -= jac[r] * res;
-                }
-                sq += res * res;
-                coupled++;
+                lsq_rigid_add(&eq, p, q, nq);
                 break; /* one pair a point: the first view that sees it */
             }
         }
     }
-    *rms = coupled > 0 ? sqrt(sq / coupled) : 0.0;
-    if (coupled >= 6 && lsq_solve(6, a, b, x) == 0) {
-        struct frame_xform s, moved;
-        frame_from_small_motion(x, &s);
+    uint32_t coupled = eq.pairs;
+    *rms = coupled > 0 ? sqrt(eq.sq / coupled) : 0.0;
+    struct frame_xform s, moved;
+    if (lsq_rigid_step(&eq, &s) == 0) {
         frame_compose(&s, &rg.first_from_second, &moved);
         rg.first_from_second = moved;
     }

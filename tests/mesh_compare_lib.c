@@ -96,31 +96,25 @@ static void align_to_truth(struct sim_mesh *m, const struct sim_bvh *truth, doub
     uint32_t step = m->vert_count / 20000u + 1u;
     struct frame_xform total = {{1, 0, 0, 0, 1, 0, 0, 0, 1}, {0, 0, 0}};
     for (int it = 0; it < 30; it++) {
-        double a[36] = {0}, b[6] = {0}, x[6];
+        struct lsq_rigid eq;
+        lsq_rigid_clear(&eq);
         for (uint32_t i = 0; i < m->vert_count; i += step) {
             vec3 p = v3(m->pos[3 * i], m->pos[3 * i + 1], m->pos[3 * i + 2]), q;
             double d = sim_bvh_closest(truth, p, 3.0, &q);
-            if (d > 3.0 || d < 1e-9)
-                continue;
-            vec3 n = v3_scale(v3_sub(p, q), 1.0 / d), pxn = v3_cross(p, n);
-            double jac[6] = {pxn.x, pxn.y, pxn.z, n.x, n.y, n.z};
-            for (int r = 0; r < 6; r++) {
-                for (int c = 0; c < 6; c++)
-                    a[r * 6 + c] += jac[r] * jac[c];
-                b[r] -= jac[r] * d;
-            }
+            if (d <= 3.0 && d >= 1e-9)
+                lsq_rigid_add(&eq, p, q, v3_scale(v3_sub(p, q), 1.0 / d));
         }
-        if (lsq_solve(6, a, b, x) != 0)
-            break;
         struct frame_xform step_x, moved;
-        frame_from_small_motion(x, &step_x);
+        if (lsq_rigid_step(&eq, &step_x) != 0)
+            break;
         for (uint32_t i = 0; i < m->vert_count; i++) {
             vec3 p = frame_point(&step_x, v3(m->pos[3 * i], m->pos[3 * i + 1], m->pos[3 * i + 2]));
             m->pos[3 * i] = (float)p.x, m->pos[3 * i + 1] = (float)p.y, m->pos[3 * i + 2] = (float)p.z;
         }
         frame_compose(&step_x, &total, &moved);
         total = moved;
-        if (v3_len(v3(x[0], x[1], x[2])) < 1e-8 && v3_len(v3(x[3], x[4], x[5])) < 1e-6)
+        double tr = step_x.rot[0] + step_x.rot[4] + step_x.rot[8]; /* 3 - angle^2 */
+        if (3.0 - tr < 1e-14 && v3_len(step_x.origin) < 1e-6)
             break;
     }
     double tr = total.rot[0] + total.rot[4] + total.rot[8], c = 0.5 * (tr - 1.0);
