@@ -86,7 +86,7 @@ awk -v b="$base" -v m1="$mean_1000" -v m2="$mean_2000" 'BEGIN {
 echo "| each view's angle after registration (relative to view 0) | within 0.05 deg | $angle_1000 deg (1 deg off), $angle_2000 deg (2 deg off) |"
 echo "| joint registration time, 8 views, one core | < 0.5 s | $reg_cpu s (error-free), $cpu_1000 s, $cpu_2000 s CPU |"
 echo "| cleaned mesh (bunny, one pass) | 0 fragments | $((pieces - 1)) fragments ($removed left out) |"
-echo "| holes under 10 mm (bunny, one pass) | 0 | $holes_raw as scanned; $holes_filled with max_hole_mm = 10 (what is left of larger holes, or of gaps some view saw as empty) |"
+echo "| holes under 10 mm (bunny, one pass) | 0 | $holes_raw as scanned; $holes_filled with max_hole_mm = 10 (what is left of holes wider than 10 mm, partly bridged) |"
 echo "| watertight when asked (every edge shared by two faces) | 0 boundary, 0 non-manifold edges | $wt_edges |"
 echo "| two-pass bunny: the whole true surface within 1 mm | >= 98% | $two_within% (one pass: $one_within%) |"
 echo "| two-pass bunny: symmetric mean distance (aligned) | < 0.1 mm | $two_sym mm |"
