@@ -160,7 +160,7 @@ printf '[output]\nwatertight = 1\n' | cat config/sim.ini - > "$out/watertight.in
 check watertight_needs_max_hole sh -c "$bin check-config --config $out/watertight.ini 2>&1 |
     grep -q 'watertight: a closed model needs max_hole_mm > 0'"
 # make LIMITS=small, for a board with 512 MB: under a 512 MiB address-space limit the default
-# build cannot even start (729 MiB of static buffers), the small one takes the same scan and
+# build cannot even start (754 MiB of static buffers), the small one takes the same scan and
 # gives the same model. (ASan reserves terabytes of address space: no limit under SAN=1.)
 sbin=${BUILD:-build}/small/scanner
 rm -rf "$out/scan_small"

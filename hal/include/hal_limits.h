@@ -9,8 +9,8 @@
 
 #ifdef HAL_LIMITS_SMALL
 /* make LIMITS=small, for a board with 512 MB (a Pi Zero 2 W, a Pi 3A+): frames up to the Pi
- * camera v1's 2x2 binned mode, 1296 x 972, and a smaller fusion grid (fusion.h); about 330 MiB
- * of static buffers instead of 729. */
+ * camera v1's 2x2 binned mode, 1296 x 972, and a smaller fusion grid (fusion.h); about 340 MiB
+ * of static buffers instead of 754. */
 #define HAL_MAX_WIDTH 1296u
 #define HAL_MAX_HEIGHT 972u
 #else
