@@ -331,18 +331,20 @@ void mesh_compare_print(const struct mesh_comparison *r, FILE *out)
             "result -> truth: mean %.3f mm, 95%% %.3f mm, max %.3f mm\n"
             "truth -> result: mean %.3f mm, within 1 mm %.2f%%\n"
             "truth above the table (z >= 1 mm) -> result: mean %.3f mm, within 1 mm %.2f%%\n"
-            "symmetric mean surface distance: %.3f mm\n"
-            "observable true surface: %.2f%% of it; within 1 mm of the result %.2f%%, mean "
-            "distance %.3f mm\n"
-            "symmetric mean surface distance over the observable surface: %.3f mm\n",
+            "symmetric mean surface distance: %.3f mm\n",
             (unsigned)r->result_triangles, (unsigned)r->result_pieces, (unsigned)r->holes,
             (unsigned)r->holes_under_10mm, r->largest_hole_mm, (unsigned)r->boundary_edges,
             (unsigned)r->nonmanifold_edges, r->result_to_truth_mean_mm, r->result_to_truth_p95_mm,
             r->result_to_truth_max_mm, r->truth_to_result_mean_mm, 100.0 * r->truth_within_1mm,
             r->truth_seen_to_result_mean_mm, 100.0 * r->truth_seen_within_1mm,
-            r->symmetric_mean_mm, 100.0 * r->observable_share,
-            100.0 * r->truth_observable_within_1mm, r->truth_observable_to_result_mean_mm,
-            r->symmetric_observable_mean_mm);
+            r->symmetric_mean_mm);
+    if (r->observable_share > 0.0) /* only with a scan directory's rig */
+        fprintf(out,
+                "observable true surface: %.2f%% of it; within 1 mm of the result %.2f%%, mean "
+                "distance %.3f mm\n"
+                "symmetric mean surface distance over the observable surface: %.3f mm\n",
+                100.0 * r->observable_share, 100.0 * r->truth_observable_within_1mm,
+                r->truth_observable_to_result_mean_mm, r->symmetric_observable_mean_mm);
 }
 
 int mesh_visibility_from_scan(const char *scan_dir, struct mesh_visibility *vis, char *err,
