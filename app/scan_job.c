@@ -88,6 +88,12 @@ static void json_string(FILE *out, const char *s)
     fputc('"', out);
 }
 
+/* @retval 1 for the event that ends a view's line (taken live; fused into the model). */
+static int view_finished(const char *event)
+{
+    return strcmp(event, "saved") == 0 || strcmp(event, "fused") == 0;
+}
+
 /* One event. @p view < 0: not about a view. @p done: views finished so far, for the estimate. */
 static void progress(struct job *j, const char *event, int view, uint32_t done, const char *detail)
 {
@@ -109,9 +115,9 @@ static void progress(struct job *j, const char *event, int view, uint32_t done, 
         if (left_s >= 0)
             printf(" (~%.0f s left)", left_s);
         printf("  %s %.*s", event, shown, detail);
-        if (strcmp(event, "saved") == 0 || strcmp(event, "fused") == 0)
+        if (view_finished(event))
             printf("\n");
-    } else if (view >= 0 && (strcmp(event, "saved") == 0 || strcmp(event, "fused") == 0)) {
+    } else if (view >= 0 && view_finished(event)) {
         printf("view %d of %u: %s\n", view + 1, (unsigned)j->views, detail);
     } else if (view < 0) {
         static const char *const human[][2] = {{"scan_start", "scanning into"},
@@ -191,17 +197,18 @@ static int write_view_meta(struct job *j, const struct scan_view_info *info, con
 }
 
 /* Results of a processed view once the scan is registered: its registration.ini, its point
- * cloud and its part of the fused model, all at the registered pose. */
-static int save_results(struct job *j, const struct scan_view *view, const struct reg_report *rep)
+ * cloud and its part of the fused model, all at the registered pose. @p rv: out, the view's
+ * part of the registration. */
+static int save_results(struct job *j, const struct scan_view *view, const struct reg_report *rep,
+                        struct reg_view *rv)
 {
     char path[HAL_MAX_PATH + 64];
     struct frame_xform pose;
-    struct reg_view rv;
-    int rc = reg_view_pose(j->view, &pose, &rv);
+    int rc = reg_view_pose(j->view, &pose, rv);
     if (rc == 0)
         rc = write_failed(j, "registration.ini",
                           scan_dir_write_registration(&j->hal->storage, j->out_dir, j->view, rep,
-                                                      &rv, &pose));
+                                                      rv, &pose));
     if (rc == 0)
         rc = scan_dir_path(path, sizeof(path), j->out_dir, (int)j->view, "cloud.ply");
     if (rc == 0)
@@ -258,13 +265,16 @@ static int write_model(struct job *j)
     }
     if (rc != 0)
         return rc;
+    char closed[96] = "";
+    if (j->cfg->watertight)
+        snprintf(closed, sizeof(closed), ", closed watertight, %u unseen voxels made solid",
+                 (unsigned)inside);
     snprintf(detail, sizeof(detail),
              "%u vertices, %u triangles (%u floating fragments of %u pieces left out; %u voxels "
              "filled holes%s) -> %s/mesh.ply, mesh.obj%s",
              (unsigned)ms.kept_vertices, (unsigned)ms.kept_triangles,
-             (unsigned)ms.removed_pieces, (unsigned)ms.pieces, (unsigned)filled,
-             j->cfg->watertight ? ", closed watertight" : "", j->out_dir,
-             fits ? " and mesh.stl" : "");
+             (unsigned)ms.removed_pieces, (unsigned)ms.pieces, (unsigned)filled, closed,
+             j->out_dir, fits ? " and mesh.stl" : "");
     progress(j, "mesh", -1, j->views, detail);
     return 0;
 }
@@ -343,10 +353,10 @@ static int make_model(struct job *j, const char *scan_dir)
             rc = load_view(j, scan_dir, v, &view, &info);
         if (rc == 0 && (rc = hal_storage_mkdir_p(&j->hal->storage, j->view_dir)) != 0)
             j->hal->log(HAL_LOG_ERROR, "cannot make %s: %s", j->view_dir, strerror(-rc));
-        if (rc == 0)
-            rc = save_results(j, &view, &rep);
         struct reg_view rv;
-        if (rc == 0 && reg_view_pose(v, NULL, &rv) == 0) {
+        if (rc == 0)
+            rc = save_results(j, &view, &rep, &rv);
+        if (rc == 0) {
             char detail[HAL_MAX_PATH + 160];
             snprintf(detail, sizeof(detail), "fused at %.3f deg (%+.3f deg from the table's) -> %s",
                      rv.angle_deg, rv.correction_deg, j->view_dir);
@@ -435,16 +445,14 @@ static int live_view(struct job *j, uint32_t v)
     return 0;
 }
 
-/* The person lays the object as pass @p pass asks (the simulated person does it at once).
+/* The person lays the object for the second pass (the simulated person does it at once).
  * @retval 0 @retval -EINTR the person stopped (Ctrl-D) @retval -errno */
-static int ask_for_pass(struct job *j, uint32_t pass)
+static int ask_for_second_pass(struct job *j)
 {
-    char err[256], detail[160];
-    struct board_target t = {.kind = BOARD_TARGET_OBJECT, .pass = pass};
-    snprintf(detail, sizeof(detail),
-             pass == 2 ? "pass 2 of 2: lay the object on its side (another way than before), "
-                         "near the middle of the table"
-                       : "pass 1 of 2: stand the object upright in the middle of the table");
+    char err[256];
+    const char *detail = "pass 2 of 2: lay the object on its side (another way than before), "
+                         "near the middle of the table";
+    struct board_target t = {.kind = BOARD_TARGET_OBJECT, .pass = 2};
     progress(j, "place_object", -1, 0, detail);
     int rc = board_place_target((struct hal *)j->hal, &t, err, sizeof(err));
     if (rc == 0)
@@ -466,7 +474,7 @@ static int home_and_take_views(struct job *j, uint32_t first)
     const struct hal *hal = j->hal;
     int rc = 0;
     if (j->cfg->passes == 2 && first >= j->cfg->views) /* resumed in the second pass */
-        rc = ask_for_pass(j, 2);
+        rc = ask_for_second_pass(j);
     if (rc == 0)
         progress(j, "homing", (int)first, first, "");
     if (rc == 0 && j->opts->clear_alarm && (rc = hal_table_clear_alarm(&hal->turntable)) == -ENOSYS)
@@ -477,7 +485,7 @@ static int home_and_take_views(struct job *j, uint32_t first)
                  j->opts->clear_alarm ? "" : " (if it reports an alarm: --clear-alarm)");
     for (uint32_t v = first; v < j->views && rc == 0; v++) {
         if (v == j->cfg->views && v != first) { /* the second pass begins */
-            rc = ask_for_pass(j, 2);
+            rc = ask_for_second_pass(j);
             if (rc == 0 && (rc = hal_table_home(&hal->turntable)) != 0)
                 hal->log(HAL_LOG_WARN, "the turntable did not home for the second pass");
         }

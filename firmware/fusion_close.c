@@ -5,9 +5,10 @@
  * into unobserved voxels from their observed neighbours, one voxel layer per pass, so a hole up
  * to 2 x passes voxels across closes with a smooth membrane (volumetric diffusion, Davis et al.
  * 2002). fusion_close_watertight then decides every voxel still unobserved: outside when it can
- * be reached from the grid's boundary without crossing the observed inside of the object or the
- * table plane, inside otherwise, and everything at or below the table plane outside, so
- * marching cubes over the whole grid gives a closed surface (the object closed at the table). */
+ * be reached from the grid's sides or top (one pass: sideways or down only) through passages
+ * wider than the widest hole, without crossing the observed inside of the object or the table
+ * plane; inside otherwise; everything at or below the table plane outside. Marching cubes over
+ * the whole grid then gives a closed surface (the object closed at the table). */
 #include "fusion_grid.h"
 
 #include <errno.h>
@@ -87,7 +88,7 @@ static uint32_t diffuse_once(void)
                     continue;
                 int n = neighbours(x, y, z, nb);
                 for (int k = 0; k < n; k++)
-                    if (fusion_grid[nb[k]].weight != 0 && !marked(nb[k])) {
+                    if (fusion_grid[nb[k]].weight != 0) { /* marked ones are still unobserved */
                         set_mark(i); /* filled in this pass: no source for its neighbours */
                         break;
                     }

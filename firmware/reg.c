@@ -301,11 +301,17 @@ static double gauss_newton_step(void)
     return fmax(largest, fmax(fabs(ax[2]), fabs(ax[3])));
 }
 
+/* The angle the table reported for view @p v, in radians. */
+static double reported_rad(uint32_t v)
+{
+    return rg.reported_mdeg[v] * (M_PI / 180000.0);
+}
+
 /* The unknowns at the turntable's answer. */
 static void start_from_table(void)
 {
     for (uint32_t v = 0; v < rg.views; v++)
-        rg.theta[v] = rg.reported_mdeg[v] * (M_PI / 180000.0);
+        rg.theta[v] = reported_rad(v);
     rg.a = v3_from(rg.calib.axis_point_mm);
     rg.d = v3_norm(v3_from(rg.calib.axis_dir));
 }
@@ -321,7 +327,7 @@ static void check_bounds(struct reg_report *rep)
     rep->axis_tilt_deg = acos(c > 1.0 ? 1.0 : c) * 180.0 / M_PI;
     rep->refused[0] = '\0';
     for (uint32_t v = 0; v < rg.views; v++) {
-        double corr = (rg.theta[v] - rg.reported_mdeg[v] * (M_PI / 180000.0)) * 180.0 / M_PI;
+        double corr = (rg.theta[v] - reported_rad(v)) * 180.0 / M_PI;
         if (rg.present[v] && fabs(corr) > rg.p.max_correction_deg) {
             snprintf(rep->refused, sizeof(rep->refused),
                      "view %u would turn %.2f deg from its reported angle, more than "
@@ -537,7 +543,7 @@ int reg_view_pose(uint32_t v, struct frame_xform *obj_from_cam, struct reg_view 
     memset(out, 0, sizeof(*out));
     out->present = 1;
     out->reported_mdeg = rg.reported_mdeg[v];
-    double theta = rg.use_solution ? rg.theta[v] : rg.reported_mdeg[v] * (M_PI / 180000.0);
+    double theta = rg.use_solution ? rg.theta[v] : reported_rad(v);
     out->angle_deg = theta * 180.0 / M_PI;
     out->correction_deg = out->angle_deg - rg.reported_mdeg[v] / 1000.0;
     double sq = 0.0;

@@ -331,12 +331,6 @@ out_safe:
     return rc != 0 ? rc : rc_off;
 }
 
-void scan_view_pose(const struct scan_calib *calib, const struct scan_view *view,
-                    struct frame_xform *obj_from_cam)
-{
-    frame_object_from_camera(calib, view->angle_mdeg, obj_from_cam);
-}
-
 int scan_keep_for_registration(uint32_t index, const struct scan_view *view)
 {
     return reg_add_view(index, view->angle_mdeg, &view->maps, &view->range, view->rgb);

@@ -81,10 +81,6 @@ int scan_feed_frame(uint32_t pattern, const uint8_t *pixels, uint32_t channels,
 int scan_finish_view(const struct scan_calib *calib, int32_t angle_mdeg, struct scan_view *view,
                      struct scan_view_info *info);
 
-/** Pose of @p view: camera frame to object frame, from the turntable axis and its angle. */
-void scan_view_pose(const struct scan_calib *calib, const struct scan_view *view,
-                    struct frame_xform *obj_from_cam);
-
 /** Keep samples of @p view as view @p index of the joint registration (reg_begin first). */
 int scan_keep_for_registration(uint32_t index, const struct scan_view *view);
 

@@ -132,7 +132,7 @@ int scan_save_cloud_at_turntable_pose(struct test_rig *t, const struct scan_view
                                       const char *path)
 {
     struct frame_xform pose;
-    scan_view_pose(&t->calib, view, &pose);
+    frame_object_from_camera(&t->calib, view->angle_mdeg, &pose);
     return scan_save_cloud(&t->hal, view, &pose, path);
 }
 
