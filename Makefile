@@ -6,7 +6,7 @@
 #   make test-arm64   the unit tests built for arm64, run under qemu-aarch64
 SAN ?= 0
 CC ?= cc
-PKGS := inih libpng cmocka libmodbus libgpiod libseccomp
+PKGS := inih libpng libjpeg cmocka libmodbus libgpiod libseccomp
 PKG_CONFIG := pkg-config
 DEPS_SET :=
 DEPS_TOOLS := $(CC)
@@ -57,7 +57,7 @@ CFLAGS_COMMON := $(WARN) $(OPT) $(LIMITS_CFLAGS) -g -MMD -MP
 # firmware/ sees the world only through hal/include.
 FW_CFLAGS := $(CFLAGS_COMMON) -Ihal/include -Ifirmware -fstack-usage
 PKG_CFLAGS = $(shell $(PKG_CONFIG) --cflags $(PKGS) 2>/dev/null)
-PKG_LIBS = $(shell $(PKG_CONFIG) --libs inih libpng libmodbus 2>/dev/null) -lpthread
+PKG_LIBS = $(shell $(PKG_CONFIG) --libs inih libpng libjpeg libmodbus 2>/dev/null) -lpthread
 # Each layer is compiled with only the include paths it may use, so an include that runs back up
 # (hal/ or host_sim/ reaching into app/, board/ into app/) does not compile (docs/architecture.md;
 # tests/layers.sh shows it). Everyone sees hal/include; a layer's paths are INC_<its directory>.
@@ -171,7 +171,7 @@ seccomp-tool: $(BUILD)/seccomp-run
 $(BUILD)/mesh-compare: $(call obj,tests/mesh_compare.c tests/mesh_compare_lib.c host_sim/sim_bvh.c host_sim/sim_mesh.c host_sim/sim_ply_read.c app/config.c app/ini_schema.c app/scan_dir.c hal/posix/image_io.c) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON)
 
-$(BUILD)/colour-eval: $(call obj,tests/colour_eval.c tests/colour_metrics.c host_sim/sim_bvh.c host_sim/sim_mesh.c host_sim/sim_ply_read.c host_sim/sim_rig.c host_sim/sim_target.c host_sim/sim_material.c app/config.c app/ini_schema.c app/scan_dir.c hal/posix/image_io.c hal/posix/storage_posix.c) $(BUILD)/libfirmware.a
+$(BUILD)/colour-eval: $(call obj,tests/colour_eval.c tests/colour_metrics.c host_sim/sim_bvh.c host_sim/sim_mesh.c host_sim/sim_ply_read.c host_sim/sim_rig.c host_sim/sim_jpeg.c host_sim/sim_target.c host_sim/sim_material.c app/config.c app/ini_schema.c app/scan_dir.c hal/posix/image_io.c hal/posix/storage_posix.c) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON)
 
 # ---- tests ----
@@ -368,7 +368,7 @@ clean:
 $(BUILD)/measure_view: $(BUILD)/tests/measure_view.o $(BUILD)/tests/test_util.o $(HOST_OBJ) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON) $(BOARD_LIBS)
 measure: deps $(BUILD)/measure_view
-	$(BUILD)/measure_view config/sim.ini
+	$(BUILD)/measure_view config/sim.ini config/sim-limit.ini
 
 # Intrinsic colour (issue 4): Jost et al.'s comparison reproduced on the simulator, written to
 # docs/colour-eval/ (table as Markdown and CSV, close-up PNGs of a view boundary). About 20 minutes.

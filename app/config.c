@@ -255,6 +255,11 @@ static const struct ini_key config_keys[] = {
         "light the projector leaks in its black"),
     F64("sim", "projector_blur_px", sim.projector_blur_px, 0, 1, "0.6",
         "projector defocus, as a box width in projector pixels"),
+    F64("sim", "camera_blur_px", sim.camera_blur_px, 0, 8, "0",
+        "camera lens blur, the sigma of a Gaussian point spread in camera pixels"),
+    U32("sim", "jpeg_quality", sim.jpeg_quality, 0, 100, "0",
+        "1..100: each frame is JPEG-compressed at this quality and decoded (libjpeg), as a "
+        "camera's JPEG stream; 0: off"),
     F64("sim", "light_intensity_dn", sim.light_intensity_dn, 0, 10000, "120",
         "like projector_intensity_dn, for each white light"),
     F64("sim", "light_diffuser_mm", sim.light_diffuser_mm, 0, 1000, "0",

@@ -29,6 +29,8 @@ struct sim_config {
     uint32_t table_angle_error_mdeg;
     double black_offset_dn, ambient_dn, read_noise_dn, electrons_per_dn;
     double projector_intensity_dn, projector_black_level, projector_blur_px;
+    double camera_blur_px;  /**< sigma of the camera lens's Gaussian point spread */
+    uint32_t jpeg_quality;  /**< 1..100: every frame goes through a JPEG round trip; 0: off */
     double light_intensity_dn, light_diffuser_mm, reference_distance_mm;
     uint32_t reference_exposure_us;
     char rig_file[HAL_MAX_PATH]; /**< the true rig's geometry ("": the scan's calibration) */

@@ -6,6 +6,7 @@
 #include "frames.h"
 #include "gray.h"
 #include "lens.h"
+#include "sim_jpeg.h"
 #include "sim_random.h"
 
 #include <errno.h>
@@ -182,8 +183,11 @@ int sim_rig_init(struct sim_rig *rig, const struct sim_config *cfg, const struct
     rig->proj_radiance = calloc(n * 3, sizeof(float));
     rig->light_vis = calloc(n, 1);
     rig->gauss = calloc(GAUSS_TABLE, sizeof(float));
+    rig->signal = calloc(n * 3, sizeof(float));
+    rig->blur_line = calloc((size_t)3 * (rig->width > rig->height ? rig->width : rig->height),
+                            sizeof(float));
     if (!t->hit || !t->pos_cam || !t->normal_cam || !t->albedo || !t->proj_u || !t->proj_v || !t->proj_lit ||
-        !t->dark || !rig->proj_radiance || !rig->light_vis || !rig->gauss) {
+        !t->dark || !rig->proj_radiance || !rig->light_vis || !rig->gauss || !rig->signal || !rig->blur_line) {
         rc = -ENOMEM;
         snprintf(err, len, "sim: out of memory for a %ux%u frame", (unsigned)rig->width,
                  (unsigned)rig->height);
@@ -210,6 +214,8 @@ void sim_rig_free(struct sim_rig *rig)
     free(rig->proj_radiance);
     free(rig->light_vis);
     free(rig->gauss);
+    free(rig->signal);
+    free(rig->blur_line);
     sim_bvh_free(&rig->bvh);
     sim_mesh_free(&rig->mesh);
     free(rig->sheet_pixels);
@@ -507,19 +513,11 @@ static void add_light(const struct sim_rig *rig, size_t i, uint32_t li, double s
     }
 }
 
-void sim_rig_render(struct sim_rig *rig, const struct sim_sources *src, uint64_t noise_id,
-                    uint8_t *rgb)
+/* The light reaching each pixel's sensor (before gain and noise), 3 floats per pixel. */
+static void render_signal(struct sim_rig *rig, const struct sim_sources *src, float *signal)
 {
-    sim_rig_update(rig);
-    uint32_t lights = src->lights_mask;
-    for (uint32_t li = 0; li < rig->calib.light_count; li++)
-        if (lights & (1u << li))
-            ensure_light(rig, li);
     const struct sim_config *c = &rig->cfg;
-    double gain = (double)src->exposure_us / c->reference_exposure_us * src->gain_milli / 1000.0;
-    uint64_t state = ((uint64_t)c->seed << 32) ^ (noise_id * 0x9E3779B97F4A7C15ull) ^
-                     (uint64_t)(uint32_t)rig->truth_angle_mdeg;
-    double var_read = c->read_noise_dn * c->read_noise_dn;
+    uint32_t lights = src->lights_mask;
     size_t n = (size_t)rig->width * rig->height;
     for (size_t i = 0; i < n; i++) {
         double sig[3] = {0, 0, 0};
@@ -537,13 +535,81 @@ void sim_rig_render(struct sim_rig *rig, const struct sim_sources *src, uint64_t
                 if (lights & (1u << li))
                     add_light(rig, i, li, sig);
         }
+        for (int k = 0; k < 3; k++)
+            signal[3 * i + (size_t)k] = (float)sig[k];
+    }
+}
+
+/* One 1-D pass of the camera's Gaussian blur over @p count lines of @p len pixels, @p stride
+ * floats between pixels, @p line_step between lines (edges clamp). */
+static void blur_pass(float *buf, float *line, uint32_t count, uint32_t len, size_t stride,
+                      size_t line_step, const float *kernel, int radius)
+{
+    for (uint32_t l = 0; l < count; l++) {
+        float *base = buf + l * line_step;
+        for (uint32_t x = 0; x < len; x++)
+            for (int k = 0; k < 3; k++)
+                line[3 * x + (size_t)k] = base[x * stride + (size_t)k];
+        for (uint32_t x = 0; x < len; x++) {
+            float acc[3] = {0, 0, 0};
+            for (int d = -radius; d <= radius; d++) {
+                long xs = (long)x + d;
+                xs = xs < 0 ? 0 : xs >= (long)len ? (long)len - 1 : xs;
+                for (int k = 0; k < 3; k++)
+                    acc[k] += kernel[d + radius] * line[3 * (size_t)xs + (size_t)k];
+            }
+            for (int k = 0; k < 3; k++)
+                base[x * stride + (size_t)k] = acc[k];
+        }
+    }
+}
+
+#define BLUR_MAX_RADIUS 16
+
+/* [sim] camera_blur_px: the camera lens's point spread, a Gaussian of that sigma (separable). */
+static void camera_blur(struct sim_rig *rig, float *signal)
+{
+    double sigma = rig->cfg.camera_blur_px;
+    int radius = (int)ceil(3.0 * sigma);
+    radius = radius > BLUR_MAX_RADIUS ? BLUR_MAX_RADIUS : radius;
+    float kernel[2 * BLUR_MAX_RADIUS + 1];
+    double sum = 0.0;
+    for (int d = -radius; d <= radius; d++)
+        sum += kernel[d + radius] = (float)exp(-0.5 * d * d / (sigma * sigma));
+    for (int d = -radius; d <= radius; d++)
+        kernel[d + radius] = (float)(kernel[d + radius] / sum);
+    uint32_t w = rig->width, h = rig->height;
+    blur_pass(signal, rig->blur_line, h, w, 3, (size_t)3 * w, kernel, radius);
+    blur_pass(signal, rig->blur_line, w, h, (size_t)3 * w, 3, kernel, radius);
+}
+
+void sim_rig_render(struct sim_rig *rig, const struct sim_sources *src, uint64_t noise_id,
+                    uint8_t *rgb)
+{
+    sim_rig_update(rig);
+    for (uint32_t li = 0; li < rig->calib.light_count; li++)
+        if (src->lights_mask & (1u << li))
+            ensure_light(rig, li);
+    const struct sim_config *c = &rig->cfg;
+    float *signal = rig->signal;
+    render_signal(rig, src, signal);
+    if (c->camera_blur_px > 0.0)
+        camera_blur(rig, signal);
+    double gain = (double)src->exposure_us / c->reference_exposure_us * src->gain_milli / 1000.0;
+    uint64_t state = ((uint64_t)c->seed << 32) ^ (noise_id * 0x9E3779B97F4A7C15ull) ^
+                     (uint64_t)(uint32_t)rig->truth_angle_mdeg;
+    double var_read = c->read_noise_dn * c->read_noise_dn;
+    size_t n = (size_t)rig->width * rig->height;
+    for (size_t i = 0; i < n; i++) {
         uint64_t r = sim_random_next(&state);
         for (int k = 0; k < 3; k++) {
-            double s = sig[k] * gain;
+            double s = signal[3 * i + (size_t)k] * gain;
             double sigma = sqrt(var_read + (s > 0.0 ? s / c->electrons_per_dn : 0.0));
             double dn = c->black_offset_dn + s + sigma * rig->gauss[(r >> (16 * k)) & 0xFFFFu];
             dn = floor(dn + 0.5);
             rgb[3 * i + (size_t)k] = (uint8_t)(dn < 0.0 ? 0.0 : dn > 255.0 ? 255.0 : dn);
         }
     }
+    if (c->jpeg_quality > 0)
+        sim_jpeg_roundtrip(rgb, rig->width, rig->height, c->jpeg_quality);
 }

@@ -51,6 +51,8 @@ struct sim_rig {
     uint8_t *light_vis;   /**< bit i: light i reaches the point */
     uint32_t lights_done; /**< lights whose visibility is computed for truth_angle_mdeg */
     float *gauss;         /**< table of standard normal samples for the noise */
+    float *signal;        /**< 3 per pixel: the frame being rendered, before gain and noise */
+    float *blur_line;     /**< one row or column of signal, for the camera blur */
     struct sim_target target;      /**< what stands on the table (SIM_TARGET_OBJECT: the object) */
     struct sim_sheet_frame sheet;  /**< a board's printed sheet, object frame */
     uint8_t *sheet_pixels;         /**< the rig's copy of the sheet */

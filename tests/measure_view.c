@@ -13,46 +13,92 @@ static double now_ms(void)
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
 }
 
-int main(int argc, char **argv)
+/* One view of @p object in @p material under the rig of @p config; 0 ok. */
+static int measure_one(const char *config, const char *object, const char *material, int refine,
+                       struct view_quality *q, double *ms)
+{
+    static struct test_rig t;
+    if (test_rig_load(&t, config) != 0)
+        return 1;
+    snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "%s", object);
+    snprintf(t.cfg.sim.material, sizeof(t.cfg.sim.material), "%s", material);
+    t.cfg.scan.refine = (uint32_t)refine;
+    if (test_rig_start(&t) != 0)
+        return 1;
+    struct scan_view view;
+    struct scan_view_info info;
+    double t0 = now_ms();
+    int rc = scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info);
+    *ms = now_ms() - t0;
+    if (rc == 0)
+        test_measure_view(sim_ctl_rig(), &view, q);
+    test_rig_stop(&t);
+    return rc != 0;
+}
+
+static const char *shown(const char *object)
+{
+    return strcmp(object, "mesh") == 0 ? "bunny" : object;
+}
+
+/* The first table: every object and material, refinement off and on. */
+static int table_objects(const char *config)
 {
     const char *objects[] = {"sphere", "mesh", "cylinder", "box", "torus"};
     const char *materials[] = {"lambert", "phong"};
-    int refine_from = 0, refine_to = 1;
     printf("| object | material | lit px | decoded right (+-1) | same, incidence < 75 deg, not "
            "dark paint | dark paint flagged | valid px | depth RMS mm | RMS / distance | max dist. "
            "to surface mm | "
            "points > 2 mm | normal error deg | refine | view ms |\n"
            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
-    for (size_t o = 0; o < sizeof(objects) / sizeof(objects[0]); o++) {
+    for (size_t o = 0; o < sizeof(objects) / sizeof(objects[0]); o++)
         for (size_t m = 0; m < sizeof(materials) / sizeof(materials[0]); m++)
-            for (int refine = refine_from; refine <= refine_to; refine++) {
-                static struct test_rig t;
-                if (test_rig_load(&t, argc > 1 ? argv[1] : "config/sim.ini") != 0)
-                    return 1;
-                snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "%s", objects[o]);
-                snprintf(t.cfg.sim.material, sizeof(t.cfg.sim.material), "%s", materials[m]);
-                t.cfg.scan.refine = (uint32_t)refine;
-                if (test_rig_start(&t) != 0)
-                    return 1;
-                struct scan_view view;
-                struct scan_view_info info;
-                double t0 = now_ms();
-                int rc = scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info);
-                double ms = now_ms() - t0;
-                if (rc != 0)
-                    return 1;
+            for (int refine = 0; refine <= 1; refine++) {
                 struct view_quality q;
-                test_measure_view(sim_ctl_rig(), &view, &q);
+                double ms;
+                if (measure_one(config, objects[o], materials[m], refine, &q, &ms) != 0)
+                    return 1;
                 printf("| %s | %s | %u | %.2f%% | %.2f%% | %u of %u | %u | %.3f | %.3f%% | %.2f | "
-                       "%u | "
-                       "%.1f | %s | %.0f |\n",
-                       strcmp(objects[o], "mesh") == 0 ? "bunny" : objects[o], materials[m], q.lit,
-                       100.0 * q.lit_correct / q.lit, 100.0 * q.lit_head_on_correct / q.lit_head_on,
-                       q.dark_flagged, q.dark, q.valid, q.depth_rms_mm,
-                       100.0 * q.depth_rms_mm / q.distance_mm, q.max_surface_mm, q.outliers_2mm,
-                       q.normal_err_deg, refine ? "on" : "off", ms);
-                test_rig_stop(&t);
+                       "%u | %.1f | %s | %.0f |\n",
+                       shown(objects[o]), materials[m], q.lit, 100.0 * q.lit_correct / q.lit,
+                       100.0 * q.lit_head_on_correct / q.lit_head_on, q.dark_flagged, q.dark,
+                       q.valid, q.depth_rms_mm, 100.0 * q.depth_rms_mm / q.distance_mm,
+                       q.max_surface_mm, q.outliers_2mm, q.normal_err_deg, refine ? "on" : "off",
+                       ms);
             }
-    }
     return 0;
+}
+
+/* The second table (issue 16): decoding where the finest stripe is at the camera's limit. The
+ * lit surface is the projector-lit surface at incidence below 75 degrees, dark paint aside. */
+static int table_limit(const char *config)
+{
+    const char *objects[] = {"sphere", "mesh", "box", "torus"};
+    const char *materials[] = {"lambert", "phong"};
+    printf("\n%s: finest stripe at the camera's limit\n\n"
+           "| object | material | finest stripe, camera px | lit px | valid | more than +-1 column "
+           "off | depth RMS mm | points > 2 mm | view ms |\n"
+           "|---|---|---|---|---|---|---|---|---|\n",
+           config);
+    for (size_t o = 0; o < sizeof(objects) / sizeof(objects[0]); o++)
+        for (size_t m = 0; m < sizeof(materials) / sizeof(materials[0]); m++) {
+            struct view_quality q;
+            double ms;
+            if (measure_one(config, objects[o], materials[m], 1, &q, &ms) != 0)
+                return 1;
+            printf("| %s | %s | %.2f | %u | %.2f%% | %.3f%% | %.3f | %u | %.0f |\n",
+                   shown(objects[o]), materials[m], q.stripe_px, q.lit_head_on,
+                   100.0 * q.lit_head_on_valid / q.lit_head_on,
+                   100.0 * q.lit_head_on_off / q.lit_head_on, q.depth_rms_mm, q.outliers_2mm, ms);
+        }
+    return 0;
+}
+
+/* measure_view [CONFIG [LIMIT_CONFIG]]; CONFIG "-" leaves the first table out. */
+int main(int argc, char **argv)
+{
+    const char *config = argc > 1 ? argv[1] : "config/sim.ini";
+    if (strcmp(config, "-") != 0 && table_objects(config) != 0)
+        return 1;
+    return argc > 2 ? table_limit(argv[2]) : 0;
 }

@@ -136,6 +136,31 @@ int scan_save_cloud_at_turntable_pose(struct test_rig *t, const struct scan_view
     return scan_save_cloud(&t->hal, view, &pose, path);
 }
 
+/* Median width in camera pixels of two projector columns (the finest Gray stripe), from the
+ * true column's change between horizontal neighbours on the lit surface. */
+static double stripe_width_px(const struct sim_rig *rig)
+{
+    static uint32_t histogram[4096]; /* columns per pixel, in 1/1024 */
+    const struct sim_truth *t = &rig->truth;
+    uint32_t count = 0;
+    memset(histogram, 0, sizeof(histogram));
+    for (uint32_t y = 0; y < rig->height; y++)
+        for (uint32_t x = 0; x + 1 < rig->width; x++) {
+            size_t i = (size_t)y * rig->width + x;
+            if (!t->proj_lit[i] || !t->proj_lit[i + 1])
+                continue;
+            double du = fabs((double)t->proj_u[i + 1] - t->proj_u[i]) * 1024.0;
+            if (du < 4096.0) {
+                histogram[(uint32_t)du]++;
+                count++;
+            }
+        }
+    for (uint32_t b = 0, seen = 0; b < 4096 && count > 0; b++)
+        if ((seen += histogram[b]) * 2 >= count)
+            return b > 0 ? 2.0 * 1024.0 / (b + 0.5) : INFINITY;
+    return 0.0;
+}
+
 void test_measure_view(const struct sim_rig *rig, const struct scan_view *view,
                        struct view_quality *q)
 {
@@ -164,6 +189,8 @@ void test_measure_view(const struct sim_rig *rig, const struct scan_view *view,
             } else if (cos_in >= min_cos) {
                 q->lit_head_on++;
                 q->lit_head_on_correct += (uint32_t)correct;
+                q->lit_head_on_valid += (uint32_t)valid;
+                q->lit_head_on_off += (uint32_t)(valid && !correct);
             }
         }
         if (!valid)
@@ -189,6 +216,7 @@ void test_measure_view(const struct sim_rig *rig, const struct scan_view *view,
         q->max_surface_mm = plane > q->max_surface_mm ? plane : q->max_surface_mm;
         q->outliers_2mm += (uint32_t)(plane > 2.0);
     }
+    q->stripe_px = stripe_width_px(rig);
     q->depth_rms_mm = q->valid ? sqrt(sum_sq / q->valid) : 0.0;
     q->normal_err_deg = q->valid ? sum_angle / q->valid : 0.0;
     q->distance_mm = q->lit ? sum_dist / q->lit : 0.0;

@@ -53,6 +53,9 @@ struct view_quality {
     uint32_t lit_correct; /**< of those: valid and column within +-1 of the truth */
     uint32_t lit_head_on; /**< lit pixels not on the very dark paint, incidence below 75 deg */
     uint32_t lit_head_on_correct;
+    uint32_t lit_head_on_valid; /**< of lit_head_on: valid, right or not */
+    uint32_t lit_head_on_off;   /**< of lit_head_on: valid but more than +-1 column off */
+    double stripe_px;           /**< finest projected stripe (2 columns) in camera pixels, median */
     uint32_t valid;        /**< all valid pixels */
     uint32_t valid_unlit;  /**< valid pixels the projector does not light (must be 0) */
     uint32_t dark;         /**< lit pixels on the very dark paint */
