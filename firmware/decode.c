@@ -2,6 +2,7 @@
 #include "decode.h"
 
 #include <errno.h>
+#include <math.h>
 #include <string.h>
 
 /* One block of pixels: its accumulators stay in the first-level cache while every frame streams
@@ -11,13 +12,16 @@
 static uint8_t frame_store[DECODE_MAX_PATTERNS][HAL_MAX_PIXELS];
 static uint16_t column_map[HAL_MAX_PIXELS];
 static uint16_t row_map[HAL_MAX_PIXELS];
-static uint8_t consistent[HAL_MAX_PIXELS];
+static uint16_t unclear_col[HAL_MAX_PIXELS]; /* bit k: Gray bit k of the column was unclear */
+static uint16_t unclear_row[HAL_MAX_PIXELS];
+static uint8_t scratch[HAL_MAX_PIXELS]; /* the neighbourhood stages' verdicts, applied after */
 
 static struct {
     struct scan_params params;
     struct gray_layout layout;
     uint32_t proj_width, proj_height;
     uint32_t next_pattern;
+    uint8_t bit_threshold[256]; /* |I - I_inverse| at or below this is unclear, per contrast */
 } dec;
 
 const char *scan_reason_name(unsigned reason)
@@ -36,6 +40,18 @@ void decode_rgb_to_grey(const uint8_t *rgb, uint8_t *grey, size_t n, uint32_t sa
     }
 }
 
+uint32_t decode_bit_threshold(const struct scan_params *p, uint32_t contrast_dn)
+{
+    /* The difference of two frames of the same pixel has variance 2 read^2 + shot noise; the
+     * shot noise of I and I_inverse together is that of white minus black (they sum to it):
+     * sigma^2 = 2 read^2 + contrast / (electrons per grey level). */
+    double var = 2.0 * p->read_noise_dn * p->read_noise_dn +
+                 (p->electrons_per_dn > 0.0 ? contrast_dn / p->electrons_per_dn : 0.0);
+    double t = ceil(p->bit_noise_sigmas * sqrt(var));
+    t = t > p->min_bit_diff_dn ? t : p->min_bit_diff_dn;
+    return t > 254.0 ? 254u : (uint32_t)t;
+}
+
 int decode_begin(const struct scan_params *params, const struct gray_layout *layout,
                  uint32_t proj_width, uint32_t proj_height)
 {
@@ -48,6 +64,8 @@ int decode_begin(const struct scan_params *params, const struct gray_layout *lay
     dec.proj_width = proj_width;
     dec.proj_height = proj_height;
     dec.next_pattern = 0;
+    for (uint32_t c = 0; c < 256; c++)
+        dec.bit_threshold[c] = (uint8_t)decode_bit_threshold(params, c);
     return 0;
 }
 
@@ -66,31 +84,35 @@ int decode_frame(uint32_t pattern, const uint8_t *grey)
     return 0;
 }
 
-/* The bits of one coordinate for a block: Gray code, ambiguous-bit count, brightest value.
+/* The bits of one coordinate for a block: Gray code, unclear-bit mask, saturated pairs.
  * Only 8-bit arithmetic in the loop over pixels, so that it runs 16 (or 32) pixels per
- * instruction once vectorised: the code is gathered in two byte planes (the first 8 bits, then
- * the rest), |I - I_inverse| comes from two saturating subtractions, and saturation is the
- * maximum over the frames reaching DECODE_SATURATED. decode_reference is the same, plainly. */
-static void accumulate(uint32_t first, uint32_t bits, size_t start, size_t len, uint16_t *code,
-                       uint8_t *ambiguous, uint8_t *brightest)
+ * instruction once vectorised: the code and the unclear mask are gathered in byte planes (the
+ * first 8 bits, then the rest), |I - I_inverse| comes from two saturating subtractions and is
+ * compared with the pixel's own threshold, and a pair is saturated when both frames reached
+ * DECODE_SATURATED (one saturated frame still says which is brighter). decode_reference is the
+ * same, plainly. */
+static void accumulate(uint32_t first, uint32_t bits, size_t start, size_t len,
+                       const uint8_t *threshold, uint16_t *code, uint16_t *unclear,
+                       uint8_t *both_saturated)
 {
     static uint8_t plane_hi[DECODE_BLOCK], plane_lo[DECODE_BLOCK];
-    const uint8_t t = (uint8_t)(dec.params.min_bit_diff_dn > 254 ? 254 : dec.params.min_bit_diff_dn);
+    static uint8_t unclear_hi[DECODE_BLOCK], unclear_lo[DECODE_BLOCK];
     memset(plane_hi, 0, len);
     memset(plane_lo, 0, len);
-    memset(ambiguous, 0, len);
+    memset(unclear_hi, 0, len);
+    memset(unclear_lo, 0, len);
     for (uint32_t k = 0; k < bits; k++) {
         const uint8_t *restrict pos = frame_store[first + 2u * k] + start;
         const uint8_t *restrict neg = frame_store[first + 2u * k + 1u] + start;
         uint8_t *restrict plane = k < 8 ? plane_hi : plane_lo;
-        uint8_t *restrict amb = ambiguous, *restrict mx = brightest;
+        uint8_t *restrict unc = k < 8 ? unclear_hi : unclear_lo;
+        uint8_t *restrict sat = both_saturated;
         for (size_t i = 0; i < len; i++) {
             uint8_t a = pos[i], b = neg[i];
             uint8_t up = (uint8_t)(a > b ? a - b : 0), down = (uint8_t)(b > a ? b - a : 0);
             plane[i] = (uint8_t)((plane[i] << 1) | (up != 0));
-            amb[i] = (uint8_t)(amb[i] + ((up | down) <= t));
-            uint8_t m = a > b ? a : b;
-            mx[i] = mx[i] > m ? mx[i] : m;
+            unc[i] = (uint8_t)((unc[i] << 1) | ((up | down) <= threshold[i]));
+            sat[i] = (uint8_t)(sat[i] | ((a & b) == DECODE_SATURATED));
         }
     }
     const uint32_t lo_bits = bits > 8 ? bits - 8 : 0;
@@ -101,47 +123,61 @@ static void accumulate(uint32_t first, uint32_t bits, size_t start, size_t len, 
         g ^= (uint16_t)(g >> 4);
         g ^= (uint16_t)(g >> 8);
         code[i] = g;
+        unclear[i] = (uint16_t)(((unsigned)unclear_hi[i] << lo_bits) | unclear_lo[i]);
     }
 }
 
-/* The reasons, in order of precedence; shared by the blocked decoder and the reference. */
-static uint8_t classify(const struct scan_params *p, int white, int black, int saturated,
-                        unsigned amb_col, unsigned amb_row, int out_of_range)
+static unsigned count_bits(uint32_t v)
+{
+    unsigned n = 0;
+    for (; v != 0; v &= v - 1)
+        n++;
+    return n;
+}
+
+/* The reasons, in order of precedence; shared by the blocked decoder and the reference. A pixel
+ * with too many unclear bits may still be resolved by its neighbourhood (resolve_unclear). */
+static uint8_t classify(const struct scan_params *p, int white, int black, int both_saturated,
+                        unsigned unclear_col, unsigned unclear_row, int out_of_range)
 {
     int contrast = white - black;
-    if (saturated)
+    if (black == DECODE_SATURATED) /* no contrast to judge by */
         return SCAN_SATURATED;
     if (contrast <= (int)p->shadow_contrast_dn)
         return SCAN_SHADOW;
     if (contrast < (int)p->min_contrast_dn)
         return SCAN_DARK;
-    /* One ambiguous bit per coordinate is a pixel on the edge between two columns (rows): adjacent
-     * Gray codes differ in one bit, so either reading is one of the two. More is weak signal. */
-    if (amb_col > p->max_ambiguous_bits || amb_row > p->max_ambiguous_bits)
-        return SCAN_LOW_CONTRAST;
+    /* One unclear bit per coordinate is a pixel on the edge between two columns (rows): adjacent
+     * Gray codes differ in one bit, so either reading is one of the two. */
+    if (count_bits(unclear_col) > p->max_ambiguous_bits ||
+        count_bits(unclear_row) > p->max_ambiguous_bits)
+        return both_saturated ? SCAN_SATURATED : SCAN_LOW_CONTRAST;
     return out_of_range ? SCAN_INCONSISTENT : SCAN_VALID;
 }
 
 static void decode_block(size_t start, size_t len, uint8_t *reason)
 {
     static uint16_t code_col[DECODE_BLOCK], code_row[DECODE_BLOCK];
-    static uint8_t amb_col[DECODE_BLOCK], amb_row[DECODE_BLOCK], sat[DECODE_BLOCK];
+    static uint8_t threshold[DECODE_BLOCK], sat[DECODE_BLOCK];
     const uint8_t *white = frame_store[GRAY_PATTERN_WHITE] + start;
     const uint8_t *black = frame_store[GRAY_PATTERN_BLACK] + start;
     const struct gray_layout *l = &dec.layout;
-    for (size_t i = 0; i < len; i++) /* brightest so far; == DECODE_SATURATED means saturated */
-        sat[i] = white[i] > black[i] ? white[i] : black[i];
-    accumulate(GRAY_PATTERN_FIRST_BIT, l->col_bits, start, len, code_col, amb_col, sat);
+    for (size_t i = 0; i < len; i++) {
+        threshold[i] = dec.bit_threshold[white[i] > black[i] ? white[i] - black[i] : 0];
+        sat[i] = 0;
+    }
+    accumulate(GRAY_PATTERN_FIRST_BIT, l->col_bits, start, len, threshold, code_col,
+               unclear_col + start, sat);
     if (l->row_bits > 0)
-        accumulate(GRAY_PATTERN_FIRST_BIT + 2u * l->col_bits, l->row_bits, start, len, code_row,
-                   amb_row, sat);
+        accumulate(GRAY_PATTERN_FIRST_BIT + 2u * l->col_bits, l->row_bits, start, len, threshold,
+                   code_row, unclear_row + start, sat);
     else
-        memset(amb_row, 0, len);
+        memset(unclear_row + start, 0, len * sizeof(uint16_t));
     for (size_t i = 0; i < len; i++) {
         int out = code_col[i] >= dec.proj_width ||
                   (l->row_bits > 0 && code_row[i] >= dec.proj_height);
-        reason[start + i] = classify(&dec.params, white[i], black[i],
-                                         sat[i] == DECODE_SATURATED, amb_col[i], amb_row[i], out);
+        reason[start + i] = classify(&dec.params, white[i], black[i], sat[i],
+                                     unclear_col[start + i], unclear_row[start + i], out);
         column_map[start + i] = code_col[i];
         row_map[start + i] = l->row_bits > 0 ? code_row[i] : 0;
     }
@@ -162,62 +198,214 @@ int decode_pixels(uint8_t *reason, struct decode_maps *maps)
     return 0;
 }
 
-static int columns_agree(const uint8_t *reason, size_t a, size_t b)
+/* ---- the neighbourhood stages ---- */
+
+#define RESOLVE_RADIUS 2 /* the neighbourhood an unclear pixel is resolved in: 5 x 5 */
+#define RESOLVE_MAX (2 * RESOLVE_RADIUS + 1) * (2 * RESOLVE_RADIUS + 1)
+/* A reading (a neighbour) agrees with the neighbourhood's plane within this many columns: the
+ * width of a stripe edge, where either of two adjacent columns is right. */
+#define RESOLVE_FIT_COLUMNS 1.5
+
+static int within(int a, int b, uint32_t jump)
+{
+    return a - b <= (int)jump && b - a <= (int)jump;
+}
+
+/* The column (row) the decoded pixels around (x, y) predict for it. The stripes run across
+ * the window (about a column per pixel at the camera's limit), so not their median: a plane
+ * c = a + b dx + e dy fitted to the pixels the per-pixel stage left valid, after dropping those
+ * far from their median (a wrong bit), and trusted when at least min_consistent_neighbours lie
+ * within RESOLVE_FIT_COLUMNS of it. @retval 1 found (a, in *ref) @retval 0 no agreement */
+static int neighbourhood_code(const uint8_t *reason, const uint16_t *map, uint32_t x, uint32_t y,
+                              double *ref)
+{
+    const uint32_t w = dec.params.width, h = dec.params.height;
+    int v[RESOLVE_MAX], sorted[RESOLVE_MAX], ox[RESOLVE_MAX], oy[RESOLVE_MAX];
+    uint32_t n = 0;
+    for (int dy = -RESOLVE_RADIUS; dy <= RESOLVE_RADIUS; dy++)
+        for (int dx = -RESOLVE_RADIUS; dx <= RESOLVE_RADIUS; dx++) {
+            long nx = (long)x + dx, ny = (long)y + dy;
+            if (nx < 0 || ny < 0 || nx >= (long)w || ny >= (long)h)
+                continue;
+            uint8_t r = reason[(size_t)ny * w + (size_t)nx];
+            if (r == SCAN_SHADOW)
+                return 0; /* beside a silhouette or a shadow: a blurred pixel mixes two surfaces */
+            if (r != SCAN_VALID)
+                continue;
+            int c = map[(size_t)ny * w + (size_t)nx];
+            v[n] = c, ox[n] = dx, oy[n] = dy;
+            uint32_t k = n++; /* insertion sort: a handful of values */
+            for (; k > 0 && sorted[k - 1] > c; k--)
+                sorted[k] = sorted[k - 1];
+            sorted[k] = c;
+        }
+    if (n < dec.params.min_consistent_neighbours || n < 3)
+        return 0;
+    int median = sorted[n / 2];
+    double s[3][4] = {{0}}; /* normal equations of the plane, augmented */
+    for (uint32_t k = 0; k < n; k++) {
+        if (!within(v[k], median, 2 * RESOLVE_RADIUS)) {
+            continue;
+        }
+        double row[3] = {1.0, ox[k], oy[k]};
+        for (int i = 0; i < 3; i++) {
+            for (int j = 0; j < 3; j++)
+                s[i][j] += row[i] * row[j];
+            s[i][3] += row[i] * v[k];
+        }
+    }
+    double det = s[0][0] * (s[1][1] * s[2][2] - s[1][2] * s[2][1]) -
+                 s[0][1] * (s[1][0] * s[2][2] - s[1][2] * s[2][0]) +
+                 s[0][2] * (s[1][0] * s[2][1] - s[1][1] * s[2][0]);
+    if (fabs(det) < 1e-9)
+        return 0; /* the pixels lie on a line: no plane */
+    double coef[3]; /* Cramer's rule */
+    for (int c = 0; c < 3; c++) {
+        double m[3][3];
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                m[i][j] = j == c ? s[i][3] : s[i][j];
+        coef[c] = (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+                   m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                   m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])) /
+                  det;
+    }
+    uint32_t agree = 0;
+    for (uint32_t k = 0; k < n; k++)
+        agree += fabs(coef[0] + coef[1] * ox[k] + coef[2] * oy[k] - v[k]) <= RESOLVE_FIT_COLUMNS;
+    *ref = coef[0];
+    return agree >= dec.params.min_consistent_neighbours;
+}
+
+/* Of the codes an unclear pixel can have, the one nearest @p ref. An unclear Gray bit lies on a
+ * stripe edge, so the truth is one of the readings with those bits either way: flipping Gray
+ * bit k flips binary bits k..0 (b_k is the XOR of the Gray bits from the top down to k).
+ * @retval 1 a reading within max_column_jump of ref (in *code) @retval 0 none */
+static int nearest_reading(uint16_t plain, uint16_t unclear, double ref, uint32_t limit,
+                           uint16_t *code)
+{
+    int best = -1;
+    double best_d = 0.0;
+    uint32_t subset = 0;
+    do { /* every subset of the unclear bits */
+        uint32_t flip = 0;
+        for (uint32_t s = subset; s != 0; s &= s - 1)
+            flip ^= ((s & -s) << 1) - 1u; /* bits k..0 for the lowest Gray bit k of s */
+        int c = (int)(plain ^ flip);
+        double d = fabs(c - ref);
+        if (c < (int)limit && (best < 0 || d < best_d))
+            best = c, best_d = d;
+        subset = (subset - unclear) & unclear;
+    } while (subset != 0);
+    if (best < 0 || best_d > RESOLVE_FIT_COLUMNS)
+        return 0;
+    *code = (uint16_t)best;
+    return 1;
+}
+
+/* A pixel with more unclear bits than max_ambiguous_bits (or decoding outside the projector)
+ * takes, of its possible readings, the one its decoded neighbourhood agrees with; verdicts go to
+ * scratch first, so that pixels resolved here are not the reference of others. */
+static void resolve_unclear(uint8_t *reason)
+{
+    const uint32_t w = dec.params.width, h = dec.params.height;
+    const uint32_t max_unclear = dec.params.max_unclear_bits;
+    const int rows = dec.layout.row_bits > 0;
+    for (uint32_t y = 0; y < h; y++) {
+        for (uint32_t x = 0; x < w; x++) {
+            size_t i = (size_t)y * w + x;
+            uint8_t r = reason[i];
+            scratch[i] = r;
+            if ((r != SCAN_LOW_CONTRAST && r != SCAN_SATURATED && r != SCAN_INCONSISTENT) ||
+                count_bits(unclear_col[i]) > max_unclear ||
+                count_bits(unclear_row[i]) > max_unclear ||
+                (unclear_col[i] == 0 && unclear_row[i] == 0))
+                continue;
+            double ref_col, ref_row = 0.0;
+            uint16_t col, row = 0;
+            if (!neighbourhood_code(reason, column_map, x, y, &ref_col) ||
+                !nearest_reading(column_map[i], unclear_col[i], ref_col, dec.proj_width, &col) ||
+                (rows && (!neighbourhood_code(reason, row_map, x, y, &ref_row) ||
+                          !nearest_reading(row_map[i], unclear_row[i], ref_row, dec.proj_height,
+                                           &row))))
+                continue;
+            column_map[i] = col;
+            row_map[i] = row;
+            scratch[i] = SCAN_VALID;
+        }
+    }
+    memcpy(reason, scratch, (size_t)w * h);
+}
+
+static int codes_agree(const uint8_t *reason, size_t a, size_t b)
 {
     if (reason[b] != SCAN_VALID)
         return 0;
-    int d = (int)column_map[a] - (int)column_map[b];
-    return d <= (int)dec.params.max_column_jump && d >= -(int)dec.params.max_column_jump;
+    return within(column_map[a], column_map[b], dec.params.max_column_jump) &&
+           (dec.layout.row_bits == 0 || within(row_map[a], row_map[b], dec.params.max_column_jump));
 }
 
-/* A correct decode agrees with most of its neighbours; a wrong bit makes a lone jump. */
+/* A wrong bit makes a lone jump: a pixel is inconsistent when more of its valid neighbours
+ * disagree with it than agree, or when fewer than min_consistent_neighbours agree and none of
+ * its 5 x 5 neighbourhood backs it. A pixel with only a few valid neighbours, all agreeing (on
+ * a thin part, beside a shadow), is kept: alone is not wrong. Columns and, when coded, rows. */
 static void check_neighbours(uint8_t *reason)
 {
     const uint32_t w = dec.params.width, h = dec.params.height;
     for (uint32_t y = 0; y < h; y++) {
         for (uint32_t x = 0; x < w; x++) {
             size_t i = (size_t)y * w + x;
-            consistent[i] = 1;
+            scratch[i] = reason[i];
             if (reason[i] != SCAN_VALID)
                 continue;
-            uint32_t agree = 0;
+            uint32_t agree = 0, valid = 0;
             for (int dy = -1; dy <= 1; dy++) {
                 for (int dx = -1; dx <= 1; dx++) {
                     int nx = (int)x + dx, ny = (int)y + dy;
                     if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= (int)w || ny >= (int)h)
                         continue;
-                    agree += (uint32_t)columns_agree(reason, i, (size_t)ny * w + (size_t)nx);
+                    size_t j = (size_t)ny * w + (size_t)nx;
+                    valid += reason[j] == SCAN_VALID;
+                    agree += (uint32_t)codes_agree(reason, i, j);
                 }
             }
-            consistent[i] = agree >= dec.params.min_consistent_neighbours;
+            if (agree >= dec.params.min_consistent_neighbours)
+                continue;
+            double ref_col, ref_row;
+            if (valid - agree > agree || agree == 0 ||
+                !neighbourhood_code(reason, column_map, x, y, &ref_col) ||
+                fabs(column_map[i] - ref_col) > RESOLVE_FIT_COLUMNS ||
+                (dec.layout.row_bits > 0 &&
+                 (!neighbourhood_code(reason, row_map, x, y, &ref_row) ||
+                  fabs(row_map[i] - ref_row) > RESOLVE_FIT_COLUMNS)))
+                scratch[i] = SCAN_INCONSISTENT;
         }
     }
-    size_t n = (size_t)w * h;
-    for (size_t i = 0; i < n; i++)
-        if (!consistent[i] && reason[i] == SCAN_VALID)
-            reason[i] = SCAN_INCONSISTENT;
+    memcpy(reason, scratch, (size_t)w * h);
 }
 
 int decode_finish(uint8_t *reason, struct decode_maps *maps)
 {
     int rc = decode_pixels(reason, maps);
-    if (rc == 0)
+    if (rc == 0) {
+        resolve_unclear(reason);
         check_neighbours(reason);
+    }
     return rc;
 }
 
 /* ---- the plain reference: one pixel at a time, every frame ---- */
 
 static uint16_t reference_bits(const uint8_t *const *frames, uint32_t first, uint32_t bits,
-                               size_t i, int t, unsigned *ambiguous, int *saturated)
+                               size_t i, int t, unsigned *unclear, int *both_saturated)
 {
     uint32_t gray = 0;
-    *ambiguous = 0;
+    *unclear = 0;
     for (uint32_t k = 0; k < bits; k++) {
         int a = frames[first + 2u * k][i], b = frames[first + 2u * k + 1u][i];
         gray = (gray << 1) | (a > b ? 1u : 0u);
-        *ambiguous += a - b <= t && b - a <= t;
-        *saturated |= a == DECODE_SATURATED || b == DECODE_SATURATED;
+        *unclear = (*unclear << 1) | (a - b <= t && b - a <= t);
+        *both_saturated |= a == DECODE_SATURATED && b == DECODE_SATURATED;
     }
     return (uint16_t)gray_decode(gray);
 }
@@ -226,20 +414,20 @@ void decode_reference(const struct scan_params *p, const struct gray_layout *l,
                       uint32_t proj_width, uint32_t proj_height, const uint8_t *const *frames,
                       size_t n, uint16_t *column, uint16_t *row, uint8_t *reason)
 {
-    const int t = (int)p->min_bit_diff_dn;
     for (size_t i = 0; i < n; i++) {
-        unsigned amb_col = 0, amb_row = 0;
+        unsigned unclear_c = 0, unclear_r = 0;
         int white = frames[GRAY_PATTERN_WHITE][i], black = frames[GRAY_PATTERN_BLACK][i];
-        int sat = white == DECODE_SATURATED || black == DECODE_SATURATED;
-        column[i] = reference_bits(frames, GRAY_PATTERN_FIRST_BIT, l->col_bits, i, t, &amb_col,
+        int t = (int)decode_bit_threshold(p, (uint32_t)(white > black ? white - black : 0));
+        int sat = 0;
+        column[i] = reference_bits(frames, GRAY_PATTERN_FIRST_BIT, l->col_bits, i, t, &unclear_c,
                                    &sat);
         uint16_t r = 0;
         if (l->row_bits > 0)
             r = reference_bits(frames, GRAY_PATTERN_FIRST_BIT + 2u * l->col_bits, l->row_bits, i,
-                               t, &amb_row, &sat);
+                               t, &unclear_r, &sat);
         if (row != NULL)
             row[i] = r;
         int out = column[i] >= proj_width || (l->row_bits > 0 && r >= proj_height);
-        reason[i] = classify(p, white, black, sat, amb_col, amb_row, out);
+        reason[i] = classify(p, white, black, sat, unclear_c, unclear_r, out);
     }
 }

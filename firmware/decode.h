@@ -43,6 +43,11 @@ const char *scan_reason_name(unsigned reason);
  *  offline re-processing both decode exactly such frames, so they agree to the bit. */
 void decode_rgb_to_grey(const uint8_t *rgb, uint8_t *grey, size_t n, uint32_t saturation_dn);
 
+/** The pixel's bit threshold: |I - I_inverse| at or below it leaves the bit unclear. From the
+ *  camera's noise model, bit_noise_sigmas standard deviations of the difference of two frames
+ *  at this white-minus-black contrast, and never below min_bit_diff_dn. */
+uint32_t decode_bit_threshold(const struct scan_params *params, uint32_t contrast_dn);
+
 /** Start a view of a @p proj_width x @p proj_height projector coded as @p layout.
  *  @retval 0 ok @retval -EINVAL size or pattern count above the compiled limits */
 int decode_begin(const struct scan_params *params, const struct gray_layout *layout,
@@ -53,7 +58,8 @@ uint8_t *decode_frame_slot(uint32_t pattern);
 /** Hand over the grey frame of pattern @p pattern, in sequence order (copied into its slot
  *  unless it already is the slot). @retval 0 ok @retval -EINVAL out of order */
 int decode_frame(uint32_t pattern, const uint8_t *grey);
-/** Decode every pixel from the kept frames (decode_pixels), then the neighbour check.
+/** Decode every pixel from the kept frames (decode_pixels); then pixels with several unclear
+ *  bits take the reading their neighbourhood agrees with; then the neighbour check.
  *  @param reason  out: enum scan_reason per pixel (width * height, the caller's buffer)
  *  @param maps    out: the decoder's column and row maps, and @p reason
  *  @retval 0 ok @retval -EINVAL frames missing */

@@ -48,7 +48,11 @@ struct scan_params {
     uint32_t min_contrast_dn;    /**< white minus black below this: not lit enough */
     uint32_t shadow_contrast_dn; /**< white minus black at or below this: no projector light */
     uint32_t min_bit_diff_dn;    /**< |I - I_inverse| at or below this: the bit is ambiguous */
-    uint32_t max_ambiguous_bits; /**< more ambiguous bits than this: low contrast */
+    uint32_t max_ambiguous_bits; /**< more unclear bits than this: resolved by the neighbourhood */
+    uint32_t max_unclear_bits;   /**< more unclear bits than this: low contrast, not resolved */
+    double bit_noise_sigmas;     /**< bit threshold in noise standard deviations (0: fixed) */
+    double read_noise_dn;        /**< the camera's read noise (sigma, grey levels) */
+    double electrons_per_dn;     /**< the camera's conversion gain (sets its shot noise) */
     uint32_t saturation_dn;      /**< a channel at or above this is saturated */
     uint32_t max_column_jump;    /**< neighbours differing by more are not consistent */
     uint32_t min_consistent_neighbours; /**< of 8; fewer makes the pixel inconsistent */

@@ -77,8 +77,9 @@ static int table_limit(const char *config)
     const char *materials[] = {"lambert", "phong"};
     printf("\n%s: finest stripe at the camera's limit\n\n"
            "| object | material | finest stripe, camera px | lit px | valid | more than +-1 column "
-           "off | depth RMS mm | points > 2 mm | view ms |\n"
-           "|---|---|---|---|---|---|---|---|---|\n",
+           "off | of those, off every column under the pixel's 3x3 footprint | depth RMS mm | "
+           "points > 2 mm | view ms | rejected as |\n"
+           "|---|---|---|---|---|---|---|---|---|---|---|\n",
            config);
     for (size_t o = 0; o < sizeof(objects) / sizeof(objects[0]); o++)
         for (size_t m = 0; m < sizeof(materials) / sizeof(materials[0]); m++) {
@@ -86,10 +87,15 @@ static int table_limit(const char *config)
             double ms;
             if (measure_one(config, objects[o], materials[m], 1, &q, &ms) != 0)
                 return 1;
-            printf("| %s | %s | %.2f | %u | %.2f%% | %.3f%% | %.3f | %u | %.0f |\n",
+            printf("| %s | %s | %.2f | %u | %.2f%% | %.3f%% | %.3f%% | %.3f | %u | %.0f |",
                    shown(objects[o]), materials[m], q.stripe_px, q.lit_head_on,
                    100.0 * q.lit_head_on_valid / q.lit_head_on,
-                   100.0 * q.lit_head_on_off / q.lit_head_on, q.depth_rms_mm, q.outliers_2mm, ms);
+                   100.0 * q.lit_head_on_off / q.lit_head_on,
+                   100.0 * q.lit_head_on_wrong / q.lit_head_on, q.depth_rms_mm, q.outliers_2mm, ms);
+            for (unsigned r = 1; r < SCAN_REASON_COUNT; r++)
+                if (q.head_on_reason[r] > 0)
+                    printf(" %s %u", scan_reason_name(r), q.head_on_reason[r]);
+            printf(" |\n");
         }
     return 0;
 }

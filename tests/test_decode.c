@@ -35,6 +35,7 @@ static struct scan_params params(void)
     p.shadow_contrast_dn = 5;
     p.min_bit_diff_dn = 4;
     p.max_ambiguous_bits = 1;
+    p.max_unclear_bits = 4;
     p.saturation_dn = 250;
     p.max_column_jump = 3;
     p.min_consistent_neighbours = 3;
@@ -42,7 +43,8 @@ static struct scan_params params(void)
 }
 
 /* Pixel (x, y) sees projector column x; rows choose the surface: 0-3 normal, 4 shadow (no
- * projector light), 5 dark paint, 6 saturated in white, 7 normal. */
+ * projector light), 5 dark paint, 6 saturated wherever the projector lights it, 7 normal but
+ * for pixel 30, saturated in every frame. */
 static void render(uint32_t pattern, uint32_t bits)
 {
     for (uint32_t y = 0; y < H; y++) {
@@ -50,7 +52,7 @@ static void render(uint32_t pattern, uint32_t bits)
             int lit = gray_pattern_lit(bits, pattern, x);
             double gain = y == 4 ? 0.0 : y == 5 ? 0.03 : 1.0;
             double v = 51.0 + gain * (lit ? 150.0 : 2.0);
-            if (y == 6 && lit)
+            if ((y == 6 && lit) || (y == 7 && x == 30))
                 v = 255.0;
             uint8_t *px = &frame[3 * (y * W + x)];
             px[0] = px[1] = px[2] = (uint8_t)v;
@@ -92,8 +94,12 @@ static void test_columns_and_reasons(void **state)
         }
         assert_int_equal(m->reason[4 * W + x], SCAN_SHADOW);
         assert_int_equal(m->reason[5 * W + x], SCAN_SHADOW); /* 0.03 * 148 = 4 <= 5 */
-        assert_int_equal(m->reason[6 * W + x], SCAN_SATURATED);
+        /* each pattern's pair has one frame unsaturated: which is brighter is still clear */
+        assert_int_equal(m->reason[6 * W + x], SCAN_VALID);
+        assert_int_equal(m->column[6 * W + x], x);
     }
+    assert_int_equal(m->reason[7 * W + 30], SCAN_SATURATED); /* even black: no contrast known */
+    assert_int_equal(m->reason[7 * W + 31], SCAN_VALID);
     assert_string_equal(scan_reason_name(SCAN_LOW_CONTRAST), "low_contrast");
 }
 
@@ -150,7 +156,9 @@ static void feed_ambiguous_scene(uint32_t bits)
     }
 }
 
-/* Two ambiguous bits in one pixel cannot be a column edge: low contrast. One is tolerated. */
+/* One unclear bit is a column edge: either reading is one of two neighbouring columns. Two are
+ * resolved by the neighbourhood (the reading its decoded neighbours predict), unless more than
+ * max_unclear_bits are allowed to be. */
 static void test_ambiguous_bits(void **state)
 {
     (void)state;
@@ -161,7 +169,31 @@ static void test_ambiguous_bits(void **state)
     assert_int_equal(decode_finish(reason_out, &maps_out), 0);
     const struct decode_maps *m = &maps_out;
     assert_int_equal(m->reason[10], SCAN_VALID);
+    assert_int_equal(m->reason[20], SCAN_VALID);
+    assert_int_equal(m->column[20], 20);
+    p.max_unclear_bits = 1;
+    assert_int_equal(begin(&p, bits), 0);
+    feed_ambiguous_scene(bits);
+    assert_int_equal(decode_finish(reason_out, &maps_out), 0);
+    assert_int_equal(m->reason[10], SCAN_VALID);
     assert_int_equal(m->reason[20], SCAN_LOW_CONTRAST);
+}
+
+/* The bit threshold follows the camera's noise at the pixel's contrast, never below the floor:
+ * sigma^2 = 2 read^2 + contrast / gain. */
+static void test_bit_threshold_from_noise(void **state)
+{
+    (void)state;
+    struct scan_params p = params();
+    assert_int_equal(decode_bit_threshold(&p, 100), 4); /* no noise model: the fixed floor */
+    p.read_noise_dn = 1.5;
+    p.electrons_per_dn = 20.0;
+    p.bit_noise_sigmas = 2.0;
+    assert_int_equal(decode_bit_threshold(&p, 100), 7); /* 2 sqrt(4.5 + 5) = 6.2 */
+    assert_int_equal(decode_bit_threshold(&p, 200), 8); /* 2 sqrt(4.5 + 10) = 7.6 */
+    assert_int_equal(decode_bit_threshold(&p, 0), 5);   /* 2 sqrt(4.5) = 4.2 */
+    p.min_bit_diff_dn = 12;
+    assert_int_equal(decode_bit_threshold(&p, 100), 12);
 }
 
 /* A pixel whose code is wrong in a high bit disagrees with its neighbours. */
@@ -222,6 +254,7 @@ int main(void)
         cmocka_unit_test(test_frames_out_of_order_rejected),
         cmocka_unit_test(test_size_above_limit_rejected),
         cmocka_unit_test(test_ambiguous_bits),
+        cmocka_unit_test(test_bit_threshold_from_noise),
         cmocka_unit_test(test_lone_wrong_code_inconsistent),
         cmocka_unit_test(test_blocked_matches_reference),
     };

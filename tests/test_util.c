@@ -161,6 +161,23 @@ static double stripe_width_px(const struct sim_rig *rig)
     return 0.0;
 }
 
+/* Is @p column within one of the true column of pixel @p i or of a lit pixel beside it? At a
+ * depth edge a blurred camera pixel sees both surfaces, and may rightly decode either. */
+static int near_column(const struct sim_rig *rig, size_t i, uint16_t column)
+{
+    long x = (long)(i % rig->width), y = (long)(i / rig->width);
+    for (long dy = -1; dy <= 1; dy++)
+        for (long dx = -1; dx <= 1; dx++) {
+            long nx = x + dx, ny = y + dy;
+            if (nx < 0 || ny < 0 || nx >= (long)rig->width || ny >= (long)rig->height)
+                continue;
+            size_t j = (size_t)ny * rig->width + (size_t)nx;
+            if (rig->truth.proj_lit[j] && fabs(column - floor(rig->truth.proj_u[j] + 0.5)) <= 1.0)
+                return 1;
+        }
+    return 0;
+}
+
 void test_measure_view(const struct sim_rig *rig, const struct scan_view *view,
                        struct view_quality *q)
 {
@@ -191,6 +208,9 @@ void test_measure_view(const struct sim_rig *rig, const struct scan_view *view,
                 q->lit_head_on_correct += (uint32_t)correct;
                 q->lit_head_on_valid += (uint32_t)valid;
                 q->lit_head_on_off += (uint32_t)(valid && !correct);
+                q->lit_head_on_wrong += (uint32_t)(valid && !correct &&
+                                                   !near_column(rig, i, maps->column[i]));
+                q->head_on_reason[maps->reason[i]]++;
             }
         }
         if (!valid)

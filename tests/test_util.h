@@ -55,6 +55,9 @@ struct view_quality {
     uint32_t lit_head_on_correct;
     uint32_t lit_head_on_valid; /**< of lit_head_on: valid, right or not */
     uint32_t lit_head_on_off;   /**< of lit_head_on: valid but more than +-1 column off */
+    uint32_t lit_head_on_wrong; /**< of those: off every lit pixel's column in the 3x3 around it
+                                     (not a blurred pixel seeing its neighbour's surface) */
+    uint32_t head_on_reason[SCAN_REASON_COUNT]; /**< lit_head_on pixels by reason */
     double stripe_px;           /**< finest projected stripe (2 columns) in camera pixels, median */
     uint32_t valid;        /**< all valid pixels */
     uint32_t valid_unlit;  /**< valid pixels the projector does not light (must be 0) */
