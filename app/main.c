@@ -7,6 +7,7 @@
 #include "scan_job.h"
 #include "white_cal.h"
 #include "clock_posix.h"
+#include "patterns.h"
 #include "storage_posix.h"
 
 #include <errno.h>
@@ -358,6 +359,8 @@ static void usage(FILE *out)
             "           (BASE.png at 300 dpi, BASE.svg at true size)\n"
             "       scanner calibrate-white --config FILE [--albedo A]  white reference scales\n"
             "       scanner check-config --config FILE    check a config and its calibration\n"
+            "       scanner patterns --config FILE --out DIR  the projector's pattern sequence as\n"
+            "           PNG files, for a projector that stores its own (DLP pattern memory)\n"
             "       scanner selftest --config FILE        try each configured device (new rig)\n"
             "       scanner config-doc                    print the config reference (Markdown)\n"
             "       scanner --version\n");
@@ -431,6 +434,19 @@ int main(int argc, char **argv)
             return 2;
         printf("%s: ok\n", config_path);
         return 0;
+    }
+    if (strcmp(argv[1], "patterns") == 0) {
+        static struct app_config cfg;
+        static struct scan_calib calib;
+        struct hal_storage st;
+        if (opts.out_dir == NULL) {
+            fprintf(stderr, "scanner: patterns: --out DIR is required\n");
+            return 2;
+        }
+        if (load_all(config_path, &cfg, &calib) != 0)
+            return 2;
+        storage_posix_init(&st);
+        return patterns_write(&st, &cfg, &calib, opts.out_dir) == 0 ? 0 : 1;
     }
     if (strcmp(argv[1], "scan") == 0)
         return cmd_scan(config_path, &opts);
