@@ -77,6 +77,11 @@ static const struct ini_key config_keys[] = {
         "2: after the first turn the person lays the object another way (on its side) and the "
         "table turns again; the second pass is found in the first and both make one model (the "
         "parts one pass cannot see: the underside, deep folds)"),
+    {"scan", "exposures_us", INI_LIST, C(exposures_us), SCAN_MAX_EXPOSURES, 10, 10000000, 0, "",
+     NULL,
+     "HDR patterns: every pattern captured at each of these exposures (ascending, one of them "
+     "[camera] exposure_us), per pixel the longest whose white frame is not saturated; for "
+     "objects with dark and shiny parts. Empty: [camera] exposure_us alone"},
     F64("scan", "start_angle_deg", start_angle_deg, -360, 360, "0", "turntable angle of view 0"),
     U32("scan", "min_contrast_dn", scan.min_contrast_dn, 1, 255, "10",
         "white minus black (grey levels) below this: too dark to decode, flagged 'dark'"),
@@ -459,6 +464,31 @@ static int load_sim_rig(struct app_config *cfg, const char *path, char *err, siz
     return 0;
 }
 
+/* [scan] exposures_us into the scan's exposures: ascending, and holding the camera's own (the
+ * view's colour is taken at it). */
+static int config_exposures(struct app_config *cfg, const char *path, char *err, size_t err_len)
+{
+    const struct ini_list *l = &cfg->exposures_us;
+    int has_camera = l->count == 0;
+    for (unsigned k = 0; k < l->count; k++) {
+        if (k > 0 && l->value[k] <= l->value[k - 1]) {
+            snprintf(err, err_len, "%s: [scan] exposures_us: must be ascending", path);
+            return -EINVAL;
+        }
+        cfg->scan.exposures_us[k] = (uint32_t)l->value[k];
+        has_camera |= cfg->scan.exposures_us[k] == cfg->camera.exposure_us;
+    }
+    if (!has_camera) {
+        snprintf(err, err_len,
+                 "%s: [scan] exposures_us: must include [camera] exposure_us (%u), at which the "
+                 "view's colour is taken",
+                 path, (unsigned)cfg->camera.exposure_us);
+        return -EINVAL;
+    }
+    cfg->scan.exposure_count = l->count;
+    return 0;
+}
+
 int config_load(struct app_config *cfg, const char *path, char *err, size_t err_len)
 {
     memset(cfg, 0, sizeof(*cfg));
@@ -483,6 +513,8 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
         return -EINVAL;
     }
     cfg->scan.height = cfg->camera.height;
+    if ((rc = config_exposures(cfg, path, err, err_len)) != 0)
+        return rc;
     if (cfg->scan.shadow_contrast_dn >= cfg->scan.min_contrast_dn) {
         snprintf(err, err_len, "%s: [scan] shadow_contrast_dn: %u must be below min_contrast_dn %u",
                  path, (unsigned)cfg->scan.shadow_contrast_dn, (unsigned)cfg->scan.min_contrast_dn);

@@ -8,6 +8,7 @@
 #include "hal.h"
 #include "fusion.h"
 #include "reg.h"
+#include "ini_schema.h"
 #include "scan_types.h"
 #include "sim_config.h"
 #include "turntable_modbus.h"
@@ -28,6 +29,7 @@ struct app_config {
     uint32_t views;  /**< per pass */
     uint32_t passes; /**< 1, or 2: the object laid another way for a second turn */
     double start_angle_deg;
+    struct ini_list exposures_us; /**< [scan] exposures_us as written (HDR patterns) */
     char calibration_file[HAL_MAX_PATH]; /**< resolved against the config file's directory */
     char output_dir[HAL_MAX_PATH];
     double min_fragment_share; /**< [output]: smaller floating pieces are left out of the mesh */

@@ -196,6 +196,26 @@ static int set_value(const struct ini_key *k, void *target, const char *value, c
         }
         memcpy(dst, value, strlen(value) + 1);
         return 0;
+    case INI_LIST: {
+        struct ini_list *list = (struct ini_list *)(void *)dst;
+        char buf[512];
+        snprintf(buf, sizeof(buf), "%s", value);
+        list->count = 0;
+        for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok != NULL;
+             tok = strtok_r(NULL, ",", &save)) {
+            while (*tok == ' ' || *tok == '\t')
+                tok++;
+            if (list->count == k->size || list->count == INI_LIST_MAX ||
+                parse_double(tok, &v) != 0) {
+                snprintf(msg, len, "'%s' is not a list of at most %zu numbers", value, k->size);
+                return -1;
+            }
+            if (range_error(k, v, msg, len))
+                return -1;
+            list->value[list->count++] = v;
+        }
+        return 0;
+    }
     case INI_VEC: {
         char buf[512];
         snprintf(buf, sizeof(buf), "%s", value);
@@ -327,6 +347,9 @@ static const char *type_name(const struct ini_key *k, char *buf, size_t len)
     }
     case INI_VEC:
         return k->size == 3 ? "x, y, z" : "list of numbers";
+    case INI_LIST:
+        snprintf(buf, len, "up to %zu numbers", k->size);
+        return buf;
     case INI_LINE:
         return "offset or name";
     }
@@ -347,7 +370,7 @@ void ini_schema_print_doc(const struct ini_key *keys, size_t key_count, FILE *ou
         }
         char range[64] = "", type_buf[128];
         if (k->type == INI_U32 || k->type == INI_I32 || k->type == INI_F64 || k->type == INI_VEC ||
-            k->type == INI_LINE)
+            k->type == INI_LINE || k->type == INI_LIST)
             snprintf(range, sizeof(range), "%.10g .. %.10g%s", k->min, k->max,
                      k->max_is_limit ? " (compiled limit)" : "");
         fprintf(out, "| `%s` | %s | %s | %s | %s |\n", k->name,

@@ -8,14 +8,23 @@
 
 /* INI_LINE: a GPIO line as a whole number (offset; -1 = not wired) or a name, into a
  * struct hal_gpio_line_ref. */
-enum ini_type { INI_U32, INI_I32, INI_F64, INI_STR, INI_ENUM, INI_VEC, INI_LINE };
+/* INI_LIST: up to size numbers (at most INI_LIST_MAX), into a struct ini_list; empty: none. */
+enum ini_type { INI_U32, INI_I32, INI_F64, INI_STR, INI_ENUM, INI_VEC, INI_LINE, INI_LIST };
+
+#define INI_LIST_MAX 8
+
+/** The value of an INI_LIST key: how many numbers were given, and them. */
+struct ini_list {
+    unsigned count;
+    double value[INI_LIST_MAX];
+};
 
 struct ini_key {
     const char *section;
     const char *name;
     enum ini_type type;
     size_t offset;       /**< into the target struct */
-    size_t size;         /**< INI_STR: buffer size; INI_VEC: number of doubles */
+    size_t size;         /**< INI_STR: buffer size; INI_VEC: number of doubles; INI_LIST: most */
     double min, max;     /**< numeric range (each element of a vector) */
     int max_is_limit;    /**< max is a compiled buffer limit: say so in the error */
     const char *def;     /**< default, as it would be written in the file; NULL = required */

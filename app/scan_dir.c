@@ -49,18 +49,20 @@ static void colour_frame_name(const struct colour_layout *lay, uint32_t k, char 
         snprintf(buf, len, "light %u alone, %u us, RGB", (unsigned)(k - COLOUR_FRAME_LIGHT0), us);
 }
 
-static void pattern_name(uint32_t pattern, const struct gray_layout *l, char *buf, size_t len)
+static void pattern_name(uint32_t pattern, const struct gray_layout *l, int hdr, char *buf,
+                         size_t len)
 {
     uint32_t k = (pattern - GRAY_PATTERN_FIRST_BIT) / 2u;
+    const char *grey = hdr ? "grey, HDR merged" : "grey";
     if (pattern == GRAY_PATTERN_WHITE)
-        snprintf(buf, len, "white, RGB (the view's colour)");
+        snprintf(buf, len, hdr ? "white, grey, HDR merged" : "white, RGB (the view's colour)");
     else if (pattern == GRAY_PATTERN_BLACK)
-        snprintf(buf, len, "black, grey");
+        snprintf(buf, len, "black, %s", grey);
     else
-        snprintf(buf, len, "%s bit %u of %u%s, grey", k < l->col_bits ? "column" : "row",
+        snprintf(buf, len, "%s bit %u of %u%s, %s", k < l->col_bits ? "column" : "row",
                  (unsigned)(k < l->col_bits ? k : k - l->col_bits),
                  (unsigned)(k < l->col_bits ? l->col_bits : l->row_bits),
-                 (pattern - GRAY_PATTERN_FIRST_BIT) % 2u ? " inverse" : "");
+                 (pattern - GRAY_PATTERN_FIRST_BIT) % 2u ? " inverse" : "", grey);
 }
 
 void scan_dir_describe_frames(const struct scan_params *p, const struct scan_calib *c,
@@ -71,12 +73,15 @@ void scan_dir_describe_frames(const struct scan_params *p, const struct scan_cal
     gray_layout_for(c->proj_width, c->proj_height, (int)p->decode_rows, &layout);
     colour_layout(&p->colour, c->light_count, &lay);
     uint32_t patterns = gray_layout_count(&layout);
-    v->frame_count = patterns + lay.count;
+    int hdr = p->exposure_count > 0;
+    v->frame_count = patterns + lay.count + (hdr ? 1u : 0u);
     for (uint32_t f = 0; f < v->frame_count && f < SCAN_DIR_MAX_FRAMES; f++) {
         if (f < patterns)
-            pattern_name(f, &layout, v->frame_name[f], SCAN_DIR_FRAME_NAME);
-        else
+            pattern_name(f, &layout, hdr, v->frame_name[f], SCAN_DIR_FRAME_NAME);
+        else if (f < patterns + lay.count)
             colour_frame_name(&lay, f - patterns, v->frame_name[f], SCAN_DIR_FRAME_NAME);
+        else /* HDR: the white at the camera's exposure */
+            snprintf(v->frame_name[f], SCAN_DIR_FRAME_NAME, "white, RGB (the view's colour)");
     }
 }
 

@@ -13,7 +13,7 @@
 #include <stdint.h>
 
 /** Frames a view can hold: the patterns, then the colour frames. */
-#define SCAN_DIR_MAX_FRAMES (DECODE_MAX_PATTERNS + COLOUR_MAX_FRAMES)
+#define SCAN_DIR_MAX_FRAMES (DECODE_MAX_PATTERNS + COLOUR_MAX_FRAMES + 1) /* + HDR colour */
 /** Longest description of a frame in view.ini ("light 3 alone, 20000 us, RGB"). */
 #define SCAN_DIR_FRAME_NAME 64u
 /** Room for any path inside a scan directory. */

@@ -625,14 +625,16 @@ int scan_job_feed_view(const char *scan_dir, uint32_t v, const struct scan_param
     scan_layout(params, calib, &layout);
     uint32_t count = gray_layout_count(&layout);
     uint32_t lights = scan_light_frame_count(params, calib);
+    int hdr = params->exposure_count > 0; /* merged grey patterns, the colour after the lights */
     int rc = scan_begin_view(params, calib);
-    for (uint32_t f = 0; f < count + lights && rc == 0; f++) {
-        uint32_t channels = f == GRAY_PATTERN_WHITE || f >= count ? 3 : 1;
+    for (uint32_t f = 0; f < count + lights + (hdr ? 1u : 0u) && rc == 0; f++) {
+        uint32_t channels = (f == GRAY_PATTERN_WHITE && !hdr) || f >= count ? 3 : 1;
         rc = scan_dir_read_frame(scan_dir, v, f, pixels, sizeof(pixels), params->width,
                                  params->height, channels, err, err_len);
         if (rc == 0)
-            rc = f < count ? scan_feed_frame(f, pixels, channels, NULL)
-                           : scan_feed_light_frame(f - count, pixels);
+            rc = f < count            ? scan_feed_frame(f, pixels, channels, NULL)
+                 : f < count + lights ? scan_feed_light_frame(f - count, pixels)
+                                      : scan_feed_white_colour(pixels);
     }
     return rc;
 }

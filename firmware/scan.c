@@ -21,6 +21,8 @@ static int light_present[COLOUR_MAX_FRAMES];
 static uint8_t view_rgb[HAL_MAX_PIXELS * 3]; /* the view's colour: compensated, or raw */
 static float view_confidence[HAL_MAX_PIXELS];
 static uint8_t view_reason[HAL_MAX_PIXELS];  /* decoded, then refined by each later stage */
+static uint8_t hdr_choice[HAL_MAX_PIXELS];   /* HDR: the exposure each pixel is read at */
+static uint8_t hdr_grey[HAL_MAX_PIXELS];     /* HDR: one exposure of the pattern being merged */
 static struct scan_params view_params;        /* of the view being fed */
 
 int scan_check(const struct scan_params *p, const struct scan_calib *c, char *msg, size_t len)
@@ -168,8 +170,9 @@ int scan_feed_frame(uint32_t pattern, const uint8_t *pixels, uint32_t channels,
     uint8_t *slot = decode_frame_slot(pattern);
     if (slot == NULL)
         return -EINVAL;
+    int colour = channels == 3 && pattern == GRAY_PATTERN_WHITE;
     if (channels == 3) {
-        if (pattern == GRAY_PATTERN_WHITE && pixels != colour_rgb)
+        if (colour && pixels != colour_rgb)
             memcpy(colour_rgb, pixels, n * 3); /* the view's colour */
         decode_rgb_to_grey(pixels, slot, n, view_params.saturation_dn);
         grey = slot; /* converted straight into the decoder's store */
@@ -178,11 +181,17 @@ int scan_feed_frame(uint32_t pattern, const uint8_t *pixels, uint32_t channels,
     /* The white frame is kept in colour (its grey is derived again offline); the others are
      * kept exactly as the decoder saw them. */
     if (rc == 0 && sink != NULL && sink->save != NULL)
-        rc = pattern == GRAY_PATTERN_WHITE
-                 ? sink->save(sink->priv, pattern, colour_rgb, view_params.width,
-                              view_params.height, 3)
-                 : sink->save(sink->priv, pattern, grey, view_params.width, view_params.height, 1);
+        rc = colour ? sink->save(sink->priv, pattern, colour_rgb, view_params.width,
+                                 view_params.height, 3)
+                    : sink->save(sink->priv, pattern, grey, view_params.width, view_params.height, 1);
     return rc;
+}
+
+int scan_feed_white_colour(const uint8_t *rgb)
+{
+    if (rgb != colour_rgb)
+        memcpy(colour_rgb, rgb, (size_t)view_params.width * view_params.height * 3);
+    return 0;
 }
 
 uint32_t scan_light_frame_count(const struct scan_params *p, const struct scan_calib *c)
@@ -236,18 +245,87 @@ int scan_finish_view(const struct scan_calib *c, int32_t angle_mdeg, struct scan
     return 0;
 }
 
+static int capture_sequence(const struct hal *hal, const struct scan_params *p, uint32_t count,
+                            const struct scan_frame_sink *sink, uint32_t *exposure_us,
+                            struct scan_view_info *info);
+
+/* HDR: pattern @p i at every exposure, merged in the decoder's slot before it is fed: each
+ * pixel at the exposure hdr_choice holds, chosen on the white pattern as the longest whose
+ * white is not saturated (the brightest unsaturated). The pixel's patterns, inverses, white and
+ * black are then all read at one exposure, so the decoder's comparisons stay within it and
+ * need no scaling. The white at the camera's own exposure is kept as the view's colour.
+ * @p exposure_us  in/out: the camera's exposure now */
+static int capture_hdr(const struct hal *hal, const struct scan_params *p, uint32_t i,
+                       uint32_t *exposure_us, struct scan_view_info *info)
+{
+    const size_t n = (size_t)p->width * p->height;
+    uint8_t *slot = decode_frame_slot(i);
+    int rc = 0;
+    for (uint32_t e = 0; e < p->exposure_count && rc == 0; e++) {
+        if (p->exposures_us[e] != *exposure_us) {
+            rc = hal_cam_set_exposure(&hal->camera, p->exposures_us[e], p->colour.gain_milli);
+            *exposure_us = p->exposures_us[e];
+        }
+        int colour = i == GRAY_PATTERN_WHITE && p->exposures_us[e] == p->colour.exposure_us;
+        uint8_t *buf = colour ? colour_rgb : frame_rgb;
+        if (rc == 0)
+            rc = capture(hal, p, buf, i, info);
+        if (rc != 0)
+            break;
+        info->frames_captured++;
+        decode_rgb_to_grey(buf, hdr_grey, n, p->saturation_dn);
+        if (i == GRAY_PATTERN_WHITE) /* ascending: a longer unsaturated exposure wins */
+            for (size_t k = 0; k < n; k++)
+                if (e == 0 || hdr_grey[k] != DECODE_SATURATED)
+                    hdr_choice[k] = (uint8_t)e;
+        for (size_t k = 0; k < n; k++)
+            if (hdr_choice[k] == e)
+                slot[k] = hdr_grey[k];
+    }
+    return rc;
+}
+
+/* One pattern as the decoder takes it: RGB at the camera's exposure, or merged HDR grey. */
+static int capture_pattern(const struct hal *hal, const struct scan_params *p, uint32_t i,
+                           const struct scan_frame_sink *sink, uint32_t *exposure_us,
+                           struct scan_view_info *info)
+{
+    if (p->exposure_count > 0) {
+        int rc = capture_hdr(hal, p, i, exposure_us, info);
+        return rc != 0 ? rc : scan_feed_frame(i, decode_frame_slot(i), 1, sink);
+    }
+    uint8_t *buf = i == GRAY_PATTERN_WHITE ? colour_rgb : frame_rgb;
+    int rc = capture(hal, p, buf, i, info);
+    if (rc != 0)
+        return rc;
+    info->frames_captured++;
+    return scan_feed_frame(i, buf, 3, sink);
+}
+
+/* Every pattern of the sequence, the camera back at its own exposure after (also on failure). */
 static int capture_patterns(const struct hal *hal, const struct scan_params *p, uint32_t count,
                             const struct scan_frame_sink *sink, struct scan_view_info *info)
+{
+    uint32_t exposure_us = p->colour.exposure_us;
+    int rc = capture_sequence(hal, p, count, sink, &exposure_us, info);
+    if (exposure_us != p->colour.exposure_us) {
+        int rc_exp = hal_cam_set_exposure(&hal->camera, p->colour.exposure_us, p->colour.gain_milli);
+        rc = rc != 0 ? rc : rc_exp;
+    }
+    if (rc == -ENOSYS)
+        hal->log(HAL_LOG_ERROR, "camera: cannot change the exposure for HDR patterns; leave "
+                                "[scan] exposures_us empty");
+    return rc;
+}
+
+static int capture_sequence(const struct hal *hal, const struct scan_params *p, uint32_t count,
+                            const struct scan_frame_sink *sink, uint32_t *exposure_us,
+                            struct scan_view_info *info)
 {
     for (uint32_t i = 0; i < count; i++) {
         if (hal_should_stop(hal))
             return -EINTR;
-        uint8_t *buf = i == GRAY_PATTERN_WHITE ? colour_rgb : frame_rgb;
-        int rc = capture(hal, p, buf, i, info);
-        if (rc != 0)
-            return rc;
-        info->frames_captured++;
-        rc = scan_feed_frame(i, buf, 3, sink);
+        int rc = capture_pattern(hal, p, i, sink, exposure_us, info);
         if (rc != 0)
             return rc;
         if (i + 1 == count)
@@ -323,6 +401,10 @@ int scan_take_view(const struct hal *hal, const struct scan_params *p, const str
     int rc_off = hal_gpio_set(&hal->gpio, HAL_GPIO_PROJECTOR_ENABLE, 0);
     if (rc == 0 && rc_off == 0)
         rc = capture_lights(hal, p, c, count, sink, info);
+    /* HDR: the pattern frames are merged grey; the view's colour is kept after the lights. */
+    if (rc == 0 && rc_off == 0 && p->exposure_count > 0 && sink != NULL && sink->save != NULL)
+        rc = sink->save(sink->priv, count + scan_light_frame_count(p, c), colour_rgb, p->width,
+                        p->height, 3);
     if (rc != 0 || rc_off != 0)
         goto out_safe;
     return scan_finish_view(c, angle_mdeg, view, info);

@@ -98,6 +98,10 @@ int scan_save_cloud(const struct hal *hal, const struct scan_view *view,
 int scan_recolour(const struct colour_params *colour, const struct scan_calib *calib,
                   struct scan_view *view);
 
+/** Offline, HDR: hand over the view's colour (the white pattern at the camera's exposure; the
+ *  white fed to scan_feed_frame is then the merged grey). @retval 0 */
+int scan_feed_white_colour(const uint8_t *rgb);
+
 /** Colour frames a view takes after its patterns (0 when [colour] method = none). */
 uint32_t scan_light_frame_count(const struct scan_params *params, const struct scan_calib *calib);
 /** Offline: hand over colour frame @p k (colour.h numbering), RGB24. @retval 0 or -EINVAL */

@@ -42,6 +42,9 @@ struct colour_params {
     uint32_t light_exposure_us;       /**< each single-light frame (0: exposure_us) */
 };
 
+/** Exposures an HDR pattern can be captured at. */
+#define SCAN_MAX_EXPOSURES 3
+
 /** Processing and sequencing parameters of one view. */
 struct scan_params {
     uint32_t width, height;      /**< camera frame size */
@@ -63,6 +66,8 @@ struct scan_params {
     uint32_t pattern_settle_us; /**< wait after the projector changes pattern */
     uint32_t trigger_pulse_us;  /**< projector trigger/reset pulse width */
     uint32_t capture_retries;   /**< extra tries of a failed capture */
+    uint32_t exposure_count;    /**< HDR: each pattern at these exposures (0: the camera's only) */
+    uint32_t exposures_us[SCAN_MAX_EXPOSURES]; /**< ascending, one of them the camera's */
     struct colour_params colour; /**< intrinsic colour; its frames are captured unless none */
 };
 

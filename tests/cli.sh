@@ -159,6 +159,23 @@ check slipped_object_names_the_view sh -c "! $bin scan --config $out/slip.ini --
 printf '[output]\nwatertight = 1\n' | cat config/sim.ini - > "$out/watertight.ini"
 check watertight_needs_max_hole sh -c "$bin check-config --config $out/watertight.ini 2>&1 |
     grep -q 'watertight: a closed model needs max_hole_mm > 0'"
+# HDR patterns: the exposures must hold the camera's own (the view's colour is taken at it); a
+# scan with two exposures per pattern keeps the merged frames and the colour, and process makes
+# the same model from them.
+sed 's/^views = 8$/views = 4\nexposures_us = 2500, 40000/' config/sim.ini > "$out/hdr-bad.ini"
+sed 's/^views = 8$/views = 4\nexposures_us = 10000, 40000/' config/sim.ini > "$out/hdr.ini"
+sed -i "s|^calibration = .*|calibration = $PWD/config/sim-calib.ini|; s|^mesh_file = ../|mesh_file = $PWD/|" \
+    "$out/hdr-bad.ini" "$out/hdr.ini"
+check hdr_exposures_need_the_cameras sh -c "$bin check-config --config $out/hdr-bad.ini 2>&1 |
+    grep -q 'exposures_us: must include \[camera\] exposure_us (10000)'"
+rm -rf "$out/hdr-scan" "$out/hdr-processed"
+check hdr_scan_and_process_agree sh -c "$bin scan --config $out/hdr.ini --out $out/hdr-scan >/dev/null 2>&1 &&
+    grep -q 'frame_00 = white, grey, HDR merged' $out/hdr-scan/view_000/view.ini &&
+    grep -q 'frame_22 = white, RGB' $out/hdr-scan/view_000/view.ini &&
+    grep -q '^frames = 44' $out/hdr-scan/view_000/view.ini &&
+    $bin process $out/hdr-scan --out $out/hdr-processed >/dev/null 2>&1 &&
+    cmp $out/hdr-scan/mesh.ply $out/hdr-processed/mesh.ply"
+rm -rf "$out/hdr-scan" "$out/hdr-processed"
 # make LIMITS=small, for a board with 512 MB: under a 512 MiB address-space limit the default
 # build cannot even start (754 MiB of static buffers), the small one takes the same scan and
 # gives the same model. (ASan reserves terabytes of address space: no limit under SAN=1.)

@@ -200,9 +200,15 @@ void test_measure_view(const struct sim_rig *rig, const struct scan_view *view,
             const float *pt = &t->pos_cam[3 * i], *nt = &t->normal_cam[3 * i];
             vec3 to_proj = v3_norm(v3_sub(proj, v3(pt[0], pt[1], pt[2])));
             double cos_in = v3_dot(to_proj, v3(nt[0], nt[1], nt[2]));
+            const uint8_t *white = &view->white_rgb[3 * i];
+            if (white[0] >= 250 || white[1] >= 250 || white[2] >= 250) {
+                q->saturated++;
+                q->saturated_correct += (uint32_t)correct;
+            }
             if (t->dark[i]) {
                 q->dark++;
                 q->dark_flagged += (uint32_t)!valid;
+                q->dark_correct += (uint32_t)correct;
             } else if (cos_in >= min_cos) {
                 q->lit_head_on++;
                 q->lit_head_on_correct += (uint32_t)correct;

@@ -63,6 +63,9 @@ struct view_quality {
     uint32_t valid_unlit;  /**< valid pixels the projector does not light (must be 0) */
     uint32_t dark;         /**< lit pixels on the very dark paint */
     uint32_t dark_flagged; /**< of those: rejected */
+    uint32_t dark_correct; /**< of those: valid and within +-1 column of the truth */
+    uint32_t saturated;    /**< lit pixels whose white frame (the view's colour) saturates */
+    uint32_t saturated_correct; /**< of those: valid and within +-1 column of the truth */
     uint32_t outliers_2mm; /**< valid points farther than 2 mm from the true surface */
     double normal_err_deg; /**< mean angle between estimated and true normals, valid pixels */
     double depth_rms_mm;   /**< RMS of reconstructed minus true depth (z), valid pixels */

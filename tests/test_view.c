@@ -95,6 +95,45 @@ static void test_sphere_at_the_cameras_limit(void **state)
     assert_true(q.valid_unlit <= 0.0005 * q.valid);
 }
 
+/* HDR patterns ([scan] exposures_us): the very dark paint (albedo 0.03: 2-5 grey levels of
+ * contrast at the camera's exposure, every pixel flagged) decodes at the longer exposure, and the
+ * rest of the sphere keeps the camera's. A glossy sphere's highlights, saturated in the white
+ * frame, decode without HDR: saturation is judged per pattern pair. */
+static void test_dark_paint_with_hdr_and_highlights(void **state)
+{
+    (void)state;
+    static struct test_rig t;
+    assert_int_equal(test_rig_load(&t, "config/sim-glossy.ini"), 0);
+    snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "sphere");
+    t.cfg.scan.exposure_count = 2;
+    t.cfg.scan.exposures_us[0] = 10000;
+    t.cfg.scan.exposures_us[1] = 40000;
+    assert_int_equal(test_rig_start(&t), 0);
+    struct scan_view view;
+    struct scan_view_info info;
+    struct view_quality q;
+    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), 0);
+    assert_int_equal(info.frames_captured, 44);
+    test_measure_view(sim_ctl_rig(), &view, &q);
+    test_rig_stop(&t);
+    print_message("HDR: %u of %u dark paint pixels right\n", q.dark_correct, q.dark);
+    assert_true(q.dark > 1000);
+    assert_true(q.dark_correct >= 0.9 * q.dark);
+    assert_true(q.lit_head_on_correct >= 0.98 * q.lit_head_on); /* the rest as without HDR */
+    assert_int_equal(q.outliers_2mm, 0);
+
+    assert_int_equal(test_rig_load(&t, "config/sim-glossy.ini"), 0);
+    snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "sphere");
+    snprintf(t.cfg.sim.material, sizeof(t.cfg.sim.material), "phong");
+    assert_int_equal(test_rig_start(&t), 0);
+    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), 0);
+    test_measure_view(sim_ctl_rig(), &view, &q);
+    test_rig_stop(&t);
+    print_message("glossy: %u of %u saturated pixels right\n", q.saturated_correct, q.saturated);
+    assert_true(q.saturated > 1000);
+    assert_true(q.saturated_correct >= 0.8 * q.saturated);
+}
+
 /* The blocked decoder equals the plain per-pixel reference on real simulated frames, columns
  * and rows (42 patterns), pixel for pixel: column, row and reason. */
 static void test_blocked_decoder_matches_reference(void **state)
@@ -147,6 +186,7 @@ int main(void)
         cmocka_unit_test(test_sphere),
         cmocka_unit_test(test_bunny),
         cmocka_unit_test(test_sphere_at_the_cameras_limit),
+        cmocka_unit_test(test_dark_paint_with_hdr_and_highlights),
         cmocka_unit_test(test_blocked_decoder_matches_reference),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
