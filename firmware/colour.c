@@ -195,7 +195,11 @@ int colour_compute(const struct colour_params *prm, const struct scan_calib *c,
     vec3 proj = v3_scale(m3_tmul(c->proj_rot, v3_from(c->proj_trans_mm)), -1.0);
     for (size_t i = 0; i < n; i++) {
         memcpy(&albedo[3 * i], &white[3 * i], 3); /* raw colour unless compensated below */
-        confidence[i] = prm->method == COLOUR_NONE && m->reason[i] == SCAN_VALID;
+        /* raw colour: trusted where valid, but not where the white frame clipped (a highlight
+         * now has depth, its colour is blown out): other views colour it if they can */
+        confidence[i] = prm->method == COLOUR_NONE && m->reason[i] == SCAN_VALID &&
+                        white[3 * i] < prm->saturation_dn && white[3 * i + 1] < prm->saturation_dn &&
+                        white[3 * i + 2] < prm->saturation_dn;
         if (prm->method == COLOUR_NONE && m->reason[i] == SCAN_VALID)
             white_balance(prm, &albedo[3 * i]);
         if (prm->method == COLOUR_NONE || m->reason[i] != SCAN_VALID)

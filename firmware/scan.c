@@ -422,7 +422,7 @@ int scan_fuse_view(const struct scan_calib *calib, const struct scan_view *view,
                    const struct frame_xform *obj_from_cam)
 {
     return fusion_integrate(calib, obj_from_cam, &view->maps, &view->range, view->rgb,
-                            view->colour_method == COLOUR_NONE ? NULL : view->confidence);
+                            view->confidence);
 }
 
 int scan_save_cloud(const struct hal *hal, const struct scan_view *view,

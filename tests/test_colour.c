@@ -64,6 +64,12 @@ static void measure(const char *method, struct colour_stats *out)
         vec3 to = v3_norm(v3_sub(proj, v3(pt[0], pt[1], pt[2])));
         if (v3_dot(to, v3(nt[0], nt[1], nt[2])) < 0.5)
             continue;
+        /* nor saturated in the white frame: such pixels have depth (saturation is judged per
+         * pattern pair) but no colour to compare: every method gives them confidence 0 */
+        const uint8_t *w = &view.white_rgb[3 * i];
+        uint32_t sat = t.cfg.scan.saturation_dn;
+        if (w[0] >= sat || w[1] >= sat || w[2] >= sat)
+            continue;
         const uint8_t *c = &rgb[3 * i];
         for (int k = 0; k < 3; k++) {
             sum[k] += c[k];
