@@ -368,7 +368,7 @@ clean:
 $(BUILD)/measure_view: $(BUILD)/tests/measure_view.o $(BUILD)/tests/test_util.o $(HOST_OBJ) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON) $(BOARD_LIBS)
 measure: deps $(BUILD)/measure_view
-	$(BUILD)/measure_view config/sim.ini config/sim-limit.ini config/sim-glossy.ini
+	$(BUILD)/measure_view config/sim.ini config/sim-limit.ini config/sim-glossy.ini config/sim-concave.ini
 
 # Intrinsic colour (issue 4): Jost et al.'s comparison reproduced on the simulator, written to
 # docs/colour-eval/ (table as Markdown and CSV, close-up PNGs of a view boundary). About 20 minutes.

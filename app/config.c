@@ -2,6 +2,8 @@
 #define _POSIX_C_SOURCE 200809L
 #include "config.h"
 
+#include "gray.h"
+
 #include "ini_schema.h"
 
 #include <errno.h>
@@ -106,6 +108,10 @@ static const struct ini_key config_keys[] = {
         "a pixel needs this many agreeing neighbours (of 8), else 'inconsistent'"),
     F64("scan", "max_depth_jump_mm", scan.max_depth_jump_mm, 0.01, 1000, "3",
         "a larger depth step between neighbours is a surface boundary (for normals)"),
+    ENUM("scan", "code", code, "gray|xor04", "gray",
+         "how the projector codes its columns: Gray code, or XOR-04 (every coarse bit projected "
+         "XOR the 4-pixel stripes; for concave and shiny objects whose light bounces onto "
+         "themselves; the projector's stored sequence changes: scanner patterns)"),
     U32("scan", "decode_rows", scan.decode_rows, 0, 1, "0",
         "1: code projector rows too (twice the patterns; rows must agree with neighbours)"),
     U32("scan", "refine", scan.refine, 0, 1, "1",
@@ -226,7 +232,7 @@ static const struct ini_key config_keys[] = {
         "view weights ramp up over this many pixels from the view's edge"),
     F64("fusion", "min_weight", fusion.min_weight, 0, 1, "0.05",
         "pixels weighing less (grazing, far) are not fused"),
-    ENUM("sim", "object", sim.object, "sphere|cylinder|can|box|torus|mesh", "sphere",
+    ENUM("sim", "object", sim.object, "sphere|cylinder|can|box|torus|corner|groove|mesh", "sphere",
          "simulated object"),
     STR("sim", "mesh_file", sim.mesh_file, "", "PLY mesh for object = mesh, relative to this file"),
     STR("sim", "rig", sim.rig_file, "",
@@ -276,6 +282,9 @@ static const struct ini_key config_keys[] = {
     U32("sim", "jpeg_quality", sim.jpeg_quality, 0, 100, "0",
         "1..100: each frame is JPEG-compressed at this quality and decoded (libjpeg), as a "
         "camera's JPEG stream; 0: off"),
+    U32("sim", "bounce_samples", sim.bounce_samples, 0, 1024, "0",
+        "interreflection: the projector's light bounced once between surfaces, sampled in this "
+        "many directions per point (concave objects); 0: direct light only"),
     F64("sim", "light_intensity_dn", sim.light_intensity_dn, 0, 10000, "120",
         "like projector_intensity_dn, for each white light"),
     F64("sim", "light_diffuser_mm", sim.light_diffuser_mm, 0, 1000, "0",
@@ -504,6 +513,7 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
         if (strcmp(cfg->colour_method, methods[k]) == 0)
             cfg->scan.colour.method = k;
     cfg->scan.colour.ca_per_pixel = strcmp(cfg->colour_ca, "pixel") == 0;
+    cfg->scan.code = strcmp(cfg->code, "xor04") == 0 ? GRAY_CODE_XOR04 : GRAY_CODE_GRAY;
     cfg->scan.colour.saturation_dn = cfg->scan.saturation_dn;
     cfg->scan.colour.exposure_us = cfg->camera.exposure_us;
     cfg->scan.colour.gain_milli = cfg->camera.gain_milli;

@@ -23,6 +23,7 @@ struct app_config {
     char camera_pixel_format[8]; /**< rgb24 | yuyv | grey, as written */
     char colour_method[16];  /**< none | single | uniform | multi, as written */
     char colour_ca[16];      /**< channel | pixel, as written */
+    char code[8];            /**< [scan] code: gray | xor04, as written */
     struct hal_camera_config camera;
     uint32_t light_count;
     struct scan_params scan;

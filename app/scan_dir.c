@@ -53,7 +53,8 @@ static void pattern_name(uint32_t pattern, const struct gray_layout *l, int hdr,
                          size_t len)
 {
     uint32_t k = (pattern - GRAY_PATTERN_FIRST_BIT) / 2u;
-    const char *grey = hdr ? "grey, HDR merged" : "grey";
+    const char *grey = hdr ? (l->code == GRAY_CODE_XOR04 ? "XOR-04, grey, HDR merged" : "grey, HDR merged")
+                           : (l->code == GRAY_CODE_XOR04 ? "XOR-04, grey" : "grey");
     if (pattern == GRAY_PATTERN_WHITE)
         snprintf(buf, len, hdr ? "white, grey, HDR merged" : "white, RGB (the view's colour)");
     else if (pattern == GRAY_PATTERN_BLACK)
@@ -71,6 +72,7 @@ void scan_dir_describe_frames(const struct scan_params *p, const struct scan_cal
     struct gray_layout layout;
     struct colour_layout lay;
     gray_layout_for(c->proj_width, c->proj_height, (int)p->decode_rows, &layout);
+    layout.code = p->code;
     colour_layout(&p->colour, c->light_count, &lay);
     uint32_t patterns = gray_layout_count(&layout);
     int hdr = p->exposure_count > 0;

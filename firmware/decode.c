@@ -22,6 +22,7 @@ static struct {
     uint32_t proj_width, proj_height;
     uint32_t next_pattern;
     uint8_t bit_threshold[256]; /* |I - I_inverse| at or below this is unclear, per contrast */
+    uint32_t xor_col, xor_row;  /* gray_code_xor_mask of the columns and rows */
 } dec;
 
 const char *scan_reason_name(unsigned reason)
@@ -66,6 +67,8 @@ int decode_begin(const struct scan_params *params, const struct gray_layout *lay
     dec.next_pattern = 0;
     for (uint32_t c = 0; c < 256; c++)
         dec.bit_threshold[c] = (uint8_t)decode_bit_threshold(params, c);
+    dec.xor_col = gray_code_xor_mask(layout->code, layout->col_bits);
+    dec.xor_row = gray_code_xor_mask(layout->code, layout->row_bits);
     return 0;
 }
 
@@ -95,6 +98,7 @@ static void accumulate(uint32_t first, uint32_t bits, size_t start, size_t len,
                        const uint8_t *threshold, uint16_t *code, uint16_t *unclear,
                        uint8_t *both_saturated)
 {
+    const uint16_t xor_mask = (uint16_t)gray_code_xor_mask(dec.layout.code, bits);
     static uint8_t plane_hi[DECODE_BLOCK], plane_lo[DECODE_BLOCK];
     static uint8_t unclear_hi[DECODE_BLOCK], unclear_lo[DECODE_BLOCK];
     memset(plane_hi, 0, len);
@@ -118,6 +122,7 @@ static void accumulate(uint32_t first, uint32_t bits, size_t start, size_t len,
     const uint32_t lo_bits = bits > 8 ? bits - 8 : 0;
     for (size_t i = 0; i < len; i++) {
         uint16_t g = (uint16_t)(((unsigned)plane_hi[i] << lo_bits) | plane_lo[i]);
+        g ^= (uint16_t)(-((g >> 1) & 1u) & xor_mask); /* XOR-04: the base bit off again */
         g ^= (uint16_t)(g >> 1); /* Gray to binary: prefix XOR */
         g ^= (uint16_t)(g >> 2);
         g ^= (uint16_t)(g >> 4);
@@ -135,6 +140,17 @@ static unsigned count_bits(uint32_t v)
     return n;
 }
 
+/* Unclear bits that count. XOR-04: where the base bit is unclear (on the edge of its stripes),
+ * every coarser pattern rides on that edge and is unclear with it; together they are one
+ * unclear edge of the base, plus one more when any coarser bit is unclear too, which only the
+ * neighbourhood can then resolve. */
+static unsigned unclear_count(uint32_t unclear, uint32_t xor_mask)
+{
+    if (xor_mask == 0 || !(unclear & 2u))
+        return count_bits(unclear);
+    return count_bits(unclear & ~xor_mask) + ((unclear & xor_mask) != 0);
+}
+
 /* The reasons, in order of precedence; shared by the blocked decoder and the reference. A pixel
  * with too many unclear bits may still be resolved by its neighbourhood (resolve_unclear). */
 static uint8_t classify(const struct scan_params *p, int white, int black, int both_saturated,
@@ -149,8 +165,7 @@ static uint8_t classify(const struct scan_params *p, int white, int black, int b
         return SCAN_DARK;
     /* One unclear bit per coordinate is a pixel on the edge between two columns (rows): adjacent
      * Gray codes differ in one bit, so either reading is one of the two. */
-    if (count_bits(unclear_col) > p->max_ambiguous_bits ||
-        count_bits(unclear_row) > p->max_ambiguous_bits)
+    if (unclear_col > p->max_ambiguous_bits || unclear_row > p->max_ambiguous_bits)
         return both_saturated ? SCAN_SATURATED : SCAN_LOW_CONTRAST;
     return out_of_range ? SCAN_INCONSISTENT : SCAN_VALID;
 }
@@ -177,7 +192,8 @@ static void decode_block(size_t start, size_t len, uint8_t *reason)
         int out = code_col[i] >= dec.proj_width ||
                   (l->row_bits > 0 && code_row[i] >= dec.proj_height);
         reason[start + i] = classify(&dec.params, white[i], black[i], sat[i],
-                                     unclear_col[start + i], unclear_row[start + i], out);
+                                     unclear_count(unclear_col[start + i], dec.xor_col),
+                                     unclear_count(unclear_row[start + i], dec.xor_row), out);
         column_map[start + i] = code_col[i];
         row_map[start + i] = l->row_bits > 0 ? code_row[i] : 0;
     }
@@ -277,35 +293,34 @@ static int neighbourhood_code(const uint8_t *reason, const uint16_t *map, uint32
     return agree >= dec.params.min_consistent_neighbours;
 }
 
-/* Of the codes an unclear pixel can have, the one nearest @p ref. An unclear Gray bit lies on a
- * stripe edge, so the truth is one of the readings with those bits either way: flipping Gray
- * bit k flips binary bits k..0 (b_k is the XOR of the Gray bits from the top down to k).
- * @retval 1 a reading within max_column_jump of ref (in *code) @retval 0 none */
-static int nearest_reading(uint16_t plain, uint16_t unclear, double ref, uint32_t limit,
-                           uint16_t *code)
+/* Of the values an unclear pixel can have, the one nearest @p ref: the values within
+ * RESOLVE_FIT_COLUMNS of it whose projected word matches what the pixel read on every clear
+ * pattern (an unclear bit lies on a stripe edge and may read either way). The word the pixel
+ * read is the word of its plain value (value and word are one to one).
+ * @retval 1 found (in *value) @retval 0 none */
+static int nearest_reading(uint32_t bits, uint16_t plain, uint16_t unclear, double ref,
+                           uint32_t limit, uint16_t *value)
 {
+    const uint32_t code = dec.layout.code;
+    const uint32_t read = gray_code_word(code, bits, plain);
+    long lo = (long)ceil(ref - RESOLVE_FIT_COLUMNS), hi = (long)floor(ref + RESOLVE_FIT_COLUMNS);
     int best = -1;
-    double best_d = 0.0;
-    uint32_t subset = 0;
-    do { /* every subset of the unclear bits */
-        uint32_t flip = 0;
-        for (uint32_t s = subset; s != 0; s &= s - 1)
-            flip ^= ((s & -s) << 1) - 1u; /* bits k..0 for the lowest Gray bit k of s */
-        int c = (int)(plain ^ flip);
-        double d = fabs(c - ref);
-        if (c < (int)limit && (best < 0 || d < best_d))
-            best = c, best_d = d;
-        subset = (subset - unclear) & unclear;
-    } while (subset != 0);
-    if (best < 0 || best_d > RESOLVE_FIT_COLUMNS)
+    for (long c = lo < 0 ? 0 : lo; c <= hi && c < (long)limit; c++)
+        if (((gray_code_word(code, bits, (uint32_t)c) ^ read) & ~(uint32_t)unclear) == 0 &&
+            (best < 0 || fabs((double)c - ref) < fabs((double)best - ref)))
+            best = (int)c;
+    if (best < 0)
         return 0;
-    *code = (uint16_t)best;
+    *value = (uint16_t)best;
     return 1;
 }
 
-/* A pixel with more unclear bits than max_ambiguous_bits (or decoding outside the projector)
- * takes, of its possible readings, the one its decoded neighbourhood agrees with; verdicts go to
- * scratch first, so that pixels resolved here are not the reference of others. */
+/* A pixel with unclear bits takes, of its possible readings, the one its decoded neighbourhood
+ * predicts: one with more than max_ambiguous_bits (or decoding outside the projector) becomes
+ * valid so; a valid one whose unclear bit read the wrong way (noise, not an edge) is corrected.
+ * Verdicts go to scratch and corrections wait in the unclear maps (not needed after this) until
+ * the pass ends, so that what this pass changes is not the reference of others. */
+#define RESOLVE_CORRECTED SCAN_REASON_COUNT /* in scratch: valid, its reading replaced */
 static void resolve_unclear(uint8_t *reason)
 {
     const uint32_t w = dec.params.width, h = dec.params.height;
@@ -316,25 +331,40 @@ static void resolve_unclear(uint8_t *reason)
             size_t i = (size_t)y * w + x;
             uint8_t r = reason[i];
             scratch[i] = r;
-            if ((r != SCAN_LOW_CONTRAST && r != SCAN_SATURATED && r != SCAN_INCONSISTENT) ||
-                count_bits(unclear_col[i]) > max_unclear ||
-                count_bits(unclear_row[i]) > max_unclear ||
-                (unclear_col[i] == 0 && unclear_row[i] == 0))
+            int pending = r == SCAN_LOW_CONTRAST || r == SCAN_SATURATED || r == SCAN_INCONSISTENT;
+            if ((!pending && r != SCAN_VALID) || (unclear_col[i] == 0 && unclear_row[i] == 0) ||
+                unclear_count(unclear_col[i], dec.xor_col) > max_unclear ||
+                unclear_count(unclear_row[i], dec.xor_row) > max_unclear)
                 continue;
             double ref_col, ref_row = 0.0;
             uint16_t col, row = 0;
             if (!neighbourhood_code(reason, column_map, x, y, &ref_col) ||
-                !nearest_reading(column_map[i], unclear_col[i], ref_col, dec.proj_width, &col) ||
+                !nearest_reading(dec.layout.col_bits, column_map[i], unclear_col[i], ref_col,
+                                 dec.proj_width, &col) ||
                 (rows && (!neighbourhood_code(reason, row_map, x, y, &ref_row) ||
-                          !nearest_reading(row_map[i], unclear_row[i], ref_row, dec.proj_height,
-                                           &row))))
+                          !nearest_reading(dec.layout.row_bits, row_map[i], unclear_row[i],
+                                           ref_row, dec.proj_height, &row))))
                 continue;
-            column_map[i] = col;
-            row_map[i] = row;
+            if (pending) { /* not a reference of this pass: its maps can change now */
+                column_map[i] = col;
+                row_map[i] = row;
+                scratch[i] = SCAN_VALID;
+            } else if (col != column_map[i] || (rows && row != row_map[i])) {
+                unclear_col[i] = col;
+                unclear_row[i] = rows ? row : row_map[i];
+                scratch[i] = RESOLVE_CORRECTED;
+            }
+        }
+    }
+    size_t n = (size_t)w * h;
+    for (size_t i = 0; i < n; i++) {
+        if (scratch[i] == RESOLVE_CORRECTED) {
+            column_map[i] = unclear_col[i];
+            row_map[i] = unclear_row[i];
             scratch[i] = SCAN_VALID;
         }
     }
-    memcpy(reason, scratch, (size_t)w * h);
+    memcpy(reason, scratch, n);
 }
 
 static int codes_agree(const uint8_t *reason, size_t a, size_t b)
@@ -396,18 +426,19 @@ int decode_finish(uint8_t *reason, struct decode_maps *maps)
 
 /* ---- the plain reference: one pixel at a time, every frame ---- */
 
-static uint16_t reference_bits(const uint8_t *const *frames, uint32_t first, uint32_t bits,
-                               size_t i, int t, unsigned *unclear, int *both_saturated)
+static uint16_t reference_bits(const uint8_t *const *frames, uint32_t code, uint32_t first,
+                               uint32_t bits, size_t i, int t, unsigned *unclear,
+                               int *both_saturated)
 {
-    uint32_t gray = 0;
+    uint32_t word = 0;
     *unclear = 0;
     for (uint32_t k = 0; k < bits; k++) {
         int a = frames[first + 2u * k][i], b = frames[first + 2u * k + 1u][i];
-        gray = (gray << 1) | (a > b ? 1u : 0u);
+        word = (word << 1) | (a > b ? 1u : 0u);
         *unclear = (*unclear << 1) | (a - b <= t && b - a <= t);
         *both_saturated |= a == DECODE_SATURATED && b == DECODE_SATURATED;
     }
-    return (uint16_t)gray_decode(gray);
+    return (uint16_t)gray_code_value(code, bits, word);
 }
 
 void decode_reference(const struct scan_params *p, const struct gray_layout *l,
@@ -419,15 +450,18 @@ void decode_reference(const struct scan_params *p, const struct gray_layout *l,
         int white = frames[GRAY_PATTERN_WHITE][i], black = frames[GRAY_PATTERN_BLACK][i];
         int t = (int)decode_bit_threshold(p, (uint32_t)(white > black ? white - black : 0));
         int sat = 0;
-        column[i] = reference_bits(frames, GRAY_PATTERN_FIRST_BIT, l->col_bits, i, t, &unclear_c,
-                                   &sat);
+        column[i] = reference_bits(frames, l->code, GRAY_PATTERN_FIRST_BIT, l->col_bits, i, t,
+                                   &unclear_c, &sat);
         uint16_t r = 0;
         if (l->row_bits > 0)
-            r = reference_bits(frames, GRAY_PATTERN_FIRST_BIT + 2u * l->col_bits, l->row_bits, i,
-                               t, &unclear_r, &sat);
+            r = reference_bits(frames, l->code, GRAY_PATTERN_FIRST_BIT + 2u * l->col_bits,
+                               l->row_bits, i, t, &unclear_r, &sat);
         if (row != NULL)
             row[i] = r;
         int out = column[i] >= proj_width || (l->row_bits > 0 && r >= proj_height);
-        reason[i] = classify(p, white, black, sat, unclear_c, unclear_r, out);
+        reason[i] = classify(p, white, black, sat,
+                             unclear_count(unclear_c, gray_code_xor_mask(l->code, l->col_bits)),
+                             unclear_count(unclear_r, gray_code_xor_mask(l->code, l->row_bits)),
+                             out);
     }
 }

@@ -10,10 +10,20 @@
 #define GRAY_PATTERN_BLACK 1u
 #define GRAY_PATTERN_FIRST_BIT 2u
 
+/** How the bits of a coordinate are projected. */
+enum gray_code {
+    GRAY_CODE_GRAY = 0, /**< reflected binary Gray code, each bit its own stripes */
+    /** XOR-04 (Gupta et al. 2012): every bit coarser than bit 1 (stripes 4 wide) projected XOR
+     *  bit 1, so every pattern has fine stripes: light bounced between surfaces is about the same
+     *  under a pattern and its inverse and cannot flip a bit. One code set, no voting. */
+    GRAY_CODE_XOR04 = 1,
+};
+
 /** The stored sequence: white, black, each column bit and its inverse (most significant first),
  *  then, when row_bits > 0, each row bit and its inverse. */
 struct gray_layout {
     uint32_t col_bits, row_bits;
+    uint32_t code; /**< enum gray_code */
 };
 
 /** Layout for a projector; @p rows = 0 codes columns only. */
@@ -22,6 +32,14 @@ void gray_layout_for(uint32_t proj_width, uint32_t proj_height, int rows, struct
 uint32_t gray_layout_count(const struct gray_layout *l);
 /** Whether projector pixel (column, row) is lit in pattern @p index. @retval 1 lit, 0 dark */
 int gray_layout_lit(const struct gray_layout *l, uint32_t index, uint32_t column, uint32_t row);
+
+/** The word of pattern bits (bit b: the pattern of Gray bit b, 0 the finest) that @p code
+ *  projects for @p value, of @p bits bits: the Gray code, or its XOR-04 form. */
+uint32_t gray_code_word(uint32_t code, uint32_t bits, uint32_t value);
+/** The value whose word is @p word (the inverse of gray_code_word). */
+uint32_t gray_code_value(uint32_t code, uint32_t bits, uint32_t word);
+/** The pattern bits of @p code (of @p bits) that XOR-04 projects XOR its base bit: 0 for Gray. */
+uint32_t gray_code_xor_mask(uint32_t code, uint32_t bits);
 
 /** Bits needed to code @p proj_width columns. @retval bit count (1..16) */
 uint32_t gray_bits_for_width(uint32_t proj_width);

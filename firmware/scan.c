@@ -151,6 +151,7 @@ static int projector_start(const struct hal *hal, const struct scan_params *p, u
 void scan_layout(const struct scan_params *p, const struct scan_calib *c, struct gray_layout *l)
 {
     gray_layout_for(c->proj_width, c->proj_height, (int)p->decode_rows, l);
+    l->code = p->code;
 }
 
 int scan_begin_view(const struct scan_params *p, const struct scan_calib *c)

@@ -31,6 +31,7 @@ struct sim_config {
     double projector_intensity_dn, projector_black_level, projector_blur_px;
     double camera_blur_px;  /**< sigma of the camera lens's Gaussian point spread */
     uint32_t jpeg_quality;  /**< 1..100: every frame goes through a JPEG round trip; 0: off */
+    uint32_t bounce_samples; /**< one bounce of the projector's light: directions per point */
     double light_intensity_dn, light_diffuser_mm, reference_distance_mm;
     uint32_t reference_exposure_us;
     char rig_file[HAL_MAX_PATH]; /**< the true rig's geometry ("": the scan's calibration) */

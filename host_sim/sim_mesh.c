@@ -205,6 +205,87 @@ int sim_mesh_box(struct sim_mesh *m, double sx, double sy, double sz, uint32_t s
     return 0;
 }
 
+/* One face of the open corner: s[0] the side, s[1] 0 floor (z = 0), 1 back wall (x = -side/2),
+ * 2 side wall (y = -side/2). */
+static vec3 corner_face_fn(double u, double v, const double *s)
+{
+    double a = (u - 0.5) * s[0], b = (v - 0.5) * s[0], h = s[0];
+    if (s[1] == 0.0)
+        return v3(a, b, 0.0);
+    if (s[1] == 1.0)
+        return v3(-0.5 * h, a, (b / h + 0.5) * h);
+    return v3(a, -0.5 * h, (b / h + 0.5) * h);
+}
+
+/* One face of the groove: s[0] the side, s[1] 0 floor, 1 or 2 the walls, s[2] their half angle. */
+static vec3 groove_face_fn(double u, double v, const double *s)
+{
+    double h = s[0], a = (u - 0.5) * h, b = (v - 0.5) * h;
+    if (s[1] == 0.0)
+        return v3(a, b, 0.0);
+    double side = s[1] == 1.0 ? 1.0 : -1.0, r = u * h; /* from the groove's edge outwards */
+    return v3(-0.5 * h + r * cos(s[2]), side * r * sin(s[2]), (b / h + 0.5) * h);
+}
+
+int sim_mesh_groove(struct sim_mesh *m, double side, double opening_deg, uint32_t seg)
+{
+    uint32_t n = seg / 4 + 1;
+    int rc = mesh_alloc(m, 3 * grid_verts(n, n), 6 * n * n);
+    if (rc != 0)
+        return rc;
+    uint32_t vert = 0, tri = 0;
+    for (int face = 0; face < 3; face++) {
+        double s[3] = {side, face, 0.5 * opening_deg * M_PI / 180.0};
+        add_grid(m, &vert, &tri, n, n, groove_face_fn, s);
+    }
+    m->vert_count = vert;
+    m->tri_count = tri;
+    vec3 inside = v3(0.0, 0.0, 0.5 * side); /* in the groove, above the floor */
+    for (uint32_t t = 0; t < m->tri_count; t++) {
+        uint32_t *v = &m->tri[3 * t];
+        vec3 a = v3(m->pos[3 * v[0]], m->pos[3 * v[0] + 1], m->pos[3 * v[0] + 2]);
+        vec3 b = v3(m->pos[3 * v[1]], m->pos[3 * v[1] + 1], m->pos[3 * v[1] + 2]);
+        vec3 c = v3(m->pos[3 * v[2]], m->pos[3 * v[2] + 1], m->pos[3 * v[2] + 2]);
+        if (v3_dot(v3_cross(v3_sub(b, a), v3_sub(c, a)), v3_sub(inside, a)) < 0.0) {
+            uint32_t tmp = v[1];
+            v[1] = v[2];
+            v[2] = tmp;
+        }
+    }
+    sim_mesh_compute_normals(m);
+    return 0;
+}
+
+int sim_mesh_corner(struct sim_mesh *m, double side, uint32_t seg)
+{
+    uint32_t n = seg / 4 + 1;
+    int rc = mesh_alloc(m, 3 * grid_verts(n, n), 6 * n * n);
+    if (rc != 0)
+        return rc;
+    uint32_t vert = 0, tri = 0;
+    for (int face = 0; face < 3; face++) {
+        double s[2] = {side, face};
+        add_grid(m, &vert, &tri, n, n, corner_face_fn, s);
+    }
+    m->vert_count = vert;
+    m->tri_count = tri;
+    /* Every face towards the inside of the corner, where the camera and projector are. */
+    vec3 inside = v3(0.5 * side, 0.5 * side, 0.5 * side);
+    for (uint32_t t = 0; t < m->tri_count; t++) {
+        uint32_t *v = &m->tri[3 * t];
+        vec3 a = v3(m->pos[3 * v[0]], m->pos[3 * v[0] + 1], m->pos[3 * v[0] + 2]);
+        vec3 b = v3(m->pos[3 * v[1]], m->pos[3 * v[1] + 1], m->pos[3 * v[1] + 2]);
+        vec3 c = v3(m->pos[3 * v[2]], m->pos[3 * v[2] + 1], m->pos[3 * v[2] + 2]);
+        if (v3_dot(v3_cross(v3_sub(b, a), v3_sub(c, a)), v3_sub(inside, a)) < 0.0) {
+            uint32_t tmp = v[1];
+            v[1] = v[2];
+            v[2] = tmp;
+        }
+    }
+    sim_mesh_compute_normals(m);
+    return 0;
+}
+
 static vec3 torus_fn(double u, double v, const double *s)
 {
     double phi = 2.0 * M_PI * u, th = 2.0 * M_PI * v;

@@ -19,6 +19,13 @@ int sim_mesh_cylinder(struct sim_mesh *m, double radius_mm, double height_mm, ui
 /** A spray can: a cylinder of @p radius_mm whose top quarter narrows in a rounded shoulder. */
 int sim_mesh_can(struct sim_mesh *m, double radius_mm, double height_mm, uint32_t segments);
 int sim_mesh_box(struct sim_mesh *m, double sx_mm, double sy_mm, double sz_mm, uint32_t segments);
+/** An open box corner, concave: a floor and two walls of @p side_mm meeting at (-s/2, -s/2, 0),
+ *  facing +x, +y, +z (where the camera and projector are at table angle 0): light bounces
+ *  between its faces. */
+int sim_mesh_corner(struct sim_mesh *m, double side_mm, uint32_t segments);
+/** A V groove on a floor: two walls of @p side_mm meeting along a vertical edge at x = -s/2,
+ *  opening towards +x at @p opening_deg; deeply concave, its walls light each other. */
+int sim_mesh_groove(struct sim_mesh *m, double side_mm, double opening_deg, uint32_t segments);
 int sim_mesh_torus(struct sim_mesh *m, double major_mm, double minor_mm, uint32_t segments);
 /** Load an ASCII or binary little-endian PLY (vertex x y z, uchar red green blue when present,
  *  faces as lists; other properties are skipped). @param err out: what is wrong, with the file name @retval 0 ok @retval -EINVAL -ENOMEM

@@ -107,6 +107,10 @@ static int build_object(struct sim_rig *rig, const char *dir, char *err, size_t 
         rc = sim_mesh_can(&rig->mesh, 0.3 * h, h, c->segments);
     else if (strcmp(c->object, "box") == 0)
         rc = sim_mesh_box(&rig->mesh, 0.6 * h, 0.45 * h, h, c->segments);
+    else if (strcmp(c->object, "corner") == 0)
+        rc = sim_mesh_corner(&rig->mesh, h, c->segments);
+    else if (strcmp(c->object, "groove") == 0)
+        rc = sim_mesh_groove(&rig->mesh, h, 60.0, c->segments);
     else if (strcmp(c->object, "torus") == 0) /* lying flat: h is its outer diameter */
         rc = sim_mesh_torus(&rig->mesh, 0.36 * h, 0.14 * h, c->segments);
     else {
@@ -184,6 +188,20 @@ int sim_rig_init(struct sim_rig *rig, const struct sim_config *cfg, const struct
     rig->light_vis = calloc(n, 1);
     rig->gauss = calloc(GAUSS_TABLE, sizeof(float));
     rig->signal = calloc(n * 3, sizeof(float));
+    rig->bounce_w = (rig->width + SIM_BOUNCE_STEP - 1) / SIM_BOUNCE_STEP + 1;
+    rig->bounce_h = (rig->height + SIM_BOUNCE_STEP - 1) / SIM_BOUNCE_STEP + 1;
+    size_t samples = (size_t)rig->bounce_w * rig->bounce_h * cfg->bounce_samples;
+    if (samples > 0) {
+        rig->bounce_u = calloc(samples, sizeof(float));
+        rig->bounce_v = calloc(samples, sizeof(float));
+        rig->bounce_rad = calloc(samples * 3, sizeof(float));
+        rig->bounce_light = calloc((size_t)rig->bounce_w * rig->bounce_h * 3, sizeof(float));
+        if (!rig->bounce_u || !rig->bounce_v || !rig->bounce_rad || !rig->bounce_light) {
+            rc = -ENOMEM;
+            snprintf(err, len, "sim: out of memory for %u bounce samples", cfg->bounce_samples);
+            goto out_free;
+        }
+    }
     rig->blur_line = calloc((size_t)3 * (rig->width > rig->height ? rig->width : rig->height),
                             sizeof(float));
     if (!t->hit || !t->pos_cam || !t->normal_cam || !t->albedo || !t->proj_u || !t->proj_v || !t->proj_lit ||
@@ -215,6 +233,10 @@ void sim_rig_free(struct sim_rig *rig)
     free(rig->light_vis);
     free(rig->gauss);
     free(rig->signal);
+    free(rig->bounce_u);
+    free(rig->bounce_v);
+    free(rig->bounce_rad);
+    free(rig->bounce_light);
     free(rig->blur_line);
     sim_bvh_free(&rig->bvh);
     sim_mesh_free(&rig->mesh);
@@ -337,6 +359,42 @@ static void target_albedo(const struct sim_rig *rig, const struct frame_xform *o
     albedo[0] = albedo[1] = albedo[2] = a;
 }
 
+/* A surface point in both frames. */
+struct surface_point {
+    vec3 p_cam, n_cam, p_obj, n_obj;
+};
+
+/* Where @p sp falls in the projector image (u, v: NAN behind it), and the light it sends
+ * towards @p to_viewer (camera frame, unit) under the projector's full white, in grey levels.
+ * @retval 1 the projector lights it (in its image, facing it, not shadowed) @retval 0 not */
+static int projector_light(const struct sim_rig *rig, const struct surface_point *sp,
+                           vec3 proj_cam, vec3 proj_obj, const double albedo[3], vec3 to_viewer,
+                           double *u, double *v, double rad[3])
+{
+    const struct scan_calib *c = &rig->calib;
+    rad[0] = rad[1] = rad[2] = 0.0;
+    *u = *v = NAN;
+    vec3 pp = v3_add(m3_mul(c->proj_rot, sp->p_cam), v3_from(c->proj_trans_mm));
+    if (pp.z <= 0.0)
+        return 0;
+    double xd = pp.x / pp.z, yd = pp.y / pp.z;
+    if (!lens_is_pinhole(c->proj_dist))
+        lens_distort(c->proj_dist, pp.x / pp.z, pp.y / pp.z, &xd, &yd);
+    *u = c->proj_fx_px * xd + c->proj_cx_px;
+    *v = c->proj_fy_px * yd + c->proj_cy_px;
+    vec3 to_proj = v3_sub(proj_cam, sp->p_cam);
+    vec3 l = v3_norm(to_proj);
+    if (*u < -0.5 || *u >= c->proj_width - 0.5 || *v < -0.5 || *v >= c->proj_height - 0.5 ||
+        v3_dot(sp->n_cam, l) <= 0.0 || occluded(rig, sp->p_obj, sp->n_obj, proj_obj))
+        return 0;
+    double rho[3];
+    sim_material_eval(&rig->material, albedo, sp->n_cam, l, to_viewer, rho);
+    double e = rig->cfg.projector_intensity_dn * falloff(rig, v3_len(to_proj));
+    for (int k = 0; k < 3; k++)
+        rad[k] = e * rho[k];
+    return 1;
+}
+
 /* Cast the camera ray of pixel (x, y); fill truth and the projector's reflected light. */
 static void update_pixel(struct sim_rig *rig, const struct frame_xform *obj, vec3 cam_obj,
                          vec3 proj_cam, vec3 proj_obj, uint32_t x, uint32_t y)
@@ -384,31 +442,131 @@ static void update_pixel(struct sim_rig *rig, const struct frame_xform *obj, vec
         t->pos_cam[3 * i + k] = (float)(k == 0 ? p_cam.x : k == 1 ? p_cam.y : p_cam.z);
         t->normal_cam[3 * i + k] = (float)(k == 0 ? n_cam.x : k == 1 ? n_cam.y : n_cam.z);
     }
-    /* Where the point falls in the projector image. */
-    vec3 pp = v3_add(m3_mul(c->proj_rot, p_cam), v3_from(c->proj_trans_mm));
-    if (pp.z <= 0.0)
-        return;
-    double u = c->proj_fx_px * pp.x / pp.z + c->proj_cx_px;
-    double v = c->proj_fy_px * pp.y / pp.z + c->proj_cy_px;
-    if (!lens_is_pinhole(c->proj_dist)) {
-        double xd, yd;
-        lens_distort(c->proj_dist, pp.x / pp.z, pp.y / pp.z, &xd, &yd);
-        u = c->proj_fx_px * xd + c->proj_cx_px;
-        v = c->proj_fy_px * yd + c->proj_cy_px;
-    }
+    struct surface_point sp = {p_cam, n_cam, p_obj, n_obj};
+    double u, v, rad[3];
+    t->proj_lit[i] = (uint8_t)projector_light(rig, &sp, proj_cam, proj_obj, albedo,
+                                              v3_norm(v3_scale(p_cam, -1.0)), &u, &v, rad);
     t->proj_u[i] = (float)u;
     t->proj_v[i] = (float)v;
-    vec3 to_proj = v3_sub(proj_cam, p_cam);
-    vec3 l = v3_norm(to_proj);
-    if (u < -0.5 || u >= c->proj_width - 0.5 || v < -0.5 || v >= c->proj_height - 0.5 ||
-        v3_dot(n_cam, l) <= 0.0 || occluded(rig, p_obj, n_obj, proj_obj))
-        return;
-    t->proj_lit[i] = 1;
-    double rho[3];
-    sim_material_eval(&rig->material, albedo, n_cam, l, v3_norm(v3_scale(p_cam, -1.0)), rho);
-    double e = rig->cfg.projector_intensity_dn * falloff(rig, v3_len(to_proj));
     for (int k = 0; k < 3; k++)
-        rig->proj_radiance[3 * i + k] = (float)(e * rho[k]);
+        rig->proj_radiance[3 * i + k] = (float)rad[k];
+}
+
+static double pattern_light(const struct sim_rig *rig, uint32_t pattern, double u, double v);
+
+/* ---- one bounce of the projector's light between surfaces ([sim] bounce_samples) ---- */
+
+/* The surface point of a ray hit, object frame: position, shading normal. */
+static void hit_point(const struct sim_mesh *m, const struct sim_hit *hit, vec3 *p, vec3 *n)
+{
+    const uint32_t *tv = &m->tri[3 * hit->tri];
+    double w[3] = {1.0 - hit->u - hit->v, hit->u, hit->v};
+    *p = v3(0, 0, 0);
+    *n = v3(0, 0, 0);
+    for (int k = 0; k < 3; k++) {
+        const float *pn = &m->normal[3 * tv[k]], *pp = &m->pos[3 * tv[k]];
+        *n = v3_add(*n, v3_scale(v3(pn[0], pn[1], pn[2]), w[k]));
+        *p = v3_add(*p, v3_scale(v3(pp[0], pp[1], pp[2]), w[k]));
+    }
+    *n = v3_norm(*n);
+}
+
+/* For every grid point (every SIM_BOUNCE_STEP-th pixel each way) on the object: what the surface
+ * around it sees in bounce_samples cosine-weighted directions, where that is in the projector
+ * image and how much of the projector's full white it sends back (towards the grid point). Once
+ * per angle; sim_rig_render adds pattern x that, times the albedo, to every pixel. */
+static void bounce_update(struct sim_rig *rig, const struct frame_xform *obj, vec3 proj_cam,
+                          vec3 proj_obj)
+{
+    const uint32_t k_count = rig->cfg.bounce_samples;
+    uint64_t state = 0xb0b0ull ^ rig->cfg.seed;
+    for (uint32_t gy = 0; gy < rig->bounce_h; gy++)
+        for (uint32_t gx = 0; gx < rig->bounce_w; gx++) {
+            size_t g = (size_t)gy * rig->bounce_w + gx;
+            uint32_t x = gx * SIM_BOUNCE_STEP < rig->width ? gx * SIM_BOUNCE_STEP : rig->width - 1;
+            uint32_t y = gy * SIM_BOUNCE_STEP < rig->height ? gy * SIM_BOUNCE_STEP : rig->height - 1;
+            size_t i = (size_t)y * rig->width + x;
+            for (uint32_t k = 0; k < k_count; k++)
+                rig->bounce_u[g * k_count + k] = NAN;
+            if (!rig->truth.hit[i] || rig->target.kind != SIM_TARGET_OBJECT)
+                continue;
+            const float *pc = &rig->truth.pos_cam[3 * i], *nc = &rig->truth.normal_cam[3 * i];
+            vec3 p_cam = v3(pc[0], pc[1], pc[2]);
+            vec3 p_obj = frame_point(obj, p_cam), n_obj = frame_dir(obj, v3(nc[0], nc[1], nc[2]));
+            vec3 e1 = v3_norm(v3_cross(n_obj, fabs(n_obj.x) < 0.9 ? v3(1, 0, 0) : v3(0, 1, 0)));
+            vec3 e2 = v3_cross(n_obj, e1);
+            vec3 start = v3_add(p_obj, v3_scale(n_obj, 0.01));
+            for (uint32_t k = 0; k < k_count; k++) {
+                double phi = 2.0 * M_PI * sim_random_unit(&state), r2 = sim_random_unit(&state);
+                double sr = sqrt(r2); /* cosine-weighted: pdf cos / pi */
+                vec3 dir = v3_add(v3_add(v3_scale(e1, sr * cos(phi)), v3_scale(e2, sr * sin(phi))),
+                                  v3_scale(n_obj, sqrt(1.0 - r2)));
+                struct sim_hit hit;
+                if (!sim_bvh_intersect(&rig->bvh, start, dir, 1e-6, 1e9, &hit))
+                    continue;
+                struct surface_point q;
+                hit_point(&rig->mesh, &hit, &q.p_obj, &q.n_obj);
+                if (v3_dot(q.n_obj, dir) >= 0.0)
+                    continue; /* the back of a face */
+                q.p_cam = frame_point_inv(obj, q.p_obj);
+                q.n_cam = frame_dir_inv(obj, q.n_obj);
+                double albedo[3], u, v, rad[3];
+                sim_albedo_at(&rig->cfg, rig->object_height_mm,
+                              m3_tmul(rig->pose_rot, v3_sub(q.p_obj, rig->pose_shift)), albedo);
+                if (!projector_light(rig, &q, proj_cam, proj_obj, albedo,
+                                     v3_norm(v3_sub(p_cam, q.p_cam)), &u, &v, rad))
+                    continue;
+                rig->bounce_u[g * k_count + k] = (float)u;
+                rig->bounce_v[g * k_count + k] = (float)v;
+                for (int c = 0; c < 3; c++)
+                    rig->bounce_rad[3 * (g * k_count + k) + (size_t)c] = (float)(rad[c] / k_count);
+            }
+        }
+}
+
+/* This frame's bounced light at every grid point (before the receiving albedo). */
+static void bounce_frame(struct sim_rig *rig, uint32_t pattern)
+{
+    const uint32_t k_count = rig->cfg.bounce_samples;
+    size_t grid = (size_t)rig->bounce_w * rig->bounce_h;
+    for (size_t g = 0; g < grid; g++) {
+        double sum[3] = {0, 0, 0};
+        for (uint32_t k = 0; k < k_count; k++) {
+            size_t s = g * k_count + k;
+            if (isnan(rig->bounce_u[s]))
+                continue;
+            double p = pattern_light(rig, pattern, rig->bounce_u[s], rig->bounce_v[s]);
+            for (int c = 0; c < 3; c++)
+                sum[c] += p * rig->bounce_rad[3 * s + (size_t)c];
+        }
+        for (int c = 0; c < 3; c++)
+            rig->bounce_light[3 * g + (size_t)c] = (float)sum[c];
+    }
+}
+
+/* The bounced light at pixel (x, y): bilinear between the grid points that lie on the object. */
+static void bounce_at(const struct sim_rig *rig, uint32_t x, uint32_t y, double out[3])
+{
+    double fx = (double)x / SIM_BOUNCE_STEP, fy = (double)y / SIM_BOUNCE_STEP;
+    uint32_t gx = (uint32_t)fx, gy = (uint32_t)fy;
+    double ax = fx - gx, ay = fy - gy, wsum = 0.0;
+    out[0] = out[1] = out[2] = 0.0;
+    for (uint32_t dy = 0; dy <= 1; dy++)
+        for (uint32_t dx = 0; dx <= 1; dx++) {
+            uint32_t cx = gx + dx < rig->bounce_w ? gx + dx : rig->bounce_w - 1;
+            uint32_t cy = gy + dy < rig->bounce_h ? gy + dy : rig->bounce_h - 1;
+            uint32_t px = cx * SIM_BOUNCE_STEP < rig->width ? cx * SIM_BOUNCE_STEP : rig->width - 1;
+            uint32_t py = cy * SIM_BOUNCE_STEP < rig->height ? cy * SIM_BOUNCE_STEP : rig->height - 1;
+            if (!rig->truth.hit[(size_t)py * rig->width + px])
+                continue;
+            double w = (dx ? ax : 1.0 - ax) * (dy ? ay : 1.0 - ay);
+            size_t g = (size_t)cy * rig->bounce_w + cx;
+            for (int c = 0; c < 3; c++)
+                out[c] += w * rig->bounce_light[3 * g + (size_t)c];
+            wsum += w;
+        }
+    for (int c = 0; c < 3 && wsum > 0.0; c++)
+        out[c] /= wsum;
 }
 
 /* Camera frame to object frame at table angle @p angle_mdeg: the turntable's, and the object
@@ -432,6 +590,8 @@ void sim_rig_update(struct sim_rig *rig)
     for (uint32_t y = 0; y < rig->height; y++)
         for (uint32_t x = 0; x < rig->width; x++)
             update_pixel(rig, &obj, cam_obj, proj_cam, proj_obj, x, y);
+    if (rig->cfg.bounce_samples > 0)
+        bounce_update(rig, &obj, proj_cam, proj_obj);
     rig->truth_angle_mdeg = rig->table_angle_mdeg;
     rig->truth_valid = 1;
     rig->lights_done = 0;
@@ -531,6 +691,12 @@ static void render_signal(struct sim_rig *rig, const struct sim_sources *src, fl
                 for (int k = 0; k < 3; k++)
                     sig[k] += p * rig->proj_radiance[3 * i + k];
             }
+            if (src->projector_on && rig->cfg.bounce_samples > 0) { /* Lambertian receiver */
+                double b[3];
+                bounce_at(rig, (uint32_t)(i % rig->width), (uint32_t)(i / rig->width), b);
+                for (int k = 0; k < 3; k++)
+                    sig[k] += b[k] * al[k];
+            }
             for (uint32_t li = 0; lights != 0 && li < rig->calib.light_count; li++)
                 if (lights & (1u << li))
                     add_light(rig, i, li, sig);
@@ -592,6 +758,8 @@ void sim_rig_render(struct sim_rig *rig, const struct sim_sources *src, uint64_t
             ensure_light(rig, li);
     const struct sim_config *c = &rig->cfg;
     float *signal = rig->signal;
+    if (src->projector_on && c->bounce_samples > 0)
+        bounce_frame(rig, src->pattern_index);
     render_signal(rig, src, signal);
     if (c->camera_blur_px > 0.0)
         camera_blur(rig, signal);

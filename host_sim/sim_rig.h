@@ -32,6 +32,9 @@ struct sim_truth {
     uint8_t *dark;     /**< the point lies on the very dark paint */
 };
 
+/** Pixels between the points where one bounce of light is sampled (it varies slowly). */
+#define SIM_BOUNCE_STEP 4u
+
 struct sim_rig {
     struct sim_config cfg;
     struct scan_calib calib;
@@ -53,6 +56,11 @@ struct sim_rig {
     float *gauss;         /**< table of standard normal samples for the noise */
     float *signal;        /**< 3 per pixel: the frame being rendered, before gain and noise */
     float *blur_line;     /**< one row or column of signal, for the camera blur */
+    uint32_t bounce_w, bounce_h; /**< the bounce grid: every SIM_BOUNCE_STEP-th pixel */
+    float *bounce_u, *bounce_v;  /**< per grid point and sample: where the surface it sees is in
+                                      the projector image (NAN: nothing lit) */
+    float *bounce_rad;   /**< 3 per grid point and sample: that surface's light at full white */
+    float *bounce_light; /**< 3 per grid point: the bounced light of the frame being rendered */
     struct sim_target target;      /**< what stands on the table (SIM_TARGET_OBJECT: the object) */
     struct sim_sheet_frame sheet;  /**< a board's printed sheet, object frame */
     uint8_t *sheet_pixels;         /**< the rig's copy of the sheet */

@@ -45,11 +45,14 @@ static struct scan_params params(void)
 /* Pixel (x, y) sees projector column x; rows choose the surface: 0-3 normal, 4 shadow (no
  * projector light), 5 dark paint, 6 saturated wherever the projector lights it, 7 normal but
  * for pixel 30, saturated in every frame. */
+static uint32_t render_code = GRAY_CODE_GRAY; /* how the projector codes its columns */
+
 static void render(uint32_t pattern, uint32_t bits)
 {
+    struct gray_layout l = {bits, 0, render_code};
     for (uint32_t y = 0; y < H; y++) {
         for (uint32_t x = 0; x < W; x++) {
-            int lit = gray_pattern_lit(bits, pattern, x);
+            int lit = gray_layout_lit(&l, pattern, x, 0);
             double gain = y == 4 ? 0.0 : y == 5 ? 0.03 : 1.0;
             double v = 51.0 + gain * (lit ? 150.0 : 2.0);
             if ((y == 6 && lit) || (y == 7 && x == 30))
@@ -66,7 +69,7 @@ static struct decode_maps maps_out;
 
 static int begin(struct scan_params *p, uint32_t bits)
 {
-    struct gray_layout l = {bits, 0};
+    struct gray_layout l = {bits, 0, render_code};
     return decode_begin(p, &l, PROJ_W, 1);
 }
 
@@ -137,7 +140,7 @@ static void test_size_above_limit_rejected(void **state)
     assert_int_equal(begin(&p, 6), -EINVAL);
     p = params();
     assert_int_equal(begin(&p, 17), -EINVAL);
-    struct gray_layout too_many = {16, 16}; /* more patterns than the frame store holds */
+    struct gray_layout too_many = {16, 16, GRAY_CODE_GRAY}; /* more patterns than the frame store holds */
     assert_int_equal(decode_begin(&p, &too_many, PROJ_W, 1), -EINVAL);
 }
 
@@ -224,7 +227,7 @@ static void test_blocked_matches_reference(void **state)
     (void)state;
     uint32_t bits = gray_bits_for_width(PROJ_W);
     struct scan_params p = params();
-    struct gray_layout l = {bits, 0};
+    struct gray_layout l = {bits, 0, render_code};
     assert_int_equal(decode_begin(&p, &l, PROJ_W, 1), 0);
     feed_ambiguous_scene(bits);
     assert_int_equal(decode_pixels(reason_out, &maps_out), 0);
@@ -246,6 +249,16 @@ static void test_blocked_matches_reference(void **state)
     assert_true((kinds & 0x1Bu) == 0x1Bu);
 }
 
+/* XOR-04 decodes the same scene to the same columns and reasons, blocked and plain alike. */
+static void test_xor04_columns_and_reference(void **state)
+{
+    render_code = GRAY_CODE_XOR04;
+    test_columns_and_reasons(state);
+    test_ambiguous_bits(state);
+    test_blocked_matches_reference(state);
+    render_code = GRAY_CODE_GRAY;
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -257,6 +270,7 @@ int main(void)
         cmocka_unit_test(test_bit_threshold_from_noise),
         cmocka_unit_test(test_lone_wrong_code_inconsistent),
         cmocka_unit_test(test_blocked_matches_reference),
+        cmocka_unit_test(test_xor04_columns_and_reference),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

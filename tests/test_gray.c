@@ -48,12 +48,43 @@ static void test_patterns_code_every_column(void **state)
     }
 }
 
+/* XOR-04: every column's patterns read back to the column; no pattern has stripes wider than 4
+ * projector pixels but the base's own (the point: bounced light evens out under each); and
+ * across a base stripe edge only the base and the bits riding on it change. */
+static void test_xor04_codes_every_column_in_fine_stripes(void **state)
+{
+    (void)state;
+    const uint32_t width = 1024, bits = gray_bits_for_width(width);
+    struct gray_layout l = {bits, 0, GRAY_CODE_XOR04};
+    uint32_t longest_run[16] = {0}, run[16] = {0};
+    int last[16];
+    for (uint32_t c = 0; c < width; c++) {
+        uint32_t word = 0;
+        for (uint32_t k = 0; k < bits; k++) {
+            int pos = gray_layout_lit(&l, GRAY_PATTERN_FIRST_BIT + 2 * k, c, 0);
+            assert_int_equal(pos, !gray_layout_lit(&l, GRAY_PATTERN_FIRST_BIT + 2 * k + 1, c, 0));
+            word = (word << 1) | (uint32_t)pos;
+            run[k] = c > 0 && pos == last[k] ? run[k] + 1 : 1;
+            longest_run[k] = run[k] > longest_run[k] ? run[k] : longest_run[k];
+            last[k] = pos;
+        }
+        assert_int_equal(word, gray_code_word(GRAY_CODE_XOR04, bits, c));
+        assert_int_equal(gray_code_value(GRAY_CODE_XOR04, bits, word), c);
+        assert_int_equal(gray_code_value(GRAY_CODE_GRAY, bits, gray_encode(c)), c);
+    }
+    for (uint32_t k = 0; k + 1 < bits; k++) /* every pattern but the finest: stripes of 4 */
+        assert_true(longest_run[k] <= 4);
+    assert_int_equal(gray_code_xor_mask(GRAY_CODE_XOR04, bits), 0x3FCu);
+    assert_int_equal(gray_code_xor_mask(GRAY_CODE_GRAY, bits), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_bits_for_width),
         cmocka_unit_test(test_roundtrip_and_single_bit_steps),
         cmocka_unit_test(test_patterns_code_every_column),
+        cmocka_unit_test(test_xor04_codes_every_column_in_fine_stripes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

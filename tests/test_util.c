@@ -196,6 +196,9 @@ void test_measure_view(const struct sim_rig *rig, const struct scan_view *view,
             int correct = valid && fabs((double)maps->column[i] - floor(t->proj_u[i] + 0.5)) <= 1.0;
             q->lit++;
             q->lit_correct += (uint32_t)correct;
+            q->lit_valid += (uint32_t)valid;
+            q->lit_off += (uint32_t)(valid && !correct);
+            q->lit_wrong += (uint32_t)(valid && !correct && !near_column(rig, i, maps->column[i]));
             sum_dist += t->pos_cam[3 * i + 2];
             const float *pt = &t->pos_cam[3 * i], *nt = &t->normal_cam[3 * i];
             vec3 to_proj = v3_norm(v3_sub(proj, v3(pt[0], pt[1], pt[2])));

@@ -51,6 +51,9 @@ int scan_save_cloud_at_turntable_pose(struct test_rig *t, const struct scan_view
 struct view_quality {
     uint32_t lit;         /**< pixels where the projector lights the visible surface */
     uint32_t lit_correct; /**< of those: valid and column within +-1 of the truth */
+    uint32_t lit_valid;   /**< of lit: valid, right or not */
+    uint32_t lit_off;     /**< of lit: valid but more than +-1 column off */
+    uint32_t lit_wrong;   /**< of those: off every lit column of its 3x3 footprint */
     uint32_t lit_head_on; /**< lit pixels not on the very dark paint, incidence below 75 deg */
     uint32_t lit_head_on_correct;
     uint32_t lit_head_on_valid; /**< of lit_head_on: valid, right or not */

@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "gray.h"
 #include "test_util.h"
 
 static void scan_and_measure_with(const char *config, const char *object, struct view_quality *q)
@@ -134,6 +135,36 @@ static void test_dark_paint_with_hdr_and_highlights(void **state)
     assert_true(q.saturated_correct >= 0.8 * q.saturated);
 }
 
+static void groove_view(uint32_t code, struct view_quality *q)
+{
+    static struct test_rig t;
+    assert_int_equal(test_rig_load(&t, "config/sim-concave.ini"), 0);
+    snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "groove");
+    t.cfg.scan.code = code;
+    assert_int_equal(test_rig_start(&t), 0);
+    struct scan_view view;
+    struct scan_view_info info;
+    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), 0);
+    test_measure_view(sim_ctl_rig(), &view, q);
+    test_rig_stop(&t);
+    print_message("groove, %s: %.2f%% valid, %.3f%% wrong\n", code ? "XOR-04" : "Gray",
+                  100.0 * q->lit_valid / q->lit, 100.0 * q->lit_wrong / q->lit);
+}
+
+/* Interreflections (config/sim-concave.ini: a white 60-degree groove, the projector's light
+ * bounced once between its walls): plain Gray code reads coarse bits wrong where the other wall's
+ * bounced light outshines the direct light; XOR-04, every pattern in fine stripes, does not. */
+static void test_interreflection_gray_against_xor04(void **state)
+{
+    (void)state;
+    struct view_quality gray, xor04;
+    groove_view(GRAY_CODE_GRAY, &gray);
+    groove_view(GRAY_CODE_XOR04, &xor04);
+    assert_true(gray.lit_wrong > 0.05 * gray.lit); /* the scene does defeat Gray */
+    assert_true(xor04.lit_wrong <= 0.01 * xor04.lit);
+    assert_true(xor04.lit_valid >= 0.95 * xor04.lit);
+}
+
 /* The blocked decoder equals the plain per-pixel reference on real simulated frames, columns
  * and rows (42 patterns), pixel for pixel: column, row and reason. */
 static void test_blocked_decoder_matches_reference(void **state)
@@ -187,6 +218,7 @@ int main(void)
         cmocka_unit_test(test_bunny),
         cmocka_unit_test(test_sphere_at_the_cameras_limit),
         cmocka_unit_test(test_dark_paint_with_hdr_and_highlights),
+        cmocka_unit_test(test_interreflection_gray_against_xor04),
         cmocka_unit_test(test_blocked_decoder_matches_reference),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
