@@ -66,6 +66,10 @@ static const struct ini_key config_keys[] = {
         "read noise (standard deviation, grey levels) of the camera: the decoder's bit threshold"),
     F64("camera", "electrons_per_dn", scan.electrons_per_dn, 0, 10000, "20",
         "electrons per grey level (sets the shot noise; 0: read noise only)"),
+    U32("camera", "binning", camera.binning, 1, HAL_MAX_BINNING, "1",
+        "the sensor runs at binning x width by binning x height and each binning x binning "
+        "block becomes one pixel (their mean): a sensor larger than the compiled frame limit, "
+        "with less noise; width and height (and the calibration) are the binned frame's"),
     U32("camera", "capture_retries", scan.capture_retries, 0, 10, "2",
         "extra tries of a capture that timed out or came back corrupt"),
     U32("projector", "settle_us", scan.pattern_settle_us, 0, 1000000, "20000",
@@ -523,6 +527,13 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
         return -EINVAL;
     }
     cfg->scan.height = cfg->camera.height;
+    if (cfg->camera.binning > 1 && strcmp(cfg->camera_backend, "sim") == 0) {
+        snprintf(err, err_len,
+                 "%s: [camera] binning: the simulator renders at the calibration's size; binning "
+                 "is for a real camera (v4l2 or libcamera)",
+                 path);
+        return -EINVAL;
+    }
     if ((rc = config_exposures(cfg, path, err, err_len)) != 0)
         return rc;
     if (cfg->scan.shadow_contrast_dn >= cfg->scan.min_contrast_dn) {

@@ -15,6 +15,7 @@
 #include <linux/videodev2.h>
 
 #include "camera_v4l2.h"
+#include "hal_limits.h"
 #include "v4l2_frame.h"
 #ifdef HAVE_LIBCAMERA
 #include "camera_libcamera.h"
@@ -39,7 +40,7 @@ static void test_yuyv_to_rgb(void **state)
     /* two pixels per 4 bytes: Y0 U Y1 V */
     const uint8_t yuyv[] = {16, 128, 235, 128, 81, 90, 81, 240, 145, 54, 145, 34, 41, 240, 41, 110};
     uint8_t rgb[8 * 3];
-    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_YUYV, yuyv, sizeof(yuyv), 0, 4, 2, rgb, sizeof(rgb)),
+    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_YUYV, yuyv, sizeof(yuyv), 0, 4, 2, 1, rgb, sizeof(rgb)),
                      0);
     const uint8_t want[8][3] = {{0, 0, 0},   {255, 255, 255}, {255, 0, 0}, {255, 0, 0},
                                 {0, 255, 1}, {0, 255, 1},     {0, 0, 255}, {0, 0, 255}};
@@ -54,11 +55,11 @@ static void test_rows_with_padding_and_grey(void **state)
     /* 2 x 2 RGB24 with 8 bytes per line (2 of padding), then GREY with 4 per line */
     const uint8_t rgb_src[16] = {1, 2, 3, 4, 5, 6, 99, 99, 7, 8, 9, 10, 11, 12, 99, 99};
     uint8_t out[12];
-    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_RGB24, rgb_src, 14, 8, 2, 2, out, sizeof(out)), 0);
+    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_RGB24, rgb_src, 14, 8, 2, 2, 1, out, sizeof(out)), 0);
     const uint8_t want[12] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12};
     assert_memory_equal(out, want, sizeof(want));
     const uint8_t grey[8] = {10, 20, 0, 0, 30, 40, 0, 0};
-    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_GREY, grey, sizeof(grey), 4, 2, 2, out, sizeof(out)),
+    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_GREY, grey, sizeof(grey), 4, 2, 2, 1, out, sizeof(out)),
                      0);
     assert_int_equal(out[0], 10);
     assert_int_equal(out[2], 10);
@@ -66,16 +67,65 @@ static void test_rows_with_padding_and_grey(void **state)
     assert_int_equal(out[11], 40);
 }
 
+/* [camera] binning: a sensor frame twice the compiled frame limit each way, binned 2 x 2 into
+ * a frame the firmware takes, each pixel the rounded mean of its block; YUYV binned equals the
+ * unbinned conversion averaged; a binning above the limit or a short sensor frame refused. */
+static void test_binning_a_sensor_above_the_limit(void **state)
+{
+    (void)state;
+    const uint32_t w = HAL_MAX_WIDTH, h = 3, sw = 2 * w, sh = 2 * h;
+    uint8_t *grey = malloc((size_t)sw * sh), *out = malloc((size_t)w * h * 3);
+    assert_non_null(grey);
+    assert_non_null(out);
+    for (uint32_t y = 0; y < sh; y++)
+        for (uint32_t x = 0; x < sw; x++)
+            grey[(size_t)y * sw + x] = (uint8_t)((x * 7u + y * 31u) & 0xFFu);
+    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_GREY, grey, (size_t)sw * sh, sw, w, h, 2, out,
+                                 (size_t)w * h * 3), 0);
+    for (uint32_t y = 0; y < h; y++)
+        for (uint32_t x = 0; x < w; x++) {
+            uint32_t sum = 0;
+            for (uint32_t dy = 0; dy < 2; dy++)
+                for (uint32_t dx = 0; dx < 2; dx++)
+                    sum += grey[(size_t)(2 * y + dy) * sw + 2 * x + dx];
+            for (int c = 0; c < 3; c++)
+                assert_int_equal(out[3 * ((size_t)y * w + x) + (size_t)c], (sum + 2) / 4);
+        }
+    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_GREY, grey, (size_t)sw * sh - 1, sw, w, h, 2, out,
+                                 (size_t)w * h * 3), -EIO);
+    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_GREY, grey, (size_t)sw * sh, sw, w / 4, h / 3,
+                                 HAL_MAX_BINNING + 1, out, (size_t)w * h * 3), -EINVAL);
+    /* YUYV, 8 x 4 sensor pixels to 4 x 2 */
+    uint8_t yuyv[8 * 4 * 2], full[8 * 4 * 3], binned[4 * 2 * 3];
+    for (size_t k = 0; k < sizeof(yuyv); k++)
+        yuyv[k] = (uint8_t)(40 + (k * 37u) % 180u);
+    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_YUYV, yuyv, sizeof(yuyv), 16, 8, 4, 1, full,
+                                 sizeof(full)), 0);
+    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_YUYV, yuyv, sizeof(yuyv), 16, 4, 2, 2, binned,
+                                 sizeof(binned)), 0);
+    for (uint32_t y = 0; y < 2; y++)
+        for (uint32_t x = 0; x < 4; x++)
+            for (uint32_t c = 0; c < 3; c++) {
+                uint32_t sum = 0;
+                for (uint32_t dy = 0; dy < 2; dy++)
+                    for (uint32_t dx = 0; dx < 2; dx++)
+                        sum += full[3 * ((2 * y + dy) * 8 + 2 * x + dx) + c];
+                assert_int_equal(binned[3 * (y * 4 + x) + c], (sum + 2) / 4);
+            }
+    free(grey);
+    free(out);
+}
+
 static void test_short_frame_and_small_buffer(void **state)
 {
     (void)state;
     uint8_t src[64] = {0}, out[48];
     /* 4 x 4 YUYV needs 32 bytes; one byte short is a corrupt frame */
-    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_YUYV, src, 31, 8, 4, 4, out, sizeof(out)), -EIO);
-    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_YUYV, src, 32, 8, 4, 4, out, sizeof(out)), 0);
-    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_YUYV, src, 32, 8, 4, 4, out, 47), -ENOSPC);
-    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_MJPEG, src, 64, 0, 4, 4, out, sizeof(out)), -EINVAL);
-    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_YUYV, src, 64, 0, 3, 2, out, sizeof(out)), -EINVAL);
+    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_YUYV, src, 31, 8, 4, 4, 1, out, sizeof(out)), -EIO);
+    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_YUYV, src, 32, 8, 4, 4, 1, out, sizeof(out)), 0);
+    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_YUYV, src, 32, 8, 4, 4, 1, out, 47), -ENOSPC);
+    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_MJPEG, src, 64, 0, 4, 4, 1, out, sizeof(out)), -EINVAL);
+    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_YUYV, src, 64, 0, 3, 2, 1, out, sizeof(out)), -EINVAL);
     char text[5];
     assert_string_equal(v4l2_fourcc_text(v4l2_fourcc_of(HAL_PIX_YUYV), text), "YUYV");
 }
@@ -202,6 +252,7 @@ int main(void)
         cmocka_unit_test(test_yuyv_to_rgb),
         cmocka_unit_test(test_rows_with_padding_and_grey),
         cmocka_unit_test(test_short_frame_and_small_buffer),
+        cmocka_unit_test(test_binning_a_sensor_above_the_limit),
         cmocka_unit_test(test_controls_turn_automatics_off_first),
         cmocka_unit_test(test_controls_out_of_range_are_named),
         cmocka_unit_test(test_frame_start_from_timestamp),

@@ -24,6 +24,7 @@ struct hal_camera_config {
     uint32_t frame_timeout_ms; /**< a capture with no frame after this fails with -ETIMEDOUT */
     uint32_t red_gain_milli;   /**< fixed white-balance gain of red, 1000 = 1 (libcamera) */
     uint32_t blue_gain_milli;  /**< fixed white-balance gain of blue, 1000 = 1 (libcamera) */
+    uint32_t binning; /**< 1, or the sensor runs at binning x the frame's size, binned down */
 };
 
 /** One RGB24 frame in a caller-owned buffer of at least width * height * 3 bytes. */

@@ -19,6 +19,8 @@
 #define HAL_MAX_HEIGHT 1536u
 #endif
 #define HAL_MAX_PIXELS (HAL_MAX_WIDTH * HAL_MAX_HEIGHT)
+/* [camera] binning: a sensor frame up to this many times the frame, each way, binned down. */
+#define HAL_MAX_BINNING 4u
 /* White lights around the object (Jost et al. method 3 needs several). */
 #define HAL_MAX_LIGHTS 8u
 /* Projector columns are coded with at most 11 Gray-code bits (2048 columns). */

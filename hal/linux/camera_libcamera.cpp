@@ -89,12 +89,14 @@ int configure(camera_libcamera *cam, lc_state *s)
         return fail(cam, -EINVAL, "generateConfiguration", "no still capture configuration");
     StreamConfiguration &sc = s->config->at(0);
     sc.pixelFormat = want;
-    sc.size = Size(s->cfg.width, s->cfg.height);
+    const unsigned binning = s->cfg.binning > 1 ? s->cfg.binning : 1u;
+    const Size sensor(s->cfg.width * binning, s->cfg.height * binning); /* binned in software */
+    sc.size = sensor;
     sc.bufferCount = 1;
     if (s->config->validate() == CameraConfiguration::Invalid || sc.pixelFormat != want ||
-        sc.size != Size(s->cfg.width, s->cfg.height))
+        sc.size != sensor)
         return fail(cam, -EINVAL, "configure", "asked for %ux%u %s, the camera offers %s",
-                    (unsigned)s->cfg.width, (unsigned)s->cfg.height, want.toString().c_str(),
+                    (unsigned)sensor.width, (unsigned)sensor.height, want.toString().c_str(),
                     sc.toString().c_str());
     int rc = s->camera->configure(s->config.get());
     if (rc < 0)
@@ -208,7 +210,8 @@ int lc_capture(void *priv, hal_image *img)
     const FrameBuffer::Plane &plane = fb->planes().at(0);
     const uint8_t *pixels = static_cast<const uint8_t *>(s->map) + plane.offset;
     rc = v4l2_to_rgb(s->fourcc, pixels, md.planes()[0].bytesused, s->stride, s->cfg.width,
-                     s->cfg.height, img->rgb, img->capacity);
+                     s->cfg.height, s->cfg.binning > 1 ? s->cfg.binning : 1u, img->rgb,
+                     img->capacity);
     if (rc != 0)
         return fail(cam, rc, "capture", "frame %u: %s", md.sequence,
                     rc == -EIO ? "short frame" : "cannot convert to RGB");

@@ -75,22 +75,29 @@ static int set_controls(struct camera_v4l2 *cam, uint32_t exposure_us, uint32_t 
     return 0;
 }
 
+/* [camera] binning, 0 (unset) read as 1. */
+static uint32_t binning_of(const struct hal_camera_config *cfg)
+{
+    return cfg->binning > 1 ? cfg->binning : 1u;
+}
+
 static int set_format(struct camera_v4l2 *cam)
 {
     char want[5], got[5];
     struct v4l2_format f = {.type = V4L2_BUF_TYPE_VIDEO_CAPTURE};
-    f.fmt.pix.width = cam->cfg.width;
-    f.fmt.pix.height = cam->cfg.height;
+    const uint32_t w = cam->cfg.width * binning_of(&cam->cfg), h = cam->cfg.height * binning_of(&cam->cfg);
+    f.fmt.pix.width = w; /* the sensor's mode: the frame's size times the binning */
+    f.fmt.pix.height = h;
     f.fmt.pix.pixelformat = v4l2_fourcc_of(cam->cfg.pixel_format);
     f.fmt.pix.field = V4L2_FIELD_NONE;
     int rc = xioctl(cam->fd, VIDIOC_S_FMT, &f);
     if (rc != 0)
         return fail(cam, rc, "VIDIOC_S_FMT", NULL);
     /* Drivers adjust what they cannot do instead of failing: check what we got. */
-    if (f.fmt.pix.width != cam->cfg.width || f.fmt.pix.height != cam->cfg.height ||
+    if (f.fmt.pix.width != w || f.fmt.pix.height != h ||
         f.fmt.pix.pixelformat != v4l2_fourcc_of(cam->cfg.pixel_format))
         return fail(cam, -EINVAL, "VIDIOC_S_FMT", "asked for %ux%u %s, the device offers %ux%u %s",
-                    (unsigned)cam->cfg.width, (unsigned)cam->cfg.height,
+                    (unsigned)w, (unsigned)h,
                     v4l2_fourcc_text(v4l2_fourcc_of(cam->cfg.pixel_format), want),
                     (unsigned)f.fmt.pix.width, (unsigned)f.fmt.pix.height,
                     v4l2_fourcc_text(f.fmt.pix.pixelformat, got));
@@ -232,7 +239,8 @@ static int v4l2_capture(void *priv, struct hal_image *img)
     else if (b.index >= cam->buf_count)
         rc = fail(cam, -EIO, "VIDIOC_DQBUF", "buffer index %u out of range", (unsigned)b.index);
     else if ((rc = v4l2_to_rgb(cam->fourcc, cam->buf[b.index], b.bytesused, cam->bytes_per_line,
-                               cam->cfg.width, cam->cfg.height, img->rgb, img->capacity)) == -EIO)
+                               cam->cfg.width, cam->cfg.height, binning_of(&cam->cfg), img->rgb,
+                               img->capacity)) == -EIO)
         fail(cam, rc, "capture", "short frame %u: %u bytes", (unsigned)b.sequence,
              (unsigned)b.bytesused);
     else if (rc != 0)

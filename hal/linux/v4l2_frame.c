@@ -2,6 +2,8 @@
 #define _POSIX_C_SOURCE 200809L
 #include "v4l2_frame.h"
 
+#include "hal_limits.h"
+
 #include <errno.h>
 #include <time.h> /* struct timespec, which videodev2.h uses */
 #include <linux/videodev2.h>
@@ -64,33 +66,60 @@ static uint32_t bytes_per_pixel(uint32_t fourcc)
     return fourcc == V4L2_PIX_FMT_RGB24 ? 3u : fourcc == V4L2_PIX_FMT_YUYV ? 2u : 1u;
 }
 
+/* One row of @p width pixels of @p fourcc into RGB24. */
+static void row_to_rgb(uint32_t fourcc, const uint8_t *s, uint32_t width, uint8_t *d)
+{
+    if (fourcc == V4L2_PIX_FMT_RGB24) {
+        memcpy(d, s, (size_t)width * 3u);
+    } else if (fourcc == V4L2_PIX_FMT_GREY) {
+        for (uint32_t x = 0; x < width; x++)
+            d[3 * x] = d[3 * x + 1] = d[3 * x + 2] = s[x];
+    } else {
+        for (uint32_t x = 0; x < width; x += 2, s += 4, d += 6) { /* Y0 U Y1 V */
+            yuv_to_rgb(s[0], s[1], s[3], d);
+            yuv_to_rgb(s[2], s[1], s[3], d + 3);
+        }
+    }
+}
+
+/* Binning: one sensor row in RGB, and the sums of the binned row being built. */
+static uint8_t bin_row[HAL_MAX_WIDTH * HAL_MAX_BINNING * 3];
+static uint32_t bin_sum[HAL_MAX_WIDTH * 3];
+
 int v4l2_to_rgb(uint32_t fourcc, const uint8_t *src, size_t used, uint32_t bytes_per_line,
-                uint32_t width, uint32_t height, uint8_t *rgb, size_t rgb_cap)
+                uint32_t width, uint32_t height, uint32_t binning, uint8_t *rgb, size_t rgb_cap)
 {
     if (fourcc != V4L2_PIX_FMT_RGB24 && fourcc != V4L2_PIX_FMT_YUYV && fourcc != V4L2_PIX_FMT_GREY)
         return -EINVAL;
-    if (fourcc == V4L2_PIX_FMT_YUYV && width % 2u != 0u)
+    if (binning == 0 || binning > HAL_MAX_BINNING || (binning > 1 && width > HAL_MAX_WIDTH))
         return -EINVAL;
-    size_t row = (size_t)width * bytes_per_pixel(fourcc);
+    const uint32_t sensor_w = width * binning, sensor_h = height * binning;
+    if (fourcc == V4L2_PIX_FMT_YUYV && sensor_w % 2u != 0u)
+        return -EINVAL;
+    size_t row = (size_t)sensor_w * bytes_per_pixel(fourcc);
     size_t stride = bytes_per_line > row ? bytes_per_line : row;
     if ((size_t)width * height * 3u > rgb_cap)
         return -ENOSPC;
-    if (height == 0 || used < stride * (height - 1u) + row)
+    if (height == 0 || used < stride * (sensor_h - 1u) + row)
         return -EIO; /* the last row must be complete */
+    if (binning == 1) {
+        for (uint32_t y = 0; y < height; y++)
+            row_to_rgb(fourcc, src + stride * y, width, rgb + (size_t)width * 3u * y);
+        return 0;
+    }
+    /* b x b sensor pixels to one: their mean, rounded (the noise falls by b). */
+    const uint32_t count = binning * binning;
     for (uint32_t y = 0; y < height; y++) {
-        const uint8_t *s = src + stride * y;
-        uint8_t *d = rgb + (size_t)width * 3u * y;
-        if (fourcc == V4L2_PIX_FMT_RGB24) {
-            memcpy(d, s, row);
-        } else if (fourcc == V4L2_PIX_FMT_GREY) {
-            for (uint32_t x = 0; x < width; x++)
-                d[3 * x] = d[3 * x + 1] = d[3 * x + 2] = s[x];
-        } else {
-            for (uint32_t x = 0; x < width; x += 2, s += 4, d += 6) { /* Y0 U Y1 V */
-                yuv_to_rgb(s[0], s[1], s[3], d);
-                yuv_to_rgb(s[2], s[1], s[3], d + 3);
-            }
+        memset(bin_sum, 0, (size_t)width * 3u * sizeof(bin_sum[0]));
+        for (uint32_t r = 0; r < binning; r++) {
+            row_to_rgb(fourcc, src + stride * ((size_t)y * binning + r), sensor_w, bin_row);
+            for (uint32_t x = 0; x < sensor_w; x++)
+                for (uint32_t c = 0; c < 3; c++)
+                    bin_sum[3 * (x / binning) + c] += bin_row[3 * x + c];
         }
+        uint8_t *d = rgb + (size_t)width * 3u * y;
+        for (size_t k = 0; k < (size_t)width * 3u; k++)
+            d[k] = (uint8_t)((bin_sum[k] + count / 2u) / count);
     }
     return 0;
 }

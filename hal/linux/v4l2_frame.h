@@ -19,10 +19,15 @@ const char *v4l2_fourcc_text(uint32_t fourcc, char *buf);
 
 /** Convert one frame of @p fourcc (rows @p bytes_per_line apart, @p used bytes delivered) into
  *  packed RGB24. YUYV is BT.601 limited range, as UVC cameras send it; GREY is replicated.
+ *  @param width, height  the frame delivered to the firmware
+ *  @param binning  1, or the sensor frame is @p binning times as wide and high and each
+ *                  binning x binning block becomes one pixel, their mean ([camera] binning:
+ *                  a sensor above the compiled frame size, with less noise per pixel)
  *  @retval 0 ok @retval -EIO short frame (fewer bytes than the mode needs)
- *  @retval -ENOSPC @p rgb_cap too small @retval -EINVAL unknown format or odd YUYV width */
+ *  @retval -ENOSPC @p rgb_cap too small @retval -EINVAL unknown format, odd YUYV width or a
+ *  binning outside 1..HAL_MAX_BINNING */
 int v4l2_to_rgb(uint32_t fourcc, const uint8_t *src, size_t used, uint32_t bytes_per_line,
-                uint32_t width, uint32_t height, uint8_t *rgb, size_t rgb_cap);
+                uint32_t width, uint32_t height, uint32_t binning, uint8_t *rgb, size_t rgb_cap);
 
 /** When the exposure of a dequeued frame began, in microseconds of CLOCK_MONOTONIC (the HAL
  *  clock), from its timestamp. A start-of-exposure stamp is taken as it is; an end-of-frame
