@@ -142,8 +142,9 @@ static void test_controls_turn_automatics_off_first(void **state)
     (void)state;
     struct v4l2_ctrl_value plan[V4L2_PLAN_MAX];
     size_t n;
+    int fixed;
     char err[160];
-    assert_int_equal(v4l2_plan_controls(uvc, 6, 10000, 2000, plan, &n, err, sizeof(err)), 0);
+    assert_int_equal(v4l2_plan_controls(uvc, 6, 10000, 2000, plan, &n, &fixed, err, sizeof(err)), 0);
     assert_int_equal(n, 4);
     assert_int_equal(plan[0].id, V4L2_CID_EXPOSURE_AUTO);
     assert_int_equal(plan[0].value, V4L2_EXPOSURE_MANUAL);
@@ -160,14 +161,21 @@ static void test_controls_out_of_range_are_named(void **state)
     (void)state;
     struct v4l2_ctrl_value plan[V4L2_PLAN_MAX];
     size_t n;
+    int fixed;
     char err[160];
-    assert_int_equal(v4l2_plan_controls(uvc, 6, 300000, 1000, plan, &n, err, sizeof(err)), -ERANGE);
+    assert_int_equal(v4l2_plan_controls(uvc, 6, 300000, 1000, plan, &n, &fixed, err, sizeof(err)), -ERANGE);
     assert_non_null(strstr(err, "exposure 300000 us is outside the camera's 300..204700 us"));
-    assert_int_equal(v4l2_plan_controls(uvc, 6, 10000, 8000, plan, &n, err, sizeof(err)), -ERANGE);
+    assert_int_equal(v4l2_plan_controls(uvc, 6, 10000, 8000, plan, &n, &fixed, err, sizeof(err)), -ERANGE);
     assert_non_null(strstr(err, "gain"));
-    /* no manual exposure at all: not a camera the scanner can use */
-    assert_int_equal(v4l2_plan_controls(uvc, 3, 10000, 1000, plan, &n, err, sizeof(err)), -ENOTSUP);
+    /* an automatic exposure with no manual one: not a camera the scanner can use */
+    assert_int_equal(v4l2_plan_controls(uvc, 3, 10000, 1000, plan, &n, &fixed, err, sizeof(err)), -ENOTSUP);
     assert_non_null(strstr(err, "no manual exposure"));
+    /* no exposure control at all (vivid, a fixed-exposure module): its own, fixed */
+    assert_int_equal(v4l2_plan_controls(uvc + 1, 2, 10000, 1000, plan, &n, &fixed, err,
+                                        sizeof(err)), 0);
+    assert_int_equal(fixed, 1);
+    assert_int_equal(n, 1); /* white balance off; no exposure, no gain to set */
+    assert_int_equal(plan[0].id, V4L2_CID_AUTO_WHITE_BALANCE);
 }
 
 /* The start of exposure, which the firmware compares with when a pattern had settled: never

@@ -62,9 +62,17 @@ static int set_controls(struct camera_v4l2 *cam, uint32_t exposure_us, uint32_t 
         info[k].step = q.step;
         info[k].default_value = q.default_value;
     }
-    int rc = v4l2_plan_controls(info, n, exposure_us, gain_milli, plan, &count, why, sizeof(why));
+    int fixed;
+    int rc = v4l2_plan_controls(info, n, exposure_us, gain_milli, plan, &count, &fixed, why,
+                                sizeof(why));
     if (rc != 0)
         return fail(cam, rc, "controls", "%s", why);
+    if (fixed && !cam->exposure_fixed && cam->log != NULL)
+        cam->log(HAL_LOG_WARN,
+                 "camera %s: no exposure control; its own fixed exposure is used, exposure_us "
+                 "is not applied (and HDR or colour frames at other exposures cannot be taken)",
+                 cam->cfg.device);
+    cam->exposure_fixed = fixed;
     for (size_t k = 0; k < count; k++) {
         struct v4l2_control c = {.id = plan[k].id, .value = plan[k].value};
         rc = xioctl(cam->fd, VIDIOC_S_CTRL, &c);
@@ -260,6 +268,8 @@ static int v4l2_set_exposure(void *priv, uint32_t exposure_us, uint32_t gain_mil
     struct camera_v4l2 *cam = priv;
     if (cam->fd < 0)
         return fail(cam, -ENODEV, "set_exposure", "camera not open");
+    if (cam->exposure_fixed && exposure_us != cam->cfg.exposure_us)
+        return fail(cam, -ENOSYS, "set_exposure", "the device has no exposure control");
     int rc = set_controls(cam, exposure_us, gain_milli);
     if (rc == 0) { /* the start of exposure of the frames that follow depends on it */
         cam->cfg.exposure_us = exposure_us;

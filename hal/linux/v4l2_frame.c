@@ -153,10 +153,11 @@ static void add(struct v4l2_ctrl_value *out, size_t *count, uint32_t id, int32_t
 
 int v4l2_plan_controls(const struct v4l2_ctrl_info *info, size_t info_count, uint32_t exposure_us,
                        uint32_t gain_milli, struct v4l2_ctrl_value out[V4L2_PLAN_MAX],
-                       size_t *out_count, char *err, size_t err_len)
+                       size_t *out_count, int *exposure_fixed, char *err, size_t err_len)
 {
     const struct v4l2_ctrl_info *c;
     *out_count = 0;
+    *exposure_fixed = 0;
     /* Automatics first: while auto exposure is on, most drivers refuse a manual exposure. */
     if ((c = find(info, info_count, V4L2_CID_EXPOSURE_AUTO)) != NULL)
         add(out, out_count, c->id, V4L2_EXPOSURE_MANUAL, "exposure_auto");
@@ -164,17 +165,22 @@ int v4l2_plan_controls(const struct v4l2_ctrl_info *info, size_t info_count, uin
         add(out, out_count, c->id, 0, "autogain");
     if ((c = find(info, info_count, V4L2_CID_AUTO_WHITE_BALANCE)) != NULL)
         add(out, out_count, c->id, 0, "white_balance_automatic");
-    if ((c = find(info, info_count, V4L2_CID_EXPOSURE_ABSOLUTE)) == NULL) {
+    c = find(info, info_count, V4L2_CID_EXPOSURE_ABSOLUTE);
+    if (c == NULL && find(info, info_count, V4L2_CID_EXPOSURE_AUTO) != NULL) {
         snprintf(err, err_len, "no manual exposure control (exposure_time_absolute)");
-        return -ENOTSUP;
+        return -ENOTSUP; /* an automatic exposure that cannot be fixed would drift */
     }
-    int64_t units = ((int64_t)exposure_us + 50) / 100; /* the control counts 100 us */
-    if (units < c->minimum || units > c->maximum) {
-        snprintf(err, err_len, "exposure %u us is outside the camera's %d..%d us",
-                 (unsigned)exposure_us, (int)c->minimum * 100, (int)c->maximum * 100);
-        return -ERANGE;
+    if (c == NULL) {
+        *exposure_fixed = 1; /* no exposure control at all: the device's own, fixed */
+    } else {
+        int64_t units = ((int64_t)exposure_us + 50) / 100; /* the control counts 100 us */
+        if (units < c->minimum || units > c->maximum) {
+            snprintf(err, err_len, "exposure %u us is outside the camera's %d..%d us",
+                     (unsigned)exposure_us, (int)c->minimum * 100, (int)c->maximum * 100);
+            return -ERANGE;
+        }
+        add(out, out_count, c->id, (int32_t)units, "exposure_time_absolute");
     }
-    add(out, out_count, c->id, (int32_t)units, "exposure_time_absolute");
     c = find(info, info_count, V4L2_CID_ANALOGUE_GAIN);
     if (c == NULL)
         c = find(info, info_count, V4L2_CID_GAIN);

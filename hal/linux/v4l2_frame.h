@@ -56,15 +56,18 @@ struct v4l2_ctrl_value {
 #define V4L2_PLAN_MAX 6
 
 /** The controls that give repeatable frames: auto exposure, auto gain and auto white balance
- *  off where the driver has them, manual exposure (V4L2_CID_EXPOSURE_ABSOLUTE, 100 us units,
- *  required) and the gain (analogue gain if present, else gain; @p gain_milli 1000 = the
- *  driver's default), in the order they must be set.
+ *  off where the driver has them, manual exposure (V4L2_CID_EXPOSURE_ABSOLUTE, 100 us units)
+ *  and the gain (analogue gain if present, else gain; @p gain_milli 1000 = the driver's
+ *  default), in the order they must be set. A device with no exposure control at all (neither
+ *  manual nor automatic: a test pattern generator, a fixed-exposure module) is usable at its
+ *  own fixed exposure; one with only an automatic exposure is not.
  *  @param info  what the driver has, looked up by id (v4l2_plan_ids() lists the ids to query)
- *  @retval 0 ok @retval -ENOTSUP no manual exposure @retval -ERANGE exposure or gain out of
- *  the driver's range; @p err says which and the range */
+ *  @param exposure_fixed  out: 1 when the device has no exposure control (exposure_us unused)
+ *  @retval 0 ok @retval -ENOTSUP an automatic exposure without a manual one
+ *  @retval -ERANGE exposure or gain out of the driver's range; @p err says which and the range */
 int v4l2_plan_controls(const struct v4l2_ctrl_info *info, size_t info_count, uint32_t exposure_us,
                        uint32_t gain_milli, struct v4l2_ctrl_value out[V4L2_PLAN_MAX],
-                       size_t *out_count, char *err, size_t err_len);
+                       size_t *out_count, int *exposure_fixed, char *err, size_t err_len);
 
 /** The control ids v4l2_plan_controls() looks at. @retval their count */
 size_t v4l2_plan_ids(const uint32_t **ids);
