@@ -110,7 +110,7 @@ FW_OBJ := $(call obj,$(FW_SRC))
 HOST_OBJ := $(call obj,$(POSIX_SRC) $(APP_LIB_SRC) $(BOARD_SRC)) $(if $(filter linux,$(HAL)),$(LIBCAMERA_OBJ),)
 MAIN_OBJ := $(call obj,app/main.c)
 
-.PHONY: seccomp-tool all deps test-deps test test-run run-complete linux-build small-build install check-stack size fuzz errors-doc test-arm64 test-arm64-full test-gpio-chip arm64-check-elf arm64-run-tests run clean format docs check-firmware bench measure measure-scan interop-meshlab bench-callgrind eval calibrate-demo measure-calib
+.PHONY: seccomp-tool vivid-tool all deps test-deps test test-run run-complete linux-build small-build install check-stack size fuzz errors-doc test-arm64 test-arm64-full test-gpio-chip arm64-check-elf arm64-run-tests run clean format docs check-firmware bench measure measure-scan interop-meshlab bench-callgrind eval calibrate-demo measure-calib
 SIM_TOOLS := $(if $(filter sim,$(HAL)),$(BUILD)/turntable-sim $(BUILD)/tt-client $(BUILD)/mesh-compare $(BUILD)/colour-eval,)
 all: deps $(BUILD)/scanner $(CALIB_TOOL) $(SIM_TOOLS)
 
@@ -167,6 +167,10 @@ $(BUILD)/seccomp-run: tests/seccomp_run.c | deps
 	@mkdir -p $(dir $@)
 	$(CC) $(WARN) $(OPT) -g -o $@ $< $(shell $(PKG_CONFIG) --libs libseccomp 2>/dev/null)
 seccomp-tool: $(BUILD)/seccomp-run
+# The V4L2 backend against vivid in the arm64 VM (tests/gpio_chip.sh); HAL=linux builds.
+$(BUILD)/vivid-capture: $(call obj,tests/vivid_capture.c hal/linux/camera_v4l2.c hal/linux/v4l2_frame.c) $(BUILD)/libfirmware.a
+	$(CC) $(LDFLAGS_COMMON) -o $@ $^ -lm
+vivid-tool: $(BUILD)/vivid-capture
 
 $(BUILD)/mesh-compare: $(call obj,tests/mesh_compare.c tests/mesh_compare_lib.c host_sim/sim_bvh.c host_sim/sim_mesh.c host_sim/sim_ply_read.c app/config.c app/ini_schema.c app/scan_dir.c hal/posix/image_io.c) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON)
@@ -270,7 +274,7 @@ test-deps: deps
 test: deps test-deps
 	@$(MAKE) --no-print-directory test-run
 test-run: $(BUILD)/scanner $(CALIB_TOOL) $(SIM_TOOLS) $(BUILD)/seccomp-run $(TEST_BIN) $(FUZZ_REPLAY) check-firmware $(if $(filter 0,$(SAN)),check-stack,) linux-build small-build
-	@RUN_WITH="$(VALGRIND_RUN)" BUILD=$(BUILD) tests/run.sh $(TEST_BIN) tests/layers.sh tests/cli.sh tests/calibrate.sh tests/interop.sh tests/fuzz/replay.sh tests/resume.sh
+	@RUN_WITH="$(VALGRIND_RUN)" BUILD=$(BUILD) tests/run.sh $(TEST_BIN) tests/layers.sh tests/interop.sh tests/fuzz/replay.sh tests/resume.sh -- tests/cli.sh tests/calibrate.sh
 
 # make test VALGRIND=1: every cmocka test under valgrind memcheck; any invalid access,
 # uninitialised use or definite leak fails the test (exit code 99).
@@ -300,7 +304,7 @@ test-gpio-chip:
 	@{ command -v qemu-system-aarch64 && command -v cpio && command -v systemd-analyze; } >/dev/null 2>&1 || scripts/install-deps.sh gpio-chip
 	@$(MAKE) --no-print-directory $(ARM64) HAL=linux all
 	@$(MAKE) --no-print-directory $(ARM64) HAL=linux LIMITS=small all
-	@$(MAKE) --no-print-directory $(ARM64) HAL=linux seccomp-tool
+	@$(MAKE) --no-print-directory $(ARM64) HAL=linux seccomp-tool vivid-tool
 	@tests/run.sh tests/gpio_chip.sh
 arm64-check-elf: $(BUILD)/scanner
 	@$(CROSS_COMPILE)readelf -h $< | grep -q 'Machine: *AArch64' && echo "$<: AArch64 ELF"

@@ -173,6 +173,23 @@ static vec3 box_face_fn(double u, double v, const double *s)
     return v3(p.x * s[0], p.y * s[1], (p.z + 0.5) * s[2]);
 }
 
+/* Wind every triangle so that its normal points away from @p point (@p sign 1) or towards it
+ * (-1): grids of different faces do not wind alike. */
+static void orient_faces(struct sim_mesh *m, vec3 point, double sign)
+{
+    for (uint32_t t = 0; t < m->tri_count; t++) {
+        uint32_t *v = &m->tri[3 * t];
+        vec3 a = v3(m->pos[3 * v[0]], m->pos[3 * v[0] + 1], m->pos[3 * v[0] + 2]);
+        vec3 b = v3(m->pos[3 * v[1]], m->pos[3 * v[1] + 1], m->pos[3 * v[1] + 2]);
+        vec3 c = v3(m->pos[3 * v[2]], m->pos[3 * v[2] + 1], m->pos[3 * v[2] + 2]);
+        if (sign * v3_dot(v3_cross(v3_sub(b, a), v3_sub(c, a)), v3_sub(a, point)) < 0.0) {
+            uint32_t tmp = v[1];
+            v[1] = v[2];
+            v[2] = tmp;
+        }
+    }
+}
+
 int sim_mesh_box(struct sim_mesh *m, double sx, double sy, double sz, uint32_t seg)
 {
     uint32_t n = seg / 4 + 1;
@@ -189,18 +206,7 @@ int sim_mesh_box(struct sim_mesh *m, double sx, double sy, double sz, uint32_t s
     m->vert_count = vert;
     m->tri_count = tri;
     /* Winding of the grids is not uniform across faces: orient each triangle outwards. */
-    for (uint32_t t = 0; t < m->tri_count; t++) {
-        uint32_t *v = &m->tri[3 * t];
-        vec3 a = v3(m->pos[3 * v[0]], m->pos[3 * v[0] + 1], m->pos[3 * v[0] + 2]);
-        vec3 b = v3(m->pos[3 * v[1]], m->pos[3 * v[1] + 1], m->pos[3 * v[1] + 2]);
-        vec3 c = v3(m->pos[3 * v[2]], m->pos[3 * v[2] + 1], m->pos[3 * v[2] + 2]);
-        vec3 centre = v3(0, 0, 0.5 * sz);
-        if (v3_dot(v3_cross(v3_sub(b, a), v3_sub(c, a)), v3_sub(a, centre)) < 0.0) {
-            uint32_t tmp = v[1];
-            v[1] = v[2];
-            v[2] = tmp;
-        }
-    }
+    orient_faces(m, v3(0, 0, 0.5 * sz), 1.0);
     sim_mesh_compute_normals(m);
     return 0;
 }
@@ -240,18 +246,7 @@ int sim_mesh_groove(struct sim_mesh *m, double side, double opening_deg, uint32_
     }
     m->vert_count = vert;
     m->tri_count = tri;
-    vec3 inside = v3(0.0, 0.0, 0.5 * side); /* in the groove, above the floor */
-    for (uint32_t t = 0; t < m->tri_count; t++) {
-        uint32_t *v = &m->tri[3 * t];
-        vec3 a = v3(m->pos[3 * v[0]], m->pos[3 * v[0] + 1], m->pos[3 * v[0] + 2]);
-        vec3 b = v3(m->pos[3 * v[1]], m->pos[3 * v[1] + 1], m->pos[3 * v[1] + 2]);
-        vec3 c = v3(m->pos[3 * v[2]], m->pos[3 * v[2] + 1], m->pos[3 * v[2] + 2]);
-        if (v3_dot(v3_cross(v3_sub(b, a), v3_sub(c, a)), v3_sub(inside, a)) < 0.0) {
-            uint32_t tmp = v[1];
-            v[1] = v[2];
-            v[2] = tmp;
-        }
-    }
+    orient_faces(m, v3(0.0, 0.0, 0.5 * side), -1.0); /* towards the groove, above the floor */
     sim_mesh_compute_normals(m);
     return 0;
 }
@@ -270,18 +265,7 @@ int sim_mesh_corner(struct sim_mesh *m, double side, uint32_t seg)
     m->vert_count = vert;
     m->tri_count = tri;
     /* Every face towards the inside of the corner, where the camera and projector are. */
-    vec3 inside = v3(0.5 * side, 0.5 * side, 0.5 * side);
-    for (uint32_t t = 0; t < m->tri_count; t++) {
-        uint32_t *v = &m->tri[3 * t];
-        vec3 a = v3(m->pos[3 * v[0]], m->pos[3 * v[0] + 1], m->pos[3 * v[0] + 2]);
-        vec3 b = v3(m->pos[3 * v[1]], m->pos[3 * v[1] + 1], m->pos[3 * v[1] + 2]);
-        vec3 c = v3(m->pos[3 * v[2]], m->pos[3 * v[2] + 1], m->pos[3 * v[2] + 2]);
-        if (v3_dot(v3_cross(v3_sub(b, a), v3_sub(c, a)), v3_sub(inside, a)) < 0.0) {
-            uint32_t tmp = v[1];
-            v[1] = v[2];
-            v[2] = tmp;
-        }
-    }
+    orient_faces(m, v3(0.5 * side, 0.5 * side, 0.5 * side), -1.0);
     sim_mesh_compute_normals(m);
     return 0;
 }

@@ -6,12 +6,16 @@
 # and its holder; afterwards the kernel shows no line left requested by the scanner. Twice: the
 # default build on a 1 GB machine, the LIMITS=small build on a 512 MB one (where the default
 # build cannot start). Run by `make test-gpio-chip`, which cross-builds both.
+# The same VM (default build) loads vivid, the kernel's virtual video driver, and runs the V4L2
+# backend on it (tests/vivid_capture.c: format, the mmap ring, drop_frames, frame timestamps,
+# binning, a timeout when frames stop) and the selftest with it as the rig's camera.
 # Ends with cmocka's summary lines so that tests/run.sh counts it.
 set -eu
 cd "$(dirname "$0")/.."
 SCANNER=${SCANNER:-build/aarch64-linux-gnu/linux/scanner}
 SCANNER_SMALL=${SCANNER_SMALL:-build/aarch64-linux-gnu/small/linux/scanner}
 SECCOMP_RUN=${SECCOMP_RUN:-build/aarch64-linux-gnu/linux/seccomp-run}
+VIVID_CAPTURE=${VIVID_CAPTURE:-build/aarch64-linux-gnu/linux/vivid-capture}
 WORK=${WORK:-build/gpio-chip}
 TRIPLET=aarch64-linux-gnu
 for tool in qemu-system-aarch64 cpio "$TRIPLET-readelf"; do
@@ -48,6 +52,21 @@ cp "$WORK/unpacked/bin/busybox" "$R/bin/"
 cp "$SCANNER" "$R/bin/scanner-default"
 cp "$SCANNER_SMALL" "$R/bin/scanner-small"
 cp "$WORK/unpacked/usr/bin/gpioset" "$WORK/unpacked/usr/bin/gpioinfo" "$R/bin/"
+cp "$VIVID_CAPTURE" "$R/bin/vivid-capture"
+# vivid and the modules it needs, in an order that loads each after what it depends on (the
+# package ships no modules.dep: each module names its own in its .modinfo).
+MODDIR=$(ls -d "$WORK"/unpacked/lib/modules/* | head -n 1)
+mkdir -p "$R/lib/modules"
+: > "$R/lib/modules/order"
+add_module() { # module name, as depends= writes it
+    f=$(find "$MODDIR" -name "$1.ko" -o -name "$(echo "$1" | tr _ -).ko" | head -n 1)
+    [ -n "$f" ] || { echo "gpio_chip: no kernel module $1" >&2; exit 1; }
+    grep -qx "$(basename "$f" .ko)" "$R/lib/modules/order" && return 0
+    cp "$f" "$R/lib/modules/"
+    for dep in $(strings "$f" | sed -n 's/^depends=//p' | tr , ' '); do add_module "$dep"; done
+    basename "$f" .ko >> "$R/lib/modules/order"
+}
+add_module vivid
 # The installed unit's system-call filter, and a runner that enforces it (tests/seccomp_run.c).
 cp "$SECCOMP_RUN" "$R/bin/seccomp-run"
 scripts/syscall-list.sh config/deploy/scanner@.service > "$R/etc/scanner/syscalls"
@@ -75,7 +94,8 @@ copy_libs() { # every library an ELF needs, recursively
     done
 }
 for elf in "$R/bin/scanner-default" "$R/bin/scanner-small" "$R/bin/gpioset" "$R/bin/gpioinfo" \
-    "$R/bin/seccomp-run" "$R/bin/udevadm" "$R"/usr/lib/$TRIPLET/systemd/libsystemd-shared-*.so; do
+    "$R/bin/seccomp-run" "$R/bin/udevadm" "$R/bin/vivid-capture" \
+    "$R"/usr/lib/$TRIPLET/systemd/libsystemd-shared-*.so; do
     copy_libs "$elf"
 done
 cp -L "/usr/lib/$TRIPLET/ld-linux-aarch64.so.1" "$R/lib/ld-linux-aarch64.so.1"
@@ -114,6 +134,18 @@ sleep 1
 echo "== selftest, line 6 held"; scanner selftest --config /etc/scanner/rig.ini 2>&1
 echo "== gpioinfo after"; gpioinfo
 kill $holder
+if [ "$build" = default ]; then
+    echo "== vivid"
+    for m in $(cat /lib/modules/order); do insmod /lib/modules/$m.ko || echo "insmod $m failed"; done
+    for d in /sys/class/video4linux/video*; do
+        grep -q 'vid-cap' "$d/name" 2>/dev/null && dev=/dev/${d##*/} && break
+    done
+    echo "capture node ${dev:-none}"
+    echo "== vivid capture"; vivid-capture "$dev" 2>&1
+    echo "== selftest, vivid as the camera"
+    sed "s|^device = .*|device = $dev|" /etc/scanner/rig.ini > /tmp/vivid.ini
+    scanner selftest --config /tmp/vivid.ini 2>&1
+fi
 echo "== done"
 poweroff -f
 EOF
@@ -173,6 +205,19 @@ boot() { # memory in MB, the build the checks run
 
 boot 1024 default
 check "the default build starts" "default build starts" "^scanner .*HAL=linux" "^exit 0$"
+check "vivid loads and makes a capture node" "vivid" "^capture node /dev/video[0-9]+$" "!failed"
+check "V4L2 on vivid: format negotiated, streaming" "vivid capture" "^open 640x480 yuyv: ok$" \
+    "^frame 5: 640x480 sequence"
+check "V4L2 on vivid: no exposure control, its own used, others refused" "vivid capture" \
+    "no exposure control; its own fixed exposure is used" "^other exposure: refused"
+check "V4L2 on vivid: queued frames and drop_frames skipped, timestamps, the picture" \
+    "vivid capture" "^frames: 6, smallest sequence step ([3-9]|[1-9][0-9]+) \(drop_frames 2\), timestamps ok, test pattern seen$"
+check "V4L2 on vivid: a 1280x720 sensor binned 2x2" "vivid capture" \
+    "^open 1280x720 binned to 640x360: ok$" "^binned frame: ok 640x360$"
+check "V4L2 on vivid: a timeout when frames stop" "vivid capture" \
+    "^no frames \(control set\): timed out after [0-9]+ ms$" "^done$"
+check "the selftest with vivid as the camera" "selftest, vivid as the camera" \
+    "^camera +/dev/video[0-9]+ +ok +v4l2 frame 1280x720"
 # 512 MB: the default build's 657 MiB of static buffers do not fit; LIMITS=small's do.
 boot 512 small
 check "the default build cannot start" "default build starts" "!^scanner .*HAL=linux" "!^exit 0$"

@@ -3,11 +3,32 @@
 # A binary that crashes or exits non-zero without cmocka's summary counts as one failure.
 # RUN_WITH runs each test binary through an emulator or checker (make test-arm64: qemu-aarch64;
 # make test VALGRIND=1: valgrind memcheck).
+# "A... -- B...": the tests B run beside A, in a second process (the machine has two cores and
+# most tests use one); B's output follows A's, and the last line counts both.
 set -u
 cd "$(dirname "$0")/.."
+first=""
+second=""
+split=0
+for t in "$@"; do
+    if [ "$t" = "--" ]; then
+        split=1
+    elif [ $split -eq 1 ]; then
+        second="$second $t"
+    else
+        first="$first $t"
+    fi
+done
+side_log=""
+if [ -n "$second" ]; then
+    side_log=$(mktemp)
+    # shellcheck disable=SC2086 # the list is word-split on purpose
+    "$0" $second >"$side_log" 2>&1 &
+    side=$!
+fi
 passed=0
 failed=0
-for t in "$@"; do
+for t in $first; do
     case $t in
     *.sh) out=$("$t" 2>&1) ;;                  # scripts run the scanner themselves
     *) out=$(${RUN_WITH:-} "$t" 2>&1) ;;
@@ -25,5 +46,20 @@ for t in "$@"; do
     passed=$((passed + p))
     failed=$((failed + f))
 done
+if [ -n "$side_log" ]; then
+    wait "$side" || true
+    cat "$side_log"
+    counts=$(tail -n 1 "$side_log")
+    p=$(printf '%s\n' "$counts" | sed -n 's/^\([0-9]*\) passed, \([0-9]*\) failed$/\1/p')
+    f=$(printf '%s\n' "$counts" | sed -n 's/^\([0-9]*\) passed, \([0-9]*\) failed$/\2/p')
+    if [ -z "$p" ]; then
+        echo "tests run beside:$second: no summary (killed?)"
+        p=0
+        f=1
+    fi
+    passed=$((passed + p))
+    failed=$((failed + f))
+    rm -f "$side_log"
+fi
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]
