@@ -110,9 +110,10 @@ int main(int argc, char **argv)
            rc == 0 ? "ok" : cam.error);
     if (rc == 0)
         rc = capture_frames(&hc, cfg.drop_frames);
-    printf("other exposure: %s\n", hal_cam_set_exposure(&hc, 20000, 1000) == -ENOSYS
-                                       ? "refused (no exposure control)"
-                                       : "ACCEPTED");
+    int exp_rc = hal_cam_set_exposure(&hc, 20000, 1000);
+    printf("other exposure: %s\n", exp_rc == -ENOSYS ? "refused (no exposure control)"
+                                    : exp_rc == 0    ? "accepted"
+                                                     : strerror(-exp_rc));
     hal_cam_close(&hc);
 
     /* [camera] binning = 2: the driver streams 1280 x 960... it has 1280 x 720; 640 x 360 it is */
