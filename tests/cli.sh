@@ -177,7 +177,7 @@ check hdr_scan_and_process_agree sh -c "$bin scan --config $out/hdr.ini --out $o
     cmp $out/hdr-scan/mesh.ply $out/hdr-processed/mesh.ply"
 rm -rf "$out/hdr-scan" "$out/hdr-processed"
 # make LIMITS=small, for a board with 512 MB: under a 512 MiB address-space limit the default
-# build cannot even start (754 MiB of static buffers), the small one takes the same scan and
+# build cannot even start (784 MiB of static buffers), the small one takes the same scan and
 # gives the same model. (ASan reserves terabytes of address space: no limit under SAN=1.)
 sbin=${BUILD:-build}/small/scanner
 rm -rf "$out/scan_small"
