@@ -7,7 +7,9 @@
 #include "scan_dir.h"
 
 #include <string.h>
+#include <stdlib.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #define W 32u
 #define H 24u
@@ -20,9 +22,23 @@ static void put(const char *path, const uint8_t *data, size_t size)
     fclose(f);
 }
 
+static char dir[64];
+
+/* The directory goes when the run ends: a replay of the corpus must not leave it in /tmp. */
+static void remove_dir(void)
+{
+    char path[SCAN_DIR_PATH_MAX];
+    scan_dir_path(path, sizeof(path), dir, 0, "view.ini");
+    unlink(path);
+    scan_dir_frame_path(path, sizeof(path), dir, 0, 0);
+    unlink(path);
+    snprintf(path, sizeof(path), "%s/view_000", dir);
+    rmdir(path);
+    rmdir(dir);
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    static char dir[64];
     static struct scan_dir_view v;
     static uint8_t pixels[W * H * 3];
     char path[SCAN_DIR_PATH_MAX], err[SCAN_DIR_PATH_MAX + 256] = "";
@@ -31,6 +47,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         snprintf(path, sizeof(path), "%s/view_000", dir);
         mkdir(dir, 0700);
         mkdir(path, 0700);
+        atexit(remove_dir);
     }
     const uint8_t *nul = memchr(data, 0, size);
     size_t ini_len = nul != NULL ? (size_t)(nul - data) : size;
