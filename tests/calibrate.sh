@@ -145,4 +145,4 @@ check verify_sphere sh -c "$bin calibrate verify --config $out/calibrated.ini > 
     cat $out/verify.txt && awk '/^diameter:/ { e = \$9 + 0; if (e < 0) e = -e; ok = e <= 0.3 }
     END { exit !ok }' $out/verify.txt && grep -q '^sphere fit RMS' $out/verify.txt &&
     grep -q '^reprojection RMS (from the calibration): camera' $out/verify.txt"
-check_summary
+check_summary "$out"

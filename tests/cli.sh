@@ -253,4 +253,4 @@ else
     echo "[  FAILED  ] open3d_reads_ply: python3-open3d missing (scripts/install-deps.sh test)"
     fail=$((fail + 1))
 fi
-check_summary
+check_summary "$out"

@@ -87,3 +87,4 @@ awk '/^result -> truth: mean/ { a = $5 } /^truth -> result: mean/ { b = $5; w = 
     fail "the two-pass model resumed in its second pass is not whole: $(sed -n 4,5p "$out/two.compare")"
 echo "[       OK ] two_pass_killed_in_second_pass_resumes"
 echo "[  PASSED  ] 2 test(s)."
+rm -rf "$out" # passed: its scans need not stay on the disk
