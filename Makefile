@@ -6,7 +6,7 @@
 #   make test-arm64   the unit tests built for arm64, run under qemu-aarch64
 SAN ?= 0
 CC ?= cc
-PKGS := inih libpng libjpeg cmocka libmodbus libgpiod libseccomp
+PKGS := inih libpng libjpeg libdrm cmocka libmodbus libgpiod libseccomp
 PKG_CONFIG := pkg-config
 DEPS_SET :=
 DEPS_TOOLS := $(CC)
@@ -88,7 +88,7 @@ FW_SRC := $(wildcard firmware/*.c) hal/hal.c
 POSIX_SRC := $(wildcard hal/posix/*.c) $(wildcard hal/modbus/*.c)
 APP_LIB_SRC := app/config.c app/ini_schema.c app/patterns.c app/scan_dir.c app/scan_job.c app/white_cal.c board/board_frame.c
 SIM_SRC := $(filter-out host_sim/turntable_sim_main.c,$(wildcard host_sim/*.c)) board/board_sim.c
-LINUX_SRC := $(wildcard hal/linux/*.c) board/board_linux.c
+LINUX_SRC := $(wildcard hal/linux/*.c) board/board_linux.c board/board_display.c
 # The libcamera backend (C++) is built where libcamera is found (Raspberry Pi OS, or Debian's
 # libcamera-dev, which make test installs); without it [camera] backend = libcamera says so.
 HAVE_LIBCAMERA := $(shell $(PKG_CONFIG) --exists libcamera 2>/dev/null && echo 1)
@@ -103,7 +103,7 @@ HAVE_OPENCV := $(shell $(PKG_CONFIG) --exists opencv4 2>/dev/null && echo 1)
 CALIB_SRC := app/calibrate.c app/calib_solve.c app/calib_files.c
 OPENCV_LIBS := -lopencv_aruco -lopencv_calib3d -lopencv_imgproc -lopencv_core
 CALIB_TOOL := $(if $(HAVE_OPENCV),$(BUILD)/scanner-calibrate,)
-BOARD_LIBS = $(if $(filter linux,$(HAL)),$(shell $(PKG_CONFIG) --libs libgpiod 2>/dev/null) $(LIBCAMERA_LIBS),)
+BOARD_LIBS = $(if $(filter linux,$(HAL)),$(shell $(PKG_CONFIG) --libs libgpiod libdrm 2>/dev/null) $(LIBCAMERA_LIBS),)
 
 obj = $(patsubst %.c,$(BUILD)/%.o,$(1))
 FW_OBJ := $(call obj,$(FW_SRC))
@@ -170,7 +170,10 @@ seccomp-tool: $(BUILD)/seccomp-run
 # The V4L2 backend against vivid in the arm64 VM (tests/gpio_chip.sh); HAL=linux builds.
 $(BUILD)/vivid-capture: $(call obj,tests/vivid_capture.c hal/linux/camera_v4l2.c hal/linux/v4l2_frame.c) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ -lm
-vivid-tool: $(BUILD)/vivid-capture
+vivid-tool: $(BUILD)/vivid-capture $(BUILD)/drm-show
+# The HDMI projector against virtio-gpu in the same VM.
+$(BUILD)/drm-show: $(call obj,tests/drm_show.c board/board_display.c hal/linux/projector_drm.c) $(BUILD)/libfirmware.a
+	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(shell $(PKG_CONFIG) --libs libdrm) -lm
 
 $(BUILD)/mesh-compare: $(call obj,tests/mesh_compare.c tests/mesh_compare_lib.c host_sim/sim_bvh.c host_sim/sim_mesh.c host_sim/sim_ply_read.c app/config.c app/ini_schema.c app/scan_dir.c hal/posix/image_io.c) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON)
@@ -187,7 +190,7 @@ TEST_LIBS = $(shell $(PKG_CONFIG) --libs cmocka libmodbus 2>/dev/null)
 
 # The appliance backends are tested in every build, without their hardware.
 TEST_EXTRA_OBJ = $(if $(filter sim,$(HAL)),$(call obj,hal/linux/gpio_gpiod.c hal/linux/v4l2_frame.c hal/linux/camera_v4l2.c) $(LIBCAMERA_OBJ),)
-TEST_EXTRA_LIBS = $(shell $(PKG_CONFIG) --libs libgpiod 2>/dev/null) $(LIBCAMERA_LIBS)
+TEST_EXTRA_LIBS = $(shell $(PKG_CONFIG) --libs libgpiod libdrm 2>/dev/null) $(LIBCAMERA_LIBS)
 
 $(BUILD)/tests/%: $(BUILD)/tests/%.o $(TEST_SUPPORT) $(HOST_OBJ) $(TEST_EXTRA_OBJ) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) $(TEST_LDFLAGS) -o $@ $^ $(TEST_LIBS) $(LDLIBS_COMMON) $(TEST_EXTRA_LIBS)
@@ -301,7 +304,7 @@ test-arm64-full:
 # build on 512 MB: tests/gpio_chip.sh. About two minutes.
 test-gpio-chip:
 	@$(MAKE) --no-print-directory $(ARM64) HAL=linux deps
-	@{ command -v qemu-system-aarch64 && command -v cpio && command -v systemd-analyze; } >/dev/null 2>&1 || scripts/install-deps.sh gpio-chip
+	@{ command -v qemu-system-aarch64 && command -v cpio && command -v systemd-analyze && command -v socat; } >/dev/null 2>&1 || scripts/install-deps.sh gpio-chip
 	@$(MAKE) --no-print-directory $(ARM64) HAL=linux all
 	@$(MAKE) --no-print-directory $(ARM64) HAL=linux LIMITS=small all
 	@$(MAKE) --no-print-directory $(ARM64) HAL=linux seccomp-tool vivid-tool

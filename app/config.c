@@ -74,6 +74,12 @@ static const struct ini_key config_keys[] = {
         "extra tries of a capture that timed out or came back corrupt"),
     U32("projector", "settle_us", scan.pattern_settle_us, 0, 1000000, "20000",
         "wait after switching pattern before capturing"),
+    ENUM("projector", "backend", projector_backend, "gpio|drm", "gpio",
+         "gpio: a projector with its own stored sequence, stepped by the trigger and reset "
+         "lines; drm: a projector on the board's HDMI output, each pattern drawn by the scanner "
+         "and shown by a page flip (libdrm)"),
+    STR("projector", "device", projector_device, "/dev/dri/card0",
+        "the DRM device of the HDMI output (backend = drm)"),
     U32("projector", "trigger_pulse_us", scan.trigger_pulse_us, 1, 100000, "100",
         "width of the trigger and reset pulses"),
     LIM("lights", "count", light_count, 0, HAL_MAX_LIGHTS, "0",
@@ -755,5 +761,7 @@ void config_board(const struct app_config *cfg, struct board_config *out)
                                  .gpio = &cfg->gpio,
                                  .turntable = &cfg->turntable,
                                  .scan = &cfg->scan,
+                                 .projector_backend = cfg->projector_backend,
+                                 .projector_device = cfg->projector_device,
                                  .sim = &cfg->sim};
 }

@@ -24,6 +24,8 @@ struct app_config {
     char colour_method[16];  /**< none | single | uniform | multi, as written */
     char colour_ca[16];      /**< channel | pixel, as written */
     char code[8];            /**< [scan] code: gray | xor04, as written */
+    char projector_backend[8]; /**< [projector] backend: gpio | drm */
+    char projector_device[HAL_MAX_PATH]; /**< [projector] device (drm) */
     struct hal_camera_config camera;
     uint32_t light_count;
     struct scan_params scan;

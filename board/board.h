@@ -20,6 +20,8 @@ struct board_config {
     const struct hal_gpio_config *gpio;
     const struct tt_client_config *turntable;
     const struct scan_params *scan;          /**< the simulator shows the view's patterns */
+    const char *projector_backend;           /**< gpio | drm */
+    const char *projector_device;            /**< the DRM device (drm) */
     const struct sim_config *sim;
 };
 

@@ -2,6 +2,7 @@
  * a serial port or TCP), POSIX clock and storage. No simulator is linked into this build. */
 #define _POSIX_C_SOURCE 200809L
 #include "board.h"
+#include "board_display.h"
 
 #include "camera_v4l2.h"
 #include "clock_posix.h"
@@ -23,6 +24,8 @@ static struct {
     struct camera_libcamera libcamera;
 #endif
     struct gpio_gpiod gpio;
+    struct board_display display; /* [projector] backend = drm */
+    int display_open;
     struct tt_client turntable;
     const char *camera_error; /* the backend's last message */
 } board;
@@ -72,7 +75,6 @@ static void camera_free(void)
 int board_init(struct hal *hal, const struct board_config *cfg, const struct scan_calib *calib,
                char *err, size_t err_len)
 {
-    (void)calib;
     clock_posix_init(&hal->clock);
     storage_posix_init(&hal->storage);
     /* Camera first: a camera that fails leaves no GPIO line requested. */
@@ -82,11 +84,23 @@ int board_init(struct hal *hal, const struct board_config *cfg, const struct sca
     rc = gpio_gpiod_open(&board.gpio, cfg->gpio->chip, cfg->gpio->line, &hal->gpio, err, err_len);
     if (rc != 0)
         goto out_camera;
+    if (cfg->projector_backend != NULL && strcmp(cfg->projector_backend, "drm") == 0) {
+        struct hal_gpio lights = hal->gpio;
+        rc = board_display_open(&board.display, cfg->projector_device, cfg->scan, calib, &lights,
+                                &hal->gpio, err, err_len);
+        if (rc != 0)
+            goto out_gpio;
+        board.display_open = 1;
+    }
     rc = tt_client_open(&board.turntable, cfg->turntable, &hal->clock, hal->log, &hal->turntable,
                         err, err_len);
     if (rc != 0)
-        goto out_gpio;
+        goto out_display;
     return 0;
+out_display:
+    if (board.display_open)
+        board_display_close(&board.display);
+    board.display_open = 0;
 out_gpio:
     gpio_gpiod_close(&board.gpio);
 out_camera:
@@ -115,6 +129,9 @@ void board_shutdown(struct hal *hal)
 {
     hal_safe_state(hal);
     tt_client_close(&board.turntable);
+    if (board.display_open)
+        board_display_close(&board.display);
+    board.display_open = 0;
     gpio_gpiod_close(&board.gpio);
     camera_free();
 }

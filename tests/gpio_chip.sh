@@ -8,7 +8,10 @@
 # build cannot start). Run by `make test-gpio-chip`, which cross-builds both.
 # The same VM (default build) loads vivid, the kernel's virtual video driver, and runs the V4L2
 # backend on it (tests/vivid_capture.c: format, the mmap ring, drop_frames, frame timestamps,
-# binning, a timeout when frames stop) and the selftest with it as the rig's camera.
+# binning, a timeout when frames stop) and the selftest with it as the rig's camera; and it has
+# a virtio-gpu display, on which the HDMI projector backend steps through the pattern sequence
+# (tests/drm_show.c) while this script takes qemu's screendump of each pattern on screen and
+# compares it with the pattern.
 # Ends with cmocka's summary lines so that tests/run.sh counts it.
 set -eu
 cd "$(dirname "$0")/.."
@@ -16,6 +19,7 @@ SCANNER=${SCANNER:-build/aarch64-linux-gnu/linux/scanner}
 SCANNER_SMALL=${SCANNER_SMALL:-build/aarch64-linux-gnu/small/linux/scanner}
 SECCOMP_RUN=${SECCOMP_RUN:-build/aarch64-linux-gnu/linux/seccomp-run}
 VIVID_CAPTURE=${VIVID_CAPTURE:-build/aarch64-linux-gnu/linux/vivid-capture}
+DRM_SHOW=${DRM_SHOW:-build/aarch64-linux-gnu/linux/drm-show}
 WORK=${WORK:-build/gpio-chip}
 TRIPLET=aarch64-linux-gnu
 for tool in qemu-system-aarch64 cpio "$TRIPLET-readelf"; do
@@ -53,6 +57,7 @@ cp "$SCANNER" "$R/bin/scanner-default"
 cp "$SCANNER_SMALL" "$R/bin/scanner-small"
 cp "$WORK/unpacked/usr/bin/gpioset" "$WORK/unpacked/usr/bin/gpioinfo" "$R/bin/"
 cp "$VIVID_CAPTURE" "$R/bin/vivid-capture"
+cp "$DRM_SHOW" "$R/bin/drm-show"
 # vivid and the modules it needs, in an order that loads each after what it depends on (the
 # package ships no modules.dep: each module names its own in its .modinfo).
 MODDIR=$(ls -d "$WORK"/unpacked/lib/modules/* | head -n 1)
@@ -69,6 +74,8 @@ add_module() { # module name, as depends= writes it
     echo "$2" >> "$R/lib/modules/order"
 }
 add_module vivid
+add_module virtio_pci
+add_module virtio-gpu
 # The installed unit's system-call filter, and a runner that enforces it (tests/seccomp_run.c).
 cp "$SECCOMP_RUN" "$R/bin/seccomp-run"
 scripts/syscall-list.sh config/deploy/scanner@.service > "$R/etc/scanner/syscalls"
@@ -96,7 +103,7 @@ copy_libs() { # every library an ELF needs, recursively
     done
 }
 for elf in "$R/bin/scanner-default" "$R/bin/scanner-small" "$R/bin/gpioset" "$R/bin/gpioinfo" \
-    "$R/bin/seccomp-run" "$R/bin/udevadm" "$R/bin/vivid-capture" \
+    "$R/bin/seccomp-run" "$R/bin/udevadm" "$R/bin/vivid-capture" "$R/bin/drm-show" \
     "$R"/usr/lib/$TRIPLET/systemd/libsystemd-shared-*.so; do
     copy_libs "$elf"
 done
@@ -147,6 +154,8 @@ if [ "$build" = default ]; then
     echo "== selftest, vivid as the camera"
     sed "/^\[camera\]/,/^\[/ s|^device = .*|device = $dev|" /etc/scanner/rig.ini > /tmp/vivid.ini
     scanner selftest --config /tmp/vivid.ini 2>&1
+    echo "== display"; ls /dev/dri
+    echo "== drm show"; drm-show /dev/dri/card0 2>&1
 fi
 echo "== done"
 poweroff -f
@@ -178,12 +187,38 @@ check() { # name, section, then patterns the section must (or, with !, must not)
     fi
 }
 
+# Each "shown pattern N" the VM prints: qemu's screendump of the display, through its monitor
+# (the log is read as it grows; this runs beside qemu and is killed when it ends).
+screendumps() {
+    seen=0
+    while :; do
+        lines=$(wc -l < "$log")
+        while [ "$seen" -lt "$lines" ]; do
+            seen=$((seen + 1))
+            line=$(sed -n "${seen}p" "$log")
+            case $line in
+            "shown "*)
+                set -- $line
+                echo "screendump $WORK/shot-$2-$3.ppm" |
+                    socat - "UNIX-CONNECT:$WORK/monitor.sock" >/dev/null 2>&1 ;;
+            esac
+        done
+        sleep 0.2
+    done
+}
+
 boot() { # memory in MB, the build the checks run
     vm="$2 build, $1 MB"
     log=$WORK/vm-$2.log
+    rm -f "$WORK"/shot-*.ppm "$WORK/monitor.sock"
+    : > "$log"
+    screendumps & watcher=$!
     timeout 600 qemu-system-aarch64 -M virt -cpu cortex-a57 -m "$1" -nographic -no-reboot \
-        -nic none -kernel "$IMAGE" -initrd "$WORK/initramfs.gz" \
-        -append "console=ttyAMA0 panic=-1 quiet scanner=$2" 2>&1 | tr -d '\r' > "$log" || true
+        -nic none -device virtio-gpu-pci -monitor "unix:$WORK/monitor.sock,server,nowait" \
+        -kernel "$IMAGE" -initrd "$WORK/initramfs.gz" \
+        -append "console=ttyAMA0 panic=-1 quiet scanner=$2" 2>&1 | stdbuf -oL tr -d '\r' > "$log" || true
+    kill "$watcher" 2>/dev/null || true
+    wait "$watcher" 2>/dev/null || true
     check "the VM found the PL061 chip" "gpioinfo" "^gpiochip0 - 8 lines"
     check "the installed udev rule leaves another board's chip alone" \
         "udev, the installed rule" "Reading rules file: .*60-scanner-gpio.rules" \
@@ -218,6 +253,20 @@ check "V4L2 on vivid: a 1280x720 sensor binned 2x2" "vivid capture" \
     "^open 1280x720 binned to 640x360: ok$" "^binned frame: ok 640x360$"
 check "V4L2 on vivid: a timeout when frames stop" "vivid capture" \
     "^no frames \(control set\): timed out after [0-9]+ ms$" "^done$"
+check "virtio-gpu makes a DRM device" "display" "^card0"
+check "the HDMI projector: 1024x768 taken, the whole sequence stepped" "drm show" \
+    "^open 1024x768: ok$" "^sequence: ok \(22 patterns\)$" "^done$"
+shots=$(/usr/bin/python3 tests/drm_screendumps.py "$WORK" 2>&1)
+printf '%s\n' "$shots" | sed 's/^/    /'
+for name in "pattern 0" "pattern 1" "pattern 2" "pattern 3" "pattern 12" "pattern 21" "off 0"; do
+    if printf '%s\n' "$shots" | grep -q "^$name: 1024x768, 0 pixels differ"; then
+        echo "[       OK ] gpio_chip ($vm): the display shows $name"
+        passed=$((passed + 1))
+    else
+        echo "[  FAILED  ] gpio_chip ($vm): the display shows $name"
+        failed=$((failed + 1))
+    fi
+done
 check "the selftest with vivid as the camera" "selftest, vivid as the camera" \
     "^camera +/dev/video[0-9]+ +ok +v4l2 frame 1280x720" "!^turntable +/dev/video"
 # 512 MB: the default build's 657 MiB of static buffers do not fit; LIMITS=small's do.
