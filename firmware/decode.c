@@ -1,6 +1,8 @@
 /* Gray-code decoding of a whole view from its kept frames, block by block. */
 #include "decode.h"
 
+#include "lsq.h"
+
 #include <errno.h>
 #include <math.h>
 #include <string.h>
@@ -263,34 +265,22 @@ static int neighbourhood_code(const uint8_t *reason, const uint16_t *map, uint32
     if (n < dec.params.min_consistent_neighbours || n < 3)
         return 0;
     int median = sorted[n / 2];
-    double s[3][4] = {{0}}; /* normal equations of the plane, augmented */
+    double a[9] = {0}, b[3] = {0}, coef[3]; /* normal equations of the plane */
     for (uint32_t k = 0; k < n; k++) {
-        if (!within(v[k], median, 2 * RESOLVE_RADIUS)) {
+        if (!within(v[k], median, 2 * RESOLVE_RADIUS))
             continue;
-        }
         double row[3] = {1.0, ox[k], oy[k]};
         for (int i = 0; i < 3; i++) {
             for (int j = 0; j < 3; j++)
-                s[i][j] += row[i] * row[j];
-            s[i][3] += row[i] * v[k];
+                a[3 * i + j] += row[i] * row[j];
+            b[i] += row[i] * v[k];
         }
     }
-    double det = s[0][0] * (s[1][1] * s[2][2] - s[1][2] * s[2][1]) -
-                 s[0][1] * (s[1][0] * s[2][2] - s[1][2] * s[2][0]) +
-                 s[0][2] * (s[1][0] * s[2][1] - s[1][1] * s[2][0]);
-    if (fabs(det) < 1e-9)
-        return 0; /* the pixels lie on a line: no plane */
-    double coef[3]; /* Cramer's rule */
-    for (int c = 0; c < 3; c++) {
-        double m[3][3];
-        for (int i = 0; i < 3; i++)
-            for (int j = 0; j < 3; j++)
-                m[i][j] = j == c ? s[i][3] : s[i][j];
-        coef[c] = (m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
-                   m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
-                   m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])) /
-                  det;
-    }
+    /* The pixels on one line fix no plane (lsq_solve would leave that slope 0 and go on). */
+    double det = a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) +
+                 a[2] * (a[3] * a[7] - a[4] * a[6]);
+    if (fabs(det) < 1e-9 || lsq_solve(3, a, b, coef) != 0)
+        return 0;
     uint32_t agree = 0;
     for (uint32_t k = 0; k < n; k++)
         agree += fabs(coef[0] + coef[1] * ox[k] + coef[2] * oy[k] - v[k]) <= RESOLVE_FIT_COLUMNS;
