@@ -27,15 +27,12 @@ static void describe(const struct gray_layout *l, uint32_t index, char *out, siz
     uint32_t bits = row ? l->row_bits : l->col_bits, bit = row ? k - l->col_bits : k;
     uint32_t position = bits - 1u - bit; /* of the bit in the word, 0 the finest */
     int rides = (gray_code_xor_mask(l->code, bits) >> position) & 1u;
+    char rides_on[24] = ""; /* XOR-04: the base it rides on */
+    if (rides)
+        snprintf(rides_on, sizeof(rides_on), " XOR bit %u", bits - 1u);
     snprintf(out, len, "%s bit %u of %u%s%s%s", row ? "row" : "column", bit + 1u, bits,
-             bit == 0 ? " (coarsest)" : bit + 1u == bits ? " (finest)" : "",
-             rides ? " XOR bit " : "", inverse ? ", inverse" : "");
-    if (rides) { /* XOR-04: name the base it rides on */
-        size_t used = strlen(out);
-        const char *tail = inverse ? ", inverse" : "";
-        out[used - strlen(tail)] = '\0';
-        snprintf(out + strlen(out), len - strlen(out), "%u%s", bits - 1u, tail);
-    }
+             bit == 0 ? " (coarsest)" : bit + 1u == bits ? " (finest)" : "", rides_on,
+             inverse ? ", inverse" : "");
 }
 
 static int write_listing(const struct hal_storage *st, const char *dir,
@@ -67,9 +64,10 @@ int patterns_write(const struct hal_storage *st, const struct app_config *cfg,
                    const struct scan_calib *calib, const char *dir)
 {
     const uint32_t w = calib->proj_width, h = calib->proj_height;
+    struct scan_params calibration = cfg->scan; /* the calibration's: columns, then rows */
+    calibration.decode_rows = 1;
     struct gray_layout full, scan;
-    gray_layout_for(w, h, 1, &full); /* the calibration's: columns, then rows */
-    full.code = cfg->scan.code;
+    scan_layout(&calibration, calib, &full);
     scan_layout(&cfg->scan, calib, &scan);
     int rc = hal_storage_mkdir_p(st, dir);
     if (rc != 0) {

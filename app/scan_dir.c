@@ -2,6 +2,8 @@
 #define _DEFAULT_SOURCE /* flock */
 #include "scan_dir.h"
 
+#include "scan.h"
+
 #include "gray.h"
 #include "image_io.h"
 #include "ini_schema.h"
@@ -71,8 +73,7 @@ void scan_dir_describe_frames(const struct scan_params *p, const struct scan_cal
 {
     struct gray_layout layout;
     struct colour_layout lay;
-    gray_layout_for(c->proj_width, c->proj_height, (int)p->decode_rows, &layout);
-    layout.code = p->code;
+    scan_layout(p, c, &layout);
     colour_layout(&p->colour, c->light_count, &lay);
     uint32_t patterns = gray_layout_count(&layout);
     int hdr = p->exposure_count > 0;

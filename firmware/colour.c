@@ -67,6 +67,13 @@ struct frame_ctx {
     double ca_channel[COLOUR_MAX_FRAMES][3];
 };
 
+/* A channel of RGB pixel @p px at or above the saturation level. */
+static int clipped(const struct colour_params *prm, const uint8_t *px)
+{
+    return px[0] >= prm->saturation_dn || px[1] >= prm->saturation_dn ||
+           px[2] >= prm->saturation_dn;
+}
+
 /* Frame k's light at pixel i (@p px) with its Ca taken off, in grey levels at the camera's
  * exposure, so that one white reference serves every exposure. @retval 0 when a channel is
  * saturated (@p out is filled all the same), 1 otherwise */
@@ -75,13 +82,11 @@ static int frame_light(const struct frame_ctx *f, uint32_t k, const uint8_t *px,
 {
     uint32_t d = f->lay->dark_of[k];
     double gain = (double)f->prm->exposure_us / f->lay->exposure_us[k];
-    int sat = 0;
     for (int c = 0; c < 3; c++) {
         double ca = f->prm->ca_per_pixel ? f->frames[d][3 * i + (size_t)c] : f->ca_channel[d][c];
         out[c] = (px[c] - ca) * gain;
-        sat |= px[c] >= f->prm->saturation_dn;
     }
-    return !sat;
+    return !clipped(f->prm, px);
 }
 
 /* cos(theta) of a source at @p src for surface point p with normal n, and the falloff factor. */
@@ -198,8 +203,7 @@ int colour_compute(const struct colour_params *prm, const struct scan_calib *c,
         /* raw colour: trusted where valid, but not where the white frame clipped (a highlight
          * now has depth, its colour is blown out): other views colour it if they can */
         confidence[i] = prm->method == COLOUR_NONE && m->reason[i] == SCAN_VALID &&
-                        white[3 * i] < prm->saturation_dn && white[3 * i + 1] < prm->saturation_dn &&
-                        white[3 * i + 2] < prm->saturation_dn;
+                        !clipped(prm, &white[3 * i]);
         if (prm->method == COLOUR_NONE && m->reason[i] == SCAN_VALID)
             white_balance(prm, &albedo[3 * i]);
         if (prm->method == COLOUR_NONE || m->reason[i] != SCAN_VALID)

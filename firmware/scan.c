@@ -246,10 +246,6 @@ int scan_finish_view(const struct scan_calib *c, int32_t angle_mdeg, struct scan
     return 0;
 }
 
-static int capture_sequence(const struct hal *hal, const struct scan_params *p, uint32_t count,
-                            const struct scan_frame_sink *sink, uint32_t *exposure_us,
-                            struct scan_view_info *info);
-
 /* HDR: pattern @p i at every exposure, merged in the decoder's slot before it is fed: each
  * pixel at the exposure hdr_choice holds, chosen on the white pattern as the longest whose
  * white is not saturated (the brightest unsaturated). The pixel's patterns, inverses, white and
@@ -303,22 +299,6 @@ static int capture_pattern(const struct hal *hal, const struct scan_params *p, u
     return scan_feed_frame(i, buf, 3, sink);
 }
 
-/* Every pattern of the sequence, the camera back at its own exposure after (also on failure). */
-static int capture_patterns(const struct hal *hal, const struct scan_params *p, uint32_t count,
-                            const struct scan_frame_sink *sink, struct scan_view_info *info)
-{
-    uint32_t exposure_us = p->colour.exposure_us;
-    int rc = capture_sequence(hal, p, count, sink, &exposure_us, info);
-    if (exposure_us != p->colour.exposure_us) {
-        int rc_exp = hal_cam_set_exposure(&hal->camera, p->colour.exposure_us, p->colour.gain_milli);
-        rc = rc != 0 ? rc : rc_exp;
-    }
-    if (rc == -ENOSYS)
-        hal->log(HAL_LOG_ERROR, "camera: cannot change the exposure for HDR patterns; leave "
-                                "[scan] exposures_us empty");
-    return rc;
-}
-
 static int capture_sequence(const struct hal *hal, const struct scan_params *p, uint32_t count,
                             const struct scan_frame_sink *sink, uint32_t *exposure_us,
                             struct scan_view_info *info)
@@ -340,6 +320,31 @@ static int capture_sequence(const struct hal *hal, const struct scan_params *p, 
     }
     return 0;
 }
+
+/* Back to the camera's own exposure from @p exposure_us (the HDR patterns' or the colour
+ * frames' last). @retval 0 or the camera's error */
+static int camera_exposure_back(const struct hal *hal, const struct scan_params *p,
+                                uint32_t exposure_us)
+{
+    if (exposure_us == p->colour.exposure_us)
+        return 0;
+    return hal_cam_set_exposure(&hal->camera, p->colour.exposure_us, p->colour.gain_milli);
+}
+
+/* Every pattern of the sequence, the camera back at its own exposure after (also on failure). */
+static int capture_patterns(const struct hal *hal, const struct scan_params *p, uint32_t count,
+                            const struct scan_frame_sink *sink, struct scan_view_info *info)
+{
+    uint32_t exposure_us = p->colour.exposure_us;
+    int rc = capture_sequence(hal, p, count, sink, &exposure_us, info);
+    int rc_exp = camera_exposure_back(hal, p, exposure_us);
+    rc = rc != 0 ? rc : rc_exp;
+    if (rc == -ENOSYS)
+        hal->log(HAL_LOG_ERROR, "camera: cannot change the exposure for HDR patterns; leave "
+                                "[scan] exposures_us empty");
+    return rc;
+}
+
 
 /* The colour frames (colour_layout): projector off, each with its lights and exposure; lights off
  * and the camera back at its own exposure after, also on failure. */
@@ -373,10 +378,8 @@ static int capture_lights(const struct hal *hal, const struct scan_params *p,
             rc = sink->save(sink->priv, first_index + k, light_rgb[k], p->width, p->height, 3);
     }
     int rc_off = lights_off(hal, c->light_count);
-    if (exposure_us != p->colour.exposure_us) {
-        int rc_exp = hal_cam_set_exposure(&hal->camera, p->colour.exposure_us, p->colour.gain_milli);
-        rc_off = rc_off != 0 ? rc_off : rc_exp;
-    }
+    int rc_exp = camera_exposure_back(hal, p, exposure_us);
+    rc_off = rc_off != 0 ? rc_off : rc_exp;
     if (rc == -ENOSYS)
         hal->log(HAL_LOG_ERROR, "camera: cannot change the exposure for the colour frames; set "
                                 "[colour] all_lights_exposure_us and light_exposure_us to 0");

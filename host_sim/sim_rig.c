@@ -395,6 +395,29 @@ static int projector_light(const struct sim_rig *rig, const struct surface_point
     return 1;
 }
 
+/* The surface point of a ray hit, object frame: position, shading normal. */
+static void hit_point(const struct sim_mesh *m, const struct sim_hit *hit, vec3 *p, vec3 *n)
+{
+    const uint32_t *tv = &m->tri[3 * hit->tri];
+    double w[3] = {1.0 - hit->u - hit->v, hit->u, hit->v};
+    *p = v3(0, 0, 0);
+    *n = v3(0, 0, 0);
+    for (int k = 0; k < 3; k++) {
+        const float *pn = &m->normal[3 * tv[k]], *pp = &m->pos[3 * tv[k]];
+        *n = v3_add(*n, v3_scale(v3(pn[0], pn[1], pn[2]), w[k]));
+        *p = v3_add(*p, v3_scale(v3(pp[0], pp[1], pp[2]), w[k]));
+    }
+    *n = v3_norm(*n);
+}
+
+/* The object's paint at @p p_obj (as placed), asked in its standing frame, where it was laid
+ * out. @retval 1 the very dark paint, 0 not */
+static int object_albedo(const struct sim_rig *rig, vec3 p_obj, double albedo[3])
+{
+    return sim_albedo_at(&rig->cfg, rig->object_height_mm,
+                         m3_tmul(rig->pose_rot, v3_sub(p_obj, rig->pose_shift)), albedo);
+}
+
 /* Cast the camera ray of pixel (x, y); fill truth and the projector's reflected light. */
 static void update_pixel(struct sim_rig *rig, const struct frame_xform *obj, vec3 cam_obj,
                          vec3 proj_cam, vec3 proj_obj, uint32_t x, uint32_t y)
@@ -417,24 +440,13 @@ static void update_pixel(struct sim_rig *rig, const struct frame_xform *obj, vec
         (uint8_t)sim_bvh_intersect(&rig->bvh, cam_obj, frame_dir(obj, d_cam), 1e-6, 1e9, &hit);
     if (!t->hit[i])
         return;
-    const struct sim_mesh *m = &rig->mesh;
-    const uint32_t *tv = &m->tri[3 * hit.tri];
-    double w0 = 1.0 - hit.u - hit.v;
-    vec3 n_obj = v3(0, 0, 0), p_obj = v3(0, 0, 0);
-    double w[3] = {w0, hit.u, hit.v};
-    for (int k = 0; k < 3; k++) {
-        const float *pn = &m->normal[3 * tv[k]], *pp = &m->pos[3 * tv[k]];
-        n_obj = v3_add(n_obj, v3_scale(v3(pn[0], pn[1], pn[2]), w[k]));
-        p_obj = v3_add(p_obj, v3_scale(v3(pp[0], pp[1], pp[2]), w[k]));
-    }
-    n_obj = v3_norm(n_obj);
+    vec3 p_obj, n_obj;
+    hit_point(&rig->mesh, &hit, &p_obj, &n_obj);
     vec3 p_cam = v3_scale(d_cam, hit.t);
     vec3 n_cam = frame_dir_inv(obj, n_obj);
     double albedo[3];
-    if (rig->target.kind == SIM_TARGET_OBJECT) /* the paint, in the object's standing frame */
-        t->dark[i] = (uint8_t)sim_albedo_at(&rig->cfg, rig->object_height_mm,
-                                            m3_tmul(rig->pose_rot, v3_sub(p_obj, rig->pose_shift)),
-                                            albedo);
+    if (rig->target.kind == SIM_TARGET_OBJECT)
+        t->dark[i] = (uint8_t)object_albedo(rig, p_obj, albedo);
     else
         target_albedo(rig, obj, cam_obj, d_cam, p_obj, albedo);
     for (int k = 0; k < 3; k++) {
@@ -456,20 +468,6 @@ static double pattern_light(const struct sim_rig *rig, uint32_t pattern, double 
 
 /* ---- one bounce of the projector's light between surfaces ([sim] bounce_samples) ---- */
 
-/* The surface point of a ray hit, object frame: position, shading normal. */
-static void hit_point(const struct sim_mesh *m, const struct sim_hit *hit, vec3 *p, vec3 *n)
-{
-    const uint32_t *tv = &m->tri[3 * hit->tri];
-    double w[3] = {1.0 - hit->u - hit->v, hit->u, hit->v};
-    *p = v3(0, 0, 0);
-    *n = v3(0, 0, 0);
-    for (int k = 0; k < 3; k++) {
-        const float *pn = &m->normal[3 * tv[k]], *pp = &m->pos[3 * tv[k]];
-        *n = v3_add(*n, v3_scale(v3(pn[0], pn[1], pn[2]), w[k]));
-        *p = v3_add(*p, v3_scale(v3(pp[0], pp[1], pp[2]), w[k]));
-    }
-    *n = v3_norm(*n);
-}
 
 /* For every grid point (every SIM_BOUNCE_STEP-th pixel each way) on the object: what the surface
  * around it sees in bounce_samples cosine-weighted directions, where that is in the projector
@@ -511,8 +509,7 @@ static void bounce_update(struct sim_rig *rig, const struct frame_xform *obj, ve
                 q.p_cam = frame_point_inv(obj, q.p_obj);
                 q.n_cam = frame_dir_inv(obj, q.n_obj);
                 double albedo[3], u, v, rad[3];
-                sim_albedo_at(&rig->cfg, rig->object_height_mm,
-                              m3_tmul(rig->pose_rot, v3_sub(q.p_obj, rig->pose_shift)), albedo);
+                object_albedo(rig, q.p_obj, albedo);
                 if (!projector_light(rig, &q, proj_cam, proj_obj, albedo,
                                      v3_norm(v3_sub(p_cam, q.p_cam)), &u, &v, rad))
                     continue;

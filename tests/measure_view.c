@@ -13,6 +13,22 @@ static double now_ms(void)
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
 }
 
+/* One view of the rig @p t (loaded, set as the table wants), measured and timed; 0 ok. */
+static int measure_rig(struct test_rig *t, struct view_quality *q, double *ms)
+{
+    if (test_rig_start(t) != 0)
+        return 1;
+    struct scan_view view;
+    struct scan_view_info info;
+    double t0 = now_ms();
+    int rc = scan_take_view(&t->hal, &t->cfg.scan, &t->calib, 0, NULL, &view, &info);
+    *ms = now_ms() - t0;
+    if (rc == 0)
+        test_measure_view(sim_ctl_rig(), &view, q);
+    test_rig_stop(t);
+    return rc != 0;
+}
+
 /* One view of @p object in @p material under the rig of @p config, with the HDR exposures
  * @p exposures (NULL: none; a list ending in 0); 0 ok. */
 static int measure_hdr(const char *config, const char *object, const char *material, int refine,
@@ -29,17 +45,7 @@ static int measure_hdr(const char *config, const char *object, const char *mater
     snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "%s", object);
     snprintf(t.cfg.sim.material, sizeof(t.cfg.sim.material), "%s", material);
     t.cfg.scan.refine = (uint32_t)refine;
-    if (test_rig_start(&t) != 0)
-        return 1;
-    struct scan_view view;
-    struct scan_view_info info;
-    double t0 = now_ms();
-    int rc = scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info);
-    *ms = now_ms() - t0;
-    if (rc == 0)
-        test_measure_view(sim_ctl_rig(), &view, q);
-    test_rig_stop(&t);
-    return rc != 0;
+    return measure_rig(&t, q, ms);
 }
 
 static int measure_one(const char *config, const char *object, const char *material, int refine,
@@ -161,18 +167,9 @@ static int table_concave(const char *config)
         t.cfg.sim.bounce_samples = bounce;
         t.cfg.scan.code = code;
         snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "%s", objects[run >> 2]);
-        if (test_rig_start(&t) != 0)
-            return 1;
-        struct scan_view view;
-        struct scan_view_info info;
         struct view_quality q;
-        double t0 = now_ms();
-        int rc = scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info);
-        double ms = now_ms() - t0;
-        if (rc == 0)
-            test_measure_view(sim_ctl_rig(), &view, &q);
-        test_rig_stop(&t);
-        if (rc != 0)
+        double ms;
+        if (measure_rig(&t, &q, &ms) != 0)
             return 1;
         printf("| %s | %s | %u | %u | %.2f%% | %.3f%% | %.3f%% | %.3f | %u | %.0f |\n",
                t.cfg.sim.object, code ? "XOR-04" : "Gray", bounce, q.lit, 100.0 * q.lit_valid / q.lit,

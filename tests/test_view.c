@@ -13,18 +13,25 @@
 #include "gray.h"
 #include "test_util.h"
 
+/* One view of the rig @p t (loaded, its settings as the test wants them), measured. */
+static void take_and_measure(struct test_rig *t, struct view_quality *q,
+                             struct scan_view_info *info)
+{
+    assert_int_equal(test_rig_start(t), 0);
+    struct scan_view view;
+    assert_int_equal(scan_take_view(&t->hal, &t->cfg.scan, &t->calib, 0, NULL, &view, info), 0);
+    test_measure_view(sim_ctl_rig(), &view, q);
+    test_rig_stop(t);
+}
+
 static void scan_and_measure_with(const char *config, const char *object, struct view_quality *q)
 {
     static struct test_rig t;
+    struct scan_view_info info;
     assert_int_equal(test_rig_load(&t, config), 0);
     snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "%s", object);
-    assert_int_equal(test_rig_start(&t), 0);
-    struct scan_view view;
-    struct scan_view_info info;
-    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), 0);
-    test_measure_view(sim_ctl_rig(), &view, q);
+    take_and_measure(&t, q, &info);
     assert_int_equal(info.valid_points, q->valid);
-    test_rig_stop(&t);
     print_message("%s: %u lit, %.2f%% right (+-1), %.2f%% head-on right, depth RMS %.3f mm "
                   "(%.3f%% of %.0f mm), max %.2f mm from the surface, %u of %u dark flagged, "
                   "normals %.1f deg\n",
@@ -109,14 +116,10 @@ static void test_dark_paint_with_hdr_and_highlights(void **state)
     t.cfg.scan.exposure_count = 2;
     t.cfg.scan.exposures_us[0] = 10000;
     t.cfg.scan.exposures_us[1] = 40000;
-    assert_int_equal(test_rig_start(&t), 0);
-    struct scan_view view;
     struct scan_view_info info;
     struct view_quality q;
-    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), 0);
+    take_and_measure(&t, &q, &info);
     assert_int_equal(info.frames_captured, 44);
-    test_measure_view(sim_ctl_rig(), &view, &q);
-    test_rig_stop(&t);
     print_message("HDR: %u of %u dark paint pixels right\n", q.dark_correct, q.dark);
     assert_true(q.dark > 1000);
     assert_true(q.dark_correct >= 0.9 * q.dark);
@@ -126,10 +129,7 @@ static void test_dark_paint_with_hdr_and_highlights(void **state)
     assert_int_equal(test_rig_load(&t, "config/sim-glossy.ini"), 0);
     snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "sphere");
     snprintf(t.cfg.sim.material, sizeof(t.cfg.sim.material), "phong");
-    assert_int_equal(test_rig_start(&t), 0);
-    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), 0);
-    test_measure_view(sim_ctl_rig(), &view, &q);
-    test_rig_stop(&t);
+    take_and_measure(&t, &q, &info);
     print_message("glossy: %u of %u saturated pixels right\n", q.saturated_correct, q.saturated);
     assert_true(q.saturated > 1000);
     assert_true(q.saturated_correct >= 0.8 * q.saturated);
@@ -141,12 +141,8 @@ static void groove_view(uint32_t code, struct view_quality *q)
     assert_int_equal(test_rig_load(&t, "config/sim-concave.ini"), 0);
     snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "groove");
     t.cfg.scan.code = code;
-    assert_int_equal(test_rig_start(&t), 0);
-    struct scan_view view;
     struct scan_view_info info;
-    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), 0);
-    test_measure_view(sim_ctl_rig(), &view, q);
-    test_rig_stop(&t);
+    take_and_measure(&t, q, &info);
     print_message("groove, %s: %.2f%% valid, %.3f%% wrong\n", code ? "XOR-04" : "Gray",
                   100.0 * q->lit_valid / q->lit, 100.0 * q->lit_wrong / q->lit);
 }
