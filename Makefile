@@ -6,7 +6,7 @@
 #   make test-arm64   the unit tests built for arm64, run under qemu-aarch64
 SAN ?= 0
 CC ?= cc
-PKGS := inih libpng libjpeg libdrm cmocka libmodbus libgpiod libseccomp
+PKGS := inih libpng libzstd libjpeg libdrm cmocka libmodbus libgpiod libseccomp
 PKG_CONFIG := pkg-config
 DEPS_SET :=
 DEPS_TOOLS := $(CC)
@@ -57,7 +57,7 @@ CFLAGS_COMMON := $(WARN) $(OPT) $(LIMITS_CFLAGS) -g -MMD -MP
 # firmware/ sees the world only through hal/include.
 FW_CFLAGS := $(CFLAGS_COMMON) -Ihal/include -Ifirmware -fstack-usage
 PKG_CFLAGS = $(shell $(PKG_CONFIG) --cflags $(PKGS) 2>/dev/null)
-PKG_LIBS = $(shell $(PKG_CONFIG) --libs inih libpng libjpeg libmodbus 2>/dev/null) -lpthread
+PKG_LIBS = $(shell $(PKG_CONFIG) --libs inih libpng libzstd libjpeg libmodbus 2>/dev/null) -lpthread
 # Each layer is compiled with only the include paths it may use, so an include that runs back up
 # (hal/ or host_sim/ reaching into app/, board/ into app/) does not compile (docs/architecture.md;
 # tests/layers.sh shows it). Everyone sees hal/include; a layer's paths are INC_<its directory>.
@@ -86,7 +86,7 @@ LDLIBS_COMMON = $(PKG_LIBS) -lm
 
 FW_SRC := $(wildcard firmware/*.c) hal/hal.c
 POSIX_SRC := $(wildcard hal/posix/*.c) $(wildcard hal/modbus/*.c)
-APP_LIB_SRC := app/config.c app/ini_schema.c app/patterns.c app/scan_dir.c app/scan_job.c app/white_cal.c board/board_frame.c
+APP_LIB_SRC := app/config.c app/frame_writer.c app/ini_schema.c app/patterns.c app/scan_dir.c app/scan_job.c app/white_cal.c board/board_frame.c
 SIM_SRC := $(filter-out host_sim/turntable_sim_main.c,$(wildcard host_sim/*.c)) board/board_sim.c
 LINUX_SRC := $(wildcard hal/linux/*.c) board/board_linux.c board/board_display.c
 # The libcamera backend (C++) is built where libcamera is found (Raspberry Pi OS, or Debian's
@@ -227,7 +227,7 @@ FUZZ_SECONDS ?= 600
 FUZZ_LIB_SRC := app/config.c app/ini_schema.c app/scan_dir.c hal/posix/image_io.c \
 	host_sim/sim_mesh.c host_sim/sim_ply_read.c hal/modbus/turntable_modbus.c host_sim/clock_sim.c
 FUZZ_CFLAGS = -std=c11 -g -O1 $(HOST_INC) -Itests/fuzz $(PKG_CFLAGS)
-FUZZ_LIBS = $(shell $(PKG_CONFIG) --libs inih libmodbus libpng 2>/dev/null) -lpthread -lm
+FUZZ_LIBS = $(shell $(PKG_CONFIG) --libs inih libmodbus libpng libzstd 2>/dev/null) -lpthread -lm
 FUZZ_REPLAY := $(patsubst %,$(BUILD)/tests/fuzz-replay-%,$(FUZZ_TARGETS))
 
 $(BUILD)/tests/fuzz-replay-%: $(call obj,tests/fuzz/replay.c) $(BUILD)/tests/fuzz/fuzz_%.o $(call obj,$(FUZZ_LIB_SRC)) $(BUILD)/libfirmware.a
@@ -415,6 +415,13 @@ measure-calib: deps $(BUILD)/scanner $(BUILD)/scanner-calibrate $(BUILD)/mesh-co
 # Time per view, split between the simulated capture and the firmware's processing.
 $(BUILD)/bench_view: $(BUILD)/bench/bench_view.o $(BUILD)/tests/test_util.o $(HOST_OBJ) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON) $(BOARD_LIBS)
+# Frame encodings side by side (libspng and libzstd only here).
+$(BUILD)/bench_frames: $(BUILD)/bench/bench_frames.o $(BUILD)/tests/test_util.o $(HOST_OBJ) $(BUILD)/libfirmware.a
+	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON) $(BOARD_LIBS) -lspng -lzstd
+$(BUILD)/bench/bench_frames.o: bench/bench_frames.c | deps
+	@pkg-config --exists spng libzstd || scripts/install-deps.sh bench
+	@mkdir -p $(dir $@)
+	$(CC) $(HOST_CFLAGS) -Itests -c $< -o $@
 $(BUILD)/bench/%.o: bench/%.c | deps
 	@mkdir -p $(dir $@)
 	$(CC) $(HOST_CFLAGS) -Itests -c $< -o $@

@@ -81,8 +81,7 @@ static int frame_exists(const char *dir, uint32_t view, uint32_t frame)
 {
     char path[SCAN_DIR_PATH_MAX];
     struct stat sb;
-    return scan_dir_frame_path(path, sizeof(path), dir, view, frame) == 0 &&
-           stat(path, &sb) == 0;
+    return scan_dir_find_frame(path, sizeof(path), dir, view, frame) == 0 && stat(path, &sb) == 0;
 }
 
 /* Feed a capture's pattern frames to the decoder. @retval 0 @retval -ENOENT not all there */

@@ -101,8 +101,9 @@ static int save_frame(void *priv, uint32_t pattern, const uint8_t *pixels, uint3
                       uint32_t height, uint32_t channels)
 {
     struct capture *c = priv;
+    /* PNG: calibration captures are few, and any image tool opens them */
     int rc = scan_dir_write_frame(&c->hal->storage, c->dir, c->view, pattern, pixels, width,
-                                  height, channels);
+                                  height, channels, SCAN_FRAMES_PNG);
     if (rc != 0)
         c->hal->log(HAL_LOG_ERROR, "cannot write frame %u of %s/view_%03u: %s",
                     (unsigned)pattern, c->dir, (unsigned)c->view, strerror(-rc));

@@ -137,6 +137,14 @@ static const struct ini_key config_keys[] = {
     U32("output", "watertight", watertight, 0, 1, "0",
         "1: close the model for printing: at the table plane, and what no camera saw under a "
         "surface or behind a hole up to max_hole_mm is solid (needs max_hole_mm > 0)"),
+    ENUM("output", "frame_format", frame_format_name, "zstd|png|pnm", "zstd",
+         "how frames are kept: zstd (frame_NN.pgm.zst / .ppm.zst, a PGM or PPM compressed; "
+         "'zstd -d' gives the image), png, or pnm (uncompressed PGM/PPM); make bench compares "
+         "their size and time"),
+    ENUM("output", "keep_frames", keep_frames_name, "all|colour|none", "all",
+         "which camera frames a scan keeps: all (scanner process can decode and colour again), "
+         "colour (the colour frames, not the stripe patterns), or none; each view's range image "
+         "(range.bin) is kept in every case, so process can still register and fuse again"),
     F64("output", "min_fragment_share", min_fragment_share, 0, 1, "0.01",
         "floating pieces of the mesh with fewer triangles than this share of the largest piece "
         "are left out of every output (0: keep every piece)"),
@@ -289,6 +297,12 @@ static const struct ini_key config_keys[] = {
         "projector defocus, as a box width in projector pixels"),
     F64("sim", "camera_blur_px", sim.camera_blur_px, 0, 8, "0",
         "camera lens blur, the sigma of a Gaussian point spread in camera pixels"),
+    F64("sim", "frame_rate_hz", sim.frame_rate_hz, 0, 1000, "30",
+        "the camera streams frames at this rate, as a real sensor does: a capture waits for the "
+        "next frame to begin and for it to end (and readout_us), so the simulated scan takes "
+        "the real rig's time; 0: a frame takes only its exposure"),
+    U32("sim", "readout_us", sim.readout_us, 0, 1000000, "0",
+        "from the end of a frame to its arrival (ISP, USB transfer)"),
     U32("sim", "jpeg_quality", sim.jpeg_quality, 0, 100, "0",
         "1..100: each frame is JPEG-compressed at this quality and decoded (libjpeg), as a "
         "camera's JPEG stream; 0: off"),
@@ -524,6 +538,12 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
             cfg->scan.colour.method = k;
     cfg->scan.colour.ca_per_pixel = strcmp(cfg->colour_ca, "pixel") == 0;
     cfg->scan.code = strcmp(cfg->code, "xor04") == 0 ? GRAY_CODE_XOR04 : GRAY_CODE_GRAY;
+    cfg->frame_format = strcmp(cfg->frame_format_name, "png") == 0   ? SCAN_FRAMES_PNG
+                        : strcmp(cfg->frame_format_name, "pnm") == 0 ? SCAN_FRAMES_PNM
+                                                                     : SCAN_FRAMES_ZSTD;
+    cfg->keep_frames = strcmp(cfg->keep_frames_name, "colour") == 0 ? KEEP_FRAMES_COLOUR
+                       : strcmp(cfg->keep_frames_name, "none") == 0 ? KEEP_FRAMES_NONE
+                                                                    : KEEP_FRAMES_ALL;
     cfg->scan.colour.saturation_dn = cfg->scan.saturation_dn;
     cfg->scan.colour.exposure_us = cfg->camera.exposure_us;
     cfg->scan.colour.gain_milli = cfg->camera.gain_milli;

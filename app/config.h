@@ -8,6 +8,7 @@
 #include "hal.h"
 #include "fusion.h"
 #include "reg.h"
+#include "scan_dir.h"
 #include "ini_schema.h"
 #include "scan_types.h"
 #include "sim_config.h"
@@ -16,6 +17,9 @@
 
 #include <stddef.h>
 #include <stdio.h>
+
+/** [output] keep_frames: which camera frames a scan keeps. */
+enum keep_frames { KEEP_FRAMES_ALL, KEEP_FRAMES_COLOUR, KEEP_FRAMES_NONE };
 
 struct app_config {
     char path[HAL_MAX_PATH];     /**< the file it came from */
@@ -35,6 +39,10 @@ struct app_config {
     struct ini_list exposures_us; /**< [scan] exposures_us as written (HDR patterns) */
     char calibration_file[HAL_MAX_PATH]; /**< resolved against the config file's directory */
     char output_dir[HAL_MAX_PATH];
+    char frame_format_name[8]; /**< [output] frame_format, as written */
+    uint32_t frame_format;     /**< enum scan_frame_format */
+    char keep_frames_name[8];  /**< [output] keep_frames, as written */
+    uint32_t keep_frames;      /**< enum keep_frames */
     double min_fragment_share; /**< [output]: smaller floating pieces are left out of the mesh */
     double max_hole_mm;        /**< [output]: holes up to this wide are filled */
     uint32_t watertight;       /**< [output]: 1: the model is closed */

@@ -30,11 +30,43 @@ int scan_dir_path(char *buf, size_t len, const char *dir, int view, const char *
     return n < 0 || (size_t)n >= len ? -ENAMETOOLONG : 0;
 }
 
-int scan_dir_frame_path(char *buf, size_t len, const char *dir, uint32_t view, uint32_t frame)
+/* File name endings of each format, and of the ones a reader looks for (older scans: PNG). */
+static const char *frame_ending(enum scan_frame_format format, uint32_t channels)
+{
+    switch (format) {
+    case SCAN_FRAMES_PNG:
+        return ".png";
+    case SCAN_FRAMES_PNM:
+        return channels == 3 ? ".ppm" : ".pgm";
+    default:
+        return channels == 3 ? ".ppm.zst" : ".pgm.zst";
+    }
+}
+static const char *const frame_endings[] = {".pgm.zst", ".ppm.zst", ".png", ".pgm", ".ppm"};
+
+int scan_dir_frame_path(char *buf, size_t len, const char *dir, uint32_t view, uint32_t frame,
+                        enum scan_frame_format format, uint32_t channels)
 {
     char name[32];
-    snprintf(name, sizeof(name), "frame_%02u.png", (unsigned)frame);
+    snprintf(name, sizeof(name), "frame_%02u%s", (unsigned)frame, frame_ending(format, channels));
     return scan_dir_path(buf, len, dir, (int)view, name);
+}
+
+int scan_dir_find_frame(char *buf, size_t len, const char *dir, uint32_t view, uint32_t frame)
+{
+    char name[32];
+    struct stat sb;
+    for (size_t k = 0; k < sizeof(frame_endings) / sizeof(frame_endings[0]); k++) {
+        snprintf(name, sizeof(name), "frame_%02u%s", (unsigned)frame, frame_endings[k]);
+        int rc = scan_dir_path(buf, len, dir, (int)view, name);
+        if (rc != 0)
+            return rc;
+        if (stat(buf, &sb) == 0)
+            return 0;
+    }
+    snprintf(name, sizeof(name), "frame_%02u", (unsigned)frame);
+    int rc = scan_dir_path(buf, len, dir, (int)view, name);
+    return rc != 0 ? rc : -ENOENT;
 }
 
 /* ---- what each frame shows ---- */
@@ -214,11 +246,17 @@ int scan_dir_view_complete(const char *dir, uint32_t view)
 
 int scan_dir_write_frame(const struct hal_storage *st, const char *dir, uint32_t view,
                          uint32_t frame, const uint8_t *pixels, uint32_t width, uint32_t height,
-                         uint32_t channels)
+                         uint32_t channels, enum scan_frame_format format)
 {
     char path[SCAN_DIR_PATH_MAX];
-    int rc = scan_dir_frame_path(path, sizeof(path), dir, view, frame);
-    return rc != 0 ? rc : image_write_png(st, path, pixels, width, height, (int)channels);
+    int rc = scan_dir_frame_path(path, sizeof(path), dir, view, frame, format, channels);
+    if (rc != 0)
+        return rc;
+    if (format == SCAN_FRAMES_PNG)
+        return image_write_png(st, path, pixels, width, height, (int)channels);
+    /* zstd level 1: make bench's frame table (bench/bench_frames.c) */
+    return image_write_pnm(st, path, pixels, width, height, (int)channels,
+                           format == SCAN_FRAMES_ZSTD ? 1 : 0);
 }
 
 int scan_dir_read_frame(const char *dir, uint32_t view, uint32_t frame, uint8_t *pixels,
@@ -227,9 +265,14 @@ int scan_dir_read_frame(const char *dir, uint32_t view, uint32_t frame, uint8_t 
 {
     char path[SCAN_DIR_PATH_MAX], why[160];
     uint32_t w = 0, h = 0;
-    int rc = scan_dir_frame_path(path, sizeof(path), dir, view, frame);
-    if (rc == 0)
+    int rc = scan_dir_find_frame(path, sizeof(path), dir, view, frame);
+    size_t n = strlen(path);
+    if (rc == -ENOENT)
+        snprintf(why, sizeof(why), "no such frame (.pgm.zst, .ppm.zst, .png, .pgm or .ppm)");
+    else if (rc == 0 && n > 4 && strcmp(path + n - 4, ".png") == 0)
         rc = image_read_png(path, pixels, capacity, &w, &h, (int)channels, why, sizeof(why));
+    else if (rc == 0)
+        rc = image_read_pnm(path, pixels, capacity, &w, &h, (int)channels, why, sizeof(why));
     if (rc == 0 && (w != width || h != height)) {
         snprintf(why, sizeof(why), "%ux%u, but this scan's frames are %ux%u", (unsigned)w,
                  (unsigned)h, (unsigned)width, (unsigned)height);
@@ -237,6 +280,137 @@ int scan_dir_read_frame(const char *dir, uint32_t view, uint32_t frame, uint8_t 
     }
     if (rc != 0)
         snprintf(err, err_len, "%s: %s", path, why);
+    return rc;
+}
+
+/* ---- range.bin ---- */
+
+/* The file's header; then width * height reason bytes, then a range_point per valid pixel in
+ * pixel order. Native byte order (little-endian on every board the scanner builds for). */
+struct range_header {
+    char magic[8]; /* "SCANRNG1" */
+    uint32_t width, height, valid_count, colour_method;
+    int32_t angle_mdeg;
+    uint32_t reserved;
+};
+struct range_point {
+    float xyz_mm[3], normal[3], confidence;
+    uint8_t rgb[3], pad;
+};
+_Static_assert(sizeof(struct range_header) == 32 && sizeof(struct range_point) == 32,
+               "range.bin's layout has no padding");
+static const char range_magic[8] = {'S', 'C', 'A', 'N', 'R', 'N', 'G', '1'};
+#define RANGE_CHUNK 2048u /* points a write or read moves at once */
+
+int scan_dir_write_range(const struct hal_storage *st, const char *dir, uint32_t view,
+                         const struct scan_view *v)
+{
+    static struct range_point chunk[RANGE_CHUNK];
+    char path[SCAN_DIR_PATH_MAX];
+    struct hal_file f;
+    size_t n = (size_t)v->width * v->height, used = 0;
+    uint32_t valid = 0;
+    for (size_t i = 0; i < n; i++)
+        valid += v->maps.reason[i] == SCAN_VALID;
+    struct range_header h = {.width = v->width, .height = v->height, .valid_count = valid,
+                             .colour_method = v->colour_method, .angle_mdeg = v->angle_mdeg};
+    memcpy(h.magic, range_magic, sizeof(h.magic));
+    int rc = scan_dir_path(path, sizeof(path), dir, (int)view, "range.bin");
+    if (rc == 0)
+        rc = hal_storage_open(st, &f, path);
+    if (rc != 0)
+        return rc;
+    rc = hal_storage_write(st, &f, &h, sizeof(h));
+    if (rc == 0)
+        rc = hal_storage_write(st, &f, v->maps.reason, n);
+    for (size_t i = 0; i < n && rc == 0; i++) {
+        if (v->maps.reason[i] != SCAN_VALID)
+            continue;
+        struct range_point *p = &chunk[used++];
+        memcpy(p->xyz_mm, v->range.xyz_mm + 3 * i, sizeof(p->xyz_mm));
+        memcpy(p->normal, v->range.normal + 3 * i, sizeof(p->normal));
+        p->confidence = v->confidence[i];
+        memcpy(p->rgb, v->rgb + 3 * i, 3);
+        p->pad = 0;
+        if (used == RANGE_CHUNK) {
+            rc = hal_storage_write(st, &f, chunk, used * sizeof(chunk[0]));
+            used = 0;
+        }
+    }
+    if (rc == 0 && used > 0)
+        rc = hal_storage_write(st, &f, chunk, used * sizeof(chunk[0]));
+    if (rc == 0)
+        return hal_storage_commit(st, &f);
+    hal_storage_abort(st, &f);
+    return rc;
+}
+
+/* The points of range.bin into @p fill, in pixel order of the reasons already read. */
+static int read_range_points(FILE *fp, size_t n, struct scan_view_fill *fill)
+{
+    static struct range_point chunk[RANGE_CHUNK];
+    size_t have = 0, next = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (fill->reason[i] != SCAN_VALID) {
+            memset(fill->rgb + 3 * i, 0, 3);
+            fill->confidence[i] = 0.0f;
+            continue;
+        }
+        if (next == have) {
+            have = fread(chunk, sizeof(chunk[0]), RANGE_CHUNK, fp);
+            next = 0;
+            if (have == 0)
+                return -EINVAL;
+        }
+        const struct range_point *p = &chunk[next++];
+        memcpy(fill->xyz_mm + 3 * i, p->xyz_mm, sizeof(p->xyz_mm));
+        memcpy(fill->normal + 3 * i, p->normal, sizeof(p->normal));
+        fill->confidence[i] = p->confidence;
+        memcpy(fill->rgb + 3 * i, p->rgb, 3);
+    }
+    return next == have && fgetc(fp) == EOF ? 0 : -EINVAL; /* nothing left over */
+}
+
+int scan_dir_read_range(const char *dir, uint32_t view, uint32_t width, uint32_t height,
+                        struct scan_view *v, char *err, size_t err_len)
+{
+    char path[SCAN_DIR_PATH_MAX];
+    struct range_header h;
+    struct scan_view_fill fill;
+    int rc = scan_dir_path(path, sizeof(path), dir, (int)view, "range.bin");
+    FILE *fp = rc == 0 ? fopen(path, "rb") : NULL;
+    if (fp == NULL) {
+        rc = rc != 0 ? rc : -errno;
+        snprintf(err, err_len, "%s: %s", path, strerror(-rc));
+        return rc;
+    }
+    size_t n = (size_t)width * height;
+    rc = -EINVAL;
+    const char *why = "not a range image (range.bin)";
+    if (fread(&h, sizeof(h), 1, fp) != 1 || memcmp(h.magic, range_magic, sizeof(h.magic)) != 0)
+        goto out_close;
+    why = "of another frame size than this scan's";
+    if (h.width != width || h.height != height || h.valid_count > n)
+        goto out_close;
+    why = "larger than the compiled frame limit";
+    if (scan_restore_view(width, height, h.angle_mdeg, h.valid_count, h.colour_method, v,
+                          &fill) != 0)
+        goto out_close;
+    why = "cut short or damaged";
+    if (fread(fill.reason, 1, n, fp) != n)
+        goto out_close;
+    uint32_t valid = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (fill.reason[i] >= SCAN_REASON_COUNT)
+            goto out_close;
+        valid += fill.reason[i] == SCAN_VALID;
+    }
+    if (valid == h.valid_count && read_range_points(fp, n, &fill) == 0)
+        rc = 0;
+out_close:
+    if (rc != 0)
+        snprintf(err, err_len, "%s: %s", path, why);
+    fclose(fp);
     return rc;
 }
 
@@ -331,10 +505,13 @@ static int scan_file(const char *name)
 static int view_file(const char *name)
 {
     unsigned frame;
-    char tail[8];
-    if (sscanf(name, "frame_%2u.pn%1s", &frame, tail) == 2 && strcmp(tail, "g") == 0)
-        return 1;
+    int end = 0;
+    if (sscanf(name, "frame_%2u%n", &frame, &end) == 1 && end == 8)
+        for (size_t k = 0; k < sizeof(frame_endings) / sizeof(frame_endings[0]); k++)
+            if (strcmp(name + end, frame_endings[k]) == 0)
+                return 1;
     return strcmp(name, "view.ini") == 0 || strcmp(name, "cloud.ply") == 0 ||
+           strcmp(name, "range.bin") == 0 ||
            strcmp(name, "target.ini") == 0 ||
            strcmp(name, "registration.ini") == 0 || strncmp(name, "truth_", 6) == 0;
 }

@@ -7,6 +7,7 @@
 #include "decode.h"
 #include "hal.h"
 #include "reg.h"
+#include "scan.h"
 #include "scan_types.h"
 
 #include <stddef.h>
@@ -38,8 +39,22 @@ struct scan_dir_view {
  *  (@p name NULL: that directory itself). @retval 0 @retval -ENAMETOOLONG */
 int scan_dir_path(char *buf, size_t len, const char *dir, int view, const char *name);
 
-/** Path of frame @p frame of view @p view. @retval 0 @retval -ENAMETOOLONG */
-int scan_dir_frame_path(char *buf, size_t len, const char *dir, uint32_t view, uint32_t frame);
+/** How frames are kept ([output] frame_format): make bench compares them. */
+enum scan_frame_format {
+    SCAN_FRAMES_ZSTD, /**< frame_NN.pgm.zst / .ppm.zst: a PGM/PPM in one zstd frame (zstd -d) */
+    SCAN_FRAMES_PNG,  /**< frame_NN.png */
+    SCAN_FRAMES_PNM,  /**< frame_NN.pgm / .ppm, uncompressed */
+};
+
+/** Path of frame @p frame of view @p view as @p format writes it (@p channels 1 or 3).
+ *  @retval 0 @retval -ENAMETOOLONG */
+int scan_dir_frame_path(char *buf, size_t len, const char *dir, uint32_t view, uint32_t frame,
+                        enum scan_frame_format format, uint32_t channels);
+
+/** Path of the file frame @p frame of view @p view is kept in, whatever its format.
+ *  @retval 0 @retval -ENOENT none (@p buf: the frame's path without an ending)
+ *  @retval -ENAMETOOLONG */
+int scan_dir_find_frame(char *buf, size_t len, const char *dir, uint32_t view, uint32_t frame);
 
 /** Describe every frame a view of @p params and @p calib takes, in order, into
  *  @p v->frame_name and @p v->frame_count. */
@@ -63,17 +78,31 @@ int scan_dir_read_view_file(const char *path, uint32_t view, struct scan_dir_vie
 /** @retval 1 when view @p view finished (its view.ini is there and reads) */
 int scan_dir_view_complete(const char *dir, uint32_t view);
 
-/** Keep frame @p frame of view @p view (8-bit PNG, @p channels 1 or 3), atomically. */
+/** Keep frame @p frame of view @p view (8 bits, @p channels 1 or 3) in @p format, atomically.
+ *  @retval 0 @retval -errno */
 int scan_dir_write_frame(const struct hal_storage *st, const char *dir, uint32_t view,
                          uint32_t frame, const uint8_t *pixels, uint32_t width, uint32_t height,
-                         uint32_t channels);
+                         uint32_t channels, enum scan_frame_format format);
 
-/** Read frame @p frame of view @p view into @p pixels as @p channels (1 or 3); it must be an
- *  8-bit PNG without alpha of @p width x @p height. @p err names the file and says what is
+/** Read frame @p frame of view @p view into @p pixels as @p channels (1 or 3), whatever format
+ *  it was kept in; it must be 8 bits without alpha, @p width x @p height. @p err names the file and says what is
  *  wrong (libpng's own words for a damaged file). @retval 0 @retval -ENOENT @retval -EINVAL */
 int scan_dir_read_frame(const char *dir, uint32_t view, uint32_t frame, uint8_t *pixels,
                         size_t capacity, uint32_t width, uint32_t height, uint32_t channels,
                         char *err, size_t err_len);
+
+/** Keep view @p view's range image (range.bin: reason per pixel; point, normal, colour and
+ *  colour confidence per valid pixel), atomically, so that the model can be made again (after
+ *  the registration, by resume, by process) without decoding the frames.
+ *  @retval 0 @retval -errno */
+int scan_dir_write_range(const struct hal_storage *st, const char *dir, uint32_t view,
+                         const struct scan_view *v);
+
+/** Read view @p view's range.bin into the firmware's buffers (scan_restore_view); @p v points
+ *  at them. It must be @p width x @p height. @retval 0 @retval -ENOENT none @retval -EINVAL
+ *  damaged or of another size (@p err names the file and says what) */
+int scan_dir_read_range(const char *dir, uint32_t view, uint32_t width, uint32_t height,
+                        struct scan_view *v, char *err, size_t err_len);
 
 /** Write view @p view's registration.ini: the scan's joint registration @p r, this view's part
  *  of it @p v, and @p pose, the camera-to-object pose it was fused with.

@@ -4,6 +4,7 @@
 
 #include "board.h"
 #include "colour.h"
+#include "frame_writer.h"
 #include "fusion.h"
 #include "gray.h"
 #include "scan.h"
@@ -26,6 +27,8 @@ struct job {
     const char *out_dir;
     uint32_t views;
     double start_ms;
+    double start_cpu_s, start_sim_cpu_s; /* the process's CPU, and the simulator's part of it */
+    uint64_t start_rig_us;               /* the rig's clock (the simulator's: the modelled rig's) */
     int tty;
     uint32_t view;                    /* the view being taken or processed */
     char view_dir[SCAN_DIR_PATH_MAX]; /* its directory */
@@ -33,6 +36,8 @@ struct job {
 
 static int load_view(struct job *j, const char *scan_dir, uint32_t v, struct scan_view *view,
                      struct scan_view_info *info);
+static int load_range(struct job *j, const char *scan_dir, uint32_t v, struct scan_view *view,
+                      struct scan_view_info *info);
 static int stopped_offline(struct job *j, const char *scan_dir, uint32_t v);
 
 static double wall_ms(void)
@@ -50,6 +55,14 @@ static double cpu_s(void)
     return (double)ts.tv_sec + (double)ts.tv_nsec / 1e9;
 }
 
+/* CPU time of the whole process (every thread). */
+static double process_cpu_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec / 1e9;
+}
+
 static void job_init(struct job *j, const struct hal *hal, const struct app_config *cfg,
                      const struct scan_calib *calib, const struct scan_job_opts *opts,
                      const char *out_dir)
@@ -61,7 +74,35 @@ static void job_init(struct job *j, const struct hal *hal, const struct app_conf
                       .out_dir = out_dir,
                       .views = cfg->views * cfg->passes, /* every pass's */
                       .start_ms = wall_ms(),
+                      .start_cpu_s = process_cpu_s(),
+                      .start_sim_cpu_s = board_simulator_cpu_s(),
                       .tty = isatty(STDOUT_FILENO) && !opts->json};
+    if (hal_clock_now_us(&hal->clock, &j->start_rig_us) != 0)
+        j->start_rig_us = 0;
+}
+
+static void progress(struct job *j, const char *event, int view, uint32_t done,
+                     const char *detail);
+
+/* What the job cost: the rig's time (with the simulator, the modelled rig's: its turntable and
+ * frame rate) and the CPU the scanner spent, the simulator's rendering left out. make bench
+ * reads this line. */
+static void report_cost(struct job *j, const char *what)
+{
+    uint64_t now_us = j->start_rig_us;
+    hal_clock_now_us(&j->hal->clock, &now_us);
+    double cpu = process_cpu_s() - j->start_cpu_s;
+    double sim = board_simulator_cpu_s() - j->start_sim_cpu_s, own = cpu - sim;
+    double storage = frame_writer_cpu_s();
+    char detail[320];
+    int n = snprintf(detail, sizeof(detail),
+                     "%s %.2f s CPU for %u views (%.3f s a view; storage thread %.2f s)", what,
+                     own, (unsigned)j->views, own / (j->views ? j->views : 1), storage);
+    if (sim > 0.0 && n > 0 && (size_t)n < sizeof(detail))
+        snprintf(detail + n, sizeof(detail) - (size_t)n,
+                 ", the simulator's rendering (%.2f s) left out; %.1f s on the rig's clock",
+                 sim, (double)(now_us - j->start_rig_us) / 1e6);
+    progress(j, "cost", -1, j->views, detail);
 }
 
 static void utc_now(char *buf, size_t len)
@@ -125,6 +166,7 @@ static void progress(struct job *j, const char *event, int view, uint32_t done, 
                                                {"scan_failed", "scan failed:"},
                                                {"process_start", "processing"},
                                                {"registration", "registration:"},
+                                               {"cost", "cost:"},
                                                {"place_object", ">>>"},
                                                {"process_done", "process finished:"}};
         const char *text = event;
@@ -157,15 +199,44 @@ static int write_failed(const struct job *j, const char *name, int rc)
     return rc;
 }
 
+/* Frames a scan keeps ([output] keep_frames): "colour" keeps the white pattern (the colour of
+ * method none, the white of the others), the light frames and an HDR scan's colour frame. */
+static int keeps_frame(const struct job *j, uint32_t frame)
+{
+    if (j->cfg->keep_frames != KEEP_FRAMES_COLOUR)
+        return j->cfg->keep_frames == KEEP_FRAMES_ALL;
+    struct gray_layout layout;
+    scan_layout(&j->cfg->scan, j->calib, &layout);
+    return frame >= gray_layout_count(&layout) ||
+           (frame == GRAY_PATTERN_WHITE && j->cfg->scan.exposure_count == 0);
+}
+
+/* A frame goes to the storage thread; a write of an earlier frame that failed is said here,
+ * once, with its file. */
 static int save_frame(void *priv, uint32_t pattern, const uint8_t *pixels, uint32_t width,
                       uint32_t height, uint32_t channels)
 {
     struct job *j = priv;
-    char name[32];
-    snprintf(name, sizeof(name), "frame_%02u.png", (unsigned)pattern);
-    return write_failed(j, name,
-                        scan_dir_write_frame(&j->hal->storage, j->out_dir, j->view, pattern, pixels,
-                                             width, height, channels));
+    char failed[SCAN_DIR_PATH_MAX] = "";
+    if (!keeps_frame(j, pattern))
+        return 0;
+    int rc = frame_writer_put(j->out_dir, j->view, pattern, pixels, width, height, channels,
+                              (enum scan_frame_format)j->cfg->frame_format, failed,
+                              sizeof(failed));
+    if (rc != 0)
+        j->hal->log(HAL_LOG_ERROR, "cannot write %s: %s", failed[0] ? failed : j->view_dir,
+                    strerror(-rc));
+    return rc;
+}
+
+/* Every frame of the view on disk (before its view.ini); a failed write said once. */
+static int flush_frames(const struct job *j)
+{
+    char failed[SCAN_DIR_PATH_MAX] = "";
+    int rc = frame_writer_flush(failed, sizeof(failed));
+    if (rc != 0)
+        j->hal->log(HAL_LOG_ERROR, "cannot write %s: %s", failed, strerror(-rc));
+    return rc;
 }
 
 void scan_job_view_meta(const struct app_config *cfg, const struct scan_params *params,
@@ -336,7 +407,8 @@ static int report_registration(struct job *j, const struct reg_report *r, double
 
 /* Once every view is in: register them jointly, then fuse each at its registered pose. The
  * fusion must wait for the registration, and the views' range images are not kept in memory
- * (a view's are 40 MB), so each view is decoded again from its kept frames in @p scan_dir. */
+ * (a view's are 40 MB): each is read back from its range.bin in the output directory, or, for a
+ * scan kept before range.bin existed, decoded again from its frames in @p scan_dir. */
 static int make_model(struct job *j, const char *scan_dir)
 {
     struct reg_report rep;
@@ -350,7 +422,7 @@ static int make_model(struct job *j, const char *scan_dir)
         struct scan_view_info info;
         rc = stopped_offline(j, scan_dir, v);
         if (rc == 0)
-            rc = load_view(j, scan_dir, v, &view, &info);
+            rc = load_range(j, scan_dir, v, &view, &info);
         if (rc == 0 && (rc = hal_storage_mkdir_p(&j->hal->storage, j->view_dir)) != 0)
             j->hal->log(HAL_LOG_ERROR, "cannot make %s: %s", j->view_dir, strerror(-rc));
         struct reg_view rv;
@@ -424,6 +496,9 @@ static int live_view(struct job *j, uint32_t v)
     struct scan_view_info info;
     double t0 = wall_ms();
     rc = scan_take_view(hal, &j->cfg->scan, j->calib, st.position_mdeg, &sink, &view, &info);
+    int rc_frames = flush_frames(j); /* nothing writes into the view's directory after this */
+    if (rc == 0)
+        rc = rc_frames;
     if (rc != 0) { /* the layer that met the fault has said what it was */
         char kept[2 * HAL_MAX_PATH + 96];
         hal->log(HAL_LOG_WARN, "view %u at %.3f deg was not finished (%s); %s", (unsigned)v,
@@ -433,6 +508,9 @@ static int live_view(struct job *j, uint32_t v)
     }
     progress(j, "saving", (int)v, v, "");
     rc = scan_keep_for_registration(v, &view); /* the model is made once every view is in */
+    if (rc == 0) /* what the model is made of, so that it is not decoded again */
+        rc = write_failed(j, "range.bin",
+                          scan_dir_write_range(&hal->storage, j->out_dir, v, &view));
     if (rc == 0)
         rc = write_failed(j, "(the simulator's truth)", board_write_view_extras(hal, j->view_dir));
     /* view.ini last: its presence says the view is complete */
@@ -465,6 +543,15 @@ static int ask_for_second_pass(struct job *j)
     fflush(stdout);
     char line[64];
     return fgets(line, sizeof(line), stdin) == NULL || hal_should_stop(j->hal) ? -EINTR : 0;
+}
+
+/* The storage thread that keeps the frames while the next are taken. */
+static int start_storage(const struct job *j)
+{
+    int rc = frame_writer_start(&j->hal->storage);
+    if (rc != 0)
+        j->hal->log(HAL_LOG_ERROR, "cannot start the storage thread: %s", strerror(-rc));
+    return rc;
 }
 
 /* Home the table, then take views @p first .. the last, each saved before the next move; a
@@ -534,9 +621,14 @@ int scan_job_live(const struct hal *hal, const struct app_config *cfg,
     if (rc != 0)
         goto out_unlock;
     progress(&j, "scan_start", -1, 0, j.out_dir);
-    rc = home_and_take_views(&j, 0);
+    rc = start_storage(&j);
+    if (rc == 0)
+        rc = home_and_take_views(&j, 0);
+    frame_writer_stop();
     if (rc == 0)
         rc = make_model(&j, j.out_dir);
+    if (rc == 0)
+        report_cost(&j, "the scan");
     if (rc == 0)
         progress(&j, "scan_done", -1, j.views, finished_detail(&j, path, sizeof(path)));
     else if (opts->json)
@@ -589,7 +681,10 @@ int scan_job_resume(const struct hal *hal, const struct app_config *cfg,
     if (first < j.views) {
         rc = begin_model(&j); /* the model comes from scan_job_process afterwards */
         if (rc == 0)
+            rc = start_storage(&j);
+        if (rc == 0)
             rc = home_and_take_views(&j, first);
+        frame_writer_stop();
     }
     scan_dir_close(lock_fd);
     return rc;
@@ -636,6 +731,53 @@ int scan_job_feed_view(const char *scan_dir, uint32_t v, const struct scan_param
                  : f < count + lights ? scan_feed_light_frame(f - count, pixels)
                                       : scan_feed_white_colour(pixels);
     }
+    return rc;
+}
+
+/* Reasons counted and valid points of a view read back from its range.bin. */
+static void count_reasons(const struct scan_view *view, struct scan_view_info *info)
+{
+    memset(info, 0, sizeof(*info));
+    info->angle_mdeg = view->angle_mdeg;
+    for (size_t i = 0; i < (size_t)view->width * view->height; i++)
+        info->reason_count[view->maps.reason[i]]++;
+    info->valid_points = info->reason_count[SCAN_VALID];
+}
+
+/* View @p v as the model is made of it: its range.bin in the output directory, else (a scan
+ * from before range.bin) decoded again from its frames in @p scan_dir. */
+static int load_range(struct job *j, const char *scan_dir, uint32_t v, struct scan_view *view,
+                      struct scan_view_info *info)
+{
+    char err[SCAN_DIR_PATH_MAX + 128];
+    int rc = scan_dir_read_range(j->out_dir, v, j->cfg->scan.width, j->cfg->scan.height, view,
+                                 err, sizeof(err));
+    if (rc == 0) {
+        set_view(j, v);
+        count_reasons(view, info);
+        return 0;
+    }
+    if (j->cfg->keep_frames != KEEP_FRAMES_ALL) {
+        j->hal->log(HAL_LOG_ERROR, "%s; the scan kept no pattern frames to decode it from", err);
+        return rc;
+    }
+    if (rc != -ENOENT)
+        j->hal->log(HAL_LOG_WARN, "%s: decoded again from its frames", err);
+    return load_view(j, scan_dir, v, view, info);
+}
+
+/* View @p v of a scan that kept no pattern frames: its range.bin in @p scan_dir. */
+static int load_kept_range(struct job *j, const char *scan_dir, uint32_t v,
+                           struct scan_view *view, struct scan_view_info *info)
+{
+    char err[SCAN_DIR_PATH_MAX + 128];
+    set_view(j, v);
+    int rc = scan_dir_read_range(scan_dir, v, j->cfg->scan.width, j->cfg->scan.height, view, err,
+                                 sizeof(err));
+    if (rc != 0)
+        j->hal->log(HAL_LOG_ERROR, "%s; the scan kept no pattern frames to decode it from", err);
+    else
+        count_reasons(view, info);
     return rc;
 }
 
@@ -704,14 +846,27 @@ int scan_job_process(const struct hal *hal, const char *scan_dir, const struct s
     if (rc == 0)
         rc = begin_model(&j);
     progress(&j, "process_start", -1, 0, scan_dir);
+    if (rc == 0 && cfg.keep_frames != KEEP_FRAMES_ALL)
+        hal->log(HAL_LOG_WARN,
+                 "%s kept %s of its camera frames ([output] keep_frames = %s): its views are "
+                 "registered and fused again from their range images (range.bin) as they were "
+                 "decoded and coloured; [scan] and [colour] settings cannot change them",
+                 scan_dir, cfg.keep_frames == KEEP_FRAMES_NONE ? "none" : "only the colour",
+                 cfg.keep_frames_name);
     for (uint32_t v = 0; v < j.views && rc == 0; v++) {
         struct scan_view view;
         struct scan_view_info info;
         rc = stopped_offline(&j, scan_dir, v);
         if (rc == 0)
-            rc = load_view(&j, scan_dir, v, &view, &info);
+            rc = cfg.keep_frames == KEEP_FRAMES_ALL ? load_view(&j, scan_dir, v, &view, &info)
+                                                    : load_kept_range(&j, scan_dir, v, &view, &info);
         if (rc == 0)
             rc = scan_keep_for_registration(v, &view);
+        if (rc == 0 && (rc = hal_storage_mkdir_p(&hal->storage, j.view_dir)) != 0)
+            hal->log(HAL_LOG_ERROR, "cannot make %s: %s", j.view_dir, strerror(-rc));
+        if (rc == 0) /* the model is made of this one, not of an older range.bin */
+            rc = write_failed(&j, "range.bin",
+                              scan_dir_write_range(&hal->storage, j.out_dir, v, &view));
         if (rc == 0) {
             char detail[HAL_MAX_PATH + 160];
             describe(detail, sizeof(detail), &info, j.view_dir);
@@ -720,6 +875,8 @@ int scan_job_process(const struct hal *hal, const char *scan_dir, const struct s
     }
     if (rc == 0)
         rc = make_model(&j, scan_dir);
+    if (rc == 0)
+        report_cost(&j, "processing");
     if (rc == 0)
         progress(&j, "process_done", -1, j.views, finished_detail(&j, path, sizeof(path)));
     scan_dir_close(lock_fd);

@@ -39,6 +39,10 @@ int board_write_scan_extras(const struct hal *hal, const char *scan_dir);
 /** Extra files for a finished view (the simulator writes its ground truth). @retval 0 or -errno */
 int board_write_view_extras(const struct hal *hal, const char *view_dir);
 
+/** CPU time this process spent being the simulated rig (rendering frames, writing its ground
+ *  truth), in seconds: a scan's own CPU is its total less this. 0 on a real rig. */
+double board_simulator_cpu_s(void);
+
 /** What the person puts on the turntable for a calibration step. */
 enum board_target_kind { BOARD_TARGET_OBJECT = 0, BOARD_TARGET_BOARD, BOARD_TARGET_SPHERE };
 struct board_target {

@@ -118,6 +118,11 @@ int board_write_scan_extras(const struct hal *hal, const char *scan_dir)
     return 0; /* real hardware has no ground truth to write */
 }
 
+double board_simulator_cpu_s(void)
+{
+    return 0.0; /* a real rig: no simulator in this process */
+}
+
 int board_write_view_extras(const struct hal *hal, const char *view_dir)
 {
     (void)hal;

@@ -246,6 +246,24 @@ int scan_finish_view(const struct scan_calib *c, int32_t angle_mdeg, struct scan
     return 0;
 }
 
+int scan_restore_view(uint32_t width, uint32_t height, int32_t angle_mdeg, uint32_t valid_count,
+                      uint32_t colour_method, struct scan_view *view, struct scan_view_fill *fill)
+{
+    memset(view, 0, sizeof(*view));
+    int rc = tri_restore(width, height, valid_count, &view->range, &fill->xyz_mm, &fill->normal);
+    if (rc != 0)
+        return rc;
+    view->width = width;
+    view->height = height;
+    view->angle_mdeg = angle_mdeg;
+    view->maps = (struct decode_maps){.reason = view_reason, .width = width, .height = height};
+    view->rgb = fill->rgb = view_rgb;
+    view->confidence = fill->confidence = view_confidence;
+    view->colour_method = colour_method;
+    fill->reason = view_reason;
+    return 0;
+}
+
 /* HDR: pattern @p i at every exposure, merged in the decoder's slot before it is fed: each
  * pixel at the exposure hdr_choice holds, chosen on the white pattern as the longest whose
  * white is not saturated (the brightest unsaturated). The pixel's patterns, inverses, white and

@@ -38,6 +38,23 @@ struct scan_view {
     uint32_t colour_method; /**< enum colour_method the colour was made with */
 };
 
+/** Where a view restored from its kept range image goes (scan_restore_view): the firmware's
+ *  own buffers, to be filled by the caller. */
+struct scan_view_fill {
+    uint8_t *reason;  /**< width * height reason codes */
+    float *xyz_mm;    /**< 3 per pixel (valid pixels) */
+    float *normal;    /**< 3 per pixel (valid pixels) */
+    uint8_t *rgb;     /**< 3 per pixel */
+    float *confidence;
+};
+
+/** A view as the stages after decoding take it (registration, cloud, fusion), from a range
+ *  image kept earlier instead of from frames: @p view points into the firmware's buffers, which
+ *  @p fill gives to the caller to fill. No colour frames (recolouring needs frames).
+ *  @retval 0 @retval -E2BIG larger than the compiled limits */
+int scan_restore_view(uint32_t width, uint32_t height, int32_t angle_mdeg, uint32_t valid_count,
+                      uint32_t colour_method, struct scan_view *view, struct scan_view_fill *fill);
+
 /** Check parameters and calibration against each other and the compiled limits.
  *  @param msg  out: a sentence saying what is wrong
  *  @retval 0 ok @retval -EINVAL */

@@ -152,3 +152,15 @@ int tri_normals(struct tri_range *range, uint8_t *reason, uint32_t radius_px,
     range->valid_count = valid;
     return 0;
 }
+
+int tri_restore(uint32_t width, uint32_t height, uint32_t valid_count, struct tri_range *range,
+                float **xyz_mm, float **normal)
+{
+    if ((uint64_t)width * height > HAL_MAX_PIXELS)
+        return -E2BIG;
+    *range = (struct tri_range){.xyz_mm = xyz_map, .normal = normal_map, .width = width,
+                                .height = height, .valid_count = valid_count};
+    *xyz_mm = xyz_map;
+    *normal = normal_map;
+    return 0;
+}

@@ -35,4 +35,11 @@ int tri_range_image(const struct scan_calib *calib, uint32_t width, uint32_t hei
  *  @retval 0 */
 int tri_normals(struct tri_range *range, uint8_t *reason, uint32_t radius_px,
                 double max_depth_jump_mm);
+
+/** The triangulator's buffers, to be filled with a range image kept earlier (a view restored
+ *  from its scan directory) instead of triangulated. @param range  out: points to them, with
+ *  @p width, @p height and @p valid_count @param xyz_mm, normal  out: the same, writable
+ *  @retval 0 @retval -E2BIG larger than the compiled limit */
+int tri_restore(uint32_t width, uint32_t height, uint32_t valid_count, struct tri_range *range,
+                float **xyz_mm, float **normal);
 #endif

@@ -1,8 +1,12 @@
 /* Simulated camera: renders the rig in its current light state, with injectable faults. */
-#include "sim_devices.h"
 
+#define _POSIX_C_SOURCE 200809L
 #include <errno.h>
+#include <math.h>
 #include <string.h>
+#include <time.h>
+
+#include "sim_devices.h"
 
 static int camera_sim_open(void *priv, const struct hal_camera_config *cfg)
 {
@@ -49,6 +53,30 @@ static int stale(struct camera_sim *cam, struct sim_sources *src, uint64_t *star
     return 1;
 }
 
+static double thread_cpu_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec / 1e9;
+}
+
+/* When a frame asked for at @p now_us begins and arrives. A streaming sensor starts a frame
+ * every period (1 / frame_rate_hz, longer when the exposure is): the next start after the
+ * request, then the whole frame time and the readout before it arrives. Without a frame rate,
+ * a frame takes its exposure from the request on. */
+static void frame_times(const struct camera_sim *cam, uint64_t now_us, uint64_t *start_us,
+                        uint64_t *arrive_us)
+{
+    if (cam->frame_rate_hz <= 0.0) {
+        *start_us = now_us;
+        *arrive_us = now_us + cam->cfg.exposure_us;
+        return;
+    }
+    double period = fmax(1e6 / cam->frame_rate_hz, (double)cam->cfg.exposure_us);
+    *start_us = (uint64_t)(ceil((double)now_us / period) * period);
+    *arrive_us = *start_us + (uint64_t)period + cam->readout_us;
+}
+
 static int camera_sim_capture(void *priv, struct hal_image *img)
 {
     struct camera_sim *cam = priv;
@@ -70,15 +98,20 @@ static int camera_sim_capture(void *priv, struct hal_image *img)
     gpio_sim_sources(cam->gpio, cam->light_count, &src);
     src.exposure_us = cam->cfg.exposure_us;
     src.gain_milli = cam->cfg.gain_milli;
-    uint64_t start_us = clock_sim_now(cam->clock);
+    uint64_t start_us, arrive_us;
+    frame_times(cam, clock_sim_now(cam->clock), &start_us, &arrive_us);
     if (!(faulty && stale(cam, &src, &start_us))) {
         cam->shown = src;
         cam->shown_start_us = start_us;
         cam->shown_angle_mdeg = cam->rig->table_angle_mdeg;
         cam->has_shown = 1;
     }
+    double t0 = thread_cpu_s();
     sim_rig_render(cam->rig, &src, noise_id(cam, &src), img->rgb);
-    atomic_fetch_add(&cam->clock->now_us, (uint64_t)cam->cfg.exposure_us);
+    cam->render_cpu_s += thread_cpu_s() - t0;
+    uint64_t now_us = clock_sim_now(cam->clock);
+    if (arrive_us > now_us)
+        atomic_fetch_add(&cam->clock->now_us, arrive_us - now_us);
     img->width = cam->rig->width;
     img->height = cam->rig->height;
     img->sequence = frame;

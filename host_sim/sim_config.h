@@ -30,6 +30,8 @@ struct sim_config {
     double black_offset_dn, ambient_dn, read_noise_dn, electrons_per_dn;
     double projector_intensity_dn, projector_black_level, projector_blur_px;
     double camera_blur_px;  /**< sigma of the camera lens's Gaussian point spread */
+    double frame_rate_hz;   /**< the sensor's streaming rate (0: a frame takes its exposure) */
+    uint32_t readout_us;    /**< from a frame's end to its arrival */
     uint32_t jpeg_quality;  /**< 1..100: every frame goes through a JPEG round trip; 0: off */
     uint32_t bounce_samples; /**< one bounce of the projector's light: directions per point */
     double light_intensity_dn, light_diffuser_mm, reference_distance_mm;

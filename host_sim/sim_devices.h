@@ -21,8 +21,11 @@ struct clock_sim {
 struct camera_sim {
     struct sim_rig *rig;
     const struct gpio_sim *gpio;
-    struct clock_sim *clock; /* a frame takes its exposure time */
+    struct clock_sim *clock; /* frames are paced as a streaming sensor paces them */
     uint32_t light_count;
+    double frame_rate_hz; /* the sensor streams at this rate; 0: a frame takes its exposure */
+    uint32_t readout_us;  /* from a frame's end to its arrival (ISP, transfer) */
+    double render_cpu_s;  /* CPU time spent rendering: the simulator's, not the firmware's */
     struct hal_camera_config cfg;
     int32_t (*table_angle)(void *priv); /* where the turntable is, if there is one */
     void *table_priv;

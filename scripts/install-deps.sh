@@ -8,8 +8,8 @@
 # virtual machine of tests/gpio_chip.sh, with a target triplet
 # (aarch64-linux-gnu) what cross-building for it needs.
 set -eu
-pkgs="build-essential pkg-config libinih-dev libpng-dev libjpeg-dev libdrm-dev libcmocka-dev libmodbus-dev libgpiod-dev libseccomp-dev"
-[ "${1:-}" = "bench" ] && pkgs="$pkgs g++ libopencv-dev libopencv-contrib-dev valgrind"
+pkgs="build-essential pkg-config libinih-dev libpng-dev libzstd-dev libjpeg-dev libdrm-dev libcmocka-dev libmodbus-dev libgpiod-dev libseccomp-dev"
+[ "${1:-}" = "bench" ] && pkgs="$pkgs g++ libopencv-dev libopencv-contrib-dev valgrind libspng-dev libzstd-dev python3-open3d"
 [ "${1:-}" = "fuzz" ] && pkgs="$pkgs clang libclang-rt-14-dev"
 [ "${1:-}" = "gpio-chip" ] && pkgs="qemu-system-arm cpio systemd socat python3"
 [ "${1:-}" = "test" ] && pkgs="$pkgs python3 python3-numpy python3-open3d python3-pymodbus python3-serial python3-serial-asyncio socat g++ libcamera-dev libopencv-contrib-dev systemd valgrind"
@@ -19,7 +19,7 @@ case "${1:-}" in
 *-linux-gnu*)
     arch=$(dpkg-architecture -t "$1" -q DEB_HOST_ARCH 2>/dev/null || echo arm64)
     pkgs="pkg-config gcc-$1 binutils-$1 qemu-user"
-    for p in libinih-dev libpng-dev libjpeg-dev libdrm-dev libcmocka-dev libmodbus-dev libgpiod-dev libseccomp-dev; do
+    for p in libinih-dev libpng-dev libzstd-dev libjpeg-dev libdrm-dev libcmocka-dev libmodbus-dev libgpiod-dev libseccomp-dev; do
         pkgs="$pkgs $p:$arch"
     done
     if ! dpkg --print-foreign-architectures | grep -qx "$arch"; then

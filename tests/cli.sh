@@ -136,8 +136,8 @@ two_scanners_test() {
     [ "$rc" -ne 0 ] && grep -q 'another scanner is using this directory' "$out/second.txt"
 }
 check two_scanners_cannot_share_a_directory two_scanners_test
-check scan_dir_complete sh -c "for f in config.ini calibration.ini view_000/cloud.ply view_000/frame_00.png \
-    view_000/frame_21.png view_000/view.ini view_000/truth_depth_mm.pfm view_000/truth_albedo.png \
+check scan_dir_complete sh -c "for f in config.ini calibration.ini view_000/cloud.ply view_000/frame_00.ppm.zst \
+    view_000/frame_21.pgm.zst view_000/view.ini view_000/truth_depth_mm.pfm view_000/truth_albedo.png \
     view_000/truth_angle.ini view_000/registration.ini; do test -s $out/scan/\$f || exit 1; done &&
     grep -q '^pose_rotation = ' $out/scan/view_003/registration.ini &&
     grep -q '^angle_mdeg = 135000' $out/scan/view_003/truth_angle.ini"
@@ -196,9 +196,9 @@ import json, sys
 events = [json.loads(line)[\"event\"] for line in sys.stdin]
 assert events[0] == \"process_start\" and events[-1] == \"process_done\", events
 assert \"registration\" in events and events.count(\"fused\") == 8, events'"
-cp -r "$out/scan" "$out/broken" 2>/dev/null; rm -f "$out/broken/view_000/frame_07.png"
+cp -r "$out/scan" "$out/broken" 2>/dev/null; rm -f "$out/broken/view_000/frame_07.pgm.zst"
 check process_names_missing_frame sh -c "$bin process $out/broken --out $out/broken_out 2>&1 | \
-    grep -q 'view_000/frame_07.png: No such file'; test \$? -eq 0"
+    grep -q 'view_000/frame_07: no such frame'; test \$? -eq 0"
 # A stop signal mid-scan (Ctrl-C, systemd's SIGTERM, a dropped ssh session's SIGHUP, Ctrl-\,
 # Ctrl-Z): the scan stops between frames, says so, and the rig ends in its safe state; the
 # process neither dies lit nor freezes lit.

@@ -26,7 +26,7 @@ intact() { # every finished view holds the reference's frames
     for ini in "$out/killed"/view_*/view.ini; do
         [ -f "$ini" ] || continue
         v=$(dirname "$ini")
-        for f in "$out/reference/$(basename "$v")"/frame_*.png; do
+        for f in "$out/reference/$(basename "$v")"/frame_*; do
             cmp -s "$f" "$v/$(basename "$f")" || return 1
         done
     done

@@ -141,7 +141,7 @@ static void test_view_ini_bad_values(void **state)
 static void write_frame_bytes(const char *dir, const void *bytes, size_t n)
 {
     char path[SCAN_DIR_PATH_MAX];
-    assert_int_equal(scan_dir_frame_path(path, sizeof(path), dir, 0, 3), 0);
+    assert_int_equal(scan_dir_frame_path(path, sizeof(path), dir, 0, 3, SCAN_FRAMES_PNG, 1), 0);
     FILE *f = fopen(path, "wb");
     assert_non_null(f);
     assert_int_equal(fwrite(bytes, 1, n, f), n);
@@ -152,7 +152,7 @@ static void write_frame_bytes(const char *dir, const void *bytes, size_t n)
 static void write_frame_png(const char *dir, uint32_t format, uint32_t w, uint32_t h)
 {
     char path[SCAN_DIR_PATH_MAX];
-    assert_int_equal(scan_dir_frame_path(path, sizeof(path), dir, 0, 3), 0);
+    assert_int_equal(scan_dir_frame_path(path, sizeof(path), dir, 0, 3, SCAN_FRAMES_PNG, 1), 0);
     png_image img;
     memset(&img, 0, sizeof(img));
     img.version = PNG_IMAGE_VERSION;
@@ -178,10 +178,10 @@ static void test_bad_frames_say_why(void **state)
     static uint8_t buf[W * H * 3];
     const char *dir = view_with("frames", "");
     char path[SCAN_DIR_PATH_MAX];
-    assert_int_equal(scan_dir_frame_path(path, sizeof(path), dir, 0, 3), 0);
+    assert_int_equal(scan_dir_frame_path(path, sizeof(path), dir, 0, 3, SCAN_FRAMES_PNG, 1), 0);
     unlink(path); /* from an earlier run */
     assert_int_equal(read_frame3(dir, buf, sizeof(buf)), -ENOENT);
-    assert_non_null(strstr(err, "view_000/frame_03.png: No such file or directory"));
+    assert_non_null(strstr(err, "view_000/frame_03: no such frame (.pgm.zst, .ppm.zst, .png"));
 
     write_frame_png(dir, PNG_FORMAT_GRAY, W, H);
     assert_int_equal(read_frame3(dir, buf, sizeof(buf)), 0);
@@ -216,6 +216,63 @@ static void test_bad_frames_say_why(void **state)
     print_message("truncated: %s\n", err);
 }
 
+/* Frames kept as zstd-compressed or raw PGM/PPM come back byte for byte; a grey frame reads as
+ * RGB, an RGB one is not read as grey, and damage is named. */
+static void test_pnm_frames_round_trip(void **state)
+{
+    (void)state;
+    static uint8_t frame[W * H * 3], back[W * H * 3];
+    const char *dir = view_with("pnm", "");
+    char path[SCAN_DIR_PATH_MAX];
+    for (size_t i = 0; i < sizeof(frame); i++)
+        frame[i] = (uint8_t)(i * 7u + i / W);
+    const enum scan_frame_format formats[] = {SCAN_FRAMES_ZSTD, SCAN_FRAMES_PNM, SCAN_FRAMES_PNG};
+    for (size_t k = 0; k < 3; k++) {
+        for (uint32_t f = 4; f < 6; f++) /* the pattern grey, the colour RGB */
+            assert_int_equal(scan_dir_write_frame(&hal.storage, dir, 0, f, frame, W, H,
+                                                  f == 4 ? 1 : 3, formats[k]),
+                             0);
+        memset(back, 0, sizeof(back));
+        assert_int_equal(scan_dir_read_frame(dir, 0, 4, back, sizeof(back), W, H, 1, err,
+                                             sizeof(err)),
+                         0);
+        assert_memory_equal(back, frame, (size_t)W * H);
+        assert_int_equal(scan_dir_read_frame(dir, 0, 5, back, sizeof(back), W, H, 3, err,
+                                             sizeof(err)),
+                         0);
+        assert_memory_equal(back, frame, sizeof(frame));
+        for (uint32_t f = 4; f < 6; f++) {
+            assert_int_equal(scan_dir_find_frame(path, sizeof(path), dir, 0, f), 0);
+            unlink(path);
+        }
+    }
+    assert_int_equal(
+        scan_dir_write_frame(&hal.storage, dir, 0, 4, frame, W, H, 1, SCAN_FRAMES_ZSTD), 0);
+    assert_int_equal(scan_dir_read_frame(dir, 0, 4, back, sizeof(back), W, H, 3, err, sizeof(err)),
+                     0);
+    assert_int_equal(back[3 * 1000 + 2], frame[1000]); /* grey to RGB: repeated */
+    assert_int_equal(
+        scan_dir_write_frame(&hal.storage, dir, 0, 5, frame, W, H, 3, SCAN_FRAMES_ZSTD), 0);
+    assert_int_equal(scan_dir_read_frame(dir, 0, 5, back, sizeof(back), W, H, 1, err, sizeof(err)),
+                     -EINVAL);
+    assert_non_null(strstr(err, "frame_05.ppm.zst: an RGB frame where a grey one belongs"));
+    assert_int_equal(scan_dir_find_frame(path, sizeof(path), dir, 0, 4), 0);
+    assert_int_equal(truncate(path, 5000), 0);
+    assert_int_equal(scan_dir_read_frame(dir, 0, 4, back, sizeof(back), W, H, 1, err, sizeof(err)),
+                     -EINVAL);
+    assert_non_null(strstr(err, "frame_04.pgm.zst: damaged zstd data"));
+    print_message("truncated zstd: %s\n", err);
+    unlink(path);
+    assert_int_equal(
+        scan_dir_write_frame(&hal.storage, dir, 0, 4, frame, W, H, 1, SCAN_FRAMES_PNM), 0);
+    assert_int_equal(scan_dir_find_frame(path, sizeof(path), dir, 0, 4), 0);
+    assert_int_equal(truncate(path, 5000), 0);
+    assert_int_equal(scan_dir_read_frame(dir, 0, 4, back, sizeof(back), W, H, 1, err, sizeof(err)),
+                     -EINVAL);
+    assert_non_null(strstr(err, "frame_04.pgm: truncated"));
+    unlink(path);
+}
+
 /* A scan directory of one view whose view.ini describes the frames of @p config_text, with
  * frames 00-02 written (black) and frame 03 as @p frame3 bytes. */
 static void fake_scan(const char *dir, const char *config_text, const void *frame3, size_t n)
@@ -236,7 +293,9 @@ static void fake_scan(const char *dir, const char *config_text, const void *fram
     v.frames = v.frame_count;
     assert_int_equal(scan_dir_write_view(&hal.storage, dir, 0, &v), 0);
     for (uint32_t f = 0; f < 3; f++)
-        assert_int_equal(scan_dir_write_frame(&hal.storage, dir, 0, f, black, W, H, f ? 1 : 3), 0);
+        assert_int_equal(scan_dir_write_frame(&hal.storage, dir, 0, f, black, W, H, f ? 1 : 3,
+                                                  SCAN_FRAMES_ZSTD),
+                         0);
     write_frame_bytes(dir, frame3, n);
 }
 
@@ -301,6 +360,7 @@ int main(void)
         cmocka_unit_test(test_view_ini_round_trip),
         cmocka_unit_test(test_view_ini_bad_values),
         cmocka_unit_test(test_bad_frames_say_why),
+        cmocka_unit_test(test_pnm_frames_round_trip),
         cmocka_unit_test(test_process_damaged_frame_one_error),
         cmocka_unit_test(test_process_other_frames_refused),
         cmocka_unit_test(test_begin_view_removes_view_ini),

@@ -135,8 +135,8 @@ static void test_stall_stops_scan_then_resume_finishes_it(void **state)
     scan_dir_path(ref, sizeof(ref), OUT "/reference", -1, "mesh.ply");
     assert_true(test_files_equal(path, ref));
     for (uint32_t v = 0; v < VIEWS; v++) { /* each view's frames too, e.g. the white one */
-        scan_dir_frame_path(path, sizeof(path), dir, v, 0);
-        scan_dir_frame_path(ref, sizeof(ref), OUT "/reference", v, 0);
+        assert_int_equal(scan_dir_find_frame(path, sizeof(path), dir, v, 0), 0);
+        assert_int_equal(scan_dir_find_frame(ref, sizeof(ref), OUT "/reference", v, 0), 0);
         assert_true(test_files_equal(path, ref));
     }
     assert_true(test_rig_dark());

@@ -1,0 +1,158 @@
+/* The storage thread: a ring of FRAME_WRITER_SLOTS static frame buffers, filled by the scan,
+ * emptied by one writer thread through scan_dir_write_frame (so each frame stays an atomic,
+ * durable write). The scan waits only when the ring is full or when a view ends: view.ini is
+ * written after frame_writer_flush, so its presence still means every frame is on disk. */
+#define _POSIX_C_SOURCE 200809L
+#include "frame_writer.h"
+
+#include "hal_limits.h"
+
+#include <errno.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <string.h>
+#include <time.h>
+
+struct slot {
+    char dir[HAL_MAX_PATH];
+    uint32_t view, frame, width, height, channels;
+    enum scan_frame_format format;
+};
+
+static uint8_t slot_pixels[FRAME_WRITER_SLOTS][HAL_MAX_PIXELS * 3];
+static struct slot slots[FRAME_WRITER_SLOTS];
+
+static struct {
+    pthread_mutex_t lock;
+    pthread_cond_t changed; /* a slot was queued or emptied, or the thread is asked to end */
+    pthread_t thread;
+    const struct hal_storage *storage;
+    uint32_t head, count; /* the oldest queued slot (being written), and how many are queued */
+    int stopping, running;
+    int error;                      /* the first failed write since the last flush */
+    char failed[SCAN_DIR_PATH_MAX]; /* its file */
+    double cpu_s;
+} w = {.lock = PTHREAD_MUTEX_INITIALIZER, .changed = PTHREAD_COND_INITIALIZER};
+
+static double thread_cpu_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec / 1e9;
+}
+
+static void *writer(void *arg)
+{
+    (void)arg;
+    pthread_mutex_lock(&w.lock);
+    for (;;) {
+        while (w.count == 0 && !w.stopping)
+            pthread_cond_wait(&w.changed, &w.lock);
+        if (w.count == 0)
+            break;
+        uint32_t k = w.head;
+        pthread_mutex_unlock(&w.lock);
+        /* outside the lock: the scan queues the next frames meanwhile */
+        const struct slot *s = &slots[k];
+        int rc = scan_dir_write_frame(w.storage, s->dir, s->view, s->frame, slot_pixels[k],
+                                      s->width, s->height, s->channels, s->format);
+        pthread_mutex_lock(&w.lock);
+        if (rc != 0 && w.error == 0) {
+            w.error = rc;
+            scan_dir_frame_path(w.failed, sizeof(w.failed), s->dir, s->view, s->frame, s->format,
+                                s->channels);
+        }
+        w.head = (w.head + 1) % FRAME_WRITER_SLOTS;
+        w.count--;
+        w.cpu_s = thread_cpu_s();
+        pthread_cond_broadcast(&w.changed);
+    }
+    pthread_mutex_unlock(&w.lock);
+    return NULL;
+}
+
+int frame_writer_start(const struct hal_storage *storage)
+{
+    if (w.running)
+        return 0;
+    w.storage = storage;
+    w.head = w.count = 0;
+    w.stopping = w.error = 0;
+    w.cpu_s = 0.0;
+    int rc = pthread_create(&w.thread, NULL, writer, NULL);
+    if (rc != 0)
+        return -rc;
+    w.running = 1;
+    return 0;
+}
+
+/* Take the error to report (with the lock held): it is reported once. */
+static int take_error(char *failed, size_t failed_len)
+{
+    int rc = w.error;
+    if (rc != 0)
+        snprintf(failed, failed_len, "%s", w.failed);
+    w.error = 0;
+    return rc;
+}
+
+int frame_writer_put(const char *dir, uint32_t view, uint32_t frame, const uint8_t *pixels,
+                     uint32_t width, uint32_t height, uint32_t channels,
+                     enum scan_frame_format format, char *failed, size_t failed_len)
+{
+    size_t bytes = (size_t)width * height * channels;
+    if (!w.running)
+        return -EPIPE;
+    if (bytes > sizeof(slot_pixels[0]) || strlen(dir) >= sizeof(slots[0].dir))
+        return -E2BIG;
+    pthread_mutex_lock(&w.lock);
+    while (w.count == FRAME_WRITER_SLOTS && w.error == 0)
+        pthread_cond_wait(&w.changed, &w.lock);
+    int rc = take_error(failed, failed_len);
+    if (rc == 0) {
+        /* the slot after the queued ones is free: the writer only touches queued slots */
+        uint32_t k = (w.head + w.count) % FRAME_WRITER_SLOTS;
+        pthread_mutex_unlock(&w.lock);
+        memcpy(slot_pixels[k], pixels, bytes);
+        slots[k] = (struct slot){.view = view, .frame = frame, .width = width, .height = height,
+                                 .channels = channels, .format = format};
+        snprintf(slots[k].dir, sizeof(slots[k].dir), "%s", dir);
+        pthread_mutex_lock(&w.lock);
+        w.count++;
+        pthread_cond_broadcast(&w.changed);
+    }
+    pthread_mutex_unlock(&w.lock);
+    return rc;
+}
+
+int frame_writer_flush(char *failed, size_t failed_len)
+{
+    if (!w.running)
+        return 0;
+    pthread_mutex_lock(&w.lock);
+    while (w.count > 0)
+        pthread_cond_wait(&w.changed, &w.lock);
+    int rc = take_error(failed, failed_len);
+    pthread_mutex_unlock(&w.lock);
+    return rc;
+}
+
+void frame_writer_stop(void)
+{
+    if (!w.running)
+        return;
+    pthread_mutex_lock(&w.lock);
+    w.stopping = 1;
+    pthread_cond_broadcast(&w.changed);
+    pthread_mutex_unlock(&w.lock);
+    pthread_join(w.thread, NULL);
+    w.running = 0;
+}
+
+double frame_writer_cpu_s(void)
+{
+    pthread_mutex_lock(&w.lock);
+    double s = w.cpu_s;
+    pthread_mutex_unlock(&w.lock);
+    return s;
+}

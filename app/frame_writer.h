@@ -1,0 +1,38 @@
+/* The storage thread: keeps a view's frames on disk while the next ones are captured and
+ * processed, from a fixed ring of static buffers (nothing allocated during a scan). */
+#ifndef FRAME_WRITER_H
+#define FRAME_WRITER_H
+
+#include "hal.h"
+#include "scan_dir.h"
+
+#include <stddef.h>
+#include <stdint.h>
+
+/** Frames waiting to be written at most; a capture waits when all are taken. */
+#define FRAME_WRITER_SLOTS 4u
+
+/** Start the thread that writes into @p storage. @retval 0 @retval -errno (the thread could not
+ *  be made) */
+int frame_writer_start(const struct hal_storage *storage);
+
+/** Queue frame @p frame of view @p view of scan directory @p dir for writing: @p pixels are
+ *  copied, so the caller may reuse them at once. Waits while every slot is taken.
+ *  @retval 0 @retval -errno a write queued earlier failed (and nothing is queued): @p failed
+ *  names its file */
+int frame_writer_put(const char *dir, uint32_t view, uint32_t frame, const uint8_t *pixels,
+                     uint32_t width, uint32_t height, uint32_t channels,
+                     enum scan_frame_format format, char *failed, size_t failed_len);
+
+/** Wait until every queued frame is on disk (written, fsynced, renamed).
+ *  @retval 0 @retval -errno the first write that failed since the last flush, whose file
+ *  @p failed names (the error is then cleared) */
+int frame_writer_flush(char *failed, size_t failed_len);
+
+/** Flush and end the thread; safe when it was not started. */
+void frame_writer_stop(void);
+
+/** CPU time the thread has spent, in seconds (make bench splits the scan's CPU with it). */
+double frame_writer_cpu_s(void);
+
+#endif
