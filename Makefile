@@ -437,8 +437,10 @@ $(BUILD)/bench/bench_decode.o: bench/bench_decode.c | deps
 	@mkdir -p $(dir $@)
 	$(CC) $(HOST_CFLAGS) -Itests -Ibench -c $< -o $@
 
-bench: deps $(BUILD)/bench_view $(BUILD)/bench_decode
+bench: deps $(BUILD)/bench_view $(BUILD)/bench_decode $(BUILD)/bench_frames
 	$(BUILD)/bench_decode
+	@echo
+	$(BUILD)/bench_frames config/sim.ini
 	@echo
 	$(BUILD)/bench_view config/sim.ini
 	@echo

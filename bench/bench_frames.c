@@ -99,21 +99,9 @@ static size_t png_adaptive(const struct frame *f, uint8_t *o, size_t c)
 {
     return libpng_encode(f, o, c, PNG_ALL_FILTERS, Z_DEFAULT_STRATEGY);
 }
-static size_t png_up(const struct frame *f, uint8_t *o, size_t c)
-{
-    return libpng_encode(f, o, c, PNG_FILTER_UP, Z_DEFAULT_STRATEGY);
-}
-static size_t png_sub(const struct frame *f, uint8_t *o, size_t c)
-{
-    return libpng_encode(f, o, c, PNG_FILTER_SUB, Z_DEFAULT_STRATEGY);
-}
 static size_t png_up_rle(const struct frame *f, uint8_t *o, size_t c)
 {
     return libpng_encode(f, o, c, PNG_FILTER_UP, Z_RLE);
-}
-static size_t png_none_rle(const struct frame *f, uint8_t *o, size_t c)
-{
-    return libpng_encode(f, o, c, PNG_FILTER_NONE, Z_RLE);
 }
 
 /* ---- libspng ---- */
@@ -186,17 +174,9 @@ static size_t zstd_encode(const struct frame *f, uint8_t *out, size_t cap)
 {
     return zstd_level(f, out, cap, 1);
 }
-static size_t zstd_fast1(const struct frame *f, uint8_t *out, size_t cap)
-{
-    return zstd_level(f, out, cap, -1);
-}
 static size_t zstd_fast3(const struct frame *f, uint8_t *out, size_t cap)
 {
     return zstd_level(f, out, cap, -3);
-}
-static size_t zstd_fast10(const struct frame *f, uint8_t *out, size_t cap)
-{
-    return zstd_level(f, out, cap, -10);
 }
 
 static int zstd_decode(const uint8_t *in, size_t len, const struct frame *f)
@@ -212,19 +192,12 @@ struct codec {
 };
 
 static const struct codec codecs[] = {
-#if 0
     {"PNG, libpng, zlib 1, adaptive filters (until now)", png_adaptive, libpng_decode},
-    {"PNG, libpng, zlib 1, filter Sub", png_sub, libpng_decode},
-    {"PNG, libpng, zlib 1, filter Up", png_up, libpng_decode},
-    {"PNG, libpng, zlib 1 RLE, filter Up", png_up_rle, libpng_decode},
-    {"PNG, libpng, zlib 1 RLE, no filter", png_none_rle, libpng_decode},
+    {"PNG, libpng, zlib 1 RLE, filter Up (frame_format = png)", png_up_rle, libpng_decode},
     {"PNG, libspng, zlib 1 RLE, filter Up", spng_encode, spng_decode},
-#endif
-    {"PGM/PPM, raw", pnm_encode, pnm_decode},
-    {"zstd 1, raw pixels", zstd_encode, zstd_decode},
-    {"zstd -1, raw pixels", zstd_fast1, zstd_decode},
-    {"zstd -3, raw pixels", zstd_fast3, zstd_decode},
-    {"zstd -10, raw pixels", zstd_fast10, zstd_decode},
+    {"PGM/PPM, raw (frame_format = pnm)", pnm_encode, pnm_decode},
+    {"**PGM/PPM in zstd 1 (frame_format = zstd, the default)**", zstd_encode, zstd_decode},
+    {"PGM/PPM in zstd -3", zstd_fast3, zstd_decode},
 };
 
 static int render_view(const char *config, struct test_rig *t)
