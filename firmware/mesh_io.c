@@ -1,10 +1,11 @@
 /* The fused mesh as binary PLY, OBJ and binary STL, without its floating fragments.
  *
- * Marching cubes is deterministic, so the mesh is not stored: fusion_mesh_prepare runs it once to
- * find the connected pieces (union-find over vertex numbers) and keep each vertex's position
- * (STL repeats them per triangle), and each writer runs it again, renumbering the vertices it
- * keeps. Without room for every vertex (more than MESH_MAX_VERTICES) nothing is left out and
- * no STL is written; PLY and OBJ stream as before. */
+ * fusion_mesh_prepare runs marching cubes once and keeps the mesh in static tables (position,
+ * normal and colour per vertex, three vertex numbers per triangle); the connected pieces are
+ * found over those (union-find over vertex numbers) and every writer reads the tables,
+ * renumbering the vertices it keeps. A mesh too large for the tables (more than
+ * MESH_MAX_VERTICES or MESH_MAX_TRIANGLES) keeps every piece and gets no STL; PLY and OBJ then
+ * stream from marching cubes again, which is deterministic. */
 #include "fusion.h"
 #include "outbuf.h"
 #include "ply.h"
@@ -15,12 +16,15 @@
 #define DROPPED 0xFFFFFFFFu
 
 static float mesh_pos[MESH_MAX_VERTICES * 3];
+static float mesh_nrm[MESH_MAX_VERTICES * 3];
+static uint8_t mesh_rgb[MESH_MAX_VERTICES * 3];
+static uint32_t mesh_tri[MESH_MAX_TRIANGLES * 3];
 /* Union-find parent of each vertex; after prepare, the vertex's new number or DROPPED. */
 static uint32_t mesh_index[MESH_MAX_VERTICES];
 static uint32_t mesh_tris[MESH_MAX_VERTICES]; /* triangles of the piece rooted here */
 
 static struct {
-    int prepared, fits; /* fits: every vertex had room (else nothing is dropped) */
+    int prepared, fits; /* fits: the whole mesh is in the tables (else nothing is dropped) */
     struct mesh_summary s;
 } mp;
 
@@ -41,112 +45,101 @@ static void join(uint32_t a, uint32_t b)
         mesh_index[a > b ? a : b] = a < b ? a : b;
 }
 
-static int note_vertex(void *priv, const float p[3], const float n[3], const uint8_t rgb[3])
+static int keep_vertex(void *priv, const float p[3], const float n[3], const uint8_t rgb[3])
 {
     (void)priv;
-    (void)n;
-    (void)rgb;
     uint32_t v = mp.s.vertices++;
     if (v < MESH_MAX_VERTICES) {
         memcpy(&mesh_pos[3 * (size_t)v], p, 3 * sizeof(float));
+        memcpy(&mesh_nrm[3 * (size_t)v], n, 3 * sizeof(float));
+        memcpy(&mesh_rgb[3 * (size_t)v], rgb, 3);
         mesh_index[v] = v;
     }
     return 0;
 }
 
-static int note_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
+static int keep_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
 {
     (void)priv;
-    mp.s.triangles++;
-    if (mp.s.vertices <= MESH_MAX_VERTICES) {
+    uint32_t t = mp.s.triangles++;
+    if (mp.s.vertices <= MESH_MAX_VERTICES && t < MESH_MAX_TRIANGLES) {
+        uint32_t *tri = &mesh_tri[3 * (size_t)t];
+        tri[0] = a;
+        tri[1] = b;
+        tri[2] = c;
         join(a, b);
         join(b, c);
     }
     return 0;
 }
 
-static int count_piece(void *priv, uint32_t a, uint32_t b, uint32_t c)
+/* Number the vertices of the pieces kept (DROPPED for the others), counting what is kept. */
+static void drop_fragments(double min_fragment_share)
 {
-    (void)priv;
-    (void)b;
-    (void)c;
-    mesh_tris[find_root(a)]++;
-    return 0;
+    uint32_t n = mp.s.vertices, largest = 0, next = 0;
+    memset(mesh_tris, 0, n * sizeof(uint32_t));
+    for (uint32_t t = 0; t < mp.s.triangles; t++)
+        mesh_tris[find_root(mesh_tri[3 * (size_t)t])]++;
+    for (uint32_t v = 0; v < n; v++)
+        mesh_index[v] = find_root(v); /* every vertex straight to its root */
+    for (uint32_t v = 0; v < n; v++)
+        if (mesh_index[v] == v && mesh_tris[v] > largest)
+            largest = mesh_tris[v];
+    double keep_from = min_fragment_share * largest;
+    mp.s.kept_triangles = 0;
+    for (uint32_t v = 0; v < n; v++) {
+        uint32_t root = mesh_index[v], tris = mesh_tris[root];
+        int keep = tris > 0 && tris >= keep_from;
+        if (root == v) {
+            mp.s.pieces++;
+            mp.s.removed_pieces += !keep;
+            mp.s.kept_triangles += keep ? tris : 0;
+        }
+        mesh_index[v] = keep ? next++ : DROPPED; /* its root's entry is read before: root <= v */
+    }
+    mp.s.kept_vertices = next;
 }
 
 int fusion_mesh_prepare(double min_fragment_share, struct mesh_summary *out)
 {
     memset(&mp, 0, sizeof(mp));
-    struct mesh_sink pass1 = {note_vertex, note_triangle, NULL};
-    int rc = fusion_extract(&pass1);
+    struct mesh_sink keep = {keep_vertex, keep_triangle, NULL};
+    int rc = fusion_extract(&keep);
     if (rc != 0)
         return rc;
-    mp.fits = mp.s.vertices <= MESH_MAX_VERTICES;
+    mp.fits = mp.s.vertices <= MESH_MAX_VERTICES && mp.s.triangles <= MESH_MAX_TRIANGLES;
     mp.s.kept_vertices = mp.s.vertices;
     mp.s.kept_triangles = mp.s.triangles;
-    if (mp.fits) {
-        uint32_t n = mp.s.vertices, largest = 0, next = 0;
-        memset(mesh_tris, 0, n * sizeof(uint32_t));
-        struct mesh_sink pass2 = {NULL, count_piece, NULL};
-        fusion_extract(&pass2);
-        for (uint32_t v = 0; v < n; v++)
-            mesh_index[v] = find_root(v); /* every vertex straight to its root */
-        for (uint32_t v = 0; v < n; v++)
-            if (mesh_index[v] == v && mesh_tris[v] > largest)
-                largest = mesh_tris[v];
-        double keep_from = min_fragment_share * largest;
-        mp.s.kept_triangles = 0;
-        for (uint32_t v = 0; v < n; v++) {
-            uint32_t root = mesh_index[v], tris = mesh_tris[root];
-            int keep = tris > 0 && tris >= keep_from;
-            if (root == v) {
-                mp.s.pieces++;
-                mp.s.removed_pieces += !keep;
-                mp.s.kept_triangles += keep ? tris : 0;
-            }
-            mesh_index[v] = keep ? next++ : DROPPED; /* its root's entry is read before: root <= v */
-        }
-        mp.s.kept_vertices = next;
-    }
+    if (mp.fits)
+        drop_fragments(min_fragment_share);
     mp.prepared = 1;
     *out = mp.s;
     return mp.fits ? 0 : -E2BIG;
 }
 
-/* A writer's sink behind the filter: vertices renumbered, dropped ones and their triangles
- * left out. */
-struct filtered {
-    const struct mesh_sink *to;
-    uint32_t next_vertex;
-};
-
-static int filter_vertex(void *priv, const float p[3], const float n[3], const uint8_t rgb[3])
+/* The kept mesh from the tables: the vertices, then the triangles, renumbered. */
+static int emit_kept(const struct mesh_sink *sink)
 {
-    struct filtered *f = priv;
-    uint32_t v = f->next_vertex++;
-    if (mp.fits && mesh_index[v] == DROPPED)
-        return 0;
-    return f->to->vertex(f->to->priv, p, n, rgb);
-}
-
-static int filter_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
-{
-    struct filtered *f = priv;
-    if (!mp.fits)
-        return f->to->triangle(f->to->priv, a, b, c);
-    if (mesh_index[a] == DROPPED)
-        return 0;
-    return f->to->triangle(f->to->priv, mesh_index[a], mesh_index[b], mesh_index[c]);
+    int rc = 0;
+    for (uint32_t v = 0; v < mp.s.vertices && sink->vertex != NULL && rc == 0; v++)
+        if (mesh_index[v] != DROPPED)
+            rc = sink->vertex(sink->priv, &mesh_pos[3 * (size_t)v], &mesh_nrm[3 * (size_t)v],
+                              &mesh_rgb[3 * (size_t)v]);
+    for (uint32_t t = 0; t < mp.s.triangles && sink->triangle != NULL && rc == 0; t++) {
+        const uint32_t *tri = &mesh_tri[3 * (size_t)t];
+        if (mesh_index[tri[0]] != DROPPED)
+            rc = sink->triangle(sink->priv, mesh_index[tri[0]], mesh_index[tri[1]],
+                                mesh_index[tri[2]]);
+    }
+    return rc;
 }
 
 int fusion_extract_prepared(const struct mesh_sink *sink)
 {
     if (!mp.prepared)
         return -EINVAL;
-    struct filtered f = {sink, 0};
-    struct mesh_sink through = {sink->vertex ? filter_vertex : NULL,
-                                sink->triangle ? filter_triangle : NULL, &f};
-    return fusion_extract(&through);
+    /* too large for the tables: marching cubes again, every piece kept */
+    return mp.fits ? emit_kept(sink) : fusion_extract(sink);
 }
 
 static int ply_vertex(void *priv, const float p[3], const float n[3], const uint8_t rgb[3])
@@ -174,7 +167,7 @@ int fusion_write_ply(const struct hal_storage *st, const char *path)
         return -EINVAL;
     if (outbuf_open(&o, st, path) != 0)
         return o.rc;
-    /* PLY wants its counts first and its vertices before its faces: two more runs */
+    /* PLY wants its counts first and its vertices before its faces */
     ply_put_header(&o, "fused mesh", mp.s.kept_vertices, mp.s.kept_triangles, 0);
     struct mesh_sink vertex_pass = {ply_vertex, NULL, &o};
     struct mesh_sink face_pass = {NULL, ply_triangle, &o};
@@ -212,13 +205,13 @@ int fusion_write_obj(const struct hal_storage *st, const char *path)
     return outbuf_close(&o);
 }
 
-/* One STL facet: its normal (right-handed from the vertex order), then the three corners. The
- * triangle callback gets the vertex numbers before renumbering: positions are looked up there. */
-static int stl_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
+/* One STL facet: its normal (right-handed from the vertex order), then the three corners, of
+ * triangle @p t of the tables (vertex numbers before renumbering). */
+static void stl_triangle(struct outbuf *o, uint32_t t)
 {
-    struct outbuf *o = priv;
-    const float *p[3] = {&mesh_pos[3 * (size_t)a], &mesh_pos[3 * (size_t)b],
-                         &mesh_pos[3 * (size_t)c]};
+    const uint32_t *tri = &mesh_tri[3 * (size_t)t];
+    const float *p[3] = {&mesh_pos[3 * (size_t)tri[0]], &mesh_pos[3 * (size_t)tri[1]],
+                         &mesh_pos[3 * (size_t)tri[2]]};
     vec3 e1 = v3(p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]);
     vec3 e2 = v3(p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]);
     vec3 n = v3_cross(e1, e2);
@@ -232,12 +225,6 @@ static int stl_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
             outbuf_f32le(o, p[k][d]);
     static const uint8_t no_attribute[2] = {0, 0};
     outbuf_put(o, no_attribute, 2);
-    return o->rc;
-}
-
-static int stl_kept_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
-{
-    return mesh_index[a] == DROPPED ? 0 : stl_triangle(priv, a, b, c);
 }
 
 int fusion_write_stl(const struct hal_storage *st, const char *path)
@@ -254,7 +241,8 @@ int fusion_write_stl(const struct hal_storage *st, const char *path)
     strncpy(header, "turntable colour scanner: fused mesh, units millimetres", sizeof(header) - 1);
     outbuf_put(&o, header, sizeof(header));
     outbuf_u32le(&o, mp.s.kept_triangles);
-    struct mesh_sink sink = {NULL, stl_kept_triangle, &o};
-    fusion_extract(&sink); /* the original vertex numbers: mesh_pos is indexed by them */
+    for (uint32_t t = 0; t < mp.s.triangles && o.rc == 0; t++)
+        if (mesh_index[mesh_tri[3 * (size_t)t]] != DROPPED)
+            stl_triangle(&o, t);
     return outbuf_close(&o);
 }

@@ -45,13 +45,16 @@
 #define FUSION_MAX_DIM 400u
 #define FUSION_MAX_VOXELS (320u * 320u * 280u)
 #endif
-/* Vertices of the fused mesh that fit the mesh writers' tables (mesh_io.c: fragments, STL),
- * 20 bytes each; a larger mesh is still written as PLY and OBJ, whole. */
+/* Vertices of the fused mesh that fit the mesh writers' tables (mesh_io.c: the mesh extracted
+ * once for every output, its fragments, STL), 35 bytes each, and its triangles, 12 bytes each
+ * (a closed surface has about two per vertex); a larger mesh is still written as PLY and OBJ,
+ * whole, extracted again for each. */
 #ifdef HAL_LIMITS_SMALL
 #define MESH_MAX_VERTICES (1u << 20)
 #else
 #define MESH_MAX_VERTICES (2u << 20)
 #endif
+#define MESH_MAX_TRIANGLES (2u * MESH_MAX_VERTICES)
 /* Joint registration (reg.h): the views of one scan (as many as [scan] views allows), and the
  * samples kept of all of them together, 28 bytes each; a scan of many views keeps every n-th
  * pixel with a larger n. */

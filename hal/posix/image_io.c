@@ -204,7 +204,8 @@ static int read_whole(const char *path, uint8_t **data, size_t *len, char *why, 
         goto out_close;
     }
     unsigned long long plain_len = ZSTD_getFrameContentSize(raw, (size_t)size);
-    if (plain_len == ZSTD_CONTENTSIZE_UNKNOWN || plain_len > ((size_t)1 << 30) ||
+    /* no frame is larger than the compiled limit, and a header claiming more is not believed */
+    if (plain_len == ZSTD_CONTENTSIZE_UNKNOWN || plain_len > (size_t)HAL_MAX_PIXELS * 3 + 64 ||
         (plain = malloc((size_t)plain_len + 1)) == NULL) {
         snprintf(why, why_len, "a zstd frame of unknown or too large size");
         goto out_close;

@@ -1,6 +1,7 @@
 /* Fuzz target: the scan directory reader on a directory built from the input, frames included.
- * The input is a view.ini, a NUL byte, then the bytes of frame_00.png (a 32 x 24 frame is
- * expected, grey), as `scanner process` meets them on disk. */
+ * The input is a view.ini, a NUL byte, then the bytes of a frame, kept as frame_00.png,
+ * frame_01.pgm.zst and frame_02.ppm (32 x 24 frames expected), as `scanner process` meets them
+ * on disk. */
 #define _GNU_SOURCE
 #include "fuzz_input.h"
 
@@ -30,8 +31,10 @@ static void remove_dir(void)
     char path[SCAN_DIR_PATH_MAX];
     scan_dir_path(path, sizeof(path), dir, 0, "view.ini");
     unlink(path);
-    scan_dir_frame_path(path, sizeof(path), dir, 0, 0);
-    unlink(path);
+    for (uint32_t f = 0; f < 3; f++) {
+        scan_dir_find_frame(path, sizeof(path), dir, 0, f);
+        unlink(path);
+    }
     snprintf(path, sizeof(path), "%s/view_000", dir);
     rmdir(path);
     rmdir(dir);
@@ -53,17 +56,25 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     size_t ini_len = nul != NULL ? (size_t)(nul - data) : size;
     scan_dir_path(path, sizeof(path), dir, 0, "view.ini");
     put(path, data, ini_len);
-    scan_dir_frame_path(path, sizeof(path), dir, 0, 0);
-    put(path, nul != NULL ? nul + 1 : data, nul != NULL ? size - ini_len - 1 : 0);
+    /* the same bytes as a PNG, a zstd PGM and a raw PPM frame: every reader sees them */
+    static const enum scan_frame_format formats[3] = {SCAN_FRAMES_PNG, SCAN_FRAMES_ZSTD,
+                                                      SCAN_FRAMES_PNM};
+    static const char *const names[3] = {"frame_00.png: ", "frame_01.pgm.zst: ",
+                                         "frame_02.ppm: "};
+    for (uint32_t f = 0; f < 3; f++) {
+        scan_dir_frame_path(path, sizeof(path), dir, 0, f, formats[f], f == 2 ? 3 : 1);
+        put(path, nul != NULL ? nul + 1 : data, nul != NULL ? size - ini_len - 1 : 0);
+    }
 
     int rc = scan_dir_read_view(dir, 0, &v, err, sizeof(err));
     FUZZ_EXPECT(rc <= 0 && (rc == 0 || strlen(err) > 0));
     FUZZ_EXPECT(rc != 0 || (v.index == 0 && v.frame_count <= SCAN_DIR_MAX_FRAMES));
-    for (uint32_t channels = 1; channels <= 3; channels += 2) {
-        err[0] = '\0';
-        rc = scan_dir_read_frame(dir, 0, 0, pixels, sizeof(pixels), W, H, channels, err,
-                                 sizeof(err));
-        FUZZ_EXPECT(rc <= 0 && (rc == 0 || strstr(err, "frame_00.png: ") != NULL));
-    }
+    for (uint32_t f = 0; f < 3; f++)
+        for (uint32_t channels = 1; channels <= 3; channels += 2) {
+            err[0] = '\0';
+            rc = scan_dir_read_frame(dir, 0, f, pixels, sizeof(pixels), W, H, channels, err,
+                                     sizeof(err));
+            FUZZ_EXPECT(rc <= 0 && (rc == 0 || strstr(err, names[f]) != NULL));
+        }
     return 0;
 }
