@@ -415,6 +415,9 @@ measure-calib: deps $(BUILD)/scanner $(BUILD)/scanner-calibrate $(BUILD)/mesh-co
 # Time per view, split between the simulated capture and the firmware's processing.
 $(BUILD)/bench_view: $(BUILD)/bench/bench_view.o $(BUILD)/tests/test_util.o $(HOST_OBJ) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON) $(BOARD_LIBS)
+# Fusion beside Open3D's ScalableTSDFVolume on the same depth (bench/fusion_open3d.py).
+$(BUILD)/bench_fusion: $(BUILD)/bench/bench_fusion.o $(BUILD)/tests/test_util.o $(HOST_OBJ) $(BUILD)/libfirmware.a
+	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON) $(BOARD_LIBS)
 # Frame encodings side by side (libspng and libzstd only here).
 $(BUILD)/bench_frames: $(BUILD)/bench/bench_frames.o $(BUILD)/tests/test_util.o $(HOST_OBJ) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON) $(BOARD_LIBS) -lspng -lzstd
@@ -437,7 +440,8 @@ $(BUILD)/bench/bench_decode.o: bench/bench_decode.c | deps
 	@mkdir -p $(dir $@)
 	$(CC) $(HOST_CFLAGS) -Itests -Ibench -c $< -o $@
 
-bench: deps $(BUILD)/bench_view $(BUILD)/bench_decode $(BUILD)/bench_frames
+bench: deps $(BUILD)/bench_view $(BUILD)/bench_decode $(BUILD)/bench_frames $(BUILD)/bench_fusion $(BUILD)/scanner $(BUILD)/mesh-compare
+	@/usr/bin/python3 -c 'import open3d' 2>/dev/null || scripts/install-deps.sh bench
 	$(BUILD)/bench_decode
 	@echo
 	$(BUILD)/bench_frames config/sim.ini
@@ -445,11 +449,17 @@ bench: deps $(BUILD)/bench_view $(BUILD)/bench_decode $(BUILD)/bench_frames
 	$(BUILD)/bench_view config/sim.ini
 	@echo
 	@bench/static_memory.sh $(BUILD)/libfirmware.a
+	@echo
+	bench/bench_scan.sh $(BUILD) config/sim.ini
+	@echo
+	@$(MAKE) --no-print-directory bench-callgrind
 
 # Instruction counts of one view's firmware processing (stable on a noisy machine): compare a
 # change with the one before it.
 bench-callgrind: deps $(BUILD)/bench_view
 	@command -v valgrind >/dev/null || scripts/install-deps.sh bench
-	BENCH_REPEAT=1 valgrind --tool=callgrind --callgrind-out-file=$(BUILD)/callgrind.out \
-		--toggle-collect=process_view_once $(BUILD)/bench_view config/sim.ini > /dev/null
+	@BENCH_REPEAT=1 valgrind --tool=callgrind --callgrind-out-file=$(BUILD)/callgrind.out \
+		--collect-atstart=no --toggle-collect=process_view_once $(BUILD)/bench_view config/sim.ini > /dev/null 2>$(BUILD)/callgrind.log
+	@callgrind_annotate $(BUILD)/callgrind.out 2>/dev/null | \
+		awk '/PROGRAM TOTALS/ { gsub(",", "", $$1); printf "instructions per view, firmware decode to PLY (callgrind, machine-independent): %.0f million\n\n", $$1 / 1e6 }'
 	@callgrind_annotate $(BUILD)/callgrind.out 2>/dev/null | sed -n '/Ir/,/^$$/p' | head -n 30

@@ -1,0 +1,62 @@
+#!/bin/sh
+# The whole scan's figures (issue 17), from a simulated 8-view scan and its processing: the
+# scanner's own CPU per view (the simulator's rendering left out, as the scan's "cost:" line
+# reports it), process CPU per view, bytes kept per view, peak memory, the predicted scan time
+# on the modelled rig, then fusion beside Open3D on the same depth. make bench.
+#   bench/bench_scan.sh BUILD_DIR CONFIG
+set -eu
+build=$1
+config=$2
+out=$build/bench-scan
+trap 'rm -rf "$out" "$out-fusion"' EXIT
+rm -rf "$out" "$out-fusion"
+"$build/scanner" scan --config "$config" --out "$out" >"$out.log" 2>&1 || {
+    tail -n 3 "$out.log"
+    exit 1
+}
+"$build/scanner" process "$out" >"$out-process.log" 2>&1 || {
+    tail -n 3 "$out-process.log"
+    exit 1
+}
+# cost: the scan 3.26 s CPU for 8 views (0.408 s a view; storage thread 1.32 s), the
+# simulator's rendering (9.70 s) left out; 29.9 s on the rig's clock
+cost=$(grep '^cost: the scan' "$out.log")
+pcost=$(grep '^cost: processing' "$out-process.log")
+views=$(echo "$cost" | sed 's/.* CPU for \([0-9]*\) views.*/\1/')
+own=$(echo "$cost" | sed 's/^cost: the scan \([0-9.]*\) s CPU.*/\1/')
+storage=$(echo "$cost" | sed 's/.*storage thread \([0-9.]*\) s.*/\1/')
+sim=$(echo "$cost" | sed 's/.*rendering (\([0-9.]*\) s).*/\1/')
+clock=$(echo "$cost" | sed 's/.*; \([0-9.]*\) s on the rig.s clock.*/\1/')
+proc=$(echo "$pcost" | sed 's/^cost: processing \([0-9.]*\) s CPU.*/\1/')
+peak_scan=$(sed -n 's/.*peak memory \([0-9.]*\) MB.*/\1/p' "$out.log")
+peak_proc=$(sed -n 's/.*peak memory \([0-9.]*\) MB.*/\1/p' "$out-process.log")
+# what a view keeps: its frames and range.bin (the simulator's truth_ files left out)
+bytes=$(find "$out"/view_* -type f ! -name 'truth_*' -printf '%s\n' | awk '{ s += $1 } END { print s }')
+fps=$(sed -n 's/^frame_rate_hz *= *//p' "$config")
+echo "a simulated scan of $views views ($config; the sensor at ${fps:-30} fps), then scanner process"
+echo "| figure | value |"
+echo "|---|---|"
+awk -v own="$own" -v st="$storage" -v sim="$sim" -v v="$views" -v p="$proc" -v b="$bytes" \
+    -v clock="$clock" -v ps="$peak_scan" -v pp="$peak_proc" 'BEGIN {
+    printf "| live scan CPU per view, the simulator left out (of it the storage thread) | **%.3f s** (%.3f s) |\n", own / v, st / v
+    printf "| the simulator rendering, per view (not the scanner'"'"'s) | %.3f s |\n", sim / v
+    printf "| scanner process CPU, %d views | **%.2f s** (%.3f s a view) |\n", v, p, p / v
+    printf "| bytes kept per view (frames and range.bin) | %.1f MB |\n", b / v / 1e6
+    printf "| peak memory, scan / process | %.0f / %.0f MB |\n", ps, pp
+    # In line with capture: the main thread works between a view'"'"'s last frame and the next
+    # move, and after the last view (registration, fusion, mesh); the storage thread has its
+    # own core. A Pi 4-class core is taken as 4 times slower (the issue'"'"'s 3-5x).
+    inline = own - st
+    printf "| rig time of the scan (turntable, frames at the sensor rate) | %.1f s |\n", clock
+    printf "| predicted %d-view scan, processing included: this machine / a Pi 4-class core (x4) | **%.1f s** / %.1f s |\n", v, clock + inline, clock + 4 * inline
+}'
+echo
+"$build/bench_fusion" "$out" "$out-fusion" >"$out-fusion.txt"
+/usr/bin/python3 bench/fusion_open3d.py "$out-fusion" "$(cat "$out-fusion.txt")"
+echo
+echo "accuracy of each against the truth (build/mesh-compare --align):"
+for m in mesh.ply open3d_mesh.ply; do
+    printf '%s: ' "$( [ "$m" = mesh.ply ] && echo scanner || echo Open3D)"
+    "$build/mesh-compare" --align "$out-fusion/$m" "$out/truth_mesh.ply" |
+        awk '/^result -> truth/ { r = $0 } /^truth -> result/ { t = $0 } END { print r "; " t }'
+done
