@@ -13,6 +13,8 @@
 #include <string.h>
 #include <time.h>
 
+#define FRAME_WRITER_STACK (512u * 1024u)
+
 struct slot {
     char dir[HAL_MAX_PATH];
     uint32_t view, frame, width, height, channels;
@@ -79,7 +81,15 @@ int frame_writer_start(const struct hal_storage *storage)
     w.head = w.count = 0;
     w.stopping = w.error = 0;
     w.cpu_s = 0.0;
-    int rc = pthread_create(&w.thread, NULL, writer, NULL);
+    /* A small stack: the encoders keep their state on the heap, and a board with 512 MB has no
+     * address space to spare for the default 8 MiB (make LIMITS=small under ulimit -v). */
+    pthread_attr_t attr;
+    int rc = pthread_attr_init(&attr);
+    if (rc == 0)
+        rc = pthread_attr_setstacksize(&attr, FRAME_WRITER_STACK);
+    if (rc == 0)
+        rc = pthread_create(&w.thread, &attr, writer, NULL);
+    pthread_attr_destroy(&attr);
     if (rc != 0)
         return -rc;
     w.running = 1;

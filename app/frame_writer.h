@@ -9,8 +9,9 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/** Frames waiting to be written at most; a capture waits when all are taken. */
-#define FRAME_WRITER_SLOTS 4u
+/** Frames waiting to be written at most; a capture waits when all are taken. Encoding a frame
+ *  (zstd: 7 ms grey, 25 ms RGB at 1280x960) is faster than capturing one (33 ms at 30 fps). */
+#define FRAME_WRITER_SLOTS 3u
 
 /** Start the thread that writes into @p storage. @retval 0 @retval -errno (the thread could not
  *  be made) */

@@ -478,13 +478,16 @@ int scan_dir_copy_file(const struct hal_storage *st, const char *from, const cha
 int scan_dir_keep_settings(const struct hal_storage *st, const char *config_path,
                            const char *calibration_path, const char *dir)
 {
+    /* The calibration first: config.ini's presence says the settings are complete (resume
+     * takes a directory with config.ini as a scan; a kill between the two left it without its
+     * calibration). */
     char path[SCAN_DIR_PATH_MAX];
-    int rc = scan_dir_path(path, sizeof(path), dir, -1, "config.ini");
+    int rc = scan_dir_path(path, sizeof(path), dir, -1, "calibration.ini");
     if (rc == 0)
-        rc = scan_dir_copy_file(st, config_path, path);
+        rc = scan_dir_copy_file(st, calibration_path, path);
     if (rc == 0)
-        rc = scan_dir_path(path, sizeof(path), dir, -1, "calibration.ini");
-    return rc != 0 ? rc : scan_dir_copy_file(st, calibration_path, path);
+        rc = scan_dir_path(path, sizeof(path), dir, -1, "config.ini");
+    return rc != 0 ? rc : scan_dir_copy_file(st, config_path, path);
 }
 
 /* ---- opening: a lock, and what is already there ---- */

@@ -50,7 +50,7 @@
  * (a closed surface has about two per vertex); a larger mesh is still written as PLY and OBJ,
  * whole, extracted again for each. */
 #ifdef HAL_LIMITS_SMALL
-#define MESH_MAX_VERTICES (1u << 20)
+#define MESH_MAX_VERTICES (1u << 19)
 #else
 #define MESH_MAX_VERTICES (2u << 20)
 #endif
