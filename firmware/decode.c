@@ -36,10 +36,17 @@ const char *scan_reason_name(unsigned reason)
 
 void decode_rgb_to_grey(const uint8_t *rgb, uint8_t *grey, size_t n, uint32_t saturation_dn)
 {
-    for (size_t i = 0; i < n; i++, rgb += 3) {
-        int saturated = rgb[0] >= saturation_dn || rgb[1] >= saturation_dn || rgb[2] >= saturation_dn;
-        uint32_t luma = (77u * rgb[0] + 150u * rgb[1] + 29u * rgb[2]) >> 8; /* BT.601 weights */
-        grey[i] = saturated ? DECODE_SATURATED : (uint8_t)(luma < 254u ? luma : 254u);
+    /* Written without branches and in 16 bits (77 + 150 + 29 = 256: the sum fits), so that
+     * GCC vectorises it where the target loads RGB triples in one instruction (NEON ld3 on the
+     * boards: 16 pixels a step); it runs over every pixel of every frame of a colour camera. */
+    const uint16_t sat = (uint16_t)(saturation_dn < 256u ? saturation_dn : 256u);
+    for (size_t i = 0; i < n; i++) {
+        uint16_t r = rgb[3 * i], g = rgb[3 * i + 1], b = rgb[3 * i + 2];
+        uint16_t mx = r > g ? r : g;
+        mx = mx > b ? mx : b;
+        uint16_t luma = (uint16_t)((uint16_t)(77u * r + 150u * g + 29u * b) >> 8); /* BT.601 */
+        luma = luma < 254u ? luma : 254u;
+        grey[i] = mx >= sat ? DECODE_SATURATED : (uint8_t)luma;
     }
 }
 

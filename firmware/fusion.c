@@ -133,36 +133,104 @@ static void fuse_voxel(struct voxel *vx, double sdf, double w, double cw, const 
     vx->weight = (uint16_t)lround(fmin(new_w, fusion_vol.p.max_weight) * WEIGHT_SCALE);
 }
 
-/* Voxels this view can change: those within the truncation band of its fused points. Voxels
- * farther in front of the surface would only be told "empty", which costs a projection each and
- * changes no surface. @retval 0 when the view has no fused point */
-static int view_box(const struct frame_xform *obj_from_cam, const struct decode_maps *m,
-                    const struct tri_range *r, uint32_t lo[3], uint32_t hi[3])
+/* Voxels this view can change: those near its fused points. The grid is cut in blocks of
+ * BLOCK^3 voxels; a block is marked when one of the view's points falls in it, and the marks
+ * are then grown by as many blocks as the truncation band reaches, so that every voxel within
+ * the band of a point is in a marked block (as Open3D's ScalableTSDFVolume touches only the
+ * blocks of the current frame's points). Voxels farther in front of the surface would only be
+ * told "empty", which costs a projection each and changes no surface. */
+#define BLOCK 4u
+#define BLOCKS_MAX ((FUSION_MAX_DIM + BLOCK - 1) / BLOCK)
+static uint8_t block_mark[BLOCKS_MAX * BLOCKS_MAX * BLOCKS_MAX];
+static uint8_t block_grown[BLOCKS_MAX * BLOCKS_MAX * BLOCKS_MAX];
+
+static size_t bidx(const uint32_t nb[3], uint32_t x, uint32_t y, uint32_t z)
 {
-    double mn[3] = {1e30, 1e30, 1e30}, mx[3] = {-1e30, -1e30, -1e30};
+    return ((size_t)z * nb[1] + y) * nb[0] + x;
+}
+
+/* Mark the blocks of the view's fused points. @retval 0 when the view has none */
+static int mark_blocks(const struct frame_xform *obj_from_cam, const struct decode_maps *m,
+                       const struct tri_range *r, const uint32_t nb[3])
+{
     size_t n = (size_t)m->width * m->height;
+    const double scale = 1.0 / (fusion_vol.p.voxel_mm * BLOCK);
     int any = 0;
+    memset(block_mark, 0, (size_t)nb[0] * nb[1] * nb[2]);
     for (size_t i = 0; i < n; i++) {
         if (weight_map[i] <= 0.0f)
             continue;
-        vec3 p = frame_point(obj_from_cam, v3(r->xyz_mm[3 * i], r->xyz_mm[3 * i + 1],
-                                              r->xyz_mm[3 * i + 2]));
-        double pa[3] = {p.x, p.y, p.z}, oa[3] = {fusion_vol.origin.x, fusion_vol.origin.y, fusion_vol.origin.z};
-        for (int a = 0; a < 3; a++) {
-            double g = (pa[a] - oa[a]) / fusion_vol.p.voxel_mm;
-            mn[a] = g < mn[a] ? g : mn[a];
-            mx[a] = g > mx[a] ? g : mx[a];
-        }
+        vec3 p = v3_sub(frame_point(obj_from_cam, v3(r->xyz_mm[3 * i], r->xyz_mm[3 * i + 1],
+                                                     r->xyz_mm[3 * i + 2])),
+                        fusion_vol.origin);
+        double g[3] = {p.x * scale, p.y * scale, p.z * scale};
+        if (g[0] < 0.0 || g[1] < 0.0 || g[2] < 0.0 || g[0] >= nb[0] || g[1] >= nb[1] ||
+            g[2] >= nb[2])
+            continue; /* outside the grid: its band may still reach in, at most one block */
+        block_mark[bidx(nb, (uint32_t)g[0], (uint32_t)g[1], (uint32_t)g[2])] = 1;
         any = 1;
     }
-    double margin = fusion_vol.p.truncation_mm / fusion_vol.p.voxel_mm + 1.0;
-    for (int a = 0; a < 3 && any; a++) {
-        double l = floor(mn[a] - margin), h = ceil(mx[a] + margin);
-        lo[a] = l < 0.0 ? 0u : (uint32_t)l;
-        hi[a] = h > fusion_vol.dims[a] - 1.0 ? fusion_vol.dims[a] - 1u : (uint32_t)h;
-        any = lo[a] <= hi[a];
-    }
     return any;
+}
+
+/* Grow the marks by @p reach blocks along each axis in turn (a cube of 2 reach + 1 blocks). */
+static void grow_blocks(const uint32_t nb[3], uint32_t reach)
+{
+    for (int axis = 0; axis < 3; axis++) {
+        size_t stride = axis == 0 ? 1 : axis == 1 ? nb[0] : (size_t)nb[0] * nb[1];
+        memcpy(block_grown, block_mark, (size_t)nb[0] * nb[1] * nb[2]);
+        for (uint32_t z = 0; z < nb[2]; z++)
+            for (uint32_t y = 0; y < nb[1]; y++)
+                for (uint32_t x = 0; x < nb[0]; x++) {
+                    uint32_t c[3] = {x, y, z};
+                    size_t i = bidx(nb, x, y, z);
+                    if (!block_mark[i])
+                        continue;
+                    for (uint32_t d = 1; d <= reach; d++) {
+                        if (c[axis] >= d)
+                            block_grown[i - d * stride] = 1;
+                        if (c[axis] + d < nb[axis])
+                            block_grown[i + d * stride] = 1;
+                    }
+                }
+        memcpy(block_mark, block_grown, (size_t)nb[0] * nb[1] * nb[2]);
+    }
+}
+
+/* The voxels x of row (y, z) in block bx within the grid. */
+static void integrate_run(const struct scan_calib *c, const struct frame_xform *obj_from_cam,
+                          const struct decode_maps *m, const struct tri_range *r,
+                          const uint8_t *rgb, const float *confidence, uint32_t x0, uint32_t x1,
+                          uint32_t y, uint32_t z, int pinhole)
+{
+    const double trunc = fusion_vol.p.truncation_mm, vox = fusion_vol.p.voxel_mm;
+    const vec3 step_x = m3_tmul(obj_from_cam->rot, v3(vox, 0, 0));
+    vec3 p_obj = v3_add(fusion_vol.origin, v3(x0 * vox, y * vox, z * vox));
+    vec3 p = frame_point_inv(obj_from_cam, p_obj); /* camera frame */
+    for (uint32_t x = x0; x < x1; x++, p = v3_add(p, step_x)) {
+        if (p.z <= 1.0)
+            continue;
+        double a = p.x / p.z, b = p.y / p.z;
+        double fu = c->cam_fx_px * a + c->cam_cx_px, fv = c->cam_fy_px * b + c->cam_cy_px;
+        if (!pinhole)
+            camray_project(c, p, &fu, &fv);
+        if (fu < -0.5 || fv < -0.5)
+            continue;
+        /* nearest pixel; a cast rounds correctly once the value is known >= -0.5, and avoids a
+         * libm call per voxel */
+        long u = (long)(fu + 0.5), v = (long)(fv + 0.5);
+        if (u >= (long)m->width || v >= (long)m->height)
+            continue;
+        size_t i = (size_t)v * m->width + (size_t)u;
+        if (weight_map[i] <= 0.0f)
+            continue;
+        /* distance along the ray from the voxel to the measured surface */
+        double sdf = (r->xyz_mm[3 * i + 2] - p.z) * sqrt(1.0 + a * a + b * b);
+        if (sdf < -trunc)
+            continue; /* hidden behind the surface: this view knows nothing of it */
+        double w = weight_map[i], cw = confidence != NULL ? w * confidence[i] : w;
+        fuse_voxel(&fusion_grid[vidx(x, y, z)], sdf, w, cw, rgb + 3 * i);
+    }
 }
 
 int fusion_integrate(const struct scan_calib *c, const struct frame_xform *obj_from_cam,
@@ -170,42 +238,26 @@ int fusion_integrate(const struct scan_calib *c, const struct frame_xform *obj_f
                      const float *confidence)
 {
     pixel_weights(c, m, r);
-    const double trunc = fusion_vol.p.truncation_mm, vox = fusion_vol.p.voxel_mm;
+    const uint32_t *dims = fusion_vol.dims;
+    const uint32_t nb[3] = {(dims[0] + BLOCK - 1) / BLOCK, (dims[1] + BLOCK - 1) / BLOCK,
+                            (dims[2] + BLOCK - 1) / BLOCK};
     const int pinhole = lens_is_pinhole(c->cam_dist); /* the voxel loop's common case, inline */
-    const vec3 step_x = m3_tmul(obj_from_cam->rot, v3(vox, 0, 0));
-    uint32_t lo[3], hi[3];
-    if (!view_box(obj_from_cam, m, r, lo, hi))
+    if (!mark_blocks(obj_from_cam, m, r, nb))
         return 0;
-    for (uint32_t z = lo[2]; z <= hi[2]; z++) {
-        for (uint32_t y = lo[1]; y <= hi[1]; y++) {
-            vec3 p_obj = v3_add(fusion_vol.origin, v3(lo[0] * vox, y * vox, z * vox));
-            vec3 p = frame_point_inv(obj_from_cam, p_obj); /* camera frame */
-            for (uint32_t x = lo[0]; x <= hi[0]; x++, p = v3_add(p, step_x)) {
-                if (p.z <= 1.0)
+    /* a point's band reaches truncation / voxel voxels (and one for rounding) from its block */
+    double band = fusion_vol.p.truncation_mm / fusion_vol.p.voxel_mm + 1.0;
+    grow_blocks(nb, (uint32_t)ceil(band / BLOCK));
+    for (uint32_t bz = 0; bz < nb[2]; bz++)
+        for (uint32_t by = 0; by < nb[1]; by++)
+            for (uint32_t bx = 0; bx < nb[0]; bx++) {
+                if (!block_mark[bidx(nb, bx, by, bz)])
                     continue;
-                double a = p.x / p.z, b = p.y / p.z;
-                double fu = c->cam_fx_px * a + c->cam_cx_px, fv = c->cam_fy_px * b + c->cam_cy_px;
-                if (!pinhole)
-                    camray_project(c, p, &fu, &fv);
-                if (fu < -0.5 || fv < -0.5)
-                    continue;
-                /* nearest pixel; a cast rounds correctly once the value is known >= -0.5, and
-                 * avoids a libm call per voxel */
-                long u = (long)(fu + 0.5), v = (long)(fv + 0.5);
-                if (u >= (long)m->width || v >= (long)m->height)
-                    continue;
-                size_t i = (size_t)v * m->width + (size_t)u;
-                if (weight_map[i] <= 0.0f)
-                    continue;
-                /* distance along the ray from the voxel to the measured surface */
-                double sdf = (r->xyz_mm[3 * i + 2] - p.z) * sqrt(1.0 + a * a + b * b);
-                if (sdf < -trunc)
-                    continue; /* hidden behind the surface: this view knows nothing of it */
-                double w = weight_map[i], cw = confidence != NULL ? w * confidence[i] : w;
-                fuse_voxel(&fusion_grid[vidx(x, y, z)], sdf, w, cw, rgb + 3 * i);
+                uint32_t x0 = bx * BLOCK, x1 = x0 + BLOCK < dims[0] ? x0 + BLOCK : dims[0];
+                for (uint32_t z = bz * BLOCK; z < (bz + 1) * BLOCK && z < dims[2]; z++)
+                    for (uint32_t y = by * BLOCK; y < (by + 1) * BLOCK && y < dims[1]; y++)
+                        integrate_run(c, obj_from_cam, m, r, rgb, confidence, x0, x1, y, z,
+                                      pinhole);
             }
-        }
-    }
     return 0;
 }
 
