@@ -60,10 +60,12 @@ static double thread_cpu_s(void)
     return (double)ts.tv_sec + (double)ts.tv_nsec / 1e9;
 }
 
-/* When a frame asked for at @p now_us begins and arrives. A streaming sensor starts a frame
- * every period (1 / frame_rate_hz, longer when the exposure is): the next start after the
- * request, then the whole frame time and the readout before it arrives. Without a frame rate,
- * a frame takes its exposure from the request on. */
+/* When the frame delivered for a capture asked for at @p now_us began, and when it arrives. A
+ * streaming sensor starts a frame every period (1 / frame_rate_hz, longer when the exposure
+ * is); a capture waits for the next start, then lets [camera] drop_frames frames go by as the
+ * V4L2 backend does (frames exposed during a pattern change), then takes the next whole frame,
+ * which arrives after its period and the readout. Without a frame rate, a frame takes its
+ * exposure from the request on. */
 static void frame_times(const struct camera_sim *cam, uint64_t now_us, uint64_t *start_us,
                         uint64_t *arrive_us)
 {
@@ -73,8 +75,9 @@ static void frame_times(const struct camera_sim *cam, uint64_t now_us, uint64_t 
         return;
     }
     double period = fmax(1e6 / cam->frame_rate_hz, (double)cam->cfg.exposure_us);
-    *start_us = (uint64_t)(ceil((double)now_us / period) * period);
-    *arrive_us = *start_us + (uint64_t)period + cam->readout_us;
+    double first = ceil((double)now_us / period) * period;
+    *start_us = (uint64_t)(first + cam->cfg.drop_frames * period);
+    *arrive_us = (uint64_t)(first + (cam->cfg.drop_frames + 1u) * period) + cam->readout_us;
 }
 
 static int camera_sim_capture(void *priv, struct hal_image *img)
