@@ -8,8 +8,25 @@ set -eu
 build=$1
 config=$2
 out=$build/bench-scan
-trap 'rm -rf "$out" "$out-fusion"' EXIT
-rm -rf "$out" "$out-fusion"
+trap 'rm -rf "$out" "$out-fusion" "$out-variant" "$out"-*.ini "$out.log" "$out-process.log" "$out-fusion.txt"' EXIT
+rm -rf "$out" "$out-fusion" "$out-variant"
+# The config with one more section (a later section's keys override), its paths made absolute.
+variant() { # NAME SECTION KEY VALUE
+    dir=$(cd "$(dirname "$config")" && pwd)
+    sed -e "s|^calibration = \([^/]\)|calibration = $dir/\1|" -e "s|^mesh_file = \([^/]\)|mesh_file = $dir/\1|" "$config" >"$out-$1.ini"
+    printf '\n[%s]\n%s = %s\n' "$2" "$3" "$4" >>"$out-$1.ini"
+    echo "$out-$1.ini"
+}
+# One scan of a variant: its cost line.
+variant_cost() { # CONFIG
+    rm -rf "$out-variant"
+    "$build/scanner" scan --config "$1" --out "$out-variant" >"$out-variant.log" 2>&1 || {
+        tail -n 3 "$out-variant.log" >&2
+        exit 1
+    }
+    grep '^cost: the scan' "$out-variant.log"
+    rm -rf "$out-variant" "$out-variant.log"
+}
 "$build/scanner" scan --config "$config" --out "$out" >"$out.log" 2>&1 || {
     tail -n 3 "$out.log"
     exit 1
@@ -49,6 +66,18 @@ awk -v own="$own" -v st="$storage" -v sim="$sim" -v v="$views" -v p="$proc" -v b
     inline = own - st
     printf "| rig time of the scan (turntable, frames at the sensor rate) | %.1f s |\n", clock
     printf "| predicted %d-view scan, processing included: this machine / a Pi 4-class core (x4) | **%.1f s** / %.1f s |\n", v, clock + inline, clock + 4 * inline
+}'
+# The same scan with fewer frames kept, and with a camera that needs no frame dropped after a
+# pattern change (hardware-triggered, or one whose frames say when their exposure began).
+none=$(variant_cost "$(variant none output keep_frames none)")
+nodrop=$(variant_cost "$(variant nodrop camera drop_frames 0)")
+awk -v none="$none" -v nodrop="$nodrop" -v v="$views" '
+BEGIN {
+    split(none, a, " "); own = a[4]; match(none, /storage thread [0-9.]+/); st = substr(none, RSTART + 15, RLENGTH - 15)
+    printf "| live scan CPU per view with [output] keep_frames = none | %.3f s |\n", own / v
+    split(nodrop, b, " "); own = b[4]; match(nodrop, /storage thread [0-9.]+/); st = substr(nodrop, RSTART + 15, RLENGTH - 15)
+    match(nodrop, /; [0-9.]+ s on the rig/); clock = substr(nodrop, RSTART + 2, RLENGTH - 16) + 0
+    printf "| predicted with [camera] drop_frames = 0: this machine / a Pi 4-class core (x4) | %.1f s / %.1f s (rig %.1f s) |\n", clock + own - st, clock + 4 * (own - st), clock
 }'
 echo
 "$build/bench_fusion" "$out" "$out-fusion" >"$out-fusion.txt"
