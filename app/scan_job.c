@@ -11,6 +11,7 @@
 #include "scan_dir.h"
 
 #include <errno.h>
+#include <pthread.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -28,10 +29,27 @@ struct job {
     uint32_t views;
     double start_ms;
     double start_cpu_s, start_sim_cpu_s; /* the process's CPU, and the simulator's part of it */
+    double start_thread_cpu_s;           /* this (the rig's) thread's CPU */
+    double views_cpu_s, last_view_cpu_s; /* the threads that processed views, and the last */
     uint64_t start_rig_us;               /* the rig's clock (the simulator's: the modelled rig's) */
     int tty;
     uint32_t view;                    /* the view being taken or processed */
     char view_dir[SCAN_DIR_PATH_MAX]; /* its directory */
+    struct pending *pending;          /* the view processed while the table turns, or NULL */
+};
+
+/* A captured view, processed and saved by a thread of its own while the table turns to the next
+ * view (the firmware is used by one thread at a time: the next capture waits for it). */
+struct pending {
+    struct job *j;
+    pthread_t thread;
+    uint32_t view;
+    char view_dir[SCAN_DIR_PATH_MAX];
+    char started[32];
+    double t0_ms;
+    struct scan_view_info info;
+    int rc;
+    double cpu_s; /* its thread's CPU */
 };
 
 static int load_view(struct job *j, const char *scan_dir, uint32_t v, struct scan_view *view,
@@ -76,6 +94,7 @@ static void job_init(struct job *j, const struct hal *hal, const struct app_conf
                       .start_ms = wall_ms(),
                       .start_cpu_s = process_cpu_s(),
                       .start_sim_cpu_s = board_simulator_cpu_s(),
+                      .start_thread_cpu_s = cpu_s(),
                       .tty = isatty(STDOUT_FILENO) && !opts->json};
     if (hal_clock_now_us(&hal->clock, &j->start_rig_us) != 0)
         j->start_rig_us = 0;
@@ -83,21 +102,34 @@ static void job_init(struct job *j, const struct hal *hal, const struct app_conf
 
 static void progress(struct job *j, const char *event, int view, uint32_t done,
                      const char *detail);
+static void progress_line(struct job *j, const char *event, int view, uint32_t done,
+                          const char *detail);
 
 /* What the job cost: the rig's time (with the simulator, the modelled rig's: its turntable and
- * frame rate) and the CPU the scanner spent, the simulator's rendering left out. make bench
- * reads this line. */
+ * frame rate) and the CPU the scanner spent, the simulator's rendering left out, split by what
+ * delays the scan (in line with the rig) and what runs beside it. make bench reads this line. */
 static void report_cost(struct job *j, const char *what)
 {
     uint64_t now_us = j->start_rig_us;
     hal_clock_now_us(&j->hal->clock, &now_us);
     double cpu = process_cpu_s() - j->start_cpu_s;
     double sim = board_simulator_cpu_s() - j->start_sim_cpu_s, own = cpu - sim;
-    double storage = frame_writer_cpu_s();
-    char detail[320];
+    uint32_t views = j->views ? j->views : 1;
+    char detail[400];
+    if (j->views_cpu_s <= 0.0) { /* offline: one thread */
+        snprintf(detail, sizeof(detail), "%s %.2f s CPU for %u views (%.3f s a view)", what, own,
+                 (unsigned)j->views, own / views);
+        progress(j, "cost", -1, j->views, detail);
+        return;
+    }
+    /* In line with the rig: this thread's work between its moves and captures, and the last
+     * view's processing (the others ran while the table turned) */
+    double in_line = cpu_s() - j->start_thread_cpu_s - sim + j->last_view_cpu_s;
     int n = snprintf(detail, sizeof(detail),
-                     "%s %.2f s CPU for %u views (%.3f s a view; storage thread %.2f s)", what,
-                     own, (unsigned)j->views, own / (j->views ? j->views : 1), storage);
+                     "%s %.2f s CPU for %u views (%.3f s a view: storing frames %.2f s, "
+                     "processing views as the table turned %.2f s, in line with the rig %.2f s)",
+                     what, own, (unsigned)j->views, own / views, frame_writer_cpu_s(),
+                     j->views_cpu_s - j->last_view_cpu_s, in_line);
     if (sim > 0.0 && n > 0 && (size_t)n < sizeof(detail))
         snprintf(detail + n, sizeof(detail) - (size_t)n,
                  ", the simulator's rendering (%.2f s) left out; %.1f s on the rig's clock",
@@ -137,6 +169,16 @@ static int view_finished(const char *event)
 
 /* One event. @p view < 0: not about a view. @p done: views finished so far, for the estimate. */
 static void progress(struct job *j, const char *event, int view, uint32_t done, const char *detail)
+{
+    /* a line at a time: a view is saved by its own thread while the next is taken */
+    static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
+    pthread_mutex_lock(&lock);
+    progress_line(j, event, view, done, detail);
+    pthread_mutex_unlock(&lock);
+}
+
+static void progress_line(struct job *j, const char *event, int view, uint32_t done,
+                          const char *detail)
 {
     double elapsed_s = (wall_ms() - j->start_ms) / 1000.0;
     double left_s = done > 0 ? elapsed_s / done * (j->views - done) : -1.0;
@@ -192,11 +234,16 @@ static const char *finished_detail(struct job *j, char *buf, size_t len)
 
 /* A write into the view's directory that failed, said once, naming the file.
  * @retval @p rc */
-static int write_failed(const struct job *j, const char *name, int rc)
+static int write_failed_at(const struct job *j, const char *dir, const char *name, int rc)
 {
     if (rc != 0)
-        j->hal->log(HAL_LOG_ERROR, "cannot write %s/%s: %s", j->view_dir, name, strerror(-rc));
+        j->hal->log(HAL_LOG_ERROR, "cannot write %s/%s: %s", dir, name, strerror(-rc));
     return rc;
+}
+
+static int write_failed(const struct job *j, const char *name, int rc)
+{
+    return write_failed_at(j, j->view_dir, name, rc);
 }
 
 /* Frames a scan keeps ([output] keep_frames): "colour" keeps the white pattern (the colour of
@@ -255,16 +302,16 @@ void scan_job_view_meta(const struct app_config *cfg, const struct scan_params *
     memcpy(v->reason_count, info->reason_count, sizeof(v->reason_count));
 }
 
-static int write_view_meta(struct job *j, const struct scan_view_info *info, const char *started,
-                           double ms)
+static int write_view_meta(const struct pending *p, double ms)
 {
     static struct scan_dir_view v; /* large; one view at a time */
-    scan_job_view_meta(j->cfg, &j->cfg->scan, j->calib, j->view, info, &v);
-    snprintf(v.started, sizeof(v.started), "%s", started);
+    const struct job *j = p->j;
+    scan_job_view_meta(j->cfg, &j->cfg->scan, j->calib, p->view, &p->info, &v);
+    snprintf(v.started, sizeof(v.started), "%s", p->started);
     utc_now(v.finished, sizeof(v.finished));
     v.wall_ms = ms;
-    return write_failed(j, "view.ini",
-                        scan_dir_write_view(&j->hal->storage, j->out_dir, j->view, &v));
+    return write_failed_at(j, p->view_dir, "view.ini",
+                           scan_dir_write_view(&j->hal->storage, j->out_dir, p->view, &v));
 }
 
 /* Results of a processed view once the scan is registered: its registration.ini, its point
@@ -467,6 +514,80 @@ static void table_failed(const struct job *j, uint32_t v, int32_t target_mdeg)
                  target_mdeg / 1000.0, kept_views(j, v, "", kept, sizeof(kept)));
 }
 
+/* The thread of a captured view: decode it, keep its frames and range image, then its view.ini
+ * last (its presence says the view is complete). */
+static void *process_view(void *arg)
+{
+    struct pending *p = arg;
+    struct job *j = p->j;
+    const struct hal *hal = j->hal;
+    struct scan_view view;
+    char detail[HAL_MAX_PATH + 160];
+    double t0_cpu = cpu_s();
+    int rc = scan_finish_view(j->calib, p->info.angle_mdeg, &view, &p->info);
+    int rc_frames = flush_frames(j); /* nothing writes into the view's directory after this */
+    if (rc == 0)
+        rc = rc_frames;
+    if (rc != 0) { /* the layer that met the fault has said what it was */
+        char kept[2 * HAL_MAX_PATH + 96];
+        hal->log(HAL_LOG_WARN, "view %u at %.3f deg was not finished (%s); %s",
+                 (unsigned)p->view, p->info.angle_mdeg / 1000.0, strerror(-rc),
+                 kept_views(j, p->view, "", kept, sizeof(kept)));
+        p->rc = rc;
+        p->cpu_s = cpu_s() - t0_cpu;
+        return NULL;
+    }
+    progress(j, "saving", (int)p->view, p->view, "");
+    rc = scan_keep_for_registration(p->view, &view); /* the model is made once every view is in */
+    if (rc == 0) /* what the model is made of, so that it is not decoded again */
+        rc = write_failed_at(j, p->view_dir, "range.bin",
+                             scan_dir_write_range(&hal->storage, j->out_dir, p->view, &view));
+    if (rc == 0)
+        rc = write_view_meta(p, wall_ms() - p->t0_ms);
+    if (rc == 0) {
+        describe(detail, sizeof(detail), &p->info, p->view_dir);
+        progress(j, "saved", (int)p->view, p->view + 1, detail);
+    }
+    p->rc = rc;
+    p->cpu_s = cpu_s() - t0_cpu;
+    return NULL;
+}
+
+/* Wait for the view being processed, if any. @retval 0 @retval its error (said already) */
+static int finish_pending(struct job *j)
+{
+    if (j->pending == NULL)
+        return 0;
+    pthread_join(j->pending->thread, NULL);
+    int rc = j->pending->rc;
+    j->views_cpu_s += j->pending->cpu_s;
+    j->last_view_cpu_s = j->pending->cpu_s;
+    j->pending = NULL;
+    return rc;
+}
+
+/* Process the view just captured on a thread of its own, so that the table turns meanwhile;
+ * without a thread, here. @retval 0 @retval what processing it met */
+static int start_processing(struct job *j, uint32_t v, const char *started, double t0_ms,
+                            const struct scan_view_info *info)
+{
+    static struct pending p; /* one at a time */
+    p = (struct pending){.j = j, .view = v, .t0_ms = t0_ms, .info = *info};
+    snprintf(p.view_dir, sizeof(p.view_dir), "%s", j->view_dir);
+    snprintf(p.started, sizeof(p.started), "%s", started);
+    int rc = pthread_create(&p.thread, NULL, process_view, &p);
+    if (rc == 0) {
+        j->pending = &p;
+        return 0;
+    }
+    j->hal->log(HAL_LOG_WARN, "cannot start a thread (%s): view %u is processed before the "
+                              "table turns", strerror(rc), (unsigned)v);
+    process_view(&p);
+    j->views_cpu_s += p.cpu_s;
+    j->last_view_cpu_s = p.cpu_s;
+    return p.rc;
+}
+
 static int live_view(struct job *j, uint32_t v)
 {
     const struct hal *hal = j->hal;
@@ -479,6 +600,9 @@ static int live_view(struct job *j, uint32_t v)
     struct hal_turntable_status st;
     if (rc == 0)
         rc = hal_table_get_status(&hal->turntable, &st); /* the angle the controller reports */
+    int rc_before = finish_pending(j); /* the view before, processed while the table turned */
+    if (rc_before != 0)
+        return rc_before;
     if (rc != 0) {
         table_failed(j, v, target);
         return rc;
@@ -492,35 +616,21 @@ static int live_view(struct job *j, uint32_t v)
     utc_now(started, sizeof(started));
     progress(j, "capturing", (int)v, v, "");
     struct scan_frame_sink sink = {save_frame, j};
-    struct scan_view view;
     struct scan_view_info info;
     double t0 = wall_ms();
-    rc = scan_take_view(hal, &j->cfg->scan, j->calib, st.position_mdeg, &sink, &view, &info);
-    int rc_frames = flush_frames(j); /* nothing writes into the view's directory after this */
+    rc = scan_capture_view(hal, &j->cfg->scan, j->calib, st.position_mdeg, &sink, &info);
+    /* the simulator's truth of this view while the table is still at its angle */
     if (rc == 0)
-        rc = rc_frames;
+        rc = write_failed(j, "(the simulator's truth)", board_write_view_extras(hal, j->view_dir));
     if (rc != 0) { /* the layer that met the fault has said what it was */
         char kept[2 * HAL_MAX_PATH + 96];
+        flush_frames(j); /* nothing writes into the view's directory after this */
         hal->log(HAL_LOG_WARN, "view %u at %.3f deg was not finished (%s); %s", (unsigned)v,
                  st.position_mdeg / 1000.0, rc == -EINTR ? "stopped by request" : strerror(-rc),
                  kept_views(j, v, "", kept, sizeof(kept)));
         return rc;
     }
-    progress(j, "saving", (int)v, v, "");
-    rc = scan_keep_for_registration(v, &view); /* the model is made once every view is in */
-    if (rc == 0) /* what the model is made of, so that it is not decoded again */
-        rc = write_failed(j, "range.bin",
-                          scan_dir_write_range(&hal->storage, j->out_dir, v, &view));
-    if (rc == 0)
-        rc = write_failed(j, "(the simulator's truth)", board_write_view_extras(hal, j->view_dir));
-    /* view.ini last: its presence says the view is complete */
-    if (rc == 0)
-        rc = write_view_meta(j, &info, started, wall_ms() - t0);
-    if (rc != 0)
-        return rc;
-    describe(detail, sizeof(detail), &info, j->view_dir);
-    progress(j, "saved", (int)v, v + 1, detail);
-    return 0;
+    return start_processing(j, v, started, t0, &info);
 }
 
 /* The person lays the object for the second pass (the simulated person does it at once).
@@ -554,8 +664,9 @@ static int start_storage(const struct job *j)
     return rc;
 }
 
-/* Home the table, then take views @p first .. the last, each saved before the next move; a
- * two-pass scan asks for the object to be laid for the second pass, and homes again. */
+/* Home the table, then take views @p first .. the last, each processed and saved while the
+ * table turns to the next; a two-pass scan asks for the object to be laid for the second pass
+ * (the first pass saved), and homes again. */
 static int home_and_take_views(struct job *j, uint32_t first)
 {
     const struct hal *hal = j->hal;
@@ -572,14 +683,17 @@ static int home_and_take_views(struct job *j, uint32_t first)
                  j->opts->clear_alarm ? "" : " (if it reports an alarm: --clear-alarm)");
     for (uint32_t v = first; v < j->views && rc == 0; v++) {
         if (v == j->cfg->views && v != first) { /* the second pass begins */
-            rc = ask_for_second_pass(j);
+            rc = finish_pending(j);
+            if (rc == 0)
+                rc = ask_for_second_pass(j);
             if (rc == 0 && (rc = hal_table_home(&hal->turntable)) != 0)
                 hal->log(HAL_LOG_WARN, "the turntable did not home for the second pass");
         }
         if (rc == 0)
             rc = live_view(j, v);
     }
-    return rc;
+    int rc_last = finish_pending(j); /* on every path: a captured view is always saved */
+    return rc != 0 ? rc : rc_last;
 }
 
 /* Lock the job's output directory against a second scanner (checking what it holds by

@@ -34,6 +34,12 @@ const char *scan_reason_name(unsigned reason)
     return reason < SCAN_REASON_COUNT ? names[reason] : "unknown";
 }
 
+/* x86-64's baseline (SSE2) has no byte shuffle to split RGB triples: a clone for SSSE3 and one
+ * for AVX2 are built beside it and the loader picks the best the CPU has (GCC target_clones;
+ * Arm's NEON needs none). */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+__attribute__((target_clones("default", "ssse3", "avx2")))
+#endif
 void decode_rgb_to_grey(const uint8_t *rgb, uint8_t *grey, size_t n, uint32_t saturation_dn)
 {
     /* Written without branches and in 16 bits (77 + 150 + 29 = 256: the sum fits), so that

@@ -129,8 +129,10 @@ static void fuse_voxel(struct voxel *vx, double sdf, double w, double cw, const 
     double s = (old_s * old_w + sdf * w) / new_w;
     if (fabs(sdf) < trunc) /* colour comes from near the surface only */
         fuse_colour(vx, cw, rgb);
-    vx->sdf = (int16_t)lround(s / trunc * 32767.0);
-    vx->weight = (uint16_t)lround(fmin(new_w, fusion_vol.p.max_weight) * WEIGHT_SCALE);
+    /* rounded half away from zero, as lround, without a libm call per voxel */
+    double q = s / trunc * 32767.0;
+    vx->sdf = (int16_t)(q >= 0.0 ? q + 0.5 : q - 0.5);
+    vx->weight = (uint16_t)(fmin(new_w, fusion_vol.p.max_weight) * WEIGHT_SCALE + 0.5);
 }
 
 /* Voxels this view can change: those near its fused points. The grid is cut in blocks of

@@ -404,9 +404,9 @@ static int capture_lights(const struct hal *hal, const struct scan_params *p,
     return rc != 0 ? rc : rc_off;
 }
 
-int scan_take_view(const struct hal *hal, const struct scan_params *p, const struct scan_calib *c,
-                   int32_t angle_mdeg, const struct scan_frame_sink *sink, struct scan_view *view,
-                   struct scan_view_info *info)
+int scan_capture_view(const struct hal *hal, const struct scan_params *p,
+                      const struct scan_calib *c, int32_t angle_mdeg,
+                      const struct scan_frame_sink *sink, struct scan_view_info *info)
 {
     memset(info, 0, sizeof(*info));
     info->angle_mdeg = angle_mdeg;
@@ -429,10 +429,18 @@ int scan_take_view(const struct hal *hal, const struct scan_params *p, const str
                         p->height, 3);
     if (rc != 0 || rc_off != 0)
         goto out_safe;
-    return scan_finish_view(c, angle_mdeg, view, info);
+    return 0;
 out_safe:
     hal->gpio.ops->safe_state(hal->gpio.priv);
     return rc != 0 ? rc : rc_off;
+}
+
+int scan_take_view(const struct hal *hal, const struct scan_params *p, const struct scan_calib *c,
+                   int32_t angle_mdeg, const struct scan_frame_sink *sink, struct scan_view *view,
+                   struct scan_view_info *info)
+{
+    int rc = scan_capture_view(hal, p, c, angle_mdeg, sink, info);
+    return rc != 0 ? rc : scan_finish_view(c, angle_mdeg, view, info);
 }
 
 int scan_keep_for_registration(uint32_t index, const struct scan_view *view)

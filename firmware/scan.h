@@ -73,6 +73,16 @@ struct scan_frame_sink {
     void *priv;
 };
 
+/** Capture one view at the current turntable angle, without processing it: the frames wait in
+ *  the firmware's buffers for scan_finish_view (which may run while the table turns to the
+ *  next view; nothing else may use the firmware meanwhile). On any failure the projector and
+ *  lights are off when it returns. @param sink  keeps every frame (NULL: not kept)
+ *  @param info  out: frames and retries counted
+ *  @retval 0 ok @retval -EINTR stop requested @retval capture error */
+int scan_capture_view(const struct hal *hal, const struct scan_params *params,
+                      const struct scan_calib *calib, int32_t angle_mdeg,
+                      const struct scan_frame_sink *sink, struct scan_view_info *info);
+
 /** Capture and process one view at the current turntable angle. On any failure the projector
  *  and lights are off when it returns.
  *  @param sink  keeps every frame as captured (NULL: frames are not kept)
