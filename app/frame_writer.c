@@ -9,6 +9,7 @@
 
 #include <errno.h>
 #include <pthread.h>
+#include <signal.h>
 #include <stdio.h>
 #include <string.h>
 #include <time.h>
@@ -83,12 +84,18 @@ int frame_writer_start(const struct hal_storage *storage)
     w.cpu_s = 0.0;
     /* A small stack: the encoders keep their state on the heap, and a board with 512 MB has no
      * address space to spare for the default 8 MiB (make LIMITS=small under ulimit -v). */
+    /* Signals stay with the thread that runs the scan (it stops the rig): the new thread starts
+     * with every signal blocked. */
     pthread_attr_t attr;
+    sigset_t all, old;
+    sigfillset(&all);
     int rc = pthread_attr_init(&attr);
     if (rc == 0)
         rc = pthread_attr_setstacksize(&attr, FRAME_WRITER_STACK);
-    if (rc == 0)
+    if (rc == 0 && (rc = pthread_sigmask(SIG_BLOCK, &all, &old)) == 0) {
         rc = pthread_create(&w.thread, &attr, writer, NULL);
+        pthread_sigmask(SIG_SETMASK, &old, NULL);
+    }
     pthread_attr_destroy(&attr);
     if (rc != 0)
         return -rc;

@@ -12,6 +12,7 @@
 
 #include <errno.h>
 #include <pthread.h>
+#include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -575,7 +576,14 @@ static int start_processing(struct job *j, uint32_t v, const char *started, doub
     p = (struct pending){.j = j, .view = v, .t0_ms = t0_ms, .info = *info};
     snprintf(p.view_dir, sizeof(p.view_dir), "%s", j->view_dir);
     snprintf(p.started, sizeof(p.started), "%s", started);
-    int rc = pthread_create(&p.thread, NULL, process_view, &p);
+    /* signals stay with this thread, which stops the rig: the new one has them blocked */
+    sigset_t all, old;
+    sigfillset(&all);
+    int rc = pthread_sigmask(SIG_BLOCK, &all, &old);
+    if (rc == 0) {
+        rc = pthread_create(&p.thread, NULL, process_view, &p);
+        pthread_sigmask(SIG_SETMASK, &old, NULL);
+    }
     if (rc == 0) {
         j->pending = &p;
         return 0;
