@@ -51,12 +51,47 @@ int fusion_begin(const struct fusion_params *p)
 }
 
 
-/* City-block distance of each valid pixel to the nearest invalid one (two passes), capped. */
+/* The rectangle of pixels a view's work covers: its valid pixels and a ring of one pixel
+ * around them (within the image), x0 <= x < x1, y0 <= y < y1. The object fills a part of the
+ * frame; the passes over pixels stay inside. */
+static struct {
+    uint32_t x0, y0, x1, y1;
+} rect;
+
+/* @retval 0 when the view has no valid pixel */
+static int find_rect(const struct decode_maps *m)
+{
+    const uint32_t w = m->width, h = m->height;
+    uint32_t x0 = w, x1 = 0, y0 = h, y1 = 0;
+    for (uint32_t y = 0; y < h; y++) {
+        const uint8_t *row = m->reason + (size_t)y * w;
+        const uint8_t *first = memchr(row, SCAN_VALID, w); /* SCAN_VALID is 0: a fast scan */
+        if (first == NULL)
+            continue;
+        uint32_t last = w - 1;
+        while (row[last] != SCAN_VALID)
+            last--;
+        x0 = (uint32_t)(first - row) < x0 ? (uint32_t)(first - row) : x0;
+        x1 = last + 1 > x1 ? last + 1 : x1;
+        y0 = y < y0 ? y : y0;
+        y1 = y + 1;
+    }
+    if (x1 == 0)
+        return 0;
+    rect.x0 = x0 > 0 ? x0 - 1 : 0;
+    rect.y0 = y0 > 0 ? y0 - 1 : 0;
+    rect.x1 = x1 < w ? x1 + 1 : w;
+    rect.y1 = y1 < h ? y1 + 1 : h;
+    return 1;
+}
+
+/* City-block distance of each valid pixel to the nearest invalid one (two passes), capped.
+ * Inside the rectangle only: its ring holds no valid pixel, so nothing outside is read. */
 static void distance_to_edge(const struct decode_maps *m, uint16_t cap)
 {
     const uint32_t w = m->width, h = m->height;
-    for (uint32_t y = 0; y < h; y++) {
-        for (uint32_t x = 0; x < w; x++) {
+    for (uint32_t y = rect.y0; y < rect.y1; y++) {
+        for (uint32_t x = rect.x0; x < rect.x1; x++) {
             size_t i = (size_t)y * w + x;
             uint16_t d = 0;
             if (m->reason[i] == SCAN_VALID) {
@@ -71,8 +106,8 @@ static void distance_to_edge(const struct decode_maps *m, uint16_t cap)
             edge_dist[i] = d;
         }
     }
-    for (uint32_t y = h; y-- > 0;) {
-        for (uint32_t x = w; x-- > 0;) {
+    for (uint32_t y = rect.y1; y-- > rect.y0;) {
+        for (uint32_t x = rect.x1; x-- > rect.x0;) {
             size_t i = (size_t)y * w + x;
             if (x + 1 < w && edge_dist[i + 1] + 1 < edge_dist[i])
                 edge_dist[i] = (uint16_t)(edge_dist[i + 1] + 1);
@@ -83,16 +118,19 @@ static void distance_to_edge(const struct decode_maps *m, uint16_t cap)
 }
 
 /* How much a pixel is trusted: head-on, close (finer sampling), and away from the view's edge,
- * where depth is least reliable and colour seams would show (Jost et al., boundary filtering). */
-static void pixel_weights(const struct scan_calib *c, const struct decode_maps *m,
-                          const struct tri_range *r)
+ * where depth is least reliable and colour seams would show (Jost et al., boundary filtering).
+ * @retval 0 when no pixel is valid */
+static int pixel_weights(const struct scan_calib *c, const struct decode_maps *m,
+                         const struct tri_range *r)
 {
     const double fade = fusion_vol.p.edge_fade_px > 0 ? (double)fusion_vol.p.edge_fade_px : 1.0;
+    memset(weight_map, 0, (size_t)m->width * m->height * sizeof(weight_map[0]));
+    if (!find_rect(m))
+        return 0;
     distance_to_edge(m, (uint16_t)(fusion_vol.p.edge_fade_px > 0 ? fusion_vol.p.edge_fade_px : 1));
-    for (uint32_t y = 0; y < m->height; y++) {
-        for (uint32_t x = 0; x < m->width; x++) {
+    for (uint32_t y = rect.y0; y < rect.y1; y++) {
+        for (uint32_t x = rect.x0; x < rect.x1; x++) {
             size_t i = (size_t)y * m->width + x;
-            weight_map[i] = 0.0f;
             if (m->reason[i] != SCAN_VALID)
                 continue;
             vec3 ray = v3_norm(camray_at(c, x, y));
@@ -102,6 +140,7 @@ static void pixel_weights(const struct scan_calib *c, const struct decode_maps *
             weight_map[i] = w >= fusion_vol.p.min_weight ? (float)w : 0.0f;
         }
     }
+    return 1;
 }
 
 /* Blend colour @p rgb with weight @p cw into the voxel; a voxel no confident view has coloured
@@ -155,22 +194,29 @@ static size_t bidx(const uint32_t nb[3], uint32_t x, uint32_t y, uint32_t z)
 static int mark_blocks(const struct frame_xform *obj_from_cam, const struct decode_maps *m,
                        const struct tri_range *r, const uint32_t nb[3])
 {
-    size_t n = (size_t)m->width * m->height;
     const double scale = 1.0 / (fusion_vol.p.voxel_mm * BLOCK);
     int any = 0;
     memset(block_mark, 0, (size_t)nb[0] * nb[1] * nb[2]);
-    for (size_t i = 0; i < n; i++) {
-        if (weight_map[i] <= 0.0f)
-            continue;
-        vec3 p = v3_sub(frame_point(obj_from_cam, v3(r->xyz_mm[3 * i], r->xyz_mm[3 * i + 1],
-                                                     r->xyz_mm[3 * i + 2])),
-                        fusion_vol.origin);
-        double g[3] = {p.x * scale, p.y * scale, p.z * scale};
-        if (g[0] < 0.0 || g[1] < 0.0 || g[2] < 0.0 || g[0] >= nb[0] || g[1] >= nb[1] ||
-            g[2] >= nb[2])
-            continue; /* outside the grid: its band may still reach in, at most one block */
-        block_mark[bidx(nb, (uint32_t)g[0], (uint32_t)g[1], (uint32_t)g[2])] = 1;
-        any = 1;
+    for (size_t y = rect.y0; y < rect.y1; y++) {
+        for (size_t i = y * m->width + rect.x0; i < y * m->width + rect.x1; i++) {
+            if (weight_map[i] <= 0.0f)
+                continue;
+            vec3 p = v3_sub(frame_point(obj_from_cam, v3(r->xyz_mm[3 * i], r->xyz_mm[3 * i + 1],
+                                                         r->xyz_mm[3 * i + 2])),
+                            fusion_vol.origin);
+            double g[3] = {p.x * scale, p.y * scale, p.z * scale};
+            uint32_t b[3];
+            int inside = 1;
+            for (int a = 0; a < 3; a++) {
+                /* a point up to a block outside the grid: its band may reach in */
+                inside = inside && g[a] >= -1.0 && g[a] < nb[a] + 1.0;
+                b[a] = g[a] < 0.0 ? 0u : g[a] >= nb[a] ? nb[a] - 1u : (uint32_t)g[a];
+            }
+            if (inside) {
+                block_mark[bidx(nb, b[0], b[1], b[2])] = 1;
+                any = 1;
+            }
+        }
     }
     return any;
 }
@@ -199,20 +245,20 @@ static void grow_blocks(const uint32_t nb[3], uint32_t reach)
     }
 }
 
-/* The voxels x of row (y, z) in block bx within the grid. */
+/* The voxels x0 .. x1 - 1 of row (y, z). @p step_x: one voxel along x, in the camera frame. */
 static void integrate_run(const struct scan_calib *c, const struct frame_xform *obj_from_cam,
                           const struct decode_maps *m, const struct tri_range *r,
-                          const uint8_t *rgb, const float *confidence, uint32_t x0, uint32_t x1,
-                          uint32_t y, uint32_t z, int pinhole)
+                          const uint8_t *rgb, const float *confidence, vec3 step_x, uint32_t x0,
+                          uint32_t x1, uint32_t y, uint32_t z, int pinhole)
 {
     const double trunc = fusion_vol.p.truncation_mm, vox = fusion_vol.p.voxel_mm;
-    const vec3 step_x = m3_tmul(obj_from_cam->rot, v3(vox, 0, 0));
     vec3 p_obj = v3_add(fusion_vol.origin, v3(x0 * vox, y * vox, z * vox));
     vec3 p = frame_point_inv(obj_from_cam, p_obj); /* camera frame */
+    struct voxel *row = &fusion_grid[vidx(0, y, z)];
     for (uint32_t x = x0; x < x1; x++, p = v3_add(p, step_x)) {
         if (p.z <= 1.0)
             continue;
-        double a = p.x / p.z, b = p.y / p.z;
+        double iz = 1.0 / p.z, a = p.x * iz, b = p.y * iz;
         double fu = c->cam_fx_px * a + c->cam_cx_px, fv = c->cam_fy_px * b + c->cam_cy_px;
         if (!pinhole)
             camray_project(c, p, &fu, &fv);
@@ -231,7 +277,7 @@ static void integrate_run(const struct scan_calib *c, const struct frame_xform *
         if (sdf < -trunc)
             continue; /* hidden behind the surface: this view knows nothing of it */
         double w = weight_map[i], cw = confidence != NULL ? w * confidence[i] : w;
-        fuse_voxel(&fusion_grid[vidx(x, y, z)], sdf, w, cw, rgb + 3 * i);
+        fuse_voxel(&row[x], sdf, w, cw, rgb + 3 * i);
     }
 }
 
@@ -239,27 +285,35 @@ int fusion_integrate(const struct scan_calib *c, const struct frame_xform *obj_f
                      const struct decode_maps *m, const struct tri_range *r, const uint8_t *rgb,
                      const float *confidence)
 {
-    pixel_weights(c, m, r);
+    if (!pixel_weights(c, m, r))
+        return 0;
     const uint32_t *dims = fusion_vol.dims;
     const uint32_t nb[3] = {(dims[0] + BLOCK - 1) / BLOCK, (dims[1] + BLOCK - 1) / BLOCK,
                             (dims[2] + BLOCK - 1) / BLOCK};
     const int pinhole = lens_is_pinhole(c->cam_dist); /* the voxel loop's common case, inline */
+    const vec3 step_x = m3_tmul(obj_from_cam->rot, v3(fusion_vol.p.voxel_mm, 0, 0));
     if (!mark_blocks(obj_from_cam, m, r, nb))
         return 0;
     /* a point's band reaches truncation / voxel voxels (and one for rounding) from its block */
     double band = fusion_vol.p.truncation_mm / fusion_vol.p.voxel_mm + 1.0;
     grow_blocks(nb, (uint32_t)ceil(band / BLOCK));
-    for (uint32_t bz = 0; bz < nb[2]; bz++)
-        for (uint32_t by = 0; by < nb[1]; by++)
-            for (uint32_t bx = 0; bx < nb[0]; bx++) {
-                if (!block_mark[bidx(nb, bx, by, bz)])
+    /* Row by row in the grid's memory order; along a row, each run of marked blocks at once. */
+    for (uint32_t z = 0; z < dims[2]; z++)
+        for (uint32_t y = 0; y < dims[1]; y++) {
+            const uint8_t *marks = &block_mark[bidx(nb, 0, y / BLOCK, z / BLOCK)];
+            for (uint32_t bx = 0; bx < nb[0];) {
+                if (!marks[bx]) {
+                    bx++;
                     continue;
-                uint32_t x0 = bx * BLOCK, x1 = x0 + BLOCK < dims[0] ? x0 + BLOCK : dims[0];
-                for (uint32_t z = bz * BLOCK; z < (bz + 1) * BLOCK && z < dims[2]; z++)
-                    for (uint32_t y = by * BLOCK; y < (by + 1) * BLOCK && y < dims[1]; y++)
-                        integrate_run(c, obj_from_cam, m, r, rgb, confidence, x0, x1, y, z,
-                                      pinhole);
+                }
+                uint32_t first = bx;
+                while (bx < nb[0] && marks[bx])
+                    bx++;
+                uint32_t x1 = bx * BLOCK < dims[0] ? bx * BLOCK : dims[0];
+                integrate_run(c, obj_from_cam, m, r, rgb, confidence, step_x, first * BLOCK, x1,
+                              y, z, pinhole);
             }
+        }
     return 0;
 }
 
