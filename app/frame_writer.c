@@ -1,11 +1,14 @@
-/* The storage thread: a ring of FRAME_WRITER_SLOTS static frame buffers, filled by the scan,
- * emptied by one writer thread through scan_dir_write_frame (so each frame stays an atomic,
- * durable write). The scan waits only when the ring is full or when a view ends: view.ini is
- * written after frame_writer_flush, so its presence still means every frame is on disk. */
+/* The storage thread: a ring of frames to keep, queued by the scan, written by one thread
+ * through scan_dir_write_frame (so each frame stays an atomic, durable write). The frames are
+ * not copied: they stay in the firmware's static buffers, which the next view overwrites only
+ * after frame_writer_flush (the caller's promise). view.ini is written after the flush, so its
+ * presence still means every frame is on disk. The thread keeps one zstd compressor for all its
+ * frames: writing allocates nothing. */
 #define _POSIX_C_SOURCE 200809L
 #include "frame_writer.h"
 
 #include "hal_limits.h"
+#include "image_io.h"
 
 #include <errno.h>
 #include <pthread.h>
@@ -18,11 +21,11 @@
 
 struct slot {
     char dir[HAL_MAX_PATH];
+    const uint8_t *pixels; /* the caller's, unchanged until the flush */
     uint32_t view, frame, width, height, channels;
     enum scan_frame_format format;
 };
 
-static uint8_t slot_pixels[FRAME_WRITER_SLOTS][HAL_MAX_PIXELS * 3];
 static struct slot slots[FRAME_WRITER_SLOTS];
 
 static struct {
@@ -47,6 +50,7 @@ static double thread_cpu_s(void)
 static void *writer(void *arg)
 {
     (void)arg;
+    int kept = image_zstd_keep(); /* without it, each frame makes its own compressor */
     pthread_mutex_lock(&w.lock);
     for (;;) {
         while (w.count == 0 && !w.stopping)
@@ -57,8 +61,8 @@ static void *writer(void *arg)
         pthread_mutex_unlock(&w.lock);
         /* outside the lock: the scan queues the next frames meanwhile */
         const struct slot *s = &slots[k];
-        int rc = scan_dir_write_frame(w.storage, s->dir, s->view, s->frame, slot_pixels[k],
-                                      s->width, s->height, s->channels, s->format);
+        int rc = scan_dir_write_frame(w.storage, s->dir, s->view, s->frame, s->pixels, s->width,
+                                      s->height, s->channels, s->format);
         pthread_mutex_lock(&w.lock);
         if (rc != 0 && w.error == 0) {
             w.error = rc;
@@ -71,6 +75,8 @@ static void *writer(void *arg)
         pthread_cond_broadcast(&w.changed);
     }
     pthread_mutex_unlock(&w.lock);
+    if (kept == 0)
+        image_zstd_release();
     return NULL;
 }
 
@@ -117,10 +123,9 @@ int frame_writer_put(const char *dir, uint32_t view, uint32_t frame, const uint8
                      uint32_t width, uint32_t height, uint32_t channels,
                      enum scan_frame_format format, char *failed, size_t failed_len)
 {
-    size_t bytes = (size_t)width * height * channels;
     if (!w.running)
         return -EPIPE;
-    if (bytes > sizeof(slot_pixels[0]) || strlen(dir) >= sizeof(slots[0].dir))
+    if (strlen(dir) >= sizeof(slots[0].dir))
         return -E2BIG;
     pthread_mutex_lock(&w.lock);
     while (w.count == FRAME_WRITER_SLOTS && w.error == 0)
@@ -130,9 +135,8 @@ int frame_writer_put(const char *dir, uint32_t view, uint32_t frame, const uint8
         /* the slot after the queued ones is free: the writer only touches queued slots */
         uint32_t k = (w.head + w.count) % FRAME_WRITER_SLOTS;
         pthread_mutex_unlock(&w.lock);
-        memcpy(slot_pixels[k], pixels, bytes);
-        slots[k] = (struct slot){.view = view, .frame = frame, .width = width, .height = height,
-                                 .channels = channels, .format = format};
+        slots[k] = (struct slot){.pixels = pixels, .view = view, .frame = frame, .width = width,
+                                 .height = height, .channels = channels, .format = format};
         snprintf(slots[k].dir, sizeof(slots[k].dir), "%s", dir);
         pthread_mutex_lock(&w.lock);
         w.count++;

@@ -1,5 +1,5 @@
-/* The storage thread: keeps a view's frames on disk while the next ones are captured and
- * processed, from a fixed ring of static buffers (nothing allocated during a scan). */
+/* The storage thread: keeps a view's frames on disk while the scan goes on, from the
+ * firmware's static frame buffers (nothing copied, nothing allocated during a scan). */
 #ifndef FRAME_WRITER_H
 #define FRAME_WRITER_H
 
@@ -9,16 +9,16 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/** Frames waiting to be written at most; a capture waits when all are taken. Encoding a frame
- *  (zstd: 7 ms grey, 25 ms RGB at 1280x960) is faster than capturing one (33 ms at 30 fps). */
-#define FRAME_WRITER_SLOTS 3u
+/** Frames waiting to be written at most: a whole view's, so that a capture never waits. */
+#define FRAME_WRITER_SLOTS SCAN_DIR_MAX_FRAMES
 
 /** Start the thread that writes into @p storage. @retval 0 @retval -errno (the thread could not
  *  be made) */
 int frame_writer_start(const struct hal_storage *storage);
 
-/** Queue frame @p frame of view @p view of scan directory @p dir for writing: @p pixels are
- *  copied, so the caller may reuse them at once. Waits while every slot is taken.
+/** Queue frame @p frame of view @p view of scan directory @p dir for writing. @p pixels are
+ *  not copied: they must stay as they are until frame_writer_flush returns (the scan's frames
+ *  stay in the firmware's buffers until the next view). Waits while every slot is taken.
  *  @retval 0 @retval -errno a write queued earlier failed (and nothing is queued): @p failed
  *  names its file */
 int frame_writer_put(const char *dir, uint32_t view, uint32_t frame, const uint8_t *pixels,

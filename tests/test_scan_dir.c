@@ -257,7 +257,13 @@ static void test_pnm_frames_round_trip(void **state)
                      -EINVAL);
     assert_non_null(strstr(err, "frame_05.ppm.zst: an RGB frame where a grey one belongs"));
     assert_int_equal(scan_dir_find_frame(path, sizeof(path), dir, 0, 4), 0);
-    assert_int_equal(truncate(path, 5000), 0);
+    struct stat sb;
+    assert_int_equal(stat(path, &sb), 0);
+    assert_int_equal(truncate(path, sb.st_size + 100), 0); /* zeros after the frame */
+    assert_int_equal(scan_dir_read_frame(dir, 0, 4, back, sizeof(back), W, H, 1, err, sizeof(err)),
+                     -EINVAL);
+    assert_non_null(strstr(err, "frame_04.pgm.zst: damaged zstd data (bytes after its frame)"));
+    assert_int_equal(truncate(path, sb.st_size / 2), 0); /* cut short */
     assert_int_equal(scan_dir_read_frame(dir, 0, 4, back, sizeof(back), W, H, 1, err, sizeof(err)),
                      -EINVAL);
     assert_non_null(strstr(err, "frame_04.pgm.zst: damaged zstd data"));

@@ -135,6 +135,69 @@ int image_write_pfm(const struct hal_storage *st, const char *path, const float 
 
 /* ---- PGM/PPM, raw or as one zstd frame ---- */
 
+#define ZSTD_CHUNK (128u * 1024u) /* compressed bytes moved at a time, both ways */
+
+/* The compressor a thread keeps for its frames (image_zstd_keep), and its output chunk. */
+static _Thread_local struct zstd_out {
+    ZSTD_CCtx *cctx;
+    uint8_t *out;
+} kept;
+
+static void zstd_out_free(struct zstd_out *z)
+{
+    ZSTD_freeCCtx(z->cctx);
+    free(z->out);
+    z->cctx = NULL;
+    z->out = NULL;
+}
+
+static int zstd_out_make(struct zstd_out *z)
+{
+    z->cctx = ZSTD_createCCtx();
+    z->out = malloc(ZSTD_CHUNK);
+    if (z->cctx != NULL && z->out != NULL)
+        return 0;
+    zstd_out_free(z);
+    return -ENOMEM;
+}
+
+int image_zstd_keep(void)
+{
+    return kept.cctx != NULL ? 0 : zstd_out_make(&kept);
+}
+
+void image_zstd_release(void)
+{
+    zstd_out_free(&kept);
+}
+
+/* Header and pixels as one zstd frame, streamed to @p f a chunk at a time: neither the pixels
+ * nor the compressed frame are copied whole. */
+static int write_zstd(const struct hal_storage *st, struct hal_file *f, struct zstd_out *z,
+                      const char *header, size_t header_len, const uint8_t *pixels, size_t n,
+                      int level)
+{
+    ZSTD_CCtx_reset(z->cctx, ZSTD_reset_session_only);
+    ZSTD_CCtx_setParameter(z->cctx, ZSTD_c_compressionLevel, level);
+    /* the content size goes into the frame: readers know what they get before they get it */
+    ZSTD_CCtx_setPledgedSrcSize(z->cctx, (unsigned long long)(header_len + n));
+    ZSTD_inBuffer in[2] = {{header, header_len, 0}, {pixels, n, 0}};
+    int rc = 0;
+    for (int part = 0; part < 2 && rc == 0; part++) {
+        ZSTD_EndDirective mode = part == 0 ? ZSTD_e_continue : ZSTD_e_end;
+        size_t left;
+        do {
+            ZSTD_outBuffer o = {z->out, ZSTD_CHUNK, 0};
+            left = ZSTD_compressStream2(z->cctx, &o, &in[part], mode);
+            if (ZSTD_isError(left))
+                return -EIO;
+            if (o.pos > 0)
+                rc = hal_storage_write(st, f, z->out, o.pos);
+        } while (rc == 0 && (part == 0 ? in[0].pos < in[0].size : left != 0));
+    }
+    return rc;
+}
+
 int image_write_pnm(const struct hal_storage *st, const char *path, const uint8_t *pixels,
                     uint32_t width, uint32_t height, int channels, int zstd_level)
 {
@@ -142,6 +205,7 @@ int image_write_pnm(const struct hal_storage *st, const char *path, const uint8_
     int hl = snprintf(header, sizeof(header), "P%c\n%u %u\n255\n", channels == 3 ? '6' : '5',
                       (unsigned)width, (unsigned)height);
     size_t n = (size_t)width * height * (size_t)channels;
+    struct zstd_out temp = {NULL, NULL};
     struct hal_file f;
     int rc = hal_storage_open(st, &f, path);
     if (rc != 0)
@@ -150,83 +214,20 @@ int image_write_pnm(const struct hal_storage *st, const char *path, const uint8_
         rc = hal_storage_write(st, &f, header, (size_t)hl);
         if (rc == 0)
             rc = hal_storage_write(st, &f, pixels, n);
-        goto out_commit;
+    } else if (kept.cctx != NULL) {
+        rc = write_zstd(st, &f, &kept, header, (size_t)hl, pixels, n, zstd_level);
+    } else if ((rc = zstd_out_make(&temp)) == 0) { /* a thread that keeps none: one for now */
+        rc = write_zstd(st, &f, &temp, header, (size_t)hl, pixels, n, zstd_level);
+        zstd_out_free(&temp);
     }
-    /* One zstd frame of header and pixels, with its content size so that readers can size their
-     * buffer; the two inputs streamed in so that the pixels are not copied. */
-    size_t cap = ZSTD_compressBound((size_t)hl + n);
-    uint8_t *out = malloc(cap);
-    ZSTD_CCtx *cctx = ZSTD_createCCtx();
-    rc = -ENOMEM;
-    if (out == NULL || cctx == NULL)
-        goto out_free;
-    ZSTD_CCtx_setParameter(cctx, ZSTD_c_compressionLevel, zstd_level);
-    ZSTD_CCtx_setPledgedSrcSize(cctx, (unsigned long long)hl + n);
-    ZSTD_outBuffer o = {out, cap, 0};
-    ZSTD_inBuffer in_header = {header, (size_t)hl, 0}, in_pixels = {pixels, n, 0};
-    size_t z = ZSTD_compressStream2(cctx, &o, &in_header, ZSTD_e_continue);
-    while (!ZSTD_isError(z) && (z = ZSTD_compressStream2(cctx, &o, &in_pixels, ZSTD_e_end)) != 0 &&
-           !ZSTD_isError(z))
-        ;
-    rc = ZSTD_isError(z) ? -EIO : hal_storage_write(st, &f, out, o.pos);
-out_free:
-    ZSTD_freeCCtx(cctx);
-    free(out);
-out_commit:
     if (rc == 0)
         return hal_storage_commit(st, &f);
     hal_storage_abort(st, &f);
     return rc;
 }
 
-/* The whole file in memory, decompressed when it is a zstd frame. @p why on failure. */
-static int read_whole(const char *path, uint8_t **data, size_t *len, char *why, size_t why_len)
-{
-    FILE *fp = fopen(path, "rb");
-    if (fp == NULL) {
-        int rc = -errno;
-        snprintf(why, why_len, "%s", strerror(-rc));
-        return rc;
-    }
-    int rc = -EINVAL;
-    uint8_t *raw = NULL, *plain = NULL;
-    long size = fseek(fp, 0, SEEK_END) == 0 ? ftell(fp) : -1;
-    if (size < 0 || fseek(fp, 0, SEEK_SET) != 0 || (raw = malloc((size_t)size + 1)) == NULL ||
-        fread(raw, 1, (size_t)size, fp) != (size_t)size) {
-        snprintf(why, why_len, "cannot read it");
-        goto out_close;
-    }
-    if (size < 4 || ZSTD_getFrameContentSize(raw, (size_t)size) == ZSTD_CONTENTSIZE_ERROR) {
-        *data = raw; /* not zstd: the file itself */
-        *len = (size_t)size;
-        raw = NULL;
-        rc = 0;
-        goto out_close;
-    }
-    unsigned long long plain_len = ZSTD_getFrameContentSize(raw, (size_t)size);
-    /* no frame is larger than the compiled limit, and a header claiming more is not believed */
-    if (plain_len == ZSTD_CONTENTSIZE_UNKNOWN || plain_len > (size_t)HAL_MAX_PIXELS * 3 + 64 ||
-        (plain = malloc((size_t)plain_len + 1)) == NULL) {
-        snprintf(why, why_len, "a zstd frame of unknown or too large size");
-        goto out_close;
-    }
-    size_t z = ZSTD_decompress(plain, (size_t)plain_len, raw, (size_t)size);
-    if (ZSTD_isError(z) || z != plain_len) {
-        snprintf(why, why_len, "damaged zstd data (%s)",
-                 ZSTD_isError(z) ? ZSTD_getErrorName(z) : "short");
-        free(plain);
-        goto out_close;
-    }
-    *data = plain;
-    *len = z;
-    rc = 0;
-out_close:
-    free(raw);
-    fclose(fp);
-    return rc;
-}
-
-/* Width, height, channels and the offset of the pixels of a binary PGM/PPM of maxval 255. */
+/* Width, height, channels and the offset of the pixels of a binary PGM/PPM of maxval 255 whose
+ * first @p len bytes are @p d. */
 static int parse_pnm(const uint8_t *d, size_t len, uint32_t *w, uint32_t *h, int *channels,
                      size_t *offset)
 {
@@ -260,38 +261,126 @@ static int parse_pnm(const uint8_t *d, size_t len, uint32_t *w, uint32_t *h, int
     return 0;
 }
 
+/* A source of a file's bytes, decompressed when the file is a zstd frame. */
+struct pnm_source {
+    FILE *fp;
+    ZSTD_DCtx *dctx; /* NULL: a raw file */
+    uint8_t *in;
+    ZSTD_inBuffer ib; /* starts empty: the first read fills it */
+    int ended; /* the zstd frame is complete */
+};
+
+/* Up to @p len bytes into @p out. @retval bytes read @retval -1 damaged (@p why says) */
+static long source_read(struct pnm_source *s, uint8_t *out, size_t len, char *why, size_t why_len)
+{
+    if (s->dctx == NULL)
+        return (long)fread(out, 1, len, s->fp);
+    ZSTD_outBuffer o = {out, len, 0};
+    while (o.pos < o.size && !s->ended) {
+        /* what the input read so far gives (also the end of a frame whose data are all in) */
+        size_t before_in = s->ib.pos, before_out = o.pos;
+        size_t r = ZSTD_decompressStream(s->dctx, &o, &s->ib);
+        if (ZSTD_isError(r)) {
+            snprintf(why, why_len, "damaged zstd data (%s)", ZSTD_getErrorName(r));
+            return -1;
+        }
+        s->ended = r == 0;
+        if (s->ended || s->ib.pos != before_in || o.pos != before_out)
+            continue;
+        s->ib.src = s->in; /* no progress: more input */
+        s->ib.size = fread(s->in, 1, ZSTD_CHUNK, s->fp);
+        s->ib.pos = 0;
+        if (s->ib.size == 0) {
+            snprintf(why, why_len, "damaged zstd data (cut short)");
+            return -1;
+        }
+    }
+    return (long)o.pos;
+}
+
 int image_read_pnm(const char *path, uint8_t *pixels, size_t capacity, uint32_t *width,
                    uint32_t *height, int channels, char *why, size_t why_len)
 {
-    uint8_t *d = NULL;
-    size_t len = 0, offset = 0;
-    uint32_t w = 0, h = 0;
-    int have = 0;
-    int rc = read_whole(path, &d, &len, why, why_len);
-    if (rc != 0)
+    struct pnm_source src = {.fp = fopen(path, "rb")};
+    uint8_t head[64], magic[4];
+    if (src.fp == NULL) {
+        int rc = -errno;
+        snprintf(why, why_len, "%s", strerror(-rc));
         return rc;
-    rc = -EINVAL;
-    if (parse_pnm(d, len, &w, &h, &have, &offset) != 0)
+    }
+    int rc = -EINVAL;
+    size_t got = fread(magic, 1, sizeof(magic), src.fp);
+    rewind(src.fp);
+    uint32_t zstd_magic = ZSTD_MAGICNUMBER; /* a zstd frame begins with it, little-endian */
+    uint8_t zm[4] = {(uint8_t)zstd_magic, (uint8_t)(zstd_magic >> 8), (uint8_t)(zstd_magic >> 16),
+                     (uint8_t)(zstd_magic >> 24)};
+    if (got == sizeof(magic) && memcmp(magic, zm, sizeof(zm)) == 0) {
+        src.dctx = ZSTD_createDCtx();
+        src.in = malloc(ZSTD_CHUNK);
+        if (src.dctx == NULL || src.in == NULL) {
+            snprintf(why, why_len, "%s", strerror(ENOMEM));
+            rc = -ENOMEM;
+            goto out_free;
+        }
+    }
+    /* the header from the first bytes, then the pixels straight into the caller's buffer */
+    long have = source_read(&src, head, sizeof(head), why, why_len);
+    uint32_t w = 0, h = 0;
+    int stored = 0;
+    size_t offset = 0;
+    if (have < 0)
+        goto out_free;
+    if (parse_pnm(head, (size_t)have, &w, &h, &stored, &offset) != 0) {
         snprintf(why, why_len, "not an 8-bit binary PGM or PPM");
-    else if (len - offset < (size_t)w * h * (size_t)have)
-        snprintf(why, why_len, "truncated: %zu bytes of pixels for %ux%u", len - offset,
-                 (unsigned)w, (unsigned)h);
-    else if (have == 3 && channels == 1)
+        goto out_free;
+    }
+    size_t n = (size_t)w * h * (size_t)stored;
+    if (stored == 3 && channels == 1) {
         snprintf(why, why_len, "an RGB frame where a grey one belongs");
-    else if ((size_t)w * h * (size_t)channels > capacity)
+        goto out_free;
+    }
+    if ((size_t)w * h * (size_t)channels > capacity) {
         snprintf(why, why_len, "%ux%u, larger than the compiled frame limit", (unsigned)w,
                  (unsigned)h);
-    else
-        rc = 0;
-    if (rc == 0 && have == channels)
-        memcpy(pixels, d + offset, (size_t)w * h * (size_t)channels);
-    else if (rc == 0) /* grey to RGB */
-        for (size_t i = 0; i < (size_t)w * h; i++)
-            memset(pixels + 3 * i, d[offset + i], 3);
-    if (rc == 0) {
-        *width = w;
-        *height = h;
+        goto out_free;
     }
-    free(d);
+    size_t first = (size_t)have - offset < n ? (size_t)have - offset : n;
+    memcpy(pixels, head + offset, first);
+    if (src.dctx == NULL && fseek(src.fp, (long)(offset + first), SEEK_SET) != 0)
+        goto out_free;
+    long rest = first < n ? source_read(&src, pixels + first, n - first, why, why_len) : 0;
+    if (rest < 0)
+        goto out_free;
+    uint8_t extra;
+    if (first + (size_t)rest < n) {
+        snprintf(why, why_len, "truncated: %zu bytes of pixels for %ux%u", first + (size_t)rest,
+                 (unsigned)w, (unsigned)h);
+        goto out_free;
+    }
+    /* a zstd frame must end with the image (its checksum, if any, read) */
+    long more = (size_t)have - offset > n ? 1 : 0;
+    if (more == 0 && src.dctx != NULL && !src.ended)
+        more = source_read(&src, &extra, 1, why, why_len);
+    if (more < 0)
+        goto out_free;
+    if (more == 0 && src.dctx != NULL &&
+        (src.ib.pos < src.ib.size || fgetc(src.fp) != EOF)) { /* more after the frame */
+        snprintf(why, why_len, "damaged zstd data (bytes after its frame)");
+        goto out_free;
+    }
+    if (more > 0) {
+        snprintf(why, why_len, "more bytes than a %ux%u image", (unsigned)w, (unsigned)h);
+        goto out_free;
+    }
+    if (stored == 1 && channels == 3) /* grey to RGB, from the end so nothing is overwritten */
+        for (size_t i = (size_t)w * h; i-- > 0;)
+            memset(pixels + 3 * i, pixels[i], 3);
+    *width = w;
+    *height = h;
+    rc = 0;
+out_free:
+    free(src.in);
+    ZSTD_freeDCtx(src.dctx);
+    fclose(src.fp);
     return rc;
 }

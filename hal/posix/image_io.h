@@ -17,10 +17,16 @@ int image_write_png(const struct hal_storage *st, const char *path, const uint8_
 int image_read_png(const char *path, uint8_t *pixels, size_t capacity, uint32_t *width,
                    uint32_t *height, int channels, char *why, size_t why_len);
 /** Write an 8-bit PGM (channels 1) or PPM (channels 3) atomically, compressed as one zstd frame
- *  at @p zstd_level (`zstd -d` gives the PGM/PPM back), or raw with @p zstd_level 0.
+ *  at @p zstd_level (`zstd -d` gives the PGM/PPM back), or raw with @p zstd_level 0. Streamed
+ *  out a chunk at a time, with the thread's kept compressor (image_zstd_keep) if it has one.
  *  @retval 0 ok @retval -ENOMEM @retval -errno */
 int image_write_pnm(const struct hal_storage *st, const char *path, const uint8_t *pixels,
                     uint32_t width, uint32_t height, int channels, int zstd_level);
+/** Keep a zstd compressor and its output chunk for this thread's image_write_pnm calls, so
+ *  that writing a frame allocates nothing; image_zstd_release frees them (before the thread
+ *  ends). @retval 0 @retval -ENOMEM */
+int image_zstd_keep(void);
+void image_zstd_release(void);
 /** Read an 8-bit binary PGM or PPM, raw or zstd-compressed (told apart by the file's first bytes),
  *  into @p pixels as @p channels: a PGM read as 3 channels is repeated, a PPM read as grey is
  *  refused (a frame never changes what it says on the way in).
