@@ -13,6 +13,7 @@
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #define C(member) offsetof(struct app_config, member)
 #define SZ(member) sizeof(((struct app_config *)0)->member)
@@ -475,6 +476,34 @@ static int path_beside(const char *config_path, const char *name, char *out, siz
     int n = name[0] == '/' ? snprintf(out, len, "%s", name)
                            : snprintf(out, len, "%s/%s", dirname(dir_buf), name);
     return n < 0 || (size_t)n >= len ? -ENAMETOOLONG : 0;
+}
+
+int config_check_files(const struct app_config *cfg, char *err, size_t err_len)
+{
+    /* the simulator's own files, where the config makes it read them */
+    const struct {
+        const char *key, *name;
+        int used;
+    } files[] = {
+        {"mesh_file", cfg->sim.mesh_file, strcmp(cfg->sim.object, "mesh") == 0},
+        {"merl_file", cfg->sim.merl_file, strcmp(cfg->sim.material, "merl") == 0},
+    };
+    if (strcmp(cfg->camera_backend, "sim") != 0)
+        return 0;
+    for (size_t k = 0; k < sizeof(files) / sizeof(files[0]); k++) {
+        char joined[HAL_MAX_PATH * 2 + 2];
+        if (!files[k].used || files[k].name[0] == '\0')
+            continue;
+        int rc = path_beside(cfg->path, files[k].name, joined, sizeof(joined));
+        if (rc == 0 && access(joined, R_OK) != 0)
+            rc = -errno;
+        if (rc != 0) {
+            snprintf(err, err_len, "%s: [sim] %s: %s: %s", cfg->path, files[k].key, joined,
+                     strerror(-rc));
+            return rc;
+        }
+    }
+    return 0;
 }
 
 /* [sim] rig: the geometry the simulator renders with, loaded now so that a bad file is named at

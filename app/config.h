@@ -58,6 +58,12 @@ struct app_config {
  *  @retval 0 ok @retval -EINVAL bad content @retval -ENOENT no such file */
 int config_load(struct app_config *cfg, const char *path, char *err, size_t err_len);
 
+/** Check that the files the config names beyond its calibration can be read (the simulator's
+ *  mesh_file and merl_file, where used; [sim] rig is read at load). A scan kept with its config
+ *  does not need them again, so config_load leaves this to the commands that run the rig.
+ *  @retval 0 @retval -errno (@p err names the file, the key and what is wrong) */
+int config_check_files(const struct app_config *cfg, char *err, size_t err_len);
+
 /** Parse and check a calibration file. @retval 0 ok, otherwise @p err says file, line and key */
 int calib_load(struct scan_calib *calib, const char *path, uint32_t light_count, char *err,
                size_t err_len);

@@ -342,28 +342,124 @@ static int cmd_calibrate(int argc, char **argv)
 }
 #endif
 
+/* The commands: name, what each takes (its usage lines), and what it cannot go without. */
+enum needs { NEEDS_NOTHING, NEEDS_CONFIG, NEEDS_DIR };
+static const struct command {
+    const char *name, *usage;
+    enum needs needs;
+} commands[] = {
+    {"scan",
+     "scanner scan --config FILE [--out DIR] [--replace] [--json]   take a scan\n"
+     "    (into an empty or new DIR; --replace: replace the scan already there)\n",
+     NEEDS_CONFIG},
+    {"process",
+     "scanner process DIR [--out DIR2 [--replace]] [--config F] [--json]  recompute a scan from\n"
+     "    its frames\n",
+     NEEDS_DIR},
+    {"resume",
+     "scanner resume DIR [--config F] [--json] [--clear-alarm]  finish a stopped scan\n"
+     "    (--clear-alarm: the turntable's alarm, once its cause is fixed)\n",
+     NEEDS_DIR},
+    {"calibrate",
+     "scanner calibrate --config FILE --out CAL.ini [--dir DIR]  calibrate the rig\n"
+     "    (step by step; every capture kept in DIR, default CAL-captures)\n"
+     "scanner calibrate --config FILE --from DIR --out CAL.ini  from kept captures\n"
+     "scanner calibrate verify --config FILE   scan the sphere, print the errors\n"
+     "scanner calibrate board --config FILE --out BASE  the board to print\n"
+     "    (BASE.png at 300 dpi, BASE.svg at true size)\n",
+     NEEDS_CONFIG},
+    {"calibrate-white", "scanner calibrate-white --config FILE [--albedo A]  white reference scales\n",
+     NEEDS_CONFIG},
+    {"check-config",
+     "scanner check-config --config FILE    check a config, its calibration and the files it "
+     "names\n",
+     NEEDS_CONFIG},
+    {"patterns",
+     "scanner patterns --config FILE --out DIR  the projector's pattern sequence as PNG files,\n"
+     "    for a projector that stores its own (DLP pattern memory)\n",
+     NEEDS_CONFIG},
+    {"selftest", "scanner selftest --config FILE        try each configured device (new rig)\n",
+     NEEDS_CONFIG},
+    {"config-doc", "scanner config-doc                    print the config reference (Markdown)\n",
+     NEEDS_NOTHING},
+};
+
+static const struct command *find_command(const char *name)
+{
+    for (size_t k = 0; k < sizeof(commands) / sizeof(commands[0]); k++)
+        if (strcmp(name, commands[k].name) == 0)
+            return &commands[k];
+    return NULL;
+}
+
+/* Usage lines, each indented under "usage: ": of one command, or of them all. */
+static void usage_of(FILE *out, const struct command *only)
+{
+    int first = 1;
+    for (size_t k = 0; k < sizeof(commands) / sizeof(commands[0]); k++) {
+        if (only != NULL && only != &commands[k])
+            continue;
+        for (const char *line = commands[k].usage; *line != '\0';) {
+            size_t len = strcspn(line, "\n");
+            fprintf(out, "%s%.*s\n", first ? "usage: " : "       ", (int)len, line);
+            first = 0;
+            line += len + (line[len] == '\n');
+        }
+    }
+    if (only == NULL)
+        fprintf(out, "       scanner --version\n"
+                     "       scanner --help, scanner COMMAND --help\n");
+}
+
 static void usage(FILE *out)
 {
-    fprintf(out,
-            "usage: scanner scan --config FILE [--out DIR] [--replace] [--json]   take a scan\n"
-            "           (into an empty or new DIR; --replace: replace the scan already there)\n"
-            "       scanner process DIR [--out DIR2 [--replace]] [--config F] [--json]  recompute\n"
-            "           a scan from its frames\n"
-            "       scanner resume DIR [--config F] [--json] [--clear-alarm]  finish a stopped\n"
-            "           scan (--clear-alarm: the turntable's alarm, once its cause is fixed)\n"
-            "       scanner calibrate --config FILE --out CAL.ini [--dir DIR]  calibrate the rig\n"
-            "           (step by step; every capture kept in DIR, default CAL-captures)\n"
-            "       scanner calibrate --config FILE --from DIR --out CAL.ini  from kept captures\n"
-            "       scanner calibrate verify --config FILE   scan the sphere, print the errors\n"
-            "       scanner calibrate board --config FILE --out BASE  the board to print\n"
-            "           (BASE.png at 300 dpi, BASE.svg at true size)\n"
-            "       scanner calibrate-white --config FILE [--albedo A]  white reference scales\n"
-            "       scanner check-config --config FILE    check a config and its calibration\n"
-            "       scanner patterns --config FILE --out DIR  the projector's pattern sequence as\n"
-            "           PNG files, for a projector that stores its own (DLP pattern memory)\n"
-            "       scanner selftest --config FILE        try each configured device (new rig)\n"
-            "       scanner config-doc                    print the config reference (Markdown)\n"
-            "       scanner --version\n");
+    usage_of(out, NULL);
+}
+
+static int is_help(const char *arg)
+{
+    return strcmp(arg, "--help") == 0 || strcmp(arg, "-h") == 0;
+}
+
+/* The command line's words before any work: help, an unknown command, an unknown or missing
+ * option said plainly. @retval -1 go on @retval the exit status (0 help, 2 a mistake) */
+static int check_command_line(int argc, char **argv, const struct command **cmd)
+{
+    if (argc < 2) {
+        usage(stderr);
+        return 2;
+    }
+    if (is_help(argv[1]) || strcmp(argv[1], "help") == 0) {
+        const struct command *c = argc > 2 ? find_command(argv[2]) : NULL;
+        if (argc > 2 && c == NULL) {
+            fprintf(stderr, "scanner: unknown command '%s' (scanner --help lists them)\n",
+                    argv[2]);
+            return 2;
+        }
+        usage_of(stdout, c);
+        return 0;
+    }
+    if (strcmp(argv[1], "--version") == 0)
+        return -1;
+    *cmd = find_command(argv[1]);
+    if (*cmd == NULL) {
+        fprintf(stderr, "scanner: unknown command '%s' (scanner --help lists them)\n", argv[1]);
+        return 2;
+    }
+    for (int i = 2; i < argc; i++)
+        if (is_help(argv[i])) {
+            usage_of(stdout, *cmd);
+            return 0;
+        }
+    return -1;
+}
+
+/* A required option or operand the command line lacks: named, with the command's usage. */
+static int missing(const struct command *cmd, const char *what)
+{
+    fprintf(stderr, "scanner %s: %s is required\n", cmd->name, what);
+    usage_of(stderr, cmd);
+    return 2;
 }
 
 int main(int argc, char **argv)
@@ -371,15 +467,18 @@ int main(int argc, char **argv)
     const char *config_path = NULL, *scan_dir = NULL;
     struct scan_job_opts opts = {0, NULL, NULL, 0, 0};
     double white_albedo = 0.95; /* a typical white reference target */
-    if (argc < 2) {
-        usage(stderr);
-        return 2;
+    const struct command *cmd = NULL;
+    int status = check_command_line(argc, argv, &cmd);
+    if (status >= 0)
+        return status;
+    if (strcmp(argv[1], "--version") == 0) {
+        printf("scanner %s (HAL=%s)\n", SCANNER_VERSION, board_name());
+        return 0;
     }
     if (strcmp(argv[1], "calibrate") == 0)
         return cmd_calibrate(argc, argv);
     int first = 2;
-    if ((strcmp(argv[1], "process") == 0 || strcmp(argv[1], "resume") == 0) && argc > 2 &&
-        argv[2][0] != '-') {
+    if (cmd->needs == NEEDS_DIR && argc > 2 && argv[2][0] != '-') {
         scan_dir = argv[2];
         first = 3;
     }
@@ -398,40 +497,40 @@ int main(int argc, char **argv)
         else if (strcmp(argv[i], "--albedo") == 0 && i + 1 < argc)
             white_albedo = atof(argv[++i]);
         else {
-            fprintf(stderr, "scanner: unknown argument '%s'\n", argv[i]);
-            usage(stderr);
+            int valued = strcmp(argv[i], "--config") == 0 || strcmp(argv[i], "--out") == 0 ||
+                         strcmp(argv[i], "--albedo") == 0;
+            fprintf(stderr, "scanner %s: %s '%s'\n", cmd->name,
+                    valued ? "a value is missing after" : "unknown argument", argv[i]);
+            usage_of(stderr, cmd);
             return 2;
         }
-    }
-    if (strcmp(argv[1], "--version") == 0) {
-        printf("scanner %s (HAL=%s)\n", SCANNER_VERSION, board_name());
-        return 0;
     }
     if (strcmp(argv[1], "config-doc") == 0) {
         config_print_doc(stdout);
         return 0;
     }
-    if (strcmp(argv[1], "--help") == 0) {
-        usage(stdout);
-        return 0;
-    }
-    if (strcmp(argv[1], "process") == 0 && scan_dir != NULL) {
+    if (cmd->needs == NEEDS_DIR && scan_dir == NULL)
+        return missing(cmd, "the scan directory DIR");
+    if (strcmp(argv[1], "process") == 0) {
         opts.config_path = config_path; /* optional: other settings for the same frames */
         return cmd_process(scan_dir, &opts);
     }
-    if (strcmp(argv[1], "resume") == 0 && scan_dir != NULL) {
+    if (strcmp(argv[1], "resume") == 0) {
         opts.config_path = config_path; /* optional: the scan's config where it was written */
         return cmd_resume(scan_dir, &opts);
     }
-    if (config_path == NULL) {
-        usage(stderr);
-        return 2;
-    }
+    if (config_path == NULL)
+        return missing(cmd, "--config FILE");
     if (strcmp(argv[1], "check-config") == 0) {
         static struct app_config cfg;
         static struct scan_calib calib;
+        char err[1024];
         if (load_all(config_path, &cfg, &calib) != 0)
             return 2;
+        if (config_check_files(&cfg, err, sizeof(err)) != 0) {
+            fprintf(stderr, "scanner: error: %s\n", err);
+            return 2;
+        }
         printf("%s: ok\n", config_path);
         return 0;
     }
@@ -439,10 +538,8 @@ int main(int argc, char **argv)
         static struct app_config cfg;
         static struct scan_calib calib;
         struct hal_storage st;
-        if (opts.out_dir == NULL) {
-            fprintf(stderr, "scanner: patterns: --out DIR is required\n");
-            return 2;
-        }
+        if (opts.out_dir == NULL)
+            return missing(cmd, "--out DIR");
         if (load_all(config_path, &cfg, &calib) != 0)
             return 2;
         storage_posix_init(&st);
@@ -452,8 +549,5 @@ int main(int argc, char **argv)
         return cmd_scan(config_path, &opts);
     if (strcmp(argv[1], "calibrate-white") == 0)
         return cmd_calibrate_white(config_path, white_albedo);
-    if (strcmp(argv[1], "selftest") == 0)
-        return cmd_selftest(config_path);
-    usage(stderr);
-    return 2;
+    return cmd_selftest(config_path);
 }

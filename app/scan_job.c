@@ -104,7 +104,9 @@ static void job_init(struct job *j, const struct hal *hal, const struct app_conf
 static void progress(struct job *j, const char *event, int view, uint32_t done,
                      const char *detail);
 static void progress_line(struct job *j, const char *event, int view, uint32_t done,
-                          const char *detail);
+                          const char *fields, const char *detail);
+static void progress_with(struct job *j, const char *event, int view, uint32_t done,
+                          const char *fields, const char *detail);
 
 /* What the job cost: the rig's time (with the simulator, the modelled rig's: its turntable and
  * frame rate) and the CPU the scanner spent, the simulator's rendering left out, split by what
@@ -118,9 +120,12 @@ static void report_cost(struct job *j, const char *what)
     uint32_t views = j->views ? j->views : 1;
     char detail[400];
     if (j->views_cpu_s <= 0.0) { /* offline: one thread */
+        char fields[96];
         snprintf(detail, sizeof(detail), "%s %.2f s CPU for %u views (%.3f s a view)", what, own,
                  (unsigned)j->views, own / views);
-        progress(j, "cost", -1, j->views, detail);
+        snprintf(fields, sizeof(fields), "\"cpu_s\":%.3f,\"cpu_per_view_s\":%.4f", own,
+                 own / views);
+        progress_with(j, "cost", -1, j->views, fields, detail);
         return;
     }
     /* In line with the rig: this thread's work between its moves and captures, and the last
@@ -131,11 +136,17 @@ static void report_cost(struct job *j, const char *what)
                      "processing views as the table turned %.2f s, in line with the rig %.2f s)",
                      what, own, (unsigned)j->views, own / views, frame_writer_cpu_s(),
                      j->views_cpu_s - j->last_view_cpu_s, in_line);
+    double rig_s = (double)(now_us - j->start_rig_us) / 1e6;
     if (sim > 0.0 && n > 0 && (size_t)n < sizeof(detail))
         snprintf(detail + n, sizeof(detail) - (size_t)n,
-                 ", the simulator's rendering (%.2f s) left out; %.1f s on the rig's clock",
-                 sim, (double)(now_us - j->start_rig_us) / 1e6);
-    progress(j, "cost", -1, j->views, detail);
+                 ", the simulator's rendering (%.2f s) left out; %.1f s on the rig's clock", sim,
+                 rig_s);
+    char fields[256];
+    snprintf(fields, sizeof(fields),
+             "\"cpu_s\":%.3f,\"cpu_per_view_s\":%.4f,\"storage_cpu_s\":%.3f,"
+             "\"in_line_cpu_s\":%.3f,\"simulator_cpu_s\":%.3f,\"rig_s\":%.2f",
+             own, own / views, frame_writer_cpu_s(), in_line, sim, rig_s);
+    progress_with(j, "cost", -1, j->views, fields, detail);
 }
 
 static void utc_now(char *buf, size_t len)
@@ -168,25 +179,33 @@ static int view_finished(const char *event)
     return strcmp(event, "saved") == 0 || strcmp(event, "fused") == 0;
 }
 
-/* One event. @p view < 0: not about a view. @p done: views finished so far, for the estimate. */
-static void progress(struct job *j, const char *event, int view, uint32_t done, const char *detail)
+/* One event with its numbers as JSON fields too (@p fields: '"name":value,...' or NULL, for
+ * --json). @p view < 0: not about a view. @p done: views finished so far, for the estimate. */
+static void progress_with(struct job *j, const char *event, int view, uint32_t done,
+                          const char *fields, const char *detail)
 {
     /* a line at a time: a view is saved by its own thread while the next is taken */
     static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
     pthread_mutex_lock(&lock);
-    progress_line(j, event, view, done, detail);
+    progress_line(j, event, view, done, fields, detail);
     pthread_mutex_unlock(&lock);
 }
 
+static void progress(struct job *j, const char *event, int view, uint32_t done, const char *detail)
+{
+    progress_with(j, event, view, done, NULL, detail);
+}
+
 static void progress_line(struct job *j, const char *event, int view, uint32_t done,
-                          const char *detail)
+                          const char *fields, const char *detail)
 {
     double elapsed_s = (wall_ms() - j->start_ms) / 1000.0;
     double left_s = done > 0 ? elapsed_s / done * (j->views - done) : -1.0;
     if (j->opts->json) {
-        printf("{\"event\":\"%s\",\"view\":%d,\"views\":%u,\"elapsed_s\":%.1f,\"left_s\":%.1f,"
-               "\"detail\":",
-               event, view, (unsigned)j->views, elapsed_s, left_s);
+        printf("{\"event\":\"%s\",\"view\":%d,\"views\":%u,\"views_done\":%u,"
+               "\"elapsed_s\":%.1f,\"left_s\":%.1f,%s%s\"detail\":",
+               event, view, (unsigned)j->views, (unsigned)done, elapsed_s, left_s,
+               fields != NULL ? fields : "", fields != NULL ? "," : "");
         json_string(stdout, detail);
         printf("}\n");
     } else if (j->tty && view >= 0) {
@@ -394,7 +413,11 @@ static int write_model(struct job *j)
              (unsigned)ms.kept_vertices, (unsigned)ms.kept_triangles,
              (unsigned)ms.removed_pieces, (unsigned)ms.pieces, (unsigned)filled, closed,
              j->out_dir, fits ? " and mesh.stl" : "");
-    progress(j, "mesh", -1, j->views, detail);
+    char fields[128];
+    snprintf(fields, sizeof(fields), "\"vertices\":%u,\"triangles\":%u,\"pieces_left_out\":%u",
+             (unsigned)ms.kept_vertices, (unsigned)ms.kept_triangles,
+             (unsigned)ms.removed_pieces);
+    progress_with(j, "mesh", -1, j->views, fields, detail);
     return 0;
 }
 
@@ -431,7 +454,12 @@ static int report_registration(struct job *j, const struct reg_report *r, double
                  "; second pass found turned %.1f deg, residual %.3f mm over %u pairs",
                  r->second_turned_deg, r->second_rms_mm, (unsigned)r->second_coupled);
     }
-    progress(j, "registration", -1, j->views, detail);
+    char fields[160];
+    snprintf(fields, sizeof(fields),
+             "\"solved\":%d,\"accepted\":%d,\"residual_mm\":%.4f,\"loop_closure_mm\":%.4f,"
+             "\"cpu_s\":%.3f",
+             r->solved, r->accepted, r->rms_mm, r->loop_rms_mm, cpu_seconds);
+    progress_with(j, "registration", -1, j->views, fields, detail);
     if (r->failed_view >= 0 && r->failed_against < 0) {
         j->hal->log(HAL_LOG_ERROR,
                     "registration failed: the second pass (from view %d) matches nothing of the "
@@ -478,9 +506,12 @@ static int make_model(struct job *j, const char *scan_dir)
             rc = save_results(j, &view, &rep, &rv);
         if (rc == 0) {
             char detail[HAL_MAX_PATH + 160];
+            char fields[96];
             snprintf(detail, sizeof(detail), "fused at %.3f deg (%+.3f deg from the table's) -> %s",
                      rv.angle_deg, rv.correction_deg, j->view_dir);
-            progress(j, "fused", (int)v, v + 1, detail);
+            snprintf(fields, sizeof(fields), "\"angle_deg\":%.4f,\"correction_deg\":%.4f",
+                     rv.angle_deg, rv.correction_deg);
+            progress_with(j, "fused", (int)v, v + 1, fields, detail);
         }
     }
     return rc == 0 ? write_model(j) : rc;
@@ -546,8 +577,11 @@ static void *process_view(void *arg)
     if (rc == 0)
         rc = write_view_meta(p, wall_ms() - p->t0_ms);
     if (rc == 0) {
+        char fields[96];
         describe(detail, sizeof(detail), &p->info, p->view_dir);
-        progress(j, "saved", (int)p->view, p->view + 1, detail);
+        snprintf(fields, sizeof(fields), "\"points\":%u,\"angle_deg\":%.3f",
+                 (unsigned)p->info.valid_points, p->info.angle_mdeg / 1000.0);
+        progress_with(j, "saved", (int)p->view, p->view + 1, fields, detail);
     }
     p->rc = rc;
     p->cpu_s = cpu_s() - t0_cpu;

@@ -9,6 +9,23 @@ out=${BUILD:-build}/cli
 mkdir -p "$out"
 check version sh -c "$bin --version | grep -q 'HAL=sim'"
 check check_config sh -c "$bin check-config --config config/sim.ini | grep -q ': ok'"
+# The command line says what is wrong (issue 19): help on stdout with status 0, an unknown
+# command or argument and a missing option named, status 2.
+check help_lists_commands sh -c "$bin --help | grep -q 'scanner resume DIR' && $bin -h | grep -q 'usage:' &&
+    $bin help | grep -q 'scanner check-config'"
+check command_help_is_its_own sh -c "$bin scan --help > $out/scan-help.txt && grep -q 'scanner scan --config' $out/scan-help.txt &&
+    ! grep -q 'scanner process' $out/scan-help.txt && $bin help process | grep -q 'scanner process DIR'"
+check unknown_command_said sh -c "$bin frobnicate 2> $out/unknown.txt; test \$? -eq 2 &&
+    grep -q \"unknown command 'frobnicate'\" $out/unknown.txt && ! $bin help frobnicate 2>/dev/null"
+check missing_option_named sh -c "$bin scan 2> $out/missing.txt; test \$? -eq 2 &&
+    grep -q 'scanner scan: --config FILE is required' $out/missing.txt &&
+    $bin process 2>&1 | grep -q 'the scan directory DIR is required' &&
+    $bin scan --config 2>&1 | grep -q \"a value is missing after '--config'\" &&
+    $bin scan --config config/sim.ini --frob 2>&1 | grep -q \"unknown argument '--frob'\""
+sed -e "s|^calibration = .*|calibration = $PWD/config/sim-calib.ini|" \
+    -e "s|^mesh_file = .*|mesh_file = no-such-mesh.ply|" config/sim.ini > "$out/no-mesh.ini"
+check check_config_names_missing_mesh sh -c "$bin check-config --config $out/no-mesh.ini 2> $out/no-mesh.txt;
+    test \$? -eq 2 && grep -q '\\[sim\\] mesh_file: .*no-such-mesh.ply: No such file' $out/no-mesh.txt"
 check selftest_sim sh -c "$bin selftest --config config/sim.ini > $out/selftest.txt &&
     test \$(grep -c ' ok ' $out/selftest.txt) -eq 4"
 # The appliance build on a machine without its devices: each one MISSING with its path and
@@ -193,9 +210,16 @@ check process_reproduces_scan sh -c "$bin process $out/scan --out $out/processed
     cmp $out/scan/view_000/cloud.ply $out/processed/view_000/cloud.ply"
 check json_events sh -c "$bin process $out/scan --out $out/processed --replace --json | /usr/bin/python3 -c '
 import json, sys
-events = [json.loads(line)[\"event\"] for line in sys.stdin]
+lines = [json.loads(line) for line in sys.stdin]
+events = [e[\"event\"] for e in lines]
 assert events[0] == \"process_start\" and events[-1] == \"process_done\", events
-assert \"registration\" in events and events.count(\"fused\") == 8, events'"
+assert \"registration\" in events and events.count(\"fused\") == 8, events
+# the numbers as fields, not only in the text (issue 19)
+by = {e[\"event\"]: e for e in lines}
+assert 0 < by[\"registration\"][\"residual_mm\"] < 1, by[\"registration\"]
+assert by[\"mesh\"][\"vertices\"] > 10000 and by[\"mesh\"][\"triangles\"] > 10000, by[\"mesh\"]
+assert by[\"cost\"][\"cpu_s\"] > 0 and by[\"fused\"][\"views_done\"] == 8, by[\"cost\"]
+assert abs(by[\"fused\"][\"angle_deg\"] - 315) < 1, by[\"fused\"]'"
 cp -r "$out/scan" "$out/broken" 2>/dev/null; rm -f "$out/broken/view_000/frame_07.pgm.zst"
 check process_names_missing_frame sh -c "$bin process $out/broken --out $out/broken_out 2>&1 | \
     grep -q 'view_000/frame_07: no such frame'; test \$? -eq 0"

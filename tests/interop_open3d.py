@@ -7,16 +7,21 @@ import numpy as np
 import open3d as o3d
 
 if sys.argv[1] == "--mesh":
-    counts = []
+    counts, verts = [], []
     for name in ("mesh.ply", "mesh.obj"):
         m = o3d.io.read_triangle_mesh(sys.argv[2] + "/" + name)
         assert len(m.triangles) > 10000, (name, len(m.triangles))
         assert m.has_vertex_colors() and m.has_vertex_normals(), name
         assert m.is_edge_manifold(), name + " is not edge-manifold"
         v = np.asarray(m.vertices)
-        assert v[:, 2].min() > -4.0 and v[:, 2].max() < 166.0, (v[:, 2].min(), v[:, 2].max())
+        up = v[:, 2] if name == "mesh.ply" else v[:, 1]  # PLY keeps the object frame; OBJ is Y up
+        assert up.min() > -4.0 and up.max() < 166.0, (name, up.min(), up.max())
         counts.append((len(m.vertices), len(m.triangles)))
+        verts.append(v)
     assert counts[0] == counts[1], counts  # same mesh in both files
+    # the OBJ is the PLY turned Y up: (x, y, z) -> (x, z, -y), vertex for vertex
+    turned = np.stack([verts[0][:, 0], verts[0][:, 2], -verts[0][:, 1]], axis=1)
+    assert np.abs(turned - verts[1]).max() < 1e-3, np.abs(turned - verts[1]).max()
     print("open3d %s read mesh.ply and mesh.obj: %d vertices, %d triangles, colours and normals"
           % (o3d.__version__, counts[0][0], counts[0][1]))
     sys.exit(0)
