@@ -347,12 +347,12 @@ small-build: deps
 	@$(MAKE) --no-print-directory LIMITS=small SAN=$(SAN) $(BUILD)/small/scanner
 
 run: deps $(BUILD)/scanner
-	$(BUILD)/scanner scan --config config/sim.ini --replace
+	$(BUILD)/scanner scan --config config/sim.ini
 
-# The bunny in two passes (upright, then on its side), one model: scans/sim-complete/.
+# The bunny in two passes (upright, then on its side), one model: scans/sim-complete/latest/.
 run-complete: deps $(BUILD)/scanner $(BUILD)/mesh-compare
-	$(BUILD)/scanner scan --config config/sim-complete.ini --replace
-	$(BUILD)/mesh-compare --align scans/sim-complete/mesh.ply scans/sim-complete/truth_mesh.ply
+	$(BUILD)/scanner scan --config config/sim-complete.ini
+	$(BUILD)/mesh-compare --align scans/sim-complete/latest/mesh.ply scans/sim-complete/latest/truth_mesh.ply
 
 docs: $(BUILD)/scanner
 	$(BUILD)/scanner config-doc > docs/config.md

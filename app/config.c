@@ -131,7 +131,9 @@ static const struct ini_key config_keys[] = {
         "normals are estimated across up to this many pixels on each side"),
     STR("scan", "calibration", calibration_file, NULL,
         "calibration file, relative to this config file"),
-    STR("output", "dir", output_dir, "scans/latest", "scan directory (created if missing)"),
+    STR("output", "dir", output_dir, "scans", "where scans go: each scan without --out gets a "
+        "new folder here named by when it began (UTC, YYYY-MM-DD_HHMMSS), and 'latest' links "
+        "to the newest; relative to the working directory"),
     F64("output", "max_hole_mm", max_hole_mm, 0, 100, "0",
         "holes in the model up to this wide are filled (in the volume, from the surface around "
         "them; the filling also extends open edges by half this); 0: none, nothing invented"),

@@ -755,16 +755,64 @@ static int open_out(struct job *j, enum scan_dir_mode mode, int *lock_fd)
     return rc;
 }
 
+/* A scan without --out goes to a new folder under [output] dir named by when it began (UTC),
+ * so that no scan ever replaces another. @retval 0 @retval -EEXIST (a hundred this second) */
+static int new_scan_dir(const char *parent, char *out, size_t len, const char **name)
+{
+    char stamp[32];
+    time_t now = time(NULL);
+    struct tm tm;
+    gmtime_r(&now, &tm);
+    strftime(stamp, sizeof(stamp), "%Y-%m-%d_%H%M%S", &tm);
+    for (int k = 1; k < 100; k++) {
+        int n = k == 1 ? snprintf(out, len, "%s/%s", parent, stamp)
+                       : snprintf(out, len, "%s/%s-%d", parent, stamp, k);
+        if (n < 0 || (size_t)n >= len)
+            return -ENAMETOOLONG;
+        if (access(out, F_OK) != 0) {
+            *name = out + strlen(parent) + 1;
+            return 0;
+        }
+    }
+    return -EEXIST;
+}
+
+/* [output] dir/latest: a link to the newest scan's folder, replaced atomically. A convenience:
+ * a failure is said and the scan goes on. */
+static void link_latest(const struct hal *hal, const char *parent, const char *name)
+{
+    char link[HAL_MAX_PATH + 16], temp[HAL_MAX_PATH + 32];
+    snprintf(link, sizeof(link), "%s/latest", parent);
+    snprintf(temp, sizeof(temp), "%s/.latest.%ld", parent, (long)getpid());
+    unlink(temp);
+    if (symlink(name, temp) != 0 || rename(temp, link) != 0) {
+        hal->log(HAL_LOG_WARN, "cannot point %s at %s: %s", link, name, strerror(errno));
+        unlink(temp);
+    }
+}
+
 int scan_job_live(const struct hal *hal, const struct app_config *cfg,
                   const struct scan_calib *calib, const struct scan_job_opts *opts)
 {
+    static char auto_dir[HAL_MAX_PATH + 32];
+    const char *name = NULL;
+    if (opts->out_dir == NULL) {
+        int rc = new_scan_dir(cfg->output_dir, auto_dir, sizeof(auto_dir), &name);
+        if (rc != 0) {
+            hal->log(HAL_LOG_ERROR, "cannot name a new scan folder in %s: %s", cfg->output_dir,
+                     strerror(-rc));
+            return rc;
+        }
+    }
     struct job j;
-    job_init(&j, hal, cfg, calib, opts, opts->out_dir ? opts->out_dir : cfg->output_dir);
+    job_init(&j, hal, cfg, calib, opts, opts->out_dir ? opts->out_dir : auto_dir);
     char path[HAL_MAX_PATH + 32];
     int lock_fd;
     int rc = open_out(&j, opts->replace ? SCAN_DIR_REPLACE : SCAN_DIR_NEW, &lock_fd);
     if (rc != 0)
         return rc;
+    if (name != NULL)
+        link_latest(hal, cfg->output_dir, name);
     rc = scan_dir_keep_settings(&hal->storage, cfg->path, cfg->calibration_file, j.out_dir);
     if (rc != 0) {
         hal->log(HAL_LOG_ERROR, "cannot set up the scan directory %s: %s", j.out_dir,

@@ -109,6 +109,18 @@ check self_contained sh -c "! git grep -n '[.][.]/shared' -- ':!*.md' && rm -rf 
     --out $clone/scan2 2> $clone/err.txt && grep 'data/bunny/bun_zipper.ply: No such file' $clone/err.txt"
 rm -rf "$out/scan" "$out/broken" "$out/broken_out"
 check scan sh -c "$bin scan --config config/sim.ini --out $out/scan | grep -q 'scan finished'"
+# Without --out a scan never replaces another: each goes to a new folder under [output] dir,
+# named by when it began, and 'latest' links to the newest (issue 19).
+rm -rf "$out/auto"
+sed -e "s|^calibration = .*|calibration = $PWD/config/sim-calib.ini|" \
+    -e "s|^mesh_file = ../|mesh_file = $PWD/|" -e 's/^views = .*/views = 1/' \
+    -e "s|^dir = .*|dir = $out/auto|" config/sim.ini > "$out/auto.ini"
+check scan_never_replaces sh -c "$bin scan --config $out/auto.ini > $out/auto1.txt &&
+    $bin scan --config $out/auto.ini > $out/auto2.txt &&
+    test \$(ls -d $out/auto/20??-??-??_?????? $out/auto/20??-??-??_??????-* 2>/dev/null | wc -l) -eq 2 &&
+    test -f $out/auto/latest/mesh.ply &&
+    grep -q \"scan finished: $out/auto/\$(readlink $out/auto/latest) \" $out/auto2.txt"
+rm -rf "$out/auto"
 # process where it cannot write (it exited 1 without a word): on a read-only mount of a scan, one
 # error naming the file and why. Needs mount(8) (root with CAP_SYS_ADMIN): said, not counted,
 # where it cannot be done.
