@@ -37,6 +37,10 @@ struct job {
     uint32_t view;                    /* the view being taken or processed */
     char view_dir[SCAN_DIR_PATH_MAX]; /* its directory */
     struct pending *pending;          /* the view processed while the table turns, or NULL */
+    struct eta {                      /* views finished of the current run, and when */
+        uint32_t first_done, last_done;
+        double first_ms, last_ms;
+    } eta;
 };
 
 /* A captured view, processed and saved by a thread of its own while the table turns to the next
@@ -179,6 +183,34 @@ static int view_finished(const char *event)
     return strcmp(event, "saved") == 0 || strcmp(event, "fused") == 0;
 }
 
+/* Seconds left of the current run of views (taken live, decoded, or fused after the
+ * registration): the measured time a view takes (from the first finished view of the run to the
+ * last, so that homing and start-up do not count) times the views left, less the time already
+ * spent since the last one finished. -1 until a view's time is known. Only the events that
+ * finish a view move it; @p done: views finished of the run. */
+static double time_left_s(struct job *j, const char *event, uint32_t done, double now_ms)
+{
+    struct eta *e = &j->eta;
+    int finishes = view_finished(event) || strcmp(event, "decoded") == 0;
+    if (finishes && done < e->last_done) /* a new run of views (the fusion after the capture) */
+        e->first_done = e->last_done = 0;
+    if (finishes && done > e->last_done) {
+        if (e->first_done == 0) {
+            e->first_done = done;
+            e->first_ms = now_ms;
+        }
+        e->last_done = done;
+        e->last_ms = now_ms;
+    }
+    if (e->last_done >= j->views)
+        return 0.0;
+    if (e->first_done == 0 || e->last_done == e->first_done)
+        return -1.0;
+    double per_view_ms = (e->last_ms - e->first_ms) / (e->last_done - e->first_done);
+    double left_ms = per_view_ms * (j->views - e->last_done) - (now_ms - e->last_ms);
+    return left_ms > 0.0 ? left_ms / 1000.0 : 0.0;
+}
+
 /* One event with its numbers as JSON fields too (@p fields: '"name":value,...' or NULL, for
  * --json). @p view < 0: not about a view. @p done: views finished so far, for the estimate. */
 static void progress_with(struct job *j, const char *event, int view, uint32_t done,
@@ -199,8 +231,8 @@ static void progress(struct job *j, const char *event, int view, uint32_t done, 
 static void progress_line(struct job *j, const char *event, int view, uint32_t done,
                           const char *fields, const char *detail)
 {
-    double elapsed_s = (wall_ms() - j->start_ms) / 1000.0;
-    double left_s = done > 0 ? elapsed_s / done * (j->views - done) : -1.0;
+    double now = wall_ms(), elapsed_s = (now - j->start_ms) / 1000.0;
+    double left_s = time_left_s(j, event, done, now);
     if (j->opts->json) {
         printf("{\"event\":\"%s\",\"view\":%d,\"views\":%u,\"views_done\":%u,"
                "\"elapsed_s\":%.1f,\"left_s\":%.1f,%s%s\"detail\":",
