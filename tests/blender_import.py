@@ -1,0 +1,47 @@
+"""Blender 3.4 (Debian's, in background mode) imports a scan's mesh.ply, mesh.obj and mesh.stl
+with its own importers and their default settings, in a scene whose unit is the millimetre
+(how a user working with scans sets it): each must come in upright (the turntable's axis along
+Blender's Z) at the object's true size, and the three must agree.
+
+    blender -b --python-exit-code 1 -P tests/blender_import.py -- SCAN_DIR HEIGHT_MM"""
+import sys
+
+import bpy
+
+
+def main():
+    args = sys.argv[sys.argv.index("--") + 1:]
+    scan, height = args[0], float(args[1])
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    units = bpy.context.scene.unit_settings
+    units.system, units.length_unit, units.scale_length = "METRIC", "MILLIMETERS", 0.001
+    importers = {
+        "mesh.ply": lambda p: bpy.ops.import_mesh.ply(filepath=p),
+        "mesh.obj": lambda p: bpy.ops.wm.obj_import(filepath=p),  # its defaults: Y up, -Z forward
+        "mesh.stl": lambda p: bpy.ops.import_mesh.stl(filepath=p),
+    }
+    sizes = {}
+    for name, load in importers.items():
+        before = set(bpy.data.objects)
+        load(f"{scan}/{name}")
+        (obj,) = set(bpy.data.objects) - before
+        pts = [obj.matrix_world @ v.co for v in obj.data.vertices]
+        lo = [min(p[k] for p in pts) for k in range(3)]
+        hi = [max(p[k] for p in pts) for k in range(3)]
+        size = [hi[k] - lo[k] for k in range(3)]
+        sizes[name] = (size, lo, hi)
+        print(f"blender: {name}: {len(obj.data.vertices)} vertices, {size[0]:.1f} x {size[1]:.1f} x "
+              f"{size[2]:.1f} mm, from z {lo[2]:.1f} to {hi[2]:.1f}")
+        # upright: standing on the table (z from about 0) to the object's height along Z
+        assert abs(size[2] - height) < 0.05 * height, (name, "height", size)
+        assert -5.0 < lo[2] < 5.0, (name, "not on the table", lo)
+    ref = sizes["mesh.ply"]
+    for name, (size, lo, hi) in sizes.items():
+        for k in range(3):
+            assert abs(lo[k] - ref[1][k]) < 0.01 and abs(hi[k] - ref[2][k]) < 0.01, \
+                (name, "differs from mesh.ply", lo, hi, ref)
+    print("blender: mesh.ply, mesh.obj and mesh.stl upright, %.1f mm tall, the same in all three"
+          % ref[0][2])
+
+
+main()
