@@ -951,7 +951,6 @@ static int check_frames(const struct job *j, const char *scan_dir, uint32_t v,
 int scan_job_feed_view(const char *scan_dir, uint32_t v, const struct scan_params *params,
                        const struct scan_calib *calib, char *err, size_t err_len)
 {
-    static uint8_t pixels[HAL_MAX_PIXELS * 3];
     struct gray_layout layout;
     scan_layout(params, calib, &layout);
     uint32_t count = gray_layout_count(&layout);
@@ -960,8 +959,12 @@ int scan_job_feed_view(const char *scan_dir, uint32_t v, const struct scan_param
     int rc = scan_begin_view(params, calib);
     for (uint32_t f = 0; f < count + lights + (hdr ? 1u : 0u) && rc == 0; f++) {
         uint32_t channels = (f == GRAY_PATTERN_WHITE && !hdr) || f >= count ? 3 : 1;
-        rc = scan_dir_read_frame(scan_dir, v, f, pixels, sizeof(pixels), params->width,
-                                 params->height, channels, err, err_len);
+        /* straight into the firmware's buffer for it: fed without a copy */
+        uint8_t *pixels = scan_frame_buffer(f);
+        if (pixels == NULL)
+            return -EINVAL;
+        rc = scan_dir_read_frame(scan_dir, v, f, pixels, (size_t)HAL_MAX_PIXELS * channels,
+                                 params->width, params->height, channels, err, err_len);
         if (rc == 0)
             rc = f < count            ? scan_feed_frame(f, pixels, channels, NULL)
                  : f < count + lights ? scan_feed_light_frame(f - count, pixels)

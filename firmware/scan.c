@@ -24,6 +24,7 @@ static uint8_t view_reason[HAL_MAX_PIXELS];  /* decoded, then refined by each la
 static uint8_t hdr_choice[HAL_MAX_PIXELS];   /* HDR: the exposure each pixel is read at */
 static uint8_t hdr_grey[HAL_MAX_PIXELS];     /* HDR: one exposure of the pattern being merged */
 static struct scan_params view_params;        /* of the view being fed */
+static uint32_t view_patterns, view_lights;    /* its pattern and colour frames */
 
 int scan_check(const struct scan_params *p, const struct scan_calib *c, char *msg, size_t len)
 {
@@ -160,6 +161,8 @@ int scan_begin_view(const struct scan_params *p, const struct scan_calib *c)
     view_params = *p;
     memset(light_present, 0, sizeof(light_present));
     scan_layout(p, c, &layout);
+    view_patterns = gray_layout_count(&layout);
+    view_lights = scan_light_frame_count(p, c);
     return decode_begin(p, &layout, c->proj_width, c->proj_height);
 }
 
@@ -186,6 +189,17 @@ int scan_feed_frame(uint32_t pattern, const uint8_t *pixels, uint32_t channels,
                                  view_params.height, 3)
                     : sink->save(sink->priv, pattern, grey, view_params.width, view_params.height, 1);
     return rc;
+}
+
+uint8_t *scan_frame_buffer(uint32_t frame)
+{
+    uint32_t count = view_patterns, lights = view_lights;
+    int hdr = view_params.exposure_count > 0;
+    if (frame < count)
+        return frame == GRAY_PATTERN_WHITE && !hdr ? colour_rgb : decode_frame_slot(frame);
+    if (frame < count + lights)
+        return frame - count < COLOUR_MAX_FRAMES ? light_rgb[frame - count] : NULL;
+    return hdr && frame == count + lights ? colour_rgb : NULL;
 }
 
 int scan_feed_white_colour(const uint8_t *rgb)

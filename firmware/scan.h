@@ -103,6 +103,11 @@ void scan_layout(const struct scan_params *params, const struct scan_calib *cali
                  struct gray_layout *layout);
 int scan_feed_frame(uint32_t pattern, const uint8_t *pixels, uint32_t channels,
                     const struct scan_frame_sink *sink);
+/** Where frame @p frame of the view begun (kept-frame order: patterns, lights, HDR colour) is
+ *  kept once fed: reading a kept frame straight into it spares a copy. @retval the buffer, of
+ *  HAL_MAX_PIXELS RGB pixels for the white and colour frames, HAL_MAX_PIXELS grey ones for the
+ *  other patterns @retval NULL no such frame */
+uint8_t *scan_frame_buffer(uint32_t frame);
 /** Decode, refine, triangulate, take normals and colour of the frames fed since
  *  scan_begin_view. @param view  out @param info  out: reasons counted, valid points */
 int scan_finish_view(const struct scan_calib *calib, int32_t angle_mdeg, struct scan_view *view,
