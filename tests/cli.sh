@@ -232,7 +232,7 @@ assert 0 < by[\"registration\"][\"residual_mm\"] < 1, by[\"registration\"]
 assert by[\"mesh\"][\"vertices\"] > 10000 and by[\"mesh\"][\"triangles\"] > 10000, by[\"mesh\"]
 assert by[\"cost\"][\"cpu_s\"] > 0 and by[\"fused\"][\"views_done\"] == 8, by[\"cost\"]
 assert abs(by[\"fused\"][\"angle_deg\"] - 315) < 1, by[\"fused\"]
-# time left: unknown until a view's time is measured, then an estimate, 0 at the end
+# time left: unknown until the time of a view is measured, then an estimate, 0 at the end
 fused = [e[\"left_s\"] for e in lines if e[\"event\"] == \"fused\"]
 assert fused[0] == -1 and min(fused[1:]) >= 0 and fused[-1] == 0, fused'"
 cp -r "$out/scan" "$out/broken" 2>/dev/null; rm -f "$out/broken/view_000/frame_07.pgm.zst"
