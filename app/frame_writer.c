@@ -3,7 +3,7 @@
  * not copied: they stay in the firmware's static buffers, which the next view overwrites only
  * after frame_writer_flush (the caller's promise). view.ini is written after the flush, so its
  * presence still means every frame is on disk. The thread keeps one zstd compressor for all its
- * frames: writing allocates nothing. */
+ * frames: writing a zstd or PGM/PPM frame allocates nothing (libpng allocates for png). */
 #define _POSIX_C_SOURCE 200809L
 #include "frame_writer.h"
 
