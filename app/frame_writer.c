@@ -7,15 +7,15 @@
 #define _POSIX_C_SOURCE 200809L
 #include "frame_writer.h"
 
+#include "clock_posix.h"
 #include "hal_limits.h"
 #include "image_io.h"
+#include "thread_posix.h"
 
 #include <errno.h>
 #include <pthread.h>
-#include <signal.h>
 #include <stdio.h>
 #include <string.h>
-#include <time.h>
 
 #define FRAME_WRITER_STACK (512u * 1024u)
 
@@ -39,13 +39,6 @@ static struct {
     char failed[SCAN_DIR_PATH_MAX]; /* its file */
     double cpu_s;
 } w = {.lock = PTHREAD_MUTEX_INITIALIZER, .changed = PTHREAD_COND_INITIALIZER};
-
-static double thread_cpu_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + (double)ts.tv_nsec / 1e9;
-}
 
 static void *writer(void *arg)
 {
@@ -71,7 +64,7 @@ static void *writer(void *arg)
         }
         w.head = (w.head + 1) % FRAME_WRITER_SLOTS;
         w.count--;
-        w.cpu_s = thread_cpu_s();
+        w.cpu_s = clock_posix_thread_cpu_s();
         pthread_cond_broadcast(&w.changed);
     }
     pthread_mutex_unlock(&w.lock);
@@ -90,21 +83,9 @@ int frame_writer_start(const struct hal_storage *storage)
     w.cpu_s = 0.0;
     /* A small stack: the encoders keep their state on the heap, and a board with 512 MB has no
      * address space to spare for the default 8 MiB (make LIMITS=small under ulimit -v). */
-    /* Signals stay with the thread that runs the scan (it stops the rig): the new thread starts
-     * with every signal blocked. */
-    pthread_attr_t attr;
-    sigset_t all, old;
-    sigfillset(&all);
-    int rc = pthread_attr_init(&attr);
-    if (rc == 0)
-        rc = pthread_attr_setstacksize(&attr, FRAME_WRITER_STACK);
-    if (rc == 0 && (rc = pthread_sigmask(SIG_BLOCK, &all, &old)) == 0) {
-        rc = pthread_create(&w.thread, &attr, writer, NULL);
-        pthread_sigmask(SIG_SETMASK, &old, NULL);
-    }
-    pthread_attr_destroy(&attr);
+    int rc = thread_posix_start(&w.thread, FRAME_WRITER_STACK, writer, NULL);
     if (rc != 0)
-        return -rc;
+        return rc;
     w.running = 1;
     return 0;
 }

@@ -13,6 +13,7 @@
 #include <fcntl.h>
 #include <stddef.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <sys/file.h>
 #include <sys/stat.h>
@@ -461,6 +462,41 @@ int scan_dir_write_registration(const struct hal_storage *st, const char *dir, u
         return -ENAMETOOLONG;
     int rc = scan_dir_path(path, sizeof(path), dir, (int)view, "registration.ini");
     return rc != 0 ? rc : hal_storage_write_file(st, path, text, (size_t)len);
+}
+
+/* The @p n numbers after "key =" on line @p line ("a, b, c"). @retval 1 when they are there */
+static int numbers_of(const char *line, const char *key, double *v, int n)
+{
+    size_t kl = strlen(key);
+    if (strncmp(line, key, kl) != 0 || line[kl + strspn(line + kl, " ")] != '=')
+        return 0;
+    const char *p = strchr(line, '=') + 1;
+    for (int k = 0; k < n; k++) {
+        char *end;
+        v[k] = strtod(p, &end);
+        if (end == p)
+            return 0;
+        p = end + strspn(end, " ,");
+    }
+    return 1;
+}
+
+int scan_dir_read_pose(const char *dir, uint32_t view, struct frame_xform *pose)
+{
+    char path[SCAN_DIR_PATH_MAX], line[512];
+    double origin[3];
+    int have_rot = 0, have_origin = 0;
+    int rc = scan_dir_path(path, sizeof(path), dir, (int)view, "registration.ini");
+    FILE *f = rc == 0 ? fopen(path, "r") : NULL;
+    if (f == NULL)
+        return rc != 0 ? rc : -errno;
+    while (fgets(line, sizeof(line), f) != NULL) {
+        have_rot |= numbers_of(line, "pose_rotation", pose->rot, 9);
+        have_origin |= numbers_of(line, "pose_origin_mm", origin, 3);
+    }
+    fclose(f);
+    pose->origin = v3(origin[0], origin[1], origin[2]);
+    return have_rot && have_origin ? 0 : -EINVAL;
 }
 
 int scan_dir_copy_file(const struct hal_storage *st, const char *from, const char *to)

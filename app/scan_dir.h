@@ -111,6 +111,10 @@ int scan_dir_write_registration(const struct hal_storage *st, const char *dir, u
                                 const struct reg_report *r, const struct reg_view *v,
                                 const struct frame_xform *pose);
 
+/** The pose view @p view was fused with, from its registration.ini (the tools that measure a
+ *  scan read it back). @retval 0 @retval -ENOENT no registration.ini @retval -EINVAL no pose */
+int scan_dir_read_pose(const char *dir, uint32_t view, struct frame_xform *pose);
+
 /** How scan_dir_open treats what @p dir already holds. */
 enum scan_dir_mode {
     SCAN_DIR_EXISTING, /**< a scan to finish or process in place: kept as it is */

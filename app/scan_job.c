@@ -3,16 +3,17 @@
 #include "scan_job.h"
 
 #include "board.h"
+#include "clock_posix.h"
 #include "colour.h"
 #include "frame_writer.h"
 #include "fusion.h"
 #include "gray.h"
 #include "scan.h"
 #include "scan_dir.h"
+#include "thread_posix.h"
 
 #include <errno.h>
 #include <pthread.h>
-#include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -70,22 +71,6 @@ static double wall_ms(void)
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
 }
 
-/* CPU time of this thread: what a stage costs, whatever else the machine does. */
-static double cpu_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + (double)ts.tv_nsec / 1e9;
-}
-
-/* CPU time of the whole process (every thread). */
-static double process_cpu_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + (double)ts.tv_nsec / 1e9;
-}
-
 static void job_init(struct job *j, const struct hal *hal, const struct app_config *cfg,
                      const struct scan_calib *calib, const struct scan_job_opts *opts,
                      const char *out_dir)
@@ -97,9 +82,9 @@ static void job_init(struct job *j, const struct hal *hal, const struct app_conf
                       .out_dir = out_dir,
                       .views = cfg->views * cfg->passes, /* every pass's */
                       .start_ms = wall_ms(),
-                      .start_cpu_s = process_cpu_s(),
+                      .start_cpu_s = clock_posix_process_cpu_s(),
                       .start_sim_cpu_s = board_simulator_cpu_s(),
-                      .start_thread_cpu_s = cpu_s(),
+                      .start_thread_cpu_s = clock_posix_thread_cpu_s(),
                       .tty = isatty(STDOUT_FILENO) && !opts->json};
     if (hal_clock_now_us(&hal->clock, &j->start_rig_us) != 0)
         j->start_rig_us = 0;
@@ -119,7 +104,7 @@ static void report_cost(struct job *j, const char *what)
 {
     uint64_t now_us = j->start_rig_us;
     hal_clock_now_us(&j->hal->clock, &now_us);
-    double cpu = process_cpu_s() - j->start_cpu_s;
+    double cpu = clock_posix_process_cpu_s() - j->start_cpu_s;
     double sim = board_simulator_cpu_s() - j->start_sim_cpu_s, own = cpu - sim;
     uint32_t views = j->views ? j->views : 1;
     char detail[400];
@@ -134,7 +119,8 @@ static void report_cost(struct job *j, const char *what)
     }
     /* In line with the rig: this thread's work between its moves and captures, and the last
      * view's processing (the others ran while the table turned) */
-    double in_line = cpu_s() - j->start_thread_cpu_s - sim + j->last_view_cpu_s;
+    double in_line =
+        clock_posix_thread_cpu_s() - j->start_thread_cpu_s - sim + j->last_view_cpu_s;
     int n = snprintf(detail, sizeof(detail),
                      "%s %.2f s CPU for %u views (%.3f s a view: storing frames %.2f s, "
                      "processing views as the table turned %.2f s, in line with the rig %.2f s)",
@@ -298,16 +284,23 @@ static int write_failed(const struct job *j, const char *name, int rc)
     return write_failed_at(j, j->view_dir, name, rc);
 }
 
+/* The directory of the view being processed, in the output directory. @retval 0 @retval -errno
+ * (said) */
+static int make_view_dir(const struct job *j)
+{
+    int rc = hal_storage_mkdir_p(&j->hal->storage, j->view_dir);
+    if (rc != 0)
+        j->hal->log(HAL_LOG_ERROR, "cannot make %s: %s", j->view_dir, strerror(-rc));
+    return rc;
+}
+
 /* Frames a scan keeps ([output] keep_frames): "colour" keeps the white pattern (the colour of
  * method none, the white of the others), the light frames and an HDR scan's colour frame. */
 static int keeps_frame(const struct job *j, uint32_t frame)
 {
     if (j->cfg->keep_frames != KEEP_FRAMES_COLOUR)
         return j->cfg->keep_frames == KEEP_FRAMES_ALL;
-    struct gray_layout layout;
-    scan_layout(&j->cfg->scan, j->calib, &layout);
-    return frame >= gray_layout_count(&layout) ||
-           (frame == GRAY_PATTERN_WHITE && j->cfg->scan.exposure_count == 0);
+    return scan_frame_channels(&j->cfg->scan, j->calib, frame) == 3;
 }
 
 /* A frame goes to the storage thread; a write of an earlier frame that failed is said here,
@@ -520,9 +513,9 @@ static int report_registration(struct job *j, const struct reg_report *r, double
 static int make_model(struct job *j, const char *scan_dir)
 {
     struct reg_report rep;
-    double t0 = cpu_s();
+    double t0 = clock_posix_thread_cpu_s();
     reg_solve(&rep);
-    int rc = report_registration(j, &rep, cpu_s() - t0, scan_dir);
+    int rc = report_registration(j, &rep, clock_posix_thread_cpu_s() - t0, scan_dir);
     if (rc == 0)
         rc = fusion_begin(&j->cfg->fusion);
     for (uint32_t v = 0; v < j->views && rc == 0; v++) {
@@ -531,8 +524,8 @@ static int make_model(struct job *j, const char *scan_dir)
         rc = stopped_offline(j, scan_dir, v);
         if (rc == 0)
             rc = load_range(j, scan_dir, v, &view, &info);
-        if (rc == 0 && (rc = hal_storage_mkdir_p(&j->hal->storage, j->view_dir)) != 0)
-            j->hal->log(HAL_LOG_ERROR, "cannot make %s: %s", j->view_dir, strerror(-rc));
+        if (rc == 0)
+            rc = make_view_dir(j);
         struct reg_view rv;
         if (rc == 0)
             rc = save_results(j, &view, &rep, &rv);
@@ -578,28 +571,30 @@ static void table_failed(const struct job *j, uint32_t v, int32_t target_mdeg)
                  target_mdeg / 1000.0, kept_views(j, v, "", kept, sizeof(kept)));
 }
 
-/* The thread of a captured view: decode it, keep its frames and range image, then its view.ini
- * last (its presence says the view is complete). */
-static void *process_view(void *arg)
+/* A view that will not be complete: said once, with what is kept and how to go on. */
+static void view_not_finished(const struct job *j, uint32_t v, int32_t angle_mdeg, int rc)
 {
-    struct pending *p = arg;
+    char kept[2 * HAL_MAX_PATH + 96];
+    j->hal->log(HAL_LOG_WARN, "view %u at %.3f deg was not finished (%s); %s", (unsigned)v,
+                angle_mdeg / 1000.0, rc == -EINTR ? "stopped by request" : strerror(-rc),
+                kept_views(j, v, "", kept, sizeof(kept)));
+}
+
+/* Decode a captured view, keep its frames and range image, then its view.ini last (its
+ * presence says the view is complete). @retval 0 @retval -errno (said) */
+static int save_view(struct pending *p)
+{
     struct job *j = p->j;
     const struct hal *hal = j->hal;
     struct scan_view view;
-    char detail[HAL_MAX_PATH + 160];
-    double t0_cpu = cpu_s();
+    char detail[HAL_MAX_PATH + 160], fields[96];
     int rc = scan_finish_view(j->calib, p->info.angle_mdeg, &view, &p->info);
     int rc_frames = flush_frames(j); /* nothing writes into the view's directory after this */
     if (rc == 0)
         rc = rc_frames;
     if (rc != 0) { /* the layer that met the fault has said what it was */
-        char kept[2 * HAL_MAX_PATH + 96];
-        hal->log(HAL_LOG_WARN, "view %u at %.3f deg was not finished (%s); %s",
-                 (unsigned)p->view, p->info.angle_mdeg / 1000.0, strerror(-rc),
-                 kept_views(j, p->view, "", kept, sizeof(kept)));
-        p->rc = rc;
-        p->cpu_s = cpu_s() - t0_cpu;
-        return NULL;
+        view_not_finished(j, p->view, p->info.angle_mdeg, rc);
+        return rc;
     }
     progress(j, "saving", (int)p->view, p->view, "");
     rc = scan_keep_for_registration(p->view, &view); /* the model is made once every view is in */
@@ -608,16 +603,31 @@ static void *process_view(void *arg)
                              scan_dir_write_range(&hal->storage, j->out_dir, p->view, &view));
     if (rc == 0)
         rc = write_view_meta(p, wall_ms() - p->t0_ms);
-    if (rc == 0) {
-        char fields[96];
-        describe(detail, sizeof(detail), &p->info, p->view_dir);
-        snprintf(fields, sizeof(fields), "\"points\":%u,\"angle_deg\":%.3f",
-                 (unsigned)p->info.valid_points, p->info.angle_mdeg / 1000.0);
-        progress_with(j, "saved", (int)p->view, p->view + 1, fields, detail);
-    }
-    p->rc = rc;
-    p->cpu_s = cpu_s() - t0_cpu;
+    if (rc != 0)
+        return rc;
+    describe(detail, sizeof(detail), &p->info, p->view_dir);
+    snprintf(fields, sizeof(fields), "\"points\":%u,\"angle_deg\":%.3f",
+             (unsigned)p->info.valid_points, p->info.angle_mdeg / 1000.0);
+    progress_with(j, "saved", (int)p->view, p->view + 1, fields, detail);
+    return 0;
+}
+
+/* The thread of a captured view: save_view, its result and CPU kept for finish_pending. */
+static void *process_view(void *arg)
+{
+    struct pending *p = arg;
+    double t0 = clock_posix_thread_cpu_s();
+    p->rc = save_view(p);
+    p->cpu_s = clock_posix_thread_cpu_s() - t0;
     return NULL;
+}
+
+/* The view processed: its result, its CPU counted. @retval its error (said already) */
+static int view_processed(struct job *j, const struct pending *p)
+{
+    j->views_cpu_s += p->cpu_s;
+    j->last_view_cpu_s = p->cpu_s;
+    return p->rc;
 }
 
 /* Wait for the view being processed, if any. @retval 0 @retval its error (said already) */
@@ -626,9 +636,7 @@ static int finish_pending(struct job *j)
     if (j->pending == NULL)
         return 0;
     pthread_join(j->pending->thread, NULL);
-    int rc = j->pending->rc;
-    j->views_cpu_s += j->pending->cpu_s;
-    j->last_view_cpu_s = j->pending->cpu_s;
+    int rc = view_processed(j, j->pending);
     j->pending = NULL;
     return rc;
 }
@@ -642,24 +650,15 @@ static int start_processing(struct job *j, uint32_t v, const char *started, doub
     p = (struct pending){.j = j, .view = v, .t0_ms = t0_ms, .info = *info};
     snprintf(p.view_dir, sizeof(p.view_dir), "%s", j->view_dir);
     snprintf(p.started, sizeof(p.started), "%s", started);
-    /* signals stay with this thread, which stops the rig: the new one has them blocked */
-    sigset_t all, old;
-    sigfillset(&all);
-    int rc = pthread_sigmask(SIG_BLOCK, &all, &old);
-    if (rc == 0) {
-        rc = pthread_create(&p.thread, NULL, process_view, &p);
-        pthread_sigmask(SIG_SETMASK, &old, NULL);
-    }
+    int rc = thread_posix_start(&p.thread, 0, process_view, &p);
     if (rc == 0) {
         j->pending = &p;
         return 0;
     }
     j->hal->log(HAL_LOG_WARN, "cannot start a thread (%s): view %u is processed before the "
-                              "table turns", strerror(rc), (unsigned)v);
+                              "table turns", strerror(-rc), (unsigned)v);
     process_view(&p);
-    j->views_cpu_s += p.cpu_s;
-    j->last_view_cpu_s = p.cpu_s;
-    return p.rc;
+    return view_processed(j, &p);
 }
 
 static int live_view(struct job *j, uint32_t v)
@@ -697,11 +696,8 @@ static int live_view(struct job *j, uint32_t v)
     if (rc == 0)
         rc = write_failed(j, "(the simulator's truth)", board_write_view_extras(hal, j->view_dir));
     if (rc != 0) { /* the layer that met the fault has said what it was */
-        char kept[2 * HAL_MAX_PATH + 96];
         flush_frames(j); /* nothing writes into the view's directory after this */
-        hal->log(HAL_LOG_WARN, "view %u at %.3f deg was not finished (%s); %s", (unsigned)v,
-                 st.position_mdeg / 1000.0, rc == -EINTR ? "stopped by request" : strerror(-rc),
-                 kept_views(j, v, "", kept, sizeof(kept)));
+        view_not_finished(j, v, st.position_mdeg, rc);
         return rc;
     }
     return start_processing(j, v, started, t0, &info);
@@ -955,10 +951,9 @@ int scan_job_feed_view(const char *scan_dir, uint32_t v, const struct scan_param
     scan_layout(params, calib, &layout);
     uint32_t count = gray_layout_count(&layout);
     uint32_t lights = scan_light_frame_count(params, calib);
-    int hdr = params->exposure_count > 0; /* merged grey patterns, the colour after the lights */
+    uint32_t channels;
     int rc = scan_begin_view(params, calib);
-    for (uint32_t f = 0; f < count + lights + (hdr ? 1u : 0u) && rc == 0; f++) {
-        uint32_t channels = (f == GRAY_PATTERN_WHITE && !hdr) || f >= count ? 3 : 1;
+    for (uint32_t f = 0; rc == 0 && (channels = scan_frame_channels(params, calib, f)) != 0; f++) {
         /* straight into the firmware's buffer for it: fed without a copy */
         uint8_t *pixels = scan_frame_buffer(f);
         if (pixels == NULL)
@@ -973,14 +968,32 @@ int scan_job_feed_view(const char *scan_dir, uint32_t v, const struct scan_param
     return rc;
 }
 
-/* Reasons counted and valid points of a view read back from its range.bin. */
-static void count_reasons(const struct scan_view *view, struct scan_view_info *info)
+/* View @p v read back from its range.bin in @p dir, with what describe() says of it (the
+ * reader has checked that the valid pixels are the header's count). @retval 0 @retval -ENOENT
+ * none @retval -EINVAL (@p err says) */
+static int read_range(struct job *j, const char *dir, uint32_t v, struct scan_view *view,
+                      struct scan_view_info *info, char *err, size_t err_len)
 {
-    memset(info, 0, sizeof(*info));
-    info->angle_mdeg = view->angle_mdeg;
-    for (size_t i = 0; i < (size_t)view->width * view->height; i++)
-        info->reason_count[view->maps.reason[i]]++;
-    info->valid_points = info->reason_count[SCAN_VALID];
+    set_view(j, v);
+    int rc = scan_dir_read_range(dir, v, j->cfg->scan.width, j->cfg->scan.height, view, err,
+                                 err_len);
+    if (rc == 0) {
+        memset(info, 0, sizeof(*info));
+        info->angle_mdeg = view->angle_mdeg;
+        info->valid_points = view->range.valid_count;
+    }
+    return rc;
+}
+
+/* View @p v of a scan that kept no pattern frames: its range.bin in @p scan_dir. */
+static int load_kept_range(struct job *j, const char *scan_dir, uint32_t v,
+                           struct scan_view *view, struct scan_view_info *info)
+{
+    char err[SCAN_DIR_PATH_MAX + 128];
+    int rc = read_range(j, scan_dir, v, view, info, err, sizeof(err));
+    if (rc != 0)
+        j->hal->log(HAL_LOG_ERROR, "%s; the scan kept no pattern frames to decode it from", err);
+    return rc;
 }
 
 /* View @p v as the model is made of it: its range.bin in the output directory, else (a scan
@@ -989,13 +1002,9 @@ static int load_range(struct job *j, const char *scan_dir, uint32_t v, struct sc
                       struct scan_view_info *info)
 {
     char err[SCAN_DIR_PATH_MAX + 128];
-    int rc = scan_dir_read_range(j->out_dir, v, j->cfg->scan.width, j->cfg->scan.height, view,
-                                 err, sizeof(err));
-    if (rc == 0) {
-        set_view(j, v);
-        count_reasons(view, info);
+    int rc = read_range(j, j->out_dir, v, view, info, err, sizeof(err));
+    if (rc == 0)
         return 0;
-    }
     if (j->cfg->keep_frames != KEEP_FRAMES_ALL) {
         j->hal->log(HAL_LOG_ERROR, "%s; the scan kept no pattern frames to decode it from", err);
         return rc;
@@ -1003,21 +1012,6 @@ static int load_range(struct job *j, const char *scan_dir, uint32_t v, struct sc
     if (rc != -ENOENT)
         j->hal->log(HAL_LOG_WARN, "%s: decoded again from its frames", err);
     return load_view(j, scan_dir, v, view, info);
-}
-
-/* View @p v of a scan that kept no pattern frames: its range.bin in @p scan_dir. */
-static int load_kept_range(struct job *j, const char *scan_dir, uint32_t v,
-                           struct scan_view *view, struct scan_view_info *info)
-{
-    char err[SCAN_DIR_PATH_MAX + 128];
-    set_view(j, v);
-    int rc = scan_dir_read_range(scan_dir, v, j->cfg->scan.width, j->cfg->scan.height, view, err,
-                                 sizeof(err));
-    if (rc != 0)
-        j->hal->log(HAL_LOG_ERROR, "%s; the scan kept no pattern frames to decode it from", err);
-    else
-        count_reasons(view, info);
-    return rc;
 }
 
 /* Decode view @p v of @p scan_dir from its kept frames, as it was decoded live. */
@@ -1101,9 +1095,10 @@ int scan_job_process(const struct hal *hal, const char *scan_dir, const struct s
                                                     : load_kept_range(&j, scan_dir, v, &view, &info);
         if (rc == 0)
             rc = scan_keep_for_registration(v, &view);
-        if (rc == 0 && (rc = hal_storage_mkdir_p(&hal->storage, j.view_dir)) != 0)
-            hal->log(HAL_LOG_ERROR, "cannot make %s: %s", j.view_dir, strerror(-rc));
-        if (rc == 0) /* the model is made of this one, not of an older range.bin */
+        /* the model is made of this one, not of an older range.bin (one read back from where
+         * it goes is that one already) */
+        if (rc == 0 && (cfg.keep_frames == KEEP_FRAMES_ALL || elsewhere) &&
+            (rc = make_view_dir(&j)) == 0)
             rc = write_failed(&j, "range.bin",
                               scan_dir_write_range(&hal->storage, j.out_dir, v, &view));
         if (rc == 0) {

@@ -25,26 +25,6 @@ static double cpu_ms(void)
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
 }
 
-/* The pose a view was fused with, from its registration.ini. */
-static int read_pose(const char *dir, uint32_t v, struct frame_xform *pose)
-{
-    char path[SCAN_DIR_PATH_MAX], line[512];
-    double *r = pose->rot;
-    int have = 0;
-    scan_dir_path(path, sizeof(path), dir, (int)v, "registration.ini");
-    FILE *f = fopen(path, "r");
-    if (f == NULL)
-        return -errno;
-    while (fgets(line, sizeof(line), f) != NULL) {
-        have += sscanf(line, "pose_rotation = %lf, %lf, %lf, %lf, %lf, %lf, %lf, %lf, %lf", &r[0],
-                       &r[1], &r[2], &r[3], &r[4], &r[5], &r[6], &r[7], &r[8]) == 9;
-        have += sscanf(line, "pose_origin_mm = %lf, %lf, %lf", &pose->origin.x, &pose->origin.y,
-                       &pose->origin.z) == 3;
-    }
-    fclose(f);
-    return have == 2 ? 0 : -EINVAL;
-}
-
 /* View @p v's depth (mm, 0: none) and colour, the points outside the volume left out. */
 static int dump_view(const char *out, uint32_t v, const struct scan_view *view,
                      const struct frame_xform *pose, const struct fusion_params *fp)
@@ -120,7 +100,7 @@ int main(int argc, char **argv)
             struct frame_xform pose;
             if (scan_dir_read_range(dir, v, calib.cam_width, calib.cam_height, &view, err,
                                     sizeof(err)) != 0 ||
-                read_pose(dir, v, &pose) != 0) {
+                scan_dir_read_pose(dir, v, &pose) != 0) {
                 fprintf(stderr, "view %u: %s\n", (unsigned)v, err);
                 return 1;
             }

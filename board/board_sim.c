@@ -4,6 +4,7 @@
 
 #include "gray.h"
 #include "scan.h"
+#include "clock_posix.h"
 #include "image_io.h"
 #include "sim_devices.h"
 #include "pty_link.h"
@@ -18,7 +19,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 static struct {
     struct sim_rig rig;
@@ -32,13 +32,6 @@ static struct {
     int ready;
 } sim;
 static double truth_cpu_s; /* writing the ground truth: the simulator's work */
-
-static double thread_cpu_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec + (double)ts.tv_nsec / 1e9;
-}
 
 const char *board_name(void)
 {
@@ -244,9 +237,9 @@ int board_write_scan_extras(const struct hal *hal, const char *scan_dir)
 
 int board_write_view_extras(const struct hal *hal, const char *view_dir)
 {
-    double t0 = thread_cpu_s();
+    double t0 = clock_posix_thread_cpu_s();
     int rc = write_truth(hal, view_dir);
-    truth_cpu_s += thread_cpu_s() - t0;
+    truth_cpu_s += clock_posix_thread_cpu_s() - t0;
     return rc;
 }
 

@@ -191,6 +191,18 @@ int scan_feed_frame(uint32_t pattern, const uint8_t *pixels, uint32_t channels,
     return rc;
 }
 
+uint32_t scan_frame_channels(const struct scan_params *p, const struct scan_calib *c,
+                             uint32_t frame)
+{
+    struct gray_layout layout;
+    scan_layout(p, c, &layout);
+    uint32_t count = gray_layout_count(&layout);
+    int hdr = p->exposure_count > 0; /* the patterns merged grey, the colour after the lights */
+    if (frame >= count + scan_light_frame_count(p, c) + (hdr ? 1u : 0u))
+        return 0;
+    return (frame == GRAY_PATTERN_WHITE && !hdr) || frame >= count ? 3u : 1u;
+}
+
 uint8_t *scan_frame_buffer(uint32_t frame)
 {
     uint32_t count = view_patterns, lights = view_lights;

@@ -103,6 +103,11 @@ void scan_layout(const struct scan_params *params, const struct scan_calib *cali
                  struct gray_layout *layout);
 int scan_feed_frame(uint32_t pattern, const uint8_t *pixels, uint32_t channels,
                     const struct scan_frame_sink *sink);
+/** How frame @p frame of a view (kept-frame order: patterns, lights, HDR colour) is fed and
+ *  kept: @retval 3 RGB (the white pattern, the colour frames) @retval 1 grey (the other
+ *  patterns, HDR's merged white among them) @retval 0 no such frame */
+uint32_t scan_frame_channels(const struct scan_params *params, const struct scan_calib *calib,
+                             uint32_t frame);
 /** Where frame @p frame of the view begun (kept-frame order: patterns, lights, HDR colour) is
  *  kept once fed: reading a kept frame straight into it spares a copy. @retval the buffer, of
  *  HAL_MAX_PIXELS RGB pixels for the white and colour frames, HAL_MAX_PIXELS grey ones for the

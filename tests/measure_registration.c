@@ -63,13 +63,13 @@ int main(int argc, char **argv)
     uint32_t views = 0;
     for (uint32_t v = 0; v < cfg.views; v++) {
         static struct scan_dir_view meta;
-        double rot[9], origin[3], truth;
+        struct frame_xform pose;
+        double truth;
         if (scan_dir_read_view(argv[1], v, &meta, err, sizeof(err)) != 0)
             continue;
-        scan_dir_path(path, sizeof(path), argv[1], (int)v, "registration.ini");
-        if (read_numbers(path, "pose_rotation", rot, 9) != 0 ||
-            read_numbers(path, "pose_origin_mm", origin, 3) != 0)
+        if (scan_dir_read_pose(argv[1], v, &pose) != 0)
             continue;
+        const double *rot = pose.rot;
         scan_dir_path(path, sizeof(path), argv[1], (int)v, "truth_angle.ini");
         if (read_numbers(path, "angle_mdeg", &truth, 1) != 0)
             continue;

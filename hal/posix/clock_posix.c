@@ -43,3 +43,21 @@ void clock_posix_init(struct hal_clock *clock)
     clock->ops = &posix_clock_ops;
     clock->priv = NULL;
 }
+
+static double cpu_clock_s(clockid_t id)
+{
+    struct timespec ts;
+    if (clock_gettime(id, &ts) != 0)
+        return 0.0;
+    return (double)ts.tv_sec + (double)ts.tv_nsec / 1e9;
+}
+
+double clock_posix_thread_cpu_s(void)
+{
+    return cpu_clock_s(CLOCK_THREAD_CPUTIME_ID);
+}
+
+double clock_posix_process_cpu_s(void)
+{
+    return cpu_clock_s(CLOCK_PROCESS_CPUTIME_ID);
+}
