@@ -9,6 +9,7 @@
 #include "fusion.h"
 #include "outbuf.h"
 #include "ply.h"
+#include "srgb.h"
 
 #include <errno.h>
 #include <string.h>
@@ -179,11 +180,13 @@ int fusion_write_ply(const struct hal_storage *st, const char *path)
 static int obj_vertex(void *priv, const float p[3], const float n[3], const uint8_t rgb[3])
 {
     struct outbuf *o = priv;
-    /* "v x y z r g b": vertex colours as MeshLab, Blender and Open3D read them. Y up, as OBJ
+    /* "v x y z r g b": vertex colours as MeshLab, Blender and Open3D read them (and show them:
+     * sRGB-encoded, see srgb.h). Y up, as OBJ
      * readers assume (Blender's importer turns Y up into its Z up): the object frame's
      * (x, y, z) with z up is written (x, z, -y), a right-handed turn about x. */
     outbuf_printf(o, "v %.4f %.4f %.4f %.4f %.4f %.4f\nvn %.5f %.5f %.5f\n", p[0], p[2], -p[1],
-                  rgb[0] / 255.0, rgb[1] / 255.0, rgb[2] / 255.0, n[0], n[2], -n[1]);
+                  srgb_encode(rgb[0]) / 255.0, srgb_encode(rgb[1]) / 255.0,
+                  srgb_encode(rgb[2]) / 255.0, n[0], n[2], -n[1]);
     return o->rc;
 }
 
@@ -202,7 +205,8 @@ int fusion_write_obj(const struct hal_storage *st, const char *path)
     if (outbuf_open(&o, st, path) != 0)
         return o.rc;
     outbuf_printf(&o, "# turntable colour scanner: fused mesh; units: millimetres; Y up (the "
-                      "object frame's x, z, -y: its z, up the turntable's axis, is Y here)\n");
+                      "object frame's x, z, -y: its z, up the turntable's axis, is Y here); vertex "
+                      "colours sRGB-encoded\n");
     struct mesh_sink sink = {obj_vertex, obj_triangle, &o};
     fusion_extract_prepared(&sink);
     return outbuf_close(&o);

@@ -1,6 +1,8 @@
 /* One static chunk serves every file the firmware writes (one at a time). */
 #include "outbuf.h"
 
+#include <errno.h>
+
 #include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
@@ -43,8 +45,10 @@ void outbuf_printf(struct outbuf *o, const char *fmt, ...)
     va_start(ap, fmt);
     int n = vsnprintf(line, sizeof(line), fmt, ap);
     va_end(ap);
-    if (n > 0)
-        outbuf_put(o, line, (size_t)n < sizeof(line) ? (size_t)n : sizeof(line) - 1);
+    if (n >= (int)sizeof(line) && o->rc == 0)
+        o->rc = -EOVERFLOW; /* a cut line would make a damaged file: a writer's bug, said */
+    else if (n > 0)
+        outbuf_put(o, line, (size_t)n);
 }
 
 void outbuf_u32le(struct outbuf *o, uint32_t u)

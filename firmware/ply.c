@@ -2,6 +2,7 @@
 #include "ply.h"
 
 #include "outbuf.h"
+#include "srgb.h"
 
 static uint32_t count_valid(const struct decode_maps *maps)
 {
@@ -20,7 +21,11 @@ void ply_put_vertex(struct outbuf *o, vec3 p, vec3 n, const uint8_t rgb[3])
     outbuf_f32le(o, (float)n.x);
     outbuf_f32le(o, (float)n.y);
     outbuf_f32le(o, (float)n.z);
-    outbuf_put(o, rgb, 3);
+    /* viewers show 8-bit colours as sRGB; the fused linear values follow as floats */
+    const uint8_t encoded[3] = {srgb_encode(rgb[0]), srgb_encode(rgb[1]), srgb_encode(rgb[2])};
+    outbuf_put(o, encoded, 3);
+    for (int k = 0; k < 3; k++)
+        outbuf_f32le(o, rgb[k] / 255.0f);
 }
 
 void ply_put_header(struct outbuf *o, const char *what, uint32_t vertices, uint32_t faces,
@@ -29,11 +34,15 @@ void ply_put_header(struct outbuf *o, const char *what, uint32_t vertices, uint3
     outbuf_printf(o,
                   "ply\nformat binary_little_endian 1.0\n"
                   "comment turntable colour scanner: %s; units: millimetres\n"
+                  "comment red green blue: sRGB-encoded colour; red_linear green_linear "
+                  "blue_linear: the same colour in linear units 0..1\n"
                   "element vertex %u\n"
                   "property float x\nproperty float y\nproperty float z\n"
-                  "property float nx\nproperty float ny\nproperty float nz\n"
-                  "property uchar red\nproperty uchar green\nproperty uchar blue\n",
+                  "property float nx\nproperty float ny\nproperty float nz\n",
                   what, (unsigned)vertices);
+    outbuf_printf(o, "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+                     "property float red_linear\nproperty float green_linear\n"
+                     "property float blue_linear\n");
     if (with_quality)
         outbuf_printf(o, "property float quality\n");
     if (faces > 0)

@@ -27,7 +27,8 @@ struct outbuf;
  *  a float `quality` after it when @p with_quality. */
 void ply_put_header(struct outbuf *o, const char *what, uint32_t vertices, uint32_t faces,
                     int with_quality);
-/** One vertex: float x y z nx ny nz, uchar red green blue (27 bytes). */
+/** One vertex: float x y z nx ny nz, uchar red green blue sRGB-encoded from the linear @p rgb,
+ *  float red_linear green_linear blue_linear (@p rgb / 255): 39 bytes. */
 void ply_put_vertex(struct outbuf *o, vec3 pos, vec3 normal, const uint8_t rgb[3]);
 
 #endif

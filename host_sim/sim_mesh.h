@@ -9,7 +9,8 @@ struct sim_mesh {
     float *pos;    /**< 3 per vertex, object frame, mm (z up, base on z = 0 once placed) */
     float *normal; /**< 3 per vertex, area-weighted smooth normals */
     uint32_t *tri; /**< 3 vertex indices per triangle, counter-clockwise seen from outside */
-    uint8_t *rgb;  /**< 3 per vertex when the PLY file has vertex colours, else NULL */
+    uint8_t *rgb;  /**< 3 per vertex when the PLY file has vertex colours, else NULL; the linear
+                      floats (red_linear...) where the file has them, else its bytes as they are */
     float *quality; /**< per vertex when the PLY file has `quality` (clouds: colour confidence) */
 };
 

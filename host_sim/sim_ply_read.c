@@ -9,8 +9,22 @@
 
 enum ply_type { PT_NONE, PT_I8, PT_U8, PT_I16, PT_U16, PT_I32, PT_U32, PT_F32, PT_F64 };
 
-/* What a property is read into; x, y, z and red, green, blue are consecutive. */
-enum ply_role { ROLE_X, ROLE_Y, ROLE_Z, ROLE_FACE, ROLE_RED, ROLE_GREEN, ROLE_BLUE, ROLE_QUALITY };
+/* What a property is read into; x, y, z, red, green, blue and their linear floats are
+ * consecutive. The scanner writes colours sRGB-encoded and linear (firmware/ply.c): the linear
+ * ones are read where a file has them, as the simulator and the measurements work in linear. */
+enum ply_role {
+    ROLE_X,
+    ROLE_Y,
+    ROLE_Z,
+    ROLE_FACE,
+    ROLE_RED,
+    ROLE_GREEN,
+    ROLE_BLUE,
+    ROLE_QUALITY,
+    ROLE_RED_LINEAR,
+    ROLE_GREEN_LINEAR,
+    ROLE_BLUE_LINEAR
+};
 
 struct ply_prop {
     enum ply_type type;
@@ -110,7 +124,10 @@ static int vertex_role(const char *name)
     static const char *const names[] = {[ROLE_X] = "x",       [ROLE_Y] = "y",
                                         [ROLE_Z] = "z",       [ROLE_FACE] = "",
                                         [ROLE_RED] = "red",   [ROLE_GREEN] = "green",
-                                        [ROLE_BLUE] = "blue", [ROLE_QUALITY] = "quality"};
+                                        [ROLE_BLUE] = "blue", [ROLE_QUALITY] = "quality",
+                                        [ROLE_RED_LINEAR] = "red_linear",
+                                        [ROLE_GREEN_LINEAR] = "green_linear",
+                                        [ROLE_BLUE_LINEAR] = "blue_linear"};
     for (int r = 0; r < (int)(sizeof(names) / sizeof(names[0])); r++)
         if (names[r][0] != '\0' && strcmp(name, names[r]) == 0)
             return r;
@@ -231,6 +248,9 @@ static int read_element(FILE *f, const struct ply_header *h, const struct ply_el
                     m->rgb[3 * r + (unsigned long)(p->role - ROLE_RED)] = (uint8_t)(v < 0     ? 0
                                                                                     : v > 255 ? 255
                                                                                               : v);
+                else if (is_vertex && p->role >= ROLE_RED_LINEAR && m->rgb != NULL)
+                    m->rgb[3 * r + (unsigned long)(p->role - ROLE_RED_LINEAR)] =
+                        (uint8_t)(v < 0 ? 0 : v > 1 ? 255 : v * 255.0 + 0.5);
                 continue;
             }
             double cnt;
@@ -298,6 +318,15 @@ static int ply_has_role(const struct ply_header *h, enum ply_role role)
     return 0;
 }
 
+/* Skip the vertex properties of roles @p first .. @p last. */
+static void ply_drop_roles(struct ply_header *h, enum ply_role first, enum ply_role last)
+{
+    for (int e = 0; e < h->elem_count; e++)
+        for (int k = 0; k < h->elems[e].prop_count; k++)
+            if (h->elems[e].props[k].role >= (int)first && h->elems[e].props[k].role <= (int)last)
+                h->elems[e].props[k].role = -1;
+}
+
 static int load_ply(struct sim_mesh *m, const char *path, int need_faces, char *err,
                     unsigned err_len)
 {
@@ -332,7 +361,10 @@ static int load_ply(struct sim_mesh *m, const char *path, int need_faces, char *
     }
     m->pos = calloc((size_t)m->vert_count * 3, sizeof(float));
     m->normal = calloc((size_t)m->vert_count * 3, sizeof(float));
-    int has_rgb = ply_has_role(&h, ROLE_RED), has_quality = ply_has_role(&h, ROLE_QUALITY);
+    int has_rgb = ply_has_role(&h, ROLE_RED) || ply_has_role(&h, ROLE_RED_LINEAR);
+    int has_quality = ply_has_role(&h, ROLE_QUALITY);
+    if (ply_has_role(&h, ROLE_RED_LINEAR))
+        ply_drop_roles(&h, ROLE_RED, ROLE_BLUE); /* the sRGB bytes only repeat them */
     if (has_rgb)
         m->rgb = calloc((size_t)m->vert_count * 3, 1);
     if (has_quality)

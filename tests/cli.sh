@@ -26,6 +26,11 @@ sed -e "s|^calibration = .*|calibration = $PWD/config/sim-calib.ini|" \
     -e "s|^mesh_file = .*|mesh_file = no-such-mesh.ply|" config/sim.ini > "$out/no-mesh.ini"
 check check_config_names_missing_mesh sh -c "$bin check-config --config $out/no-mesh.ini 2> $out/no-mesh.txt;
     test \$? -eq 2 && grep -q '\\[sim\\] mesh_file: .*no-such-mesh.ply: No such file' $out/no-mesh.txt"
+# make run's intrinsic colour is white-referenced on its own rig: the white_scale in
+# config/sim.ini is what calibrate-white gives for config/sim-white.ini (issue 18).
+check sim_white_reference_current sh -c "$bin calibrate-white --config config/sim-white.ini 2>/dev/null |
+    awk '\$2 == \"multi\" { getline; print }' > $out/white.txt && test -s $out/white.txt &&
+    grep -qx \"\$(cat $out/white.txt)\" config/sim.ini"
 check selftest_sim sh -c "$bin selftest --config config/sim.ini > $out/selftest.txt &&
     test \$(grep -c ' ok ' $out/selftest.txt) -eq 4"
 # The appliance build on a machine without its devices: each one MISSING with its path and

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "frames.h"
+#include "srgb.h"
 #include "test_util.h"
 
 static void test_ply_roundtrip(void **state)
@@ -40,7 +41,7 @@ static void test_ply_roundtrip(void **state)
             assert_string_equal(line, "format binary_little_endian 1.0\n");
     }
     assert_int_equal(count, info.valid_points);
-    assert_int_equal(props, 10);
+    assert_int_equal(props, 13);
     /* Vertices are in the object frame: rotating back by the angle gives the camera points. */
     struct frame_xform obj;
     frame_object_from_camera(&t.calib, angle_mdeg, &obj);
@@ -51,16 +52,20 @@ static void test_ply_roundtrip(void **state)
     for (size_t i = 0; i < n; i++) {
         if (maps->reason[i] != SCAN_VALID)
             continue;
-        unsigned char rec[31];
-        assert_int_equal(fread(rec, 1, 31, f), 31);
+        unsigned char rec[43];
+        assert_int_equal(fread(rec, 1, 43, f), 43);
         float v[6];
         memcpy(v, rec, sizeof(v)); /* little-endian host, as the file */
         vec3 p = frame_point_inv(&obj, v3(v[0], v[1], v[2]));
         assert_true(fabs(p.x - r->xyz_mm[3 * i]) < 1e-3 && fabs(p.z - r->xyz_mm[3 * i + 2]) < 1e-3);
         assert_true(fabs(sqrt(v[3] * v[3] + v[4] * v[4] + v[5] * v[5]) - 1.0) < 1e-4);
-        assert_memory_equal(rec + 24, rgb + 3 * i, 3);
-        float quality;
-        memcpy(&quality, rec + 27, sizeof(quality));
+        float linear[3], quality;
+        memcpy(linear, rec + 27, sizeof(linear));
+        for (int k = 0; k < 3; k++) { /* sRGB bytes for viewers, the linear colour as floats */
+            assert_int_equal(rec[24 + k], srgb_encode(rgb[3 * i + (size_t)k]));
+            assert_true(linear[k] == rgb[3 * i + (size_t)k] / 255.0f);
+        }
+        memcpy(&quality, rec + 39, sizeof(quality));
         assert_true(quality == view.confidence[i]); /* 1 for a valid pixel without method */
         assert_true(quality == 1.0f);
         seen++;
@@ -72,9 +77,26 @@ static void test_ply_roundtrip(void **state)
     test_rig_stop(&t);
 }
 
+/* Every entry of the encoding table is the sRGB formula (IEC 61966-2-1), and it rises. */
+static void test_srgb_table(void **state)
+{
+    (void)state;
+    for (int i = 0; i < 256; i++) {
+        double x = i / 255.0;
+        double e = x <= 0.0031308 ? 12.92 * x : 1.055 * pow(x, 1.0 / 2.4) - 0.055;
+        assert_int_equal(srgb_encode((uint8_t)i), (int)(e * 255.0 + 0.5));
+        if (i > 0)
+            assert_true(srgb_encode((uint8_t)i) >= srgb_encode((uint8_t)(i - 1)));
+    }
+    assert_int_equal(srgb_encode(0), 0);
+    assert_int_equal(srgb_encode(255), 255);
+    assert_int_equal(srgb_encode(46), 118); /* 18% grey reads as the middle of the scale */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_srgb_table),
         cmocka_unit_test(test_ply_roundtrip),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -1,0 +1,13 @@
+/* The sRGB transfer function for colours people look at: the scanner computes and fuses colour
+ * in linear units (albedo), while viewers show a file's 8-bit colours as sRGB-encoded. */
+#ifndef SRGB_H
+#define SRGB_H
+
+#include <stdint.h>
+
+/** The sRGB encoding of a linear byte (IEC 61966-2-1: 12.92 x below 0.0031308, else
+ *  1.055 x^(1/2.4) - 0.055), both as 0..255, rounded.
+ *  @param linear  linear value 0..255 @retval the sRGB-encoded value 0..255 */
+uint8_t srgb_encode(uint8_t linear);
+
+#endif
