@@ -268,10 +268,14 @@ size: deps $(BUILD)/scanner $(BUILD)/libfirmware.a
 	@bench/static_memory.sh $(BUILD)/libfirmware.a
 
 # Test-only packages: Open3D reads our PLY (tests/cli.sh); pymodbus and socat are the Modbus
-# peers of tests/interop.sh; OpenCV builds scanner-calibrate (tests/calibrate.sh).
+# peers of tests/interop.sh; OpenCV builds scanner-calibrate (tests/calibrate.sh); the Khronos
+# glTF validator (npm, pinned in tests/gltf/package-lock.json) checks mesh.glb (tests/cli.sh).
 test-deps: deps
 	@{ /usr/bin/python3 -c 'import open3d, pymodbus, serial_asyncio' && command -v socat systemd-analyze && pkg-config --exists libcamera opencv4; } \
 		>/dev/null 2>&1 || scripts/install-deps.sh test
+	@scripts/install-deps.sh node
+	@test -f tests/gltf/node_modules/gltf-validator/package.json || \
+		npm ci --prefix tests/gltf --no-audit --no-fund --loglevel=error
 
 # A second make, so that what test-deps installed (libcamera-dev) is seen when it starts.
 test: deps test-deps
@@ -350,7 +354,7 @@ run: deps $(BUILD)/scanner
 	$(BUILD)/scanner scan --config config/sim.ini
 
 # Blender 3.4 (Debian's, installed if missing; not in CI: 66 packages) imports a scan's
-# mesh.ply, mesh.obj and mesh.stl upright and at the object's size in a millimetre scene.
+# mesh.ply, mesh.obj, mesh.stl and mesh.glb upright and at the object's size in a millimetre scene.
 check-blender: deps $(BUILD)/scanner
 	@command -v blender >/dev/null || scripts/install-deps.sh blender
 	@rm -rf $(BUILD)/blender-scan

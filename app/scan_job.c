@@ -263,7 +263,7 @@ static const char *finished_detail(struct job *j, char *buf, size_t len)
 {
     struct rusage ru;
     getrusage(RUSAGE_SELF, &ru);
-    snprintf(buf, len, "%s (mesh: %s/mesh.ply, mesh.obj, mesh.stl; peak memory %.1f MB)", j->out_dir,
+    snprintf(buf, len, "%s (mesh: %s/mesh.ply, mesh.obj, mesh.stl, mesh.glb; peak memory %.1f MB)", j->out_dir,
              j->out_dir, ru.ru_maxrss / 1024.0);
     return buf;
 }
@@ -393,13 +393,13 @@ static void set_view(struct job *j, uint32_t view)
     scan_dir_path(j->view_dir, sizeof(j->view_dir), j->out_dir, (int)view, NULL);
 }
 
-/* The fused model: mesh.ply, mesh.obj and mesh.stl in the scan directory, without floating
- * fragments. */
+/* The fused model: mesh.ply, mesh.obj, mesh.stl and mesh.glb in the scan directory, without
+ * floating fragments. */
 static int write_model(struct job *j)
 {
-    static const char *const names[] = {"mesh.ply", "mesh.obj", "mesh.stl"};
+    static const char *const names[] = {"mesh.ply", "mesh.obj", "mesh.stl", "mesh.glb"};
     int (*const writers[])(const struct hal_storage *, const char *) = {
-        fusion_write_ply, fusion_write_obj, fusion_write_stl};
+        fusion_write_ply, fusion_write_obj, fusion_write_stl, fusion_write_glb};
     char path[SCAN_DIR_PATH_MAX], detail[HAL_MAX_PATH + 160];
     struct mesh_summary ms;
     uint32_t filled = 0, inside = 0;
@@ -413,14 +413,15 @@ static int write_model(struct job *j)
     if (rc == -E2BIG)
         j->hal->log(HAL_LOG_WARN,
                     "the mesh has %u vertices, more than MESH_MAX_VERTICES (%u): it is written "
-                    "whole, fragments and all, and without mesh.stl (a larger [fusion] voxel_mm "
+                    "whole, fragments and all, and without mesh.stl and mesh.glb (a larger "
+                    "[fusion] voxel_mm "
                     "makes a smaller mesh)",
                     (unsigned)ms.vertices, MESH_MAX_VERTICES);
     else if (rc != 0)
         return rc;
     rc = 0;
     for (size_t k = 0; k < sizeof(names) / sizeof(names[0]) && rc == 0; k++) {
-        if (!fits && writers[k] == fusion_write_stl)
+        if (!fits && (writers[k] == fusion_write_stl || writers[k] == fusion_write_glb))
             continue;
         rc = scan_dir_path(path, sizeof(path), j->out_dir, -1, names[k]);
         if (rc == 0 && (rc = writers[k](&j->hal->storage, path)) != 0)
@@ -437,7 +438,7 @@ static int write_model(struct job *j)
              "filled holes%s) -> %s/mesh.ply, mesh.obj%s",
              (unsigned)ms.kept_vertices, (unsigned)ms.kept_triangles,
              (unsigned)ms.removed_pieces, (unsigned)ms.pieces, (unsigned)filled, closed,
-             j->out_dir, fits ? " and mesh.stl" : "");
+             j->out_dir, fits ? ", mesh.stl and mesh.glb" : "");
     char fields[128];
     snprintf(fields, sizeof(fields), "\"vertices\":%u,\"triangles\":%u,\"pieces_left_out\":%u",
              (unsigned)ms.kept_vertices, (unsigned)ms.kept_triangles,

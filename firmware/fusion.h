@@ -85,6 +85,10 @@ int fusion_mesh_prepare(double min_fragment_share, struct mesh_summary *summary)
  *  are not given, the vertices renumbered. @retval 0 @retval -EINVAL not prepared */
 int fusion_extract_prepared(const struct mesh_sink *sink);
 
+/** What fusion_mesh_prepare found, for a writer that needs the counts first.
+ *  @retval 0 @retval -EINVAL not prepared @retval -E2BIG the mesh did not fit the tables */
+int fusion_mesh_counts(struct mesh_summary *summary);
+
 /** Write the prepared mesh as binary PLY (vertex x y z nx ny nz red green blue, faces), as OBJ
  *  (with vertex colours and normals) or as binary STL (for printing: triangles only), atomically,
  *  in millimetres. @retval 0 @retval -EINVAL not prepared @retval -E2BIG (STL) the mesh did not
@@ -92,5 +96,11 @@ int fusion_extract_prepared(const struct mesh_sink *sink);
 int fusion_write_ply(const struct hal_storage *st, const char *path);
 int fusion_write_obj(const struct hal_storage *st, const char *path);
 int fusion_write_stl(const struct hal_storage *st, const char *path);
+
+/** Write the prepared mesh as glTF 2.0 binary (firmware/mesh_glb.c): metres, +Y up, linear vertex
+ *  colours, one material, atomically. @retval 0 @retval -EINVAL not prepared @retval -E2BIG the
+ *  mesh did not fit MESH_MAX_VERTICES @retval -ENODATA no vertex @retval -EFBIG over 4 GiB
+ *  @retval -errno from storage */
+int fusion_write_glb(const struct hal_storage *st, const char *path);
 
 #endif

@@ -143,6 +143,14 @@ int fusion_extract_prepared(const struct mesh_sink *sink)
     return mp.fits ? emit_kept(sink) : fusion_extract(sink);
 }
 
+int fusion_mesh_counts(struct mesh_summary *summary)
+{
+    if (!mp.prepared)
+        return -EINVAL;
+    *summary = mp.s;
+    return mp.fits ? 0 : -E2BIG;
+}
+
 static int ply_vertex(void *priv, const float p[3], const float n[3], const uint8_t rgb[3])
 {
     struct outbuf *o = priv;

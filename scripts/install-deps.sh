@@ -4,7 +4,7 @@
 # With the argument "test" it adds what only the tests use (Open3D reads our PLY files; the
 # libcamera backend is compiled and tested without a camera; OpenCV builds the calibration
 # program), with
-# "bench" what only the benchmarks use (OpenCV to compare with, valgrind), with "blender" Blender
+# "node" Node.js and npm (the glTF validator of make test), "bench" what only the benchmarks use (OpenCV to compare with, valgrind), with "blender" Blender
 # (make check-blender), with "gpio-chip" the
 # virtual machine of tests/gpio_chip.sh, with a target triplet
 # (aarch64-linux-gnu) what cross-building for it needs.
@@ -13,6 +13,12 @@ pkgs="build-essential pkg-config libinih-dev libpng-dev libzstd-dev libjpeg-dev 
 [ "${1:-}" = "bench" ] && pkgs="$pkgs g++ libopencv-dev libopencv-contrib-dev valgrind libspng-dev libzstd-dev python3-open3d"
 [ "${1:-}" = "fuzz" ] && pkgs="$pkgs clang libclang-rt-14-dev"
 [ "${1:-}" = "blender" ] && pkgs="blender"
+# Node.js and npm run the Khronos glTF validator (tests/gltf); a machine that has them from
+# elsewhere (NodeSource's nodejs carries its own npm, which Debian's npm conflicts with) keeps them.
+if [ "${1:-}" = "node" ]; then
+    command -v node >/dev/null 2>&1 && command -v npm >/dev/null 2>&1 && exit 0
+    pkgs="nodejs npm"
+fi
 [ "${1:-}" = "gpio-chip" ] && pkgs="qemu-system-arm cpio systemd socat python3"
 [ "${1:-}" = "test" ] && pkgs="$pkgs python3 python3-numpy python3-open3d python3-pymodbus python3-serial python3-serial-asyncio socat g++ libcamera-dev libopencv-contrib-dev systemd valgrind"
 # A cross build's target (make CROSS_COMPILE=aarch64-linux-gnu-): its compiler, its -dev

@@ -1,4 +1,4 @@
-"""Blender 3.4 (Debian's, in background mode) imports a scan's mesh.ply, mesh.obj and mesh.stl
+"""Blender 3.4 (Debian's, in background mode) imports a scan's mesh.ply, mesh.obj, mesh.stl and mesh.glb
 with its own importers and their default settings, in a scene whose unit is the millimetre
 (how a user working with scans sets it): each must come in upright (the turntable's axis along
 Blender's Z) at the object's true size, and the three must agree.
@@ -7,6 +7,12 @@ Blender's Z) at the object's true size, and the three must agree.
 import sys
 
 import bpy
+import numpy
+
+# Blender 3.4's glTF importer still says numpy.bool, which numpy 1.24 (Debian 12's) removed: the
+# importer fails with "module 'numpy' has no attribute 'bool'". The alias it meant is bool.
+if not hasattr(numpy, "bool"):
+    numpy.bool = bool
 
 
 def main():
@@ -19,12 +25,15 @@ def main():
         "mesh.ply": lambda p: bpy.ops.import_mesh.ply(filepath=p),
         "mesh.obj": lambda p: bpy.ops.wm.obj_import(filepath=p),  # its defaults: Y up, -Z forward
         "mesh.stl": lambda p: bpy.ops.import_mesh.stl(filepath=p),
+        "mesh.glb": lambda p: bpy.ops.import_scene.gltf(filepath=p),  # metres, +Y up
     }
     sizes = {}
     for name, load in importers.items():
         before = set(bpy.data.objects)
         load(f"{scan}/{name}")
         (obj,) = set(bpy.data.objects) - before
+        if name == "mesh.glb":  # glTF's colours and material arrive too
+            assert len(obj.data.color_attributes) == 1 and len(obj.data.materials) == 1, name
         pts = [obj.matrix_world @ v.co for v in obj.data.vertices]
         lo = [min(p[k] for p in pts) for k in range(3)]
         hi = [max(p[k] for p in pts) for k in range(3)]
@@ -40,7 +49,7 @@ def main():
         for k in range(3):
             assert abs(lo[k] - ref[1][k]) < 0.01 and abs(hi[k] - ref[2][k]) < 0.01, \
                 (name, "differs from mesh.ply", lo, hi, ref)
-    print("blender: mesh.ply, mesh.obj and mesh.stl upright, %.1f mm tall, the same in all three"
+    print("blender: mesh.ply, mesh.obj, mesh.stl and mesh.glb upright, %.1f mm tall, the same in all"
           % ref[0][2])
 
 

@@ -180,6 +180,15 @@ check scan_writes_stl_and_registration_line sh -c "test -s $out/scan/mesh.stl &&
     test \$(stat -c %s $out/scan/mesh.stl) -gt 84 &&
     grep -q '^angle_deg = ' $out/scan/view_003/registration.ini &&
     grep -q '^loop_closure_rms_mm = ' $out/scan/view_003/registration.ini"
+# mesh.glb (issue 18): the Khronos validator finds nothing wrong, it is in metres with +Y up
+# (the bunny is 150 mm tall and stands on y = 0), and the validator does catch a damaged one.
+check glb_valid_metres_y_up sh -c "node tests/gltf/validate.mjs $out/scan/mesh.glb > $out/glb.txt &&
+    grep -q ' 0 errors, 0 warnings' $out/glb.txt &&
+    /usr/bin/python3 tests/gltf/glb_extent.py $out/scan/mesh.glb |
+    awk '{ exit !(\$1 > 0.140 && \$1 < 0.160 && \$2 > -0.003 && \$2 < 0.003) }'"
+check glb_validator_catches_damage sh -c "sed 's/\"VEC4\"/\"VEC2\"/' $out/scan/mesh.glb > $out/bad.glb &&
+    ! cmp -s $out/scan/mesh.glb $out/bad.glb && ! node tests/gltf/validate.mjs $out/bad.glb > $out/bad-glb.txt &&
+    grep -q ' error ' $out/bad-glb.txt"
 # The object slips on the table between two views: the scan fails, names the view, writes no
 # model and keeps every view.
 sed -e 's/^views = .*/views = 4/' -e "s|^calibration = .*|calibration = $PWD/config/sim-calib.ini|" \
