@@ -203,8 +203,9 @@ printf '[output]\nwatertight = 1\n' | cat config/sim.ini - > "$out/watertight.in
 check watertight_needs_max_hole sh -c "$bin check-config --config $out/watertight.ini 2>&1 |
     grep -q 'watertight: a closed model needs max_hole_mm > 0'"
 # HDR patterns: the exposures must hold the camera's own (the view's colour is taken at it); a
-# scan with two exposures per pattern keeps the merged frames and the colour, and process makes
-# the same model from them.
+# scan with two exposures per pattern keeps the merged frames, the colour frames of sim.ini's
+# intrinsic colour (dark, all lights, each of 4 lights) and the view's colour after them, and
+# process makes the same model from them.
 sed 's/^views = 8$/views = 4\nexposures_us = 2500, 40000/' config/sim.ini > "$out/hdr-bad.ini"
 sed 's/^views = 8$/views = 4\nexposures_us = 10000, 40000/' config/sim.ini > "$out/hdr.ini"
 sed -i "s|^calibration = .*|calibration = $PWD/config/sim-calib.ini|; s|^mesh_file = ../|mesh_file = $PWD/|" \
@@ -214,8 +215,9 @@ check hdr_exposures_need_the_cameras sh -c "$bin check-config --config $out/hdr-
 rm -rf "$out/hdr-scan" "$out/hdr-processed"
 check hdr_scan_and_process_agree sh -c "$bin scan --config $out/hdr.ini --out $out/hdr-scan >/dev/null 2>&1 &&
     grep -q 'frame_00 = white, grey, HDR merged' $out/hdr-scan/view_000/view.ini &&
-    grep -q 'frame_22 = white, RGB' $out/hdr-scan/view_000/view.ini &&
-    grep -q '^frames = 44' $out/hdr-scan/view_000/view.ini &&
+    grep -q 'frame_22 = dark: projector and lights off, 10000 us, RGB' $out/hdr-scan/view_000/view.ini &&
+    grep -q 'frame_28 = white, RGB (the view.s colour)' $out/hdr-scan/view_000/view.ini &&
+    grep -q '^frames = 50' $out/hdr-scan/view_000/view.ini &&
     $bin process $out/hdr-scan --out $out/hdr-processed >/dev/null 2>&1 &&
     cmp $out/hdr-scan/mesh.ply $out/hdr-processed/mesh.ply"
 rm -rf "$out/hdr-scan" "$out/hdr-processed"

@@ -6,8 +6,8 @@
  * SCAN_DIR is a simulated scan (its config, calibration, truth mesh and view angles); RESULT_DIR
  * holds mesh.ply and view_NNN/cloud.ply from `scanner process SCAN_DIR --out RESULT_DIR`
  * (or SCAN_DIR itself). Fused vertices are compared with the true albedo at the closest true
- * surface point, away from paint edges (the fusion blends colour over ~2 voxels) and off the very
- * dark paint (never decoded). A vertex belongs to the view that weighs most there in the fusion
+ * surface point, away from paint edges (the fusion blends colour over ~2 voxels); the very dark
+ * paint counts as every paint and is also summed on its own (dark_*). A vertex belongs to the view that weighs most there in the fusion
  * (head-on, near, both camera and projector reaching it); where that view changes is a boundary
  * between views, and the colour step there is the difference between the two views' own colour
  * estimates (their clouds) at the boundary. */
@@ -135,18 +135,18 @@ static int dominant_view(const struct rig_views *r, const struct sim_bvh *truth,
     return best;
 }
 
-/* True albedo at @p p; @retval 0 usable, 1 on the dark paint or within EDGE_MM of a paint edge */
-static int true_albedo(const struct rig_views *r, vec3 p, double albedo[3])
+/* True albedo at @p p; @p dark: set on the very dark paint (compared as every paint, and also
+ * on its own). @retval 0 usable, 1 within EDGE_MM of a paint edge */
+static int true_albedo(const struct rig_views *r, vec3 p, double albedo[3], int *dark)
 {
-    if (sim_albedo_at(&r->cfg.sim, r->height_mm, p, albedo))
-        return 1;
+    *dark = sim_albedo_at(&r->cfg.sim, r->height_mm, p, albedo);
     static const double d[6][3] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
                                    {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
     for (int k = 0; k < 6; k++) {
         double other[3];
         vec3 q = v3_add(p, v3_scale(v3(d[k][0], d[k][1], d[k][2]), EDGE_MM));
-        if (sim_albedo_at(&r->cfg.sim, r->height_mm, q, other) ||
-            memcmp(other, albedo, sizeof(other)) != 0)
+        sim_albedo_at(&r->cfg.sim, r->height_mm, q, other);
+        if (memcmp(other, albedo, sizeof(other)) != 0)
             return 1;
     }
     return 0;
@@ -249,6 +249,7 @@ static int cloud_colour(const struct cloud *c, vec3 p, uint8_t rgb[3], double *m
 
 struct vertex_eval {
     int usable;     /* compared with the truth */
+    int dark;       /* on the very dark paint */
     int view;       /* dominant view, -1 none */
     vec3 truth_pos; /* closest true point */
     double albedo[3];
@@ -443,8 +444,8 @@ static int cmd_measure(const char *scan_dir, const char *result_dir, const char 
     }
     struct vertex_eval *ve = calloc(res.vert_count, sizeof(*ve));
     double *de = calloc(res.vert_count, sizeof(double));
-    double mae[3] = {0, 0, 0};
-    size_t used = 0;
+    double mae[3] = {0, 0, 0}, dark_sum = 0.0, dark_l = 0.0;
+    size_t used = 0, dark_n = 0;
     for (uint32_t i = 0; ve != NULL && de != NULL && i < res.vert_count; i++) {
         const float *p = &res.pos[3 * i], *n = &res.normal[3 * i];
         vec3 q;
@@ -454,7 +455,7 @@ static int cmd_measure(const char *scan_dir, const char *result_dir, const char 
         double *albedo = ve[i].albedo, got[3];
         ve[i].truth_pos = q;
         ve[i].view = dominant_view(&r, &bvh, q, v3(n[0], n[1], n[2]));
-        if (true_albedo(&r, q, albedo) != 0)
+        if (true_albedo(&r, q, albedo, &ve[i].dark) != 0)
             continue;
         ve[i].usable = 1;
         for (int k = 0; k < 3; k++) {
@@ -463,7 +464,13 @@ static int cmd_measure(const char *scan_dir, const char *result_dir, const char 
         }
         colour_linear_rgb_to_lab(albedo, ve[i].lab_true);
         colour_linear_rgb_to_lab(got, ve[i].lab_got);
-        de[used++] = colour_ciede2000(ve[i].lab_true, ve[i].lab_got);
+        de[used] = colour_ciede2000(ve[i].lab_true, ve[i].lab_got);
+        if (ve[i].dark) {
+            dark_n++;
+            dark_sum += de[used];
+            dark_l += ve[i].lab_got[0];
+        }
+        used++;
     }
     if (used == 0) {
         fprintf(stderr, "colour-eval: %s: no vertex of the result lies on the true surface\n",
@@ -478,9 +485,11 @@ static int cmd_measure(const char *scan_dir, const char *result_dir, const char 
     boundary_steps(&res, ve, clouds, &view_step, &fused_step);
     if (highlight_shares(&res, ve, clouds, r.views, &hl_fused, &hl_views) != 0)
         return 1;
-    printf("%s,%zu,%.3f,%.3f,%.4f,%.4f,%.4f,%.3f,%.3f,%.4f,%.4f,%.4f\n", label, used, sum / used,
-           de[(size_t)(0.95 * (double)(used - 1))], mae[0] / used, mae[1] / used, mae[2] / used,
-           view_step, fused_step, hl_views, hl_fused, registration_coupling(result_dir, r.views));
+    printf("%s,%zu,%.3f,%.3f,%.4f,%.4f,%.4f,%.3f,%.3f,%.4f,%.4f,%.4f,%zu,%.3f,%.2f\n", label, used,
+           sum / used, de[(size_t)(0.95 * (double)(used - 1))], mae[0] / used, mae[1] / used,
+           mae[2] / used, view_step, fused_step, hl_views, hl_fused,
+           registration_coupling(result_dir, r.views), dark_n, dark_n ? dark_sum / dark_n : 0.0,
+           dark_n ? dark_l / dark_n : 0.0);
     free(ve);
     free(de);
     for (uint32_t v = 0; v < r.views; v++)
@@ -619,7 +628,8 @@ int main(int argc, char **argv)
         return cmd_closeup(argv[2], argv[3], argc - 4, argv + 4);
     if (argc == 2 && strcmp(argv[1], "header") == 0) {
         printf("label,vertices,de2000_mean,de2000_p95,mae_r,mae_g,mae_b,view_step_de2000,"
-               "fused_step_de2000,highlight_views,highlight_fused,icp_coupling\n");
+               "fused_step_de2000,highlight_views,highlight_fused,icp_coupling,dark_vertices,"
+               "dark_de2000_mean,dark_lstar\n");
         return 0;
     }
     fprintf(stderr, "usage: colour-eval header\n"
