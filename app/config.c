@@ -192,14 +192,23 @@ static const struct ini_key config_keys[] = {
     ENUM("colour", "method", colour_method, "none|single|uniform|multi", "none",
          "intrinsic colour: none (raw projector-lit colour), single (projector only, Jost eq. 4), "
          "uniform (all lights), multi (each light alone, eq. 6)"),
-    ENUM("colour", "ca", colour_ca, "channel|pixel", "channel",
-         "ambient + black offset from the dark frame: one value per channel, or per pixel"),
+    ENUM("colour", "ca", colour_ca, "channel|pixel|albedo", "albedo",
+         "ambient + black offset from the dark frame: one value per channel, per pixel, or per "
+         "channel as an offset plus the ambient light times the pixel's albedo (fitted over the "
+         "object; dark paint reflects little of the ambient light)"),
     U32("colour", "all_lights_exposure_us", scan.colour.all_lights_exposure_us, 0, 10000000, "0",
         "exposure of the all-lights frame (0: [camera] exposure_us); a dark frame is taken at it "
         "too"),
     U32("colour", "light_exposure_us", scan.colour.light_exposure_us, 0, 10000000, "0",
         "exposure of each single-light frame (0: [camera] exposure_us); a dark frame is taken "
         "at it too"),
+    U32("colour", "bracket", scan.colour.bracket, 0, 64, "0",
+        "multi: each light is also taken at this many times its exposure (with a dark frame at "
+        "it), and each pixel read in the longer frame where no channel saturates there: dark "
+        "paint gets signal above the noise (0 or 1: one exposure)"),
+    F64("colour", "shadow_ratio", scan.colour.shadow_ratio, 0, 1, "0.25",
+        "multi: a light whose albedo estimate at a pixel is below this share of the best "
+        "unhighlighted light's is taken as shadowed there (light from other surfaces only)"),
     F64("colour", "min_cos", scan.colour.min_cos, 0, 1, "0.2",
         "light at a lower cos(incidence) is not used (it would amplify noise)"),
     F64("colour", "ke", scan.colour.ke, 1, 10000, "40", "highlight rejection exponent ke (eq. 6)"),
@@ -567,7 +576,9 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
     for (uint32_t k = 0; k < 4; k++)
         if (strcmp(cfg->colour_method, methods[k]) == 0)
             cfg->scan.colour.method = k;
-    cfg->scan.colour.ca_per_pixel = strcmp(cfg->colour_ca, "pixel") == 0;
+    cfg->scan.colour.ca = strcmp(cfg->colour_ca, "pixel") == 0    ? COLOUR_CA_PIXEL
+                          : strcmp(cfg->colour_ca, "albedo") == 0 ? COLOUR_CA_ALBEDO
+                                                                  : COLOUR_CA_CHANNEL;
     cfg->scan.code = strcmp(cfg->code, "xor04") == 0 ? GRAY_CODE_XOR04 : GRAY_CODE_GRAY;
     cfg->frame_format = strcmp(cfg->frame_format_name, "png") == 0   ? SCAN_FRAMES_PNG
                         : strcmp(cfg->frame_format_name, "pnm") == 0 ? SCAN_FRAMES_PNM

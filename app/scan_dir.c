@@ -80,8 +80,12 @@ static void colour_frame_name(const struct colour_layout *lay, uint32_t k, char 
         snprintf(buf, len, "dark: projector and lights off, %u us, RGB", us);
     else if (k == COLOUR_FRAME_ALL)
         snprintf(buf, len, "all lights on, projector off, %u us, RGB", us);
-    else
-        snprintf(buf, len, "light %u alone, %u us, RGB", (unsigned)(k - COLOUR_FRAME_LIGHT0), us);
+    else {
+        unsigned light = 0; /* the number of its one light */
+        while (!(lay->lights_mask[k] >> light & 1u))
+            light++;
+        snprintf(buf, len, "light %u alone, %u us, RGB", light, us);
+    }
 }
 
 static void pattern_name(uint32_t pattern, const struct gray_layout *l, int hdr, char *buf,

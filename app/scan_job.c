@@ -400,7 +400,7 @@ static int write_model(struct job *j)
     static const char *const names[] = {"mesh.ply", "mesh.obj", "mesh.stl", "mesh.glb"};
     int (*const writers[])(const struct hal_storage *, const char *) = {
         fusion_write_ply, fusion_write_obj, fusion_write_stl, fusion_write_glb};
-    char path[SCAN_DIR_PATH_MAX], detail[HAL_MAX_PATH + 160];
+    char path[SCAN_DIR_PATH_MAX], detail[HAL_MAX_PATH + 320];
     struct mesh_summary ms;
     uint32_t filled = 0, inside = 0;
     progress(j, "meshing", -1, j->views, "marching cubes");
@@ -433,16 +433,24 @@ static int write_model(struct job *j)
     if (j->cfg->watertight)
         snprintf(closed, sizeof(closed), ", closed watertight, %u unseen voxels made solid",
                  (unsigned)inside);
+    char uncoloured[128] = "";
+    if (ms.colour_filled > 0 || ms.uncoloured > 0)
+        snprintf(uncoloured, sizeof(uncoloured),
+                 "; %u vertices no view could colour took their neighbours' colour, %u marked "
+                 "grey",
+                 (unsigned)ms.colour_filled, (unsigned)ms.uncoloured);
     snprintf(detail, sizeof(detail),
              "%u vertices, %u triangles (%u floating fragments of %u pieces left out; %u voxels "
-             "filled holes%s) -> %s/mesh.ply, mesh.obj%s",
+             "filled holes%s%s) -> %s/mesh.ply, mesh.obj%s",
              (unsigned)ms.kept_vertices, (unsigned)ms.kept_triangles,
              (unsigned)ms.removed_pieces, (unsigned)ms.pieces, (unsigned)filled, closed,
-             j->out_dir, fits ? ", mesh.stl and mesh.glb" : "");
-    char fields[128];
-    snprintf(fields, sizeof(fields), "\"vertices\":%u,\"triangles\":%u,\"pieces_left_out\":%u",
+             uncoloured, j->out_dir, fits ? ", mesh.stl and mesh.glb" : "");
+    char fields[192];
+    snprintf(fields, sizeof(fields),
+             "\"vertices\":%u,\"triangles\":%u,\"pieces_left_out\":%u,\"colour_filled\":%u,"
+             "\"uncoloured\":%u",
              (unsigned)ms.kept_vertices, (unsigned)ms.kept_triangles,
-             (unsigned)ms.removed_pieces);
+             (unsigned)ms.removed_pieces, (unsigned)ms.colour_filled, (unsigned)ms.uncoloured);
     progress_with(j, "mesh", -1, j->views, fields, detail);
     return 0;
 }

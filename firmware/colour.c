@@ -37,6 +37,9 @@ void colour_layout(const struct colour_params *p, uint32_t light_count, struct c
     add_frame(out, (1u << light_count) - 1u, all_us);
     for (uint32_t l = 0; l < light_count; l++)
         add_frame(out, 1u << l, one_us);
+    if (p->method == COLOUR_MULTI && p->bracket > 1)
+        for (uint32_t l = 0; l < light_count; l++)
+            out->long_of[COLOUR_FRAME_LIGHT0 + l] = add_frame(out, 1u << l, one_us * p->bracket);
     uint32_t lit = out->count;
     for (uint32_t k = COLOUR_FRAME_ALL; k < lit; k++)
         out->dark_of[k] = dark_at(out, out->exposure_us[k]);
@@ -59,12 +62,15 @@ static void channel_offset(const struct decode_maps *m, const uint8_t *dark, dou
         ca[k] = count ? sum[k] / count : 0.0;
 }
 
-/* What frame_light() needs: the frames in colour_layout() order and each dark frame's Ca. */
+/* What frame_light() needs: the frames in colour_layout() order and each dark frame's Ca:
+ * ca_channel + ca_slope x the pixel's albedo from a first pass (ca = albedo; else slope 0). */
 struct frame_ctx {
     const struct colour_params *prm;
     const struct colour_layout *lay;
     const uint8_t *const *frames;
     double ca_channel[COLOUR_MAX_FRAMES][3];
+    double ca_slope[COLOUR_MAX_FRAMES][3];
+    const uint8_t *albedo; /* the first pass's albedo bytes (ca = albedo) */
 };
 
 /* A channel of RGB pixel @p px at or above the saturation level. */
@@ -83,7 +89,10 @@ static int frame_light(const struct frame_ctx *f, uint32_t k, const uint8_t *px,
     uint32_t d = f->lay->dark_of[k];
     double gain = (double)f->prm->exposure_us / f->lay->exposure_us[k];
     for (int c = 0; c < 3; c++) {
-        double ca = f->prm->ca_per_pixel ? f->frames[d][3 * i + (size_t)c] : f->ca_channel[d][c];
+        size_t at = 3 * i + (size_t)c;
+        double ca = f->prm->ca == COLOUR_CA_PIXEL
+                        ? f->frames[d][at]
+                        : f->ca_channel[d][c] + f->ca_slope[d][c] * f->albedo[at] / 255.0;
         out[c] = (px[c] - ca) * gain;
     }
     return !clipped(f->prm, px);
@@ -160,35 +169,125 @@ static double pixel_estimate(const struct frame_ctx *f, const struct scan_calib 
         }
         return (ok && lit) || relaxed ? 1.0 : 0.0;
     }
-    for (uint32_t l = 0; l < c->light_count; l++) { /* eq. 6, shadowed lights weigh 0 */
-        uint32_t k = COLOUR_FRAME_LIGHT0 + l;
+    /* eq. 6 over the lights that reach the pixel: each light read in its longer frame where
+     * that one does not saturate ([colour] bracket), so that dark paint rises above the noise */
+    double est[HAL_MAX_LIGHTS], best = 0.0;
+    double lit[HAL_MAX_LIGHTS][3], cosine[HAL_MAX_LIGHTS], weight[HAL_MAX_LIGHTS];
+    for (uint32_t l = 0; l < c->light_count; l++) {
+        uint32_t k = COLOUR_FRAME_LIGHT0 + l, kl = f->lay->long_of[k];
+        if (kl != 0 && !clipped(prm, &f->frames[kl][3 * i]))
+            k = kl;
         double fall, ct = incidence(prm, p, nn, v3_from(c->light_pos_mm[l]), &fall);
-        int ok = frame_light(f, k, &f->frames[k][3 * i], i, light);
-        if ((!ok && !relaxed) || ct < min_cos ||
-            (light[0] + light[1] + light[2]) / 3.0 <= prm->shadow_dn)
+        int ok = frame_light(f, k, &f->frames[k][3 * i], i, lit[l]);
+        /* the signal in grey levels of the frame it was read in: below shadow_dn it is noise */
+        double raw =
+            (lit[l][0] + lit[l][1] + lit[l][2]) / 3.0 * f->lay->exposure_us[k] / prm->exposure_us;
+        est[l] = -1.0;
+        if ((!ok && !relaxed) || ct < min_cos || raw <= prm->shadow_dn)
             continue;
-        double w = specular_weight(prm, p, nn, v3_from(c->light_pos_mm[l]));
+        weight[l] = specular_weight(prm, p, nn, v3_from(c->light_pos_mm[l]));
         /* a brighter light gives more signal for the same albedo: its gain takes that out */
         double gain = c->light_gain[l] > 0.0 ? c->light_gain[l] : 1.0;
-        for (int k = 0; k < 3; k++)
-            num[k] += light[k] * fall * w / gain;
-        den += ct * w;
+        for (int ch = 0; ch < 3; ch++)
+            lit[l][ch] *= fall / gain;
+        cosine[l] = ct;
+        est[l] = (lit[l][0] + lit[l][1] + lit[l][2]) / (3.0 * ct); /* this light's albedo */
+        if (weight[l] > 0.5 && est[l] > best)
+            best = est[l];
+    }
+    for (uint32_t l = 0; l < c->light_count; l++) {
+        /* cast shadow: what reaches the pixel is light from other surfaces, far below what
+         * the lights that do reach it say (dark paint is dark under every light) */
+        if (est[l] < 0.0 || est[l] < prm->shadow_ratio * best)
+            continue;
+        for (int ch = 0; ch < 3; ch++)
+            num[ch] += lit[l][ch] * weight[l];
+        den += cosine[l] * weight[l];
     }
     *confidence = den;
     return den;
+}
+
+/* One pass over the pixels with the Ca of @p f: albedo and confidence of every valid pixel. */
+static void compute_pass(const struct frame_ctx *f, const struct scan_calib *c,
+                         const struct decode_maps *m, const struct tri_range *r,
+                         const uint8_t *white, uint8_t *albedo, float *confidence)
+{
+    const struct colour_params *prm = f->prm;
+    size_t n = (size_t)m->width * m->height;
+    vec3 proj = v3_scale(m3_tmul(c->proj_rot, v3_from(c->proj_trans_mm)), -1.0);
+    for (size_t i = 0; i < n; i++) {
+        if (prm->method == COLOUR_NONE || m->reason[i] != SCAN_VALID) {
+            memcpy(&albedo[3 * i], &white[3 * i], 3); /* the raw colour */
+            /* trusted where valid, but not where the white frame clipped (a highlight now has
+             * depth, its colour is blown out): other views colour it if they can */
+            confidence[i] = prm->method == COLOUR_NONE && m->reason[i] == SCAN_VALID &&
+                            !clipped(prm, &white[3 * i]);
+            if (prm->method == COLOUR_NONE && m->reason[i] == SCAN_VALID)
+                white_balance(prm, &albedo[3 * i]);
+            continue;
+        }
+        /* from here on pixel i's albedo is written only after its estimate, which may read the
+         * first pass's value there (ca = albedo): the passes share one buffer */
+        vec3 p = v3(r->xyz_mm[3 * i], r->xyz_mm[3 * i + 1], r->xyz_mm[3 * i + 2]);
+        vec3 nn = v3(r->normal[3 * i], r->normal[3 * i + 1], r->normal[3 * i + 2]);
+        double num[3], trust, den = pixel_estimate(f, c, proj, white, i, p, nn, 0, num, &trust);
+        float conf = (float)(trust > 1.0 ? 1.0 : trust);
+        if (den <= 1e-6) { /* no reliable estimate: a best effort that weighs nothing in the
+                              fusion unless no view has better (raw colour is not an albedo) */
+            den = pixel_estimate(f, c, proj, white, i, p, nn, 1, num, &trust);
+            conf = 0.0f;
+        }
+        if (den <= 1e-6) { /* no estimate at all: no colour, rather than the raw one (which
+                              holds the offset Ca and the light's shading); the fusion leaves
+                              it out and the mesh takes its neighbours' colour */
+            memset(&albedo[3 * i], 0, 3);
+            confidence[i] = COLOUR_NO_ESTIMATE;
+            continue;
+        }
+        for (int k = 0; k < 3; k++)
+            albedo[3 * i + (size_t)k] = albedo_byte(num[k] / den * prm->white_scale[k]);
+        confidence[i] = conf;
+    }
+}
+
+/* ca = albedo: each dark frame's value at a confident pixel, per channel, as offset + slope x
+ * the pixel's albedo (least squares over the object): the black offset and the ambient light
+ * the paint reflects. */
+static void fit_ambient(struct frame_ctx *f, const struct decode_maps *m, const uint8_t *albedo,
+                        const float *confidence, uint32_t k)
+{
+    size_t n = (size_t)m->width * m->height;
+    for (int c = 0; c < 3; c++) {
+        double s1 = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
+        for (size_t i = 0; i < n; i++) {
+            if (m->reason[i] != SCAN_VALID || confidence[i] <= 0.0f)
+                continue;
+            double x = albedo[3 * i + (size_t)c] / 255.0, y = f->frames[k][3 * i + (size_t)c];
+            s1 += 1.0, sx += x, sy += y, sxx += x * x, sxy += x * y;
+        }
+        double det = s1 * sxx - sx * sx;
+        if (s1 < 100.0 || det <= 1e-9 * s1 * s1)
+            continue; /* too few, or one albedo only: the mean stands */
+        double slope = (s1 * sxy - sx * sy) / det;
+        slope = slope > 0.0 ? slope : 0.0; /* light is never taken away */
+        f->ca_slope[k][c] = slope;
+        f->ca_channel[k][c] = (sy - slope * sx) / s1;
+    }
 }
 
 int colour_compute(const struct colour_params *prm, const struct scan_calib *c,
                    const struct decode_maps *m, const struct tri_range *r, const uint8_t *white,
                    const uint8_t *const *lights, uint8_t *albedo, float *confidence)
 {
-    size_t n = (size_t)m->width * m->height;
     static struct frame_ctx f; /* static: the firmware keeps large state off the stack */
     static struct colour_layout lay;
     colour_layout(prm, c->light_count, &lay);
+    memset(&f, 0, sizeof(f));
     f.prm = prm;
     f.lay = &lay;
     f.frames = lights;
+    f.albedo = albedo;
     for (uint32_t k = 0; k < lay.count; k++) {
         if (lights[k] == NULL &&
             (prm->method == COLOUR_MULTI || k == COLOUR_FRAME_DARK || lay.dark_of[k] == k ||
@@ -197,32 +296,12 @@ int colour_compute(const struct colour_params *prm, const struct scan_calib *c,
         if (lights[k] != NULL && lay.dark_of[k] == k)
             channel_offset(m, lights[k], f.ca_channel[k]);
     }
-    vec3 proj = v3_scale(m3_tmul(c->proj_rot, v3_from(c->proj_trans_mm)), -1.0);
-    for (size_t i = 0; i < n; i++) {
-        memcpy(&albedo[3 * i], &white[3 * i], 3); /* raw colour unless compensated below */
-        /* raw colour: trusted where valid, but not where the white frame clipped (a highlight
-         * now has depth, its colour is blown out): other views colour it if they can */
-        confidence[i] = prm->method == COLOUR_NONE && m->reason[i] == SCAN_VALID &&
-                        !clipped(prm, &white[3 * i]);
-        if (prm->method == COLOUR_NONE && m->reason[i] == SCAN_VALID)
-            white_balance(prm, &albedo[3 * i]);
-        if (prm->method == COLOUR_NONE || m->reason[i] != SCAN_VALID)
-            continue;
-        vec3 p = v3(r->xyz_mm[3 * i], r->xyz_mm[3 * i + 1], r->xyz_mm[3 * i + 2]);
-        vec3 nn = v3(r->normal[3 * i], r->normal[3 * i + 1], r->normal[3 * i + 2]);
-        double num[3], trust, den = pixel_estimate(&f, c, proj, white, i, p, nn, 0, num, &trust);
-        float conf = (float)(trust > 1.0 ? 1.0 : trust);
-        if (den <= 1e-6) { /* no reliable estimate: a best effort that weighs nothing in the
-                              fusion unless no view has better (raw colour is not an albedo) */
-            den = pixel_estimate(&f, c, proj, white, i, p, nn, 1, num, &trust);
-            conf = 0.0f;
-        }
-        if (den <= 1e-6)
-            continue;
-        for (int k = 0; k < 3; k++) {
-            albedo[3 * i + (size_t)k] = albedo_byte(num[k] / den * prm->white_scale[k]);
-        }
-        confidence[i] = conf;
-    }
+    compute_pass(&f, c, m, r, white, albedo, confidence);
+    if (prm->method == COLOUR_NONE || prm->ca != COLOUR_CA_ALBEDO)
+        return 0;
+    for (uint32_t k = 0; k < lay.count; k++)
+        if (lights[k] != NULL && lay.dark_of[k] == k)
+            fit_ambient(&f, m, albedo, confidence, k);
+    compute_pass(&f, c, m, r, white, albedo, confidence);
     return 0;
 }

@@ -17,28 +17,35 @@
 #define COLOUR_FRAME_DARK 0u
 #define COLOUR_FRAME_ALL 1u
 #define COLOUR_FRAME_LIGHT0 2u
-/* At most COLOUR_MAX_FRAMES (hal_limits.h): dark, all lights, every light, and two more dark
- * frames for other exposures. */
-HAL_STATIC_ASSERT(COLOUR_MAX_FRAMES == COLOUR_FRAME_LIGHT0 + HAL_MAX_LIGHTS + 2u,
+/* At most COLOUR_MAX_FRAMES (hal_limits.h): dark, all lights, every light at two exposures, and
+ * three more dark frames for the other exposures. */
+HAL_STATIC_ASSERT(COLOUR_MAX_FRAMES == COLOUR_FRAME_LIGHT0 + 2u * HAL_MAX_LIGHTS + 3u,
                   "COLOUR_MAX_FRAMES counts the frames colour_layout() can ask for");
 
 /** What each colour frame shows: its lights, its exposure and the dark frame (Ca) taken at the
- *  same exposure. Frames: dark, all lights, each light alone, then a dark frame for each other
- *  exposure the lights use. */
+ *  same exposure. Frames: dark, all lights, each light alone, with [colour] bracket each light
+ *  alone again at the longer exposure, then a dark frame for each other exposure. */
 struct colour_layout {
     uint32_t count;
     uint32_t lights_mask[COLOUR_MAX_FRAMES];
     uint32_t exposure_us[COLOUR_MAX_FRAMES];
     uint32_t dark_of[COLOUR_MAX_FRAMES]; /**< index of the frame's dark frame */
+    uint32_t long_of[COLOUR_MAX_FRAMES]; /**< the same light at the longer exposure (0: none) */
 };
 
 /** The colour frames of @p p with @p light_count lights (none when the method is none). */
 void colour_layout(const struct colour_params *p, uint32_t light_count, struct colour_layout *out);
 
+/** Confidence of a pixel with no colour estimate at all (every light shadowed or too dark for
+ *  its frames): its colour is 0 and the fusion leaves it out. */
+#define COLOUR_NO_ESTIMATE (-1.0f)
+
 /** Compute albedo (0..1 scaled to 0..255) and a confidence (0..1) for every valid pixel.
  *  @param white  projector-white frame (RGB24); @param lights  light frames (RGB24) in
- *  colour_layout() order, NULL entries allowed when the method does not need them. Pixels without a usable estimate
- *  get confidence 0 and keep their raw colour. @retval 0 @retval -EINVAL a needed frame missing */
+ *  colour_layout() order, NULL entries allowed when the method does not need them. A pixel
+ *  with only a weak estimate (grazing or saturated light) gets it with confidence 0 (used where
+ *  no view has better); one with none gets colour 0 and COLOUR_NO_ESTIMATE.
+ *  @retval 0 @retval -EINVAL a needed frame missing */
 int colour_compute(const struct colour_params *p, const struct scan_calib *calib,
                    const struct decode_maps *maps, const struct tri_range *range,
                    const uint8_t *white, const uint8_t *const *lights, uint8_t *albedo_rgb,

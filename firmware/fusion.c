@@ -144,18 +144,23 @@ static int pixel_weights(const struct scan_calib *c, const struct decode_maps *m
 }
 
 /* Blend colour @p rgb with weight @p cw into the voxel; a voxel no confident view has coloured
- * yet takes any estimate, so that every surface gets some colour. */
+ * yet takes any estimate (weight 0: a best effort), so that every surface gets some colour.
+ * colour_weight: 0 never coloured, COLOUR_BEST_EFFORT only best efforts, else the summed weight
+ * x COLOUR_WEIGHT_SCALE. */
 static void fuse_colour(struct voxel *vx, double cw, const uint8_t *rgb)
 {
-    double old_cw = vx->colour_weight / COLOUR_WEIGHT_SCALE, new_cw = old_cw + cw;
+    double old_cw = vx->colour_weight > COLOUR_BEST_EFFORT ? vx->colour_weight / COLOUR_WEIGHT_SCALE
+                                                           : 0.0;
+    double new_cw = old_cw + cw;
     if (new_cw <= 0.0) {
         memcpy(vx->rgb, rgb, 3);
+        vx->colour_weight = COLOUR_BEST_EFFORT;
         return;
     }
     for (int k = 0; k < 3; k++)
         vx->rgb[k] = (uint8_t)((vx->rgb[k] * old_cw + rgb[k] * cw) / new_cw + 0.5);
     new_cw = fmin(new_cw * COLOUR_WEIGHT_SCALE, 255.0);
-    vx->colour_weight = (uint8_t)(new_cw + 0.5);
+    vx->colour_weight = (uint8_t)fmax(new_cw + 0.5, COLOUR_BEST_EFFORT + 1);
 }
 
 static void fuse_voxel(struct voxel *vx, double sdf, double w, double cw, const uint8_t *rgb)
@@ -166,7 +171,7 @@ static void fuse_voxel(struct voxel *vx, double sdf, double w, double cw, const 
     double old_w = vx->weight / WEIGHT_SCALE, old_s = vx->sdf / 32767.0 * trunc;
     double new_w = old_w + w;
     double s = (old_s * old_w + sdf * w) / new_w;
-    if (fabs(sdf) < trunc) /* colour comes from near the surface only */
+    if (fabs(sdf) < trunc && cw >= 0.0) /* colour from near the surface, where there is one */
         fuse_colour(vx, cw, rgb);
     /* rounded half away from zero, as lround, without a libm call per voxel */
     double q = s / trunc * 32767.0;
@@ -381,12 +386,15 @@ static int edge_vertex(struct extract_state *st, const uint32_t s[3], int axis, 
     double shift[3] = {0, 0, 0};
     shift[axis] = f * fusion_vol.p.voxel_mm;
     pos = v3_add(pos, v3(shift[0], shift[1], shift[2]));
-    float fp[3] = {(float)pos.x, (float)pos.y, (float)pos.z};
-    float fn[3] = {(float)n.x, (float)n.y, (float)n.z};
-    uint8_t rgb[3];
+    struct mesh_vertex mv = {{(float)pos.x, (float)pos.y, (float)pos.z},
+                             {(float)n.x, (float)n.y, (float)n.z},
+                             {0, 0, 0},
+                             va->colour_weight > 0 || vb->colour_weight > 0};
+    /* a sample no view coloured does not darken its neighbour's colour */
+    double fc = va->colour_weight == 0 ? 1.0 : vb->colour_weight == 0 ? 0.0 : f;
     for (int k = 0; k < 3; k++)
-        rgb[k] = (uint8_t)(va->rgb[k] * (1.0 - f) + vb->rgb[k] * f + 0.5);
-    int rc = st->sink->vertex != NULL ? st->sink->vertex(st->sink->priv, fp, fn, rgb) : 0;
+        mv.rgb[k] = (uint8_t)(va->rgb[k] * (1.0 - fc) + vb->rgb[k] * fc + 0.5);
+    int rc = st->sink->vertex != NULL ? st->sink->vertex(st->sink->priv, &mv) : 0;
     *slot = *out = st->next_vertex++;
     return rc;
 }

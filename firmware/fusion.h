@@ -54,9 +54,18 @@ int fusion_fill_holes(double max_hole_mm, uint32_t *filled);
  *  @param inside  out: voxels decided inside @retval 0 @retval -EINVAL no grid */
 int fusion_close_watertight(double max_hole_mm, int one_pass, uint32_t *inside);
 
+/** A vertex of the mesh: object frame, mm; its colour linear (0..255), and whether any view gave
+ *  the surface there a colour estimate (else rgb is 0 and the writers fill it from the mesh
+ *  around it: mesh_io.c). */
+struct mesh_vertex {
+    float pos[3], normal[3];
+    uint8_t rgb[3];
+    uint8_t coloured;
+};
+
 /** Receives the mesh: vertices are numbered from 0 in the order given. */
 struct mesh_sink {
-    int (*vertex)(void *priv, const float pos[3], const float normal[3], const uint8_t rgb[3]);
+    int (*vertex)(void *priv, const struct mesh_vertex *v);
     int (*triangle)(void *priv, uint32_t a, uint32_t b, uint32_t c);
     void *priv;
 };
@@ -71,6 +80,8 @@ struct mesh_summary {
     uint32_t vertices, triangles;           /**< the whole marching-cubes mesh */
     uint32_t kept_vertices, kept_triangles; /**< what the writers write */
     uint32_t pieces, removed_pieces;        /**< connected pieces; those left out */
+    uint32_t colour_filled; /**< kept vertices no view coloured, given their neighbours' colour */
+    uint32_t uncoloured;    /**< kept vertices no coloured one reached: marked mid grey */
 };
 
 /** Run marching cubes once to find the mesh's connected pieces: the writers then leave out

@@ -101,21 +101,23 @@ static uint32_t diffuse_once(void)
                     continue;
                 int n = neighbours(x, y, z, nb), used = 0;
                 double sdf = 0.0, rgb[3] = {0, 0, 0};
+                int coloured = 0;
                 for (int k = 0; k < n; k++) {
                     const struct voxel *v = &fusion_grid[nb[k]];
                     if (v->weight == 0 || marked(nb[k]))
                         continue;
                     sdf += v->sdf;
-                    for (int c = 0; c < 3; c++)
+                    for (int c = 0; c < 3 && v->colour_weight > 0; c++)
                         rgb[c] += v->rgb[c];
+                    coloured += v->colour_weight > 0;
                     used++;
                 }
                 struct voxel *v = &fusion_grid[i];
                 v->sdf = (int16_t)lround(sdf / used);
-                for (int c = 0; c < 3; c++)
-                    v->rgb[c] = (uint8_t)lround(rgb[c] / used);
+                for (int c = 0; c < 3; c++) /* the colour of the neighbours that have one */
+                    v->rgb[c] = (uint8_t)lround(coloured ? rgb[c] / coloured : 0.0);
                 v->weight = 1; /* the least weight there is: any observation outweighs it */
-                v->colour_weight = 0;
+                v->colour_weight = coloured ? COLOUR_BEST_EFFORT : 0;
                 filled++;
             }
     return filled;

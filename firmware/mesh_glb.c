@@ -45,13 +45,11 @@ struct glb_bounds {
 };
 
 /* POSITION needs its min and max in the JSON, which precedes the data: a pass for them. */
-static int bounds_vertex(void *priv, const float p[3], const float n[3], const uint8_t rgb[3])
+static int bounds_vertex(void *priv, const struct mesh_vertex *v)
 {
     struct glb_bounds *b = priv;
     float q[3];
-    (void)n;
-    (void)rgb;
-    gltf_position(p, q);
+    gltf_position(v->pos, q);
     for (int k = 0; k < 3; k++) {
         b->lo[k] = q[k] < b->lo[k] ? q[k] : b->lo[k];
         b->hi[k] = q[k] > b->hi[k] ? q[k] : b->hi[k];
@@ -59,24 +57,21 @@ static int bounds_vertex(void *priv, const float p[3], const float n[3], const u
     return 0;
 }
 
-static int position_vertex(void *priv, const float p[3], const float n[3], const uint8_t rgb[3])
+static int position_vertex(void *priv, const struct mesh_vertex *v)
 {
     struct outbuf *o = priv;
     float q[3];
-    (void)n;
-    (void)rgb;
-    gltf_position(p, q);
+    gltf_position(v->pos, q);
     for (int k = 0; k < 3; k++)
         outbuf_f32le(o, q[k]);
     return o->rc;
 }
 
 /* Normals must be unit length (the validator checks): a degenerate one points up. */
-static int normal_vertex(void *priv, const float p[3], const float n[3], const uint8_t rgb[3])
+static int normal_vertex(void *priv, const struct mesh_vertex *v)
 {
     struct outbuf *o = priv;
-    (void)p;
-    (void)rgb;
+    const float *n = v->normal;
     double len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
     float q[3] = {0.0f, 1.0f, 0.0f};
     if (len > 1e-12) {
@@ -89,12 +84,10 @@ static int normal_vertex(void *priv, const float p[3], const float n[3], const u
     return o->rc;
 }
 
-static int colour_vertex(void *priv, const float p[3], const float n[3], const uint8_t rgb[3])
+static int colour_vertex(void *priv, const struct mesh_vertex *v)
 {
     struct outbuf *o = priv;
-    (void)p;
-    (void)n;
-    const uint8_t rgba[4] = {rgb[0], rgb[1], rgb[2], 255};
+    const uint8_t rgba[4] = {v->rgb[0], v->rgb[1], v->rgb[2], 255};
     outbuf_put(o, rgba, 4);
     return o->rc;
 }

@@ -19,6 +19,8 @@
 static float mesh_pos[MESH_MAX_VERTICES * 3];
 static float mesh_nrm[MESH_MAX_VERTICES * 3];
 static uint8_t mesh_rgb[MESH_MAX_VERTICES * 3];
+/* 1: a view gave the surface there a colour; 0: none did (colour_fill gives it one) */
+static uint8_t mesh_coloured[MESH_MAX_VERTICES];
 static uint32_t mesh_tri[MESH_MAX_TRIANGLES * 3];
 /* Union-find parent of each vertex; after prepare, the vertex's new number or DROPPED. */
 static uint32_t mesh_index[MESH_MAX_VERTICES];
@@ -46,14 +48,15 @@ static void join(uint32_t a, uint32_t b)
         mesh_index[a > b ? a : b] = a < b ? a : b;
 }
 
-static int keep_vertex(void *priv, const float p[3], const float n[3], const uint8_t rgb[3])
+static int keep_vertex(void *priv, const struct mesh_vertex *mv)
 {
     (void)priv;
     uint32_t v = mp.s.vertices++;
     if (v < MESH_MAX_VERTICES) {
-        memcpy(&mesh_pos[3 * (size_t)v], p, 3 * sizeof(float));
-        memcpy(&mesh_nrm[3 * (size_t)v], n, 3 * sizeof(float));
-        memcpy(&mesh_rgb[3 * (size_t)v], rgb, 3);
+        memcpy(&mesh_pos[3 * (size_t)v], mv->pos, 3 * sizeof(float));
+        memcpy(&mesh_nrm[3 * (size_t)v], mv->normal, 3 * sizeof(float));
+        memcpy(&mesh_rgb[3 * (size_t)v], mv->rgb, 3);
+        mesh_coloured[v] = mv->coloured;
         mesh_index[v] = v;
     }
     return 0;
@@ -101,6 +104,53 @@ static void drop_fragments(double min_fragment_share)
     mp.s.kept_vertices = next;
 }
 
+/* Vertices no view coloured (every view that saw the surface there had no estimate, e.g. paint
+ * too dark at every exposure) take the colour of a coloured neighbour along the kept triangles,
+ * a ring a pass (a flood fill from the surface around), so the surface's own colour spreads in
+ * rather than a raw or black one; what no coloured vertex reaches within COLOUR_FILL_PASSES
+ * rings is marked mid grey. mesh_tris, free after drop_fragments, holds each one's source. */
+#define COLOUR_FILL_PASSES 64
+#define GREY_LINEAR 55 /* sRGB 128 */
+#define NO_SOURCE 0xFFFFFFFFu
+static void colour_fill(void)
+{
+    uint32_t n = mp.s.vertices, missing = 0;
+    for (uint32_t v = 0; v < n; v++)
+        missing += mesh_index[v] != DROPPED && !mesh_coloured[v];
+    for (int pass = 0; pass < COLOUR_FILL_PASSES && missing > 0; pass++) {
+        uint32_t filled = 0;
+        memset(mesh_tris, 0xFF, n * sizeof(uint32_t));
+        for (uint32_t t = 0; t < mp.s.triangles; t++) {
+            const uint32_t *tri = &mesh_tri[3 * (size_t)t];
+            for (int k = 0; k < 3 && mesh_index[tri[0]] != DROPPED; k++) {
+                uint32_t a = tri[k], b = tri[(k + 1) % 3];
+                if (!mesh_coloured[a] && mesh_coloured[b])
+                    mesh_tris[a] = b;
+                else if (!mesh_coloured[b] && mesh_coloured[a])
+                    mesh_tris[b] = a;
+            }
+        }
+        for (uint32_t v = 0; v < n; v++) {
+            if (mesh_tris[v] == NO_SOURCE)
+                continue;
+            /* sources were coloured before this pass: one ring a pass, whatever the numbering */
+            memcpy(&mesh_rgb[3 * (size_t)v], &mesh_rgb[3 * (size_t)mesh_tris[v]], 3);
+            filled++;
+        }
+        for (uint32_t v = 0; v < n; v++)
+            mesh_coloured[v] |= mesh_tris[v] != NO_SOURCE;
+        mp.s.colour_filled += filled;
+        missing -= filled;
+        if (filled == 0)
+            break;
+    }
+    for (uint32_t v = 0; v < n && missing > 0; v++)
+        if (mesh_index[v] != DROPPED && !mesh_coloured[v]) {
+            memset(&mesh_rgb[3 * (size_t)v], GREY_LINEAR, 3);
+            mp.s.uncoloured++;
+        }
+}
+
 int fusion_mesh_prepare(double min_fragment_share, struct mesh_summary *out)
 {
     memset(&mp, 0, sizeof(mp));
@@ -111,11 +161,24 @@ int fusion_mesh_prepare(double min_fragment_share, struct mesh_summary *out)
     mp.fits = mp.s.vertices <= MESH_MAX_VERTICES && mp.s.triangles <= MESH_MAX_TRIANGLES;
     mp.s.kept_vertices = mp.s.vertices;
     mp.s.kept_triangles = mp.s.triangles;
-    if (mp.fits)
+    if (mp.fits) {
         drop_fragments(min_fragment_share);
+        colour_fill();
+    }
     mp.prepared = 1;
     *out = mp.s;
     return mp.fits ? 0 : -E2BIG;
+}
+
+/* Vertex @p v of the tables as the sinks take it (valid until the next call). */
+static const struct mesh_vertex *mesh_vertex_at(uint32_t v)
+{
+    static struct mesh_vertex mv;
+    memcpy(mv.pos, &mesh_pos[3 * (size_t)v], sizeof(mv.pos));
+    memcpy(mv.normal, &mesh_nrm[3 * (size_t)v], sizeof(mv.normal));
+    memcpy(mv.rgb, &mesh_rgb[3 * (size_t)v], sizeof(mv.rgb));
+    mv.coloured = mesh_coloured[v];
+    return &mv;
 }
 
 /* The kept mesh from the tables: the vertices, then the triangles, renumbered. */
@@ -124,8 +187,7 @@ static int emit_kept(const struct mesh_sink *sink)
     int rc = 0;
     for (uint32_t v = 0; v < mp.s.vertices && sink->vertex != NULL && rc == 0; v++)
         if (mesh_index[v] != DROPPED)
-            rc = sink->vertex(sink->priv, &mesh_pos[3 * (size_t)v], &mesh_nrm[3 * (size_t)v],
-                              &mesh_rgb[3 * (size_t)v]);
+            rc = sink->vertex(sink->priv, mesh_vertex_at(v));
     for (uint32_t t = 0; t < mp.s.triangles && sink->triangle != NULL && rc == 0; t++) {
         const uint32_t *tri = &mesh_tri[3 * (size_t)t];
         if (mesh_index[tri[0]] != DROPPED)
@@ -151,10 +213,11 @@ int fusion_mesh_counts(struct mesh_summary *summary)
     return mp.fits ? 0 : -E2BIG;
 }
 
-static int ply_vertex(void *priv, const float p[3], const float n[3], const uint8_t rgb[3])
+static int ply_vertex(void *priv, const struct mesh_vertex *v)
 {
     struct outbuf *o = priv;
-    ply_put_vertex(o, v3(p[0], p[1], p[2]), v3(n[0], n[1], n[2]), rgb);
+    const float *p = v->pos, *n = v->normal;
+    ply_put_vertex(o, v3(p[0], p[1], p[2]), v3(n[0], n[1], n[2]), v->rgb);
     return o->rc;
 }
 
@@ -185,9 +248,11 @@ int fusion_write_ply(const struct hal_storage *st, const char *path)
     return outbuf_close(&o);
 }
 
-static int obj_vertex(void *priv, const float p[3], const float n[3], const uint8_t rgb[3])
+static int obj_vertex(void *priv, const struct mesh_vertex *v)
 {
     struct outbuf *o = priv;
+    const float *p = v->pos, *n = v->normal;
+    const uint8_t *rgb = v->rgb;
     /* "v x y z r g b": vertex colours as MeshLab, Blender and Open3D read them (and show them:
      * sRGB-encoded, see srgb.h). Y up, as OBJ
      * readers assume (Blender's importer turns Y up into its Z up): the object frame's

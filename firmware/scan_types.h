@@ -26,10 +26,15 @@ struct scan_calib {
 
 enum colour_method { COLOUR_NONE = 0, COLOUR_SINGLE, COLOUR_UNIFORM, COLOUR_MULTI };
 
+/** Where Ca (ambient + black offset) comes from: the dark frame's mean over the object per
+ *  channel, the dark frame per pixel, or per channel as offset + slope x the pixel's albedo
+ *  (the ambient light is reflected by the paint like any other: dark paint gets little). */
+enum colour_ca { COLOUR_CA_CHANNEL = 0, COLOUR_CA_PIXEL, COLOUR_CA_ALBEDO };
+
 /** Intrinsic colour (firmware/colour.h). */
 struct colour_params {
     uint32_t method;       /**< enum colour_method */
-    uint32_t ca_per_pixel; /**< 1: Ca per pixel from the dark frame; 0: per channel (mean) */
+    uint32_t ca;           /**< enum colour_ca */
     double min_cos;        /**< cos(theta) below this: not used (grazing light amplifies noise) */
     double ke, ko;         /**< highlight rejection exponents of eq. 6 */
     double shadow_dn;      /**< a light frame within this of Ca: the light does not reach */
@@ -40,6 +45,8 @@ struct colour_params {
     uint32_t exposure_us, gain_milli; /**< the camera's: patterns, projector white, dark */
     uint32_t all_lights_exposure_us;  /**< the all-lights frame (0: exposure_us) */
     uint32_t light_exposure_us;       /**< each single-light frame (0: exposure_us) */
+    uint32_t bracket;     /**< multi: each light also at this x its exposure (0, 1: not) */
+    double shadow_ratio;  /**< multi: a light estimating below this x the best one is shadowed */
 };
 
 /** Exposures an HDR pattern can be captured at. */

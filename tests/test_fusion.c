@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "fusion.h"
+#include "fusion_grid.h"
 #include "mc_table.h"
 #include "storage_posix.h"
 
@@ -21,10 +22,9 @@ struct collected {
     uint32_t nv, nt, cap_v, cap_t;
 };
 
-static int on_vertex(void *priv, const float p[3], const float n[3], const uint8_t rgb[3])
+static int on_vertex(void *priv, const struct mesh_vertex *v)
 {
-    (void)n;
-    (void)rgb;
+    const float *p = v->pos;
     struct collected *c = priv;
     if (c->nv == c->cap_v) {
         c->cap_v = c->cap_v ? 2 * c->cap_v : 4096;
@@ -312,6 +312,59 @@ static void test_watertight_closes_at_the_table(void **state)
     free(c.tri);
 }
 
+struct colour_check {
+    uint32_t vertices, red, not_coloured;
+};
+
+static int check_colour(void *priv, const struct mesh_vertex *v)
+{
+    struct colour_check *c = priv;
+    c->vertices++;
+    c->red += v->rgb[0] == 200 && v->rgb[1] == 30 && v->rgb[2] == 20;
+    c->not_coloured += !v->coloured;
+    return 0;
+}
+
+/* A cap no view could colour (every estimate there was none: COLOUR_NO_ESTIMATE) takes the
+ * colour of the surface around it, ring by ring; with no colour anywhere, mid grey, counted. */
+static void test_uncoloured_surface_takes_its_neighbours_colour(void **state)
+{
+    (void)state;
+    struct fusion_params p = grid_params();
+    assert_int_equal(fusion_begin(&p), 0);
+    assert_int_equal(fusion_fill(sphere, NULL), 0);
+    uint32_t dims[3], cap = 0;
+    assert_int_equal(fusion_dims(&p, dims), 0);
+    for (uint32_t z = 0; z < dims[2]; z++)
+        for (uint32_t y = 0; y < dims[1]; y++)
+            for (uint32_t x = 0; x < dims[0]; x++) {
+                struct voxel *v = &fusion_grid[vidx(x, y, z)];
+                static const uint8_t red[3] = {200, 30, 20};
+                memcpy(v->rgb, red, 3);
+                if (fusion_vol.origin.z + z * p.voxel_mm > 42.0) { /* the top 8 mm */
+                    memset(v->rgb, 0, 3);
+                    v->colour_weight = 0;
+                    cap++;
+                }
+            }
+    struct mesh_summary ms;
+    assert_int_equal(fusion_mesh_prepare(0.0, &ms), 0);
+    assert_true(cap > 0 && ms.colour_filled > 100);
+    assert_int_equal(ms.uncoloured, 0);
+    struct colour_check c = {0, 0, 0};
+    struct mesh_sink sink = {check_colour, NULL, &c};
+    assert_int_equal(fusion_extract_prepared(&sink), 0);
+    assert_int_equal(c.vertices, ms.kept_vertices);
+    assert_int_equal(c.red, c.vertices); /* no black, no raw: the surface's own red */
+    assert_int_equal(c.not_coloured, 0);
+    /* nothing coloured at all: every vertex marked grey */
+    for (size_t i = 0; i < (size_t)dims[0] * dims[1] * dims[2]; i++)
+        fusion_grid[i].colour_weight = 0;
+    assert_int_equal(fusion_mesh_prepare(0.0, &ms), 0);
+    assert_int_equal(ms.colour_filled, 0);
+    assert_int_equal(ms.uncoloured, ms.kept_vertices);
+}
+
 /* The generated table: complementary cases mirror each other, and every case's triangles are
  * edges of the cube where the sign changes. */
 static void test_table_properties(void **state)
@@ -342,6 +395,7 @@ int main(void)
         cmocka_unit_test(test_random_blobs_stay_closed),
         cmocka_unit_test(test_fragments_left_out_and_stl),
         cmocka_unit_test(test_small_hole_filled),
+        cmocka_unit_test(test_uncoloured_surface_takes_its_neighbours_colour),
         cmocka_unit_test(test_watertight_closes_at_the_table),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

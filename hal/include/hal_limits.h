@@ -33,9 +33,10 @@
 /* ---- firmware/ buffers ---- */
 /* Frames a view's decoder keeps: white, black, and every column and row bit with its inverse. */
 #define DECODE_MAX_PATTERNS (2u + 2u * (HAL_MAX_CODE_BITS + HAL_MAX_CODE_BITS))
-/* Colour frames after the patterns (colour.h): dark, all lights, each light alone, and two more
- * dark frames for other exposures. */
-#define COLOUR_MAX_FRAMES (2u + HAL_MAX_LIGHTS + 2u)
+/* Colour frames after the patterns (colour.h): dark, all lights, each light alone at its
+ * exposure and at a longer one ([colour] bracket), and three more dark frames for the other
+ * exposures. */
+#define COLOUR_MAX_FRAMES (2u + 2u * HAL_MAX_LIGHTS + 3u)
 /* The fusion grid (fusion.h): at most FUSION_MAX_DIM voxels along an axis, FUSION_MAX_VOXELS in
  * all, 8 bytes each. */
 #ifdef HAL_LIMITS_SMALL
