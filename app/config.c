@@ -203,8 +203,8 @@ static const struct ini_key config_keys[] = {
         "exposure of each single-light frame (0: [camera] exposure_us); a dark frame is taken "
         "at it too"),
     U32("colour", "bracket", scan.colour.bracket, 0, 64, "0",
-        "multi: each light is also taken at this many times its exposure (with a dark frame at "
-        "it), and each pixel read in the longer frame where no channel saturates there: dark "
+        "each light is also taken at this many times its exposure (with a dark frame at it); "
+        "multi reads each pixel in the longer frame where no channel saturates there, so dark "
         "paint gets signal above the noise (0 or 1: one exposure)"),
     F64("colour", "shadow_ratio", scan.colour.shadow_ratio, 0, 1, "0.25",
         "multi: a light whose albedo estimate at a pixel is below this share of the best "

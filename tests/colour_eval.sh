@@ -15,7 +15,7 @@ mkdir -p "$work" "$report"
 
 # White reference: one view of the white sphere gives each method's white_scale; once more for
 # each variant below, which changes what the white sphere gives.
-variants="falloff=0 ca=pixel"
+variants="falloff=0 ca=channel ca=pixel"
 with_setting() { # KEY=VALUE FILE: the config with KEY set in its [colour] section
     sed "/^\[colour\]/a ${1%%=*} = ${1#*=}" "$2"
 }
@@ -53,7 +53,8 @@ for scene in $scenes; do
     for m in $methods; do
         measure "$scene" "$m"
     done
-    # Does the inverse-square falloff help, and is Ca better per channel or per pixel?
+    # Does the inverse-square falloff help, and is Ca better fitted to the albedo (the default),
+    # one per channel or per pixel?
     if [ "$scene" = owl ] || [ "$scene" = can ]; then
         for v in $variants; do
             measure "$scene" single "$v"
