@@ -189,9 +189,14 @@ static const struct ini_key config_keys[] = {
         "the reached angle must be this close to the target"),
     U32("turntable", "settle_ms", turntable.settle_ms, 0, 60000, "300",
         "wait after a move before capturing"),
-    ENUM("colour", "method", colour_method, "none|single|uniform|multi", "none",
+    ENUM("colour", "method", colour_method, "none|single|uniform|multi|fit", "none",
          "intrinsic colour: none (raw projector-lit colour), single (projector only, Jost eq. 4), "
-         "uniform (all lights), multi (each light alone, eq. 6)"),
+         "uniform (all lights), multi (each light alone, eq. 6), fit (reflectance parameters: "
+         "diffuse colour per point, a specular lobe per material cluster, from every light and "
+         "view; docs/colour.md)"),
+    U32("colour", "clusters", scan.colour.clusters, 1, REFLECT_MAX_CLUSTERS, "4",
+        "fit: material clusters at most (k-means on the diffuse colour), each with its own "
+        "specular lobe"),
     ENUM("colour", "ca", colour_ca, "channel|pixel|albedo", "albedo",
          "ambient + black offset from the dark frame: one value per channel, per pixel, or per "
          "channel as an offset plus the ambient light times the pixel's albedo (fitted over the "
@@ -572,8 +577,8 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
     snprintf(cfg->path, sizeof(cfg->path), "%s", path);
     cfg->camera.pixel_format = pixel_format_of(cfg->camera_pixel_format);
     cfg->scan.width = cfg->camera.width;
-    static const char *const methods[] = {"none", "single", "uniform", "multi"};
-    for (uint32_t k = 0; k < 4; k++)
+    static const char *const methods[] = {"none", "single", "uniform", "multi", "fit"};
+    for (uint32_t k = 0; k < 5; k++)
         if (strcmp(cfg->colour_method, methods[k]) == 0)
             cfg->scan.colour.method = k;
     cfg->scan.colour.ca = strcmp(cfg->colour_ca, "pixel") == 0    ? COLOUR_CA_PIXEL

@@ -1,6 +1,7 @@
 /* The scan directory's layout and its small files, read and written in one place. */
 #define _DEFAULT_SOURCE /* flock */
 #include "scan_dir.h"
+#include "reflect.h"
 
 #include "scan.h"
 
@@ -433,6 +434,31 @@ int scan_dir_sweep(const struct hal_storage *st, const char *dir, uint32_t views
 
 /* ---- the other small files ---- */
 
+int scan_dir_write_reflectance(const struct hal_storage *st, const char *dir,
+                               const struct reflect_model *m)
+{
+    char text[4096], path[SCAN_DIR_PATH_MAX];
+    size_t len = (size_t)snprintf(
+        text, sizeof(text),
+        "; reflectance parameters of [colour] method = fit (docs/colour.md): per material\n"
+        "; cluster, S = rho cos(theta_i) + specular exp(-alpha^2 / (2 roughness^2)) / "
+        "cos(theta_r)\n[reflectance]\nclusters = %u\n",
+        (unsigned)m->count);
+    for (uint32_t k = 0; k < m->count && len < sizeof(text); k++) {
+        const struct reflect_cluster *c = &m->cluster[k];
+        len += (size_t)snprintf(text + len, sizeof(text) - len,
+                                "[cluster_%u]\ndiffuse = %.4f, %.4f, %.4f\nspecular = %.4f, %.4f, "
+                                "%.4f\nroughness_rad = %.4f\nsamples = %u\nrms = %.4f\n",
+                                (unsigned)k, c->centre[0], c->centre[1], c->centre[2],
+                                c->specular[0], c->specular[1], c->specular[2], c->roughness,
+                                (unsigned)c->samples, c->rms);
+    }
+    if (len >= sizeof(text))
+        return -ENAMETOOLONG;
+    int rc = scan_dir_path(path, sizeof(path), dir, -1, "reflectance.ini");
+    return rc != 0 ? rc : hal_storage_write_file(st, path, text, len);
+}
+
 int scan_dir_write_registration(const struct hal_storage *st, const char *dir, uint32_t view,
                                 const struct reg_report *r, const struct reg_view *v,
                                 const struct frame_xform *pose)
@@ -537,7 +563,7 @@ int scan_dir_keep_settings(const struct hal_storage *st, const char *config_path
 static int scan_file(const char *name)
 {
     static const char *const names[] = {"config.ini", "calibration.ini", "mesh.ply", "mesh.obj",
-                                        "mesh.stl", "mesh.glb"};
+                                        "mesh.stl", "mesh.glb", "reflectance.ini"};
     for (size_t k = 0; k < sizeof(names) / sizeof(names[0]); k++)
         if (strcmp(name, names[k]) == 0)
             return 1;

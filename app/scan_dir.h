@@ -107,6 +107,13 @@ int scan_dir_read_range(const char *dir, uint32_t view, uint32_t width, uint32_t
 /** Write view @p view's registration.ini: the scan's joint registration @p r, this view's part
  *  of it @p v, and @p pose, the camera-to-object pose it was fused with.
  *  @retval 0 @retval -errno */
+struct reflect_model;
+/** Keep the reflectance model of [colour] method = fit as reflectance.ini at the top of @p dir:
+ *  per cluster its diffuse centre, specular colour x strength, roughness, samples and residual
+ *  (docs/scan-format.md). @retval 0 @retval -errno */
+int scan_dir_write_reflectance(const struct hal_storage *st, const char *dir,
+                               const struct reflect_model *m);
+
 int scan_dir_write_registration(const struct hal_storage *st, const char *dir, uint32_t view,
                                 const struct reg_report *r, const struct reg_view *v,
                                 const struct frame_xform *pose);

@@ -8,6 +8,7 @@
 #include "frame_writer.h"
 #include "fusion.h"
 #include "gray.h"
+#include "reflect.h"
 #include "scan.h"
 #include "scan_dir.h"
 #include "thread_posix.h"
@@ -515,6 +516,88 @@ static int report_registration(struct job *j, const struct reg_report *r, double
     return -EPROTO;
 }
 
+/* [colour] method = fit: view @p v's colour frames read back from @p scan_dir into the
+ * firmware's buffers (range.bin keeps the view's colour, not its frames), and its colour made
+ * again with them: while the pool collects, the multi estimate and samples; once the lobes are
+ * fitted, the diffuse colour under them. */
+static int recolour_from_frames(struct job *j, const char *scan_dir, uint32_t v,
+                                struct scan_view *view)
+{
+    const struct scan_params *p = &j->cfg->scan;
+    struct gray_layout layout;
+    scan_layout(p, j->calib, &layout);
+    uint32_t count = gray_layout_count(&layout), lights = scan_light_frame_count(p, j->calib);
+    uint32_t white = p->exposure_count > 0 ? count + lights : GRAY_PATTERN_WHITE;
+    char err[SCAN_DIR_PATH_MAX + 256];
+    int rc = scan_begin_view(p, j->calib);
+    for (uint32_t f = count; rc == 0 && f <= count + lights; f++) {
+        uint32_t frame = f < count + lights ? f : white; /* the lights, then the white colour */
+        uint8_t *pixels = scan_frame_buffer(frame);
+        rc = pixels == NULL ? -EINVAL
+                            : scan_dir_read_frame(scan_dir, v, frame, pixels,
+                                                  (size_t)HAL_MAX_PIXELS * 3, p->width, p->height,
+                                                  3, err, sizeof(err));
+        if (rc == 0 && f < count + lights)
+            rc = scan_feed_light_frame(f - count, pixels);
+    }
+    if (rc != 0) {
+        j->hal->log(HAL_LOG_ERROR, "[colour] method = fit needs the colour frames: %s", err);
+        return rc;
+    }
+    scan_attach_colour(view);
+    return scan_recolour(&p->colour, j->calib, view);
+}
+
+/* [colour] method = fit: the samples of every view (each view's colour frames read back), the
+ * clusters and their lobes fitted, said and kept in reflectance.ini. Too few samples: the views
+ * keep the multi estimate, said. */
+static int fit_reflectance(struct job *j, const char *scan_dir)
+{
+    reflect_forget();
+    if (j->cfg->scan.colour.method != COLOUR_FIT)
+        return 0;
+    double t0 = clock_posix_thread_cpu_s();
+    reflect_begin(j->views);
+    int rc = 0;
+    for (uint32_t v = 0; v < j->views && rc == 0; v++) {
+        struct scan_view view;
+        struct scan_view_info info;
+        rc = stopped_offline(j, scan_dir, v);
+        if (rc == 0)
+            rc = load_range(j, scan_dir, v, &view, &info);
+        if (rc == 0)
+            rc = recolour_from_frames(j, scan_dir, v, &view);
+    }
+    struct reflect_model m;
+    if (rc == 0 && (rc = reflect_fit(j->cfg->scan.colour.clusters, &m)) == -ENODATA) {
+        j->hal->log(HAL_LOG_WARN, "reflectance: too few samples to fit (lit, unsaturated "
+                                  "surface seen by two lights or more); the views keep the "
+                                  "multi method's colour");
+        return 0;
+    }
+    if (rc == 0)
+        rc = write_failed(j, "reflectance.ini",
+                          scan_dir_write_reflectance(&j->hal->storage, j->out_dir, &m));
+    if (rc != 0)
+        return rc;
+    char detail[128 + REFLECT_MAX_CLUSTERS * 96];
+    size_t len = (size_t)snprintf(detail, sizeof(detail), "%u material clusters (%.2f s CPU):",
+                                  (unsigned)m.count, clock_posix_thread_cpu_s() - t0);
+    for (uint32_t k = 0; k < m.count && len < sizeof(detail); k++) {
+        const struct reflect_cluster *c = &m.cluster[k];
+        len += (size_t)snprintf(detail + len, sizeof(detail) - len,
+                                "%s diffuse %.2f %.2f %.2f, specular %.3f %.3f %.3f, roughness "
+                                "%.3f rad (%u samples)",
+                                k ? ";" : "", c->centre[0], c->centre[1], c->centre[2],
+                                c->specular[0], c->specular[1], c->specular[2], c->roughness,
+                                (unsigned)c->samples);
+    }
+    char fields[64];
+    snprintf(fields, sizeof(fields), "\"clusters\":%u", (unsigned)m.count);
+    progress_with(j, "reflectance", -1, j->views, fields, detail);
+    return 0;
+}
+
 /* Once every view is in: register them jointly, then fuse each at its registered pose. The
  * fusion must wait for the registration, and the views' range images are not kept in memory
  * (a view's are 40 MB): each is read back from its range.bin in the output directory, or, for a
@@ -526,6 +609,8 @@ static int make_model(struct job *j, const char *scan_dir)
     reg_solve(&rep);
     int rc = report_registration(j, &rep, clock_posix_thread_cpu_s() - t0, scan_dir);
     if (rc == 0)
+        rc = fit_reflectance(j, scan_dir);
+    if (rc == 0)
         rc = fusion_begin(&j->cfg->fusion);
     for (uint32_t v = 0; v < j->views && rc == 0; v++) {
         struct scan_view view;
@@ -533,6 +618,8 @@ static int make_model(struct job *j, const char *scan_dir)
         rc = stopped_offline(j, scan_dir, v);
         if (rc == 0)
             rc = load_range(j, scan_dir, v, &view, &info);
+        if (rc == 0 && reflect_model() != NULL)
+            rc = recolour_from_frames(j, scan_dir, v, &view);
         if (rc == 0)
             rc = make_view_dir(j);
         struct reg_view rv;
@@ -896,6 +983,12 @@ int scan_job_load_settings(const char *scan_dir, const char *config_path, struct
     }
     if (rc == 0)
         rc = config_load(cfg, config_path ? config_path : path, err, err_len);
+    /* other settings: the colour frames are those the scan took (method none shows the raw
+     * colour of a scan taken with every light) */
+    static struct app_config taken;
+    if (rc == 0 && config_path != NULL && access(path, F_OK) == 0 &&
+        config_load(&taken, path, err, err_len) == 0)
+        cfg->scan.colour.taken_with = taken.scan.colour.method;
     /* the calibration is the copy kept with the scan, whatever the config named */
     if (rc == 0)
         rc = scan_dir_path(cfg->calibration_file, sizeof(cfg->calibration_file), scan_dir, -1,

@@ -1,6 +1,7 @@
 /* Intrinsic colour: dark-frame offset, single-light, constant and multiple-light compensation. */
 #include "colour.h"
 
+#include "reflect.h"
 #include "vec3.h"
 
 #include <errno.h>
@@ -29,7 +30,7 @@ static uint32_t dark_at(struct colour_layout *l, uint32_t exposure_us)
 void colour_layout(const struct colour_params *p, uint32_t light_count, struct colour_layout *out)
 {
     memset(out, 0, sizeof(*out));
-    if (p->method == COLOUR_NONE)
+    if ((p->taken_with ? p->taken_with : p->method) == COLOUR_NONE)
         return;
     uint32_t all_us = p->all_lights_exposure_us ? p->all_lights_exposure_us : p->exposure_us;
     uint32_t one_us = p->light_exposure_us ? p->light_exposure_us : p->exposure_us;
@@ -133,6 +134,51 @@ static void white_balance(const struct colour_params *prm, uint8_t *rgb)
         rgb[k] = albedo_byte(rgb[k] * prm->white_scale[k]);
 }
 
+/* Each light's signal at a valid pixel, as the multi and fit methods take it: read in its
+ * longer frame where that one does not saturate ([colour] bracket), so that dark paint rises
+ * above the noise; Ca, the falloff and the light's gain taken out (lit = rho cos(theta) x the
+ * white reference's inverse for a matte surface). @c used: the lights that reach the pixel. */
+struct light_signals {
+    double lit[HAL_MAX_LIGHTS][3], cosine[HAL_MAX_LIGHTS], weight[HAL_MAX_LIGHTS];
+    uint32_t used;
+};
+
+static void light_signals(const struct frame_ctx *f, const struct scan_calib *c, size_t i, vec3 p,
+                          vec3 nn, int relaxed, struct light_signals *out)
+{
+    const struct colour_params *prm = f->prm;
+    const double min_cos = relaxed ? 0.02 : prm->min_cos;
+    double est[HAL_MAX_LIGHTS], best = 0.0;
+    out->used = 0;
+    for (uint32_t l = 0; l < c->light_count; l++) {
+        uint32_t k = COLOUR_FRAME_LIGHT0 + l, kl = f->lay->long_of[k];
+        if (kl != 0 && !clipped(prm, &f->frames[kl][3 * i]))
+            k = kl;
+        double fall, ct = incidence(prm, p, nn, v3_from(c->light_pos_mm[l]), &fall);
+        double *lit = out->lit[l];
+        int ok = frame_light(f, k, &f->frames[k][3 * i], i, lit);
+        /* the signal in grey levels of the frame it was read in: below shadow_dn it is noise */
+        double raw = (lit[0] + lit[1] + lit[2]) / 3.0 * f->lay->exposure_us[k] / prm->exposure_us;
+        est[l] = -1.0;
+        if ((!ok && !relaxed) || ct < min_cos || raw <= prm->shadow_dn)
+            continue;
+        out->weight[l] = specular_weight(prm, p, nn, v3_from(c->light_pos_mm[l]));
+        /* a brighter light gives more signal for the same albedo: its gain takes that out */
+        double gain = c->light_gain[l] > 0.0 ? c->light_gain[l] : 1.0;
+        for (int ch = 0; ch < 3; ch++)
+            lit[ch] *= fall / gain;
+        out->cosine[l] = ct;
+        est[l] = (lit[0] + lit[1] + lit[2]) / (3.0 * ct); /* this light's albedo */
+        if (out->weight[l] > 0.5 && est[l] > best)
+            best = est[l];
+    }
+    /* cast shadow: what reaches the pixel is light from other surfaces, far below what the
+     * lights that do reach it say (dark paint is dark under every light) */
+    for (uint32_t l = 0; l < c->light_count; l++)
+        if (est[l] >= 0.0 && est[l] >= prm->shadow_ratio * best)
+            out->used |= 1u << l;
+}
+
 /* Albedo estimate of valid pixel i: numerator per channel and the denominator (0: none), and
  * how much the fusion may trust it (@p confidence, 0..; not clamped). @p relaxed: the best
  * effort for a pixel without a reliable estimate (grazing or saturated light still used). */
@@ -169,53 +215,116 @@ static double pixel_estimate(const struct frame_ctx *f, const struct scan_calib 
         }
         return (ok && lit) || relaxed ? 1.0 : 0.0;
     }
-    /* eq. 6 over the lights that reach the pixel: each light read in its longer frame where
-     * that one does not saturate ([colour] bracket), so that dark paint rises above the noise */
-    double est[HAL_MAX_LIGHTS], best = 0.0;
-    double lit[HAL_MAX_LIGHTS][3], cosine[HAL_MAX_LIGHTS], weight[HAL_MAX_LIGHTS];
-    for (uint32_t l = 0; l < c->light_count; l++) {
-        uint32_t k = COLOUR_FRAME_LIGHT0 + l, kl = f->lay->long_of[k];
-        if (kl != 0 && !clipped(prm, &f->frames[kl][3 * i]))
-            k = kl;
-        double fall, ct = incidence(prm, p, nn, v3_from(c->light_pos_mm[l]), &fall);
-        int ok = frame_light(f, k, &f->frames[k][3 * i], i, lit[l]);
-        /* the signal in grey levels of the frame it was read in: below shadow_dn it is noise */
-        double raw =
-            (lit[l][0] + lit[l][1] + lit[l][2]) / 3.0 * f->lay->exposure_us[k] / prm->exposure_us;
-        est[l] = -1.0;
-        if ((!ok && !relaxed) || ct < min_cos || raw <= prm->shadow_dn)
-            continue;
-        weight[l] = specular_weight(prm, p, nn, v3_from(c->light_pos_mm[l]));
-        /* a brighter light gives more signal for the same albedo: its gain takes that out */
-        double gain = c->light_gain[l] > 0.0 ? c->light_gain[l] : 1.0;
-        for (int ch = 0; ch < 3; ch++)
-            lit[l][ch] *= fall / gain;
-        cosine[l] = ct;
-        est[l] = (lit[l][0] + lit[l][1] + lit[l][2]) / (3.0 * ct); /* this light's albedo */
-        if (weight[l] > 0.5 && est[l] > best)
-            best = est[l];
-    }
-    for (uint32_t l = 0; l < c->light_count; l++) {
-        /* cast shadow: what reaches the pixel is light from other surfaces, far below what
-         * the lights that do reach it say (dark paint is dark under every light) */
-        if (est[l] < 0.0 || est[l] < prm->shadow_ratio * best)
+    struct light_signals ls;
+    light_signals(f, c, i, p, nn, relaxed, &ls);
+    for (uint32_t l = 0; l < c->light_count; l++) { /* eq. 6 */
+        if (!(ls.used >> l & 1u))
             continue;
         for (int ch = 0; ch < 3; ch++)
-            num[ch] += lit[l][ch] * weight[l];
-        den += cosine[l] * weight[l];
+            num[ch] += ls.lit[l][ch] * ls.weight[l];
+        den += ls.cosine[l] * ls.weight[l];
     }
     *confidence = den;
     return den;
 }
 
+/* What fit_pixel needs across the pixels of a pass: the model (NULL before it is fitted) and,
+ * while the pool collects, every how many valid pixels a sample is taken. */
+struct fit_state {
+    const struct reflect_model *model;
+    int collect;
+    uint32_t stride, seen;
+};
+
+/* One sample for the pool: pixel at @p p (normal @p nn) with each used light's white-referenced
+ * signal and its angles (reflect.h). */
+static void add_sample(const struct colour_params *prm, const struct scan_calib *c, vec3 p,
+                       vec3 nn, const struct light_signals *ls, const double rho0[3])
+{
+    struct reflect_obs o;
+    memset(&o, 0, sizeof(o));
+    vec3 view = v3_norm(v3_scale(p, -1.0)); /* the camera is the origin */
+    o.cos_r = (float)v3_dot(nn, view);
+    o.lights = ls->used;
+    for (int ch = 0; ch < 3; ch++)
+        o.rho0[ch] = (float)rho0[ch];
+    for (uint32_t l = 0; l < c->light_count; l++) {
+        if (!(ls->used >> l & 1u))
+            continue;
+        vec3 to = v3_norm(v3_sub(v3_from(c->light_pos_mm[l]), p));
+        double nh = v3_dot(nn, v3_norm(v3_add(to, view)));
+        o.alpha[l] = (float)acos(nh > 1.0 ? 1.0 : nh < -1.0 ? -1.0 : nh);
+        o.cos_i[l] = (float)ls->cosine[l];
+        for (int ch = 0; ch < 3; ch++)
+            o.signal[l][ch] = (float)(ls->lit[l][ch] * prm->white_scale[ch]);
+    }
+    reflect_add(&o);
+}
+
+/* [colour] method = fit at valid pixel i: before the lobes are known, the multi estimate (and a
+ * sample for the pool now and then); after, the diffuse colour with the pixel's cluster's lobe
+ * taken off each light: rho = sum w (S_l - K g_l) cos_l / sum w cos_l^2, w as eq. 6 (the lobe
+ * takes out what the weights leave: the broad sheen of metals and satin). */
+static void fit_pixel(const struct frame_ctx *f, const struct scan_calib *c, struct fit_state *fs,
+                      size_t i, vec3 p, vec3 nn, uint8_t out[3], float *confidence)
+{
+    const struct colour_params *prm = f->prm;
+    struct light_signals ls;
+    int relaxed = 0;
+    light_signals(f, c, i, p, nn, 0, &ls);
+    if (ls.used == 0) { /* a best effort, weighing nothing (as multi) */
+        light_signals(f, c, i, p, nn, 1, &ls);
+        relaxed = 1;
+    }
+    double num[3] = {0, 0, 0}, den = 0.0, rho0[3];
+    for (uint32_t l = 0; l < c->light_count; l++)
+        for (int ch = 0; ch < 3 && (ls.used >> l & 1u); ch++)
+            num[ch] += ls.lit[l][ch] * ls.weight[l];
+    for (uint32_t l = 0; l < c->light_count; l++)
+        den += ls.used >> l & 1u ? ls.cosine[l] * ls.weight[l] : 0.0;
+    if (den <= 1e-6) {
+        memset(out, 0, 3);
+        *confidence = COLOUR_NO_ESTIMATE;
+        return;
+    }
+    for (int ch = 0; ch < 3; ch++)
+        rho0[ch] = num[ch] / den * prm->white_scale[ch];
+    *confidence = relaxed ? 0.0f : (float)(den > 1.0 ? 1.0 : den);
+    if (fs->model == NULL) {
+        for (int ch = 0; ch < 3; ch++)
+            out[ch] = albedo_byte(rho0[ch]);
+        if (fs->collect && !relaxed && fs->seen++ % fs->stride == 0)
+            add_sample(prm, c, p, nn, &ls, rho0);
+        return;
+    }
+    const struct reflect_cluster *cl = &fs->model->cluster[reflect_cluster_of(fs->model, rho0)];
+    vec3 view = v3_norm(v3_scale(p, -1.0));
+    double cos_r = v3_dot(nn, view), fit_num[3] = {0, 0, 0}, fit_den = 0.0;
+    for (uint32_t l = 0; l < c->light_count; l++) {
+        if (!(ls.used >> l & 1u))
+            continue;
+        vec3 to = v3_norm(v3_sub(v3_from(c->light_pos_mm[l]), p));
+        double nh = v3_dot(nn, v3_norm(v3_add(to, view)));
+        double g = reflect_lobe(cl->roughness, acos(nh > 1.0 ? 1.0 : nh < -1.0 ? -1.0 : nh), cos_r);
+        double w = ls.weight[l], ct = ls.cosine[l];
+        for (int ch = 0; ch < 3; ch++)
+            fit_num[ch] += w * (ls.lit[l][ch] * prm->white_scale[ch] - cl->specular[ch] * g) * ct;
+        fit_den += w * ct * ct;
+    }
+    for (int ch = 0; ch < 3; ch++)
+        out[ch] = albedo_byte(fit_den > 1e-9 ? fit_num[ch] / fit_den : rho0[ch]);
+}
+
 /* One pass over the pixels with the Ca of @p f: albedo and confidence of every valid pixel. */
 static void compute_pass(const struct frame_ctx *f, const struct scan_calib *c,
                          const struct decode_maps *m, const struct tri_range *r,
-                         const uint8_t *white, uint8_t *albedo, float *confidence)
+                         const uint8_t *white, uint8_t *albedo, float *confidence, int last)
 {
     const struct colour_params *prm = f->prm;
     size_t n = (size_t)m->width * m->height;
     vec3 proj = v3_scale(m3_tmul(c->proj_rot, v3_from(c->proj_trans_mm)), -1.0);
+    struct fit_state fs = {reflect_model(), last && reflect_collecting(),
+                           reflect_stride(r->valid_count), 0};
     for (size_t i = 0; i < n; i++) {
         if (prm->method == COLOUR_NONE || m->reason[i] != SCAN_VALID) {
             memcpy(&albedo[3 * i], &white[3 * i], 3); /* the raw colour */
@@ -231,6 +340,10 @@ static void compute_pass(const struct frame_ctx *f, const struct scan_calib *c,
          * first pass's value there (ca = albedo): the passes share one buffer */
         vec3 p = v3(r->xyz_mm[3 * i], r->xyz_mm[3 * i + 1], r->xyz_mm[3 * i + 2]);
         vec3 nn = v3(r->normal[3 * i], r->normal[3 * i + 1], r->normal[3 * i + 2]);
+        if (prm->method == COLOUR_FIT) {
+            fit_pixel(f, c, &fs, i, p, nn, &albedo[3 * i], &confidence[i]);
+            continue;
+        }
         double num[3], trust, den = pixel_estimate(f, c, proj, white, i, p, nn, 0, num, &trust);
         float conf = (float)(trust > 1.0 ? 1.0 : trust);
         if (den <= 1e-6) { /* no reliable estimate: a best effort that weighs nothing in the
@@ -290,18 +403,19 @@ int colour_compute(const struct colour_params *prm, const struct scan_calib *c,
     f.albedo = albedo;
     for (uint32_t k = 0; k < lay.count; k++) {
         if (lights[k] == NULL &&
-            (prm->method == COLOUR_MULTI || k == COLOUR_FRAME_DARK || lay.dark_of[k] == k ||
+            (prm->method >= COLOUR_MULTI || k == COLOUR_FRAME_DARK || lay.dark_of[k] == k ||
              (prm->method == COLOUR_UNIFORM && k == COLOUR_FRAME_ALL)))
             return -EINVAL;
         if (lights[k] != NULL && lay.dark_of[k] == k)
             channel_offset(m, lights[k], f.ca_channel[k]);
     }
-    compute_pass(&f, c, m, r, white, albedo, confidence);
-    if (prm->method == COLOUR_NONE || prm->ca != COLOUR_CA_ALBEDO)
+    int two = prm->method != COLOUR_NONE && prm->ca == COLOUR_CA_ALBEDO;
+    compute_pass(&f, c, m, r, white, albedo, confidence, !two);
+    if (!two)
         return 0;
     for (uint32_t k = 0; k < lay.count; k++)
         if (lights[k] != NULL && lay.dark_of[k] == k)
             fit_ambient(&f, m, albedo, confidence, k);
-    compute_pass(&f, c, m, r, white, albedo, confidence);
+    compute_pass(&f, c, m, r, white, albedo, confidence, 1);
     return 0;
 }

@@ -494,6 +494,13 @@ int scan_save_cloud(const struct hal *hal, const struct scan_view *view,
     return rc;
 }
 
+void scan_attach_colour(struct scan_view *view)
+{
+    view->white_rgb = colour_rgb;
+    for (uint32_t k = 0; k < COLOUR_MAX_FRAMES; k++)
+        view->lights[k] = light_present[k] ? light_rgb[k] : NULL;
+}
+
 int scan_recolour(const struct colour_params *colour, const struct scan_calib *c,
                   struct scan_view *view)
 {

@@ -135,6 +135,11 @@ int scan_save_cloud(const struct hal *hal, const struct scan_view *view,
 int scan_recolour(const struct colour_params *colour, const struct scan_calib *calib,
                   struct scan_view *view);
 
+/** Point @p view (restored from its range image) at the colour frames fed since
+ *  scan_begin_view (scan_feed_light_frame, and the white colour read into scan_frame_buffer),
+ *  so that scan_recolour can colour it again. */
+void scan_attach_colour(struct scan_view *view);
+
 /** Offline, HDR: hand over the view's colour (the white pattern at the camera's exposure; the
  *  white fed to scan_feed_frame is then the merged grey). @retval 0 */
 int scan_feed_white_colour(const uint8_t *rgb);

@@ -24,7 +24,7 @@ struct scan_calib {
                                             equal lights); the multi method divides by it */
 };
 
-enum colour_method { COLOUR_NONE = 0, COLOUR_SINGLE, COLOUR_UNIFORM, COLOUR_MULTI };
+enum colour_method { COLOUR_NONE = 0, COLOUR_SINGLE, COLOUR_UNIFORM, COLOUR_MULTI, COLOUR_FIT };
 
 /** Where Ca (ambient + black offset) comes from: the dark frame's mean over the object per
  *  channel, the dark frame per pixel, or per channel as offset + slope x the pixel's albedo
@@ -47,6 +47,9 @@ struct colour_params {
     uint32_t light_exposure_us;       /**< each single-light frame (0: exposure_us) */
     uint32_t bracket;     /**< multi: each light also at this x its exposure (0, 1: not) */
     double shadow_ratio;  /**< multi: a light estimating below this x the best one is shadowed */
+    uint32_t clusters;    /**< fit: material clusters at most (reflect.h) */
+    uint32_t taken_with;  /**< the method the colour frames were taken with, when processing
+                               with another (0: this one): method none reads a scan that has them */
 };
 
 /** Exposures an HDR pattern can be captured at. */

@@ -56,6 +56,14 @@
 #define MESH_MAX_VERTICES (2u << 20)
 #endif
 #define MESH_MAX_TRIANGLES (2u * MESH_MAX_VERTICES)
+/* [colour] method = fit (reflect.h): the light x view samples its lobes are fitted from, ~180
+ * bytes each. */
+#ifdef HAL_LIMITS_SMALL
+#define REFLECT_MAX_SAMPLES 16384u
+#else
+#define REFLECT_MAX_SAMPLES 32768u
+#endif
+#define REFLECT_MAX_CLUSTERS 8u /* material clusters, each with its specular lobe */
 /* Joint registration (reg.h): the views of one scan (as many as [scan] views allows), and the
  * samples kept of all of them together, 28 bytes each; a scan of many views keeps every n-th
  * pixel with a larger n. */

@@ -1,0 +1,296 @@
+/* Reflectance parameters: a pool of light x view observations, k-means clusters on the diffuse
+ * colour, and per cluster the lobe of the simplified Torrance-Sparrow model (reflect.h). */
+#include "reflect.h"
+
+#include <errno.h>
+#include <math.h>
+#include <string.h>
+
+static struct reflect_obs pool[REFLECT_MAX_SAMPLES];
+static float pool_rho[REFLECT_MAX_SAMPLES][3]; /* each sample's diffuse colour as fitted */
+static uint8_t pool_cluster[REFLECT_MAX_SAMPLES];
+static uint32_t pool_used[REFLECT_MAX_SAMPLES]; /* lights kept after the outliers are out */
+
+static struct {
+    uint32_t count, per_view;
+    int collecting, fitted;
+    struct reflect_model model;
+} rs;
+
+void reflect_begin(uint32_t views)
+{
+    memset(&rs, 0, sizeof(rs));
+    rs.per_view = REFLECT_MAX_SAMPLES / (views > 0 ? views : 1);
+    rs.collecting = 1;
+}
+
+void reflect_forget(void)
+{
+    memset(&rs, 0, sizeof(rs));
+}
+
+int reflect_collecting(void)
+{
+    return rs.collecting;
+}
+
+uint32_t reflect_stride(uint32_t valid_pixels)
+{
+    return rs.per_view == 0 ? UINT32_MAX : valid_pixels / rs.per_view + 1;
+}
+
+void reflect_add(const struct reflect_obs *obs)
+{
+    if (rs.collecting && rs.count < REFLECT_MAX_SAMPLES)
+        pool[rs.count++] = *obs;
+}
+
+const struct reflect_model *reflect_model(void)
+{
+    return rs.fitted ? &rs.model : NULL;
+}
+
+double reflect_lobe(double roughness, double alpha, double cos_r)
+{
+    return exp(-alpha * alpha / (2.0 * roughness * roughness)) / (cos_r > 0.05 ? cos_r : 0.05);
+}
+
+/* Colour feature for the clusters: square roots, roughly even steps of lightness. */
+static double feature_dist2(const float a[3], const double centre[3])
+{
+    double d = 0.0;
+    for (int c = 0; c < 3; c++) {
+        double x = sqrt(a[c] > 0.0f ? a[c] : 0.0f) - sqrt(centre[c] > 0.0 ? centre[c] : 0.0);
+        d += x * x;
+    }
+    return d;
+}
+
+uint32_t reflect_cluster_of(const struct reflect_model *m, const double rho[3])
+{
+    const float f[3] = {(float)rho[0], (float)rho[1], (float)rho[2]};
+    uint32_t best = 0;
+    for (uint32_t k = 1; k < m->count; k++)
+        if (feature_dist2(f, m->cluster[k].centre) < feature_dist2(f, m->cluster[best].centre))
+            best = k;
+    return best;
+}
+
+static void kmeans_rounds(struct reflect_model *m, int rounds);
+
+/* k-means on the multi method's colour: seeds by farthest point (deterministic), ten rounds. */
+static uint32_t cluster_samples(uint32_t wanted, struct reflect_model *m)
+{
+    uint32_t k = 0;
+    for (int c = 0; c < 3; c++)
+        m->cluster[0].centre[c] = pool[0].rho0[c];
+    for (k = 1; k < wanted; k++) { /* the sample farthest from every seed so far */
+        double far = 0.0;
+        uint32_t at = 0;
+        for (uint32_t i = 0; i < rs.count; i++) {
+            double d = 1e30;
+            for (uint32_t j = 0; j < k; j++)
+                d = fmin(d, feature_dist2(pool[i].rho0, m->cluster[j].centre));
+            if (d > far)
+                far = d, at = i;
+        }
+        if (far < 0.002) /* no other colour there: fewer clusters */
+            break;
+        for (int c = 0; c < 3; c++)
+            m->cluster[k].centre[c] = pool[at].rho0[c];
+    }
+    m->count = k;
+    kmeans_rounds(m, 10);
+    /* a cluster of a few samples would fit its lobe to their noise: its samples join the
+     * nearest cluster (they keep their own diffuse colour; only the lobe is shared) */
+    uint32_t least = rs.count / 50 > 200 ? rs.count / 50 : 200;
+    for (;;) {
+        uint32_t small = 0;
+        for (uint32_t c = 1; c < m->count; c++)
+            if (m->cluster[c].samples < m->cluster[small].samples)
+                small = c;
+        if (m->count == 1 || m->cluster[small].samples >= least)
+            break;
+        m->cluster[small] = m->cluster[--m->count];
+        kmeans_rounds(m, 3);
+    }
+    return m->count;
+}
+
+/* @p rounds of k-means over the pool from @p m's centres; each cluster's sample count. */
+static void kmeans_rounds(struct reflect_model *m, int rounds)
+{
+    for (int round = 0; round < rounds; round++) {
+        double sum[REFLECT_MAX_CLUSTERS][3] = {{0}};
+        uint32_t n[REFLECT_MAX_CLUSTERS] = {0};
+        for (uint32_t i = 0; i < rs.count; i++) {
+            double rho[3] = {pool[i].rho0[0], pool[i].rho0[1], pool[i].rho0[2]};
+            uint32_t c = reflect_cluster_of(m, rho);
+            pool_cluster[i] = (uint8_t)c;
+            n[c]++;
+            for (int ch = 0; ch < 3; ch++)
+                sum[c][ch] += rho[ch];
+        }
+        for (uint32_t c = 0; c < m->count; c++)
+            for (int ch = 0; ch < 3 && n[c] > 0; ch++)
+                m->cluster[c].centre[ch] = sum[c][ch] / n[c];
+        for (uint32_t c = 0; c < m->count; c++)
+            m->cluster[c].samples = n[c];
+    }
+}
+
+/* The lobe's K for roughness @p sigma over cluster @p c's kept observations (least squares of
+ * the residual after the diffuse part, per channel, not below 0); @retval the squared error */
+static double fit_specular(uint32_t c, double sigma, double k_out[3])
+{
+    double sgg = 0.0, srg[3] = {0, 0, 0}, srr = 0.0;
+    for (uint32_t i = 0; i < rs.count; i++) {
+        if (pool_cluster[i] != c)
+            continue;
+        const struct reflect_obs *o = &pool[i];
+        for (uint32_t l = 0; l < HAL_MAX_LIGHTS; l++) {
+            if (!(pool_used[i] >> l & 1u))
+                continue;
+            double g = reflect_lobe(sigma, o->alpha[l], o->cos_r);
+            sgg += g * g;
+            for (int ch = 0; ch < 3; ch++) {
+                double r = o->signal[l][ch] - pool_rho[i][ch] * o->cos_i[l];
+                srg[ch] += r * g;
+                srr += r * r;
+            }
+        }
+    }
+    double err = srr;
+    for (int ch = 0; ch < 3; ch++) {
+        k_out[ch] = sgg > 0.0 && srg[ch] > 0.0 ? srg[ch] / sgg : 0.0;
+        err += k_out[ch] * k_out[ch] * sgg - 2.0 * k_out[ch] * srg[ch];
+    }
+    return err;
+}
+
+/* Each sample's diffuse colour given its cluster's lobe: least squares over its kept lights,
+ * rho = sum (S_l - K g_l) cos_l / sum cos_l^2. */
+static void fit_diffuse(const struct reflect_model *m)
+{
+    for (uint32_t i = 0; i < rs.count; i++) {
+        const struct reflect_obs *o = &pool[i];
+        const struct reflect_cluster *cl = &m->cluster[pool_cluster[i]];
+        double num[3] = {0, 0, 0}, den = 0.0;
+        for (uint32_t l = 0; l < HAL_MAX_LIGHTS; l++) {
+            if (!(pool_used[i] >> l & 1u))
+                continue;
+            double g = reflect_lobe(cl->roughness, o->alpha[l], o->cos_r);
+            for (int ch = 0; ch < 3; ch++)
+                num[ch] += (o->signal[l][ch] - cl->specular[ch] * g) * o->cos_i[l];
+            den += o->cos_i[l] * o->cos_i[l];
+        }
+        for (int ch = 0; ch < 3; ch++)
+            pool_rho[i][ch] = den > 0.0 ? (float)fmax(0.0, num[ch] / den) : pool[i].rho0[ch];
+    }
+}
+
+/* Observations far off the model (a shadow edge, a neighbour's paint, a wrong normal) are left
+ * out: more than 4 x the cluster's median absolute residual (luminance), and at least 0.02. */
+static void drop_outliers(const struct reflect_model *m)
+{
+    for (uint32_t c = 0; c < m->count; c++) {
+        double hist[64] = {0}; /* |residual| in steps of 0.005: the median without a sort */
+        uint32_t n = 0;
+        const struct reflect_cluster *cl = &m->cluster[c];
+        for (uint32_t i = 0; i < rs.count; i++) {
+            if (pool_cluster[i] != c)
+                continue;
+            const struct reflect_obs *o = &pool[i];
+            for (uint32_t l = 0; l < HAL_MAX_LIGHTS; l++) {
+                if (!(o->lights >> l & 1u))
+                    continue;
+                double g = reflect_lobe(cl->roughness, o->alpha[l], o->cos_r), r = 0.0;
+                for (int ch = 0; ch < 3; ch++)
+                    r += (o->signal[l][ch] - pool_rho[i][ch] * o->cos_i[l] - cl->specular[ch] * g) /
+                         3.0;
+                hist[(int)fmin(63.0, fabs(r) / 0.005)]++;
+                n++;
+            }
+        }
+        double median = 0.0, seen = 0.0;
+        for (int b = 0; b < 64 && seen < n / 2.0; b++)
+            seen += hist[b], median = (b + 0.5) * 0.005;
+        double limit = fmax(0.02, 4.0 * median);
+        for (uint32_t i = 0; i < rs.count; i++) {
+            if (pool_cluster[i] != c)
+                continue;
+            const struct reflect_obs *o = &pool[i];
+            pool_used[i] = 0;
+            for (uint32_t l = 0; l < HAL_MAX_LIGHTS; l++) {
+                if (!(o->lights >> l & 1u))
+                    continue;
+                double g = reflect_lobe(cl->roughness, o->alpha[l], o->cos_r), r = 0.0;
+                for (int ch = 0; ch < 3; ch++)
+                    r += (o->signal[l][ch] - pool_rho[i][ch] * o->cos_i[l] - cl->specular[ch] * g) /
+                         3.0;
+                if (fabs(r) <= limit)
+                    pool_used[i] |= 1u << l;
+            }
+        }
+    }
+}
+
+/* Cluster @p c's roughness: the grid value with the least error, then a golden-section search
+ * between its neighbours. */
+static void fit_lobe(struct reflect_cluster *cl, uint32_t c)
+{
+    enum { GRID = 24 };
+    double best_s = 0.1, best_e = 1e300, k[3];
+    for (int g = 0; g < GRID; g++) { /* 0.02 .. 1 rad, evenly in log */
+        double s = 0.02 * pow(50.0, g / (GRID - 1.0)), e = fit_specular(c, s, k);
+        if (e < best_e)
+            best_e = e, best_s = s;
+    }
+    double step = pow(50.0, 1.0 / (GRID - 1.0)), lo = best_s / step, hi = best_s * step;
+    const double phi = 0.6180339887498949;
+    for (int it = 0; it < 20; it++) {
+        double a = hi - phi * (hi - lo), b = lo + phi * (hi - lo);
+        if (fit_specular(c, a, k) < fit_specular(c, b, k))
+            hi = b;
+        else
+            lo = a;
+    }
+    cl->roughness = 0.5 * (lo + hi);
+    double e = fit_specular(c, cl->roughness, cl->specular);
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < rs.count; i++)
+        for (uint32_t l = 0; pool_cluster[i] == c && l < HAL_MAX_LIGHTS; l++)
+            n += pool_used[i] >> l & 1u;
+    cl->rms = n > 0 ? sqrt(fmax(0.0, e) / (3.0 * n)) : 0.0;
+}
+
+int reflect_fit(uint32_t clusters, struct reflect_model *out)
+{
+    rs.collecting = 0;
+    if (rs.count < 100)
+        return -ENODATA;
+    struct reflect_model *m = &rs.model;
+    memset(m, 0, sizeof(*m));
+    cluster_samples(clusters < 1                      ? 1
+                    : clusters > REFLECT_MAX_CLUSTERS ? REFLECT_MAX_CLUSTERS
+                                                      : clusters,
+                    m);
+    for (uint32_t i = 0; i < rs.count; i++) {
+        memcpy(pool_rho[i], pool[i].rho0, sizeof(pool_rho[i]));
+        pool_used[i] = pool[i].lights;
+    }
+    for (uint32_t c = 0; c < m->count; c++)
+        m->cluster[c].roughness = 0.1;
+    /* alternate: the lobes for the diffuse colours, the diffuse colours for the lobes; the
+     * outliers judged once the model is near */
+    for (int round = 0; round < 6; round++) {
+        for (uint32_t c = 0; c < m->count; c++)
+            fit_lobe(&m->cluster[c], c);
+        fit_diffuse(m);
+        if (round == 2 || round == 4)
+            drop_outliers(m);
+    }
+    rs.fitted = 1;
+    *out = *m;
+    return 0;
+}

@@ -1,0 +1,75 @@
+/* Reflectance parameters ([colour] method = fit; Park & DeSouza, section 6.5): per surface point
+ * a diffuse colour, per material cluster a specular lobe, fitted from every light x view
+ * observation, so that the model can be shown under any light. The model, in the units of the
+ * multi method (a light's signal with Ca, falloff and the light's gain taken out, white-
+ * referenced: rho cos(theta_i) for a matte surface), is the simplified Torrance-Sparrow model
+ * of Sato and Ikeuchi (1994):
+ *     S_l = rho cos(theta_l) + K exp(-alpha_l^2 / (2 sigma^2)) / cos(theta_r)
+ * alpha_l: the angle between the normal and the half vector of light l and the camera; theta_r:
+ * between the normal and the camera; K: the specular colour x strength (RGB: a metal tints its
+ * highlights); sigma: the roughness (radians).
+ *
+ * Clusters as Lensch et al. (2003) begin them: k-means on the points' diffuse colour (from the
+ * multi method, highlights already left out), then one lobe fitted per cluster, alternating
+ * with every sample's diffuse colour (least squares; the roughness by a search over a grid).
+ * The samples are a fixed pool: each view gives up to REFLECT_MAX_SAMPLES / views of its valid
+ * pixels, evenly spread. */
+#ifndef REFLECT_H
+#define REFLECT_H
+
+#include "hal.h"
+
+/** One sample: a pixel of a view with each light's signal and the angles that go with it. */
+struct reflect_obs {
+    float rho0[3];                   /**< the multi method's diffuse colour there */
+    float cos_r;                     /**< cos of the angle between normal and camera */
+    uint32_t lights;                 /**< mask: lights observed (lit, not saturated) */
+    float signal[HAL_MAX_LIGHTS][3]; /**< S_l */
+    float cos_i[HAL_MAX_LIGHTS];     /**< cos(theta_l) */
+    float alpha[HAL_MAX_LIGHTS];     /**< alpha_l, radians */
+};
+
+/** A material cluster's lobe and where it sits in diffuse colour. */
+struct reflect_cluster {
+    double centre[3];   /**< mean diffuse colour of its samples (linear) */
+    double specular[3]; /**< K: specular colour x strength */
+    double roughness;   /**< sigma, radians */
+    uint32_t samples;   /**< samples it was fitted from */
+    double rms;         /**< fit residual, albedo units */
+};
+
+struct reflect_model {
+    uint32_t count; /**< clusters */
+    struct reflect_cluster cluster[REFLECT_MAX_CLUSTERS];
+};
+
+/** Empty the pool and start collecting: each of @p views views may add its share. */
+void reflect_begin(uint32_t views);
+
+/** Forget the pool and the model (a new scan): colouring with fit gives the multi estimate. */
+void reflect_forget(void);
+
+/** Collecting (after reflect_begin, before reflect_fit)? */
+int reflect_collecting(void);
+
+/** Every how many valid pixels a view of @p valid_pixels valid pixels gives a sample. */
+uint32_t reflect_stride(uint32_t valid_pixels);
+
+/** Add one sample (dropped when the pool is full). */
+void reflect_add(const struct reflect_obs *obs);
+
+/** Cluster the pool into at most @p clusters and fit each cluster's lobe; the model is kept
+ *  for reflect_model() and collecting stops. @param out  the model
+ *  @retval 0 @retval -ENODATA too few samples (fewer than 100) */
+int reflect_fit(uint32_t clusters, struct reflect_model *out);
+
+/** The fitted model, or NULL before reflect_fit (or after reflect_begin). */
+const struct reflect_model *reflect_model(void);
+
+/** The cluster nearest to diffuse colour @p rho (linear). */
+uint32_t reflect_cluster_of(const struct reflect_model *m, const double rho[3]);
+
+/** The lobe's factor exp(-alpha^2 / (2 sigma^2)) / cos(theta_r) (times K: the specular part). */
+double reflect_lobe(double roughness, double alpha, double cos_r);
+
+#endif
