@@ -94,7 +94,7 @@ static uint32_t cluster_samples(uint32_t wanted, struct reflect_model *m)
             if (d > far)
                 far = d, at = i;
         }
-        if (far < 0.002) /* no other colour there: fewer clusters */
+        if (far < 0.01) /* no other colour there (0.1 in square-root units): fewer clusters */
             break;
         for (int c = 0; c < 3; c++)
             m->cluster[k].centre[c] = pool[at].rho0[c];

@@ -1,0 +1,112 @@
+/* Reflectance parameters from samples made with known ones: the fit finds the clusters, each
+ * one's specular colour x strength and roughness, and every sample's diffuse colour; samples in
+ * a shadow (a light's signal far below the model) do not move it. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <errno.h>
+#include <math.h>
+#include <string.h>
+
+#include "reflect.h"
+
+/* A small deterministic generator (xorshift), uniform in [0, 1). */
+static uint64_t rng = 88172645463325252ull;
+static double uniform(void)
+{
+    rng ^= rng << 13;
+    rng ^= rng >> 7;
+    rng ^= rng << 17;
+    return (rng >> 11) * (1.0 / 9007199254740992.0);
+}
+
+struct truth {
+    double rho[3];      /* diffuse colour */
+    double specular[3]; /* K */
+    double roughness;
+};
+
+/* A sample of paint @p t seen from a random angle under 8 lights at random angles: each light
+ * at alpha (normal to half vector) and theta_i; the signal as the model gives it. With
+ * @p shadowed, light 0 gives a tenth of it (light from other surfaces). */
+static void add_sample(const struct truth *t, int shadowed)
+{
+    struct reflect_obs o;
+    memset(&o, 0, sizeof(o));
+    o.cos_r = (float)(0.5 + 0.5 * uniform());
+    for (int c = 0; c < 3; c++)
+        o.rho0[c] = (float)(t->rho[c] * (1.0 + 0.2 * (uniform() - 0.5))); /* multi's guess */
+    for (uint32_t l = 0; l < 8; l++) {
+        o.lights |= 1u << l;
+        o.cos_i[l] = (float)(0.3 + 0.7 * uniform());
+        o.alpha[l] = (float)(0.6 * uniform() * uniform()); /* many near the highlight */
+        double g = reflect_lobe(t->roughness, o.alpha[l], o.cos_r);
+        for (int c = 0; c < 3; c++) {
+            double s = t->rho[c] * o.cos_i[l] + t->specular[c] * g;
+            o.signal[l][c] = (float)(s * (shadowed && l == 0 ? 0.1 : 1.0));
+        }
+    }
+    reflect_add(&o);
+}
+
+static void test_two_materials_recovered(void **state)
+{
+    (void)state;
+    static const struct truth gold = {{0.30, 0.20, 0.05}, {0.40, 0.30, 0.10}, 0.12};
+    static const struct truth plastic = {{0.10, 0.40, 0.60}, {0.20, 0.20, 0.20}, 0.05};
+    reflect_begin(1);
+    assert_true(reflect_collecting());
+    assert_null(reflect_model());
+    for (int i = 0; i < 6000; i++) {
+        add_sample(&gold, i % 10 == 0);
+        add_sample(&plastic, 0);
+    }
+    struct reflect_model m;
+    assert_int_equal(reflect_fit(4, &m), 0);
+    assert_false(reflect_collecting());
+    assert_non_null(reflect_model());
+    assert_int_equal(m.count, 2); /* two colours: two clusters, though four were allowed */
+    const struct truth *truths[2] = {&gold, &plastic};
+    for (int t = 0; t < 2; t++) {
+        const struct reflect_cluster *c = &m.cluster[reflect_cluster_of(&m, truths[t]->rho)];
+        print_message("cluster: K %.3f %.3f %.3f (true %.2f %.2f %.2f), roughness %.4f (%.2f), "
+                      "rms %.4f\n",
+                      c->specular[0], c->specular[1], c->specular[2], truths[t]->specular[0],
+                      truths[t]->specular[1], truths[t]->specular[2], c->roughness,
+                      truths[t]->roughness, c->rms);
+        assert_true(fabs(c->roughness - truths[t]->roughness) < 0.05 * truths[t]->roughness);
+        for (int ch = 0; ch < 3; ch++) {
+            assert_true(fabs(c->specular[ch] - truths[t]->specular[ch]) <
+                        0.05 * truths[t]->specular[ch] + 0.002);
+            assert_true(fabs(c->centre[ch] - truths[t]->rho[ch]) < 0.1 * truths[t]->rho[ch] + 0.01);
+        }
+        assert_true(c->rms < 0.005);
+    }
+}
+
+/* Too few samples: nothing is fitted. */
+static void test_too_few_samples(void **state)
+{
+    (void)state;
+    static const struct truth grey = {{0.5, 0.5, 0.5}, {0.1, 0.1, 0.1}, 0.1};
+    reflect_begin(8);
+    for (int i = 0; i < 50; i++)
+        add_sample(&grey, 0);
+    struct reflect_model m;
+    assert_int_equal(reflect_fit(4, &m), -ENODATA);
+    assert_null(reflect_model());
+    reflect_forget();
+    assert_false(reflect_collecting());
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_two_materials_recovered),
+        cmocka_unit_test(test_too_few_samples),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
