@@ -11,11 +11,15 @@
  * attributes must be), triangle indices (uint SCALAR). glTF's conventions: metres, +Y up (the
  * object frame's (x, y, z), z up the turntable's axis, is written (x, z, -y), as for OBJ), and
  * COLOR_0 is linear, so the fused albedo goes in as it is; the material multiplies it by its
- * base colour factor 1. */
+ * base colour factor 1. One material, matte; with [colour] method = fit one per material
+ * cluster (json_material), each with the triangles whose first vertex's colour is nearest to
+ * the cluster's (a primitive each, sharing the vertices). */
 #include "fusion.h"
 #include "outbuf.h"
+#include "reflect.h"
 
 #include <errno.h>
+#include <stdarg.h>
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -92,55 +96,144 @@ static int colour_vertex(void *priv, const struct mesh_vertex *v)
     return o->rc;
 }
 
-static int index_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
+/* The mesh's materials: one per cluster of [colour] method = fit (reflect.h), else one matte. */
+struct glb_parts {
+    uint32_t count;                           /* materials, one primitive each */
+    uint32_t triangles[REFLECT_MAX_CLUSTERS]; /* of each */
+    const struct reflect_model *model;        /* NULL: matte */
+};
+
+static int json_len;
+static void json_put(const char *fmt, ...)
 {
-    struct outbuf *o = priv;
-    outbuf_u32le(o, a);
-    outbuf_u32le(o, b);
-    outbuf_u32le(o, c);
-    return o->rc;
+    va_list ap;
+    va_start(ap, fmt);
+    if (json_len >= 0) {
+        int n = vsnprintf(glb_json + json_len, sizeof(glb_json) - (size_t)json_len, fmt, ap);
+        json_len = n < 0 || (size_t)n >= sizeof(glb_json) - (size_t)json_len ? -1 : json_len + n;
+    }
+    va_end(ap);
 }
 
-/* The JSON chunk's text for @p vertices and @p triangles within @p b, padded with spaces to a
- * multiple of 4. @retval its length @retval -EOVERFLOW it did not fit glb_json */
-static int glb_json_text(uint32_t vertices, uint32_t triangles, const struct glb_bounds *b)
+/* A cluster's lobe as a glTF material (metallic-roughness, KHR_materials_specular). The lobe
+ * K exp(-alpha^2 / (2 sigma^2)) / cos(theta_r), in units where a matte surface gives
+ * rho cos(theta_i), is pi f cos(theta_i) of a microfacet BRDF f = D G F / (4 cos_i cos_o) with
+ * a Beckmann D of slope m = sqrt(2) sigma (small angles, G = 1): F0 = 8 sigma^2 K. glTF's GGX
+ * takes alpha = roughness^2, about Beckmann's m. Dielectric (metallic 0): a metal's tinted F0
+ * is the specular colour. */
+static void json_material(const struct reflect_cluster *c, uint32_t k)
 {
-    uint64_t v = vertices, pos_len = 12 * v, col_len = 4 * v, idx_len = 12 * (uint64_t)triangles;
-    int n = snprintf(
-        glb_json, sizeof(glb_json),
-        "{\"asset\":{\"version\":\"2.0\",\"generator\":\"turntable colour scanner\"},"
-        "\"scene\":0,\"scenes\":[{\"nodes\":[0]}],"
-        "\"nodes\":[{\"mesh\":0,\"name\":\"scan\"}],"
-        "\"meshes\":[{\"name\":\"fused mesh\",\"primitives\":[{\"attributes\":{\"POSITION\":0,"
-        "\"NORMAL\":1,\"COLOR_0\":2},\"indices\":3,\"material\":0,\"mode\":4}]}],"
-        "\"materials\":[{\"name\":\"diffuse\",\"pbrMetallicRoughness\":{\"baseColorFactor\":"
-        "[1,1,1,1],\"metallicFactor\":0,\"roughnessFactor\":1}}],"
-        "\"buffers\":[{\"byteLength\":%llu}],"
-        "\"bufferViews\":["
-        "{\"buffer\":0,\"byteOffset\":0,\"byteLength\":%llu,\"target\":%d},"
-        "{\"buffer\":0,\"byteOffset\":%llu,\"byteLength\":%llu,\"target\":%d},"
-        "{\"buffer\":0,\"byteOffset\":%llu,\"byteLength\":%llu,\"target\":%d},"
-        "{\"buffer\":0,\"byteOffset\":%llu,\"byteLength\":%llu,\"target\":%d}],"
-        "\"accessors\":["
-        "{\"bufferView\":0,\"componentType\":%d,\"count\":%u,\"type\":\"VEC3\","
-        "\"min\":[%.9g,%.9g,%.9g],\"max\":[%.9g,%.9g,%.9g]},"
-        "{\"bufferView\":1,\"componentType\":%d,\"count\":%u,\"type\":\"VEC3\"},"
-        "{\"bufferView\":2,\"componentType\":%d,\"normalized\":true,\"count\":%u,"
-        "\"type\":\"VEC4\"},"
-        "{\"bufferView\":3,\"componentType\":%d,\"count\":%llu,\"type\":\"SCALAR\"}]}",
-        (unsigned long long)(2 * pos_len + col_len + idx_len), (unsigned long long)pos_len,
-        GL_ARRAY_BUFFER, (unsigned long long)pos_len, (unsigned long long)pos_len, GL_ARRAY_BUFFER,
-        (unsigned long long)(2 * pos_len), (unsigned long long)col_len, GL_ARRAY_BUFFER,
-        (unsigned long long)(2 * pos_len + col_len), (unsigned long long)idx_len,
-        GL_ELEMENT_ARRAY_BUFFER, GL_FLOAT, (unsigned)vertices, (double)b->lo[0], (double)b->lo[1],
-        (double)b->lo[2], (double)b->hi[0], (double)b->hi[1], (double)b->hi[2], GL_FLOAT,
-        (unsigned)vertices, GL_UNSIGNED_BYTE, (unsigned)vertices, GL_UNSIGNED_INT,
-        (unsigned long long)(3 * (uint64_t)triangles));
-    if (n < 0 || (size_t)n + 4 > sizeof(glb_json))
+    double m = sqrt(2.0) * c->roughness, f0[3];
+    for (int ch = 0; ch < 3; ch++)
+        f0[ch] = 8.0 * c->roughness * c->roughness * c->specular[ch];
+    json_put("%s{\"name\":\"cluster %u\",\"pbrMetallicRoughness\":{\"baseColorFactor\":"
+             "[1,1,1,1],\"metallicFactor\":0,\"roughnessFactor\":%.4f},\"extensions\":"
+             "{\"KHR_materials_specular\":{\"specularFactor\":1,\"specularColorFactor\":"
+             "[%.5f,%.5f,%.5f]}}}",
+             k ? "," : "", (unsigned)k, fmin(1.0, sqrt(m)), f0[0] / 0.04, f0[1] / 0.04,
+             f0[2] / 0.04);
+}
+
+/* The JSON chunk's text for @p vertices and @p parts within @p b, padded with spaces to a
+ * multiple of 4: buffer views positions, normals, colours, then each part's indices.
+ * @retval its length @retval -EOVERFLOW it did not fit glb_json */
+static int glb_json_text(uint32_t vertices, const struct glb_parts *parts,
+                         const struct glb_bounds *b, uint64_t bin_len)
+{
+    uint64_t v = vertices, pos_len = 12 * v, col_len = 4 * v, at = 2 * pos_len + col_len;
+    json_len = 0;
+    json_put("{\"asset\":{\"version\":\"2.0\",\"generator\":\"turntable colour scanner\"},");
+    if (parts->model != NULL)
+        json_put("\"extensionsUsed\":[\"KHR_materials_specular\"],");
+    json_put("\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0,\"name\":\"scan\"}],"
+             "\"meshes\":[{\"name\":\"fused mesh\",\"primitives\":[");
+    /* a cluster without triangles has no primitive, view nor accessor (none may be empty) */
+    for (uint32_t k = 0, n = 0; k < parts->count; k++)
+        if (parts->triangles[k] > 0) {
+            json_put("%s{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"COLOR_0\":2},"
+                     "\"indices\":%u,\"material\":%u,\"mode\":4}",
+                     n ? "," : "", (unsigned)(3 + n), (unsigned)k);
+            n++;
+        }
+    json_put("]}],\"materials\":[");
+    if (parts->model == NULL)
+        json_put("{\"name\":\"matte\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,1,1,1],"
+                 "\"metallicFactor\":0,\"roughnessFactor\":1}}");
+    for (uint32_t k = 0; parts->model != NULL && k < parts->count; k++)
+        json_material(&parts->model->cluster[k], k);
+    json_put("],\"buffers\":[{\"byteLength\":%llu}],\"bufferViews\":["
+             "{\"buffer\":0,\"byteOffset\":0,\"byteLength\":%llu,\"target\":%d},"
+             "{\"buffer\":0,\"byteOffset\":%llu,\"byteLength\":%llu,\"target\":%d},"
+             "{\"buffer\":0,\"byteOffset\":%llu,\"byteLength\":%llu,\"target\":%d}",
+             (unsigned long long)bin_len, (unsigned long long)pos_len, GL_ARRAY_BUFFER,
+             (unsigned long long)pos_len, (unsigned long long)pos_len, GL_ARRAY_BUFFER,
+             (unsigned long long)(2 * pos_len), (unsigned long long)col_len, GL_ARRAY_BUFFER);
+    for (uint32_t k = 0; k < parts->count; k++) {
+        uint64_t len = 12 * (uint64_t)parts->triangles[k];
+        if (len > 0)
+            json_put(",{\"buffer\":0,\"byteOffset\":%llu,\"byteLength\":%llu,\"target\":%d}",
+                     (unsigned long long)at, (unsigned long long)len, GL_ELEMENT_ARRAY_BUFFER);
+        at += len;
+    }
+    json_put("],\"accessors\":["
+             "{\"bufferView\":0,\"componentType\":%d,\"count\":%u,\"type\":\"VEC3\","
+             "\"min\":[%.9g,%.9g,%.9g],\"max\":[%.9g,%.9g,%.9g]},"
+             "{\"bufferView\":1,\"componentType\":%d,\"count\":%u,\"type\":\"VEC3\"},"
+             "{\"bufferView\":2,\"componentType\":%d,\"normalized\":true,\"count\":%u,"
+             "\"type\":\"VEC4\"}",
+             GL_FLOAT, (unsigned)vertices, (double)b->lo[0], (double)b->lo[1], (double)b->lo[2],
+             (double)b->hi[0], (double)b->hi[1], (double)b->hi[2], GL_FLOAT, (unsigned)vertices,
+             GL_UNSIGNED_BYTE, (unsigned)vertices);
+    for (uint32_t k = 0, n = 0; k < parts->count; k++)
+        if (parts->triangles[k] > 0)
+            json_put(",{\"bufferView\":%u,\"componentType\":%d,\"count\":%llu,\"type\":"
+                     "\"SCALAR\"}",
+                     (unsigned)(3 + n++), GL_UNSIGNED_INT,
+                     (unsigned long long)(3 * (uint64_t)parts->triangles[k]));
+    json_put("]}");
+    if (json_len < 0 || (size_t)json_len + 4 > sizeof(glb_json))
         return -EOVERFLOW;
-    while (n % 4 != 0)
-        glb_json[n++] = ' ';
-    return n;
+    while (json_len % 4 != 0)
+        glb_json[json_len++] = ' ';
+    return json_len;
+}
+
+/* Each vertex's cluster (by its colour) and each cluster's triangles (by their first vertex). */
+static uint8_t vertex_part[MESH_MAX_VERTICES];
+static uint32_t vertex_seen;
+
+static int part_vertex(void *priv, const struct mesh_vertex *v)
+{
+    const struct reflect_model *m = priv;
+    double rho[3] = {v->rgb[0] / 255.0, v->rgb[1] / 255.0, v->rgb[2] / 255.0};
+    vertex_part[vertex_seen++] = m != NULL ? (uint8_t)reflect_cluster_of(m, rho) : 0;
+    return 0;
+}
+
+static int part_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
+{
+    struct glb_parts *parts = priv;
+    (void)b;
+    (void)c;
+    parts->triangles[vertex_part[a]]++;
+    return 0;
+}
+
+/* The indices of part @p part only. */
+struct index_pass {
+    struct outbuf *o;
+    uint8_t part;
+};
+
+static int index_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
+{
+    struct index_pass *ip = priv;
+    if (vertex_part[a] != ip->part)
+        return 0;
+    outbuf_u32le(ip->o, a);
+    outbuf_u32le(ip->o, b);
+    outbuf_u32le(ip->o, c);
+    return ip->o->rc;
 }
 
 int fusion_write_glb(const struct hal_storage *st, const char *path)
@@ -155,11 +248,21 @@ int fusion_write_glb(const struct hal_storage *st, const char *path)
     struct glb_bounds b = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
     struct mesh_sink bounds_pass = {bounds_vertex, NULL, &b};
     fusion_extract_prepared(&bounds_pass);
-    int json_len = glb_json_text(ms.kept_vertices, ms.kept_triangles, &b);
-    if (json_len < 0)
-        return json_len;
-    uint64_t bin_len = 28 * (uint64_t)ms.kept_vertices + 12 * (uint64_t)ms.kept_triangles;
-    uint64_t total = 12 + 8 + (uint64_t)json_len + 8 + bin_len; /* bin_len is 4-aligned */
+    struct glb_parts parts = {1, {0}, reflect_model()};
+    if (parts.model != NULL)
+        parts.count = parts.model->count;
+    vertex_seen = 0;
+    struct mesh_sink part_pass = {part_vertex, part_triangle, (void *)parts.model};
+    fusion_extract_prepared(&part_pass);
+    part_pass = (struct mesh_sink){NULL, part_triangle, &parts};
+    fusion_extract_prepared(&part_pass);
+    uint64_t bin_len = 28 * (uint64_t)ms.kept_vertices;
+    for (uint32_t k = 0; k < parts.count; k++)
+        bin_len += 12 * (uint64_t)parts.triangles[k];
+    int json = glb_json_text(ms.kept_vertices, &parts, &b, bin_len);
+    if (json < 0)
+        return json;
+    uint64_t total = 12 + 8 + (uint64_t)json + 8 + bin_len; /* bin_len is 4-aligned */
     if (total > UINT32_MAX)
         return -EFBIG; /* GLB counts its length in 32 bits */
     if (outbuf_open(&o, st, path) != 0)
@@ -167,16 +270,20 @@ int fusion_write_glb(const struct hal_storage *st, const char *path)
     outbuf_u32le(&o, GLB_MAGIC);
     outbuf_u32le(&o, 2);
     outbuf_u32le(&o, (uint32_t)total);
-    outbuf_u32le(&o, (uint32_t)json_len);
+    outbuf_u32le(&o, (uint32_t)json);
     outbuf_u32le(&o, GLB_CHUNK_JSON);
-    outbuf_put(&o, glb_json, (size_t)json_len);
+    outbuf_put(&o, glb_json, (size_t)json);
     outbuf_u32le(&o, (uint32_t)bin_len);
     outbuf_u32le(&o, GLB_CHUNK_BIN);
-    struct mesh_sink passes[4] = {{position_vertex, NULL, &o},
-                                  {normal_vertex, NULL, &o},
-                                  {colour_vertex, NULL, &o},
-                                  {NULL, index_triangle, &o}};
-    for (int k = 0; k < 4 && o.rc == 0; k++)
+    struct mesh_sink passes[3] = {
+        {position_vertex, NULL, &o}, {normal_vertex, NULL, &o}, {colour_vertex, NULL, &o}};
+    for (int k = 0; k < 3 && o.rc == 0; k++)
         fusion_extract_prepared(&passes[k]);
+    for (uint32_t k = 0; k < parts.count && o.rc == 0; k++) {
+        struct index_pass ip = {&o, (uint8_t)k};
+        struct mesh_sink pass = {NULL, index_triangle, &ip};
+        if (parts.triangles[k] > 0)
+            fusion_extract_prepared(&pass);
+    }
     return outbuf_close(&o);
 }
