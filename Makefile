@@ -111,7 +111,7 @@ HOST_OBJ := $(call obj,$(POSIX_SRC) $(APP_LIB_SRC) $(BOARD_SRC)) $(if $(filter l
 MAIN_OBJ := $(call obj,app/main.c)
 
 .PHONY: check-blender seccomp-tool vivid-tool all deps test-deps test test-run run-complete linux-build small-build install check-stack size fuzz errors-doc test-arm64 test-arm64-full test-gpio-chip arm64-check-elf arm64-run-tests run clean format docs check-firmware bench measure measure-scan interop-meshlab bench-callgrind eval calibrate-demo measure-calib
-SIM_TOOLS := $(if $(filter sim,$(HAL)),$(BUILD)/turntable-sim $(BUILD)/tt-client $(BUILD)/mesh-compare $(BUILD)/colour-eval,)
+SIM_TOOLS := $(if $(filter sim,$(HAL)),$(BUILD)/turntable-sim $(BUILD)/tt-client $(BUILD)/mesh-compare $(BUILD)/colour-eval $(BUILD)/relight-eval,)
 all: deps $(BUILD)/scanner $(CALIB_TOOL) $(SIM_TOOLS)
 
 # Install missing Debian packages (fresh Debian 12): only when pkg-config cannot find them.
@@ -178,7 +178,10 @@ $(BUILD)/drm-show: $(call obj,tests/drm_show.c board/board_display.c hal/linux/p
 $(BUILD)/mesh-compare: $(call obj,tests/mesh_compare.c tests/mesh_compare_lib.c host_sim/sim_bvh.c host_sim/sim_mesh.c host_sim/sim_ply_read.c app/config.c app/ini_schema.c app/scan_dir.c hal/posix/image_io.c) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON)
 
-$(BUILD)/colour-eval: $(call obj,tests/colour_eval.c tests/colour_metrics.c host_sim/sim_bvh.c host_sim/sim_mesh.c host_sim/sim_ply_read.c host_sim/sim_rig.c host_sim/sim_jpeg.c host_sim/sim_target.c host_sim/sim_material.c app/config.c app/ini_schema.c app/scan_dir.c hal/posix/image_io.c hal/posix/storage_posix.c) $(BUILD)/libfirmware.a
+EVAL_SIM_SRC := tests/colour_metrics.c host_sim/sim_bvh.c host_sim/sim_mesh.c host_sim/sim_ply_read.c host_sim/sim_rig.c host_sim/sim_jpeg.c host_sim/sim_target.c host_sim/sim_material.c app/config.c app/ini_schema.c app/scan_dir.c hal/posix/image_io.c hal/posix/storage_posix.c
+$(BUILD)/colour-eval: $(call obj,tests/colour_eval.c $(EVAL_SIM_SRC)) $(BUILD)/libfirmware.a
+	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON)
+$(BUILD)/relight-eval: $(call obj,tests/relight_eval.c $(EVAL_SIM_SRC)) $(BUILD)/libfirmware.a
 	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON)
 
 # ---- tests ----
@@ -395,7 +398,7 @@ measure: deps $(BUILD)/measure_view
 # Intrinsic colour (issue 4): Jost et al.'s comparison reproduced on the simulator, written to
 # docs/colour-eval/ (table as Markdown and CSV, close-up PNGs of a view boundary). About 20 minutes.
 EVAL_DIR ?= docs/colour-eval
-eval: deps $(BUILD)/scanner $(BUILD)/colour-eval
+eval: deps $(BUILD)/scanner $(BUILD)/colour-eval $(BUILD)/relight-eval
 	tests/colour_eval.sh $(BUILD) $(EVAL_DIR)
 
 # Full simulated scans measured against the true surface, with a turntable that misses its

@@ -45,6 +45,10 @@ measure() { # scene method [variant]: process the scan with those settings and m
 
 csv=$report/colour-eval.csv
 echo "scene,method,$("$build/colour-eval" header | cut -d, -f2-)" > "$csv"
+# Relighting: each scene's multi and fit models under a light the scan never used, against the
+# simulator's truth under it (build/relight-eval); the fit's picture beside the truth.
+relit=$report/relight.csv
+echo "scene,method,$("$build/relight-eval" header | cut -d, -f2-)" > "$relit"
 for scene in $scenes; do
     scan=$work/$scene
     rm -rf "$scan"
@@ -61,8 +65,11 @@ for scene in $scenes; do
             measure "$scene" multi "$v"
         done
     fi
+    "$build/relight-eval" "tests/eval/$scene.ini" "$scan" "$work/$scene-multi" "$scene,multi" >> "$relit"
+    "$build/relight-eval" "tests/eval/$scene.ini" "$scan" "$work/$scene-fit" "$scene,fit" \
+        "$report/relit-$scene.png" >> "$relit"
     "$build/colour-eval" closeup "$scan" "$report/closeup-$scene.png" \
         $(for m in $methods; do printf '%s ' "$work/$scene-$m"; done)
 done
-awk -F, -f tests/colour_eval_report.awk "$csv" > "$report/colour-eval.md"
+awk -F, -f tests/colour_eval_report.awk "$csv" "$relit" > "$report/colour-eval.md"
 echo "eval: $report/colour-eval.md" >&2
