@@ -82,8 +82,12 @@ static void kmeans_rounds(struct reflect_model *m, int rounds);
 static uint32_t cluster_samples(uint32_t wanted, struct reflect_model *m)
 {
     uint32_t k = 0;
-    for (int c = 0; c < 3; c++)
-        m->cluster[0].centre[c] = pool[0].rho0[c];
+    double mean[3] = {0, 0, 0}; /* the first seed: the mean colour (an outlier would pull the
+                                   next seed into the bulk and split one paint in two) */
+    for (uint32_t i = 0; i < rs.count; i++)
+        for (int c = 0; c < 3; c++)
+            mean[c] += pool[i].rho0[c] / rs.count;
+    memcpy(m->cluster[0].centre, mean, sizeof(mean));
     for (k = 1; k < wanted; k++) { /* the sample farthest from every seed so far */
         double far = 0.0;
         uint32_t at = 0;
@@ -94,7 +98,7 @@ static uint32_t cluster_samples(uint32_t wanted, struct reflect_model *m)
             if (d > far)
                 far = d, at = i;
         }
-        if (far < 0.01) /* no other colour there (0.1 in square-root units): fewer clusters */
+        if (far < 0.03) /* no other colour there (0.17 in square-root units): fewer clusters */
             break;
         for (int c = 0; c < 3; c++)
             m->cluster[k].centre[c] = pool[at].rho0[c];

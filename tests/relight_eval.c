@@ -135,8 +135,8 @@ static void material_lobe(const struct sim_material *mat, double disk_rad, doubl
         double sum = 0.0;
         for (int j = 0; j < DISK; j++) { /* evenly over the disk (golden angle) */
             double r = disk_rad * sqrt((j + 0.5) / DISK), phi = j * 2.39996322972865332;
-            vec3 l = v3_norm(v3_add(l0, v3_add(v3_scale(e1, r * cos(phi)),
-                                               v3_scale(e2, r * sin(phi)))));
+            vec3 l =
+                v3_norm(v3_add(l0, v3_add(v3_scale(e1, r * cos(phi)), v3_scale(e2, r * sin(phi)))));
             double rho[3];
             sim_material_eval(mat, zero, n, l, v, rho);
             sum += (rho[0] + rho[1] + rho[2]) / 3.0;
