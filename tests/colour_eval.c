@@ -2,6 +2,7 @@
  *
  *   colour-eval measure SCAN_DIR RESULT_DIR LABEL   one CSV row (header with LABEL = header)
  *   colour-eval closeup SCAN_DIR OUT.png RESULT_DIR...  the boundary of views 0 and 1, truth first
+ *   colour-eval closeup-dark SCAN_DIR OUT.png RESULT_DIR...  the same on the very dark paint
  *
  * SCAN_DIR is a simulated scan (its config, calibration, truth mesh and view angles); RESULT_DIR
  * holds mesh.ply and view_NNN/cloud.ply from `scanner process SCAN_DIR --out RESULT_DIR`
@@ -576,7 +577,37 @@ static void render_panel(const struct sim_mesh *m, const struct sim_bvh *bvh,
         }
 }
 
-static int cmd_closeup(const char *scan_dir, const char *out_png, int count, char **results)
+/* View 0's camera; centre: the very dark paint it sees head-on (the stripe faces angle 0). */
+static int closeup_dark_camera(const struct rig_views *r, const struct sim_mesh *truth,
+                               const struct sim_bvh *bvh, struct frame_xform *cam_xf,
+                               double centre[2])
+{
+    *cam_xf = r->obj[0];
+    vec3 cam = r->cam_obj[0];
+    double su = 0.0, sv = 0.0, albedo[3];
+    size_t n = 0;
+    for (uint32_t i = 0; i < truth->vert_count; i++) {
+        const float *p = &truth->pos[3 * i], *nn = &truth->normal[3 * i];
+        vec3 q = v3(p[0], p[1], p[2]), nv = v3(nn[0], nn[1], nn[2]);
+        if (!sim_albedo_at(&r->cfg.sim, r->height_mm, q, albedo) ||
+            v3_dot(nv, v3_norm(v3_sub(cam, q))) < 0.5 || !reaches(bvh, q, nv, cam))
+            continue;
+        vec3 pc = frame_point_inv(cam_xf, q);
+        su += r->calib.cam_fx_px * pc.x / pc.z + r->calib.cam_cx_px;
+        sv += r->calib.cam_fy_px * pc.y / pc.z + r->calib.cam_cy_px;
+        n++;
+    }
+    if (n == 0)
+        return -ENOENT;
+    centre[0] = su / n;
+    centre[1] = sv / n;
+    return 0;
+}
+
+/* Close-up panels, truth first, then each result: at the boundary of views 0 and 1, or (@p dark)
+ * on the very dark paint. */
+static int cmd_closeup(const char *scan_dir, const char *out_png, int count, char **results,
+                       int dark)
 {
     static struct rig_views r;
     struct sim_mesh truth;
@@ -586,8 +617,11 @@ static int cmd_closeup(const char *scan_dir, const char *out_png, int count, cha
     char path[HAL_MAX_PATH + 64], err[512];
     if (rig_load(&r, scan_dir) != 0 || truth_load(scan_dir, &truth, &bvh) != 0)
         return 1;
-    if (closeup_camera(&r, &truth, &bvh, &mid, centre) != 0) {
-        fprintf(stderr, "colour-eval: views 0 and 1 share no boundary the camera sees\n");
+    if (dark ? closeup_dark_camera(&r, &truth, &bvh, &mid, centre) != 0
+             : closeup_camera(&r, &truth, &bvh, &mid, centre) != 0) {
+        fprintf(stderr, "colour-eval: %s\n", dark ? "view 0 sees no dark paint head-on"
+                                                  : "views 0 and 1 share no boundary the camera "
+                                                    "sees");
         return 1;
     }
     uint32_t width = CLOSEUP_PX * (uint32_t)(count + 1);
@@ -625,7 +659,9 @@ int main(int argc, char **argv)
     if (argc == 5 && strcmp(argv[1], "measure") == 0)
         return cmd_measure(argv[2], argv[3], argv[4]);
     if (argc >= 5 && strcmp(argv[1], "closeup") == 0)
-        return cmd_closeup(argv[2], argv[3], argc - 4, argv + 4);
+        return cmd_closeup(argv[2], argv[3], argc - 4, argv + 4, 0);
+    if (argc >= 5 && strcmp(argv[1], "closeup-dark") == 0)
+        return cmd_closeup(argv[2], argv[3], argc - 4, argv + 4, 1);
     if (argc == 2 && strcmp(argv[1], "header") == 0) {
         printf("label,vertices,de2000_mean,de2000_p95,mae_r,mae_g,mae_b,view_step_de2000,"
                "fused_step_de2000,highlight_views,highlight_fused,icp_coupling,dark_vertices,"
@@ -634,6 +670,7 @@ int main(int argc, char **argv)
     }
     fprintf(stderr, "usage: colour-eval header\n"
                     "       colour-eval measure SCAN_DIR RESULT_DIR LABEL\n"
-                    "       colour-eval closeup SCAN_DIR OUT.png RESULT_DIR...\n");
+                    "       colour-eval closeup SCAN_DIR OUT.png RESULT_DIR...\n"
+                    "       colour-eval closeup-dark SCAN_DIR OUT.png RESULT_DIR...\n");
     return 2;
 }

@@ -68,6 +68,8 @@ for scene in $scenes; do
     "$build/relight-eval" "tests/eval/$scene.ini" "$scan" "$work/$scene-multi" "$scene,multi" >> "$relit"
     "$build/relight-eval" "tests/eval/$scene.ini" "$scan" "$work/$scene-fit" "$scene,fit" \
         "$report/relit-$scene.png" >> "$relit"
+    "$build/colour-eval" closeup-dark "$scan" "$report/closeup-dark-$scene.png" \
+        "$work/$scene-none" "$work/$scene-multi" "$work/$scene-fit"
     "$build/colour-eval" closeup "$scan" "$report/closeup-$scene.png" \
         $(for m in $methods; do printf '%s ' "$work/$scene-$m"; done)
 done
