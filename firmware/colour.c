@@ -236,10 +236,30 @@ struct fit_state {
     uint32_t stride, seen;
 };
 
+/* The lobe is narrow: a normal's noise (a few degrees from the range image) blurs it as much as
+ * the material's roughness does, and the fit would take that for a rougher, weaker lobe. The
+ * fit's angles use the mean of the valid normals within LOBE_NORMAL_RADIUS pixels (about
+ * 1.5 mm on the object here, far below its curvature), both when sampling and when applying. */
+#define LOBE_NORMAL_RADIUS 6
+static vec3 lobe_normal(const struct decode_maps *m, const struct tri_range *r, size_t i)
+{
+    long x0 = (long)(i % m->width), y0 = (long)(i / m->width);
+    vec3 sum = v3(0, 0, 0);
+    for (long y = y0 - LOBE_NORMAL_RADIUS; y <= y0 + LOBE_NORMAL_RADIUS; y++)
+        for (long x = x0 - LOBE_NORMAL_RADIUS; x <= x0 + LOBE_NORMAL_RADIUS; x++) {
+            if (x < 0 || y < 0 || x >= (long)m->width || y >= (long)m->height)
+                continue;
+            size_t j = (size_t)y * m->width + (size_t)x;
+            if (m->reason[j] == SCAN_VALID)
+                sum = v3_add(sum, v3(r->normal[3 * j], r->normal[3 * j + 1], r->normal[3 * j + 2]));
+        }
+    return v3_norm(sum);
+}
+
 /* One sample for the pool: pixel at @p p (normal @p nn) with each used light's white-referenced
  * signal and its angles (reflect.h). */
-static void add_sample(const struct colour_params *prm, const struct scan_calib *c, vec3 p,
-                       vec3 nn, const struct light_signals *ls, const double rho0[3])
+static void add_sample(const struct colour_params *prm, const struct scan_calib *c, vec3 p, vec3 nn,
+                       const struct light_signals *ls, const double rho0[3])
 {
     struct reflect_obs o;
     memset(&o, 0, sizeof(o));
@@ -266,7 +286,8 @@ static void add_sample(const struct colour_params *prm, const struct scan_calib 
  * taken off each light: rho = sum w (S_l - K g_l) cos_l / sum w cos_l^2, w as eq. 6 (the lobe
  * takes out what the weights leave: the broad sheen of metals and satin). */
 static void fit_pixel(const struct frame_ctx *f, const struct scan_calib *c, struct fit_state *fs,
-                      size_t i, vec3 p, vec3 nn, uint8_t out[3], float *confidence)
+                      const struct decode_maps *m, const struct tri_range *r, size_t i, vec3 p,
+                      vec3 nn, uint8_t out[3], float *confidence)
 {
     const struct colour_params *prm = f->prm;
     struct light_signals ls;
@@ -294,17 +315,17 @@ static void fit_pixel(const struct frame_ctx *f, const struct scan_calib *c, str
         for (int ch = 0; ch < 3; ch++)
             out[ch] = albedo_byte(rho0[ch]);
         if (fs->collect && !relaxed && fs->seen++ % fs->stride == 0)
-            add_sample(prm, c, p, nn, &ls, rho0);
+            add_sample(prm, c, p, lobe_normal(m, r, i), &ls, rho0);
         return;
     }
     const struct reflect_cluster *cl = &fs->model->cluster[reflect_cluster_of(fs->model, rho0)];
-    vec3 view = v3_norm(v3_scale(p, -1.0));
-    double cos_r = v3_dot(nn, view), fit_num[3] = {0, 0, 0}, fit_den = 0.0;
+    vec3 view = v3_norm(v3_scale(p, -1.0)), ln = lobe_normal(m, r, i);
+    double cos_r = v3_dot(ln, view), fit_num[3] = {0, 0, 0}, fit_den = 0.0;
     for (uint32_t l = 0; l < c->light_count; l++) {
         if (!(ls.used >> l & 1u))
             continue;
         vec3 to = v3_norm(v3_sub(v3_from(c->light_pos_mm[l]), p));
-        double nh = v3_dot(nn, v3_norm(v3_add(to, view)));
+        double nh = v3_dot(ln, v3_norm(v3_add(to, view)));
         double g = reflect_lobe(cl->roughness, acos(nh > 1.0 ? 1.0 : nh < -1.0 ? -1.0 : nh), cos_r);
         double w = ls.weight[l], ct = ls.cosine[l];
         for (int ch = 0; ch < 3; ch++)
@@ -341,7 +362,7 @@ static void compute_pass(const struct frame_ctx *f, const struct scan_calib *c,
         vec3 p = v3(r->xyz_mm[3 * i], r->xyz_mm[3 * i + 1], r->xyz_mm[3 * i + 2]);
         vec3 nn = v3(r->normal[3 * i], r->normal[3 * i + 1], r->normal[3 * i + 2]);
         if (prm->method == COLOUR_FIT) {
-            fit_pixel(f, c, &fs, i, p, nn, &albedo[3 * i], &confidence[i]);
+            fit_pixel(f, c, &fs, m, r, i, p, nn, &albedo[3 * i], &confidence[i]);
             continue;
         }
         double num[3], trust, den = pixel_estimate(f, c, proj, white, i, p, nn, 0, num, &trust);

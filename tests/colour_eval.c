@@ -8,10 +8,10 @@
  * holds mesh.ply and view_NNN/cloud.ply from `scanner process SCAN_DIR --out RESULT_DIR`
  * (or SCAN_DIR itself). Fused vertices are compared with the true albedo at the closest true
  * surface point, away from paint edges (the fusion blends colour over ~2 voxels); the very dark
- * paint counts as every paint and is also summed on its own (dark_*). A vertex belongs to the view that weighs most there in the fusion
- * (head-on, near, both camera and projector reaching it); where that view changes is a boundary
- * between views, and the colour step there is the difference between the two views' own colour
- * estimates (their clouds) at the boundary. */
+ * paint counts as every paint and is also summed on its own (dark_*). A vertex belongs to the view
+ * that weighs most there in the fusion (head-on, near, both camera and projector reaching it);
+ * where that view changes is a boundary between views, and the colour step there is the difference
+ * between the two views' own colour estimates (their clouds) at the boundary. */
 #define _POSIX_C_SOURCE 200809L
 #include "colour_metrics.h"
 #include "config.h"
@@ -619,9 +619,10 @@ static int cmd_closeup(const char *scan_dir, const char *out_png, int count, cha
         return 1;
     if (dark ? closeup_dark_camera(&r, &truth, &bvh, &mid, centre) != 0
              : closeup_camera(&r, &truth, &bvh, &mid, centre) != 0) {
-        fprintf(stderr, "colour-eval: %s\n", dark ? "view 0 sees no dark paint head-on"
-                                                  : "views 0 and 1 share no boundary the camera "
-                                                    "sees");
+        fprintf(stderr, "colour-eval: %s\n",
+                dark ? "view 0 sees no dark paint head-on"
+                     : "views 0 and 1 share no boundary the camera "
+                       "sees");
         return 1;
     }
     uint32_t width = CLOSEUP_PX * (uint32_t)(count + 1);

@@ -146,9 +146,9 @@ static void material_lobe(const struct sim_material *mat, double disk_rad, doubl
     double best = 1e300;
     for (int g = 0; g < 400; g++) {
         double s = 0.01 * pow(100.0, g / 399.0), sgg = 0.0, syg = 0.0, syy = 0.0;
-        for (int k = 0; k < STEPS; k++) {
-            double lobe = reflect_lobe(s, a[k], cos(theta_r));
-            sgg += lobe * lobe, syg += y[k] * lobe, syy += y[k] * y[k];
+        for (int k = 0; k < STEPS; k++) { /* weighted by the ring's area: a 2-D lobe */
+            double lobe = reflect_lobe(s, a[k], cos(theta_r)), area = sin(a[k]);
+            sgg += area * lobe * lobe, syg += area * y[k] * lobe, syy += area * y[k] * y[k];
         }
         double kk = sgg > 0.0 ? syg / sgg : 0.0, err = syy - kk * syg;
         if (err < best)
