@@ -252,7 +252,7 @@ int fusion_write_glb(const struct hal_storage *st, const char *path)
     if (parts.model != NULL)
         parts.count = parts.model->count;
     vertex_seen = 0;
-    struct mesh_sink part_pass = {part_vertex, part_triangle, (void *)parts.model};
+    struct mesh_sink part_pass = {part_vertex, NULL, (void *)parts.model};
     fusion_extract_prepared(&part_pass);
     part_pass = (struct mesh_sink){NULL, part_triangle, &parts};
     fusion_extract_prepared(&part_pass);
