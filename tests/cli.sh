@@ -189,6 +189,17 @@ check glb_valid_metres_y_up sh -c "node tests/gltf/validate.mjs $out/scan/mesh.g
 check glb_validator_catches_damage sh -c "sed 's/\"VEC4\"/\"VEC2\"/' $out/scan/mesh.glb > $out/bad.glb &&
     ! cmp -s $out/scan/mesh.glb $out/bad.glb && ! node tests/gltf/validate.mjs $out/bad.glb > $out/bad-glb.txt &&
     grep -q ' error ' $out/bad-glb.txt"
+# [colour] method = fit on that scan (issue 18): a reflectance model kept and said, and mesh.glb
+# with a material per cluster (KHR_materials_specular) that the validator passes.
+sed -e 's/^method = .*/method = fit/' -e "s|^calibration = .*|calibration = $PWD/config/sim-calib.ini|" \
+    -e "s|^mesh_file = ../|mesh_file = $PWD/|" config/sim.ini > "$out/fit.ini"
+rm -rf "$out/fit"
+check fit_keeps_reflectance_and_materials sh -c "$bin process $out/scan --config $out/fit.ini \
+    --out $out/fit > $out/fit.log 2>&1 && grep -q '^reflectance [0-9] material clusters' $out/fit.log &&
+    grep -q '^roughness_rad = ' $out/fit/reflectance.ini &&
+    node tests/gltf/validate.mjs $out/fit/mesh.glb > $out/fit-glb.txt &&
+    grep -q ' 0 errors, 0 warnings' $out/fit-glb.txt &&
+    test \$(grep -a -o 'KHR_materials_specular' $out/fit/mesh.glb | wc -l) -ge 2"
 # The object slips on the table between two views: the scan fails, names the view, writes no
 # model and keeps every view.
 sed -e 's/^views = .*/views = 4/' -e "s|^calibration = .*|calibration = $PWD/config/sim-calib.ini|" \
