@@ -441,14 +441,15 @@ int scan_dir_write_reflectance(const struct hal_storage *st, const char *dir,
     size_t len = (size_t)snprintf(
         text, sizeof(text),
         "; reflectance parameters of [colour] method = fit (docs/colour.md): per material\n"
-        "; cluster, S = rho cos(theta_i) + specular exp(-alpha^2 / (2 roughness^2)) / "
-        "cos(theta_r)\n[reflectance]\nclusters = %u\n",
+        "; cluster, S = rho cos(theta_i) + specular D(alpha) / cos(theta_r), D the GGX\n"
+        "; distribution of alpha = roughness, 1 at its peak (firmware/reflect.h)\n"
+        "[reflectance]\nclusters = %u\n",
         (unsigned)m->count);
     for (uint32_t k = 0; k < m->count && len < sizeof(text); k++) {
         const struct reflect_cluster *c = &m->cluster[k];
         len += (size_t)snprintf(text + len, sizeof(text) - len,
                                 "[cluster_%u]\ndiffuse = %.4f, %.4f, %.4f\nspecular = %.4f, %.4f, "
-                                "%.4f\nroughness_rad = %.4f\nsamples = %u\nrms = %.4f\n",
+                                "%.4f\nroughness = %.4f\nsamples = %u\nrms = %.4f\n",
                                 (unsigned)k, c->centre[0], c->centre[1], c->centre[2],
                                 c->specular[0], c->specular[1], c->specular[2], c->roughness,
                                 (unsigned)c->samples, c->rms);

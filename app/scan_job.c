@@ -587,7 +587,7 @@ static int fit_reflectance(struct job *j, const char *scan_dir)
         const struct reflect_cluster *c = &m.cluster[k];
         len += (size_t)snprintf(detail + len, sizeof(detail) - len,
                                 "%s diffuse %.2f %.2f %.2f, specular %.3f %.3f %.3f, roughness "
-                                "%.3f rad (%u samples)",
+                                "%.3f (%u samples)",
                                 k ? ";" : "", c->centre[0], c->centre[1], c->centre[2],
                                 c->specular[0], c->specular[1], c->specular[2], c->roughness,
                                 (unsigned)c->samples);

@@ -320,20 +320,35 @@ static void fit_pixel(const struct frame_ctx *f, const struct scan_calib *c, str
     }
     const struct reflect_cluster *cl = &fs->model->cluster[reflect_cluster_of(fs->model, rho0)];
     vec3 view = v3_norm(v3_scale(p, -1.0)), ln = lobe_normal(m, r, i);
-    double cos_r = v3_dot(ln, view), fit_num[3] = {0, 0, 0}, fit_den = 0.0;
+    double cos_r = v3_dot(ln, view), g[HAL_MAX_LIGHTS], rho[3];
+    double k_grey = (cl->specular[0] + cl->specular[1] + cl->specular[2]) / 3.0;
     for (uint32_t l = 0; l < c->light_count; l++) {
-        if (!(ls.used >> l & 1u))
-            continue;
         vec3 to = v3_norm(v3_sub(v3_from(c->light_pos_mm[l]), p));
         double nh = v3_dot(ln, v3_norm(v3_add(to, view)));
-        double g = reflect_lobe(cl->roughness, acos(nh > 1.0 ? 1.0 : nh < -1.0 ? -1.0 : nh), cos_r);
-        double w = ls.weight[l], ct = ls.cosine[l];
-        for (int ch = 0; ch < 3; ch++)
-            fit_num[ch] += w * (ls.lit[l][ch] * prm->white_scale[ch] - cl->specular[ch] * g) * ct;
-        fit_den += w * ct * ct;
+        g[l] = reflect_lobe(cl->roughness, acos(nh > 1.0 ? 1.0 : nh < -1.0 ? -1.0 : nh), cos_r);
+    }
+    memcpy(rho, rho0, sizeof(rho));
+    /* twice: each light weighs by eq. 6 and by the share of its signal the diffuse part is
+     * (as the last estimate has it), so that where the lobe is most of the light (dark paint
+     * on a metal) an error in the lobe does not become the colour */
+    for (int pass = 0; pass < 2; pass++) {
+        double fit_num[3] = {0, 0, 0}, fit_den = 0.0;
+        double rho_grey = fmax(1e-3, (rho[0] + rho[1] + rho[2]) / 3.0);
+        for (uint32_t l = 0; l < c->light_count; l++) {
+            if (!(ls.used >> l & 1u))
+                continue;
+            double ct = ls.cosine[l], share = rho_grey * ct / (rho_grey * ct + k_grey * g[l]);
+            double w = ls.weight[l] * share * share;
+            for (int ch = 0; ch < 3; ch++)
+                fit_num[ch] +=
+                    w * (ls.lit[l][ch] * prm->white_scale[ch] - cl->specular[ch] * g[l]) * ct;
+            fit_den += w * ct * ct;
+        }
+        for (int ch = 0; ch < 3 && fit_den > 1e-12; ch++)
+            rho[ch] = fmax(0.0, fit_num[ch] / fit_den);
     }
     for (int ch = 0; ch < 3; ch++)
-        out[ch] = albedo_byte(fit_den > 1e-9 ? fit_num[ch] / fit_den : rho0[ch]);
+        out[ch] = albedo_byte(rho[ch]);
 }
 
 /* One pass over the pixels with the Ca of @p f: albedo and confidence of every valid pixel. */

@@ -116,21 +116,20 @@ static void json_put(const char *fmt, ...)
 }
 
 /* A cluster's lobe as a glTF material (metallic-roughness, KHR_materials_specular). The lobe
- * K exp(-alpha^2 / (2 sigma^2)) / cos(theta_r), in units where a matte surface gives
+ * K D(alpha) / cos(theta_r), D GGX scaled to 1 at its peak, in units where a matte surface gives
  * rho cos(theta_i), is pi f cos(theta_i) of a microfacet BRDF f = D G F / (4 cos_i cos_o) with
- * a Beckmann D of slope m = sqrt(2) sigma (small angles, G = 1): F0 = 8 sigma^2 K. glTF's GGX
- * takes alpha = roughness^2, about Beckmann's m. Dielectric (metallic 0): a metal's tinted F0
- * is the specular colour. */
+ * the normalised GGX D (peak 1 / (pi a^2)) and G = 1: F0 = 4 a^2 K. glTF's GGX takes
+ * alpha = roughness^2. Dielectric (metallic 0): a metal's tinted F0 is the specular colour. */
 static void json_material(const struct reflect_cluster *c, uint32_t k)
 {
-    double m = sqrt(2.0) * c->roughness, f0[3];
+    double a = c->roughness, f0[3];
     for (int ch = 0; ch < 3; ch++)
-        f0[ch] = 8.0 * c->roughness * c->roughness * c->specular[ch];
+        f0[ch] = 4.0 * a * a * c->specular[ch];
     json_put("%s{\"name\":\"cluster %u\",\"pbrMetallicRoughness\":{\"baseColorFactor\":"
              "[1,1,1,1],\"metallicFactor\":0,\"roughnessFactor\":%.4f},\"extensions\":"
              "{\"KHR_materials_specular\":{\"specularFactor\":1,\"specularColorFactor\":"
              "[%.5f,%.5f,%.5f]}}}",
-             k ? "," : "", (unsigned)k, fmin(1.0, sqrt(m)), f0[0] / 0.04, f0[1] / 0.04,
+             k ? "," : "", (unsigned)k, fmin(1.0, sqrt(a)), f0[0] / 0.04, f0[1] / 0.04,
              f0[2] / 0.04);
 }
 

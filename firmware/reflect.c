@@ -1,5 +1,5 @@
 /* Reflectance parameters: a pool of light x view observations, k-means clusters on the diffuse
- * colour, and per cluster the lobe of the simplified Torrance-Sparrow model (reflect.h). */
+ * colour, and per cluster a GGX lobe (reflect.h). */
 #include "reflect.h"
 
 #include <errno.h>
@@ -52,7 +52,8 @@ const struct reflect_model *reflect_model(void)
 
 double reflect_lobe(double roughness, double alpha, double cos_r)
 {
-    return exp(-alpha * alpha / (2.0 * roughness * roughness)) / (cos_r > 0.05 ? cos_r : 0.05);
+    double a2 = roughness * roughness, c = cos(alpha), t2 = (1.0 - c * c) / (c * c);
+    return a2 * a2 / (c * c * c * c * (a2 + t2) * (a2 + t2)) / (cos_r > 0.05 ? cos_r : 0.05);
 }
 
 /* Colour feature for the clusters: square roots, roughly even steps of lightness. */
@@ -143,9 +144,9 @@ static void kmeans_rounds(struct reflect_model *m, int rounds)
     }
 }
 
-/* The lobe's K for roughness @p sigma over cluster @p c's kept observations (least squares of
+/* The lobe's K for @p roughness over cluster @p c's kept observations (least squares of
  * the residual after the diffuse part, per channel, not below 0); @retval the squared error */
-static double fit_specular(uint32_t c, double sigma, double k_out[3])
+static double fit_specular(uint32_t c, double roughness, double k_out[3])
 {
     double sgg = 0.0, srg[3] = {0, 0, 0}, srr = 0.0;
     for (uint32_t i = 0; i < rs.count; i++) {
@@ -155,7 +156,7 @@ static double fit_specular(uint32_t c, double sigma, double k_out[3])
         for (uint32_t l = 0; l < HAL_MAX_LIGHTS; l++) {
             if (!(pool_used[i] >> l & 1u))
                 continue;
-            double g = reflect_lobe(sigma, o->alpha[l], o->cos_r);
+            double g = reflect_lobe(roughness, o->alpha[l], o->cos_r);
             sgg += g * g;
             for (int ch = 0; ch < 3; ch++) {
                 double r = o->signal[l][ch] - pool_rho[i][ch] * o->cos_i[l];

@@ -196,7 +196,7 @@ sed -e 's/^method = .*/method = fit/' -e "s|^calibration = .*|calibration = $PWD
 rm -rf "$out/fit"
 check fit_keeps_reflectance_and_materials sh -c "$bin process $out/scan --config $out/fit.ini \
     --out $out/fit > $out/fit.log 2>&1 && grep -q '^reflectance [0-9] material clusters' $out/fit.log &&
-    grep -q '^roughness_rad = ' $out/fit/reflectance.ini &&
+    grep -q '^roughness = ' $out/fit/reflectance.ini &&
     node tests/gltf/validate.mjs $out/fit/mesh.glb > $out/fit-glb.txt &&
     grep -q ' 0 errors, 0 warnings' $out/fit-glb.txt &&
     test \$(grep -a -o 'KHR_materials_specular' $out/fit/mesh.glb | wc -l) -ge 2"

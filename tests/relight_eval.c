@@ -8,7 +8,7 @@
  * to a place none of the rig's lights had, without noise, offset or ambient light. The model:
  * RESULT_DIR's mesh.ply (linear vertex colours: the diffuse albedo) and reflectance.ini (each
  * material cluster's lobe; none: matte), drawn by this file's own ray caster through the mesh:
- * S = rho cos(theta_i) + K exp(-alpha^2 / (2 sigma^2)) / cos(theta_r) (firmware/reflect.h), in
+ * S = rho cos(theta_i) + K D(alpha) / cos(theta_r) (GGX, firmware/reflect.h), in
  * the units where a white-referenced matte white facing the light at the reference distance is 1.
  * The truth's signal is put in the same units with the scan's white reference and falloff.
  * Compared: CIEDE2000 over the object's pixels the new light reaches in the truth (cast shadows
@@ -60,7 +60,7 @@ static int reflectance_key(void *user, const char *section, const char *name, co
         sscanf(value, "%lf, %lf, %lf", &c->centre[0], &c->centre[1], &c->centre[2]);
     else if (strcmp(name, "specular") == 0)
         sscanf(value, "%lf, %lf, %lf", &c->specular[0], &c->specular[1], &c->specular[2]);
-    else if (strcmp(name, "roughness_rad") == 0)
+    else if (strcmp(name, "roughness") == 0)
         c->roughness = atof(value);
     else if (strcmp(name, "samples") == 0)
         c->samples = (uint32_t)strtoul(value, NULL, 10);
@@ -119,10 +119,10 @@ static int model_at(const struct sim_mesh *m, const struct sim_bvh *bvh,
  * part (sim_material_eval with no diffuse colour) seen at 20 deg from the normal, lit from
  * around the mirror direction at alpha = 0 .. 0.6 rad by a disk the size of the rig's diffusers
  * (@p disk_rad: their angular radius; the scan saw the lobe through them), fitted as
- * K exp(-alpha^2 / (2 sigma^2)) / cos(theta_r) by least squares (sigma on a fine grid).
+ * K D(alpha) / cos(theta_r) (reflect_lobe) by least squares (the roughness on a fine grid).
  * @p strength: K's mean over the channels. */
 static void material_lobe(const struct sim_material *mat, double disk_rad, double *strength,
-                          double *sigma)
+                          double *roughness)
 {
     enum { STEPS = 61, DISK = 64 };
     const double theta_r = 20.0 * M_PI / 180.0, zero[3] = {0, 0, 0};
@@ -152,7 +152,7 @@ static void material_lobe(const struct sim_material *mat, double disk_rad, doubl
         }
         double kk = sgg > 0.0 ? syg / sgg : 0.0, err = syy - kk * syg;
         if (err < best)
-            best = err, *strength = kk, *sigma = s;
+            best = err, *strength = kk, *roughness = s;
     }
 }
 
@@ -293,7 +293,7 @@ int main(int argc, char **argv)
 {
     if (argc == 2 && strcmp(argv[1], "header") == 0) {
         printf("label,relit_pixels,relit_de2000_mean,relit_de2000_p95,material_strength,"
-               "fitted_strength,material_roughness_rad,fitted_roughness_rad\n");
+               "fitted_strength,material_roughness,fitted_roughness\n");
         return 0;
     }
     if (argc == 5 || argc == 6)
