@@ -91,8 +91,7 @@ static void job_init(struct job *j, const struct hal *hal, const struct app_conf
         j->start_rig_us = 0;
 }
 
-static void progress(struct job *j, const char *event, int view, uint32_t done,
-                     const char *detail);
+static void progress(struct job *j, const char *event, int view, uint32_t done, const char *detail);
 static void progress_line(struct job *j, const char *event, int view, uint32_t done,
                           const char *fields, const char *detail);
 static void progress_with(struct job *j, const char *event, int view, uint32_t done,
@@ -120,8 +119,7 @@ static void report_cost(struct job *j, const char *what)
     }
     /* In line with the rig: this thread's work between its moves and captures, and the last
      * view's processing (the others ran while the table turned) */
-    double in_line =
-        clock_posix_thread_cpu_s() - j->start_thread_cpu_s - sim + j->last_view_cpu_s;
+    double in_line = clock_posix_thread_cpu_s() - j->start_thread_cpu_s - sim + j->last_view_cpu_s;
     int n = snprintf(detail, sizeof(detail),
                      "%s %.2f s CPU for %u views (%.3f s a view: storing frames %.2f s, "
                      "processing views as the table turned %.2f s, in line with the rig %.2f s)",
@@ -242,14 +240,11 @@ static void progress_line(struct job *j, const char *event, int view, uint32_t d
     } else if (view >= 0 && view_finished(event)) {
         printf("view %d of %u: %s\n", view + 1, (unsigned)j->views, detail);
     } else if (view < 0) {
-        static const char *const human[][2] = {{"scan_start", "scanning into"},
-                                               {"scan_done", "scan finished:"},
-                                               {"scan_failed", "scan failed:"},
-                                               {"process_start", "processing"},
-                                               {"registration", "registration:"},
-                                               {"cost", "cost:"},
-                                               {"place_object", ">>>"},
-                                               {"process_done", "process finished:"}};
+        static const char *const human[][2] = {
+            {"scan_start", "scanning into"},   {"scan_done", "scan finished:"},
+            {"scan_failed", "scan failed:"},   {"process_start", "processing"},
+            {"registration", "registration:"}, {"cost", "cost:"},
+            {"place_object", ">>>"},           {"process_done", "process finished:"}};
         const char *text = event;
         for (size_t k = 0; k < sizeof(human) / sizeof(human[0]); k++)
             if (strcmp(event, human[k][0]) == 0)
@@ -264,8 +259,8 @@ static const char *finished_detail(struct job *j, char *buf, size_t len)
 {
     struct rusage ru;
     getrusage(RUSAGE_SELF, &ru);
-    snprintf(buf, len, "%s (mesh: %s/mesh.ply, mesh.obj, mesh.stl, mesh.glb; peak memory %.1f MB)", j->out_dir,
-             j->out_dir, ru.ru_maxrss / 1024.0);
+    snprintf(buf, len, "%s (mesh: %s/mesh.ply, mesh.obj, mesh.stl, mesh.glb; peak memory %.1f MB)",
+             j->out_dir, j->out_dir, ru.ru_maxrss / 1024.0);
     return buf;
 }
 
@@ -314,8 +309,7 @@ static int save_frame(void *priv, uint32_t pattern, const uint8_t *pixels, uint3
     if (!keeps_frame(j, pattern))
         return 0;
     int rc = frame_writer_put(j->out_dir, j->view, pattern, pixels, width, height, channels,
-                              (enum scan_frame_format)j->cfg->frame_format, failed,
-                              sizeof(failed));
+                              (enum scan_frame_format)j->cfg->frame_format, failed, sizeof(failed));
     if (rc != 0)
         j->hal->log(HAL_LOG_ERROR, "cannot write %s: %s", failed[0] ? failed : j->view_dir,
                     strerror(-rc));
@@ -370,9 +364,9 @@ static int save_results(struct job *j, const struct scan_view *view, const struc
     struct frame_xform pose;
     int rc = reg_view_pose(j->view, &pose, rv);
     if (rc == 0)
-        rc = write_failed(j, "registration.ini",
-                          scan_dir_write_registration(&j->hal->storage, j->out_dir, j->view, rep,
-                                                      rv, &pose));
+        rc = write_failed(
+            j, "registration.ini",
+            scan_dir_write_registration(&j->hal->storage, j->out_dir, j->view, rep, rv, &pose));
     if (rc == 0)
         rc = scan_dir_path(path, sizeof(path), j->out_dir, (int)j->view, "cloud.ply");
     if (rc == 0)
@@ -443,15 +437,15 @@ static int write_model(struct job *j)
     snprintf(detail, sizeof(detail),
              "%u vertices, %u triangles (%u floating fragments of %u pieces left out; %u voxels "
              "filled holes%s%s) -> %s/mesh.ply, mesh.obj%s",
-             (unsigned)ms.kept_vertices, (unsigned)ms.kept_triangles,
-             (unsigned)ms.removed_pieces, (unsigned)ms.pieces, (unsigned)filled, closed,
-             uncoloured, j->out_dir, fits ? ", mesh.stl and mesh.glb" : "");
+             (unsigned)ms.kept_vertices, (unsigned)ms.kept_triangles, (unsigned)ms.removed_pieces,
+             (unsigned)ms.pieces, (unsigned)filled, closed, uncoloured, j->out_dir,
+             fits ? ", mesh.stl and mesh.glb" : "");
     char fields[192];
     snprintf(fields, sizeof(fields),
              "\"vertices\":%u,\"triangles\":%u,\"pieces_left_out\":%u,\"colour_filled\":%u,"
              "\"uncoloured\":%u",
-             (unsigned)ms.kept_vertices, (unsigned)ms.kept_triangles,
-             (unsigned)ms.removed_pieces, (unsigned)ms.colour_filled, (unsigned)ms.uncoloured);
+             (unsigned)ms.kept_vertices, (unsigned)ms.kept_triangles, (unsigned)ms.removed_pieces,
+             (unsigned)ms.colour_filled, (unsigned)ms.uncoloured);
     progress_with(j, "mesh", -1, j->views, fields, detail);
     return 0;
 }
@@ -473,8 +467,9 @@ static int report_registration(struct job *j, const struct reg_report *r, double
 {
     char detail[512];
     if (!r->solved)
-        snprintf(detail, sizeof(detail), "turntable angles kept ([registration] icp = 0 or one "
-                                         "view)");
+        snprintf(detail, sizeof(detail),
+                 "turntable angles kept ([registration] icp = 0 or one "
+                 "view)");
     else
         snprintf(detail, sizeof(detail),
                  "residual %.3f mm, loop closure %.3f mm, worst view %u (%.3f mm); axis moved "
@@ -533,10 +528,10 @@ static int recolour_from_frames(struct job *j, const char *scan_dir, uint32_t v,
     for (uint32_t f = count; rc == 0 && f <= count + lights; f++) {
         uint32_t frame = f < count + lights ? f : white; /* the lights, then the white colour */
         uint8_t *pixels = scan_frame_buffer(frame);
-        rc = pixels == NULL ? -EINVAL
-                            : scan_dir_read_frame(scan_dir, v, frame, pixels,
-                                                  (size_t)HAL_MAX_PIXELS * 3, p->width, p->height,
-                                                  3, err, sizeof(err));
+        rc = pixels == NULL
+                 ? -EINVAL
+                 : scan_dir_read_frame(scan_dir, v, frame, pixels, (size_t)HAL_MAX_PIXELS * 3,
+                                       p->width, p->height, 3, err, sizeof(err));
         if (rc == 0 && f < count + lights)
             rc = scan_feed_light_frame(f - count, pixels);
     }
@@ -546,6 +541,20 @@ static int recolour_from_frames(struct job *j, const char *scan_dir, uint32_t v,
     }
     scan_attach_colour(view);
     return scan_recolour(&p->colour, j->calib, view);
+}
+
+/* View @p v as the model is made of it (load_range), coloured again from its frames while the
+ * reflectance pool collects or once its model is fitted (fit); stopped by request between
+ * views. */
+static int view_for_model(struct job *j, const char *scan_dir, uint32_t v, struct scan_view *view,
+                          struct scan_view_info *info)
+{
+    int rc = stopped_offline(j, scan_dir, v);
+    if (rc == 0)
+        rc = load_range(j, scan_dir, v, view, info);
+    if (rc == 0 && (reflect_collecting() || reflect_model() != NULL))
+        rc = recolour_from_frames(j, scan_dir, v, view);
+    return rc;
 }
 
 /* [colour] method = fit: the samples of every view (each view's colour frames read back), the
@@ -562,11 +571,7 @@ static int fit_reflectance(struct job *j, const char *scan_dir)
     for (uint32_t v = 0; v < j->views && rc == 0; v++) {
         struct scan_view view;
         struct scan_view_info info;
-        rc = stopped_offline(j, scan_dir, v);
-        if (rc == 0)
-            rc = load_range(j, scan_dir, v, &view, &info);
-        if (rc == 0)
-            rc = recolour_from_frames(j, scan_dir, v, &view);
+        rc = view_for_model(j, scan_dir, v, &view, &info);
     }
     struct reflect_model m;
     if (rc == 0 && (rc = reflect_fit(j->cfg->scan.colour.clusters, &m)) == -ENODATA) {
@@ -581,16 +586,17 @@ static int fit_reflectance(struct job *j, const char *scan_dir)
     if (rc != 0)
         return rc;
     char detail[128 + REFLECT_MAX_CLUSTERS * 96];
-    size_t len = (size_t)snprintf(detail, sizeof(detail), "%u material clusters (%.2f s CPU):",
-                                  (unsigned)m.count, clock_posix_thread_cpu_s() - t0);
+    size_t len = (size_t)snprintf(detail, sizeof(detail),
+                                  "%u material clusters (%.2f s CPU):", (unsigned)m.count,
+                                  clock_posix_thread_cpu_s() - t0);
     for (uint32_t k = 0; k < m.count && len < sizeof(detail); k++) {
         const struct reflect_cluster *c = &m.cluster[k];
-        len += (size_t)snprintf(detail + len, sizeof(detail) - len,
-                                "%s diffuse %.2f %.2f %.2f, specular %.3f %.3f %.3f, roughness "
-                                "%.3f (%u samples)",
-                                k ? ";" : "", c->centre[0], c->centre[1], c->centre[2],
-                                c->specular[0], c->specular[1], c->specular[2], c->roughness,
-                                (unsigned)c->samples);
+        len +=
+            (size_t)snprintf(detail + len, sizeof(detail) - len,
+                             "%s diffuse %.2f %.2f %.2f, specular %.3f %.3f %.3f, roughness "
+                             "%.3f (%u samples)",
+                             k ? ";" : "", c->centre[0], c->centre[1], c->centre[2], c->specular[0],
+                             c->specular[1], c->specular[2], c->roughness, (unsigned)c->samples);
     }
     char fields[64];
     snprintf(fields, sizeof(fields), "\"clusters\":%u", (unsigned)m.count);
@@ -615,11 +621,7 @@ static int make_model(struct job *j, const char *scan_dir)
     for (uint32_t v = 0; v < j->views && rc == 0; v++) {
         struct scan_view view;
         struct scan_view_info info;
-        rc = stopped_offline(j, scan_dir, v);
-        if (rc == 0)
-            rc = load_range(j, scan_dir, v, &view, &info);
-        if (rc == 0 && reflect_model() != NULL)
-            rc = recolour_from_frames(j, scan_dir, v, &view);
+        rc = view_for_model(j, scan_dir, v, &view, &info);
         if (rc == 0)
             rc = make_view_dir(j);
         struct reg_view rv;
@@ -751,8 +753,10 @@ static int start_processing(struct job *j, uint32_t v, const char *started, doub
         j->pending = &p;
         return 0;
     }
-    j->hal->log(HAL_LOG_WARN, "cannot start a thread (%s): view %u is processed before the "
-                              "table turns", strerror(-rc), (unsigned)v);
+    j->hal->log(HAL_LOG_WARN,
+                "cannot start a thread (%s): view %u is processed before the "
+                "table turns",
+                strerror(-rc), (unsigned)v);
     process_view(&p);
     return view_processed(j, &p);
 }
@@ -791,7 +795,7 @@ static int live_view(struct job *j, uint32_t v)
     /* the simulator's truth of this view while the table is still at its angle */
     if (rc == 0)
         rc = write_failed(j, "(the simulator's truth)", board_write_view_extras(hal, j->view_dir));
-    if (rc != 0) { /* the layer that met the fault has said what it was */
+    if (rc != 0) {       /* the layer that met the fault has said what it was */
         flush_frames(j); /* nothing writes into the view's directory after this */
         view_not_finished(j, v, st.position_mdeg, rc);
         return rc;
@@ -1077,8 +1081,8 @@ static int read_range(struct job *j, const char *dir, uint32_t v, struct scan_vi
                       struct scan_view_info *info, char *err, size_t err_len)
 {
     set_view(j, v);
-    int rc = scan_dir_read_range(dir, v, j->cfg->scan.width, j->cfg->scan.height, view, err,
-                                 err_len);
+    int rc =
+        scan_dir_read_range(dir, v, j->cfg->scan.width, j->cfg->scan.height, view, err, err_len);
     if (rc == 0) {
         memset(info, 0, sizeof(*info));
         info->angle_mdeg = view->angle_mdeg;
@@ -1088,8 +1092,8 @@ static int read_range(struct job *j, const char *dir, uint32_t v, struct scan_vi
 }
 
 /* View @p v of a scan that kept no pattern frames: its range.bin in @p scan_dir. */
-static int load_kept_range(struct job *j, const char *scan_dir, uint32_t v,
-                           struct scan_view *view, struct scan_view_info *info)
+static int load_kept_range(struct job *j, const char *scan_dir, uint32_t v, struct scan_view *view,
+                           struct scan_view_info *info)
 {
     char err[SCAN_DIR_PATH_MAX + 128];
     int rc = read_range(j, scan_dir, v, view, info, err, sizeof(err));
@@ -1193,8 +1197,9 @@ int scan_job_process(const struct hal *hal, const char *scan_dir, const struct s
         struct scan_view_info info;
         rc = stopped_offline(&j, scan_dir, v);
         if (rc == 0)
-            rc = cfg.keep_frames == KEEP_FRAMES_ALL ? load_view(&j, scan_dir, v, &view, &info)
-                                                    : load_kept_range(&j, scan_dir, v, &view, &info);
+            rc = cfg.keep_frames == KEEP_FRAMES_ALL
+                     ? load_view(&j, scan_dir, v, &view, &info)
+                     : load_kept_range(&j, scan_dir, v, &view, &info);
         if (rc == 0)
             rc = scan_keep_for_registration(v, &view);
         /* the model is made of this one, not of an older range.bin (one read back from where

@@ -194,6 +194,16 @@ static void fit_diffuse(const struct reflect_model *m)
     }
 }
 
+/* Sample @p i's light @p l less the model of cluster @p cl (luminance). */
+static double residual(const struct reflect_cluster *cl, uint32_t i, uint32_t l)
+{
+    const struct reflect_obs *o = &pool[i];
+    double g = reflect_lobe(cl->roughness, o->alpha[l], o->cos_r), r = 0.0;
+    for (int ch = 0; ch < 3; ch++)
+        r += (o->signal[l][ch] - pool_rho[i][ch] * o->cos_i[l] - cl->specular[ch] * g) / 3.0;
+    return r;
+}
+
 /* Observations far off the model (a shadow edge, a neighbour's paint, a wrong normal) are left
  * out: more than 4 x the cluster's median absolute residual (luminance), and at least 0.02. */
 static void drop_outliers(const struct reflect_model *m)
@@ -209,11 +219,7 @@ static void drop_outliers(const struct reflect_model *m)
             for (uint32_t l = 0; l < HAL_MAX_LIGHTS; l++) {
                 if (!(o->lights >> l & 1u))
                     continue;
-                double g = reflect_lobe(cl->roughness, o->alpha[l], o->cos_r), r = 0.0;
-                for (int ch = 0; ch < 3; ch++)
-                    r += (o->signal[l][ch] - pool_rho[i][ch] * o->cos_i[l] - cl->specular[ch] * g) /
-                         3.0;
-                hist[(int)fmin(63.0, fabs(r) / 0.005)]++;
+                hist[(int)fmin(63.0, fabs(residual(cl, i, l)) / 0.005)]++;
                 n++;
             }
         }
@@ -229,11 +235,7 @@ static void drop_outliers(const struct reflect_model *m)
             for (uint32_t l = 0; l < HAL_MAX_LIGHTS; l++) {
                 if (!(o->lights >> l & 1u))
                     continue;
-                double g = reflect_lobe(cl->roughness, o->alpha[l], o->cos_r), r = 0.0;
-                for (int ch = 0; ch < 3; ch++)
-                    r += (o->signal[l][ch] - pool_rho[i][ch] * o->cos_i[l] - cl->specular[ch] * g) /
-                         3.0;
-                if (fabs(r) <= limit)
+                if (fabs(residual(cl, i, l)) <= limit)
                     pool_used[i] |= 1u << l;
             }
         }

@@ -509,6 +509,16 @@ static uint8_t to_srgb(double linear)
     return (uint8_t)(v <= 0.0 ? 0 : v >= 1.0 ? 255 : v * 255.0 + 0.5);
 }
 
+/* Add object point @p q's pixel (pinhole) seen by camera @p xf to the sums @p su, @p sv. */
+static void add_projection(const struct rig_views *r, const struct frame_xform *xf, vec3 q,
+                           double *su, double *sv, size_t *n)
+{
+    vec3 pc = frame_point_inv(xf, q);
+    *su += r->calib.cam_fx_px * pc.x / pc.z + r->calib.cam_cx_px;
+    *sv += r->calib.cam_fy_px * pc.y / pc.z + r->calib.cam_cy_px;
+    (*n)++;
+}
+
 /* Camera half way between views 0 and 1; centre: the 0|1 boundary of the truth it sees. */
 static int closeup_camera(const struct rig_views *r, const struct sim_mesh *truth,
                           const struct sim_bvh *bvh, struct frame_xform *mid, double centre[2])
@@ -532,10 +542,7 @@ static int closeup_camera(const struct rig_views *r, const struct sim_mesh *trut
         vec3 q2 = v3_add(q, v3_scale(along, v == 0 ? 3.0 : -3.0));
         if (dominant_view(r, bvh, q2, nv) == v)
             continue;
-        vec3 pc = frame_point_inv(mid, q);
-        su += r->calib.cam_fx_px * pc.x / pc.z + r->calib.cam_cx_px;
-        sv += r->calib.cam_fy_px * pc.y / pc.z + r->calib.cam_cy_px;
-        n++;
+        add_projection(r, mid, q, &su, &sv, &n);
     }
     if (n == 0)
         return -ENOENT;
@@ -592,10 +599,7 @@ static int closeup_dark_camera(const struct rig_views *r, const struct sim_mesh 
         if (!sim_albedo_at(&r->cfg.sim, r->height_mm, q, albedo) ||
             v3_dot(nv, v3_norm(v3_sub(cam, q))) < 0.5 || !reaches(bvh, q, nv, cam))
             continue;
-        vec3 pc = frame_point_inv(cam_xf, q);
-        su += r->calib.cam_fx_px * pc.x / pc.z + r->calib.cam_cx_px;
-        sv += r->calib.cam_fy_px * pc.y / pc.z + r->calib.cam_cy_px;
-        n++;
+        add_projection(r, cam_xf, q, &su, &sv, &n);
     }
     if (n == 0)
         return -ENOENT;
