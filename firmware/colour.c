@@ -38,7 +38,9 @@ void colour_layout(const struct colour_params *p, uint32_t light_count, struct c
     add_frame(out, (1u << light_count) - 1u, all_us);
     for (uint32_t l = 0; l < light_count; l++)
         add_frame(out, 1u << l, one_us);
-    if (p->bracket > 1) /* taken whatever the method, so one scan serves every method */
+    /* taken whatever the method, so one scan serves every method; scan_check refuses more
+     * lights than the build can bracket */
+    if (p->bracket > 1 && light_count <= COLOUR_MAX_BRACKETED)
         for (uint32_t l = 0; l < light_count; l++)
             out->long_of[COLOUR_FRAME_LIGHT0 + l] = add_frame(out, 1u << l, one_us * p->bracket);
     uint32_t lit = out->count;

@@ -17,9 +17,10 @@
 #define COLOUR_FRAME_DARK 0u
 #define COLOUR_FRAME_ALL 1u
 #define COLOUR_FRAME_LIGHT0 2u
-/* At most COLOUR_MAX_FRAMES (hal_limits.h): dark, all lights, every light at two exposures, and
- * three more dark frames for the other exposures. */
-HAL_STATIC_ASSERT(COLOUR_MAX_FRAMES == COLOUR_FRAME_LIGHT0 + 2u * HAL_MAX_LIGHTS + 3u,
+/* At most COLOUR_MAX_FRAMES (hal_limits.h): dark, all lights, every light, the bracketed ones
+ * again, and a dark frame for each other exposure (all lights', single lights', bracketed). */
+HAL_STATIC_ASSERT(COLOUR_MAX_FRAMES == COLOUR_FRAME_LIGHT0 + HAL_MAX_LIGHTS + 2u +
+                                           (COLOUR_MAX_BRACKETED ? COLOUR_MAX_BRACKETED + 1u : 0u),
                   "COLOUR_MAX_FRAMES counts the frames colour_layout() can ask for");
 
 /** What each colour frame shows: its lights, its exposure and the dark frame (Ca) taken at the

@@ -49,6 +49,15 @@ int scan_check(const struct scan_params *p, const struct scan_calib *c, char *ms
                  HAL_MAX_LIGHTS);
         return -EINVAL;
     }
+    if (p->colour.method != COLOUR_NONE && p->colour.bracket > 1 &&
+        c->light_count > COLOUR_MAX_BRACKETED) {
+        snprintf(msg, len,
+                 "[colour] bracket: %u lights, but this build can bracket %u "
+                 "(COLOUR_MAX_BRACKETED; a LIMITS=small build has no room for the frames): set "
+                 "bracket = 0",
+                 (unsigned)c->light_count, COLOUR_MAX_BRACKETED);
+        return -EINVAL;
+    }
     return 0;
 }
 

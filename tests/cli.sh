@@ -242,6 +242,10 @@ case ${BUILD:-build} in
 *) limit="ulimit -v 524288;" ;;
 esac
 [ -n "$limit" ] && check default_limits_need_more_than_512MB sh -c "$limit ! $bin --version"
+sed -e "/^\[colour\]/a bracket = 4" -e "s|^calibration = .*|calibration = $PWD/config/sim-calib.ini|" \
+    -e "s|^mesh_file = ../|mesh_file = $PWD/|" config/sim.ini > "$out/small-bracket.ini"
+check small_limits_refuse_bracketing sh -c "$sbin check-config --config $out/small-bracket.ini 2>&1 |
+    grep -q 'bracket: 4 lights, but this build can bracket 0' && $bin check-config --config $out/small-bracket.ini"
 check small_limits_scan_same_model sh -c "$limit $sbin scan --config config/sim.ini \
     --out $out/scan_small >/dev/null 2>&1 && cmp $out/scan/mesh.ply $out/scan_small/mesh.ply"
 rm -rf "$out/processed"

@@ -9,8 +9,8 @@
 
 #ifdef HAL_LIMITS_SMALL
 /* make LIMITS=small, for a board with 512 MB (a Pi Zero 2 W, a Pi 3A+): frames up to the Pi
- * camera v1's 2x2 binned mode, 1296 x 972, and a smaller fusion grid (fusion.h); about 340 MiB
- * of static buffers instead of 754. */
+ * camera v1's 2x2 binned mode, 1296 x 972, a smaller fusion grid (fusion.h), no bracketed
+ * colour frames; about 370 MiB of static buffers instead of 955 (make size). */
 #define HAL_MAX_WIDTH 1296u
 #define HAL_MAX_HEIGHT 972u
 #else
@@ -34,9 +34,16 @@
 /* Frames a view's decoder keeps: white, black, and every column and row bit with its inverse. */
 #define DECODE_MAX_PATTERNS (2u + 2u * (HAL_MAX_CODE_BITS + HAL_MAX_CODE_BITS))
 /* Colour frames after the patterns (colour.h): dark, all lights, each light alone at its
- * exposure and at a longer one ([colour] bracket), and three more dark frames for the other
- * exposures. */
-#define COLOUR_MAX_FRAMES (2u + 2u * HAL_MAX_LIGHTS + 3u)
+ * exposure and, with [colour] bracket, at a longer one, and more dark frames for the other
+ * exposures (two, three with bracketing). A 512 MB board has no room for the bracketed frames
+ * (4 MB each). */
+#ifdef HAL_LIMITS_SMALL
+#define COLOUR_MAX_BRACKETED 0u
+#else
+#define COLOUR_MAX_BRACKETED HAL_MAX_LIGHTS /* lights that can be bracketed */
+#endif
+#define COLOUR_MAX_FRAMES                                                                          \
+    (2u + HAL_MAX_LIGHTS + 2u + (COLOUR_MAX_BRACKETED > 0u ? COLOUR_MAX_BRACKETED + 1u : 0u))
 /* The fusion grid (fusion.h): at most FUSION_MAX_DIM voxels along an axis, FUSION_MAX_VOXELS in
  * all, 8 bytes each. */
 #ifdef HAL_LIMITS_SMALL
