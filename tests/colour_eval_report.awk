@@ -132,6 +132,8 @@ END {
             k = sc "," methods[m]
             if (!(k in de))
                 check(0, sprintf("%s, %s: dark paint mean dE00 < 5: not measured (no %s rows)", sc, methods[m], methods[m]))
+            else if (dark_n[k] == 0 && dark_n[sc ",none"] == 0)
+                continue # painted all over in one colour: no dark paint on it
             else if (dark_n[k] < 20)
                 check(0, sprintf("%s, %s: dark paint mean dE00 < 5: only %d dark vertices compared", sc, methods[m], dark_n[k]))
             else
