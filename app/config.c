@@ -599,6 +599,13 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
                  cfg->colour_method);
         return -EINVAL;
     }
+    if (cfg->scan.colour.method == COLOUR_FIT && cfg->keep_frames == KEEP_FRAMES_NONE) {
+        snprintf(err, err_len,
+                 "%s: [colour] method: 'fit' reads each view's colour frames again once all are "
+                 "in: [output] keep_frames must keep them (all or colour), not none",
+                 path);
+        return -EINVAL;
+    }
     cfg->scan.height = cfg->camera.height;
     if (cfg->camera.binning > 1 && strcmp(cfg->camera_backend, "sim") == 0) {
         snprintf(err, err_len,

@@ -92,6 +92,9 @@ static void test_errors_name_file_line_and_key(void **state)
     expect_error("[sim]\nalbedo = 0.5, 0.5\n", "bad.ini:9: [sim] albedo: '0.5, 0.5' is not a list");
     expect_error("[sim]\nseed = 1.5\n", "[sim] seed: '1.5' is not a whole number");
     expect_error("garbage line\n", "bad.ini:8: syntax error");
+    /* fit reads the colour frames again: a scan that keeps none could not make its model */
+    expect_error("[lights]\ncount = 4\n[colour]\nmethod = fit\n[output]\nkeep_frames = none\n",
+                 "[colour] method: 'fit' reads each view's colour frames again");
 }
 
 /* GPIO lines by offset or by the name the chip gives them (issue 5); anything else is refused. */
