@@ -68,8 +68,10 @@ for scene in $scenes; do
     "$build/relight-eval" "tests/eval/$scene.ini" "$scan" "$work/$scene-multi" "$scene,multi" >> "$relit"
     "$build/relight-eval" "tests/eval/$scene.ini" "$scan" "$work/$scene-fit" "$scene,fit" \
         "$report/relit-$scene.png" >> "$relit"
-    "$build/colour-eval" closeup-dark "$scan" "$report/closeup-dark-$scene.png" \
-        "$work/$scene-none" "$work/$scene-multi" "$work/$scene-fit"
+    if grep -q '^albedo_pattern = patches' "tests/eval/$scene.ini"; then # it has dark paint
+        "$build/colour-eval" closeup-dark "$scan" "$report/closeup-dark-$scene.png" \
+            "$work/$scene-none" "$work/$scene-multi" "$work/$scene-fit"
+    fi
     "$build/colour-eval" closeup "$scan" "$report/closeup-$scene.png" \
         $(for m in $methods; do printf '%s ' "$work/$scene-$m"; done)
 done
