@@ -183,6 +183,9 @@ static int cmd_calibrate_white(const char *config_path, double target_albedo)
     for (int m = COLOUR_NONE; m <= COLOUR_MULTI; m++)
         printf("; %s (from %u pixels)\nwhite_scale = %.6f, %.6f, %.6f\n", names[m],
                (unsigned)wc.pixels[m], wc.scale[m][0], wc.scale[m][1], wc.scale[m][2]);
+    /* fit's diffuse colour is in multi's units: the same white reference */
+    printf("; fit (as multi)\nwhite_scale = %.6f, %.6f, %.6f\n", wc.scale[COLOUR_MULTI][0],
+           wc.scale[COLOUR_MULTI][1], wc.scale[COLOUR_MULTI][2]);
     return 0;
 }
 

@@ -25,8 +25,8 @@ for v in $variants; do
     "$build/scanner" calibrate-white --config "tests/eval/.white-$v.ini" > "$work/white-$v.txt"
     rm -f "tests/eval/.white-$v.ini"
 done
-scale_of() { # method [variant] -> its white_scale line's value (fit's diffuse is multi's)
-    awk -v m="$(echo "$1" | sed 's/^fit$/multi/')" '$1 == ";" && $2 == m { getline; sub(/^white_scale = /, ""); print }' \
+scale_of() { # method [variant] -> its white_scale line's value
+    awk -v m="$1" '$1 == ";" && $2 == m { getline; sub(/^white_scale = /, ""); print }' \
         "$work/white${2:+-$2}.txt"
 }
 measure() { # scene method [variant]: process the scan with those settings and measure it
