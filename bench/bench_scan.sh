@@ -60,7 +60,7 @@ awk -v own="$own" -v st="$storage" -v inl="$inline" -v sim="$sim" -v v="$views" 
     printf "| live scan CPU per view, the simulator left out (of it the storage thread) | **%.3f s** (%.3f s) |\n", own / v, st / v
     printf "| the simulator rendering, per view (not the scanner'"'"'s) | %.3f s |\n", sim / v
     printf "| scanner process CPU, %d views | **%.2f s** (%.3f s a view) |\n", v, p, p / v
-    printf "| bytes kept per view (frames, range.bin, cloud.ply; the simulator's truth left out) | %.1f MB |\n", b / v / 1e6
+    printf "| bytes kept per view (frames, range.bin, cloud.ply; the simulator'"'"'s truth left out) | %.1f MB |\n", b / v / 1e6
     printf "| peak memory, scan / process | %.0f / %.0f MB |\n", ps, pp
     # In line with the rig: the work between moves and captures, the last view'"'"'s processing
     # and the model after it; frames are stored and the other views processed on other cores
