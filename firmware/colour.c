@@ -181,6 +181,31 @@ static void light_signals(const struct frame_ctx *f, const struct scan_calib *c,
             out->used |= 1u << l;
 }
 
+/* Eq. 6 over the lights that reach the pixel: the numerator per channel (@p num) and, returned,
+ * the denominator sum cos(theta_i) w_i. */
+static double multi_sum(const struct light_signals *ls, uint32_t light_count, double num[3])
+{
+    double den = 0.0;
+    num[0] = num[1] = num[2] = 0.0;
+    for (uint32_t l = 0; l < light_count; l++) {
+        if (!(ls->used >> l & 1u))
+            continue;
+        for (int ch = 0; ch < 3; ch++)
+            num[ch] += ls->lit[l][ch] * ls->weight[l];
+        den += ls->cosine[l] * ls->weight[l];
+    }
+    return den;
+}
+
+/* The angle between normal @p n and the half vector of light @p light_pos and the camera
+ * (at the origin, direction @p view from @p p): alpha of the lobe (reflect.h). */
+static double half_angle(vec3 p, vec3 n, vec3 view, const double light_pos[3])
+{
+    vec3 to = v3_norm(v3_sub(v3_from(light_pos), p));
+    double nh = v3_dot(n, v3_norm(v3_add(to, view)));
+    return acos(nh > 1.0 ? 1.0 : nh < -1.0 ? -1.0 : nh);
+}
+
 /* Albedo estimate of valid pixel i: numerator per channel and the denominator (0: none), and
  * how much the fusion may trust it (@p confidence, 0..; not clamped). @p relaxed: the best
  * effort for a pixel without a reliable estimate (grazing or saturated light still used). */
@@ -219,13 +244,7 @@ static double pixel_estimate(const struct frame_ctx *f, const struct scan_calib 
     }
     struct light_signals ls;
     light_signals(f, c, i, p, nn, relaxed, &ls);
-    for (uint32_t l = 0; l < c->light_count; l++) { /* eq. 6 */
-        if (!(ls.used >> l & 1u))
-            continue;
-        for (int ch = 0; ch < 3; ch++)
-            num[ch] += ls.lit[l][ch] * ls.weight[l];
-        den += ls.cosine[l] * ls.weight[l];
-    }
+    den = multi_sum(&ls, c->light_count, num);
     *confidence = den;
     return den;
 }
@@ -273,9 +292,7 @@ static void add_sample(const struct colour_params *prm, const struct scan_calib 
     for (uint32_t l = 0; l < c->light_count; l++) {
         if (!(ls->used >> l & 1u))
             continue;
-        vec3 to = v3_norm(v3_sub(v3_from(c->light_pos_mm[l]), p));
-        double nh = v3_dot(nn, v3_norm(v3_add(to, view)));
-        o.alpha[l] = (float)acos(nh > 1.0 ? 1.0 : nh < -1.0 ? -1.0 : nh);
+        o.alpha[l] = (float)half_angle(p, nn, view, c->light_pos_mm[l]);
         o.cos_i[l] = (float)ls->cosine[l];
         for (int ch = 0; ch < 3; ch++)
             o.signal[l][ch] = (float)(ls->lit[l][ch] * prm->white_scale[ch]);
@@ -299,12 +316,7 @@ static void fit_pixel(const struct frame_ctx *f, const struct scan_calib *c, str
         light_signals(f, c, i, p, nn, 1, &ls);
         relaxed = 1;
     }
-    double num[3] = {0, 0, 0}, den = 0.0, rho0[3];
-    for (uint32_t l = 0; l < c->light_count; l++)
-        for (int ch = 0; ch < 3 && (ls.used >> l & 1u); ch++)
-            num[ch] += ls.lit[l][ch] * ls.weight[l];
-    for (uint32_t l = 0; l < c->light_count; l++)
-        den += ls.used >> l & 1u ? ls.cosine[l] * ls.weight[l] : 0.0;
+    double num[3], rho0[3], den = multi_sum(&ls, c->light_count, num);
     if (den <= 1e-6) {
         memset(out, 0, 3);
         *confidence = COLOUR_NO_ESTIMATE;
@@ -324,11 +336,8 @@ static void fit_pixel(const struct frame_ctx *f, const struct scan_calib *c, str
     vec3 view = v3_norm(v3_scale(p, -1.0)), ln = lobe_normal(m, r, i);
     double cos_r = v3_dot(ln, view), g[HAL_MAX_LIGHTS], rho[3];
     double k_grey = (cl->specular[0] + cl->specular[1] + cl->specular[2]) / 3.0;
-    for (uint32_t l = 0; l < c->light_count; l++) {
-        vec3 to = v3_norm(v3_sub(v3_from(c->light_pos_mm[l]), p));
-        double nh = v3_dot(ln, v3_norm(v3_add(to, view)));
-        g[l] = reflect_lobe(cl->roughness, acos(nh > 1.0 ? 1.0 : nh < -1.0 ? -1.0 : nh), cos_r);
-    }
+    for (uint32_t l = 0; l < c->light_count; l++)
+        g[l] = reflect_lobe(cl->roughness, half_angle(p, ln, view, c->light_pos_mm[l]), cos_r);
     memcpy(rho, rho0, sizeof(rho));
     /* twice: each light weighs by eq. 6 and by the share of its signal the diffuse part is
      * (as the last estimate has it), so that where the lobe is most of the light (dark paint
