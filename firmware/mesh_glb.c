@@ -33,8 +33,9 @@
 #define GL_ARRAY_BUFFER 34962
 #define GL_ELEMENT_ARRAY_BUFFER 34963
 
-/* The JSON of one mesh with four accessors: well under this, whatever the counts. */
-static char glb_json[4096];
+/* The JSON of one mesh: about 1 KB, and about 650 bytes more per material cluster (a material,
+ * a primitive, a buffer view and an accessor each): REFLECT_MAX_CLUSTERS fit well within. */
+static char glb_json[8192];
 
 /* Position in glTF's frame: metres, Y up. */
 static void gltf_position(const float p[3], float out[3])
@@ -47,19 +48,6 @@ static void gltf_position(const float p[3], float out[3])
 struct glb_bounds {
     float lo[3], hi[3];
 };
-
-/* POSITION needs its min and max in the JSON, which precedes the data: a pass for them. */
-static int bounds_vertex(void *priv, const struct mesh_vertex *v)
-{
-    struct glb_bounds *b = priv;
-    float q[3];
-    gltf_position(v->pos, q);
-    for (int k = 0; k < 3; k++) {
-        b->lo[k] = q[k] < b->lo[k] ? q[k] : b->lo[k];
-        b->hi[k] = q[k] > b->hi[k] ? q[k] : b->hi[k];
-    }
-    return 0;
-}
 
 static int position_vertex(void *priv, const struct mesh_vertex *v)
 {
@@ -197,24 +185,37 @@ static int glb_json_text(uint32_t vertices, const struct glb_parts *parts,
     return json_len;
 }
 
-/* Each vertex's cluster (by its colour) and each cluster's triangles (by their first vertex). */
+/* What the JSON, which precedes the data, must say, in one pass over the mesh (its vertices
+ * come before its triangles): POSITION's min and max, each vertex's cluster (by its colour) and
+ * each cluster's triangles (by their first vertex). */
 static uint8_t vertex_part[MESH_MAX_VERTICES];
-static uint32_t vertex_seen;
+struct glb_scan {
+    struct glb_bounds bounds;
+    struct glb_parts parts;
+    uint32_t vertices;
+};
 
-static int part_vertex(void *priv, const struct mesh_vertex *v)
+static int scan_vertex(void *priv, const struct mesh_vertex *v)
 {
-    const struct reflect_model *m = priv;
+    struct glb_scan *gs = priv;
+    const struct reflect_model *m = gs->parts.model;
+    float q[3];
+    gltf_position(v->pos, q);
+    for (int k = 0; k < 3; k++) {
+        gs->bounds.lo[k] = q[k] < gs->bounds.lo[k] ? q[k] : gs->bounds.lo[k];
+        gs->bounds.hi[k] = q[k] > gs->bounds.hi[k] ? q[k] : gs->bounds.hi[k];
+    }
     double rho[3] = {v->rgb[0] / 255.0, v->rgb[1] / 255.0, v->rgb[2] / 255.0};
-    vertex_part[vertex_seen++] = m != NULL ? (uint8_t)reflect_cluster_of(m, rho) : 0;
+    vertex_part[gs->vertices++] = m != NULL ? (uint8_t)reflect_cluster_of(m, rho) : 0;
     return 0;
 }
 
-static int part_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
+static int scan_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
 {
-    struct glb_parts *parts = priv;
+    struct glb_scan *gs = priv;
     (void)b;
     (void)c;
-    parts->triangles[vertex_part[a]]++;
+    gs->parts.triangles[vertex_part[a]]++;
     return 0;
 }
 
@@ -244,21 +245,18 @@ int fusion_write_glb(const struct hal_storage *st, const char *path)
         return rc;
     if (ms.kept_vertices == 0)
         return -ENODATA; /* an accessor must count at least one element */
-    struct glb_bounds b = {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}};
-    struct mesh_sink bounds_pass = {bounds_vertex, NULL, &b};
-    fusion_extract_prepared(&bounds_pass);
-    struct glb_parts parts = {1, {0}, reflect_model()};
-    if (parts.model != NULL)
-        parts.count = parts.model->count;
-    vertex_seen = 0;
-    struct mesh_sink part_pass = {part_vertex, NULL, (void *)parts.model};
-    fusion_extract_prepared(&part_pass);
-    part_pass = (struct mesh_sink){NULL, part_triangle, &parts};
-    fusion_extract_prepared(&part_pass);
+    struct glb_scan gs = {{{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}},
+                          {1, {0}, reflect_model()},
+                          0};
+    if (gs.parts.model != NULL)
+        gs.parts.count = gs.parts.model->count;
+    struct mesh_sink scan_pass = {scan_vertex, scan_triangle, &gs};
+    fusion_extract_prepared(&scan_pass);
+    const struct glb_parts parts = gs.parts;
     uint64_t bin_len = 28 * (uint64_t)ms.kept_vertices;
     for (uint32_t k = 0; k < parts.count; k++)
         bin_len += 12 * (uint64_t)parts.triangles[k];
-    int json = glb_json_text(ms.kept_vertices, &parts, &b, bin_len);
+    int json = glb_json_text(ms.kept_vertices, &parts, &gs.bounds, bin_len);
     if (json < 0)
         return json;
     uint64_t total = 12 + 8 + (uint64_t)json + 8 + bin_len; /* bin_len is 4-aligned */

@@ -11,7 +11,11 @@
 #include <math.h>
 #include <string.h>
 
+#include "fusion.h"
 #include "reflect.h"
+#include "storage_posix.h"
+
+#include <stdio.h>
 
 /* A small deterministic generator (xorshift), uniform in [0, 1). */
 static uint64_t rng = 88172645463325252ull;
@@ -102,11 +106,62 @@ static void test_too_few_samples(void **state)
     assert_false(reflect_collecting());
 }
 
+static double sphere(vec3 p, void *ctx)
+{
+    (void)ctx;
+    return v3_len(v3_sub(p, v3(0, 0, 30))) - 20.0;
+}
+
+/* As many materials as there can be clusters (every corner of the colour cube): each becomes a
+ * material of mesh.glb, whose JSON must still fit the writer's buffer. */
+static void test_glb_with_every_cluster(void **state)
+{
+    (void)state;
+    reflect_begin(1);
+    for (int i = 0; i < 8 * 400; i++) {
+        int corner = i % 8;
+        struct truth t = {
+            {corner & 1 ? 0.6 : 0.05, corner & 2 ? 0.6 : 0.05, corner & 4 ? 0.6 : 0.05},
+            {0.1, 0.1, 0.1},
+            0.1};
+        add_sample(&t, 0);
+    }
+    struct reflect_model m;
+    assert_int_equal(reflect_fit(REFLECT_MAX_CLUSTERS, &m), 0);
+    assert_int_equal(m.count, REFLECT_MAX_CLUSTERS);
+    struct fusion_params p = {.voxel_mm = 1.0,
+                              .radius_mm = 30,
+                              .bottom_mm = 0,
+                              .top_mm = 60,
+                              .truncation_mm = 3.0,
+                              .max_weight = 50,
+                              .edge_fade_px = 10};
+    assert_int_equal(fusion_begin(&p), 0);
+    assert_int_equal(fusion_fill(sphere, NULL), 0);
+    struct mesh_summary ms;
+    assert_int_equal(fusion_mesh_prepare(0.0, &ms), 0);
+    struct hal_storage st;
+    storage_posix_init(&st);
+    assert_int_equal(fusion_write_glb(&st, "build/test_reflect.glb"), 0);
+    FILE *f = fopen("build/test_reflect.glb", "rb");
+    assert_non_null(f);
+    static char buf[16384];
+    size_t n = fread(buf, 1, sizeof(buf) - 1, f);
+    fclose(f);
+    buf[n] = '\0';
+    int materials = 0;
+    for (const char *q = buf + 20; (q = strstr(q, "\"name\":\"cluster ")) != NULL; q++)
+        materials++;
+    assert_int_equal(materials, REFLECT_MAX_CLUSTERS);
+    reflect_forget();
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_two_materials_recovered),
         cmocka_unit_test(test_too_few_samples),
+        cmocka_unit_test(test_glb_with_every_cluster),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
