@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "fusion.h"
+#include "fusion_grid.h"
 #include "reflect.h"
 #include "storage_posix.h"
 
@@ -138,6 +139,17 @@ static void test_glb_with_every_cluster(void **state)
                               .edge_fade_px = 10};
     assert_int_equal(fusion_begin(&p), 0);
     assert_int_equal(fusion_fill(sphere, NULL), 0);
+    /* each octant of the sphere painted with one corner's colour: every cluster has triangles */
+    uint32_t dims[3];
+    assert_int_equal(fusion_dims(&p, dims), 0);
+    for (uint32_t z = 0; z < dims[2]; z++)
+        for (uint32_t y = 0; y < dims[1]; y++)
+            for (uint32_t x = 0; x < dims[0]; x++) {
+                vec3 q = v3_add(fusion_vol.origin, v3_scale(v3(x, y, z), p.voxel_mm));
+                int corner = (q.x > 0.0) | (q.y > 0.0) << 1 | (q.z > 30.0) << 2;
+                for (int c = 0; c < 3; c++)
+                    fusion_grid[vidx(x, y, z)].rgb[c] = corner >> c & 1 ? 153 : 13;
+            }
     struct mesh_summary ms;
     assert_int_equal(fusion_mesh_prepare(0.0, &ms), 0);
     struct hal_storage st;
@@ -149,10 +161,13 @@ static void test_glb_with_every_cluster(void **state)
     size_t n = fread(buf, 1, sizeof(buf) - 1, f);
     fclose(f);
     buf[n] = '\0';
-    int materials = 0;
+    int materials = 0, primitives = 0;
     for (const char *q = buf + 20; (q = strstr(q, "\"name\":\"cluster ")) != NULL; q++)
         materials++;
+    for (const char *q = buf + 20; (q = strstr(q, "\"COLOR_0\"")) != NULL; q++)
+        primitives++;
     assert_int_equal(materials, REFLECT_MAX_CLUSTERS);
+    assert_int_equal(primitives, REFLECT_MAX_CLUSTERS); /* every cluster has triangles */
     reflect_forget();
 }
 
