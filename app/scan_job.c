@@ -64,6 +64,9 @@ static int load_view(struct job *j, const char *scan_dir, uint32_t v, struct sca
 static int load_range(struct job *j, const char *scan_dir, uint32_t v, struct scan_view *view,
                       struct scan_view_info *info);
 static int stopped_offline(struct job *j, const char *scan_dir, uint32_t v);
+static int read_into_buffer(const char *scan_dir, uint32_t v, uint32_t f, uint32_t channels,
+                            const struct scan_params *params, uint8_t **pixels, char *err,
+                            size_t err_len);
 
 static double wall_ms(void)
 {
@@ -527,11 +530,8 @@ static int recolour_from_frames(struct job *j, const char *scan_dir, uint32_t v,
     int rc = scan_begin_view(p, j->calib);
     for (uint32_t f = count; rc == 0 && f <= count + lights; f++) {
         uint32_t frame = f < count + lights ? f : white; /* the lights, then the white colour */
-        uint8_t *pixels = scan_frame_buffer(frame);
-        rc = pixels == NULL
-                 ? -EINVAL
-                 : scan_dir_read_frame(scan_dir, v, frame, pixels, (size_t)HAL_MAX_PIXELS * 3,
-                                       p->width, p->height, 3, err, sizeof(err));
+        uint8_t *pixels;
+        rc = read_into_buffer(scan_dir, v, frame, 3, p, &pixels, err, sizeof(err));
         if (rc == 0 && f < count + lights)
             rc = scan_feed_light_frame(f - count, pixels);
     }
@@ -1050,6 +1050,23 @@ static int check_frames(const struct job *j, const char *scan_dir, uint32_t v,
     return 0;
 }
 
+/* Frame @p f of view @p v read from @p scan_dir straight into the firmware's buffer for it (fed
+ * without a copy), as @p channels channels. @p pixels: out, that buffer. @retval 0
+ * @retval -EINVAL no buffer for it (@p err says) @retval as scan_dir_read_frame */
+static int read_into_buffer(const char *scan_dir, uint32_t v, uint32_t f, uint32_t channels,
+                            const struct scan_params *params, uint8_t **pixels, char *err,
+                            size_t err_len)
+{
+    *pixels = scan_frame_buffer(f);
+    if (*pixels == NULL) {
+        snprintf(err, err_len, "view %u: frame %u has no buffer in these settings", (unsigned)v,
+                 (unsigned)f);
+        return -EINVAL;
+    }
+    return scan_dir_read_frame(scan_dir, v, f, *pixels, (size_t)HAL_MAX_PIXELS * channels,
+                               params->width, params->height, channels, err, err_len);
+}
+
 int scan_job_feed_view(const char *scan_dir, uint32_t v, const struct scan_params *params,
                        const struct scan_calib *calib, char *err, size_t err_len)
 {
@@ -1060,12 +1077,8 @@ int scan_job_feed_view(const char *scan_dir, uint32_t v, const struct scan_param
     uint32_t channels;
     int rc = scan_begin_view(params, calib);
     for (uint32_t f = 0; rc == 0 && (channels = scan_frame_channels(params, calib, f)) != 0; f++) {
-        /* straight into the firmware's buffer for it: fed without a copy */
-        uint8_t *pixels = scan_frame_buffer(f);
-        if (pixels == NULL)
-            return -EINVAL;
-        rc = scan_dir_read_frame(scan_dir, v, f, pixels, (size_t)HAL_MAX_PIXELS * channels,
-                                 params->width, params->height, channels, err, err_len);
+        uint8_t *pixels;
+        rc = read_into_buffer(scan_dir, v, f, channels, params, &pixels, err, err_len);
         if (rc == 0)
             rc = f < count            ? scan_feed_frame(f, pixels, channels, NULL)
                  : f < count + lights ? scan_feed_light_frame(f - count, pixels)

@@ -254,9 +254,9 @@ static int obj_vertex(void *priv, const struct mesh_vertex *v)
     const float *p = v->pos, *n = v->normal;
     const uint8_t *rgb = v->rgb;
     /* "v x y z r g b": vertex colours as MeshLab, Blender and Open3D read them (and show them:
-     * sRGB-encoded, see srgb.h). Y up, as OBJ
-     * readers assume (Blender's importer turns Y up into its Z up): the object frame's
-     * (x, y, z) with z up is written (x, z, -y), a right-handed turn about x. */
+     * sRGB-encoded, see srgb.h). Y up, as OBJ readers assume (Blender's importer turns Y up
+     * into its Z up): the object frame's (x, y, z) with z up is written (x, z, -y), a
+     * right-handed turn about x. */
     outbuf_printf(o, "v %.4f %.4f %.4f %.4f %.4f %.4f\nvn %.5f %.5f %.5f\n", p[0], p[2], -p[1],
                   srgb_encode(rgb[0]) / 255.0, srgb_encode(rgb[1]) / 255.0,
                   srgb_encode(rgb[2]) / 255.0, n[0], n[2], -n[1]);
