@@ -86,7 +86,7 @@ LDLIBS_COMMON = $(PKG_LIBS) -lm
 
 FW_SRC := $(wildcard firmware/*.c) hal/hal.c
 POSIX_SRC := $(wildcard hal/posix/*.c) $(wildcard hal/modbus/*.c)
-APP_LIB_SRC := app/config.c app/frame_writer.c app/ini_schema.c app/patterns.c app/scan_dir.c app/scan_job.c app/white_cal.c board/board_frame.c
+APP_LIB_SRC := app/config.c app/frame_writer.c app/ini_schema.c app/patterns.c app/report.c app/scan_dir.c app/scan_job.c app/white_cal.c board/board_frame.c
 SIM_SRC := $(filter-out host_sim/turntable_sim_main.c,$(wildcard host_sim/*.c)) board/board_sim.c
 LINUX_SRC := $(wildcard hal/linux/*.c) board/board_linux.c board/board_display.c
 # The libcamera backend (C++) is built where libcamera is found (Raspberry Pi OS, or Debian's

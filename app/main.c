@@ -8,6 +8,7 @@
 #include "white_cal.h"
 #include "clock_posix.h"
 #include "patterns.h"
+#include "report.h"
 #include "storage_posix.h"
 
 #include <errno.h>
@@ -383,6 +384,7 @@ static const struct command {
      NEEDS_CONFIG},
     {"selftest", "scanner selftest --config FILE        try each configured device (new rig)\n",
      NEEDS_CONFIG},
+    {"report", "scanner report DIR                    write DIR/report.html again\n", NEEDS_DIR},
     {"config-doc", "scanner config-doc                    print the config reference (Markdown)\n",
      NEEDS_NOTHING},
 };
@@ -517,6 +519,17 @@ int main(int argc, char **argv)
     if (strcmp(argv[1], "process") == 0) {
         opts.config_path = config_path; /* optional: other settings for the same frames */
         return cmd_process(scan_dir, &opts);
+    }
+    if (strcmp(argv[1], "report") == 0) {
+        struct hal_storage st;
+        char err[HAL_MAX_PATH + 128];
+        storage_posix_init(&st);
+        if (report_write(&st, scan_dir, err, sizeof(err)) != 0) {
+            fprintf(stderr, "scanner: error: %s\n", err);
+            return 1;
+        }
+        printf("%s/report.html\n", scan_dir);
+        return 0;
     }
     if (strcmp(argv[1], "resume") == 0) {
         opts.config_path = config_path; /* optional: the scan's config where it was written */

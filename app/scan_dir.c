@@ -377,6 +377,49 @@ static int read_range_points(FILE *fp, size_t n, struct scan_view_fill *fill)
     return next == have && fgetc(fp) == EOF ? 0 : -EINVAL; /* nothing left over */
 }
 
+int scan_dir_read_range_image(const char *dir, uint32_t view, uint8_t *reason, uint8_t *rgb,
+                              size_t capacity, uint32_t *width, uint32_t *height)
+{
+    static struct range_point chunk[RANGE_CHUNK];
+    char path[SCAN_DIR_PATH_MAX];
+    struct range_header h;
+    int rc = scan_dir_path(path, sizeof(path), dir, (int)view, "range.bin");
+    FILE *fp = rc == 0 ? fopen(path, "rb") : NULL;
+    if (fp == NULL)
+        return rc != 0 ? rc : -errno;
+    rc = -EINVAL;
+    if (fread(&h, sizeof(h), 1, fp) != 1 || memcmp(h.magic, range_magic, sizeof(h.magic)) != 0)
+        goto out_close;
+    size_t n = (size_t)h.width * h.height;
+    if (h.width == 0 || h.height == 0 || n > capacity || fread(reason, 1, n, fp) != n)
+        goto out_close;
+    size_t have = 0, next = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (reason[i] >= SCAN_REASON_COUNT)
+            goto out_close;
+        if (reason[i] != SCAN_VALID) {
+            if (rgb != NULL)
+                memset(rgb + 3 * i, 0, 3);
+            continue;
+        }
+        if (next == have) {
+            have = fread(chunk, sizeof(chunk[0]), RANGE_CHUNK, fp);
+            next = 0;
+            if (have == 0)
+                goto out_close;
+        }
+        if (rgb != NULL)
+            memcpy(rgb + 3 * i, chunk[next].rgb, 3);
+        next++;
+    }
+    *width = h.width;
+    *height = h.height;
+    rc = 0;
+out_close:
+    fclose(fp);
+    return rc;
+}
+
 int scan_dir_read_range(const char *dir, uint32_t view, uint32_t width, uint32_t height,
                         struct scan_view *v, char *err, size_t err_len)
 {

@@ -104,6 +104,13 @@ int scan_dir_write_range(const struct hal_storage *st, const char *dir, uint32_t
 int scan_dir_read_range(const char *dir, uint32_t view, uint32_t width, uint32_t height,
                         struct scan_view *v, char *err, size_t err_len);
 
+/** What a view's range.bin shows, as pictures (report.html, the web page's thumbnails): its
+ *  size, then, in the caller's buffers of @p capacity pixels, the reason code of every pixel and
+ *  the colour of the valid ones (linear x 255, black elsewhere; @p rgb may be NULL).
+ *  @retval 0 @retval -ENOENT @retval -EINVAL damaged, or larger than @p capacity */
+int scan_dir_read_range_image(const char *dir, uint32_t view, uint8_t *reason, uint8_t *rgb,
+                              size_t capacity, uint32_t *width, uint32_t *height);
+
 /** Write view @p view's registration.ini: the scan's joint registration @p r, this view's part
  *  of it @p v, and @p pose, the camera-to-object pose it was fused with.
  *  @retval 0 @retval -errno */

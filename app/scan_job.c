@@ -9,6 +9,7 @@
 #include "fusion.h"
 #include "gray.h"
 #include "reflect.h"
+#include "report.h"
 #include "scan.h"
 #include "scan_dir.h"
 #include "thread_posix.h"
@@ -22,6 +23,8 @@
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
+
+#define JOB_MAX_STAGES 8u
 
 struct job {
     const struct hal *hal;
@@ -43,6 +46,11 @@ struct job {
         uint32_t first_done, last_done;
         double first_ms, last_ms;
     } eta;
+    struct stages { /* when each stage ended (summary.ini), in the order they first did */
+        const char *name[JOB_MAX_STAGES];
+        double end_s[JOB_MAX_STAGES];
+        unsigned n;
+    } stages;
 };
 
 /* A captured view, processed and saved by a thread of its own while the table turns to the next
@@ -199,6 +207,28 @@ static double time_left_s(struct job *j, const char *event, uint32_t done, doubl
     return left_ms > 0.0 ? left_ms / 1000.0 : 0.0;
 }
 
+/* The stage an event ends, if it ends one: the views taken (live) or decoded (process), then
+ * the registration, the reflectance fit, the fusion (which meshing follows), the mesh. */
+static void stage_ended(struct job *j, const char *event, double elapsed_s)
+{
+    static const char *const ends[][2] = {
+        {"saved", "capture"},         {"decoded", "decoding"},
+        {"registration", "registration"}, {"reflectance", "reflectance fit"},
+        {"meshing", "fusion"},        {"mesh", "meshing"}};
+    struct stages *st = &j->stages;
+    for (size_t k = 0; k < sizeof(ends) / sizeof(ends[0]); k++) {
+        if (strcmp(event, ends[k][0]) != 0)
+            continue;
+        unsigned i = 0;
+        while (i < st->n && st->name[i] != ends[k][1])
+            i++;
+        if (i == st->n && st->n < JOB_MAX_STAGES)
+            st->name[st->n++] = ends[k][1];
+        if (i < st->n)
+            st->end_s[i] = elapsed_s;
+    }
+}
+
 /* One event with its numbers as JSON fields too (@p fields: '"name":value,...' or NULL, for
  * --json). @p view < 0: not about a view. @p done: views finished so far, for the estimate. */
 static void progress_with(struct job *j, const char *event, int view, uint32_t done,
@@ -221,6 +251,7 @@ static void progress_line(struct job *j, const char *event, int view, uint32_t d
 {
     double now = wall_ms(), elapsed_s = (now - j->start_ms) / 1000.0;
     double left_s = time_left_s(j, event, done, now);
+    stage_ended(j, event, elapsed_s);
     if (j->opts->json) {
         printf("{\"event\":\"%s\",\"view\":%d,\"views\":%u,\"views_done\":%u,"
                "\"elapsed_s\":%.1f,\"left_s\":%.1f,%s%s\"detail\":",
@@ -265,6 +296,37 @@ static const char *finished_detail(struct job *j, char *buf, size_t len)
     snprintf(buf, len, "%s (mesh: %s/mesh.ply, mesh.obj, mesh.stl, mesh.glb; peak memory %.1f MB)",
              j->out_dir, j->out_dir, ru.ru_maxrss / 1024.0);
     return buf;
+}
+
+/* summary.ini (what report.html shows of the job: its stages, time and memory), then
+ * report.html. Neither is the scan's result: a failure is said and the job goes on. */
+static void write_summary_and_report(struct job *j, const char *command)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    char text[1024], path[SCAN_DIR_PATH_MAX], finished[32], err[SCAN_DIR_PATH_MAX + 64];
+    utc_now(finished, sizeof(finished));
+    double cpu = clock_posix_process_cpu_s() - j->start_cpu_s;
+    cpu -= board_simulator_cpu_s() - j->start_sim_cpu_s;
+    int n = snprintf(text, sizeof(text),
+                     "; what the %s took, for report.html (docs/scan-format.md)\n[summary]\n"
+                     "command = %s\nfinished = %s\nviews = %u\nelapsed_s = %.1f\n"
+                     "cpu_s = %.2f\npeak_memory_mb = %.1f\n[stages]\n; seconds from the start "
+                     "at which each stage ended\n",
+                     command, command, finished, (unsigned)j->views,
+                     (wall_ms() - j->start_ms) / 1000.0, cpu, ru.ru_maxrss / 1024.0);
+    for (unsigned i = 0; i < j->stages.n && n > 0 && (size_t)n < sizeof(text); i++)
+        n += snprintf(text + n, sizeof(text) - (size_t)n, "%s = %.1f\n", j->stages.name[i],
+                      j->stages.end_s[i]);
+    int rc = n > 0 && (size_t)n < sizeof(text) ? 0 : -EOVERFLOW;
+    if (rc == 0)
+        rc = scan_dir_path(path, sizeof(path), j->out_dir, -1, "summary.ini");
+    if (rc == 0)
+        rc = hal_storage_write_file(&j->hal->storage, path, text, (size_t)n);
+    if (rc != 0)
+        j->hal->log(HAL_LOG_WARN, "cannot write %s/summary.ini: %s", j->out_dir, strerror(-rc));
+    if (report_write(&j->hal->storage, j->out_dir, err, sizeof(err)) != 0)
+        j->hal->log(HAL_LOG_WARN, "cannot write the report: %s", err);
 }
 
 /* ---- the scan directory ---- */
@@ -962,6 +1024,8 @@ int scan_job_live(const struct hal *hal, const struct app_config *cfg,
     if (rc == 0)
         report_cost(&j, "the scan");
     if (rc == 0)
+        write_summary_and_report(&j, "scan");
+    if (rc == 0)
         progress(&j, "scan_done", -1, j.views, finished_detail(&j, path, sizeof(path)));
     else if (opts->json)
         progress(&j, "scan_failed", -1, 0, strerror(-rc));
@@ -1231,6 +1295,8 @@ int scan_job_process(const struct hal *hal, const char *scan_dir, const struct s
         rc = make_model(&j, scan_dir);
     if (rc == 0)
         report_cost(&j, "processing");
+    if (rc == 0)
+        write_summary_and_report(&j, "processing");
     if (rc == 0)
         progress(&j, "process_done", -1, j.views, finished_detail(&j, path, sizeof(path)));
     scan_dir_close(lock_fd);

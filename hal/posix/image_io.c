@@ -40,8 +40,8 @@ static void sink_flush(png_structp png)
     (void)png;
 }
 
-int image_write_png(const struct hal_storage *st, const char *path, const uint8_t *pixels,
-                    uint32_t width, uint32_t height, int channels)
+int image_encode_png(const uint8_t *pixels, uint32_t width, uint32_t height, int channels,
+                     uint8_t **png_data, size_t *png_len)
 {
     struct mem_sink sink = {0};
     int rc = -ENOMEM;
@@ -67,10 +67,27 @@ int image_write_png(const struct hal_storage *st, const char *path, const uint8_
     for (uint32_t y = 0; y < height; y++)
         png_write_row(png, (png_const_bytep)(pixels + (size_t)y * width * (size_t)channels));
     png_write_end(png, NULL);
-    rc = sink.failed ? -ENOMEM : hal_storage_write_file(st, path, sink.data, sink.len);
+    if (!sink.failed) {
+        *png_data = sink.data;
+        *png_len = sink.len;
+        sink.data = NULL;
+        rc = 0;
+    }
 out_png:
     png_destroy_write_struct(&png, &info);
     free(sink.data);
+    return rc;
+}
+
+int image_write_png(const struct hal_storage *st, const char *path, const uint8_t *pixels,
+                    uint32_t width, uint32_t height, int channels)
+{
+    uint8_t *data = NULL;
+    size_t len = 0;
+    int rc = image_encode_png(pixels, width, height, channels, &data, &len);
+    if (rc == 0)
+        rc = hal_storage_write_file(st, path, data, len);
+    free(data);
     return rc;
 }
 

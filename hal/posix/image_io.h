@@ -4,8 +4,13 @@
 
 #include "hal.h"
 
+#include <stddef.h>
 #include <stdint.h>
 
+/** Encode an 8-bit PNG (channels 1 or 3) in memory: *@p png_data is the caller's to free.
+ *  @retval 0 ok @retval -ENOMEM @retval -EIO */
+int image_encode_png(const uint8_t *pixels, uint32_t width, uint32_t height, int channels,
+                     uint8_t **png_data, size_t *png_len);
 /** Write an 8-bit PNG (channels 1 or 3) atomically. @retval 0 ok @retval -errno */
 int image_write_png(const struct hal_storage *st, const char *path, const uint8_t *pixels,
                     uint32_t width, uint32_t height, int channels);
