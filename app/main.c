@@ -7,6 +7,7 @@
 #include "scan_job.h"
 #include "white_cal.h"
 #include "clock_posix.h"
+#include "image_io.h"
 #include "patterns.h"
 #include "report.h"
 #include "storage_posix.h"
@@ -144,6 +145,28 @@ static int cmd_scan(const char *config_path, const struct scan_job_opts *opts)
     if (rc == 0)
         rc = scan_job_live(&the_hal, &cfg, &calib, opts);
     rig_down();
+    return rc == 0 ? 0 : 1;
+}
+
+/* One picture of the object lit by the projector's white, as a PNG (the web page's live view). */
+static int cmd_snapshot(const char *config_path, const char *out)
+{
+    static struct app_config cfg;
+    static struct scan_calib calib;
+    const uint8_t *rgb = NULL;
+    if (load_all(config_path, &cfg, &calib) != 0)
+        return 2;
+    int rc = rig_up(&cfg, &calib);
+    if (rc == 0)
+        rc = scan_snapshot(&the_hal, &cfg.scan, &calib, &rgb);
+    rig_down();
+    if (rc == 0) {
+        struct hal_storage st;
+        storage_posix_init(&st);
+        rc = image_write_png(&st, out, rgb, cfg.scan.width, cfg.scan.height, 3);
+        if (rc != 0)
+            fprintf(stderr, "scanner: error: cannot write %s: %s\n", out, strerror(-rc));
+    }
     return rc == 0 ? 0 : 1;
 }
 
@@ -385,6 +408,8 @@ static const struct command {
     {"selftest", "scanner selftest --config FILE        try each configured device (new rig)\n",
      NEEDS_CONFIG},
     {"report", "scanner report DIR                    write DIR/report.html again\n", NEEDS_DIR},
+    {"snapshot", "scanner snapshot --config FILE --out FILE.png  one picture, projector white\n",
+     NEEDS_CONFIG},
     {"config-doc", "scanner config-doc                    print the config reference (Markdown)\n",
      NEEDS_NOTHING},
 };
@@ -563,6 +588,9 @@ int main(int argc, char **argv)
     }
     if (strcmp(argv[1], "scan") == 0)
         return cmd_scan(config_path, &opts);
+    if (strcmp(argv[1], "snapshot") == 0)
+        return opts.out_dir == NULL ? missing(cmd, "--out FILE.png")
+                                    : cmd_snapshot(config_path, opts.out_dir);
     if (strcmp(argv[1], "calibrate-white") == 0)
         return cmd_calibrate_white(config_path, white_albedo);
     return cmd_selftest(config_path);

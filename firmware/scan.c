@@ -439,6 +439,22 @@ static int capture_lights(const struct hal *hal, const struct scan_params *p,
     return rc != 0 ? rc : rc_off;
 }
 
+int scan_snapshot(const struct hal *hal, const struct scan_params *p,
+                  const struct scan_calib *c, const uint8_t **rgb)
+{
+    struct scan_view_info info;
+    memset(&info, 0, sizeof(info));
+    int rc = projector_start(hal, p, c->light_count);
+    if (rc == 0)
+        rc = capture(hal, p, frame_rgb, 0, &info);
+    /* the projector off again at once, and the rig safe on every failure */
+    int rc_off = hal_gpio_set(&hal->gpio, HAL_GPIO_PROJECTOR_ENABLE, 0);
+    if (rc != 0 || rc_off != 0)
+        hal->gpio.ops->safe_state(hal->gpio.priv);
+    *rgb = frame_rgb;
+    return rc != 0 ? rc : rc_off;
+}
+
 int scan_capture_view(const struct hal *hal, const struct scan_params *p,
                       const struct scan_calib *c, int32_t angle_mdeg,
                       const struct scan_frame_sink *sink, struct scan_view_info *info)

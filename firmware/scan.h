@@ -73,6 +73,13 @@ struct scan_frame_sink {
     void *priv;
 };
 
+/** One picture of what the camera sees lit by the projector's white (the web page's live view),
+ *  without turning the table; the projector is off again when it returns.
+ *  @param rgb  out: the RGB24 frame (params' width x height), valid until the next capture
+ *  @retval 0 ok @retval capture error */
+int scan_snapshot(const struct hal *hal, const struct scan_params *params,
+                  const struct scan_calib *calib, const uint8_t **rgb);
+
 /** Capture one view at the current turntable angle, without processing it: the frames wait in
  *  the firmware's buffers for scan_finish_view (which may run while the table turns to the
  *  next view; nothing else may use the firmware meanwhile). On any failure the projector and
