@@ -73,6 +73,9 @@ INC_board := -Iboard -Ifirmware -Ihal/posix -Ihal/modbus -Ihal/linux -Ihost_sim
 # The scanner program: the firmware, the board, and the settings structs of the backends and the
 # simulator it reads from a config (turntable_modbus.h, sim_config.h).
 INC_app := -Iapp -Iboard -Ifirmware -Ihal/posix -Ihal/modbus -Ihost_sim
+# The web server: the report's pictures and the config's reader from app/ (config.h names the
+# board's settings struct); no board code is linked: it never touches a device.
+INC_web := -Iweb -Iapp -Iboard -Ifirmware -Ihal/posix -Ihal/modbus -Ihost_sim $(shell $(PKG_CONFIG) --cflags libcjson 2>/dev/null)
 # Tests, benchmarks and fuzzers see everything.
 ALL_INC := -Ifirmware -Iapp -Iboard -Ihal/posix -Ihal/linux -Ihal/modbus -Ihost_sim
 HOST_INC := -Ihal/include $(ALL_INC)
@@ -103,6 +106,12 @@ HAVE_OPENCV := $(shell $(PKG_CONFIG) --exists opencv4 2>/dev/null && echo 1)
 CALIB_SRC := app/calibrate.c app/calib_solve.c app/calib_files.c
 OPENCV_LIBS := -lopencv_aruco -lopencv_calib3d -lopencv_imgproc -lopencv_core
 CALIB_TOOL := $(if $(HAVE_OPENCV),$(BUILD)/scanner-calibrate,)
+# The web interface (scanner serve) is its own program too, scanner-web: civetweb and cJSON
+# (Debian's libcivetweb-dev and libcjson-dev, which make installs); a scan never loads them.
+# Not cross-built: the board runs the native build's (docs/web.md).
+HAVE_CIVETWEB := $(if $(CROSS_COMPILE),,$(shell test -f /usr/include/civetweb.h && $(PKG_CONFIG) --exists libcjson 2>/dev/null && echo 1))
+WEB_SRC := web/serve.c web/api.c web/jobs.c
+WEB_TOOL := $(if $(HAVE_CIVETWEB),$(BUILD)/scanner-web,)
 BOARD_LIBS = $(if $(filter linux,$(HAL)),$(shell $(PKG_CONFIG) --libs libgpiod libdrm 2>/dev/null) $(LIBCAMERA_LIBS),)
 
 obj = $(patsubst %.c,$(BUILD)/%.o,$(1))
@@ -112,11 +121,12 @@ MAIN_OBJ := $(call obj,app/main.c)
 
 .PHONY: check-blender seccomp-tool vivid-tool all deps test-deps test test-run run-complete linux-build small-build install check-stack size fuzz errors-doc test-arm64 test-arm64-full test-gpio-chip arm64-check-elf arm64-run-tests run clean format docs check-firmware bench measure measure-scan interop-meshlab bench-callgrind eval calibrate-demo measure-calib
 SIM_TOOLS := $(if $(filter sim,$(HAL)),$(BUILD)/turntable-sim $(BUILD)/tt-client $(BUILD)/mesh-compare $(BUILD)/colour-eval $(BUILD)/relight-eval,)
-all: deps $(BUILD)/scanner $(CALIB_TOOL) $(SIM_TOOLS)
+all: deps $(BUILD)/scanner $(CALIB_TOOL) $(WEB_TOOL) $(SIM_TOOLS)
 
 # Install missing Debian packages (fresh Debian 12): only when pkg-config cannot find them.
 deps:
-	@{ $(PKG_CONFIG) --exists $(PKGS) && command -v $(DEPS_TOOLS); } >/dev/null 2>&1 || \
+	@{ $(PKG_CONFIG) --exists $(PKGS) && command -v $(DEPS_TOOLS) && { [ -n "$(CROSS_COMPILE)" ] || \
+		{ test -f /usr/include/civetweb.h && $(PKG_CONFIG) --exists libcjson; }; }; } >/dev/null 2>&1 || \
 		scripts/install-deps.sh $(DEPS_SET)
 
 # The firmware's flags in a file that changes only when they do: objects built with other
@@ -155,6 +165,10 @@ $(BUILD)/app/calib_cv.o: app/calib_cv.cpp app/calib_cv.h | deps
 	$(CXX) -std=c++17 -Wall -Wextra -Werror $(OPT) -g -MMD -MP -Iapp $(shell $(PKG_CONFIG) --cflags opencv4 2>/dev/null) -c $< -o $@
 $(BUILD)/scanner-calibrate: $(BUILD)/app/main_calibrate.o $(call obj,$(CALIB_SRC)) $(BUILD)/app/calib_cv.o $(HOST_OBJ) $(BUILD)/libfirmware.a
 	$(CXX) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON) $(BOARD_LIBS) $(OPENCV_LIBS)
+
+$(BUILD)/web/serve.o: HOST_CFLAGS += -DWEB_WWW_DIR='"$(CURDIR)/web/www"'
+$(BUILD)/scanner-web: $(call obj,$(WEB_SRC) app/report.c app/scan_dir.c app/config.c app/ini_schema.c hal/posix/image_io.c hal/posix/storage_posix.c) $(BUILD)/libfirmware.a
+	$(CC) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON) -lcivetweb -lcjson
 
 # The simulated controller as its own program, and the client as a command (interop tests).
 $(BUILD)/turntable-sim: $(call obj,host_sim/turntable_sim_main.c host_sim/tt_server.c host_sim/tt_ctrl.c)
@@ -283,7 +297,7 @@ test-deps: deps
 # A second make, so that what test-deps installed (libcamera-dev) is seen when it starts.
 test: deps test-deps
 	@$(MAKE) --no-print-directory test-run
-test-run: $(BUILD)/scanner $(CALIB_TOOL) $(SIM_TOOLS) $(BUILD)/seccomp-run $(TEST_BIN) $(FUZZ_REPLAY) check-firmware $(if $(filter 0,$(SAN)),check-stack,) linux-build small-build
+test-run: $(BUILD)/scanner $(CALIB_TOOL) $(WEB_TOOL) $(SIM_TOOLS) $(BUILD)/seccomp-run $(TEST_BIN) $(FUZZ_REPLAY) check-firmware $(if $(filter 0,$(SAN)),check-stack,) linux-build small-build
 	@RUN_WITH="$(VALGRIND_RUN)" BUILD=$(BUILD) tests/run.sh $(TEST_BIN) tests/layers.sh tests/interop.sh tests/fuzz/replay.sh tests/resume.sh -- tests/cli.sh tests/calibrate.sh
 
 # make test VALGRIND=1: every cmocka test under valgrind memcheck; any invalid access,

@@ -276,6 +276,26 @@ static int cmd_resume(const char *scan_dir, const struct scan_job_opts *opts)
     return cmd_process(scan_dir, opts);
 }
 
+/* A program installed beside this one, run in its place with the same arguments. */
+static int exec_beside(const char *program, char **argv, const char *hint)
+{
+    char self[HAL_MAX_PATH], path[HAL_MAX_PATH + 32];
+    ssize_t n = readlink("/proc/self/exe", self, sizeof(self) - 1);
+    if (n <= 0) {
+        fprintf(stderr, "scanner: error: cannot find my own program: %s\n", strerror(errno));
+        return 1;
+    }
+    self[n] = '\0';
+    char *slash = strrchr(self, '/');
+    if (slash != NULL)
+        *slash = '\0';
+    snprintf(path, sizeof(path), "%s/%s", self, program);
+    argv[0] = path;
+    execv(path, argv);
+    fprintf(stderr, "scanner: error: cannot run %s: %s (%s)\n", path, strerror(errno), hint);
+    return 1;
+}
+
 #ifdef SCANNER_CALIBRATE
 /* scanner calibrate [verify | board] --config F [--out P] [--dir D | --from D] */
 static int cmd_calibrate(int argc, char **argv)
@@ -348,24 +368,9 @@ static int cmd_calibrate(int argc, char **argv)
 static int cmd_calibrate(int argc, char **argv)
 {
     (void)argc;
-    char self[HAL_MAX_PATH], path[HAL_MAX_PATH + 32];
-    ssize_t n = readlink("/proc/self/exe", self, sizeof(self) - 1);
-    if (n <= 0) {
-        fprintf(stderr, "scanner: error: cannot find my own program: %s\n", strerror(errno));
-        return 1;
-    }
-    self[n] = '\0';
-    char *slash = strrchr(self, '/');
-    if (slash != NULL)
-        *slash = '\0';
-    snprintf(path, sizeof(path), "%s/scanner-calibrate", self);
-    argv[0] = path;
-    execv(path, argv);
-    fprintf(stderr,
-            "scanner: error: cannot run %s: %s (the calibration needs OpenCV: install Debian's "
-            "libopencv-contrib-dev and rebuild)\n",
-            path, strerror(errno));
-    return 1;
+    return exec_beside("scanner-calibrate", argv,
+                       "the calibration needs OpenCV: install Debian's libopencv-contrib-dev and "
+                       "rebuild");
 }
 #endif
 
@@ -408,6 +413,10 @@ static const struct command {
     {"selftest", "scanner selftest --config FILE        try each configured device (new rig)\n",
      NEEDS_CONFIG},
     {"report", "scanner report DIR                    write DIR/report.html again\n", NEEDS_DIR},
+    {"serve",
+     "scanner serve --config FILE [--listen ADDR:PORT] [--token-file F]  the web interface\n"
+     "    (default http://127.0.0.1:8080; scanner serve --help says more)\n",
+     NEEDS_CONFIG},
     {"snapshot", "scanner snapshot --config FILE --out FILE.png  one picture, projector white\n",
      NEEDS_CONFIG},
     {"config-doc", "scanner config-doc                    print the config reference (Markdown)\n",
@@ -476,7 +485,7 @@ static int check_command_line(int argc, char **argv, const struct command **cmd)
         fprintf(stderr, "scanner: unknown command '%s' (scanner --help lists them)\n", argv[1]);
         return 2;
     }
-    for (int i = 2; i < argc; i++)
+    for (int i = 2; i < argc && strcmp((*cmd)->name, "serve") != 0; i++) /* its own --help */
         if (is_help(argv[i])) {
             usage_of(stdout, *cmd);
             return 0;
@@ -507,6 +516,11 @@ int main(int argc, char **argv)
     }
     if (strcmp(argv[1], "calibrate") == 0)
         return cmd_calibrate(argc, argv);
+    /* The web server (civetweb) is its own program too: a scan never loads it. */
+    if (strcmp(argv[1], "serve") == 0)
+        return exec_beside("scanner-web", argv,
+                           "the web interface needs civetweb: install Debian's libcivetweb-dev "
+                           "and libcjson-dev and rebuild");
     int first = 2;
     if (cmd->needs == NEEDS_DIR && argc > 2 && argv[2][0] != '-') {
         scan_dir = argv[2];

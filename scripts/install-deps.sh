@@ -10,6 +10,8 @@
 # (aarch64-linux-gnu) what cross-building for it needs.
 set -eu
 pkgs="build-essential pkg-config libinih-dev libpng-dev libzstd-dev libjpeg-dev libdrm-dev libcmocka-dev libmodbus-dev libgpiod-dev libseccomp-dev"
+# the web interface (scanner-web): native builds only
+case "${1:-}" in *-linux-gnu*) ;; *) pkgs="$pkgs libcivetweb-dev libcjson-dev" ;; esac
 [ "${1:-}" = "bench" ] && pkgs="$pkgs g++ libopencv-dev libopencv-contrib-dev valgrind libspng-dev libzstd-dev python3-open3d"
 [ "${1:-}" = "fuzz" ] && pkgs="$pkgs clang libclang-rt-14-dev"
 [ "${1:-}" = "blender" ] && pkgs="blender"

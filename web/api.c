@@ -1,0 +1,515 @@
+/* The HTTP API (docs/api.md): JSON in and out under /api, each request checked for its token
+ * off loopback, its size and its path before anything is done for it. */
+#define _GNU_SOURCE
+#include "api.h"
+
+#include "report.h"
+
+#include <cJSON.h>
+#include <civetweb.h>
+#include <dirent.h>
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#ifndef SCANNER_VERSION
+#define SCANNER_VERSION "0.1.0"
+#endif
+
+static const char *reason_phrase(int status)
+{
+    switch (status) {
+    case 200: return "OK";
+    case 400: return "Bad Request";
+    case 401: return "Unauthorized";
+    case 403: return "Forbidden";
+    case 404: return "Not Found";
+    case 405: return "Method Not Allowed";
+    case 409: return "Conflict";
+    case 413: return "Payload Too Large";
+    case 415: return "Unsupported Media Type";
+    default: return "Internal Server Error";
+    }
+}
+
+/* Send @p body (taken) with @p status. @retval the civetweb handler's "handled" (status) */
+static int send_json(struct mg_connection *conn, int status, cJSON *body)
+{
+    char *text = cJSON_PrintUnformatted(body);
+    cJSON_Delete(body);
+    if (text == NULL)
+        return 500;
+    /* the body with mg_write: civetweb 1.15's mg_printf fails on long output (it formats
+     * twice with one va_list) */
+    mg_printf(conn,
+              "HTTP/1.1 %d %s\r\nContent-Type: application/json\r\nContent-Length: %zu\r\n"
+              "Cache-Control: no-store\r\n\r\n",
+              status, reason_phrase(status), strlen(text));
+    mg_write(conn, text, strlen(text));
+    free(text);
+    return status;
+}
+
+static int send_error(struct mg_connection *conn, int status, const char *message)
+{
+    cJSON *body = cJSON_CreateObject();
+    cJSON_AddStringToObject(body, "error", message);
+    return send_json(conn, status, body);
+}
+
+/* ---- who may ask ---- */
+
+/* Equal without telling by its timing how much of a guess was right. */
+static int token_equal(const char *a, const char *b)
+{
+    size_t la = strlen(a), lb = strlen(b);
+    unsigned diff = (unsigned)(la ^ lb);
+    for (size_t i = 0; i < lb; i++)
+        diff |= (unsigned)(unsigned char)(i < la ? a[i] : 0) ^ (unsigned char)b[i];
+    return diff == 0;
+}
+
+/* Off loopback every API request but the login carries the token: an "Authorization: Bearer"
+ * header (scripts), or the cookie the login sets (the page, and its downloads). */
+static int authorised(const struct web_server *s, const struct mg_connection *conn)
+{
+    if (s->token[0] == '\0')
+        return 1;
+    const char *h = mg_get_header(conn, "Authorization");
+    if (h != NULL && strncmp(h, "Bearer ", 7) == 0 && token_equal(h + 7, s->token))
+        return 1;
+    const char *cookie = mg_get_header(conn, "Cookie");
+    char value[sizeof(s->token)];
+    return cookie != NULL && mg_get_cookie(cookie, "scanner_token", value, sizeof(value)) > 0 &&
+           token_equal(value, s->token);
+}
+
+/* A POST's JSON body: application/json (which a page of another site cannot send here without
+ * the browser asking first, so that no other site can start the rig from a visitor's browser)
+ * and at most WEB_MAX_BODY bytes. An empty body is {}. @retval 0 or the status to answer */
+static int read_body(struct mg_connection *conn, cJSON **body)
+{
+    const struct mg_request_info *ri = mg_get_request_info(conn);
+    const char *type = mg_get_header(conn, "Content-Type");
+    char text[WEB_MAX_BODY + 1];
+    if (type == NULL || strncmp(type, "application/json", 16) != 0)
+        return 415;
+    if (ri->content_length > WEB_MAX_BODY)
+        return 413;
+    int n = 0, got;
+    while (n < WEB_MAX_BODY && (got = mg_read(conn, text + n, (size_t)(WEB_MAX_BODY - n))) > 0)
+        n += got;
+    text[n] = '\0';
+    *body = n == 0 ? cJSON_CreateObject() : cJSON_Parse(text);
+    return *body != NULL && cJSON_IsObject(*body) ? 0 : 400;
+}
+
+/* ---- scans ---- */
+
+static cJSON *job_json(struct web_server *s, const char *id)
+{
+    enum web_state state;
+    unsigned done, total;
+    char error[512];
+    if (jobs_describe(s, id, &state, &done, &total, error, sizeof(error)) != 0)
+        return NULL;
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddStringToObject(o, "id", id);
+    cJSON_AddStringToObject(o, "state", web_state_name(state));
+    cJSON_AddNumberToObject(o, "views_done", done);
+    cJSON_AddNumberToObject(o, "views_total", total);
+    cJSON_AddStringToObject(o, "error", error);
+    struct web_job *j = &s->job;
+    pthread_mutex_lock(&j->lock);
+    if (strcmp(j->id, id) == 0 && j->state != WEB_IDLE) { /* the live details */
+        cJSON_AddStringToObject(o, "stage", j->stage);
+        cJSON_AddNumberToObject(o, "stage_views_done", j->step_done);
+        cJSON_AddStringToObject(o, "detail", j->detail);
+        cJSON_AddNumberToObject(o, "elapsed_s", j->elapsed_s);
+        cJSON_AddNumberToObject(o, "left_s", j->left_s);
+        cJSON_AddStringToObject(o, "profile", j->profile);
+    }
+    pthread_mutex_unlock(&j->lock);
+    char path[WEB_PATH + 80];
+    snprintf(path, sizeof(path), "%s/%s/report.html", s->scans, id);
+    cJSON_AddBoolToObject(o, "report", access(path, F_OK) == 0);
+    snprintf(path, sizeof(path), "%s/%s/mesh.glb", s->scans, id);
+    cJSON_AddBoolToObject(o, "glb", access(path, F_OK) == 0);
+    return o;
+}
+
+static int by_name_newest_first(const void *a, const void *b)
+{
+    return strcmp(*(char *const *)b, *(char *const *)a);
+}
+
+static int list_scans(struct mg_connection *conn, struct web_server *s)
+{
+    cJSON *list = cJSON_CreateArray();
+    DIR *d = opendir(s->scans);
+    char *names[512];
+    size_t n = 0;
+    for (struct dirent *e; d != NULL && (e = readdir(d)) != NULL && n < 512;)
+        if (web_name_ok(e->d_name))
+            names[n++] = strdup(e->d_name);
+    if (d != NULL)
+        closedir(d);
+    qsort(names, n, sizeof(names[0]), by_name_newest_first);
+    for (size_t i = 0; i < n; i++) {
+        cJSON *o = names[i] != NULL ? job_json(s, names[i]) : NULL;
+        if (o != NULL)
+            cJSON_AddItemToArray(list, o);
+        free(names[i]);
+    }
+    cJSON *body = cJSON_CreateObject();
+    cJSON_AddItemToObject(body, "scans", list);
+    return send_json(conn, 200, body);
+}
+
+static const struct web_profile *find_profile(const struct web_server *s, const cJSON *body)
+{
+    const cJSON *name = cJSON_GetObjectItemCaseSensitive(body, "profile");
+    if (name == NULL)
+        return &s->profile[0]; /* {}: the served config */
+    for (unsigned i = 0; cJSON_IsString(name) && i < s->profiles; i++)
+        if (strcmp(s->profile[i].name, name->valuestring) == 0)
+            return &s->profile[i];
+    return NULL;
+}
+
+/* POST /api/scans (a new scan) or /api/scans/ID/resume. */
+static int start_scan(struct mg_connection *conn, struct web_server *s, const char *resume_id)
+{
+    cJSON *body = NULL;
+    int status = read_body(conn, &body);
+    if (status != 0) {
+        cJSON_Delete(body);
+        return send_error(conn, status, status == 415 ? "send the request as application/json"
+                                        : status == 413 ? "the request is too large"
+                                                        : "the body is not a JSON object");
+    }
+    const struct web_profile *p = find_profile(s, body);
+    cJSON_Delete(body);
+    if (p == NULL)
+        return send_error(conn, 400, "no such profile (GET /api/status lists them)");
+    char id[64], err[WEB_PATH + 128];
+    int rc = jobs_start(s, p, resume_id, id, sizeof(id), err, sizeof(err));
+    if (rc != 0)
+        return send_error(conn, rc == -EBUSY ? 409 : 500, err);
+    cJSON *answer = cJSON_CreateObject();
+    cJSON_AddStringToObject(answer, "id", id);
+    return send_json(conn, 200, answer);
+}
+
+/* Server-Sent Events: the scan's state at every event, until it ends (or the client goes). */
+static int stream_events(struct mg_connection *conn, struct web_server *s, const char *id)
+{
+    struct web_job *j = &s->job;
+    unsigned long seen = 0;
+    mg_printf(conn, "HTTP/1.1 200 OK\r\nContent-Type: text/event-stream\r\nCache-Control: "
+                    "no-store\r\nConnection: close\r\n\r\n");
+    for (;;) {
+        pthread_mutex_lock(&j->lock);
+        seen = j->seq; /* what happens from here on wakes the wait below */
+        pthread_mutex_unlock(&j->lock);
+        cJSON *o = job_json(s, id);
+        if (o == NULL)
+            break;
+        const char *state = cJSON_GetObjectItemCaseSensitive(o, "state")->valuestring;
+        int over = strcmp(state, "running") != 0;
+        char *text = cJSON_PrintUnformatted(o);
+        cJSON_Delete(o);
+        int sent = text != NULL && mg_write(conn, "data: ", 6) > 0 &&
+                           mg_write(conn, text, strlen(text)) > 0 && mg_write(conn, "\n\n", 2) > 0
+                       ? 1
+                       : -1;
+        free(text);
+        if (sent <= 0 || over)
+            break;
+        pthread_mutex_lock(&j->lock);
+        struct timespec until;
+        clock_gettime(CLOCK_REALTIME, &until);
+        until.tv_sec += 15; /* a comment now and then tells a dead client from a live one */
+        int timed_out = 0;
+        while (j->seq == seen && !j->stopping && !timed_out)
+            timed_out = pthread_cond_timedwait(&j->changed, &j->lock, &until) == ETIMEDOUT;
+        int stopping = j->stopping;
+        pthread_mutex_unlock(&j->lock);
+        if (stopping || (timed_out && mg_printf(conn, ": still here\n\n") <= 0))
+            break;
+    }
+    return 200;
+}
+
+/* A file of the scan: one name, or a view folder and a name; never anything outside it. */
+static int send_scan_file(struct mg_connection *conn, struct web_server *s, const char *id,
+                          const char *rel)
+{
+    char part[2][160], path[PATH_MAX + 400], real[PATH_MAX], root[PATH_MAX];
+    int parts = 0;
+    for (const char *p = rel; parts < 3;) {
+        size_t len = strcspn(p, "/");
+        if (parts == 2 || len == 0 || len >= sizeof(part[0]))
+            return send_error(conn, 403, "not a file of the scan");
+        memcpy(part[parts], p, len);
+        part[parts][len] = '\0';
+        if (!web_name_ok(part[parts++]))
+            return send_error(conn, 403, "not a file of the scan");
+        if (p[len] == '\0')
+            break;
+        p += len + 1;
+    }
+    snprintf(path, sizeof(path), "%s/%s", s->scans, id);
+    if (realpath(path, root) == NULL)
+        return send_error(conn, 404, "no such scan");
+    if (parts == 1)
+        snprintf(path, sizeof(path), "%s/%s", root, part[0]);
+    else
+        snprintf(path, sizeof(path), "%s/%s/%s", root, part[0], part[1]);
+    struct stat sb;
+    /* a link planted in the folder must not lead out of it */
+    if (realpath(path, real) == NULL || stat(real, &sb) != 0 || !S_ISREG(sb.st_mode))
+        return send_error(conn, 404, "no such file in the scan");
+    if (strncmp(real, root, strlen(root)) != 0 || real[strlen(root)] != '/')
+        return send_error(conn, 403, "not a file of the scan");
+    const char *name = part[parts - 1], *dot = strrchr(name, '.');
+    const char *mime = dot == NULL                 ? "application/octet-stream"
+                       : strcmp(dot, ".html") == 0 ? "text/html; charset=utf-8"
+                       : strcmp(dot, ".png") == 0  ? "image/png"
+                       : strcmp(dot, ".glb") == 0  ? "model/gltf-binary"
+                       : strcmp(dot, ".ini") == 0  ? "text/plain; charset=utf-8"
+                                                   : "application/octet-stream";
+    const struct mg_request_info *ri = mg_get_request_info(conn);
+    char extra[512] = "";
+    if (ri->query_string != NULL && strstr(ri->query_string, "download=1") != NULL)
+        snprintf(extra, sizeof(extra), "Content-Disposition: attachment; filename=\"%s\"\r\n",
+                 name);
+    mg_send_mime_file2(conn, real, mime, extra[0] ? extra : NULL);
+    return 200;
+}
+
+/* The thumbnails share the report's readers, which keep static buffers: one at a time. */
+static pthread_mutex_t thumb_lock = PTHREAD_MUTEX_INITIALIZER;
+
+static int send_thumb(struct mg_connection *conn, struct web_server *s, const char *id,
+                      const char *rest)
+{
+    unsigned view;
+    char kind[16];
+    if (sscanf(rest, "%u/%15[a-z].png", &view, kind) != 2)
+        return send_error(conn, 404, "no such thumbnail (VIEW/raw.png, colour.png, reasons.png)");
+    enum report_thumb k = strcmp(kind, "raw") == 0      ? REPORT_THUMB_RAW
+                          : strcmp(kind, "colour") == 0 ? REPORT_THUMB_INTRINSIC
+                                                        : REPORT_THUMB_REASONS;
+    if (k == REPORT_THUMB_REASONS && strcmp(kind, "reasons") != 0)
+        return send_error(conn, 404, "no such thumbnail (raw, colour or reasons)");
+    char dir[WEB_PATH + 160];
+    snprintf(dir, sizeof(dir), "%s/%s", s->scans, id);
+    uint8_t *png = NULL;
+    size_t len = 0;
+    pthread_mutex_lock(&thumb_lock);
+    int rc = report_thumb_png(dir, view, k, &png, &len);
+    pthread_mutex_unlock(&thumb_lock);
+    if (rc != 0)
+        return send_error(conn, 404, "that view has no such picture (yet)");
+    mg_printf(conn,
+              "HTTP/1.1 200 OK\r\nContent-Type: image/png\r\nContent-Length: %zu\r\n"
+              "Cache-Control: no-store\r\n\r\n",
+              len);
+    mg_write(conn, png, len);
+    free(png);
+    return 200;
+}
+
+/* The scan folder as one tar archive, streamed from tar(1) as it writes it. */
+static int send_archive(struct mg_connection *conn, struct web_server *s, const char *id)
+{
+    struct web_job *j = &s->job;
+    pthread_mutex_lock(&j->lock);
+    int running = j->state == WEB_RUNNING && strcmp(j->id, id) == 0;
+    pthread_mutex_unlock(&j->lock);
+    if (running)
+        return send_error(conn, 409, "the scan is still running");
+    char name[160];
+    snprintf(name, sizeof(name), "%s/", id);
+    const char *args[] = {"/bin/tar", "-C", s->scans, "-cf", "-", name, NULL};
+    int fd;
+    pid_t pid = web_spawn(args, &fd, NULL);
+    if (pid < 0)
+        return send_error(conn, 500, "cannot run tar");
+    char header[512];
+    snprintf(header, sizeof(header),
+             "HTTP/1.1 200 OK\r\nContent-Type: application/x-tar\r\nContent-Disposition: "
+             "attachment; filename=\"%s.tar\"\r\nConnection: close\r\n\r\n",
+             id);
+    mg_printf(conn, "%s", header);
+    /* (not on the stack: civetweb's worker threads have 100 KiB) */
+    const size_t chunk = 65536;
+    char *buf = malloc(chunk);
+    ssize_t n;
+    while (buf != NULL && ((n = read(fd, buf, chunk)) > 0 || (n < 0 && errno == EINTR)))
+        if (n > 0 && mg_write(conn, buf, (size_t)n) <= 0)
+            break; /* the client went away: tar gets SIGPIPE at its next write */
+    free(buf);
+    close(fd);
+    waitpid(pid, NULL, 0);
+    return 200;
+}
+
+/* GET /api/selftest: the rig's devices, each tried (not while a scan runs: the rig is one). */
+static int selftest(struct mg_connection *conn, struct web_server *s)
+{
+    const char *args[] = {s->scanner, "selftest", "--config", s->profile[0].path, NULL};
+    static char out[8192];
+    static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
+    int status = -1;
+    pthread_mutex_lock(&lock);
+    int rc = jobs_run_tool(s, args, out, sizeof(out), &status);
+    cJSON *body = cJSON_CreateObject();
+    cJSON_AddBoolToObject(body, "ok", rc == 0 && status == 0);
+    cJSON_AddStringToObject(body, "table", rc == 0 ? out : "");
+    pthread_mutex_unlock(&lock);
+    if (rc == -EBUSY) {
+        cJSON_Delete(body);
+        return send_error(conn, 409, "the rig is busy (a scan is running)");
+    }
+    return send_json(conn, 200, body);
+}
+
+/* GET /api/snapshot.png: what the camera sees lit by the projector's white. */
+static int snapshot(struct mg_connection *conn, struct web_server *s)
+{
+    char path[] = "/tmp/scanner-snapshot-XXXXXX.png", out[512];
+    int fd = mkstemps(path, 4);
+    if (fd < 0)
+        return send_error(conn, 500, "cannot make a temporary file");
+    close(fd);
+    const char *args[] = {s->scanner, "snapshot", "--config", s->profile[0].path, "--out", path,
+                          NULL};
+    int status = -1;
+    int rc = jobs_run_tool(s, args, out, sizeof(out), &status);
+    if (rc == -EBUSY) {
+        unlink(path);
+        return send_error(conn, 409, "the rig is busy (a scan is running)");
+    }
+    if (rc != 0 || status != 0) {
+        unlink(path);
+        return send_error(conn, 500, "the camera gave no picture (GET /api/selftest says why)");
+    }
+    mg_send_mime_file2(conn, path, "image/png", "Cache-Control: no-store\r\n");
+    unlink(path);
+    return 200;
+}
+
+static int status(struct mg_connection *conn, struct web_server *s)
+{
+    struct web_job *j = &s->job;
+    cJSON *body = cJSON_CreateObject(), *profiles = cJSON_CreateArray();
+    cJSON_AddStringToObject(body, "version", SCANNER_VERSION);
+    for (unsigned i = 0; i < s->profiles; i++)
+        cJSON_AddItemToArray(profiles, cJSON_CreateString(s->profile[i].name));
+    cJSON_AddItemToObject(body, "profiles", profiles);
+    pthread_mutex_lock(&j->lock);
+    int running = j->state == WEB_RUNNING, busy = j->rig_busy;
+    char id[64];
+    snprintf(id, sizeof(id), "%s", j->id);
+    pthread_mutex_unlock(&j->lock);
+    cJSON_AddBoolToObject(body, "scanning", running);
+    cJSON_AddStringToObject(body, "current", running ? id : "");
+    /* every scanner command leaves lights and projector off when it ends: while none runs,
+     * they are off */
+    cJSON_AddStringToObject(body, "lights_and_projector",
+                            busy ? "switched by the scanner as it works" : "off");
+    cJSON_AddBoolToObject(body, "token_required", s->token[0] != '\0');
+    return send_json(conn, 200, body);
+}
+
+/* POST /api/login {"token": "..."}: the cookie the page's requests then carry. */
+static int login(struct mg_connection *conn, struct web_server *s)
+{
+    cJSON *body = NULL;
+    int st = read_body(conn, &body);
+    const cJSON *token = cJSON_GetObjectItemCaseSensitive(body, "token");
+    int ok = st == 0 && cJSON_IsString(token) && s->token[0] != '\0' &&
+             token_equal(token->valuestring, s->token);
+    cJSON_Delete(body);
+    if (st != 0)
+        return send_error(conn, st, "send {\"token\": \"...\"} as application/json");
+    if (!ok)
+        return send_error(conn, 401, "wrong token");
+    mg_printf(conn,
+              "HTTP/1.1 200 OK\r\nContent-Type: application/json\r\nContent-Length: 2\r\n"
+              "Set-Cookie: scanner_token=%s; Path=/; HttpOnly; SameSite=Strict\r\n\r\n{}",
+              s->token);
+    return 200;
+}
+
+/* /api/scans/ID[/what[/rest]] */
+static int scan_route(struct mg_connection *conn, struct web_server *s, const char *method,
+                      const char *path)
+{
+    char id[130];
+    size_t len = strcspn(path, "/");
+    if (len >= sizeof(id))
+        return send_error(conn, 404, "no such scan");
+    memcpy(id, path, len);
+    id[len] = '\0';
+    if (!web_name_ok(id))
+        return send_error(conn, 403, "not a scan's name");
+    const char *what = path[len] == '/' ? path + len + 1 : "";
+    int is_get = strcmp(method, "GET") == 0, is_post = strcmp(method, "POST") == 0;
+    if (what[0] == '\0' && is_get) {
+        cJSON *o = job_json(s, id);
+        return o != NULL ? send_json(conn, 200, o) : send_error(conn, 404, "no such scan");
+    }
+    if (strcmp(what, "stop") == 0 && is_post)
+        return jobs_stop(s, id) == 0 ? send_json(conn, 200, cJSON_CreateObject())
+                                     : send_error(conn, 409, "that scan is not running");
+    if (strcmp(what, "resume") == 0 && is_post) {
+        cJSON *o = job_json(s, id);
+        int ok = o != NULL;
+        cJSON_Delete(o);
+        return ok ? start_scan(conn, s, id) : send_error(conn, 404, "no such scan");
+    }
+    if (strcmp(what, "events") == 0 && is_get)
+        return stream_events(conn, s, id);
+    if (strncmp(what, "files/", 6) == 0 && is_get)
+        return send_scan_file(conn, s, id, what + 6);
+    if (strncmp(what, "thumbs/", 7) == 0 && is_get)
+        return send_thumb(conn, s, id, what + 7);
+    if (strcmp(what, "archive.tar") == 0 && is_get)
+        return send_archive(conn, s, id);
+    return send_error(conn, is_get || is_post ? 404 : 405, "no such request");
+}
+
+int api_handle(struct mg_connection *conn, void *cbdata)
+{
+    struct web_server *s = cbdata;
+    const struct mg_request_info *ri = mg_get_request_info(conn);
+    /* the path as sent, decoded: the checks below see a "..", civetweb's cleaning would hide it */
+    const char *path = ri->local_uri_raw != NULL ? ri->local_uri_raw : ri->local_uri;
+    const char *method = ri->request_method;
+    int is_get = strcmp(method, "GET") == 0, is_post = strcmp(method, "POST") == 0;
+    if (strcmp(path, "/api/login") == 0 && is_post)
+        return login(conn, s);
+    if (!authorised(s, conn))
+        return send_error(conn, 401, "this scanner wants its token (POST /api/login)");
+    if (strcmp(path, "/api/status") == 0 && is_get)
+        return status(conn, s);
+    if (strcmp(path, "/api/selftest") == 0 && is_get)
+        return selftest(conn, s);
+    if (strcmp(path, "/api/snapshot.png") == 0 && is_get)
+        return snapshot(conn, s);
+    if (strcmp(path, "/api/scans") == 0 && is_get)
+        return list_scans(conn, s);
+    if (strcmp(path, "/api/scans") == 0 && is_post)
+        return start_scan(conn, s, NULL);
+    if (strncmp(path, "/api/scans/", 11) == 0)
+        return scan_route(conn, s, method, path + 11);
+    return send_error(conn, 404, "no such request (docs/api.md)");
+}

@@ -1,0 +1,430 @@
+/* The rig's users, as child processes of the web server: a scan or a resume (`scanner ... --json`,
+ * whose event lines a reader thread turns into the job's state), a selftest, a snapshot. The
+ * scanner program keeps the rig safe on every exit path of its own; the server only asks it to
+ * stop (SIGTERM) and never kills it harder. */
+#define _GNU_SOURCE
+#include "web.h"
+
+#include <cJSON.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <ini.h>
+#include <poll.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/prctl.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+const char *web_state_name(enum web_state state)
+{
+    static const char *const names[] = {"idle", "running", "finished", "failed", "stopped"};
+    return names[state];
+}
+
+int web_name_ok(const char *name)
+{
+    if (name[0] == '\0' || name[0] == '.' || strlen(name) > 128)
+        return 0;
+    for (const char *c = name; *c != '\0'; c++)
+        if (!((*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') || (*c >= '0' && *c <= '9') ||
+              *c == '_' || *c == '-' || *c == '.'))
+            return 0;
+    return 1;
+}
+
+/* The child is asked to stop with SIGTERM, the scanner's orderly shutdown. */
+pid_t web_spawn(const char *const *args, int *fd_out, int *fd_err)
+{
+    int out[2], err[2] = {-1, -1};
+    if (pipe2(out, O_CLOEXEC) != 0)
+        return -errno;
+    if (fd_err != NULL && pipe2(err, O_CLOEXEC) != 0) {
+        int e = errno;
+        close(out[0]);
+        close(out[1]);
+        return -e;
+    }
+    pid_t pid = fork();
+    if (pid == 0) {
+        sigset_t none; /* the server's threads block its stop signals; the child must not */
+        sigemptyset(&none);
+        sigprocmask(SIG_SETMASK, &none, NULL);
+        signal(SIGPIPE, SIG_DFL);
+        prctl(PR_SET_PDEATHSIG, SIGTERM);
+        int null = open("/dev/null", O_RDWR);
+        dup2(null, STDIN_FILENO);
+        dup2(out[1], STDOUT_FILENO);
+        dup2(fd_err != NULL ? err[1] : null, STDERR_FILENO);
+        execv(args[0], (char *const *)args);
+        _exit(127);
+    }
+    int e = errno;
+    close(out[1]);
+    if (err[1] >= 0)
+        close(err[1]);
+    if (pid < 0) {
+        close(out[0]);
+        if (err[0] >= 0)
+            close(err[0]);
+        return -e;
+    }
+    *fd_out = out[0];
+    if (fd_err != NULL)
+        *fd_err = err[0];
+    return pid;
+}
+
+/* One event line of `scanner --json` (docs/api.md lists them) into the job's state. */
+static void on_event(struct web_job *j, const char *line)
+{
+    cJSON *ev = cJSON_Parse(line);
+    const cJSON *event = cJSON_GetObjectItemCaseSensitive(ev, "event");
+    if (!cJSON_IsString(event)) {
+        cJSON_Delete(ev);
+        return;
+    }
+    const cJSON *views = cJSON_GetObjectItemCaseSensitive(ev, "views");
+    const cJSON *done = cJSON_GetObjectItemCaseSensitive(ev, "views_done");
+    const cJSON *elapsed = cJSON_GetObjectItemCaseSensitive(ev, "elapsed_s");
+    const cJSON *left = cJSON_GetObjectItemCaseSensitive(ev, "left_s");
+    const cJSON *detail = cJSON_GetObjectItemCaseSensitive(ev, "detail");
+    pthread_mutex_lock(&j->lock);
+    snprintf(j->stage, sizeof(j->stage), "%s", event->valuestring);
+    if (cJSON_IsNumber(views))
+        j->views_total = (unsigned)views->valuedouble;
+    if (cJSON_IsNumber(done)) { /* the fusion counts its own views again from 0: the views
+                                    * taken only grow */
+        j->step_done = (unsigned)done->valuedouble;
+        if (j->step_done > j->views_done)
+            j->views_done = j->step_done;
+    }
+    if (cJSON_IsNumber(elapsed))
+        j->elapsed_s = elapsed->valuedouble;
+    if (cJSON_IsNumber(left))
+        j->left_s = left->valuedouble;
+    if (cJSON_IsString(detail))
+        snprintf(j->detail, sizeof(j->detail), "%s", detail->valuestring);
+    if (strcmp(event->valuestring, "scan_done") == 0 ||
+        strcmp(event->valuestring, "process_done") == 0)
+        j->done_seen = 1;
+    j->seq++;
+    pthread_cond_broadcast(&j->changed);
+    pthread_mutex_unlock(&j->lock);
+    cJSON_Delete(ev);
+}
+
+/* The scanner's messages: the first error is the cause (each fault is said once, by the layer
+ * that met it); the rest stays in the server's log. */
+static void on_message(struct web_job *j, const char *line)
+{
+    static const char prefix[] = "scanner: error: ";
+    fprintf(stderr, "%s\n", line);
+    pthread_mutex_lock(&j->lock);
+    if (j->error[0] == '\0' && strncmp(line, prefix, sizeof(prefix) - 1) == 0)
+        snprintf(j->error, sizeof(j->error), "%s", line + sizeof(prefix) - 1);
+    pthread_mutex_unlock(&j->lock);
+}
+
+struct line_buf {
+    char text[8192];
+    size_t len;
+};
+
+/* Read what @p fd has; call @p on_line for each whole line. @retval 0 open @retval 1 at end */
+static int read_lines(int fd, struct line_buf *b, struct web_job *j,
+                      void (*on_line)(struct web_job *, const char *))
+{
+    ssize_t n = read(fd, b->text + b->len, sizeof(b->text) - 1 - b->len);
+    if (n < 0 && errno == EINTR)
+        return 0;
+    if (n <= 0)
+        return 1;
+    b->len += (size_t)n;
+    char *start = b->text, *nl;
+    b->text[b->len] = '\0';
+    while ((nl = memchr(start, '\n', b->len - (size_t)(start - b->text))) != NULL) {
+        *nl = '\0';
+        on_line(j, start);
+        start = nl + 1;
+    }
+    b->len -= (size_t)(start - b->text);
+    memmove(b->text, start, b->len);
+    if (b->len == sizeof(b->text) - 1) /* a line longer than any the scanner writes */
+        b->len = 0;
+    return 0;
+}
+
+/* Run to the end and wait: @retval the exit status, or -1 */
+static int run_and_wait(const char *const *args)
+{
+    int fd;
+    pid_t pid = web_spawn(args, &fd, NULL);
+    if (pid < 0)
+        return -1;
+    char sink[256];
+    while (read(fd, sink, sizeof(sink)) > 0)
+        ;
+    close(fd);
+    int status;
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR)
+        ;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+static void *reader_main(void *arg)
+{
+    struct web_server *s = arg;
+    struct web_job *j = &s->job;
+    static struct line_buf out, err;
+    out.len = err.len = 0;
+    struct pollfd pf[2] = {{.fd = j->fd_out, .events = POLLIN}, {.fd = j->fd_err, .events = POLLIN}};
+    while (pf[0].fd >= 0 || pf[1].fd >= 0) {
+        if (poll(pf, 2, -1) < 0 && errno != EINTR)
+            break;
+        for (int k = 0; k < 2; k++)
+            if (pf[k].fd >= 0 && (pf[k].revents & (POLLIN | POLLHUP | POLLERR)) &&
+                read_lines(pf[k].fd, k == 0 ? &out : &err, j, k == 0 ? on_event : on_message)) {
+                close(pf[k].fd);
+                pf[k].fd = -1;
+            }
+    }
+    int status = 0;
+    while (waitpid(j->pid, &status, 0) < 0 && errno == EINTR)
+        ;
+    pthread_mutex_lock(&j->lock);
+    int finished = WIFEXITED(status) && WEXITSTATUS(status) == 0 && j->done_seen;
+    char dir[WEB_PATH];
+    snprintf(dir, sizeof(dir), "%s", j->dir);
+    pthread_mutex_unlock(&j->lock);
+    /* a scan that ended early still gets its report, of what it has */
+    if (!finished) {
+        const char *args[] = {s->scanner, "report", dir, NULL};
+        run_and_wait(args);
+    }
+    pthread_mutex_lock(&j->lock);
+    j->state = finished ? WEB_FINISHED : j->stop_requested ? WEB_STOPPED : WEB_FAILED;
+    if (j->state == WEB_FAILED && j->error[0] == '\0')
+        snprintf(j->error, sizeof(j->error), "the scanner ended with %s %d",
+                 WIFEXITED(status) ? "status" : "signal",
+                 WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status));
+    j->pid = 0;
+    j->rig_busy = 0;
+    j->seq++;
+    pthread_cond_broadcast(&j->changed);
+    pthread_mutex_unlock(&j->lock);
+    return NULL;
+}
+
+/* A new folder named by the time (UTC), as the scanner names its own. */
+static int new_scan_dir(const struct web_server *s, char *id, size_t id_len, char *dir,
+                        size_t dir_len)
+{
+    char stamp[32];
+    time_t t = time(NULL);
+    struct tm tm;
+    gmtime_r(&t, &tm);
+    strftime(stamp, sizeof(stamp), "%Y-%m-%d_%H%M%S", &tm);
+    for (int k = 1; k < 100; k++) {
+        if (k == 1)
+            snprintf(id, id_len, "%s", stamp);
+        else
+            snprintf(id, id_len, "%s-%d", stamp, k);
+        if ((size_t)snprintf(dir, dir_len, "%s/%s", s->scans, id) >= dir_len)
+            return -ENAMETOOLONG;
+        if (mkdir(dir, 0755) == 0)
+            return 0;
+        if (errno != EEXIST)
+            return -errno;
+    }
+    return -EEXIST;
+}
+
+int jobs_start(struct web_server *s, const struct web_profile *p, const char *resume_id,
+               char *id, size_t id_len, char *err, size_t err_len)
+{
+    struct web_job *j = &s->job;
+    char dir[WEB_PATH];
+    pthread_mutex_lock(&j->lock);
+    int busy = j->rig_busy;
+    j->rig_busy = 1;
+    pthread_mutex_unlock(&j->lock);
+    if (busy) {
+        snprintf(err, err_len, "the rig is busy (one scan at a time)");
+        return -EBUSY;
+    }
+    if (j->have_reader) { /* the last scan's reader has ended: it freed the rig */
+        pthread_join(j->reader, NULL);
+        j->have_reader = 0;
+    }
+    int rc = 0;
+    dir[0] = '\0';
+    if (resume_id != NULL) {
+        snprintf(id, id_len, "%s", resume_id);
+        if ((size_t)snprintf(dir, sizeof(dir), "%s/%s", s->scans, resume_id) >= sizeof(dir))
+            rc = -ENAMETOOLONG;
+    } else {
+        rc = new_scan_dir(s, id, id_len, dir, sizeof(dir));
+    }
+    const char *scan_args[] = {s->scanner, "scan", "--config", p->path, "--out", dir, "--json",
+                               NULL};
+    const char *resume_args[] = {s->scanner, "resume", dir, "--config", p->path, "--json", NULL};
+    pid_t pid = -EINVAL;
+    if (rc == 0)
+        pid = web_spawn(resume_id != NULL ? resume_args : scan_args, &j->fd_out, &j->fd_err);
+    if (rc != 0 || pid < 0) {
+        rc = rc != 0 ? rc : (int)pid;
+        snprintf(err, err_len, "cannot start the scanner in %s: %s", dir, strerror(-rc));
+        pthread_mutex_lock(&j->lock);
+        j->rig_busy = 0;
+        pthread_mutex_unlock(&j->lock);
+        return rc;
+    }
+    pthread_mutex_lock(&j->lock);
+    j->pid = pid;
+    j->state = WEB_RUNNING;
+    j->stop_requested = j->done_seen = 0;
+    j->views_done = j->views_total = j->step_done = 0;
+    j->elapsed_s = 0;
+    j->left_s = -1;
+    j->error[0] = j->detail[0] = '\0';
+    snprintf(j->stage, sizeof(j->stage), "starting");
+    snprintf(j->id, sizeof(j->id), "%s", id);
+    snprintf(j->dir, sizeof(j->dir), "%s", dir);
+    snprintf(j->profile, sizeof(j->profile), "%s", p->name);
+    j->seq++;
+    pthread_cond_broadcast(&j->changed);
+    pthread_mutex_unlock(&j->lock);
+    if (pthread_create(&j->reader, NULL, reader_main, s) == 0) {
+        j->have_reader = 1;
+        return 0;
+    }
+    /* nobody would read its events: ask it to stop (it ends on its own shutdown path) */
+    kill(pid, SIGTERM);
+    waitpid(pid, NULL, 0);
+    pthread_mutex_lock(&j->lock);
+    j->state = WEB_FAILED;
+    j->rig_busy = 0;
+    pthread_mutex_unlock(&j->lock);
+    snprintf(err, err_len, "cannot start a thread for the scan");
+    return -EAGAIN;
+}
+
+int jobs_stop(struct web_server *s, const char *id)
+{
+    struct web_job *j = &s->job;
+    int rc = -ESRCH;
+    pthread_mutex_lock(&j->lock);
+    if (j->state == WEB_RUNNING && strcmp(j->id, id) == 0 && j->pid > 0) {
+        j->stop_requested = 1;
+        kill(j->pid, SIGTERM);
+        rc = 0;
+    }
+    pthread_mutex_unlock(&j->lock);
+    return rc;
+}
+
+int jobs_run_tool(struct web_server *s, const char *const *args, char *out, size_t out_len,
+                  int *status)
+{
+    struct web_job *j = &s->job;
+    pthread_mutex_lock(&j->lock);
+    int busy = j->rig_busy;
+    j->rig_busy = 1;
+    pthread_mutex_unlock(&j->lock);
+    if (busy)
+        return -EBUSY;
+    int fd;
+    pid_t pid = web_spawn(args, &fd, NULL);
+    size_t used = 0;
+    if (pid > 0) {
+        ssize_t n;
+        char sink[512];
+        while ((n = read(fd, used + 1 < out_len ? out + used : sink,
+                         used + 1 < out_len ? out_len - 1 - used : sizeof(sink))) > 0 ||
+               (n < 0 && errno == EINTR))
+            if (n > 0 && used + 1 < out_len)
+                used += (size_t)n;
+        close(fd);
+        int st = 0;
+        while (waitpid(pid, &st, 0) < 0 && errno == EINTR)
+            ;
+        *status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+    }
+    out[used] = '\0';
+    pthread_mutex_lock(&j->lock);
+    j->rig_busy = 0;
+    pthread_mutex_unlock(&j->lock);
+    return pid > 0 ? 0 : (int)pid;
+}
+
+void jobs_shutdown(struct web_server *s)
+{
+    struct web_job *j = &s->job;
+    pthread_mutex_lock(&j->lock);
+    j->stopping = 1;
+    pthread_cond_broadcast(&j->changed);
+    if (j->pid > 0) {
+        fprintf(stderr, "scanner-web: stopping scan %s (its finished views are kept)\n", j->id);
+        j->stop_requested = 1;
+        kill(j->pid, SIGTERM);
+    }
+    pthread_mutex_unlock(&j->lock);
+    if (j->have_reader)
+        pthread_join(j->reader, NULL); /* until the scanner has put the rig in its safe state */
+    j->have_reader = 0;
+}
+
+struct scan_counts {
+    unsigned views, passes;
+};
+
+static int count_views(void *user, const char *section, const char *key, const char *value)
+{
+    struct scan_counts *c = user;
+    if (strcmp(section, "scan") == 0 && strcmp(key, "views") == 0)
+        c->views = (unsigned)strtoul(value, NULL, 10);
+    if (strcmp(section, "scan") == 0 && strcmp(key, "passes") == 0)
+        c->passes = (unsigned)strtoul(value, NULL, 10);
+    return 1;
+}
+
+int jobs_describe(struct web_server *s, const char *id, enum web_state *state,
+                  unsigned *views_done, unsigned *views_total, char *error, size_t error_len)
+{
+    struct web_job *j = &s->job;
+    error[0] = '\0';
+    pthread_mutex_lock(&j->lock);
+    if (j->state != WEB_IDLE && strcmp(j->id, id) == 0) {
+        *state = j->state;
+        *views_done = j->views_done;
+        *views_total = j->views_total;
+        snprintf(error, error_len, "%s", j->error);
+        pthread_mutex_unlock(&j->lock);
+        return 0;
+    }
+    pthread_mutex_unlock(&j->lock);
+    /* a scan of another time: what its folder holds (a view is complete with its view.ini) */
+    char path[WEB_PATH + 64];
+    struct stat sb;
+    snprintf(path, sizeof(path), "%s/%s", s->scans, id);
+    if (!web_name_ok(id) || lstat(path, &sb) != 0 || !S_ISDIR(sb.st_mode))
+        return -ENOENT;
+    struct scan_counts c = {0, 1};
+    snprintf(path, sizeof(path), "%s/%s/config.ini", s->scans, id);
+    if (ini_parse(path, count_views, &c) < 0)
+        return -ENOENT; /* not a scan */
+    *views_total = c.views * (c.passes ? c.passes : 1);
+    *views_done = 0;
+    for (unsigned v = 0; v < *views_total; v++) {
+        snprintf(path, sizeof(path), "%s/%s/view_%03u/view.ini", s->scans, id, v);
+        *views_done += access(path, F_OK) == 0;
+    }
+    snprintf(path, sizeof(path), "%s/%s/mesh.ply", s->scans, id);
+    *state = access(path, F_OK) == 0 ? WEB_FINISHED : WEB_STOPPED;
+    return 0;
+}

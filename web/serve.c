@@ -1,0 +1,229 @@
+/* scanner-web (`scanner serve`): the appliance's web page and HTTP API on civetweb. Scans run as
+ * `scanner` child processes, so the rig's safety stays where it is (the scanner's one shutdown
+ * path); this program never touches a device. */
+#define _GNU_SOURCE
+#include "api.h"
+#include "config.h"
+#include "web.h"
+
+#include <civetweb.h>
+#include <errno.h>
+#include <libgen.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#ifndef WEB_WWW_DIR
+#define WEB_WWW_DIR "/usr/local/share/scanner/www"
+#endif
+
+static const char usage_text[] =
+    "usage: scanner serve --config FILE [--config FILE2 ...] [--listen ADDR:PORT]\n"
+    "                     [--token-file FILE] [--scans DIR] [--www DIR]\n"
+    "  --config      a config the page can scan with (a profile: its file name without .ini);\n"
+    "                the first is the default and the rig's selftest and snapshot use it\n"
+    "  --listen      where to listen (default 127.0.0.1:8080); any address but loopback\n"
+    "                needs --token-file\n"
+    "  --token-file  a file holding the secret every API request must carry off loopback\n"
+    "                (16 characters or more; set at install: there is no default)\n"
+    "  --scans       where scan folders are made and listed (default: the first config's\n"
+    "                [output] dir)\n"
+    "  --www         the page's files (default " WEB_WWW_DIR ")\n";
+
+static int is_loopback(const char *listen)
+{
+    return strncmp(listen, "127.", 4) == 0 || strncmp(listen, "localhost:", 10) == 0 ||
+           strncmp(listen, "[::1]:", 6) == 0;
+}
+
+/* The secret: the file's first line, without its line end. @retval 0 @retval -1 (said) */
+static int read_token(const char *path, char *token, size_t len)
+{
+    FILE *f = fopen(path, "r");
+    if (f == NULL || fgets(token, (int)len, f) == NULL) {
+        fprintf(stderr, "scanner serve: --token-file %s: %s\n", path,
+                f == NULL ? strerror(errno) : "empty");
+        if (f != NULL)
+            fclose(f);
+        return -1;
+    }
+    fclose(f);
+    token[strcspn(token, "\r\n")] = '\0';
+    if (strlen(token) < 16) {
+        fprintf(stderr, "scanner serve: --token-file %s: the token must be 16 characters or more\n",
+                path);
+        return -1;
+    }
+    return 0;
+}
+
+static int add_profile(struct web_server *s, const char *path)
+{
+    if (s->profiles == WEB_MAX_PROFILES) {
+        fprintf(stderr, "scanner serve: at most %u configs\n", WEB_MAX_PROFILES);
+        return -1;
+    }
+    struct web_profile *p = &s->profile[s->profiles];
+    if (realpath(path, p->path) == NULL) {
+        fprintf(stderr, "scanner serve: --config %s: %s\n", path, strerror(errno));
+        return -1;
+    }
+    char copy[WEB_PATH];
+    snprintf(copy, sizeof(copy), "%s", path);
+    snprintf(p->name, sizeof(p->name), "%s", basename(copy));
+    char *dot = strrchr(p->name, '.');
+    if (dot != NULL && strcmp(dot, ".ini") == 0)
+        *dot = '\0';
+    for (unsigned i = 0; i < s->profiles; i++)
+        if (strcmp(s->profile[i].name, p->name) == 0) {
+            fprintf(stderr, "scanner serve: two configs named %s\n", p->name);
+            return -1;
+        }
+    s->profiles++;
+    return 0;
+}
+
+/* Every config must load (file, line and key said now, not at the first scan). The first's
+ * [output] dir holds the scans unless --scans says otherwise. */
+static int check_configs(struct web_server *s, const char *scans)
+{
+    static struct app_config cfg;
+    char err[1024];
+    for (unsigned i = 0; i < s->profiles; i++) {
+        if (config_load(&cfg, s->profile[i].path, err, sizeof(err)) != 0) {
+            fprintf(stderr, "scanner serve: %s\n", err);
+            return -1;
+        }
+        if (i == 0 && scans == NULL)
+            scans = cfg.output_dir;
+    }
+    if (mkdir(scans, 0755) != 0 && errno != EEXIST) {
+        fprintf(stderr, "scanner serve: cannot make %s: %s\n", scans, strerror(errno));
+        return -1;
+    }
+    if (realpath(scans, s->scans) == NULL) {
+        fprintf(stderr, "scanner serve: %s: %s\n", scans, strerror(errno));
+        return -1;
+    }
+    return 0;
+}
+
+/* The scanner program beside this one. */
+static int find_scanner(struct web_server *s)
+{
+    char self[WEB_PATH];
+    ssize_t n = readlink("/proc/self/exe", self, sizeof(self) - 1);
+    if (n <= 0)
+        return -1;
+    self[n] = '\0';
+    snprintf(s->scanner, sizeof(s->scanner), "%s/scanner", dirname(self));
+    if (access(s->scanner, X_OK) != 0) {
+        fprintf(stderr, "scanner serve: %s: %s\n", s->scanner, strerror(errno));
+        return -1;
+    }
+    return 0;
+}
+
+static int log_message(const struct mg_connection *conn, const char *message)
+{
+    (void)conn;
+    fprintf(stderr, "scanner-web: %s\n", message);
+    return 1;
+}
+
+int main(int argc, char **argv)
+{
+    static struct web_server s = {.job = {.lock = PTHREAD_MUTEX_INITIALIZER,
+                                          .changed = PTHREAD_COND_INITIALIZER}};
+    const char *listen = "127.0.0.1:8080", *token_file = NULL, *scans = NULL;
+    snprintf(s.www, sizeof(s.www), "%s", WEB_WWW_DIR);
+    int first = argc > 1 && strcmp(argv[1], "serve") == 0 ? 2 : 1;
+    for (int i = first; i < argc; i++) {
+        const char *value = i + 1 < argc ? argv[i + 1] : NULL;
+        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
+            fputs(usage_text, stdout);
+            return 0;
+        } else if (value != NULL && strcmp(argv[i], "--config") == 0) {
+            if (add_profile(&s, value) != 0)
+                return 2;
+        } else if (value != NULL && strcmp(argv[i], "--listen") == 0) {
+            listen = value;
+        } else if (value != NULL && strcmp(argv[i], "--token-file") == 0) {
+            token_file = value;
+        } else if (value != NULL && strcmp(argv[i], "--scans") == 0) {
+            scans = value;
+        } else if (value != NULL && strcmp(argv[i], "--www") == 0) {
+            snprintf(s.www, sizeof(s.www), "%s", value);
+        } else {
+            fprintf(stderr, "scanner serve: %s '%s'\n%s",
+                    value == NULL && argv[i][0] == '-' && argv[i][1] == '-'
+                        ? "a value is missing after"
+                        : "unknown argument",
+                    argv[i], usage_text);
+            return 2;
+        }
+        i++;
+    }
+    if (s.profiles == 0) {
+        fprintf(stderr, "scanner serve: --config FILE is required\n%s", usage_text);
+        return 2;
+    }
+    if (!is_loopback(listen) && token_file == NULL) {
+        fprintf(stderr,
+                "scanner serve: --listen %s is reachable from the network: give --token-file "
+                "FILE (a secret of 16 characters or more, set at install)\n",
+                listen);
+        return 2;
+    }
+    if (token_file != NULL && read_token(token_file, s.token, sizeof(s.token)) != 0)
+        return 2;
+    if (check_configs(&s, scans) != 0 || find_scanner(&s) != 0)
+        return 2;
+    char index[WEB_PATH + 16];
+    snprintf(index, sizeof(index), "%s/index.html", s.www);
+    if (access(index, R_OK) != 0) {
+        fprintf(stderr, "scanner serve: %s: %s (--www DIR)\n", index, strerror(errno));
+        return 2;
+    }
+    /* SIGINT and SIGTERM are waited for below, in this thread only */
+    sigset_t stop;
+    sigemptyset(&stop);
+    sigaddset(&stop, SIGINT);
+    sigaddset(&stop, SIGTERM);
+    sigaddset(&stop, SIGHUP);
+    pthread_sigmask(SIG_BLOCK, &stop, NULL);
+    signal(SIGPIPE, SIG_IGN);
+    const char *options[] = {"listening_ports", listen,
+                             "document_root", s.www,
+                             "num_threads", "16",
+                             "enable_directory_listing", "no",
+                             "max_request_size", "16384",
+                             "request_timeout_ms", "30000",
+                             "additional_header", "X-Content-Type-Options: nosniff",
+                             NULL};
+    struct mg_callbacks callbacks;
+    memset(&callbacks, 0, sizeof(callbacks));
+    callbacks.log_message = log_message;
+    mg_init_library(0);
+    struct mg_context *ctx = mg_start(&callbacks, &s, options);
+    if (ctx == NULL) {
+        fprintf(stderr, "scanner serve: cannot listen on %s (in use? not an address here?)\n",
+                listen);
+        mg_exit_library();
+        return 1;
+    }
+    mg_set_request_handler(ctx, "/api", api_handle, &s);
+    printf("scanner serve: http://%s/ (%s; scans in %s%s)\n", listen, s.profile[0].path, s.scans,
+           s.token[0] ? "; a token is required" : "");
+    fflush(stdout);
+    int sig = 0;
+    sigwait(&stop, &sig);
+    fprintf(stderr, "scanner-web: %s: shutting down\n", strsignal(sig));
+    jobs_shutdown(&s); /* a scan stops in order: its views kept, the rig safe */
+    mg_stop(ctx);
+    mg_exit_library();
+    return 0;
+}

@@ -1,0 +1,95 @@
+/* The web interface's shared state: what it serves (configs as profiles, the scans' folder, the
+ * page), who may change anything (a token off loopback), and the one scan the rig can run. */
+#ifndef WEB_H
+#define WEB_H
+
+#include <limits.h>
+#include <pthread.h>
+#include <stddef.h>
+#include <sys/types.h>
+
+#define WEB_MAX_PROFILES 16u
+#define WEB_MAX_BODY 4096 /* bytes of a request body: a profile's name is all a POST carries */
+#define WEB_PATH 1024
+
+struct web_profile {
+    char name[64];       /* the config file's name without .ini */
+    char path[WEB_PATH]; /* the config file */
+};
+
+enum web_state { WEB_IDLE, WEB_RUNNING, WEB_FINISHED, WEB_FAILED, WEB_STOPPED };
+
+/* The scan (or resume) the rig runs now, or ran last: a child process, `scanner scan --json`,
+ * whose event lines a thread of ours reads. Every field under @c lock. */
+struct web_job {
+    pthread_mutex_t lock;
+    pthread_cond_t changed; /* broadcast at every event (the progress streams wait on it) */
+    enum web_state state;
+    int rig_busy;            /* a scan, a snapshot or a selftest holds the rig */
+    pid_t pid;               /* the scanner while it runs */
+    int stop_requested;
+    int have_reader;
+    pthread_t reader;
+    int fd_out, fd_err;      /* the scanner's standard output (events) and error (messages) */
+    int done_seen;           /* it said scan_done or process_done */
+    int stopping;            /* the server is shutting down: progress streams end */
+    char id[64];             /* the scan folder's name */
+    char dir[WEB_PATH];      /* the scan folder */
+    char profile[64];
+    unsigned views_done, views_total; /* views taken (complete), of all */
+    unsigned step_done;               /* views through the current stage (taken, fused ...) */
+    char stage[32];          /* the last event: capturing, registration, meshing ... */
+    char detail[512];
+    double elapsed_s, left_s;
+    char error[512];         /* the scanner's own error line, when it failed */
+    unsigned long seq;       /* events so far */
+};
+
+struct web_server {
+    char scanner[WEB_PATH]; /* the scanner program the scans run in */
+    char www[WEB_PATH];     /* the page */
+    char scans[WEB_PATH];   /* where scan folders are made and listed */
+    struct web_profile profile[WEB_MAX_PROFILES];
+    unsigned profiles;
+    char token[256];        /* "" on loopback: nothing to present */
+    struct web_job job;
+};
+
+/* ---- jobs.c: the child processes that use the rig ---- */
+
+/** Start `scanner scan` with @p p into a new folder under the scans' folder, or `scanner resume`
+ *  of the scan @p resume_id. @param id  out: the scan's id (its folder's name)
+ *  @retval 0 @retval -EBUSY the rig is in use @retval -errno (@p err says what) */
+int jobs_start(struct web_server *s, const struct web_profile *p, const char *resume_id,
+               char *id, size_t id_len, char *err, size_t err_len);
+
+/** Ask the running scan @p id to stop (it stops between frames, rig safe, finished views kept).
+ *  @retval 0 @retval -ESRCH not the running scan */
+int jobs_stop(struct web_server *s, const char *id);
+
+/** Run `scanner ARGS...` to its end on the rig (a selftest, a snapshot) unless a scan holds it;
+ *  its standard output into @p out (at most @p out_len - 1 bytes, NUL-terminated).
+ *  @param status  out: its exit status @retval 0 @retval -EBUSY @retval -errno */
+int jobs_run_tool(struct web_server *s, const char *const *args, char *out, size_t out_len,
+                  int *status);
+
+/** fork and exec @p args[0] with its standard output on a pipe (@p fd_out) and its standard
+ *  error on another (@p fd_err, or NULL: /dev/null); the child is asked to stop should the server
+ *  die first. @retval its pid @retval -errno */
+pid_t web_spawn(const char *const *args, int *fd_out, int *fd_err);
+
+/** Stop a running scan and wait for it (its own shutdown leaves the rig safe). */
+void jobs_shutdown(struct web_server *s);
+
+/** The state of scan @p id: the running one's as its events say, another's from its folder.
+ *  @retval 0 @retval -ENOENT no such scan */
+int jobs_describe(struct web_server *s, const char *id, enum web_state *state,
+                  unsigned *views_done, unsigned *views_total, char *error, size_t error_len);
+
+const char *web_state_name(enum web_state state);
+
+/** @retval 1 when @p name is one path component of letters, digits, '_', '-' and '.', not
+ *  beginning with '.' (a scan id, a file name): nothing that could leave a folder. */
+int web_name_ok(const char *name);
+
+#endif
