@@ -96,14 +96,18 @@ static int read_body(struct mg_connection *conn, cJSON **body)
 {
     const struct mg_request_info *ri = mg_get_request_info(conn);
     const char *type = mg_get_header(conn, "Content-Type");
-    char text[WEB_MAX_BODY + 1];
+    char text[WEB_MAX_BODY + 2];
     if (type == NULL || strncmp(type, "application/json", 16) != 0)
         return 415;
     if (ri->content_length > WEB_MAX_BODY)
         return 413;
+    /* a chunked body says no length: one byte more than the limit tells it is too long */
     int n = 0, got;
-    while (n < WEB_MAX_BODY && (got = mg_read(conn, text + n, (size_t)(WEB_MAX_BODY - n))) > 0)
+    while (n <= WEB_MAX_BODY &&
+           (got = mg_read(conn, text + n, (size_t)(WEB_MAX_BODY + 1 - n))) > 0)
         n += got;
+    if (n > WEB_MAX_BODY)
+        return 413;
     text[n] = '\0';
     *body = n == 0 ? cJSON_CreateObject() : cJSON_Parse(text);
     return *body != NULL && cJSON_IsObject(*body) ? 0 : 400;

@@ -97,8 +97,11 @@ static void on_event(struct web_job *j, const char *line)
     snprintf(j->stage, sizeof(j->stage), "%s", event->valuestring);
     if (cJSON_IsNumber(views))
         j->views_total = (unsigned)views->valuedouble;
-    if (cJSON_IsNumber(done)) { /* the fusion counts its own views again from 0: the views
-                                    * taken only grow */
+    /* Views taken count when one is saved (its files are there: the page asks for its
+     * thumbnails), decoded again, or fused; the fusion counts from 0 again: they only grow. */
+    const char *e = event->valuestring;
+    if (cJSON_IsNumber(done) && (strcmp(e, "saved") == 0 || strcmp(e, "decoded") == 0 ||
+                                 strcmp(e, "fused") == 0)) {
         j->step_done = (unsigned)done->valuedouble;
         if (j->step_done > j->views_done)
             j->views_done = j->step_done;

@@ -1,0 +1,258 @@
+// make test-browser: the web interface on the simulator, driven through Debian's Chromium
+// (playwright-core, no browser download) and through raw HTTP. Every check prints ok or FAIL;
+// the exit status is the number of failures. Pictures of the page go to BUILD/browser/.
+//   node tests/browser/browser_test.mjs BUILD
+import { chromium } from 'playwright-core';
+import { spawn } from 'node:child_process';
+import fs from 'node:fs';
+import http from 'node:http';
+import path from 'node:path';
+
+const build = process.argv[2] || 'build';
+const out = path.resolve(build, 'browser');
+fs.rmSync(out, { recursive: true, force: true });
+fs.mkdirSync(out, { recursive: true });
+const scans = path.join(out, 'scans');
+const scanner = path.resolve(build, 'scanner');
+let failures = 0;
+let lastServer = null; // its messages are printed when the test fails
+
+function check(ok, what) {
+  console.log(`${ok ? 'ok' : 'FAIL'}: ${what}`);
+  if (!ok) failures++;
+}
+
+const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+// scanner serve with @p args; resolves with its address once it says it listens.
+function serve(args) {
+  return new Promise((resolve, reject) => {
+    const proc = spawn(scanner, ['serve', ...args], { stdio: ['ignore', 'pipe', 'pipe'] });
+    let text = '';
+    proc.stderr.on('data', (d) => { text += d; });
+    proc.stdout.on('data', (d) => {
+      const m = /(http:\/\/[^/]+\/)/.exec(String(d));
+      if (m) {
+        lastServer = { proc, url: m[1].replace('0.0.0.0', '127.0.0.1'), log: () => text };
+        resolve(lastServer);
+      }
+    });
+    proc.on('exit', (code, signal) => reject(Object.assign(new Error(`exited ${code}: ${text}`), { code, text })));
+  });
+}
+
+function stopServer(s) {
+  return new Promise((resolve) => {
+    if (s.proc.exitCode !== null) return resolve(s.proc.exitCode);
+    s.proc.on('exit', (code) => resolve(code));
+    s.proc.kill('SIGTERM');
+  });
+}
+
+// A raw request: the path goes out exactly as written ("..", "%2e" and all).
+function raw(url, method, rawPath, headers = {}, body = null) {
+  const u = new URL(url);
+  return new Promise((resolve, reject) => {
+    // a fresh connection each time: the server closes idle ones, which a pooled socket would hit
+    const req = http.request({ host: u.hostname, port: u.port, method, path: rawPath, headers, agent: false }, (res) => {
+      const chunks = [];
+      res.on('data', (c) => chunks.push(c));
+      res.on('end', () => resolve({ status: res.statusCode, headers: res.headers, body: Buffer.concat(chunks) }));
+    });
+    req.on('error', reject);
+    if (body !== null) req.write(body);
+    req.end();
+  });
+}
+
+const json = { 'Content-Type': 'application/json' };
+const port = 20000 + (process.pid % 20000);
+
+async function waitFor(what, fn, timeoutMs) {
+  const until = Date.now() + timeoutMs;
+  for (;;) {
+    const v = await fn();
+    if (v) return v;
+    if (Date.now() > until) throw new Error(`timed out waiting for ${what}`);
+    await sleep(250);
+  }
+}
+
+const scanState = async (url, id) =>
+  JSON.parse((await raw(url, 'GET', `/api/scans/${id}`)).body.toString());
+
+// ---- the page, as a person uses it ----
+async function pageTest(browser) {
+  const s = await serve(['--config', 'config/sim.ini', '--listen', `127.0.0.1:${port}`, '--scans', scans]);
+  check(true, `scanner serve listens at ${s.url}`);
+  const page = await browser.newPage({ viewport: { width: 1400, height: 1000 }, acceptDownloads: true });
+  page.on('pageerror', (e) => check(false, `no error in the page's JavaScript (${e.message})`));
+  await page.goto(s.url);
+  await page.waitForSelector('#main:not([hidden])');
+  check((await page.textContent('#rig-state')) === 'ready', 'the page says the rig is ready');
+  check((await page.textContent('#lights')) === 'off', 'lights and projector are off while idle');
+
+  await page.click('#start');
+  await page.waitForFunction(() => /views/.test(document.getElementById('progress').textContent));
+  const busy = await raw(s.url, 'POST', '/api/scans', json, '{}');
+  check(busy.status === 409, `a second scan while one runs is refused with 409 (${busy.status})`);
+  await page.waitForFunction(() => document.querySelectorAll('#thumbs figure').length >= 4, null, { timeout: 120000 });
+  await page.screenshot({ path: path.join(out, 'page-scanning.png') });
+  const during = await page.textContent('#progress');
+  check(/taking view \d of 8/.test(during), `progress names the view being taken ("${during}")`);
+  await page.waitForFunction(() => /8 of 8 views · finished/.test(document.getElementById('progress').textContent),
+    null, { timeout: 180000 });
+  check(true, 'progress reached 8 of 8 and the scan finished');
+  await page.waitForFunction(() => document.getElementById('viewer').dataset.loaded, null, { timeout: 60000 });
+  const id = await page.evaluate(() => document.getElementById('viewer').dataset.loaded);
+  await sleep(300);
+  await page.screenshot({ path: path.join(out, 'page-finished.png') });
+
+  // the viewer drew the model: pixels unlike the background, coloured with colour on
+  const pixels = () => page.evaluate(() => {
+    const c = document.getElementById('viewer');
+    const t = document.createElement('canvas');
+    t.width = c.width; t.height = c.height;
+    const g = t.getContext('2d');
+    g.drawImage(c, 0, 0);
+    const d = g.getImageData(0, 0, t.width, t.height).data;
+    let model = 0, colourful = 0;
+    for (let i = 0; i < d.length; i += 4) {
+      const r = d[i], gr = d[i + 1], b = d[i + 2];
+      if (Math.abs(r - 0x20) + Math.abs(gr - 0x24) + Math.abs(b - 0x2a) > 30) model++;
+      if (Math.max(r, gr, b) - Math.min(r, gr, b) > 60) colourful++;
+    }
+    return { model, colourful, total: d.length / 4 };
+  });
+  const on = await pixels();
+  check(on.model > 0.03 * on.total, `the viewer drew the model (${on.model} of ${on.total} pixels differ from the background)`);
+  await page.click('#colour');
+  await sleep(300);
+  const off = await pixels();
+  check(on.colourful > 5 * off.colourful + 100,
+    `colour off greys the model (${on.colourful} coloured pixels with colour, ${off.colourful} without)`);
+
+  const thumbs = await page.evaluate(() => [...document.querySelectorAll('#thumbs img')].filter((i) => i.complete && i.naturalWidth > 0).length);
+  check(thumbs === 16, `every view has its colour and reason-map thumbnail (${thumbs} of 16 shown)`);
+
+  const [dl] = await Promise.all([page.waitForEvent('download'), page.click('#downloads a:text-is("mesh.ply")')]);
+  const got = fs.readFileSync(await dl.path());
+  const disk = fs.readFileSync(path.join(scans, id, 'mesh.ply'));
+  check(got.equals(disk), `the downloaded mesh.ply is the file on disk (${got.length} bytes)`);
+  const report = await raw(s.url, 'GET', `/api/scans/${id}/files/report.html`);
+  check(report.status === 200 && /<h1>Scan /.test(report.body) && (report.body.toString().match(/<img /g) || []).length >= 29,
+    'report.html is served, with the model and every view\'s pictures');
+  const tar = await raw(s.url, 'GET', `/api/scans/${id}/archive.tar`);
+  check(tar.status === 200 && tar.body.includes(Buffer.from(`${id}/mesh.ply`)), `the scan folder downloads as one tar (${tar.body.length} bytes)`);
+  const snap = await raw(s.url, 'GET', '/api/snapshot.png');
+  check(snap.status === 200 && snap.body.subarray(1, 4).toString() === 'PNG', 'the camera\'s picture is a PNG');
+
+  // stop a scan from the page, then resume it to the end
+  await page.click('#start');
+  await page.waitForFunction(() => /^Scan \S+: [2-7] of 8/.test(document.getElementById('progress').textContent), null, { timeout: 60000 });
+  await page.click('#stop');
+  await page.waitForFunction(() => /stopped/.test(document.getElementById('progress').textContent), null, { timeout: 60000 });
+  const stoppedText = await page.textContent('#progress');
+  const stoppedId = /^Scan (\S+):/.exec(stoppedText)[1];
+  const kept = (await scanState(s.url, stoppedId)).views_done;
+  check(kept >= 2 && kept < 8, `a stopped scan keeps its finished views (${kept}; "${stoppedText}")`);
+  check(!fs.existsSync(path.join(scans, stoppedId, 'mesh.ply')) && fs.existsSync(path.join(scans, stoppedId, 'report.html')),
+    'the stopped scan has a report of what it has, and no model');
+  const st = JSON.parse((await raw(s.url, 'GET', '/api/status')).body);
+  check(st.lights_and_projector === 'off' && !st.scanning, 'after the stop the rig is idle, lights and projector off');
+  await page.click('#resume');
+  await page.waitForFunction(() => /8 of 8 views · finished/.test(document.getElementById('progress').textContent), null, { timeout: 180000 });
+  check(fs.existsSync(path.join(scans, stoppedId, 'mesh.ply')), 'resume finished the stopped scan');
+  const rows = await page.$$eval('#past tbody tr', (trs) => trs.length);
+  check(rows === 2, `the list of scans shows both (${rows})`);
+
+  await pathTests(s.url, id);
+
+  // shutting the server down mid-scan stops the scan in order
+  const started = JSON.parse((await raw(s.url, 'POST', '/api/scans', json, '{}')).body);
+  await waitFor('a view', async () => (await scanState(s.url, started.id)).views_done >= 1, 60000);
+  const code = await stopServer(s);
+  check(code === 0, `the server shuts down cleanly during a scan (exit ${code})`);
+  check(/stopping scan/.test(s.log()) && /safe state: lights and projector off/.test(s.log()),
+    'it stopped the scan, which put the rig in its safe state');
+  check(fs.existsSync(path.join(scans, started.id, 'view_000', 'view.ini')), 'the views finished before are kept');
+  await page.close();
+}
+
+// ---- requests that must be refused ----
+async function pathTests(url, id) {
+  fs.symlinkSync('/etc/passwd', path.join(scans, id, 'planted'));
+  const cases = [
+    [`/api/scans/${id}/files/../config.ini`, [403, 404]],
+    [`/api/scans/${id}/files/%2e%2e/%2e%2e/%2e%2e/etc/passwd`, [403, 404]],
+    [`/api/scans/${id}/files/view_000/../../../../etc/passwd`, [403, 404]],
+    [`/api/scans/..%2f..%2f..%2fetc/files/passwd`, [403, 404]],
+    [`/api/scans/${id}/files/planted`, [403]],
+    [`/api/scans/${id}/files/%2fetc%2fpasswd`, [403, 404]],
+    [`/../../../etc/passwd`, [403, 404]],
+  ];
+  for (const [p, want] of cases) {
+    const r = await raw(url, 'GET', p);
+    check(want.includes(r.status) && !r.body.includes('root:'), `${p} is refused (${r.status})`);
+  }
+  const ok = await raw(url, 'GET', `/api/scans/${id}/files/view_000/view.ini`);
+  check(ok.status === 200, 'a view\'s file is served (200)');
+  const long = JSON.stringify({ profile: 'x'.repeat(5000) });
+  const big = await raw(url, 'POST', '/api/scans', { ...json, 'Content-Length': long.length }, long);
+  check(big.status === 413, `a request body over 4 KiB is refused (${big.status})`);
+  const chunked = await raw(url, 'POST', '/api/scans', json, long); // no length: chunked
+  check(chunked.status === 413, `so is one sent in chunks, without a length (${chunked.status})`);
+  const form = await raw(url, 'POST', '/api/scans', { 'Content-Type': 'text/plain' }, '{}');
+  check(form.status === 415, `a POST that is not application/json is refused (${form.status}): no other site can start the rig`);
+  const bad = await raw(url, 'POST', '/api/scans', json, '{"profile": "nope"}');
+  check(bad.status === 400, `an unknown profile is refused (${bad.status})`);
+}
+
+// ---- off loopback: a token, or nothing ----
+async function tokenTests() {
+  try {
+    await serve(['--config', 'config/sim.ini', '--listen', `0.0.0.0:${port + 1}`, '--scans', scans]);
+    check(false, 'a non-loopback listen without a token is refused');
+  } catch (e) {
+    check(e.code === 2 && /token-file/.test(e.text), 'a non-loopback listen without a token is refused at start');
+  }
+  const tokenFile = path.join(out, 'token');
+  const token = 'correct-horse-battery-staple';
+  fs.writeFileSync(tokenFile, token + '\n', { mode: 0o600 });
+  const s = await serve(['--config', 'config/sim.ini', '--listen', `0.0.0.0:${port + 1}`, '--scans', scans,
+    '--token-file', tokenFile]);
+  const anon = await raw(s.url, 'GET', '/api/status');
+  check(anon.status === 401, `without the token GET /api/status is 401 (${anon.status})`);
+  const post = await raw(s.url, 'POST', '/api/scans', json, '{}');
+  check(post.status === 401, `without the token POST /api/scans is 401 (${post.status})`);
+  const file = await raw(s.url, 'GET', '/api/scans/x/files/mesh.ply');
+  check(file.status === 401, `without the token a download is 401 (${file.status})`);
+  const wrong = await raw(s.url, 'GET', '/api/status', { Authorization: 'Bearer correct-horse-battery-stapl' });
+  check(wrong.status === 401, `a wrong token is 401 (${wrong.status})`);
+  const bearer = await raw(s.url, 'GET', '/api/status', { Authorization: `Bearer ${token}` });
+  check(bearer.status === 200 && JSON.parse(bearer.body).token_required, 'the token as a Bearer header is let in');
+  const login = await raw(s.url, 'POST', '/api/login', json, JSON.stringify({ token }));
+  const cookie = (login.headers['set-cookie'] || [''])[0].split(';')[0];
+  const withCookie = await raw(s.url, 'GET', '/api/scans', { Cookie: cookie });
+  check(login.status === 200 && withCookie.status === 200, 'the login\'s cookie lets the page in');
+  const page = await raw(s.url, 'GET', '/');
+  check(page.status === 200, 'the page itself loads (it asks for the token)');
+  check((await stopServer(s)) === 0, 'the token server shuts down cleanly');
+}
+
+const browser = await chromium.launch({
+  executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
+  args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
+    '--disable-component-update', '--disable-sync', '--use-gl=angle', '--use-angle=swiftshader'],
+});
+try {
+  await pageTest(browser);
+  await tokenTests();
+} catch (e) {
+  check(false, `the test ran to its end (${e.stack})`);
+  if (lastServer) console.log(`the server's messages (exit ${lastServer.proc.exitCode}, ${lastServer.proc.signalCode}):\n${lastServer.log()}`);
+} finally {
+  await browser.close();
+}
+console.log(failures === 0 ? 'browser test: every check passed' : `browser test: ${failures} FAILED`);
+process.exit(failures === 0 ? 0 : 1);

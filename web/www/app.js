@@ -1,0 +1,234 @@
+// The scanner's page: rig status, start/stop/resume, live progress (Server-Sent Events), each
+// view's thumbnails as it is taken, the model in a 3D viewer, downloads, the past scans.
+import { Viewer } from './viewer.js';
+
+const $ = (id) => document.getElementById(id);
+const api = (path) => 'api/' + path;
+const reasons = [['valid', '#3fa34d'], ['shadow', '#2b2b2b'], ['dark', '#2f5fb3'],
+  ['low contrast', '#e3a21a'], ['saturated', '#d7263d'], ['inconsistent', '#9b4dca']];
+
+let viewer = null;
+let shown = null;       // the scan whose views and model the page shows
+let thumbsShown = 0;
+let events = null;      // the EventSource following a running scan
+
+async function call(method, path, body) {
+  const init = { method, headers: {} };
+  if (body !== undefined) {
+    init.headers['Content-Type'] = 'application/json';
+    init.body = JSON.stringify(body);
+  }
+  const res = await fetch(api(path), init);
+  const data = await res.json().catch(() => ({}));
+  if (res.status === 401) showLogin();
+  if (!res.ok) throw new Error(data.error || res.statusText);
+  return data;
+}
+
+function showLogin() {
+  $('main').hidden = true;
+  $('login').hidden = false;
+}
+
+$('login').addEventListener('submit', async (e) => {
+  e.preventDefault();
+  try {
+    await call('POST', 'login', { token: $('token').value });
+    $('login').hidden = true;
+    start();
+  } catch (err) {
+    $('login-error').textContent = err.message;
+  }
+});
+
+function stageText(s) {
+  const n = s.views_total, k = s.stage_views_done ?? s.views_done;
+  switch (s.stage) {
+    case 'starting': case 'scan_start': case 'homing': return 'starting: homing the turntable';
+    case 'moving': case 'capturing': case 'saving': case 'saved': case 'place_object':
+      return `taking view ${Math.min(s.views_done + 1, n)} of ${n}`;
+    case 'decoded': case 'process_start': return `decoding view ${k} of ${n}`;
+    case 'registration': return 'registering the views';
+    case 'fused': return `fusing view ${k} of ${n}`;
+    case 'reflectance': return 'fitting the reflectance';
+    case 'meshing': case 'mesh': case 'cost': return 'making the mesh';
+    default: return s.stage || '';
+  }
+}
+
+function showProgress(s) {
+  const running = s.state === 'running';
+  $('bar').max = s.views_total || 1;
+  $('bar').value = s.views_done;
+  let text = `Scan ${s.id}: ${s.views_done} of ${s.views_total} views`;
+  if (running) {
+    text += ` · ${stageText(s)}`;
+    if (s.left_s >= 0) text += ` · about ${Math.ceil(s.left_s)} s left`;
+  } else {
+    text += ` · ${s.state}`;
+  }
+  $('progress').textContent = text;
+  $('error').textContent = s.error || '';
+  $('stop').disabled = !running;
+  $('start').disabled = running;
+  $('resume').hidden = s.state !== 'stopped' && s.state !== 'failed';
+  $('resume').dataset.id = s.id;
+}
+
+function addThumbs(id, upTo) {
+  $('thumbs-title').hidden = false;
+  for (; thumbsShown < upTo; thumbsShown++) {
+    const fig = document.createElement('figure');
+    const v = thumbsShown;
+    for (const kind of ['colour', 'reasons']) {
+      const img = document.createElement('img');
+      img.alt = `view ${v} ${kind}`;
+      img.src = api(`scans/${id}/thumbs/${v}/${kind}.png`);
+      fig.append(img);
+    }
+    const cap = document.createElement('figcaption');
+    cap.textContent = `view ${v}`;
+    fig.append(cap);
+    $('thumbs').append(fig);
+  }
+}
+
+function showDownloads(s) {
+  const box = $('downloads');
+  box.textContent = '';
+  if (s.state === 'running') return;
+  const base = api(`scans/${s.id}/files/`);
+  const link = (href, text, download) => {
+    const a = document.createElement('a');
+    a.href = href;
+    a.textContent = text;
+    if (download) a.download = '';
+    else a.target = '_blank';
+    box.append(a);
+  };
+  if (s.state === 'finished')
+    for (const f of ['mesh.ply', 'mesh.obj', 'mesh.stl', 'mesh.glb'])
+      if (f !== 'mesh.glb' || s.glb) link(`${base}${f}?download=1`, f, true);
+  link(api(`scans/${s.id}/archive.tar`), 'whole scan (.tar)', true);
+  if (s.report) link(`${base}report.html`, 'report', false);
+}
+
+// Show scan @p s: its views, its model, its downloads.
+async function open(s) {
+  if (shown !== s.id) {
+    shown = s.id;
+    thumbsShown = 0;
+    $('thumbs').textContent = '';
+    viewer.clear();
+    $('model-name').textContent = s.id;
+  }
+  addThumbs(s.id, s.views_done);
+  showProgress(s);
+  showDownloads(s);
+  if (s.state === 'finished' && viewer.canvas.dataset.loaded !== s.id) {
+    $('viewer-note').textContent = 'loading the model…';
+    try {
+      await viewer.load(api(`scans/${s.id}/files/`), s.glb, s.id);
+      $('viewer-note').textContent = 'Drag to turn, wheel to zoom.';
+    } catch (err) {
+      $('viewer-note').textContent = `the model cannot be shown: ${err.message}`;
+    }
+  }
+}
+
+function follow(id) {
+  if (events) events.close();
+  events = new EventSource(api(`scans/${id}/events`));
+  events.onmessage = (e) => {
+    const s = JSON.parse(e.data);
+    open(s);
+    if (s.state !== 'running') {
+      events.close();
+      events = null;
+      refresh();
+    }
+  };
+}
+
+async function startScan(resumeId) {
+  $('error').textContent = '';
+  try {
+    const body = { profile: $('profile').value };
+    const r = resumeId ? await call('POST', `scans/${resumeId}/resume`, body)
+      : await call('POST', 'scans', body);
+    $('start').disabled = true;
+    follow(r.id);
+    refresh();
+  } catch (err) {
+    $('error').textContent = err.message;
+  }
+}
+
+$('start').addEventListener('click', () => startScan(null));
+$('resume').addEventListener('click', () => startScan($('resume').dataset.id));
+$('stop').addEventListener('click', async () => {
+  try { await call('POST', `scans/${shown}/stop`, {}); } catch (err) { $('error').textContent = err.message; }
+});
+$('colour').addEventListener('change', () => viewer.setColour($('colour').checked));
+
+$('selftest-btn').addEventListener('click', async () => {
+  const pre = $('selftest');
+  pre.hidden = false;
+  pre.textContent = 'trying each device…';
+  try {
+    const r = await call('GET', 'selftest');
+    pre.textContent = r.table + (r.ok ? '\nevery device answered' : '\nsome device is missing');
+  } catch (err) {
+    pre.textContent = err.message;
+  }
+});
+
+$('snapshot-btn').addEventListener('click', async () => {
+  const img = $('snapshot');
+  const res = await fetch(api('snapshot.png'));
+  if (!res.ok) {
+    $('selftest').hidden = false;
+    $('selftest').textContent = (await res.json().catch(() => ({}))).error || res.statusText;
+    return;
+  }
+  img.src = URL.createObjectURL(await res.blob());
+  img.hidden = false;
+});
+
+// The rig's state and the list of scans.
+async function refresh() {
+  const st = await call('GET', 'status');
+  const badge = $('rig-state');
+  badge.textContent = st.scanning ? `scanning ${st.current}` : 'ready';
+  badge.className = 'badge ' + (st.scanning ? 'busy' : 'idle');
+  $('lights').textContent = st.lights_and_projector;
+  const list = await call('GET', 'scans');
+  const body = $('past').tBodies[0];
+  body.textContent = '';
+  for (const s of list.scans) {
+    const tr = body.insertRow();
+    tr.insertCell().textContent = s.id;
+    tr.insertCell().textContent = s.state;
+    tr.insertCell().textContent = `${s.views_done} / ${s.views_total}`;
+    const b = document.createElement('button');
+    b.textContent = 'Open';
+    b.addEventListener('click', () => (s.state === 'running' ? follow(s.id) : open(s)));
+    tr.insertCell().append(b);
+  }
+  return st;
+}
+
+async function start() {
+  $('main').hidden = false;
+  if (!viewer) viewer = new Viewer($('viewer'));
+  $('legend').innerHTML = reasons.map(([n, c]) => `<i style="background:${c}"></i>${n}`).join('');
+  const st = await refresh();
+  const sel = $('profile');
+  sel.textContent = '';
+  for (const p of st.profiles) sel.add(new Option(p, p));
+  if (st.scanning) follow(st.current);
+}
+
+start().catch((err) => {
+  if ($('login').hidden) $('rig-state').textContent = `cannot reach the scanner: ${err.message}`;
+});
