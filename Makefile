@@ -119,7 +119,7 @@ FW_OBJ := $(call obj,$(FW_SRC))
 HOST_OBJ := $(call obj,$(POSIX_SRC) $(APP_LIB_SRC) $(BOARD_SRC)) $(if $(filter linux,$(HAL)),$(LIBCAMERA_OBJ),)
 MAIN_OBJ := $(call obj,app/main.c)
 
-.PHONY: check-blender seccomp-tool vivid-tool all deps test-deps test test-run run-complete linux-build small-build install check-stack size fuzz errors-doc test-arm64 test-arm64-full test-gpio-chip arm64-check-elf arm64-run-tests run clean format docs check-firmware bench measure measure-scan interop-meshlab bench-callgrind eval calibrate-demo measure-calib
+.PHONY: serve test-browser check-blender seccomp-tool vivid-tool all deps test-deps test test-run run-complete linux-build small-build install check-stack size fuzz errors-doc test-arm64 test-arm64-full test-gpio-chip arm64-check-elf arm64-run-tests run clean format docs check-firmware bench measure measure-scan interop-meshlab bench-callgrind eval calibrate-demo measure-calib
 SIM_TOOLS := $(if $(filter sim,$(HAL)),$(BUILD)/turntable-sim $(BUILD)/tt-client $(BUILD)/mesh-compare $(BUILD)/colour-eval $(BUILD)/relight-eval,)
 all: deps $(BUILD)/scanner $(CALIB_TOOL) $(WEB_TOOL) $(SIM_TOOLS)
 
@@ -357,18 +357,50 @@ install: linux-build
 	install -D -m 0644 config/deploy/scanner.sysusers $(DESTDIR)/usr/lib/sysusers.d/scanner.conf
 	install -D -m 0644 config/deploy/60-scanner-gpio.rules $(DESTDIR)/usr/lib/udev/rules.d/60-scanner-gpio.rules
 	install -D -m 0644 docs/deploy.md $(DESTDIR)$(DOCDIR)/deploy.md
+	@if [ -x $(LINUX_BUILD)/scanner-web ]; then \
+		echo "install scanner-web, its page and scanner-web@.service"; \
+		install -D -m 0755 $(LINUX_BUILD)/scanner-web $(DESTDIR)$(PREFIX)/bin/scanner-web; \
+		rm -rf $(DESTDIR)$(PREFIX)/share/scanner/www; mkdir -p $(DESTDIR)$(PREFIX)/share/scanner; \
+		cp -R web/www $(DESTDIR)$(PREFIX)/share/scanner/www; \
+		sed -e 's|@BINDIR@|$(PREFIX)/bin|g' -e 's|@SYSCONFDIR@|$(SYSCONFDIR)|g' -e 's|@DOCDIR@|$(DOCDIR)|g' \
+			'config/deploy/scanner-web@.service' > '$(BUILD)/deploy/scanner-web@.service'; \
+		install -D -m 0644 '$(BUILD)/deploy/scanner-web@.service' '$(DESTDIR)$(UNITDIR)/scanner-web@.service'; \
+		install -D -m 0644 docs/web.md $(DESTDIR)$(DOCDIR)/web.md; \
+	fi
+	@# The web page's token: made here, once, never a default (docs/web.md)
+	@if [ ! -e $(DESTDIR)$(SYSCONFDIR)/scanner/web-token ]; then \
+		(umask 077; head -c 18 /dev/urandom | base64 > $(DESTDIR)$(SYSCONFDIR)/scanner/web-token); \
+		echo "make install: the web page's token is in $(SYSCONFDIR)/scanner/web-token (readable by root only)"; \
+	fi
 	@[ -n "$(DESTDIR)" ] || echo "make install: now run: systemd-sysusers; udevadm control --reload; udevadm trigger; systemctl daemon-reload"
 
 # The appliance's scanner (every backend compiled; tests/cli.sh runs its selftest).
 LINUX_BUILD := $(if $(filter linux,$(HAL)),$(BUILD),$(BUILD)/linux)
 linux-build: deps
-	@$(MAKE) --no-print-directory HAL=linux SAN=$(SAN) $(LINUX_BUILD)/scanner
+	@$(MAKE) --no-print-directory HAL=linux SAN=$(SAN) $(LINUX_BUILD)/scanner $(if $(HAVE_CIVETWEB),$(LINUX_BUILD)/scanner-web,)
 # The simulator build with LIMITS=small (a 512 MB board), for tests/cli.sh.
 small-build: deps
 	@$(MAKE) --no-print-directory LIMITS=small SAN=$(SAN) $(BUILD)/small/scanner
 
 run: deps $(BUILD)/scanner
 	$(BUILD)/scanner scan --config config/sim.ini
+
+# The web interface on the simulator (docs/web.md): http://127.0.0.1:8080, Ctrl-C ends it. A
+# second make, so that civetweb, if deps just installed it, is seen.
+serve: deps
+	@$(MAKE) --no-print-directory $(BUILD)/scanner $(BUILD)/scanner-web
+	@echo "make serve: the scanner's page is at http://127.0.0.1:8080 (Ctrl-C ends it)"
+	$(BUILD)/scanner serve --config config/sim.ini --config config/sim-glossy.ini --listen 127.0.0.1:8080
+
+# The page and its API in Debian's Chromium (tests/browser/browser_test.mjs, about 90 s; in CI).
+# The pictures it takes of the page are in $(BUILD)/browser/ (docs/web/ has a pair).
+test-browser: deps
+	@command -v chromium >/dev/null 2>&1 || scripts/install-deps.sh browser
+	@scripts/install-deps.sh node
+	@test -f tests/browser/node_modules/playwright-core/package.json || \
+		npm ci --prefix tests/browser --no-audit --no-fund --loglevel=error
+	@$(MAKE) --no-print-directory $(BUILD)/scanner $(BUILD)/scanner-web
+	node tests/browser/browser_test.mjs $(BUILD)
 
 # Blender 3.4 (Debian's, installed if missing; not in CI: 66 packages) imports a scan's
 # mesh.ply, mesh.obj, mesh.stl and mesh.glb upright and at the object's size in a millimetre scene.

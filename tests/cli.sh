@@ -71,13 +71,17 @@ check install_tree sh -c "rm -rf $stage && make -s install DESTDIR=$stage PREFIX
     test -f $stage/usr/lib/udev/rules.d/60-scanner-gpio.rules &&
     grep -q 'exec /usr/bin/scanner scan --config /etc/scanner/%i.ini' '$unit' &&
     grep -q '^User=scanner' '$unit' && grep -q '^SupplementaryGroups=video gpio dialout' '$unit' &&
-    grep -q '^NoNewPrivileges=yes' '$unit' && grep -q '^ProtectSystem=strict' '$unit'"
+    grep -q '^NoNewPrivileges=yes' '$unit' && grep -q '^ProtectSystem=strict' '$unit' &&
+    test -x $stage/usr/bin/scanner-web && test -f $stage/usr/share/scanner/www/index.html &&
+    test -f $stage/usr/share/scanner/www/vendor/three/build/three.module.min.js &&
+    grep -q 'token-file' '$stage/lib/systemd/system/scanner-web@.service' &&
+    test \$(stat -c %a $stage/etc/scanner/web-token) = 600 && test \$(wc -c < $stage/etc/scanner/web-token) -ge 17"
 check install_keeps_edited_config sh -c "echo '; edited' >> $stage/etc/scanner/pi-v4l2.ini &&
     make -s install DESTDIR=$stage PREFIX=/usr >/dev/null &&
     tail -n 1 $stage/etc/scanner/pi-v4l2.ini | grep -q '; edited' &&
     cmp -s config/pi-v4l2.ini $stage/etc/scanner/pi-v4l2.ini.dist"
 check systemd_accepts_unit sh -c "cd '$stage/lib/systemd/system' &&
-    systemd-analyze verify 'scanner@pi-v4l2.service' > $PWD/$out/verify.txt 2>&1; rc=\$?;
+    systemd-analyze verify 'scanner@pi-v4l2.service' 'scanner-web@pi-v4l2.service' > $PWD/$out/verify.txt 2>&1; rc=\$?;
     cat $PWD/$out/verify.txt; test \$rc -eq 0 && ! test -s $PWD/$out/verify.txt &&
     systemd-sysusers --root=$stage --dry-run >/dev/null"
 # The unit's exposure (systemd-analyze security, offline): at most 2.0 (it was 3.5).
@@ -85,6 +89,10 @@ check unit_exposure_at_most_2 sh -c "cd '$stage/lib/systemd/system' &&
     systemd-analyze security --offline=true 'scanner@pi-v4l2.service' > $PWD/$out/exposure.txt 2>&1;
     tail -n 1 $PWD/$out/exposure.txt; awk '/Overall exposure level/ { found = 1; if (\$(NF - 2) + 0 > 2.0) exit 1 }
     END { exit !found }' $PWD/$out/exposure.txt"
+check web_unit_exposure_at_most_2 sh -c "cd '$stage/lib/systemd/system' &&
+    systemd-analyze security --offline=true 'scanner-web@pi-v4l2.service' > $PWD/$out/exposure-web.txt 2>&1;
+    tail -n 1 $PWD/$out/exposure-web.txt; awk '/Overall exposure level/ { found = 1; if (\$(NF - 2) + 0 > 2.0) exit 1 }
+    END { exit !found }' $PWD/$out/exposure-web.txt"
 # The scanner works under exactly the unit's system-call filter (a call outside it kills the
 # process here, where the unit would answer EPERM): a whole simulated scan. (Under SAN=1 without
 # LeakSanitizer, whose check at exit stops the world with ptrace, which no service may use.)
@@ -180,6 +188,26 @@ check scan_writes_stl_and_registration_line sh -c "test -s $out/scan/mesh.stl &&
     test \$(stat -c %s $out/scan/mesh.stl) -gt 84 &&
     grep -q '^angle_deg = ' $out/scan/view_003/registration.ini &&
     grep -q '^loop_closure_rms_mm = ' $out/scan/view_003/registration.ini"
+# report.html (issue 19): written by the scan, self-contained (nothing fetched from elsewhere),
+# the model's five pictures and three per view, each stage timed; scanner report writes the same
+# page again; a folder that is no scan is refused, naming what it lacks.
+check report_written_by_scan sh -c "grep -q '^capture = ' $out/scan/summary.ini &&
+    grep -q '^meshing = ' $out/scan/summary.ini && grep -q '^peak_memory_mb = ' $out/scan/summary.ini &&
+    test \$(grep -o '<img ' $out/scan/report.html | wc -l) -eq 29 &&
+    ! grep -qE '(src|href)=.(https?:|/)' $out/scan/report.html &&
+    grep -q '<td>registration</td>' $out/scan/report.html && grep -q '8 of 8 views taken' $out/scan/report.html"
+check report_again_same sh -c "cp $out/scan/report.html $out/report.before && $bin report $out/scan >/dev/null &&
+    cmp $out/scan/report.html $out/report.before &&
+    ! $bin report $out 2> $out/report-err.txt && grep -q 'config.ini' $out/report-err.txt"
+# The camera's picture of the web page: a PNG of the camera's size.
+check snapshot_png sh -c "$bin snapshot --config config/sim.ini --out $out/snap.png 2>/dev/null &&
+    /usr/bin/python3 -c 'import struct, sys; d = open(sys.argv[1], \"rb\").read(24);
+sys.exit(not (d[:8] == b\"\\x89PNG\\r\\n\\x1a\\n\" and struct.unpack(\">II\", d[16:24]) == (1280, 960)))' $out/snap.png"
+# scanner serve (the web interface): its own help, and what it refuses before it listens.
+check serve_help_and_refusals sh -c "$bin serve --help | grep -q -- '--token-file' &&
+    { $bin serve 2> $out/serve1.txt; test \$? -eq 2; } && grep -q 'is required' $out/serve1.txt &&
+    { $bin serve --config config/sim.ini --listen 0.0.0.0:18081 2> $out/serve2.txt; test \$? -eq 2; } &&
+    grep -q 'token-file' $out/serve2.txt"
 # mesh.glb (issue 18): the Khronos validator finds nothing wrong, it is in metres with +Y up
 # (the bunny is 150 mm tall and stands on y = 0), and the validator does catch a damaged one.
 check glb_valid_metres_y_up sh -c "node tests/gltf/validate.mjs $out/scan/mesh.glb > $out/glb.txt &&

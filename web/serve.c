@@ -111,15 +111,20 @@ static int check_configs(struct web_server *s, const char *scans)
     return 0;
 }
 
-/* The scanner program beside this one. */
-static int find_scanner(struct web_server *s)
+/* The scanner program beside this one; the page where the build put it (a build tree), else
+ * where make install puts it beside the programs (PREFIX/share/scanner/www). */
+static int find_scanner(struct web_server *s, int www_given)
 {
-    char self[WEB_PATH];
+    char self[WEB_PATH], index[WEB_PATH + 16];
     ssize_t n = readlink("/proc/self/exe", self, sizeof(self) - 1);
     if (n <= 0)
         return -1;
     self[n] = '\0';
-    snprintf(s->scanner, sizeof(s->scanner), "%s/scanner", dirname(self));
+    const char *bin = dirname(self);
+    snprintf(index, sizeof(index), "%s/index.html", s->www);
+    if (!www_given && access(index, R_OK) != 0)
+        snprintf(s->www, sizeof(s->www), "%s/../share/scanner/www", bin);
+    snprintf(s->scanner, sizeof(s->scanner), "%s/scanner", bin);
     if (access(s->scanner, X_OK) != 0) {
         fprintf(stderr, "scanner serve: %s: %s\n", s->scanner, strerror(errno));
         return -1;
@@ -139,6 +144,7 @@ int main(int argc, char **argv)
     static struct web_server s = {.job = {.lock = PTHREAD_MUTEX_INITIALIZER,
                                           .changed = PTHREAD_COND_INITIALIZER}};
     const char *listen = "127.0.0.1:8080", *token_file = NULL, *scans = NULL;
+    int www_given = 0;
     snprintf(s.www, sizeof(s.www), "%s", WEB_WWW_DIR);
     int first = argc > 1 && strcmp(argv[1], "serve") == 0 ? 2 : 1;
     for (int i = first; i < argc; i++) {
@@ -157,6 +163,7 @@ int main(int argc, char **argv)
             scans = value;
         } else if (value != NULL && strcmp(argv[i], "--www") == 0) {
             snprintf(s.www, sizeof(s.www), "%s", value);
+            www_given = 1;
         } else {
             fprintf(stderr, "scanner serve: %s '%s'\n%s",
                     value == NULL && argv[i][0] == '-' && argv[i][1] == '-'
@@ -180,7 +187,7 @@ int main(int argc, char **argv)
     }
     if (token_file != NULL && read_token(token_file, s.token, sizeof(s.token)) != 0)
         return 2;
-    if (check_configs(&s, scans) != 0 || find_scanner(&s) != 0)
+    if (check_configs(&s, scans) != 0 || find_scanner(&s, www_given) != 0)
         return 2;
     char index[WEB_PATH + 16];
     snprintf(index, sizeof(index), "%s/index.html", s.www);
