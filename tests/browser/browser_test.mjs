@@ -96,7 +96,8 @@ async function pageTest(browser) {
   await page.waitForFunction(() => /views/.test(document.getElementById('progress').textContent));
   const busy = await raw(s.url, 'POST', '/api/scans', json, '{}');
   check(busy.status === 409, `a second scan while one runs is refused with 409 (${busy.status})`);
-  await page.waitForFunction(() => document.querySelectorAll('#thumbs figure').length >= 4, null, { timeout: 120000 });
+  await page.waitForFunction(() => document.querySelectorAll('#thumbs figure').length >= 4 &&
+    [...document.querySelectorAll('#thumbs img')].every((i) => i.complete), null, { timeout: 120000 });
   await page.screenshot({ path: path.join(out, 'page-scanning.png') });
   const during = await page.textContent('#progress');
   check(/taking view \d of 8/.test(during), `progress names the view being taken ("${during}")`);

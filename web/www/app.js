@@ -77,6 +77,7 @@ function showProgress(s) {
 
 function addThumbs(id, upTo) {
   $('thumbs-title').hidden = false;
+  if (upTo > thumbsShown) refresh(); // the list of scans shows the new count
   for (; thumbsShown < upTo; thumbsShown++) {
     const fig = document.createElement('figure');
     const v = thumbsShown;

@@ -46,6 +46,7 @@ export class Viewer {
       this.model = null;
     }
     delete this.canvas.dataset.loaded;
+    document.getElementById('viewer-empty').hidden = false;
     this.render();
   }
 
@@ -73,6 +74,7 @@ export class Viewer {
     this.scene.add(object);
     this.setColour(this.colour);
     this.frame();
+    document.getElementById('viewer-empty').hidden = true;
     this.canvas.dataset.loaded = id;
   }
 
