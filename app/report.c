@@ -40,8 +40,7 @@ static void text_reserve(struct text *t, size_t more)
     t->cap = cap;
 }
 
-__attribute__((format(printf, 2, 3))) static void text_printf(struct text *t, const char *fmt,
-                                                              ...)
+__attribute__((format(printf, 2, 3))) static void text_printf(struct text *t, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
@@ -60,9 +59,11 @@ __attribute__((format(printf, 2, 3))) static void text_printf(struct text *t, co
 static void text_html(struct text *t, const char *s)
 {
     for (; *s != '\0'; s++) {
-        const char *e = *s == '&' ? "&amp;" : *s == '<' ? "&lt;" : *s == '>' ? "&gt;"
-                                          : *s == '"' ? "&quot;"
-                                                      : NULL;
+        const char *e = *s == '&'   ? "&amp;"
+                        : *s == '<' ? "&lt;"
+                        : *s == '>' ? "&gt;"
+                        : *s == '"' ? "&quot;"
+                                    : NULL;
         if (e != NULL)
             text_printf(t, "%s", e);
         else
@@ -363,8 +364,8 @@ static void model_free(struct model *m)
 /* Orthographic, looking along -@p dir with @p right and @p up on screen; every picture at the
  * same scale about @p centre, so that the sides compare. */
 static void model_draw(const struct model *m, const double dir[3], const double right[3],
-                       const double up[3], const double centre[3], double px_per_mm,
-                       uint8_t *img, float *depth)
+                       const double up[3], const double centre[3], double px_per_mm, uint8_t *img,
+                       float *depth)
 {
     const int size = MODEL_PICTURE;
     for (int i = 0; i < size * size; i++) {
@@ -377,8 +378,8 @@ static void model_draw(const struct model *m, const double dir[3], const double 
             const float *v = &m->xyz[3 * m->tri[3 * t + (uint32_t)k]];
             for (int c = 0; c < 3; c++)
                 p[k][c] = v[c] - centre[c];
-            sx[k] = size / 2.0 + px_per_mm * (p[k][0] * right[0] + p[k][1] * right[1] +
-                                              p[k][2] * right[2]);
+            sx[k] = size / 2.0 +
+                    px_per_mm * (p[k][0] * right[0] + p[k][1] * right[1] + p[k][2] * right[2]);
             sy[k] = size / 2.0 - px_per_mm * (p[k][0] * up[0] + p[k][1] * up[1] + p[k][2] * up[2]);
             sz[k] = p[k][0] * dir[0] + p[k][1] * dir[1] + p[k][2] * dir[2];
         }
@@ -392,13 +393,15 @@ static void model_draw(const struct model *m, const double dir[3], const double 
         n[1] = e1[2] * e2[0] - e1[0] * e2[2];
         n[2] = e1[0] * e2[1] - e1[1] * e2[0];
         double nl = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-        double shade = nl > 0 ? 0.3 + 0.7 * fabs(n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2]) / nl
-                              : 0.3;
+        double shade =
+            nl > 0 ? 0.3 + 0.7 * fabs(n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2]) / nl : 0.3;
         double area = (sx[1] - sx[0]) * (sy[2] - sy[0]) - (sx[2] - sx[0]) * (sy[1] - sy[0]);
         if (fabs(area) < 1e-12)
             continue;
-        int x0 = (int)floor(fmin(sx[0], fmin(sx[1], sx[2]))), x1 = (int)ceil(fmax(sx[0], fmax(sx[1], sx[2])));
-        int y0 = (int)floor(fmin(sy[0], fmin(sy[1], sy[2]))), y1 = (int)ceil(fmax(sy[0], fmax(sy[1], sy[2])));
+        int x0 = (int)floor(fmin(sx[0], fmin(sx[1], sx[2]))),
+            x1 = (int)ceil(fmax(sx[0], fmax(sx[1], sx[2])));
+        int y0 = (int)floor(fmin(sy[0], fmin(sy[1], sy[2]))),
+            y1 = (int)ceil(fmax(sy[0], fmax(sy[1], sy[2])));
         x0 = x0 < 0 ? 0 : x0;
         y0 = y0 < 0 ? 0 : y0;
         x1 = x1 >= size ? size - 1 : x1;
@@ -453,9 +456,10 @@ static void model_section(struct text *t, const char *dir)
     double px_per_mm = 0.46 * MODEL_PICTURE / fmax(sqrt(radius), 1e-3);
     uint8_t *img = malloc(3u * MODEL_PICTURE * MODEL_PICTURE);
     float *depth = malloc(sizeof(float) * MODEL_PICTURE * MODEL_PICTURE);
-    text_printf(t, "<p>%u vertices, %u triangles, %.1f &times; %.1f &times; %.1f mm. "
-                   "Where the page's grey shows through, no view saw the surface.</p>\n<div "
-                   "class=row>",
+    text_printf(t,
+                "<p>%u vertices, %u triangles, %.1f &times; %.1f &times; %.1f mm. "
+                "Where the page's grey shows through, no view saw the surface.</p>\n<div "
+                "class=row>",
                 (unsigned)m.vertices, (unsigned)m.triangles, hi[0] - lo[0], hi[1] - lo[1],
                 hi[2] - lo[2]);
     static const char *const side[] = {"front", "right", "back", "left", "above"};
@@ -523,9 +527,8 @@ static void registration_section(struct text *t, const char *dir)
                 "<p>%s Residual %.3f mm over every overlap (%.3f mm before), loop closure "
                 "%.3f mm, worst view %d (%.3f mm); the turntable's axis moved %.2f mm and tilted "
                 "%.2f&deg;.</p>\n",
-                kv_num(&k, "registration", "accepted", 0) > 0
-                    ? "The views were placed by ICP."
-                    : "The turntable's angles were kept.",
+                kv_num(&k, "registration", "accepted", 0) > 0 ? "The views were placed by ICP."
+                                                              : "The turntable's angles were kept.",
                 kv_num(&k, "registration", "rms_mm", 0),
                 kv_num(&k, "registration", "score_before_mm", 0),
                 kv_num(&k, "registration", "loop_closure_rms_mm", 0),
@@ -560,8 +563,8 @@ static void views_section(struct text *t, const char *dir, uint32_t views, const
     char err[256];
     text_printf(t, "<h2>Views</h2>\n<p class=legend>Reason map: ");
     for (unsigned r = 0; r < SCAN_REASON_COUNT; r++)
-        text_printf(t, "<span><i style=\"background:%s\"></i>%s</span> ",
-                    report_reason_colour(r), scan_reason_name(r));
+        text_printf(t, "<span><i style=\"background:%s\"></i>%s</span> ", report_reason_colour(r),
+                    scan_reason_name(r));
     text_printf(t, "</p>\n<table><tr><th>view</th><th>angle (&deg;)<br>table &rarr; "
                    "registered</th><th>valid points</th><th>residual (mm)</th><th>camera "
                    "(before compensation)</th><th>colour (after: ");
@@ -620,8 +623,8 @@ int report_write(const struct hal_storage *st, const char *dir, char *err, size_
         snprintf(err, err_len, "%s/config.ini: %s (not a scan directory?)", dir, strerror(-rc));
         return rc;
     }
-    uint32_t views = (uint32_t)kv_num(&cfg, "scan", "views", 8) *
-                     (uint32_t)kv_num(&cfg, "scan", "passes", 1);
+    uint32_t views =
+        (uint32_t)kv_num(&cfg, "scan", "views", 8) * (uint32_t)kv_num(&cfg, "scan", "passes", 1);
     uint32_t done = 0;
     for (uint32_t v = 0; v < views; v++)
         done += (uint32_t)scan_dir_view_complete(dir, v);
@@ -633,8 +636,8 @@ int report_write(const struct hal_storage *st, const char *dir, char *err, size_
     text_html(&t, dir_name(dir));
     text_printf(&t, "</h1>\n<p class=state>%u of %u views taken. Files: ", (unsigned)done,
                 (unsigned)views);
-    static const char *const files[] = {"mesh.ply", "mesh.obj", "mesh.stl", "mesh.glb",
-                                        "config.ini", "calibration.ini"};
+    static const char *const files[] = {"mesh.ply", "mesh.obj",   "mesh.stl",
+                                        "mesh.glb", "config.ini", "calibration.ini"};
     struct stat sb;
     for (size_t f = 0; f < sizeof(files) / sizeof(files[0]); f++)
         if (scan_dir_path(path, sizeof(path), dir, -1, files[f]) == 0 && stat(path, &sb) == 0)

@@ -211,10 +211,12 @@ static double time_left_s(struct job *j, const char *event, uint32_t done, doubl
  * the registration, the reflectance fit, the fusion (which meshing follows), the mesh. */
 static void stage_ended(struct job *j, const char *event, double elapsed_s)
 {
-    static const char *const ends[][2] = {
-        {"saved", "capture"},         {"decoded", "decoding"},
-        {"registration", "registration"}, {"reflectance", "reflectance fit"},
-        {"meshing", "fusion"},        {"mesh", "meshing"}};
+    static const char *const ends[][2] = {{"saved", "capture"},
+                                          {"decoded", "decoding"},
+                                          {"registration", "registration"},
+                                          {"reflectance", "reflectance fit"},
+                                          {"meshing", "fusion"},
+                                          {"mesh", "meshing"}};
     struct stages *st = &j->stages;
     for (size_t k = 0; k < sizeof(ends) / sizeof(ends[0]); k++) {
         if (strcmp(event, ends[k][0]) != 0)

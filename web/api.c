@@ -24,16 +24,26 @@
 static const char *reason_phrase(int status)
 {
     switch (status) {
-    case 200: return "OK";
-    case 400: return "Bad Request";
-    case 401: return "Unauthorized";
-    case 403: return "Forbidden";
-    case 404: return "Not Found";
-    case 405: return "Method Not Allowed";
-    case 409: return "Conflict";
-    case 413: return "Payload Too Large";
-    case 415: return "Unsupported Media Type";
-    default: return "Internal Server Error";
+    case 200:
+        return "OK";
+    case 400:
+        return "Bad Request";
+    case 401:
+        return "Unauthorized";
+    case 403:
+        return "Forbidden";
+    case 404:
+        return "Not Found";
+    case 405:
+        return "Method Not Allowed";
+    case 409:
+        return "Conflict";
+    case 413:
+        return "Payload Too Large";
+    case 415:
+        return "Unsupported Media Type";
+    default:
+        return "Internal Server Error";
     }
 }
 
@@ -103,8 +113,7 @@ static int read_body(struct mg_connection *conn, cJSON **body)
         return 413;
     /* a chunked body says no length: one byte more than the limit tells it is too long */
     int n = 0, got;
-    while (n <= WEB_MAX_BODY &&
-           (got = mg_read(conn, text + n, (size_t)(WEB_MAX_BODY + 1 - n))) > 0)
+    while (n <= WEB_MAX_BODY && (got = mg_read(conn, text + n, (size_t)(WEB_MAX_BODY + 1 - n))) > 0)
         n += got;
     if (n > WEB_MAX_BODY)
         return 413;
@@ -193,9 +202,10 @@ static int start_scan(struct mg_connection *conn, struct web_server *s, const ch
     int status = read_body(conn, &body);
     if (status != 0) {
         cJSON_Delete(body);
-        return send_error(conn, status, status == 415 ? "send the request as application/json"
-                                        : status == 413 ? "the request is too large"
-                                                        : "the body is not a JSON object");
+        return send_error(conn, status,
+                          status == 415   ? "send the request as application/json"
+                          : status == 413 ? "the request is too large"
+                                          : "the body is not a JSON object");
     }
     const struct web_profile *p = find_profile(s, body);
     cJSON_Delete(body);
@@ -393,8 +403,8 @@ static int snapshot(struct mg_connection *conn, struct web_server *s)
     if (fd < 0)
         return send_error(conn, 500, "cannot make a temporary file");
     close(fd);
-    const char *args[] = {s->scanner, "snapshot", "--config", s->profile[0].path, "--out", path,
-                          NULL};
+    const char *args[] = {s->scanner, "snapshot", "--config", s->profile[0].path,
+                          "--out",    path,       NULL};
     int status = -1;
     int rc = jobs_run_tool(s, args, out, sizeof(out), &status);
     if (rc == -EBUSY) {

@@ -100,8 +100,8 @@ static void on_event(struct web_job *j, const char *line)
     /* Views taken count when one is saved (its files are there: the page asks for its
      * thumbnails), decoded again, or fused; the fusion counts from 0 again: they only grow. */
     const char *e = event->valuestring;
-    if (cJSON_IsNumber(done) && (strcmp(e, "saved") == 0 || strcmp(e, "decoded") == 0 ||
-                                 strcmp(e, "fused") == 0)) {
+    if (cJSON_IsNumber(done) &&
+        (strcmp(e, "saved") == 0 || strcmp(e, "decoded") == 0 || strcmp(e, "fused") == 0)) {
         j->step_done = (unsigned)done->valuedouble;
         if (j->step_done > j->views_done)
             j->views_done = j->step_done;
@@ -185,7 +185,8 @@ static void *reader_main(void *arg)
     struct web_job *j = &s->job;
     static struct line_buf out, err;
     out.len = err.len = 0;
-    struct pollfd pf[2] = {{.fd = j->fd_out, .events = POLLIN}, {.fd = j->fd_err, .events = POLLIN}};
+    struct pollfd pf[2] = {{.fd = j->fd_out, .events = POLLIN},
+                           {.fd = j->fd_err, .events = POLLIN}};
     while (pf[0].fd >= 0 || pf[1].fd >= 0) {
         if (poll(pf, 2, -1) < 0 && errno != EINTR)
             break;
@@ -247,8 +248,8 @@ static int new_scan_dir(const struct web_server *s, char *id, size_t id_len, cha
     return -EEXIST;
 }
 
-int jobs_start(struct web_server *s, const struct web_profile *p, const char *resume_id,
-               char *id, size_t id_len, char *err, size_t err_len)
+int jobs_start(struct web_server *s, const struct web_profile *p, const char *resume_id, char *id,
+               size_t id_len, char *err, size_t err_len)
 {
     struct web_job *j = &s->job;
     char dir[WEB_PATH];
@@ -273,8 +274,8 @@ int jobs_start(struct web_server *s, const struct web_profile *p, const char *re
     } else {
         rc = new_scan_dir(s, id, id_len, dir, sizeof(dir));
     }
-    const char *scan_args[] = {s->scanner, "scan", "--config", p->path, "--out", dir, "--json",
-                               NULL};
+    const char *scan_args[] = {s->scanner, "scan", "--config", p->path,
+                               "--out",    dir,    "--json",   NULL};
     const char *resume_args[] = {s->scanner, "resume", dir, "--config", p->path, "--json", NULL};
     pid_t pid = -EINVAL;
     if (rc == 0)
@@ -396,8 +397,8 @@ static int count_views(void *user, const char *section, const char *key, const c
     return 1;
 }
 
-int jobs_describe(struct web_server *s, const char *id, enum web_state *state,
-                  unsigned *views_done, unsigned *views_total, char *error, size_t error_len)
+int jobs_describe(struct web_server *s, const char *id, enum web_state *state, unsigned *views_done,
+                  unsigned *views_total, char *error, size_t error_len)
 {
     struct web_job *j = &s->job;
     error[0] = '\0';

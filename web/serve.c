@@ -141,8 +141,8 @@ static int log_message(const struct mg_connection *conn, const char *message)
 
 int main(int argc, char **argv)
 {
-    static struct web_server s = {.job = {.lock = PTHREAD_MUTEX_INITIALIZER,
-                                          .changed = PTHREAD_COND_INITIALIZER}};
+    static struct web_server s = {
+        .job = {.lock = PTHREAD_MUTEX_INITIALIZER, .changed = PTHREAD_COND_INITIALIZER}};
     const char *listen = "127.0.0.1:8080", *token_file = NULL, *scans = NULL;
     int www_given = 0;
     snprintf(s.www, sizeof(s.www), "%s", WEB_WWW_DIR);
@@ -203,13 +203,20 @@ int main(int argc, char **argv)
     sigaddset(&stop, SIGHUP);
     pthread_sigmask(SIG_BLOCK, &stop, NULL);
     signal(SIGPIPE, SIG_IGN);
-    const char *options[] = {"listening_ports", listen,
-                             "document_root", s.www,
-                             "num_threads", "16",
-                             "enable_directory_listing", "no",
-                             "max_request_size", "16384",
-                             "request_timeout_ms", "30000",
-                             "additional_header", "X-Content-Type-Options: nosniff",
+    const char *options[] = {"listening_ports",
+                             listen,
+                             "document_root",
+                             s.www,
+                             "num_threads",
+                             "16",
+                             "enable_directory_listing",
+                             "no",
+                             "max_request_size",
+                             "16384",
+                             "request_timeout_ms",
+                             "30000",
+                             "additional_header",
+                             "X-Content-Type-Options: nosniff",
                              NULL};
     struct mg_callbacks callbacks;
     memset(&callbacks, 0, sizeof(callbacks));

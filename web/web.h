@@ -25,24 +25,24 @@ struct web_job {
     pthread_mutex_t lock;
     pthread_cond_t changed; /* broadcast at every event (the progress streams wait on it) */
     enum web_state state;
-    int rig_busy;            /* a scan, a snapshot or a selftest holds the rig */
-    pid_t pid;               /* the scanner while it runs */
+    int rig_busy; /* a scan, a snapshot or a selftest holds the rig */
+    pid_t pid;    /* the scanner while it runs */
     int stop_requested;
     int have_reader;
     pthread_t reader;
-    int fd_out, fd_err;      /* the scanner's standard output (events) and error (messages) */
-    int done_seen;           /* it said scan_done or process_done */
-    int stopping;            /* the server is shutting down: progress streams end */
-    char id[64];             /* the scan folder's name */
-    char dir[WEB_PATH];      /* the scan folder */
+    int fd_out, fd_err; /* the scanner's standard output (events) and error (messages) */
+    int done_seen;      /* it said scan_done or process_done */
+    int stopping;       /* the server is shutting down: progress streams end */
+    char id[64];        /* the scan folder's name */
+    char dir[WEB_PATH]; /* the scan folder */
     char profile[64];
     unsigned views_done, views_total; /* views taken (complete), of all */
     unsigned step_done;               /* views through the current stage (taken, fused ...) */
-    char stage[32];          /* the last event: capturing, registration, meshing ... */
+    char stage[32];                   /* the last event: capturing, registration, meshing ... */
     char detail[512];
     double elapsed_s, left_s;
-    char error[512];         /* the scanner's own error line, when it failed */
-    unsigned long seq;       /* events so far */
+    char error[512];   /* the scanner's own error line, when it failed */
+    unsigned long seq; /* events so far */
 };
 
 struct web_server {
@@ -51,7 +51,7 @@ struct web_server {
     char scans[WEB_PATH];   /* where scan folders are made and listed */
     struct web_profile profile[WEB_MAX_PROFILES];
     unsigned profiles;
-    char token[256];        /* "" on loopback: nothing to present */
+    char token[256]; /* "" on loopback: nothing to present */
     struct web_job job;
 };
 
@@ -60,8 +60,8 @@ struct web_server {
 /** Start `scanner scan` with @p p into a new folder under the scans' folder, or `scanner resume`
  *  of the scan @p resume_id. @param id  out: the scan's id (its folder's name)
  *  @retval 0 @retval -EBUSY the rig is in use @retval -errno (@p err says what) */
-int jobs_start(struct web_server *s, const struct web_profile *p, const char *resume_id,
-               char *id, size_t id_len, char *err, size_t err_len);
+int jobs_start(struct web_server *s, const struct web_profile *p, const char *resume_id, char *id,
+               size_t id_len, char *err, size_t err_len);
 
 /** Ask the running scan @p id to stop (it stops between frames, rig safe, finished views kept).
  *  @retval 0 @retval -ESRCH not the running scan */
@@ -83,8 +83,8 @@ void jobs_shutdown(struct web_server *s);
 
 /** The state of scan @p id: the running one's as its events say, another's from its folder.
  *  @retval 0 @retval -ENOENT no such scan */
-int jobs_describe(struct web_server *s, const char *id, enum web_state *state,
-                  unsigned *views_done, unsigned *views_total, char *error, size_t error_len);
+int jobs_describe(struct web_server *s, const char *id, enum web_state *state, unsigned *views_done,
+                  unsigned *views_total, char *error, size_t error_len);
 
 const char *web_state_name(enum web_state state);
 
