@@ -8,7 +8,7 @@ cd "$(dirname "$0")/.."
 pass=0
 fail=0
 probe=layer_probe_
-trap 'rm -f firmware/$probe.c hal/posix/$probe.c hal/modbus/$probe.c hal/linux/$probe.c host_sim/$probe.c board/$probe.c' EXIT
+trap 'rm -f firmware/$probe.c hal/posix/$probe.c hal/modbus/$probe.c hal/linux/$probe.c host_sim/$probe.c board/$probe.c app/$probe.c web/$probe.c' EXIT
 # dir, header, expect (fail | ok)
 try() {
     dir=$1 header=$2 expect=$3
@@ -47,6 +47,11 @@ try host_sim frames.h ok        # agrees with the firmware on frames
 try board config.h fail         # the board does not reach up into the program that drives it
 try board scan_job.h fail
 try board sim_rig.h ok
+try app web.h fail              # the scanner program knows nothing of the web server
+try firmware api.h fail
+try web gpio_gpiod.h fail       # the web server never drives a device: scanner does
+try web camera_v4l2.h fail
+try web report.h ok             # it shows the report's pictures
 echo "[==========] $((pass + fail)) test(s) run."
 echo "[  PASSED  ] $pass test(s)."
 [ $fail -eq 0 ] || echo "[  FAILED  ] $fail test(s)."
