@@ -607,7 +607,8 @@ int scan_dir_keep_settings(const struct hal_storage *st, const char *config_path
 static int scan_file(const char *name)
 {
     static const char *const names[] = {"config.ini", "calibration.ini", "mesh.ply", "mesh.obj",
-                                        "mesh.stl", "mesh.glb", "reflectance.ini"};
+                                        "mesh.stl", "mesh.glb", "reflectance.ini", "summary.ini",
+                                        "report.html"};
     for (size_t k = 0; k < sizeof(names) / sizeof(names[0]); k++)
         if (strcmp(name, names[k]) == 0)
             return 1;
