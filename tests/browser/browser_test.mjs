@@ -92,8 +92,16 @@ async function pageTest(browser) {
   check((await page.textContent('#rig-state')) === 'ready', 'the page says the rig is ready');
   check((await page.textContent('#lights')) === 'off', 'lights and projector are off while idle');
 
-  await page.click('#start');
+  // the live camera view: pictures one after another, until a scan takes the camera
+  await page.check('#live');
+  await page.waitForFunction(() => { const i = document.getElementById('snapshot'); return !i.hidden && i.naturalWidth === 1280; },
+    null, { timeout: 30000 });
+  const first = await page.getAttribute('#snapshot', 'src');
+  await page.waitForFunction((f) => document.getElementById('snapshot').src !== f, first, { timeout: 30000 });
+  check(true, 'the live camera view shows one picture after another (1280 wide)');
+  await page.click('#start'); // live is still on: the scan waits for the picture being taken
   await page.waitForFunction(() => /views/.test(document.getElementById('progress').textContent));
+  check(!(await page.isChecked('#live')), 'starting a scan ends the live view');
   const busy = await raw(s.url, 'POST', '/api/scans', json, '{}');
   check(busy.status === 409, `a second scan while one runs is refused with 409 (${busy.status})`);
   await page.waitForFunction(() => document.querySelectorAll('#thumbs figure').length >= 4 &&

@@ -153,6 +153,8 @@ function follow(id) {
 
 async function startScan(resumeId) {
   $('error').textContent = '';
+  $('live').checked = false; // the scan needs the camera: the picture being taken ends first
+  await inflight;
   try {
     const body = { profile: $('profile').value };
     const r = resumeId ? await call('POST', `scans/${resumeId}/resume`, body)
@@ -184,16 +186,41 @@ $('selftest-btn').addEventListener('click', async () => {
   }
 });
 
-$('snapshot-btn').addEventListener('click', async () => {
+let inflight = Promise.resolve(); // the picture being taken: a scan waits for it
+
+// One picture from the camera, lit by the projector's white. @retval whether it came
+function snapshot() {
+  const p = takeSnapshot();
+  inflight = p.catch(() => false);
+  return p;
+}
+
+async function takeSnapshot() {
   const img = $('snapshot');
   const res = await fetch(api('snapshot.png'));
   if (!res.ok) {
     $('selftest').hidden = false;
     $('selftest').textContent = (await res.json().catch(() => ({}))).error || res.statusText;
-    return;
+    return false;
   }
+  if (img.src) URL.revokeObjectURL(img.src);
   img.src = URL.createObjectURL(await res.blob());
   img.hidden = false;
+  return true;
+}
+
+$('snapshot-btn').addEventListener('click', snapshot);
+
+// Live: one picture after another while the box is ticked and the rig is free (a scan takes
+// the camera: the server answers 409 and the live view stops).
+$('live').addEventListener('change', async () => {
+  while ($('live').checked) {
+    if (!(await snapshot())) {
+      $('live').checked = false;
+      break;
+    }
+    await new Promise((r) => setTimeout(r, 500));
+  }
 });
 
 // The rig's state and the list of scans.
