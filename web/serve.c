@@ -86,21 +86,39 @@ static int add_profile(struct web_server *s, const char *path)
     return 0;
 }
 
+/* mkdir -p: @retval 0 @retval -1 with errno */
+static int make_dirs(const char *path)
+{
+    char p[WEB_PATH];
+    snprintf(p, sizeof(p), "%s", path);
+    for (char *slash = strchr(p + 1, '/');; slash = strchr(slash + 1, '/')) {
+        if (slash != NULL)
+            *slash = '\0';
+        if (mkdir(p, 0755) != 0 && errno != EEXIST)
+            return -1;
+        if (slash == NULL)
+            return 0;
+        *slash = '/';
+    }
+}
+
 /* Every config must load (file, line and key said now, not at the first scan). The first's
  * [output] dir holds the scans unless --scans says otherwise. */
 static int check_configs(struct web_server *s, const char *scans)
 {
     static struct app_config cfg;
-    char err[1024];
+    char err[1024], first_output[WEB_PATH] = "";
     for (unsigned i = 0; i < s->profiles; i++) {
         if (config_load(&cfg, s->profile[i].path, err, sizeof(err)) != 0) {
             fprintf(stderr, "scanner serve: %s\n", err);
             return -1;
         }
-        if (i == 0 && scans == NULL)
-            scans = cfg.output_dir;
+        if (i == 0)
+            snprintf(first_output, sizeof(first_output), "%s", cfg.output_dir);
     }
-    if (mkdir(scans, 0755) != 0 && errno != EEXIST) {
+    if (scans == NULL)
+        scans = first_output;
+    if (make_dirs(scans) != 0) {
         fprintf(stderr, "scanner serve: cannot make %s: %s\n", scans, strerror(errno));
         return -1;
     }

@@ -16,6 +16,7 @@ const scans = path.join(out, 'scans');
 const scanner = path.resolve(build, 'scanner');
 let failures = 0;
 let lastServer = null; // its messages are printed when the test fails
+const servers = [];    // every server started: none outlives the test
 
 function check(ok, what) {
   console.log(`${ok ? 'ok' : 'FAIL'}: ${what}`);
@@ -28,6 +29,7 @@ const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 function serve(args) {
   return new Promise((resolve, reject) => {
     const proc = spawn(scanner, ['serve', ...args], { stdio: ['ignore', 'pipe', 'pipe'] });
+    servers.push(proc);
     let text = '';
     proc.stderr.on('data', (d) => { text += d; });
     proc.stdout.on('data', (d) => {
@@ -262,6 +264,9 @@ try {
   if (lastServer) console.log(`the server's messages (exit ${lastServer.proc.exitCode}, ${lastServer.proc.signalCode}):\n${lastServer.log()}`);
 } finally {
   await browser.close();
+  for (const proc of servers) // a check that threw left its server running: end it in order
+    if (proc.exitCode === null && proc.signalCode === null)
+      await new Promise((resolve) => { proc.on('exit', resolve); proc.kill('SIGTERM'); });
 }
 console.log(failures === 0 ? 'browser test: every check passed' : `browser test: ${failures} FAILED`);
 process.exit(failures === 0 ? 0 : 1);
