@@ -208,6 +208,31 @@ check serve_help_and_refusals sh -c "$bin serve --help | grep -q -- '--token-fil
     { $bin serve 2> $out/serve1.txt; test \$? -eq 2; } && grep -q 'is required' $out/serve1.txt &&
     { $bin serve --config config/sim.ini --listen 0.0.0.0:18081 2> $out/serve2.txt; test \$? -eq 2; } &&
     grep -q 'token-file' $out/serve2.txt"
+# scanner serve with a config alone: its [output] dir (made with its parents) holds the scans;
+# it answers on loopback, and SIGTERM ends it cleanly.
+serve_test() {
+    sed -e "s|^dir = .*|dir = $out/serve-scans/a/b|" -e "s|^calibration = .*|calibration = $PWD/config/sim-calib.ini|" \
+        -e "s|^mesh_file = ../|mesh_file = $PWD/|" config/sim.ini > "$out/serve.ini"
+    rm -rf "$out/serve-scans"
+    port=$((30000 + $$ % 20000))
+    "$bin" serve --config "$out/serve.ini" --listen "127.0.0.1:$port" > "$out/serve.txt" 2>&1 &
+    pid=$!
+    /usr/bin/python3 - "$port" <<'PY'
+import json, sys, time, urllib.request
+for _ in range(100):
+    try:
+        s = json.load(urllib.request.urlopen("http://127.0.0.1:%s/api/status" % sys.argv[1]))
+        sys.exit(0 if s["profiles"] == ["serve"] and not s["scanning"] else 1)
+    except OSError:
+        time.sleep(0.1)
+sys.exit(1)
+PY
+    ok=$?
+    kill -TERM "$pid"
+    wait "$pid"
+    [ $? -eq 0 ] && [ $ok -eq 0 ] && test -d "$out/serve-scans/a/b"
+}
+check serve_answers_with_its_config serve_test
 # mesh.glb (issue 18): the Khronos validator finds nothing wrong, it is in metres with +Y up
 # (the bunny is 150 mm tall and stands on y = 0), and the validator does catch a damaged one.
 check glb_valid_metres_y_up sh -c "node tests/gltf/validate.mjs $out/scan/mesh.glb > $out/glb.txt &&
