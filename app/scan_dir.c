@@ -480,12 +480,14 @@ int scan_dir_sweep(const struct hal_storage *st, const char *dir, uint32_t views
 int scan_dir_write_reflectance(const struct hal_storage *st, const char *dir,
                                const struct reflect_model *m)
 {
-    char text[4096], path[SCAN_DIR_PATH_MAX];
+    char text[8192], path[SCAN_DIR_PATH_MAX];
     size_t len = (size_t)snprintf(
         text, sizeof(text),
         "; reflectance parameters of [colour] method = fit (docs/colour.md): per material\n"
         "; cluster, S = rho cos(theta_i) + specular D(alpha) / cos(theta_r), D the GGX\n"
-        "; distribution of alpha = roughness, 1 at its peak (firmware/reflect.h)\n"
+        "; distribution of alpha = roughness, 1 at its peak (firmware/reflect.h); then the\n"
+        "; lobe as measured: lobe_specular x the shape lobe, its values at half-angles\n"
+        "; 1.2 (k / 15)^2 rad, k = 0 .. 15 (linear between, 0 beyond)\n"
         "[reflectance]\nclusters = %u\n",
         (unsigned)m->count);
     for (uint32_t k = 0; k < m->count && len < sizeof(text); k++) {
@@ -496,6 +498,16 @@ int scan_dir_write_reflectance(const struct hal_storage *st, const char *dir,
                                 (unsigned)k, c->centre[0], c->centre[1], c->centre[2],
                                 c->specular[0], c->specular[1], c->specular[2], c->roughness,
                                 (unsigned)c->samples, c->rms);
+        if (!c->measured || len >= sizeof(text))
+            continue;
+        len += (size_t)snprintf(text + len, sizeof(text) - len,
+                                "lobe_specular = %.4f, %.4f, %.4f\nlobe =", c->lobe_specular[0],
+                                c->lobe_specular[1], c->lobe_specular[2]);
+        for (uint32_t n = 0; n < REFLECT_LOBE_NODES && len < sizeof(text); n++)
+            len += (size_t)snprintf(text + len, sizeof(text) - len, "%s %.5f", n ? "," : "",
+                                    c->lobe[n]);
+        if (len < sizeof(text))
+            len += (size_t)snprintf(text + len, sizeof(text) - len, "\n");
     }
     if (len >= sizeof(text))
         return -ENAMETOOLONG;

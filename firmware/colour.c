@@ -334,10 +334,9 @@ static void fit_pixel(const struct frame_ctx *f, const struct scan_calib *c, str
     }
     const struct reflect_cluster *cl = &fs->model->cluster[reflect_cluster_of(fs->model, rho0)];
     vec3 view = v3_norm(v3_scale(p, -1.0)), ln = lobe_normal(m, r, i);
-    double cos_r = v3_dot(ln, view), g[HAL_MAX_LIGHTS], rho[3];
-    double k_grey = (cl->specular[0] + cl->specular[1] + cl->specular[2]) / 3.0;
+    double cos_r = v3_dot(ln, view), sp[HAL_MAX_LIGHTS][3], rho[3];
     for (uint32_t l = 0; l < c->light_count; l++)
-        g[l] = reflect_lobe(cl->roughness, half_angle(p, ln, view, c->light_pos_mm[l]), cos_r);
+        reflect_specular(cl, half_angle(p, ln, view, c->light_pos_mm[l]), cos_r, sp[l]);
     memcpy(rho, rho0, sizeof(rho));
     /* twice: each light weighs by eq. 6 and by the share of its signal the diffuse part is
      * (as the last estimate has it), so that where the lobe is most of the light (dark paint
@@ -348,11 +347,11 @@ static void fit_pixel(const struct frame_ctx *f, const struct scan_calib *c, str
         for (uint32_t l = 0; l < c->light_count; l++) {
             if (!(ls.used >> l & 1u))
                 continue;
-            double ct = ls.cosine[l], share = rho_grey * ct / (rho_grey * ct + k_grey * g[l]);
+            double sp_grey = (sp[l][0] + sp[l][1] + sp[l][2]) / 3.0, ct = ls.cosine[l];
+            double share = rho_grey * ct / (rho_grey * ct + sp_grey);
             double w = ls.weight[l] * share * share;
             for (int ch = 0; ch < 3; ch++)
-                fit_num[ch] +=
-                    w * (ls.lit[l][ch] * prm->white_scale[ch] - cl->specular[ch] * g[l]) * ct;
+                fit_num[ch] += w * (ls.lit[l][ch] * prm->white_scale[ch] - sp[l][ch]) * ct;
             fit_den += w * ct * ct;
         }
         for (int ch = 0; ch < 3 && fit_den > 1e-12; ch++)

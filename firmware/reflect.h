@@ -17,7 +17,15 @@
  * multi method, highlights already left out), then one lobe fitted per cluster, alternating
  * with every sample's diffuse colour (least squares; the roughness by a search over a grid).
  * The samples are a fixed pool: each view gives up to REFLECT_MAX_SAMPLES / views of its valid
- * pixels, evenly spread. */
+ * pixels, evenly spread.
+ *
+ * Then each cluster's lobe shape is measured: D at REFLECT_LOBE_NODES half-angles (piecewise
+ * linear between them, 0 beyond REFLECT_LOBE_MAX_RAD, 1 at alpha = 0), starting from the GGX
+ * fit and alternating with the diffuse colours again (least squares with a little smoothness
+ * between neighbouring nodes, not below 0), so that a material whose tails are not GGX's (the
+ * haze of a metallic paint) leaves no light on the diffuse colour. The colours and the relit
+ * model use the measured shape (reflect_specular); the GGX lobe stays the cluster's summary
+ * (reflectance.ini, the reflectance line) and is what mesh.glb's material takes. */
 #ifndef REFLECT_H
 #define REFLECT_H
 
@@ -33,13 +41,20 @@ struct reflect_obs {
     float alpha[HAL_MAX_LIGHTS];     /**< alpha_l, radians */
 };
 
+/** Nodes of a cluster's measured lobe shape: at half-angles REFLECT_LOBE_MAX_RAD (k / (n-1))^2. */
+#define REFLECT_LOBE_NODES 16u
+#define REFLECT_LOBE_MAX_RAD 1.2
+
 /** A material cluster's lobe and where it sits in diffuse colour. */
 struct reflect_cluster {
-    double centre[3];   /**< mean diffuse colour of its samples (linear) */
-    double specular[3]; /**< K: specular colour x strength */
-    double roughness;   /**< a, GGX's alpha */
-    uint32_t samples;   /**< samples it was fitted from */
-    double rms;         /**< fit residual, albedo units */
+    double centre[3];                /**< mean diffuse colour of its samples (linear) */
+    double specular[3];              /**< K: specular colour x strength */
+    double roughness;                /**< a, GGX's alpha */
+    double lobe[REFLECT_LOBE_NODES]; /**< the lobe's shape as measured (1 at alpha = 0) */
+    double lobe_specular[3];         /**< K of the measured shape */
+    int measured;                    /**< lobe[] is fitted: reflect_lobe_of uses it */
+    uint32_t samples;                /**< samples it was fitted from */
+    double rms;                      /**< fit residual, albedo units */
 };
 
 struct reflect_model {
@@ -72,6 +87,10 @@ const struct reflect_model *reflect_model(void);
 
 /** The cluster nearest to diffuse colour @p rho (linear). */
 uint32_t reflect_cluster_of(const struct reflect_model *m, const double rho[3]);
+
+/** Cluster @p cl's specular part at @p alpha, @p cos_r: K D / cos(theta_r) per channel, with its
+ *  measured shape (or its GGX lobe before that is fitted). */
+void reflect_specular(const struct reflect_cluster *cl, double alpha, double cos_r, double out[3]);
 
 /** The lobe's factor D(alpha) / cos(theta_r) (times K: the specular part), D as above. */
 double reflect_lobe(double roughness, double alpha, double cos_r);

@@ -64,6 +64,17 @@ static int reflectance_key(void *user, const char *section, const char *name, co
         c->roughness = atof(value);
     else if (strcmp(name, "samples") == 0)
         c->samples = (uint32_t)strtoul(value, NULL, 10);
+    else if (strcmp(name, "lobe_specular") == 0)
+        sscanf(value, "%lf, %lf, %lf", &c->lobe_specular[0], &c->lobe_specular[1],
+               &c->lobe_specular[2]);
+    else if (strcmp(name, "lobe") == 0) {
+        char *end = (char *)value;
+        for (uint32_t n = 0; n < REFLECT_LOBE_NODES; n++) {
+            c->lobe[n] = strtod(end, &end);
+            end += *end == ',';
+        }
+        c->measured = 1;
+    }
     return 1;
 }
 
@@ -105,9 +116,7 @@ static int model_at(const struct sim_mesh *m, const struct sim_bvh *bvh,
     if (lobes->count > 0) {
         const struct reflect_cluster *cl = &lobes->cluster[reflect_cluster_of(lobes, rho)];
         double nh = v3_dot(n, v3_norm(v3_add(l, v)));
-        double g = reflect_lobe(cl->roughness, acos(fmin(1.0, fmax(-1.0, nh))), cr);
-        for (int c = 0; c < 3; c++)
-            spec[c] = cl->specular[c] * g;
+        reflect_specular(cl, acos(fmin(1.0, fmax(-1.0, nh))), cr, spec);
     }
     /* the model's units hold at the reference distance: the new light's falloff times that */
     for (int c = 0; c < 3; c++)
