@@ -185,9 +185,10 @@ static void kmeans_rounds(struct reflect_model *m, int rounds)
     }
 }
 
-/* The lobe's K for @p roughness over cluster @p c's kept observations (least squares of
- * the residual after the diffuse part, per channel, not below 0); @retval the squared error */
-static double fit_specular(uint32_t c, double roughness, double k_out[3])
+/* The lobe's K for the shape of @p shape (its GGX roughness, or its measured shape) over
+ * cluster @p c's kept observations (least squares of the residual after the diffuse part, per
+ * channel, not below 0); @retval the squared error */
+static double fit_k(uint32_t c, const struct reflect_cluster *shape, double k_out[3])
 {
     double sgg = 0.0, srg[3] = {0, 0, 0}, srr = 0.0;
     for (uint32_t i = 0; i < rs.count; i++) {
@@ -197,7 +198,7 @@ static double fit_specular(uint32_t c, double roughness, double k_out[3])
         for (uint32_t l = 0; l < HAL_MAX_LIGHTS; l++) {
             if (!(pool_used[i] >> l & 1u))
                 continue;
-            double g = reflect_lobe(roughness, o->alpha[l], o->cos_r);
+            double g = lobe_shape(shape, o->alpha[l], o->cos_r);
             sgg += g * g;
             for (int ch = 0; ch < 3; ch++) {
                 double r = o->signal[l][ch] - pool_rho[i][ch] * o->cos_i[l];
@@ -212,6 +213,15 @@ static double fit_specular(uint32_t c, double roughness, double k_out[3])
         err += k_out[ch] * k_out[ch] * sgg - 2.0 * k_out[ch] * srg[ch];
     }
     return err;
+}
+
+/* K for GGX of @p roughness. @retval the squared error */
+static double fit_specular(uint32_t c, double roughness, double k_out[3])
+{
+    struct reflect_cluster ggx;
+    memset(&ggx, 0, sizeof(ggx));
+    ggx.roughness = roughness;
+    return fit_k(c, &ggx, k_out);
 }
 
 /* Each sample's diffuse colour given its cluster's lobe: least squares over its kept lights,
@@ -358,24 +368,8 @@ static void fit_measured(struct reflect_cluster *cl, uint32_t c)
         cl->lobe[n] = fmax(0.0, x[n] / x[0]);
     for (int ch = 0; ch < 3; ch++)
         cl->lobe_specular[ch] *= x[0];
-    /* K for this shape */
-    double sgg = 0.0, srg[3] = {0, 0, 0};
     cl->measured = 1;
-    for (uint32_t i = 0; i < rs.count; i++) {
-        if (pool_cluster[i] != c)
-            continue;
-        const struct reflect_obs *o = &pool[i];
-        for (uint32_t l = 0; l < HAL_MAX_LIGHTS; l++) {
-            if (!(pool_used[i] >> l & 1u))
-                continue;
-            double g = lobe_shape(cl, o->alpha[l], o->cos_r);
-            sgg += g * g;
-            for (int ch = 0; ch < 3; ch++)
-                srg[ch] += g * (o->signal[l][ch] - pool_rho[i][ch] * o->cos_i[l]);
-        }
-    }
-    for (int ch = 0; ch < 3; ch++)
-        cl->lobe_specular[ch] = sgg > 0.0 && srg[ch] > 0.0 ? srg[ch] / sgg : 0.0;
+    fit_k(c, cl, cl->lobe_specular); /* K for this shape */
 }
 
 int reflect_fit(uint32_t clusters, struct reflect_model *out)
