@@ -193,26 +193,80 @@ static int colour_frame_of(const char *dir, uint32_t view, uint32_t *frame)
     return -ENOENT;
 }
 
-/* Box-filtered to @p tw x @p th: colour as a mean, reasons as the most common in the box. */
-static void shrink(const uint8_t *src, uint32_t w, uint32_t h, int reasons, uint8_t *dst,
-                   uint32_t tw, uint32_t th)
+/* What a view's thumbnails are made of: its range image's reasons and colours (linear x 255),
+ * and its camera's colour frame (NULL where not kept). Read once for all three. */
+struct view_images {
+    uint8_t *reason, *rgb, *frame;
+    uint32_t w, h;
+};
+
+static void view_images_free(struct view_images *vi)
 {
-    for (uint32_t ty = 0; ty < th; ty++)
-        for (uint32_t tx = 0; tx < tw; tx++) {
-            uint32_t x0 = tx * w / tw, x1 = (tx + 1) * w / tw, y0 = ty * h / th;
-            uint32_t y1 = (ty + 1) * h / th;
+    free(vi->frame);
+    free(vi->rgb);
+    free(vi->reason);
+    *vi = (struct view_images){0};
+}
+
+/* @p want_frame: the camera's frame too. @retval 0 @retval -ENOENT no range.bin (yet)
+ * @retval -EINVAL damaged @retval -ENOMEM */
+static int view_images_read(const char *dir, uint32_t view, int want_frame, struct view_images *vi)
+{
+    *vi = (struct view_images){0};
+    vi->reason = malloc(HAL_MAX_PIXELS);
+    vi->rgb = malloc(3u * HAL_MAX_PIXELS);
+    int rc = vi->reason != NULL && vi->rgb != NULL ? 0 : -ENOMEM;
+    if (rc == 0)
+        rc = scan_dir_read_range_image(dir, view, vi->reason, vi->rgb, HAL_MAX_PIXELS, &vi->w,
+                                       &vi->h);
+    uint32_t frame;
+    char err[256];
+    if (rc == 0 && want_frame && colour_frame_of(dir, view, &frame) == 0 &&
+        (vi->frame = malloc(3u * vi->w * vi->h)) != NULL &&
+        scan_dir_read_frame(dir, view, frame, vi->frame, 3u * vi->w * vi->h, vi->w, vi->h, 3, err,
+                            sizeof(err)) != 0) {
+        free(vi->frame); /* not kept (keep_frames), or unreadable: that picture is missing */
+        vi->frame = NULL;
+    }
+    if (rc != 0)
+        view_images_free(vi);
+    return rc;
+}
+
+/* Thumbnail @p kind of @p vi, box-filtered to @p tw x @p th (RGB, @p out of REPORT_THUMB_WIDTH
+ * squared x 3 bytes at least): colour as a mean (the compensated colour encoded as a screen
+ * shows it, sRGB, before averaging), reasons as the most common in the box.
+ * @retval 0 @retval -ENOENT the camera's frame is not kept */
+static int thumb_of(const struct view_images *vi, enum report_thumb kind, uint8_t *out,
+                    uint32_t *tw, uint32_t *th)
+{
+    const uint8_t *src = kind == REPORT_THUMB_RAW       ? vi->frame
+                         : kind == REPORT_THUMB_REASONS ? vi->reason
+                                                        : vi->rgb;
+    uint32_t w = vi->w, h = vi->h;
+    if (src == NULL)
+        return -ENOENT;
+    *tw = REPORT_THUMB_WIDTH;
+    *th = (uint32_t)((uint64_t)h * REPORT_THUMB_WIDTH / w);
+    if (*th > REPORT_THUMB_WIDTH)
+        *th = REPORT_THUMB_WIDTH;
+    for (uint32_t ty = 0; ty < *th; ty++)
+        for (uint32_t tx = 0; tx < *tw; tx++) {
+            uint32_t x0 = tx * w / *tw, x1 = (tx + 1) * w / *tw, y0 = ty * h / *th;
+            uint32_t y1 = (ty + 1) * h / *th;
             uint32_t sum[3] = {0, 0, 0}, count[SCAN_REASON_COUNT] = {0}, n = 0;
             for (uint32_t y = y0; y < y1; y++)
                 for (uint32_t x = x0; x < x1; x++, n++) {
                     size_t i = (size_t)y * w + x;
-                    if (reasons)
+                    if (kind == REPORT_THUMB_REASONS)
                         count[src[i] < SCAN_REASON_COUNT ? src[i] : 0]++;
                     else
                         for (int c = 0; c < 3; c++)
-                            sum[c] += src[3 * i + c];
+                            sum[c] += kind == REPORT_THUMB_INTRINSIC ? srgb_encode(src[3 * i + c])
+                                                                     : src[3 * i + c];
                 }
-            uint8_t *o = dst + 3 * ((size_t)ty * tw + tx);
-            if (reasons) {
+            uint8_t *o = out + 3 * ((size_t)ty * *tw + tx);
+            if (kind == REPORT_THUMB_REASONS) {
                 unsigned best = 0;
                 for (unsigned r = 1; r < SCAN_REASON_COUNT; r++)
                     best = count[r] > count[best] ? r : best;
@@ -222,49 +276,22 @@ static void shrink(const uint8_t *src, uint32_t w, uint32_t h, int reasons, uint
                     o[c] = (uint8_t)(n ? sum[c] / n : 0);
             }
         }
-}
-
-/* The thumbnail's pixels (RGB, @p out of REPORT_THUMB_WIDTH squared x 3 bytes at least). */
-static int thumb_pixels(const char *dir, uint32_t view, enum report_thumb kind, uint8_t *out,
-                        uint32_t *tw, uint32_t *th)
-{
-    uint32_t w = 0, h = 0, frame = 0;
-    uint8_t *reason = malloc(HAL_MAX_PIXELS), *rgb = malloc(3u * HAL_MAX_PIXELS);
-    int rc = reason != NULL && rgb != NULL ? 0 : -ENOMEM;
-    if (rc == 0)
-        rc = scan_dir_read_range_image(dir, view, reason, rgb, HAL_MAX_PIXELS, &w, &h);
-    if (rc == 0 && kind == REPORT_THUMB_RAW) {
-        char err[256];
-        rc = colour_frame_of(dir, view, &frame);
-        if (rc == 0)
-            rc = scan_dir_read_frame(dir, view, frame, rgb, 3u * HAL_MAX_PIXELS, w, h, 3, err,
-                                     sizeof(err));
-    } else if (rc == 0 && kind == REPORT_THUMB_INTRINSIC) {
-        for (size_t i = 0; i < 3u * w * h; i++) /* linear x 255 -> what a screen shows */
-            rgb[i] = srgb_encode(rgb[i]);
-    }
-    if (rc == 0) {
-        *tw = REPORT_THUMB_WIDTH;
-        *th = (uint32_t)((uint64_t)h * REPORT_THUMB_WIDTH / w);
-        if (*th > REPORT_THUMB_WIDTH)
-            *th = REPORT_THUMB_WIDTH;
-        if (kind == REPORT_THUMB_REASONS)
-            shrink(reason, w, h, 1, out, *tw, *th);
-        else
-            shrink(rgb, w, h, 0, out, *tw, *th);
-    }
-    free(rgb);
-    free(reason);
-    return rc;
+    return 0;
 }
 
 int report_thumb_png(const char *dir, uint32_t view, enum report_thumb kind, uint8_t **png,
                      size_t *png_len)
 {
     static uint8_t pixels[3u * REPORT_THUMB_WIDTH * REPORT_THUMB_WIDTH];
+    struct view_images vi;
     uint32_t tw, th;
-    int rc = thumb_pixels(dir, view, kind, pixels, &tw, &th);
-    return rc != 0 ? rc : image_encode_png(pixels, tw, th, 3, png, png_len);
+    int rc = view_images_read(dir, view, kind == REPORT_THUMB_RAW, &vi);
+    if (rc == 0)
+        rc = thumb_of(&vi, kind, pixels, &tw, &th);
+    if (rc == 0)
+        rc = image_encode_png(pixels, tw, th, 3, png, png_len);
+    view_images_free(&vi);
+    return rc;
 }
 
 /* ---- the model seen from around: mesh.ply drawn flat-shaded into a z-buffer ---- */
@@ -543,13 +570,14 @@ static void registration_section(struct text *t, const char *dir)
     }
 }
 
-static void thumb_cell(struct text *t, const char *dir, uint32_t v, enum report_thumb kind,
+/* A cell with thumbnail @p kind of @p vi (NULL: the view has no range image). */
+static void thumb_cell(struct text *t, const struct view_images *vi, enum report_thumb kind,
                        const char *alt)
 {
     static uint8_t pixels[3u * REPORT_THUMB_WIDTH * REPORT_THUMB_WIDTH];
     uint32_t tw, th;
     text_printf(t, "<td>");
-    if (thumb_pixels(dir, v, kind, pixels, &tw, &th) == 0)
+    if (vi != NULL && thumb_of(vi, kind, pixels, &tw, &th) == 0)
         text_img(t, pixels, tw, th, 3, alt);
     else
         text_printf(t, "<span class=missing>not kept</span>");
@@ -584,9 +612,12 @@ static void views_section(struct text *t, const char *dir, uint32_t views, const
                         kv_num(&reg, "view", "view_rms_mm", 0));
         else
             text_printf(t, "</td><td>%u</td><td></td>", (unsigned)v.valid_points);
-        thumb_cell(t, dir, i, REPORT_THUMB_RAW, "camera");
-        thumb_cell(t, dir, i, REPORT_THUMB_INTRINSIC, "colour");
-        thumb_cell(t, dir, i, REPORT_THUMB_REASONS, "reason map");
+        struct view_images vi;
+        int have = view_images_read(dir, i, 1, &vi) == 0;
+        thumb_cell(t, have ? &vi : NULL, REPORT_THUMB_RAW, "camera");
+        thumb_cell(t, have ? &vi : NULL, REPORT_THUMB_INTRINSIC, "colour");
+        thumb_cell(t, have ? &vi : NULL, REPORT_THUMB_REASONS, "reason map");
+        view_images_free(&vi);
         text_printf(t, "</tr>\n");
     }
     text_printf(t, "</table>\n");
@@ -623,9 +654,8 @@ int report_write(const struct hal_storage *st, const char *dir, char *err, size_
         snprintf(err, err_len, "%s/config.ini: %s (not a scan directory?)", dir, strerror(-rc));
         return rc;
     }
-    uint32_t views =
-        (uint32_t)kv_num(&cfg, "scan", "views", 8) * (uint32_t)kv_num(&cfg, "scan", "passes", 1);
-    uint32_t done = 0;
+    uint32_t views, done = 0;
+    scan_dir_view_count(dir, &views); /* its config.ini, read just above */
     for (uint32_t v = 0; v < views; v++)
         done += (uint32_t)scan_dir_view_complete(dir, v);
     const char *method = kv_get(&cfg, "colour", "method");

@@ -10,6 +10,7 @@
 #include "ini_schema.h"
 
 #include <dirent.h>
+#include <ini.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <stddef.h>
@@ -241,6 +242,31 @@ int scan_dir_read_view_file(const char *path, uint32_t view, struct scan_dir_vie
     return rc;
 }
 
+struct view_count {
+    uint32_t views, passes;
+};
+
+static int view_count_key(void *user, const char *section, const char *key, const char *value)
+{
+    struct view_count *c = user;
+    if (strcmp(section, "scan") == 0 && strcmp(key, "views") == 0)
+        c->views = (uint32_t)strtoul(value, NULL, 10);
+    if (strcmp(section, "scan") == 0 && strcmp(key, "passes") == 0)
+        c->passes = (uint32_t)strtoul(value, NULL, 10);
+    return 1;
+}
+
+int scan_dir_view_count(const char *dir, uint32_t *views)
+{
+    char path[SCAN_DIR_PATH_MAX];
+    struct view_count c = {1, 1}; /* the config's defaults of [scan] views and passes */
+    int rc = scan_dir_path(path, sizeof(path), dir, -1, "config.ini");
+    if (rc == 0 && ini_parse(path, view_count_key, &c) == -1)
+        rc = -ENOENT;
+    *views = c.views * c.passes;
+    return rc;
+}
+
 int scan_dir_view_complete(const char *dir, uint32_t view)
 {
     static struct scan_dir_view v; /* large; one caller at a time */
@@ -351,15 +377,33 @@ int scan_dir_write_range(const struct hal_storage *st, const char *dir, uint32_t
     return rc;
 }
 
-/* The points of range.bin into @p fill, in pixel order of the reasons already read. */
-static int read_range_points(FILE *fp, size_t n, struct scan_view_fill *fill)
+/* range.bin of view @p view opened at its first reason byte, its header read and its magic
+ * checked. @retval 0 @retval -errno (no such file) @retval -EINVAL (not a range image) */
+static int range_open(const char *dir, uint32_t view, char *path, size_t path_len,
+                      struct range_header *h, FILE **fp)
+{
+    int rc = scan_dir_path(path, path_len, dir, (int)view, "range.bin");
+    *fp = rc == 0 ? fopen(path, "rb") : NULL;
+    if (*fp == NULL)
+        return rc != 0 ? rc : -errno;
+    if (fread(h, sizeof(*h), 1, *fp) == 1 && memcmp(h->magic, range_magic, sizeof(h->magic)) == 0)
+        return 0;
+    fclose(*fp);
+    return -EINVAL;
+}
+
+/* The points of range.bin after the reasons @p reason (n pixels) already read: @p each is called
+ * for every pixel in order, with its point where it is valid and NULL elsewhere.
+ * @retval 0 @retval -EINVAL cut short, or more points than valid pixels */
+static int read_range_points(FILE *fp, const uint8_t *reason, size_t n,
+                             void (*each)(void *priv, size_t i, const struct range_point *p),
+                             void *priv)
 {
     static struct range_point chunk[RANGE_CHUNK];
     size_t have = 0, next = 0;
     for (size_t i = 0; i < n; i++) {
-        if (fill->reason[i] != SCAN_VALID) {
-            memset(fill->rgb + 3 * i, 0, 3);
-            fill->confidence[i] = 0.0f;
+        if (reason[i] != SCAN_VALID) {
+            each(priv, i, NULL);
             continue;
         }
         if (next == have) {
@@ -368,53 +412,59 @@ static int read_range_points(FILE *fp, size_t n, struct scan_view_fill *fill)
             if (have == 0)
                 return -EINVAL;
         }
-        const struct range_point *p = &chunk[next++];
-        memcpy(fill->xyz_mm + 3 * i, p->xyz_mm, sizeof(p->xyz_mm));
-        memcpy(fill->normal + 3 * i, p->normal, sizeof(p->normal));
-        fill->confidence[i] = p->confidence;
-        memcpy(fill->rgb + 3 * i, p->rgb, 3);
+        each(priv, i, &chunk[next++]);
     }
     return next == have && fgetc(fp) == EOF ? 0 : -EINVAL; /* nothing left over */
+}
+
+/* A point into the firmware's buffers (scan_dir_read_range). */
+static void fill_point(void *priv, size_t i, const struct range_point *p)
+{
+    struct scan_view_fill *fill = priv;
+    if (p == NULL) {
+        memset(fill->rgb + 3 * i, 0, 3);
+        fill->confidence[i] = 0.0f;
+        return;
+    }
+    memcpy(fill->xyz_mm + 3 * i, p->xyz_mm, sizeof(p->xyz_mm));
+    memcpy(fill->normal + 3 * i, p->normal, sizeof(p->normal));
+    fill->confidence[i] = p->confidence;
+    memcpy(fill->rgb + 3 * i, p->rgb, 3);
+}
+
+/* A point's colour into an RGB image, black where no point is (scan_dir_read_range_image). */
+static void image_point(void *priv, size_t i, const struct range_point *p)
+{
+    uint8_t *rgb = priv;
+    if (rgb == NULL)
+        return;
+    if (p != NULL)
+        memcpy(rgb + 3 * i, p->rgb, 3);
+    else
+        memset(rgb + 3 * i, 0, 3);
 }
 
 int scan_dir_read_range_image(const char *dir, uint32_t view, uint8_t *reason, uint8_t *rgb,
                               size_t capacity, uint32_t *width, uint32_t *height)
 {
-    static struct range_point chunk[RANGE_CHUNK];
     char path[SCAN_DIR_PATH_MAX];
     struct range_header h;
-    int rc = scan_dir_path(path, sizeof(path), dir, (int)view, "range.bin");
-    FILE *fp = rc == 0 ? fopen(path, "rb") : NULL;
-    if (fp == NULL)
-        return rc != 0 ? rc : -errno;
+    FILE *fp;
+    int rc = range_open(dir, view, path, sizeof(path), &h, &fp);
+    if (rc != 0)
+        return rc;
     rc = -EINVAL;
-    if (fread(&h, sizeof(h), 1, fp) != 1 || memcmp(h.magic, range_magic, sizeof(h.magic)) != 0)
-        goto out_close;
     size_t n = (size_t)h.width * h.height;
     if (h.width == 0 || h.height == 0 || n > capacity || fread(reason, 1, n, fp) != n)
         goto out_close;
-    size_t have = 0, next = 0;
-    for (size_t i = 0; i < n; i++) {
+    for (size_t i = 0; i < n; i++)
         if (reason[i] >= SCAN_REASON_COUNT)
             goto out_close;
-        if (reason[i] != SCAN_VALID) {
-            if (rgb != NULL)
-                memset(rgb + 3 * i, 0, 3);
-            continue;
-        }
-        if (next == have) {
-            have = fread(chunk, sizeof(chunk[0]), RANGE_CHUNK, fp);
-            next = 0;
-            if (have == 0)
-                goto out_close;
-        }
-        if (rgb != NULL)
-            memcpy(rgb + 3 * i, chunk[next].rgb, 3);
-        next++;
+    rc = read_range_points(fp, reason, n, image_point, rgb);
+    if (rc == 0) {
+        *width = h.width;
+        *height = h.height;
     }
-    *width = h.width;
-    *height = h.height;
-    rc = 0;
 out_close:
     fclose(fp);
     return rc;
@@ -426,24 +476,21 @@ int scan_dir_read_range(const char *dir, uint32_t view, uint32_t width, uint32_t
     char path[SCAN_DIR_PATH_MAX];
     struct range_header h;
     struct scan_view_fill fill;
-    int rc = scan_dir_path(path, sizeof(path), dir, (int)view, "range.bin");
-    FILE *fp = rc == 0 ? fopen(path, "rb") : NULL;
-    if (fp == NULL) {
-        rc = rc != 0 ? rc : -errno;
-        snprintf(err, err_len, "%s: %s", path, strerror(-rc));
+    FILE *fp;
+    int rc = range_open(dir, view, path, sizeof(path), &h, &fp);
+    if (rc != 0) {
+        snprintf(err, err_len, "%s: %s", path,
+                 rc == -EINVAL ? "not a range image (range.bin)" : strerror(-rc));
         return rc;
     }
     size_t n = (size_t)width * height;
     rc = -EINVAL;
-    const char *why = "not a range image (range.bin)";
-    if (fread(&h, sizeof(h), 1, fp) != 1 || memcmp(h.magic, range_magic, sizeof(h.magic)) != 0)
-        goto out_close;
-    why = "of another frame size than this scan's";
+    const char *why = "of another frame size than this scan's";
     if (h.width != width || h.height != height || h.valid_count > n)
         goto out_close;
     why = "larger than the compiled frame limit";
-    if (scan_restore_view(width, height, h.angle_mdeg, h.valid_count, h.colour_method, v,
-                          &fill) != 0)
+    if (scan_restore_view(width, height, h.angle_mdeg, h.valid_count, h.colour_method, v, &fill) !=
+        0)
         goto out_close;
     why = "cut short or damaged";
     if (fread(fill.reason, 1, n, fp) != n)
@@ -454,7 +501,7 @@ int scan_dir_read_range(const char *dir, uint32_t view, uint32_t width, uint32_t
             goto out_close;
         valid += fill.reason[i] == SCAN_VALID;
     }
-    if (valid == h.valid_count && read_range_points(fp, n, &fill) == 0)
+    if (valid == h.valid_count && read_range_points(fp, fill.reason, n, fill_point, &fill) == 0)
         rc = 0;
 out_close:
     if (rc != 0)
@@ -533,8 +580,8 @@ int scan_dir_write_registration(const struct hal_storage *st, const char *dir, u
         r->solved, r->accepted, r->refused, (unsigned)r->stride, (unsigned)r->iterations,
         r->score_before_mm, r->score_after_mm, r->rms_mm, r->loop_rms_mm, r->axis_shift_mm,
         r->axis_tilt_deg, (unsigned)r->worst_view, r->worst_rms_mm, r->second_turned_deg,
-        r->second_rms_mm, (unsigned)r->second_coupled, v->reported_mdeg / 1000.0,
-        v->angle_deg, v->correction_deg, (unsigned)v->overlap, (unsigned)v->coupled,
+        r->second_rms_mm, (unsigned)r->second_coupled, v->reported_mdeg / 1000.0, v->angle_deg,
+        v->correction_deg, (unsigned)v->overlap, (unsigned)v->coupled,
         v->overlap ? (double)v->coupled / v->overlap : 0.0, v->rms_mm);
     const double *m = pose->rot;
     if (len > 0 && (size_t)len < sizeof(text))
@@ -618,9 +665,9 @@ int scan_dir_keep_settings(const struct hal_storage *st, const char *config_path
  * (the simulator's ground truth among them) */
 static int scan_file(const char *name)
 {
-    static const char *const names[] = {"config.ini", "calibration.ini", "mesh.ply", "mesh.obj",
-                                        "mesh.stl", "mesh.glb", "reflectance.ini", "summary.ini",
-                                        "report.html"};
+    static const char *const names[] = {"config.ini",      "calibration.ini", "mesh.ply",
+                                        "mesh.obj",        "mesh.stl",        "mesh.glb",
+                                        "reflectance.ini", "summary.ini",     "report.html"};
     for (size_t k = 0; k < sizeof(names) / sizeof(names[0]); k++)
         if (strcmp(name, names[k]) == 0)
             return 1;
@@ -637,8 +684,7 @@ static int view_file(const char *name)
             if (strcmp(name + end, frame_endings[k]) == 0)
                 return 1;
     return strcmp(name, "view.ini") == 0 || strcmp(name, "cloud.ply") == 0 ||
-           strcmp(name, "range.bin") == 0 ||
-           strcmp(name, "target.ini") == 0 ||
+           strcmp(name, "range.bin") == 0 || strcmp(name, "target.ini") == 0 ||
            strcmp(name, "registration.ini") == 0 || strncmp(name, "truth_", 6) == 0;
 }
 
@@ -653,8 +699,8 @@ static int view_dir(const char *name)
 /* Check (@p remove 0) or remove (1) every entry of @p dir that a scan writes; the first entry
  * that is not one is named in @p err. What interrupted writes left is swept first: the storage
  * backend knows its temporary files. @retval 0 @retval -EEXIST @retval -errno */
-static int scan_entries(const struct hal_storage *storage, const char *dir, int in_view,
-                        int remove, char *err, size_t err_len)
+static int scan_entries(const struct hal_storage *storage, const char *dir, int in_view, int remove,
+                        char *err, size_t err_len)
 {
     int rc_sweep = hal_storage_sweep(storage, dir);
     if (rc_sweep != 0 && rc_sweep != -ENOSYS)

@@ -75,6 +75,11 @@ int scan_dir_read_view(const char *dir, uint32_t view, struct scan_dir_view *v, 
 int scan_dir_read_view_file(const char *path, uint32_t view, struct scan_dir_view *v, char *err,
                             size_t err_len);
 
+/** How many views the scan in @p dir takes, all passes (its config.ini's [scan] views x passes;
+ *  a key not there has the config's default). Thread-safe (the web server's threads ask).
+ *  @retval 0 @retval -ENOENT no config.ini: not a scan directory */
+int scan_dir_view_count(const char *dir, uint32_t *views);
+
 /** @retval 1 when view @p view finished (its view.ini is there and reads) */
 int scan_dir_view_complete(const char *dir, uint32_t view);
 

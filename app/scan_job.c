@@ -111,12 +111,28 @@ static void progress_with(struct job *j, const char *event, int view, uint32_t d
 /* What the job cost: the rig's time (with the simulator, the modelled rig's: its turntable and
  * frame rate) and the CPU the scanner spent, the simulator's rendering left out, split by what
  * delays the scan (in line with the rig) and what runs beside it. make bench reads this line. */
+/* The CPU the scanner spent since the job began, the simulator's rendering (@p sim_s, out)
+ * left out. */
+static double own_cpu_s(const struct job *j, double *sim_s)
+{
+    double cpu = clock_posix_process_cpu_s() - j->start_cpu_s;
+    *sim_s = board_simulator_cpu_s() - j->start_sim_cpu_s;
+    return cpu - *sim_s;
+}
+
+/* The process's peak resident memory: it must not grow with the number of views. */
+static double peak_memory_mb(void)
+{
+    struct rusage ru;
+    getrusage(RUSAGE_SELF, &ru);
+    return ru.ru_maxrss / 1024.0;
+}
+
 static void report_cost(struct job *j, const char *what)
 {
     uint64_t now_us = j->start_rig_us;
     hal_clock_now_us(&j->hal->clock, &now_us);
-    double cpu = clock_posix_process_cpu_s() - j->start_cpu_s;
-    double sim = board_simulator_cpu_s() - j->start_sim_cpu_s, own = cpu - sim;
+    double sim, own = own_cpu_s(j, &sim);
     uint32_t views = j->views ? j->views : 1;
     char detail[400];
     if (j->views_cpu_s <= 0.0) { /* offline: one thread */
@@ -290,13 +306,11 @@ static void progress_line(struct job *j, const char *event, int view, uint32_t d
     fflush(stdout);
 }
 
-/* Where the results are, and the peak memory: it must not grow with the number of views. */
+/* Where the results are, and the peak memory. */
 static const char *finished_detail(struct job *j, char *buf, size_t len)
 {
-    struct rusage ru;
-    getrusage(RUSAGE_SELF, &ru);
     snprintf(buf, len, "%s (mesh: %s/mesh.ply, mesh.obj, mesh.stl, mesh.glb; peak memory %.1f MB)",
-             j->out_dir, j->out_dir, ru.ru_maxrss / 1024.0);
+             j->out_dir, j->out_dir, peak_memory_mb());
     return buf;
 }
 
@@ -304,19 +318,16 @@ static const char *finished_detail(struct job *j, char *buf, size_t len)
  * report.html. Neither is the scan's result: a failure is said and the job goes on. */
 static void write_summary_and_report(struct job *j, const char *command)
 {
-    struct rusage ru;
-    getrusage(RUSAGE_SELF, &ru);
     char text[1024], path[SCAN_DIR_PATH_MAX], finished[32], err[SCAN_DIR_PATH_MAX + 64];
     utc_now(finished, sizeof(finished));
-    double cpu = clock_posix_process_cpu_s() - j->start_cpu_s;
-    cpu -= board_simulator_cpu_s() - j->start_sim_cpu_s;
+    double sim, cpu = own_cpu_s(j, &sim);
     int n = snprintf(text, sizeof(text),
                      "; what the %s took, for report.html (docs/scan-format.md)\n[summary]\n"
                      "command = %s\nfinished = %s\nviews = %u\nelapsed_s = %.1f\n"
                      "cpu_s = %.2f\npeak_memory_mb = %.1f\n[stages]\n; seconds from the start "
                      "at which each stage ended\n",
                      command, command, finished, (unsigned)j->views,
-                     (wall_ms() - j->start_ms) / 1000.0, cpu, ru.ru_maxrss / 1024.0);
+                     (wall_ms() - j->start_ms) / 1000.0, cpu, peak_memory_mb());
     for (unsigned i = 0; i < j->stages.n && n > 0 && (size_t)n < sizeof(text); i++)
         n += snprintf(text + n, sizeof(text) - (size_t)n, "%s = %.1f\n", j->stages.name[i],
                       j->stages.end_s[i]);

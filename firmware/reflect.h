@@ -52,7 +52,7 @@ struct reflect_cluster {
     double roughness;                /**< a, GGX's alpha */
     double lobe[REFLECT_LOBE_NODES]; /**< the lobe's shape as measured (1 at alpha = 0) */
     double lobe_specular[3];         /**< K of the measured shape */
-    int measured;                    /**< lobe[] is fitted: reflect_lobe_of uses it */
+    int measured;                    /**< lobe[] is fitted: reflect_specular uses it */
     uint32_t samples;                /**< samples it was fitted from */
     double rms;                      /**< fit residual, albedo units */
 };

@@ -5,10 +5,11 @@
 #define _GNU_SOURCE
 #include "web.h"
 
+#include "scan_dir.h"
+
 #include <cJSON.h>
 #include <errno.h>
 #include <fcntl.h>
-#include <ini.h>
 #include <poll.h>
 #include <signal.h>
 #include <stdio.h>
@@ -162,21 +163,40 @@ static int read_lines(int fd, struct line_buf *b, struct web_job *j,
     return 0;
 }
 
-/* Run to the end and wait: @retval the exit status, or -1 */
-static int run_and_wait(const char *const *args)
+/* The wait status of child @p pid once it has ended. */
+static int wait_for(pid_t pid)
 {
-    int fd;
-    pid_t pid = web_spawn(args, &fd, NULL);
-    if (pid < 0)
-        return -1;
-    char sink[256];
-    while (read(fd, sink, sizeof(sink)) > 0)
-        ;
-    close(fd);
-    int status;
+    int status = 0;
     while (waitpid(pid, &status, 0) < 0 && errno == EINTR)
         ;
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return status;
+}
+
+/* Run @p args to its end, its standard output kept in @p out (up to @p out_len - 1 bytes,
+ * NUL-terminated; NULL: dropped). @param status  out: its exit status, -1 after a signal
+ * @retval 0 @retval -errno it could not start */
+static int run_to_end(const char *const *args, char *out, size_t out_len, int *status)
+{
+    int fd;
+    size_t used = 0;
+    pid_t pid = web_spawn(args, &fd, NULL);
+    for (char sink[512]; pid > 0;) {
+        int keep = out != NULL && used + 1 < out_len;
+        ssize_t n = read(fd, keep ? out + used : sink, keep ? out_len - 1 - used : sizeof(sink));
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n <= 0)
+            break;
+        used += keep ? (size_t)n : 0;
+    }
+    if (out != NULL && out_len > 0)
+        out[used] = '\0';
+    if (pid < 0)
+        return (int)pid;
+    close(fd);
+    int st = wait_for(pid);
+    *status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+    return 0;
 }
 
 static void *reader_main(void *arg)
@@ -197,9 +217,7 @@ static void *reader_main(void *arg)
                 pf[k].fd = -1;
             }
     }
-    int status = 0;
-    while (waitpid(j->pid, &status, 0) < 0 && errno == EINTR)
-        ;
+    int status = wait_for(j->pid);
     pthread_mutex_lock(&j->lock);
     int finished = WIFEXITED(status) && WEXITSTATUS(status) == 0 && j->done_seen;
     char dir[WEB_PATH];
@@ -208,7 +226,8 @@ static void *reader_main(void *arg)
     /* a scan that ended early still gets its report, of what it has */
     if (!finished) {
         const char *args[] = {s->scanner, "report", dir, NULL};
-        run_and_wait(args);
+        int ignored;
+        run_to_end(args, NULL, 0, &ignored);
     }
     pthread_mutex_lock(&j->lock);
     j->state = finished ? WEB_FINISHED : j->stop_requested ? WEB_STOPPED : WEB_FAILED;
@@ -309,7 +328,7 @@ int jobs_start(struct web_server *s, const struct web_profile *p, const char *re
     }
     /* nobody would read its events: ask it to stop (it ends on its own shutdown path) */
     kill(pid, SIGTERM);
-    waitpid(pid, NULL, 0);
+    wait_for(pid);
     pthread_mutex_lock(&j->lock);
     j->state = WEB_FAILED;
     j->rig_busy = 0;
@@ -342,28 +361,11 @@ int jobs_run_tool(struct web_server *s, const char *const *args, char *out, size
     pthread_mutex_unlock(&j->lock);
     if (busy)
         return -EBUSY;
-    int fd;
-    pid_t pid = web_spawn(args, &fd, NULL);
-    size_t used = 0;
-    if (pid > 0) {
-        ssize_t n;
-        char sink[512];
-        while ((n = read(fd, used + 1 < out_len ? out + used : sink,
-                         used + 1 < out_len ? out_len - 1 - used : sizeof(sink))) > 0 ||
-               (n < 0 && errno == EINTR))
-            if (n > 0 && used + 1 < out_len)
-                used += (size_t)n;
-        close(fd);
-        int st = 0;
-        while (waitpid(pid, &st, 0) < 0 && errno == EINTR)
-            ;
-        *status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-    }
-    out[used] = '\0';
+    int rc = run_to_end(args, out, out_len, status);
     pthread_mutex_lock(&j->lock);
     j->rig_busy = 0;
     pthread_mutex_unlock(&j->lock);
-    return pid > 0 ? 0 : (int)pid;
+    return rc;
 }
 
 void jobs_shutdown(struct web_server *s)
@@ -381,20 +383,6 @@ void jobs_shutdown(struct web_server *s)
     if (j->have_reader)
         pthread_join(j->reader, NULL); /* until the scanner has put the rig in its safe state */
     j->have_reader = 0;
-}
-
-struct scan_counts {
-    unsigned views, passes;
-};
-
-static int count_views(void *user, const char *section, const char *key, const char *value)
-{
-    struct scan_counts *c = user;
-    if (strcmp(section, "scan") == 0 && strcmp(key, "views") == 0)
-        c->views = (unsigned)strtoul(value, NULL, 10);
-    if (strcmp(section, "scan") == 0 && strcmp(key, "passes") == 0)
-        c->passes = (unsigned)strtoul(value, NULL, 10);
-    return 1;
 }
 
 int jobs_describe(struct web_server *s, const char *id, enum web_state *state, unsigned *views_done,
@@ -418,11 +406,11 @@ int jobs_describe(struct web_server *s, const char *id, enum web_state *state, u
     snprintf(path, sizeof(path), "%s/%s", s->scans, id);
     if (!web_name_ok(id) || lstat(path, &sb) != 0 || !S_ISDIR(sb.st_mode))
         return -ENOENT;
-    struct scan_counts c = {0, 1};
-    snprintf(path, sizeof(path), "%s/%s/config.ini", s->scans, id);
-    if (ini_parse(path, count_views, &c) < 0)
+    snprintf(path, sizeof(path), "%s/%s", s->scans, id);
+    uint32_t total;
+    if (scan_dir_view_count(path, &total) != 0)
         return -ENOENT; /* not a scan */
-    *views_total = c.views * (c.passes ? c.passes : 1);
+    *views_total = total;
     *views_done = 0;
     for (unsigned v = 0; v < *views_total; v++) {
         snprintf(path, sizeof(path), "%s/%s/view_%03u/view.ini", s->scans, id, v);
