@@ -642,18 +642,17 @@ static double pattern_light(const struct sim_rig *rig, uint32_t pattern, double 
     return black + (1.0 - black) * lit;
 }
 
-/* Light-i radiance at pixel i, computed on the fly (light frames are few). A light with a
- * diffuser is a disk of light_diffuser_mm facing the point, sampled at DIFFUSER_SAMPLES points
- * (a Vogel spiral, the same every frame, so no noise is added); its shadow is the centre's. */
-static void add_light(const struct sim_rig *rig, size_t i, uint32_t li, double sig[3])
+/* Light-i radiance at pixel i of a surface of diffuse colour @p albedo, computed on the fly
+ * (light frames are few). A light with a diffuser is a disk of light_diffuser_mm facing the
+ * point, sampled at DIFFUSER_SAMPLES points (a Vogel spiral, the same every frame, so no noise
+ * is added); its shadow is the centre's (the caller's to judge). */
+static void add_light_of(const struct sim_rig *rig, size_t i, uint32_t li, const double albedo[3],
+                         double sig[3])
 {
-    if (!(rig->light_vis[i] & (1u << li)))
-        return;
     const float *pc = &rig->truth.pos_cam[3 * i], *nc = &rig->truth.normal_cam[3 * i];
-    const float *al = &rig->truth.albedo[3 * i];
     vec3 p = v3(pc[0], pc[1], pc[2]), n = v3(nc[0], nc[1], nc[2]);
     vec3 centre = v3_from(rig->calib.light_pos_mm[li]), view = v3_norm(v3_scale(p, -1.0));
-    double albedo[3] = {al[0], al[1], al[2]}, radius = rig->cfg.light_diffuser_mm;
+    double radius = rig->cfg.light_diffuser_mm;
     int samples = radius > 0.0 ? DIFFUSER_SAMPLES : 1;
     vec3 axis = v3_norm(v3_sub(centre, p));
     vec3 e1 = v3_norm(v3_cross(axis, fabs(axis.x) < 0.9 ? v3(1, 0, 0) : v3(0, 1, 0)));
@@ -668,6 +667,31 @@ static void add_light(const struct sim_rig *rig, size_t i, uint32_t li, double s
         for (int k = 0; k < 3; k++)
             sig[k] += e * rho[k];
     }
+}
+
+/* Light-i radiance at pixel i where the light reaches it (the truth's paint). */
+static void add_light(const struct sim_rig *rig, size_t i, uint32_t li, double sig[3])
+{
+    if (!(rig->light_vis[i] & (1u << li)))
+        return;
+    const float *al = &rig->truth.albedo[3 * i];
+    const double albedo[3] = {al[0], al[1], al[2]};
+    add_light_of(rig, i, li, albedo, sig);
+}
+
+void sim_rig_specular_at(struct sim_rig *rig, size_t i, uint32_t li, double sig[3])
+{
+    const double none[3] = {0, 0, 0};
+    sig[0] = sig[1] = sig[2] = 0.0;
+    if (!rig->truth_valid || !rig->truth.hit[i] || li >= rig->calib.light_count)
+        return;
+    struct frame_xform obj;
+    object_frame(rig, rig->truth_angle_mdeg, &obj);
+    const float *pc = &rig->truth.pos_cam[3 * i], *nc = &rig->truth.normal_cam[3 * i];
+    vec3 p_obj = frame_point(&obj, v3(pc[0], pc[1], pc[2]));
+    vec3 n_obj = frame_dir(&obj, v3(nc[0], nc[1], nc[2]));
+    if (!occluded(rig, p_obj, n_obj, frame_point(&obj, v3_from(rig->calib.light_pos_mm[li]))))
+        add_light_of(rig, i, li, none, sig);
 }
 
 /* The light reaching each pixel's sensor (before gain and noise), 3 floats per pixel. */

@@ -75,6 +75,13 @@ int sim_rig_init(struct sim_rig *rig, const struct sim_config *cfg, const struct
                  size_t err_len);
 void sim_rig_free(struct sim_rig *rig);
 
+/** What the camera sees of light @p li's specular part at pixel @p i of the current angle (after
+ *  sim_rig_update): the material with no diffuse colour, through the light's diffuser, with its
+ *  falloff, before exposure gain and noise; 0 where the light's centre is hidden or the pixel
+ *  misses the object. For comparing a fitted lobe with the material where the rig saw it.
+ *  @param sig  3 channels, out */
+void sim_rig_specular_at(struct sim_rig *rig, size_t i, uint32_t li, double sig[3]);
+
 /** Put a calibration target on the table in place of the object (the simulated person's part
  *  of `scanner calibrate`); SIM_TARGET_OBJECT puts the object back. Allocates (a setup step).
  *  @retval 0 @retval -errno, with @p err saying what */

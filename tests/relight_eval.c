@@ -14,7 +14,8 @@
  * Compared: CIEDE2000 over the object's pixels the new light reaches in the truth (cast shadows
  * are geometry, not reflectance: this renderer draws none). Also printed: the lobe fitted to the
  * most samples (strength: K's mean over the channels; roughness) beside the simulator's material
- * put in the same form (material_lobe: its specular part as the rig's diffusers show it). */
+ * put in the same form (material_lobe: the best lobe of the model's form for its specular part
+ * where the scan saw it, through the rig's own lights). */
 #define _POSIX_C_SOURCE 200809L
 #include "colour_metrics.h"
 #include "config.h"
@@ -28,6 +29,7 @@
 #include "sim_rig.h"
 #include "storage_posix.h"
 
+#include <errno.h>
 #include <ini.h>
 #include <libgen.h>
 #include <math.h>
@@ -124,45 +126,69 @@ static int model_at(const struct sim_mesh *m, const struct sim_bvh *bvh,
     return 1;
 }
 
-/* The simulator's material as this model's lobe, to compare the fitted one with: its specular
- * part (sim_material_eval with no diffuse colour) seen at 20 deg from the normal, lit from
- * around the mirror direction at alpha = 0 .. 0.6 rad by a disk the size of the rig's diffusers
- * (@p disk_rad: their angular radius; the scan saw the lobe through them), fitted as
- * K D(alpha) / cos(theta_r) (reflect_lobe) by least squares (the roughness on a fine grid).
- * @p strength: K's mean over the channels. */
-static void material_lobe(const struct sim_material *mat, double disk_rad, double *strength,
-                          double *roughness)
+/* The simulator's material as this model's lobe, to compare the fitted one with: the best lobe
+ * of the model's form, K D(alpha) / cos(theta_r) (reflect_lobe), for the material's specular
+ * part where the scan saw it: at every 4th pixel of each view's angle (@p cfg's views, the
+ * scan's calibration in @p seen) and each light that reaches the point, the simulator's own
+ * rendering of the lobe (sim_rig_specular_at: through the light's diffuser, so a lobe sharper
+ * than the diffuser is seen as wide as the diffuser, and more so for the nearer lights) in the
+ * fit's units (the white reference, the falloff taken out); fitted by least squares over those
+ * observations alike, as the scan's fit weighs its own (the roughness on a fine grid). A
+ * material that is not of the model's form (Phong has no 1 / cos(theta_r); Low et al.'s ABC
+ * lobe a heavier tail) is compared in the form it takes on the rig, not as its own numbers.
+ * @p strength: K's mean over the channels. @retval 0, or -ENOMEM */
+static int material_lobe(struct sim_rig *seen, const struct app_config *cfg, double *strength,
+                         double *roughness)
 {
-    enum { STEPS = 61, DISK = 64 };
-    const double theta_r = 20.0 * M_PI / 180.0, zero[3] = {0, 0, 0};
-    vec3 n = v3(0, 0, 1), v = v3(sin(theta_r), 0, cos(theta_r));
-    double y[STEPS], a[STEPS];
-    for (int k = 0; k < STEPS; k++) {
-        a[k] = 0.6 * k / (STEPS - 1);
-        vec3 h = v3(-sin(a[k]), 0, cos(a[k])), l0 = v3_sub(v3_scale(h, 2.0 * v3_dot(h, v)), v);
-        vec3 e1 = v3_norm(v3_cross(l0, v3(0, 1, 0))), e2 = v3_cross(l0, e1);
-        double sum = 0.0;
-        for (int j = 0; j < DISK; j++) { /* evenly over the disk (golden angle) */
-            double r = disk_rad * sqrt((j + 0.5) / DISK), phi = j * 2.39996322972865332;
-            vec3 l =
-                v3_norm(v3_add(l0, v3_add(v3_scale(e1, r * cos(phi)), v3_scale(e2, r * sin(phi)))));
-            double rho[3];
-            sim_material_eval(mat, zero, n, l, v, rho);
-            sum += (rho[0] + rho[1] + rho[2]) / 3.0;
-        }
-        y[k] = sum / DISK;
+    const struct colour_params *col = &cfg->scan.colour;
+    enum { STEP = 4 };
+    size_t cap = 1u << 20, n = 0;
+    float *obs = malloc(sizeof(float) * 3 * cap); /* alpha, cos_r, signal */
+    if (obs == NULL)
+        return -ENOMEM;
+    double gain = (double)col->exposure_us / seen->cfg.reference_exposure_us;
+    for (uint32_t v = 0; v < cfg->views; v++) {
+        seen->table_angle_mdeg =
+            (int32_t)(1000.0 * (cfg->start_angle_deg + 360.0 * v / cfg->views));
+        sim_rig_update(seen);
+        for (uint32_t y = 0; y < seen->height; y += STEP)
+            for (uint32_t x = 0; x < seen->width; x += STEP) {
+                size_t i = (size_t)y * seen->width + x;
+                if (!seen->truth.hit[i])
+                    continue;
+                const float *pc = &seen->truth.pos_cam[3 * i], *nc = &seen->truth.normal_cam[3 * i];
+                vec3 p = v3(pc[0], pc[1], pc[2]), nn = v3(nc[0], nc[1], nc[2]);
+                vec3 view = v3_norm(v3_scale(p, -1.0));
+                for (uint32_t l = 0; l < seen->calib.light_count && n < cap; l++) {
+                    vec3 to = v3_sub(v3_from(seen->calib.light_pos_mm[l]), p);
+                    double d = v3_len(to), sig[3], sum = 0.0;
+                    if (v3_dot(nn, to) / d < col->min_cos)
+                        continue;
+                    sim_rig_specular_at(seen, i, l, sig);
+                    for (int c = 0; c < 3; c++)
+                        sum += sig[c] * gain * col->white_scale[c] / 3.0;
+                    double fall = (d / col->reference_mm) * (d / col->reference_mm);
+                    double nh = v3_dot(nn, v3_norm(v3_add(v3_scale(to, 1.0 / d), view)));
+                    obs[3 * n + 0] = (float)acos(fmin(1.0, fmax(-1.0, nh)));
+                    obs[3 * n + 1] = (float)v3_dot(nn, view);
+                    obs[3 * n + 2] = (float)(sum * fall);
+                    n++;
+                }
+            }
     }
     double best = 1e300;
     for (int g = 0; g < 400; g++) {
         double s = 0.01 * pow(100.0, g / 399.0), sgg = 0.0, syg = 0.0, syy = 0.0;
-        for (int k = 0; k < STEPS; k++) { /* weighted by the ring's area: a 2-D lobe */
-            double lobe = reflect_lobe(s, a[k], cos(theta_r)), area = sin(a[k]);
-            sgg += area * lobe * lobe, syg += area * y[k] * lobe, syy += area * y[k] * y[k];
+        for (size_t k = 0; k < n; k++) {
+            double lobe = reflect_lobe(s, obs[3 * k], obs[3 * k + 1]), yk = obs[3 * k + 2];
+            sgg += lobe * lobe, syg += yk * lobe, syy += yk * yk;
         }
         double kk = sgg > 0.0 ? syg / sgg : 0.0, err = syy - kk * syg;
         if (err < best)
             best = err, *strength = kk, *roughness = s;
     }
+    free(obs);
+    return 0;
 }
 
 static int run(const char *scene, const char *scan_dir, const char *result_dir, const char *label,
@@ -270,10 +296,19 @@ static int run(const char *scene, const char *scan_dir, const char *result_dir, 
         fit_k = (c->specular[0] + c->specular[1] + c->specular[2]) / 3.0;
         fit_s = c->roughness;
     }
-    vec3 centre = frame_point_inv(&obj, v3(0, 0, 0.5 * sim_rig_placed_height(&cfg.sim)));
-    double dist = v3_len(v3_sub(v3_from(calib.light_pos_mm[1]), centre));
-    if (rig.material.kind != SIM_MAT_LAMBERT)
-        material_lobe(&rig.material, atan(cfg.sim.light_diffuser_mm / dist), &sim_k, &sim_s);
+    if (rig.material.kind != SIM_MAT_LAMBERT) { /* the rig as it scanned: its own lights */
+        static struct sim_rig seen;
+        snprintf(dir, sizeof(dir), "%s", scene);
+        rc = sim_rig_init(&seen, &sc, &calib, &layout, dirname(dir), err, sizeof(err));
+        if (rc == 0)
+            rc = material_lobe(&seen, &cfg, &sim_k, &sim_s);
+        if (rc != 0) {
+            fprintf(stderr, "relight-eval: the material's lobe: %s\n",
+                    rc == -ENOMEM ? "no memory" : err);
+            return 1;
+        }
+        sim_rig_free(&seen);
+    }
     printf("%s,%zu,%.3f,%.3f,%.4f,%.4f,%.4f,%.4f\n", label, n, sum / n,
            de[(size_t)(0.95 * (double)(n - 1))], sim_k, fit_k, sim_s, fit_s);
     if (out_png != NULL) { /* truth | model, cropped to the object */
