@@ -341,9 +341,11 @@ static void fit_pixel(const struct frame_ctx *f, const struct scan_calib *c, str
     /* twice: each light weighs by eq. 6 and by the share of its signal the diffuse part is
      * (as the last estimate has it), so that where the lobe is most of the light (dark paint
      * on a metal) an error in the lobe does not become the colour */
+    double share_sum = 0.0, share_den = 0.0;
     for (int pass = 0; pass < 2; pass++) {
         double fit_num[3] = {0, 0, 0}, fit_den = 0.0;
         double rho_grey = fmax(1e-3, (rho[0] + rho[1] + rho[2]) / 3.0);
+        share_sum = share_den = 0.0;
         for (uint32_t l = 0; l < c->light_count; l++) {
             if (!(ls.used >> l & 1u))
                 continue;
@@ -353,12 +355,17 @@ static void fit_pixel(const struct frame_ctx *f, const struct scan_calib *c, str
             for (int ch = 0; ch < 3; ch++)
                 fit_num[ch] += w * (ls.lit[l][ch] * prm->white_scale[ch] - sp[l][ch]) * ct;
             fit_den += w * ct * ct;
+            share_sum += ls.weight[l] * ct * share, share_den += ls.weight[l] * ct;
         }
         for (int ch = 0; ch < 3 && fit_den > 1e-12; ch++)
             rho[ch] = fmax(0.0, fit_num[ch] / fit_den);
     }
     for (int ch = 0; ch < 3; ch++)
         out[ch] = albedo_byte(rho[ch]);
+    /* the colour is what is left of the light once the lobe is taken off: where that is a small
+     * part of it, a view that sees less sheen there is the better one for the fusion */
+    if (share_den > 0.0)
+        *confidence *= (float)(share_sum / share_den);
 }
 
 /* One pass over the pixels with the Ca of @p f: albedo and confidence of every valid pixel. */

@@ -120,6 +120,10 @@ uint32_t reflect_cluster_of(const struct reflect_model *m, const double rho[3])
 
 static void kmeans_rounds(struct reflect_model *m, int rounds);
 
+/* Colours nearer than this (feature_dist2; 0.17 in square-root units) are one paint: make
+ * eval's nearest two paints, green and blue, are 0.19 apart. */
+#define SAME_PAINT 0.03
+
 /* k-means on the multi method's colour: seeds by farthest point (deterministic), ten rounds. */
 static uint32_t cluster_samples(uint32_t wanted, struct reflect_model *m)
 {
@@ -140,7 +144,7 @@ static uint32_t cluster_samples(uint32_t wanted, struct reflect_model *m)
             if (d > far)
                 far = d, at = i;
         }
-        if (far < 0.03) /* no other colour there (0.17 in square-root units): fewer clusters */
+        if (far < SAME_PAINT) /* no other colour there: fewer clusters */
             break;
         for (int c = 0; c < 3; c++)
             m->cluster[k].centre[c] = pool[at].rho0[c];
@@ -158,6 +162,27 @@ static uint32_t cluster_samples(uint32_t wanted, struct reflect_model *m)
         if (m->count == 1 || m->cluster[small].samples >= least)
             break;
         m->cluster[small] = m->cluster[--m->count];
+        kmeans_rounds(m, 3);
+    }
+    /* one paint is one cluster: the multi colours of a single paint spread (what the weights
+     * leave of the lobe, the noise), and a sample far out seeds a cluster of its own that then
+     * takes half of the paint (make eval's uniform cans came out as two, one with a lobe fitted
+     * to the samples the sheen brightened most): centres nearer than SAME_PAINT are merged (a
+     * merged paint keeps its pixels' own diffuse colours; only the lobe is one). */
+    for (;;) {
+        uint32_t q = 1;
+        double nearest = 1e30;
+        for (uint32_t a = 0; a < m->count; a++)
+            for (uint32_t b = a + 1; b < m->count; b++) {
+                const float fa[3] = {(float)m->cluster[a].centre[0], (float)m->cluster[a].centre[1],
+                                     (float)m->cluster[a].centre[2]};
+                double d = feature_dist2(fa, m->cluster[b].centre);
+                if (d < nearest)
+                    nearest = d, q = b;
+            }
+        if (m->count < 2 || nearest >= SAME_PAINT)
+            break;
+        m->cluster[q] = m->cluster[--m->count];
         kmeans_rounds(m, 3);
     }
     return m->count;
@@ -185,24 +210,63 @@ static void kmeans_rounds(struct reflect_model *m, int rounds)
     }
 }
 
+/* The diffuse colours and the lobe are fitted together: a sample's diffuse colour is free (rho
+ * = its least squares over its lights), so what the lobe may explain there is what rho cos_l
+ * cannot: each light's value less its share of the sample's cos-weighted mean (the projection
+ * P = I - c c^T / c^T c, c the sample's cos_l). Fitting the lobe to the projected values is the
+ * joint least squares (variable projection); alternating with fit_diffuse instead moves along
+ * the valley where a lobe's slowly varying tail and the diffuse colour trade for each other only
+ * a little each round, and the tail, most of the light on dark paint, came out half as high
+ * (make eval's gold owl). @p c, @p v: the sample's cosines and one value per light, @p n
+ * lights; @retval c^T v / c^T c, the amount of c to take from each v_l */
+static double along_cos(const double *c, const double *v, uint32_t n)
+{
+    double cc = 0.0, cv = 0.0;
+    for (uint32_t l = 0; l < n; l++)
+        cc += c[l] * c[l], cv += c[l] * v[l];
+    return cc > 0.0 ? cv / cc : 0.0;
+}
+
+/* Sample @p i's kept lights: their cosines, lobe angles and signals (@retval how many). */
+static uint32_t kept_lights(uint32_t i, double cos_l[HAL_MAX_LIGHTS], double alpha[HAL_MAX_LIGHTS],
+                            double sig[3][HAL_MAX_LIGHTS])
+{
+    const struct reflect_obs *o = &pool[i];
+    uint32_t n = 0;
+    for (uint32_t l = 0; l < HAL_MAX_LIGHTS; l++) {
+        if (!(pool_used[i] >> l & 1u))
+            continue;
+        cos_l[n] = o->cos_i[l], alpha[n] = o->alpha[l];
+        for (int ch = 0; ch < 3; ch++)
+            sig[ch][n] = o->signal[l][ch];
+        n++;
+    }
+    return n;
+}
+
 /* The lobe's K for the shape of @p shape (its GGX roughness, or its measured shape) over
- * cluster @p c's kept observations (least squares of the residual after the diffuse part, per
- * channel, not below 0); @retval the squared error */
+ * cluster @p c's kept observations, the diffuse colours free (along_cos), per channel, not
+ * below 0; @retval the squared error */
 static double fit_k(uint32_t c, const struct reflect_cluster *shape, double k_out[3])
 {
     double sgg = 0.0, srg[3] = {0, 0, 0}, srr = 0.0;
     for (uint32_t i = 0; i < rs.count; i++) {
-        if (pool_cluster[i] != c)
+        double cos_l[HAL_MAX_LIGHTS], alpha[HAL_MAX_LIGHTS], sig[3][HAL_MAX_LIGHTS];
+        double g[HAL_MAX_LIGHTS];
+        uint32_t n = pool_cluster[i] == c ? kept_lights(i, cos_l, alpha, sig) : 0;
+        if (n < 2) /* one light: its diffuse colour explains it all */
             continue;
-        const struct reflect_obs *o = &pool[i];
-        for (uint32_t l = 0; l < HAL_MAX_LIGHTS; l++) {
-            if (!(pool_used[i] >> l & 1u))
-                continue;
-            double g = lobe_shape(shape, o->alpha[l], o->cos_r);
-            sgg += g * g;
+        for (uint32_t l = 0; l < n; l++)
+            g[l] = lobe_shape(shape, alpha[l], pool[i].cos_r);
+        double mg = along_cos(cos_l, g, n), ms[3];
+        for (int ch = 0; ch < 3; ch++)
+            ms[ch] = along_cos(cos_l, sig[ch], n);
+        for (uint32_t l = 0; l < n; l++) {
+            double gp = g[l] - mg * cos_l[l];
+            sgg += gp * gp;
             for (int ch = 0; ch < 3; ch++) {
-                double r = o->signal[l][ch] - pool_rho[i][ch] * o->cos_i[l];
-                srg[ch] += r * g;
+                double r = sig[ch][l] - ms[ch] * cos_l[l];
+                srg[ch] += r * gp;
                 srr += r * r;
             }
         }
@@ -325,7 +389,8 @@ static void fit_lobe(struct reflect_cluster *cl, uint32_t c)
 }
 
 /* Cluster @p c's lobe shape at the nodes for its K (least squares over its kept observations,
- * a little smoothness between neighbours, not below 0, 1 at alpha = 0), then K for the shape. */
+ * the diffuse colours free (along_cos), a little smoothness between neighbours, not below 0, 1
+ * at alpha = 0), then K for the shape. */
 static void fit_measured(struct reflect_cluster *cl, uint32_t c)
 {
     enum { N = REFLECT_LOBE_NODES };
@@ -335,22 +400,35 @@ static void fit_measured(struct reflect_cluster *cl, uint32_t c)
     const double *k = cl->lobe_specular;
     double kk = k[0] * k[0] + k[1] * k[1] + k[2] * k[2];
     for (uint32_t i = 0; i < rs.count; i++) {
-        if (pool_cluster[i] != c)
+        double cos_l[HAL_MAX_LIGHTS], alpha[HAL_MAX_LIGHTS], sig[3][HAL_MAX_LIGHTS];
+        double s[HAL_MAX_LIGHTS], g[HAL_MAX_LIGHTS][N];
+        uint32_t n = pool_cluster[i] == c ? kept_lights(i, cos_l, alpha, sig) : 0;
+        if (n < 2)
             continue;
-        const struct reflect_obs *o = &pool[i];
-        double inv = 1.0 / (o->cos_r > 0.05 ? o->cos_r : 0.05);
-        for (uint32_t l = 0; l < HAL_MAX_LIGHTS; l++) {
+        double inv = 1.0 / (pool[i].cos_r > 0.05 ? pool[i].cos_r : 0.05), mg[N];
+        memset(g, 0, sizeof(g));
+        for (uint32_t l = 0; l < n; l++) { /* light l's row: the nodes around its alpha */
             uint32_t k0;
             double t;
-            if (!(pool_used[i] >> l & 1u) || !lobe_segment(o->alpha[l], &k0, &t))
-                continue;
-            double w[2] = {(1.0 - t) * inv, t * inv}, kr = 0.0;
-            for (int ch = 0; ch < 3; ch++)
-                kr += k[ch] * (o->signal[l][ch] - pool_rho[i][ch] * o->cos_i[l]);
-            for (int p = 0; p < 2; p++) {
-                b[k0 + (uint32_t)p] += w[p] * kr;
-                for (int q = 0; q < 2; q++)
-                    a[(k0 + (uint32_t)p) * N + k0 + (uint32_t)q] += kk * w[p] * w[q];
+            if (lobe_segment(alpha[l], &k0, &t))
+                g[l][k0] = (1.0 - t) * inv, g[l][k0 + 1] = t * inv;
+            s[l] = k[0] * sig[0][l] + k[1] * sig[1][l] + k[2] * sig[2][l];
+        }
+        for (uint32_t q = 0; q < N; q++) {
+            double col[HAL_MAX_LIGHTS];
+            for (uint32_t l = 0; l < n; l++)
+                col[l] = g[l][q];
+            mg[q] = along_cos(cos_l, col, n);
+        }
+        double ms = along_cos(cos_l, s, n);
+        for (uint32_t l = 0; l < n; l++) {
+            double gp[N], sp = s[l] - ms * cos_l[l];
+            for (uint32_t q = 0; q < N; q++)
+                gp[q] = g[l][q] - mg[q] * cos_l[l];
+            for (uint32_t p = 0; p < N; p++) {
+                b[p] += gp[p] * sp;
+                for (uint32_t q = 0; q < N; q++)
+                    a[p * N + q] += kk * gp[p] * gp[q];
             }
         }
     }
@@ -389,13 +467,13 @@ int reflect_fit(uint32_t clusters, struct reflect_model *out)
     }
     for (uint32_t c = 0; c < m->count; c++)
         m->cluster[c].roughness = 0.1;
-    /* alternate: the lobes for the diffuse colours, the diffuse colours for the lobes; the
-     * outliers judged once the model is near */
-    for (int round = 0; round < 6; round++) {
+    /* the lobes (the diffuse colours free: along_cos) and the diffuse colours for them; the
+     * outliers judged on that model, twice (a first model leans towards them) */
+    for (int round = 0; round < 3; round++) {
         for (uint32_t c = 0; c < m->count; c++)
             fit_lobe(&m->cluster[c], c);
         fit_diffuse(m);
-        if (round == 2 || round == 4)
+        if (round < 2)
             drop_outliers(m);
     }
     /* then the lobe's shape as measured, from GGX's: real materials' tails are not GGX's, and

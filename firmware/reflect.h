@@ -14,16 +14,17 @@
  * metallic-roughness material is GGX, so mesh.glb takes the lobe as it is.
  *
  * Clusters as Lensch et al. (2003) begin them: k-means on the points' diffuse colour (from the
- * multi method, highlights already left out), then one lobe fitted per cluster, alternating
- * with every sample's diffuse colour (least squares; the roughness by a search over a grid).
- * The samples are a fixed pool: each view gives up to REFLECT_MAX_SAMPLES / views of its valid
- * pixels, evenly spread.
+ * multi method, highlights already left out; clusters of one paint merged), then one lobe
+ * fitted per cluster together with every sample's diffuse colour (least squares with the
+ * diffuse colours projected out; the roughness by a search over a grid). The samples are a
+ * fixed pool: each view gives up to REFLECT_MAX_SAMPLES / views of its valid pixels, evenly
+ * spread.
  *
  * Then each cluster's lobe shape is measured: D at REFLECT_LOBE_NODES half-angles (piecewise
  * linear between them, 0 beyond REFLECT_LOBE_MAX_RAD, 1 at alpha = 0), starting from the GGX
- * fit and alternating with the diffuse colours again (least squares with a little smoothness
- * between neighbouring nodes, not below 0), so that a material whose tails are not GGX's (the
- * haze of a metallic paint) leaves no light on the diffuse colour. The colours and the relit
+ * fit, again with the diffuse colours free (least squares with a little smoothness between
+ * neighbouring nodes, not below 0), so that a material whose tails are not GGX's (the haze of
+ * a metallic paint) leaves no light on the diffuse colour. The colours and the relit
  * model use the measured shape (reflect_specular); the GGX lobe stays the cluster's summary
  * (reflectance.ini, the reflectance line) and is what mesh.glb's material takes. */
 #ifndef REFLECT_H

@@ -139,12 +139,34 @@ static void test_measured_lobe_shape(void **state)
     }
     print_message("measured lobe: worst error %.4f (GGX fit %.4f), K %.3f %.3f %.3f\n", worst,
                   ggx_worst, c->lobe_specular[0], c->lobe_specular[1], c->lobe_specular[2]);
-    /* within 5% of the peak everywhere (what remains is light the tails and the diffuse colour
-     * trade between them), and under half of what GGX leaves */
-    assert_true(worst < 0.025);
+    /* within 1% of the peak everywhere, and under half of what GGX leaves: the lobe and the
+     * diffuse colours are fitted together (alternating from multi's guess, which the tails
+     * brightened, left 4% of the peak in the tails) */
+    assert_true(worst < 0.005);
     assert_true(worst < 0.5 * ggx_worst);
     for (int ch = 0; ch < 3; ch++)
-        assert_true(fabs(c->lobe_specular[ch] - k[ch]) < 0.05 * k[ch]);
+        assert_true(fabs(c->lobe_specular[ch] - k[ch]) < 0.02 * k[ch]);
+}
+
+/* One paint is one cluster though multi's colours of it spread (up to 1.4 x as bright, few
+ * that far: the sheen the weights leave on some): four clusters allowed, one found (k-means
+ * alone cut the spread in two). */
+static void test_one_paint_one_cluster(void **state)
+{
+    (void)state;
+    static const struct truth paint = {{0.18, 0.32, 0.62}, {0.06, 0.06, 0.06}, 0.3};
+    reflect_begin(1);
+    for (int i = 0; i < 6000; i++) {
+        struct truth seen = paint;
+        double spread = 1.0 + 0.4 * pow(uniform(), 3.0); /* a long tail: the sheen */
+        for (int c = 0; c < 3; c++)
+            seen.rho[c] = paint.rho[c] * spread;
+        add_sample(&seen, 0);
+    }
+    struct reflect_model m;
+    assert_int_equal(reflect_fit(4, &m), 0);
+    print_message("one paint: %u cluster(s)\n", m.count);
+    assert_int_equal(m.count, 1);
 }
 
 /* Too few samples: nothing is fitted. */
@@ -229,9 +251,8 @@ static void test_glb_with_every_cluster(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_two_materials_recovered),
-        cmocka_unit_test(test_measured_lobe_shape),
-        cmocka_unit_test(test_too_few_samples),
+        cmocka_unit_test(test_two_materials_recovered), cmocka_unit_test(test_measured_lobe_shape),
+        cmocka_unit_test(test_one_paint_one_cluster),   cmocka_unit_test(test_too_few_samples),
         cmocka_unit_test(test_glb_with_every_cluster),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
