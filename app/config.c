@@ -216,8 +216,11 @@ static const struct ini_key config_keys[] = {
         "unhighlighted light's is taken as shadowed there (light from other surfaces only)"),
     F64("colour", "min_cos", scan.colour.min_cos, 0, 1, "0.2",
         "light at a lower cos(incidence) is not used (it would amplify noise)"),
-    F64("colour", "ke", scan.colour.ke, 1, 10000, "40", "highlight rejection exponent ke (eq. 6)"),
-    F64("colour", "ko", scan.colour.ko, 0, 100, "2", "highlight rejection exponent ko (eq. 6)"),
+    /* 10 and 4: a plastic's or a metal's sheen spreads 30 deg and more from the mirror
+     * direction; with 40 and 2 (a light weighs 0.5 at 11 deg) dark paint under it came out
+     * L* 27 for 20 (make eval: docs/colour.md) */
+    F64("colour", "ke", scan.colour.ke, 1, 10000, "10", "highlight rejection exponent ke (eq. 6)"),
+    F64("colour", "ko", scan.colour.ko, 0, 100, "4", "highlight rejection exponent ko (eq. 6)"),
     F64("colour", "shadow_dn", scan.colour.shadow_dn, 0, 255, "6",
         "a light's frame within this of Ca: the light is shadowed there"),
     U32("colour", "falloff", scan.colour.falloff, 0, 1, "1",

@@ -191,6 +191,8 @@ static void test_single_trusts_highlights_less(void **state)
     snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "sphere");
     snprintf(t.cfg.sim.material, sizeof(t.cfg.sim.material), "phong");
     t.cfg.scan.colour.method = COLOUR_SINGLE;
+    t.cfg.scan.colour.ke = 40.0; /* a narrow rejection, so that beyond 30 deg it weighs 1 */
+    t.cfg.scan.colour.ko = 2.0;
     assert_int_equal(test_rig_start(&t), 0);
     assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), 0);
     const struct decode_maps *m = &view.maps;
