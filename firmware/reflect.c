@@ -394,14 +394,14 @@ static void fit_lobe(struct reflect_cluster *cl, uint32_t c)
 static void fit_measured(struct reflect_cluster *cl, uint32_t c)
 {
     enum { N = REFLECT_LOBE_NODES };
-    static double a[N * N], b[N], x[N];
+    static double a[N * N], b[N], x[N], g[HAL_MAX_LIGHTS][N]; /* static: off the stack */
     memset(a, 0, sizeof(a));
     memset(b, 0, sizeof(b));
     const double *k = cl->lobe_specular;
     double kk = k[0] * k[0] + k[1] * k[1] + k[2] * k[2];
     for (uint32_t i = 0; i < rs.count; i++) {
         double cos_l[HAL_MAX_LIGHTS], alpha[HAL_MAX_LIGHTS], sig[3][HAL_MAX_LIGHTS];
-        double s[HAL_MAX_LIGHTS], g[HAL_MAX_LIGHTS][N];
+        double s[HAL_MAX_LIGHTS];
         uint32_t n = pool_cluster[i] == c ? kept_lights(i, cos_l, alpha, sig) : 0;
         if (n < 2)
             continue;
