@@ -100,7 +100,8 @@ LIBCAMERA_LIBS = $(if $(HAVE_LIBCAMERA),$(shell $(PKG_CONFIG) --libs libcamera) 
 HOST_CFLAGS += $(if $(HAVE_LIBCAMERA),-DHAVE_LIBCAMERA,)
 BOARD_SRC := $(if $(filter sim,$(HAL)),$(SIM_SRC),$(LINUX_SRC))
 # The calibration (scanner calibrate) is its own program, scanner-calibrate, built where OpenCV
-# 4 is found (Debian's libopencv-contrib-dev, which make test installs): a scan never loads
+# 4 is found (Debian's libopencv-dev for its pkg-config file and libopencv-contrib-dev for ArUco,
+# which make test installs): a scan never loads
 # OpenCV. scanner execs it for 'scanner calibrate'.
 HAVE_OPENCV := $(shell $(PKG_CONFIG) --exists opencv4 2>/dev/null && echo 1)
 CALIB_SRC := app/calibrate.c app/calib_solve.c app/calib_files.c

@@ -369,8 +369,8 @@ static int cmd_calibrate(int argc, char **argv)
 {
     (void)argc;
     return exec_beside("scanner-calibrate", argv,
-                       "the calibration needs OpenCV: install Debian's libopencv-contrib-dev and "
-                       "rebuild");
+                       "the calibration needs OpenCV: install Debian's libopencv-dev and "
+                       "libopencv-contrib-dev and rebuild");
 }
 #endif
 
