@@ -296,7 +296,8 @@ static int run(const char *scene, const char *scan_dir, const char *result_dir, 
         fit_k = (c->specular[0] + c->specular[1] + c->specular[2]) / 3.0;
         fit_s = c->roughness;
     }
-    if (rig.material.kind != SIM_MAT_LAMBERT) { /* the rig as it scanned: its own lights */
+    /* the material as the rig saw it, for a model with a lobe to compare (a matte one: 0) */
+    if (rig.material.kind != SIM_MAT_LAMBERT && lobes.count > 0) {
         static struct sim_rig seen;
         snprintf(dir, sizeof(dir), "%s", scene);
         rc = sim_rig_init(&seen, &sc, &calib, &layout, dirname(dir), err, sizeof(err));
