@@ -288,25 +288,22 @@ static double fit_specular(uint32_t c, double roughness, double k_out[3])
     return fit_k(c, &ggx, k_out);
 }
 
-/* Each sample's diffuse colour given its cluster's lobe: least squares over its kept lights,
- * rho = sum (S_l - K g_l) cos_l / sum cos_l^2. */
+/* Each sample's diffuse colour given its cluster's lobe, for judging outliers: least squares
+ * over its kept lights, rho = sum (S_l - K g_l) cos_l / sum cos_l^2 (along_cos). */
 static void fit_diffuse(const struct reflect_model *m)
 {
     for (uint32_t i = 0; i < rs.count; i++) {
-        const struct reflect_obs *o = &pool[i];
-        const struct reflect_cluster *cl = &m->cluster[pool_cluster[i]];
-        double num[3] = {0, 0, 0}, den = 0.0;
-        for (uint32_t l = 0; l < HAL_MAX_LIGHTS; l++) {
-            if (!(pool_used[i] >> l & 1u))
-                continue;
+        double cos_l[HAL_MAX_LIGHTS], alpha[HAL_MAX_LIGHTS], sig[3][HAL_MAX_LIGHTS];
+        uint32_t n = kept_lights(i, cos_l, alpha, sig);
+        for (uint32_t l = 0; l < n; l++) {
             double sp[3];
-            reflect_specular(cl, o->alpha[l], o->cos_r, sp);
+            reflect_specular(&m->cluster[pool_cluster[i]], alpha[l], pool[i].cos_r, sp);
             for (int ch = 0; ch < 3; ch++)
-                num[ch] += (o->signal[l][ch] - sp[ch]) * o->cos_i[l];
-            den += o->cos_i[l] * o->cos_i[l];
+                sig[ch][l] -= sp[ch];
         }
         for (int ch = 0; ch < 3; ch++)
-            pool_rho[i][ch] = den > 0.0 ? (float)fmax(0.0, num[ch] / den) : pool[i].rho0[ch];
+            pool_rho[i][ch] =
+                n > 0 ? (float)fmax(0.0, along_cos(cos_l, sig[ch], n)) : pool[i].rho0[ch];
     }
 }
 
@@ -394,7 +391,7 @@ static void fit_lobe(struct reflect_cluster *cl, uint32_t c)
 static void fit_measured(struct reflect_cluster *cl, uint32_t c)
 {
     enum { N = REFLECT_LOBE_NODES };
-    static double a[N * N], b[N], x[N], g[HAL_MAX_LIGHTS][N]; /* static: off the stack */
+    static double a[N * N], b[N], x[N], g[N][HAL_MAX_LIGHTS]; /* static: off the stack */
     memset(a, 0, sizeof(a));
     memset(b, 0, sizeof(b));
     const double *k = cl->lobe_specular;
@@ -407,24 +404,20 @@ static void fit_measured(struct reflect_cluster *cl, uint32_t c)
             continue;
         double inv = 1.0 / (pool[i].cos_r > 0.05 ? pool[i].cos_r : 0.05), mg[N];
         memset(g, 0, sizeof(g));
-        for (uint32_t l = 0; l < n; l++) { /* light l's row: the nodes around its alpha */
+        for (uint32_t l = 0; l < n; l++) { /* light l: the nodes around its alpha */
             uint32_t k0;
             double t;
             if (lobe_segment(alpha[l], &k0, &t))
-                g[l][k0] = (1.0 - t) * inv, g[l][k0 + 1] = t * inv;
+                g[k0][l] = (1.0 - t) * inv, g[k0 + 1][l] = t * inv;
             s[l] = k[0] * sig[0][l] + k[1] * sig[1][l] + k[2] * sig[2][l];
         }
-        for (uint32_t q = 0; q < N; q++) {
-            double col[HAL_MAX_LIGHTS];
-            for (uint32_t l = 0; l < n; l++)
-                col[l] = g[l][q];
-            mg[q] = along_cos(cos_l, col, n);
-        }
+        for (uint32_t q = 0; q < N; q++)
+            mg[q] = along_cos(cos_l, g[q], n);
         double ms = along_cos(cos_l, s, n);
         for (uint32_t l = 0; l < n; l++) {
             double gp[N], sp = s[l] - ms * cos_l[l];
             for (uint32_t q = 0; q < N; q++)
-                gp[q] = g[l][q] - mg[q] * cos_l[l];
+                gp[q] = g[q][l] - mg[q] * cos_l[l];
             for (uint32_t p = 0; p < N; p++) {
                 b[p] += gp[p] * sp;
                 for (uint32_t q = 0; q < N; q++)
@@ -461,20 +454,19 @@ int reflect_fit(uint32_t clusters, struct reflect_model *out)
                     : clusters > REFLECT_MAX_CLUSTERS ? REFLECT_MAX_CLUSTERS
                                                       : clusters,
                     m);
-    for (uint32_t i = 0; i < rs.count; i++) {
-        memcpy(pool_rho[i], pool[i].rho0, sizeof(pool_rho[i]));
+    for (uint32_t i = 0; i < rs.count; i++)
         pool_used[i] = pool[i].lights;
-    }
     for (uint32_t c = 0; c < m->count; c++)
         m->cluster[c].roughness = 0.1;
-    /* the lobes (the diffuse colours free: along_cos) and the diffuse colours for them; the
-     * outliers judged on that model, twice (a first model leans towards them) */
+    /* the lobes (the diffuse colours free: along_cos); the outliers judged on that model and
+     * its diffuse colours, twice (a first model leans towards them) */
     for (int round = 0; round < 3; round++) {
         for (uint32_t c = 0; c < m->count; c++)
             fit_lobe(&m->cluster[c], c);
-        fit_diffuse(m);
-        if (round < 2)
+        if (round < 2) {
+            fit_diffuse(m);
             drop_outliers(m);
+        }
     }
     /* then the lobe's shape as measured, from GGX's: real materials' tails are not GGX's, and
      * where the paint is dark the tails are most of the light (make eval's gold metallic
@@ -485,11 +477,9 @@ int reflect_fit(uint32_t clusters, struct reflect_model *out)
             cl->lobe[n] = reflect_lobe(cl->roughness, node_angle(n), 1.0);
         memcpy(cl->lobe_specular, cl->specular, sizeof(cl->lobe_specular));
     }
-    for (int round = 0; round < 6; round++) {
+    for (int round = 0; round < 6; round++) /* K's colour and the shape settle together */
         for (uint32_t c = 0; c < m->count; c++)
             fit_measured(&m->cluster[c], c);
-        fit_diffuse(m);
-    }
     rs.fitted = 1;
     *out = *m;
     return 0;
