@@ -108,9 +108,6 @@ static void progress_line(struct job *j, const char *event, int view, uint32_t d
 static void progress_with(struct job *j, const char *event, int view, uint32_t done,
                           const char *fields, const char *detail);
 
-/* What the job cost: the rig's time (with the simulator, the modelled rig's: its turntable and
- * frame rate) and the CPU the scanner spent, the simulator's rendering left out, split by what
- * delays the scan (in line with the rig) and what runs beside it. make bench reads this line. */
 /* The CPU the scanner spent since the job began, the simulator's rendering (@p sim_s, out)
  * left out. */
 static double own_cpu_s(const struct job *j, double *sim_s)
@@ -128,6 +125,9 @@ static double peak_memory_mb(void)
     return ru.ru_maxrss / 1024.0;
 }
 
+/* What the job cost: the rig's time (with the simulator, the modelled rig's: its turntable and
+ * frame rate) and the CPU the scanner spent, the simulator's rendering left out, split by what
+ * delays the scan (in line with the rig) and what runs beside it. make bench reads this line. */
 static void report_cost(struct job *j, const char *what)
 {
     uint64_t now_us = j->start_rig_us;
