@@ -1,6 +1,8 @@
 /* The scanner's config and calibration files: key tables, cross-checks, and their documentation. */
 #define _POSIX_C_SOURCE 200809L
 #include "config.h"
+#include "calib_file.h"
+#include "file_posix.h"
 
 #include "gray.h"
 
@@ -131,7 +133,8 @@ static const struct ini_key config_keys[] = {
         "normals are estimated across up to this many pixels on each side"),
     STR("scan", "calibration", calibration_file, NULL,
         "calibration file, relative to this config file"),
-    STR("output", "dir", output_dir, "scans", "where scans go: each scan without --out gets a "
+    STR("output", "dir", output_dir, "scans",
+        "where scans go: each scan without --out gets a "
         "new folder here named by when it began (UTC, YYYY-MM-DD_HHMMSS), and 'latest' links "
         "to the newest; relative to the working directory"),
     F64("output", "max_hole_mm", max_hole_mm, 0, 100, "0",
@@ -278,8 +281,8 @@ static const struct ini_key config_keys[] = {
         "empty: the scan's calibration, so the firmware knows the rig exactly"),
     F64("sim", "object_height_mm", sim.object_height_mm, 1, 1000, "150",
         "object height after scaling (sphere: diameter)"),
-    {"sim", "second_pass_pose", INI_VEC, C(sim.second_pass_pose_deg), 3, -360, 360, 0,
-     "90, 0, 30", NULL,
+    {"sim", "second_pass_pose", INI_VEC, C(sim.second_pass_pose_deg), 3, -360, 360, 0, "90, 0, 30",
+     NULL,
      "[scan] passes = 2: how the simulated person lays the object for the second pass, as "
      "object_pose (degrees about x, then y, then z, then stood on the table)"},
     {"sim", "object_pose", INI_VEC, C(sim.object_pose_deg), 3, -360, 360, 0, "0, 0, 0", NULL,
@@ -365,8 +368,8 @@ static const struct ini_key config_keys[] = {
         "table angles of the sphere, evenly round (0: lights are not calibrated)"),
     U32("calibrate", "projector_width", calibrate.projector_width, 1, HAL_MAX_PROJECTOR_WIDTH,
         "1024", "projector columns, when no calibration file exists yet"),
-    U32("calibrate", "projector_height", calibrate.projector_height, 1,
-        HAL_MAX_PROJECTOR_HEIGHT, "768", "projector rows, when no calibration file exists yet"),
+    U32("calibrate", "projector_height", calibrate.projector_height, 1, HAL_MAX_PROJECTOR_HEIGHT,
+        "768", "projector rows, when no calibration file exists yet"),
     U32("calibrate", "min_corners", calibrate.min_corners, 6, 1024, "12",
         "fewer corners found in an image: the image is not used"),
     U32("calibrate", "fix_k3", calibrate.fix_k3, 0, 1, "1",
@@ -379,61 +382,6 @@ static const struct ini_key config_keys[] = {
 
 #undef C
 #undef SZ
-#define K(member) offsetof(struct scan_calib, member)
-#define CF(sec, key, member, lo, hi, doc)                                                          \
-    {                                                                                              \
-        sec, key, INI_F64, K(member), 0, lo, hi, 0, NULL, NULL, doc                                \
-    }
-#define CU(sec, key, member, hi, doc)                                                              \
-    {                                                                                              \
-        sec, key, INI_U32, K(member), 0, 1, hi, 1, NULL, NULL, doc                                 \
-    }
-#define CV(sec, key, member, n, lo, hi, def, doc)                                                  \
-    {                                                                                              \
-        sec, key, INI_VEC, K(member), n, lo, hi, 0, def, NULL, doc                                 \
-    }
-#define LIGHT(i)                                                                                   \
-    CV("lights", "light_" #i "_mm", light_pos_mm[i], 3, -1e5, 1e5, "0, 0, 0",                      \
-       "position of light " #i " (camera frame)"),                                                 \
-    {"lights", "light_" #i "_gain", INI_F64, K(light_gain[i]), 0, 0.01, 100, 0, "1", NULL,          \
-     "intensity of light " #i " relative to the lights' mean (scanner calibrate measures it)"}
-
-static const struct ini_key calib_keys[] = {
-    CF("camera", "fx_px", cam_fx_px, 1, 1e6, "focal length x"),
-    CF("camera", "fy_px", cam_fy_px, 1, 1e6, "focal length y"),
-    CF("camera", "cx_px", cam_cx_px, -1e5, 1e5, "principal point x"),
-    CF("camera", "cy_px", cam_cy_px, -1e5, 1e5, "principal point y"),
-    CU("camera", "width", cam_width, HAL_MAX_WIDTH, "image width the intrinsics belong to"),
-    CU("camera", "height", cam_height, HAL_MAX_HEIGHT, "image height"),
-    CV("camera", "distortion", cam_dist, 5, -100, 100, "0, 0, 0, 0, 0",
-       "lens distortion k1, k2, p1, p2, k3 (Brown-Conrady, OpenCV's order; 0: a pinhole)"),
-    CF("projector", "fx_px", proj_fx_px, 1, 1e6, "focal length x"),
-    CF("projector", "fy_px", proj_fy_px, 1, 1e6, "focal length y"),
-    CF("projector", "cx_px", proj_cx_px, -1e5, 1e5, "principal point x"),
-    CF("projector", "cy_px", proj_cy_px, -1e5, 1e5, "principal point y"),
-    CU("projector", "width", proj_width, HAL_MAX_PROJECTOR_WIDTH, "projector columns"),
-    CU("projector", "height", proj_height, HAL_MAX_PROJECTOR_HEIGHT, "projector rows"),
-    CV("projector", "distortion", proj_dist, 5, -100, 100, "0, 0, 0, 0, 0",
-       "lens distortion k1, k2, p1, p2, k3, as for the camera"),
-    CV("projector", "rotation", proj_rot, 9, -1, 1, NULL,
-       "rotation camera -> projector, row-major 3x3 (p_proj = R p_cam + t)"),
-    CV("projector", "translation_mm", proj_trans_mm, 3, -1e5, 1e5, NULL,
-       "translation camera -> projector"),
-    CV("turntable", "axis_point_mm", axis_point_mm, 3, -1e5, 1e5, NULL,
-       "a point of the turntable axis on the table surface (camera frame)"),
-    CV("turntable", "axis_dir", axis_dir, 3, -1, 1, NULL, "unit direction of the axis, upwards"),
-    LIGHT(0),
-    LIGHT(1),
-    LIGHT(2),
-    LIGHT(3),
-    LIGHT(4),
-    LIGHT(5),
-    LIGHT(6),
-    LIGHT(7),
-};
-
-_Static_assert(HAL_MAX_LIGHTS == 8, "calib_keys lists light_0 .. light_7");
-
 static enum hal_pixel_format pixel_format_of(const char *s)
 {
     return strcmp(s, "yuyv") == 0   ? HAL_PIX_YUYV
@@ -684,9 +632,10 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
         return -EINVAL;
     }
     if (cfg->views * cfg->passes > REG_MAX_VIEWS) {
-        snprintf(err, err_len, "%s: [scan] views: %u views x %u passes exceed the %u a scan holds "
-                 "(REG_MAX_VIEWS)", path, (unsigned)cfg->views, (unsigned)cfg->passes,
-                 (unsigned)REG_MAX_VIEWS);
+        snprintf(err, err_len,
+                 "%s: [scan] views: %u views x %u passes exceed the %u a scan holds "
+                 "(REG_MAX_VIEWS)",
+                 path, (unsigned)cfg->views, (unsigned)cfg->passes, (unsigned)REG_MAX_VIEWS);
         return -EINVAL;
     }
     if (cfg->watertight && cfg->max_hole_mm <= 0.0) {
@@ -697,114 +646,6 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
         return -EINVAL;
     }
     return load_sim_rig(cfg, path, err, err_len);
-}
-
-int calib_load(struct scan_calib *calib, const char *path, uint32_t light_count, char *err,
-               size_t err_len)
-{
-    memset(calib, 0, sizeof(*calib));
-    int rc = ini_schema_load(calib_keys, sizeof(calib_keys) / sizeof(calib_keys[0]), calib, path,
-                             err, err_len);
-    if (rc != 0)
-        return rc;
-    vec3 axis = v3_from(calib->axis_dir);
-    if (fabs(v3_len(axis) - 1.0) > 1e-3) {
-        snprintf(err, err_len, "%s: [turntable] axis_dir: not a unit vector (length %.4f)", path,
-                 v3_len(axis));
-        return -EINVAL;
-    }
-    /* R must be a rotation: R R^T = I within calibration-file rounding. */
-    for (int r = 0; r < 3; r++) {
-        for (int c = 0; c < 3; c++) {
-            double dot = 0.0;
-            for (int k = 0; k < 3; k++)
-                dot += calib->proj_rot[r * 3 + k] * calib->proj_rot[c * 3 + k];
-            if (fabs(dot - (r == c ? 1.0 : 0.0)) > 1e-4) {
-                snprintf(err, err_len, "%s: [projector] rotation: not a rotation matrix", path);
-                return -EINVAL;
-            }
-        }
-    }
-    /* Triangulation needs the projector off the camera's centre: a baseline of a few mm or less
-     * gives rays that meet nowhere useful (and 0 gives a scan of no points at all). */
-    double baseline_mm = v3_len(v3_from(calib->proj_trans_mm));
-    if (baseline_mm < 10.0) {
-        snprintf(err, err_len,
-                 "%s: [projector] translation_mm: the projector is %.1f mm from the camera; "
-                 "triangulation needs a baseline (typically 100-300 mm)",
-                 path, baseline_mm);
-        return -EINVAL;
-    }
-    calib->light_count = light_count;
-    for (uint32_t i = 0; i < light_count; i++) {
-        if (v3_len(v3_from(calib->light_pos_mm[i])) == 0.0) {
-            snprintf(err, err_len, "%s: [lights] light_%u_mm: required, [lights] count is %u", path,
-                     (unsigned)i, (unsigned)light_count);
-            return -EINVAL;
-        }
-    }
-    return 0;
-}
-
-void calib_read_quality(const char *path, double *camera_rms_px, double *projector_rms_px)
-{
-    char line[256];
-    *camera_rms_px = *projector_rms_px = -1.0;
-    FILE *f = fopen(path, "r");
-    while (f != NULL && fgets(line, sizeof(line), f) != NULL)
-        if (sscanf(line, "; quality: camera_rms_px = %lf, projector_rms_px = %lf", camera_rms_px,
-                   projector_rms_px) == 2)
-            break;
-    if (f != NULL)
-        fclose(f);
-}
-
-/* "a, b, c" to 12 significant digits (1e-12: far below any calibration's uncertainty; the
- * loader refuses lines over 198 characters) */
-static int put_vec(char *buf, size_t len, const char *key, const double *v, int n)
-{
-    int w = snprintf(buf, len, "%s = ", key);
-    for (int i = 0; i < n && w > 0 && (size_t)w < len; i++)
-        w += snprintf(buf + w, len - (size_t)w, "%s%.12g", i > 0 ? ", " : "", v[i]);
-    if (w > 0 && (size_t)w < len)
-        w += snprintf(buf + w, len - (size_t)w, "\n");
-    return w;
-}
-
-int calib_save(const struct hal_storage *st, const char *path, const struct scan_calib *c,
-               const char *comment)
-{
-    static char buf[16384];
-    size_t n = 0;
-#define PUT(...) n += (size_t)snprintf(buf + n, n < sizeof(buf) ? sizeof(buf) - n : 0, __VA_ARGS__)
-#define VEC(key, v, k) n += (size_t)put_vec(buf + n, n < sizeof(buf) ? sizeof(buf) - n : 0, key, v, k)
-    if (comment != NULL)
-        PUT("%s", comment);
-    PUT("[camera]\nfx_px = %.12g\nfy_px = %.12g\ncx_px = %.12g\ncy_px = %.12g\nwidth = %u\n"
-        "height = %u\n", c->cam_fx_px, c->cam_fy_px, c->cam_cx_px, c->cam_cy_px,
-        (unsigned)c->cam_width, (unsigned)c->cam_height);
-    VEC("distortion", c->cam_dist, 5);
-    PUT("\n[projector]\nfx_px = %.12g\nfy_px = %.12g\ncx_px = %.12g\ncy_px = %.12g\n"
-        "width = %u\nheight = %u\n", c->proj_fx_px, c->proj_fy_px, c->proj_cx_px, c->proj_cy_px,
-        (unsigned)c->proj_width, (unsigned)c->proj_height);
-    VEC("distortion", c->proj_dist, 5);
-    VEC("rotation", c->proj_rot, 9);
-    VEC("translation_mm", c->proj_trans_mm, 3);
-    PUT("\n[turntable]\n");
-    VEC("axis_point_mm", c->axis_point_mm, 3);
-    VEC("axis_dir", c->axis_dir, 3);
-    PUT("\n[lights]\n");
-    for (uint32_t i = 0; i < c->light_count && i < HAL_MAX_LIGHTS; i++) {
-        char key[32];
-        snprintf(key, sizeof(key), "light_%u_mm", (unsigned)i);
-        VEC(key, c->light_pos_mm[i], 3);
-        PUT("light_%u_gain = %.6f\n", (unsigned)i, c->light_gain[i]);
-    }
-#undef PUT
-#undef VEC
-    if (n >= sizeof(buf))
-        return -EFBIG;
-    return hal_storage_write_file(st, path, buf, n);
 }
 
 void config_print_doc(FILE *out)
@@ -827,7 +668,91 @@ void config_print_doc(FILE *out)
     ini_schema_print_doc(config_keys, sizeof(config_keys) / sizeof(config_keys[0]), out);
     fprintf(out, "\n## Calibration file (e.g. `config/sim-calib.ini`)\n\nAll geometry is in the "
                  "camera frame (x right, y down, z forward), in millimetres.\n");
-    ini_schema_print_doc(calib_keys, sizeof(calib_keys) / sizeof(calib_keys[0]), out);
+    calib_print_doc(out);
+}
+
+/* How a scan's views were taken: what its frames are and where the table stood. */
+struct plan_key {
+    const char *section, *key;
+    double (*get)(const struct app_config *c, unsigned i);
+    unsigned count;                                  /* a list: exposures_us */
+    const char *(*text)(const struct app_config *c); /* a word (an enum), to say it as written */
+};
+#define PLAN_GET(name, expr)                                                                       \
+    static double plan_##name(const struct app_config *c, unsigned i)                              \
+    {                                                                                              \
+        (void)i;                                                                                   \
+        return (double)(expr);                                                                     \
+    }
+PLAN_GET(views, c->views)
+PLAN_GET(passes, c->passes)
+PLAN_GET(start, c->start_angle_deg)
+PLAN_GET(width, c->camera.width)
+PLAN_GET(height, c->camera.height)
+PLAN_GET(binning, c->camera.binning)
+PLAN_GET(exposure, c->camera.exposure_us)
+PLAN_GET(gain, c->camera.gain_milli)
+PLAN_GET(hdr_count, c->scan.exposure_count)
+PLAN_GET(code, c->scan.code)
+PLAN_GET(rows, c->scan.decode_rows)
+PLAN_GET(lights, c->light_count)
+/* 0: the camera's exposure (docs/config.md): compared as the exposure the frames get */
+PLAN_GET(all_lights, c->scan.colour.all_lights_exposure_us ? c->scan.colour.all_lights_exposure_us
+                                                           : c->camera.exposure_us)
+PLAN_GET(light_exp, c->scan.colour.light_exposure_us ? c->scan.colour.light_exposure_us
+                                                     : c->camera.exposure_us)
+PLAN_GET(bracket, c->scan.colour.bracket)
+PLAN_GET(method, c->scan.colour.method)
+static const char *plan_code_text(const struct app_config *c)
+{
+    return c->code;
+}
+static const char *plan_method_text(const struct app_config *c)
+{
+    return c->colour_method;
+}
+static double plan_hdr(const struct app_config *c, unsigned i)
+{
+    return i < c->scan.exposure_count ? (double)c->scan.exposures_us[i] : 0.0;
+}
+
+int config_plan_differs(const struct app_config *taken, const struct app_config *now, int capturing,
+                        char *what, size_t what_len)
+{
+    static const struct plan_key keys[] = {
+        {"scan", "views", plan_views, 1, NULL},
+        {"scan", "passes", plan_passes, 1, NULL},
+        {"scan", "start_angle_deg", plan_start, 1, NULL},
+        {"camera", "width", plan_width, 1, NULL},
+        {"camera", "height", plan_height, 1, NULL},
+        {"camera", "binning", plan_binning, 1, NULL},
+        {"camera", "exposure_us", plan_exposure, 1, NULL},
+        {"camera", "gain_milli", plan_gain, 1, NULL},
+        {"scan", "exposures_us (count)", plan_hdr_count, 1, NULL},
+        {"scan", "exposures_us", plan_hdr, SCAN_MAX_EXPOSURES, NULL},
+        {"scan", "code", plan_code, 1, plan_code_text},
+        {"scan", "decode_rows", plan_rows, 1, NULL},
+        {"lights", "count", plan_lights, 1, NULL},
+        {"colour", "all_lights_exposure_us", plan_all_lights, 1, NULL},
+        {"colour", "light_exposure_us", plan_light_exp, 1, NULL},
+        {"colour", "bracket", plan_bracket, 1, NULL},
+        {"colour", "method", plan_method, 1, plan_method_text},
+    };
+    size_t n = sizeof(keys) / sizeof(keys[0]) - (capturing ? 0 : 1); /* method: last */
+    for (size_t k = 0; k < n; k++)
+        for (unsigned i = 0; i < keys[k].count; i++) {
+            double a = keys[k].get(taken, i), b = keys[k].get(now, i);
+            if (a == b)
+                continue;
+            if (keys[k].text != NULL)
+                snprintf(what, what_len, "[%s] %s = %s, not %s", keys[k].section, keys[k].key,
+                         keys[k].text(taken), keys[k].text(now));
+            else
+                snprintf(what, what_len, "[%s] %s = %g, not %g", keys[k].section, keys[k].key, a,
+                         b);
+            return -EINVAL;
+        }
+    return 0;
 }
 
 void config_board(const struct app_config *cfg, struct board_config *out)

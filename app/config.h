@@ -4,7 +4,8 @@
 #define CONFIG_H
 
 #include "board.h"
-#include "calibrate.h"
+#include "calib_file.h"
+#include "calib_settings.h"
 #include "hal.h"
 #include "fusion.h"
 #include "reg.h"
@@ -22,13 +23,13 @@
 enum keep_frames { KEEP_FRAMES_ALL, KEEP_FRAMES_COLOUR, KEEP_FRAMES_NONE };
 
 struct app_config {
-    char path[HAL_MAX_PATH];     /**< the file it came from */
-    char camera_backend[16];     /**< sim | v4l2 | libcamera */
-    char camera_pixel_format[8]; /**< rgb24 | yuyv | grey, as written */
-    char colour_method[16];  /**< none | single | uniform | multi, as written */
-    char colour_ca[16];      /**< channel | pixel, as written */
-    char code[8];            /**< [scan] code: gray | xor04, as written */
-    char projector_backend[8]; /**< [projector] backend: gpio | drm */
+    char path[HAL_MAX_PATH];             /**< the file it came from */
+    char camera_backend[16];             /**< sim | v4l2 | libcamera */
+    char camera_pixel_format[8];         /**< rgb24 | yuyv | grey, as written */
+    char colour_method[16];              /**< none | single | uniform | multi, as written */
+    char colour_ca[16];                  /**< channel | pixel, as written */
+    char code[8];                        /**< [scan] code: gray | xor04, as written */
+    char projector_backend[8];           /**< [projector] backend: gpio | drm */
     char projector_device[HAL_MAX_PATH]; /**< [projector] device (drm) */
     struct hal_camera_config camera;
     uint32_t light_count;
@@ -36,7 +37,7 @@ struct app_config {
     uint32_t views;  /**< per pass */
     uint32_t passes; /**< 1, or 2: the object laid another way for a second turn */
     double start_angle_deg;
-    struct ini_list exposures_us; /**< [scan] exposures_us as written (HDR patterns) */
+    struct ini_list exposures_us;        /**< [scan] exposures_us as written (HDR patterns) */
     char calibration_file[HAL_MAX_PATH]; /**< resolved against the config file's directory */
     char output_dir[HAL_MAX_PATH];
     char frame_format_name[8]; /**< [output] frame_format, as written */
@@ -64,23 +65,17 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
  *  @retval 0 @retval -errno (@p err names the file, the key and what is wrong) */
 int config_check_files(const struct app_config *cfg, char *err, size_t err_len);
 
-/** Parse and check a calibration file. @retval 0 ok, otherwise @p err says file, line and key */
-int calib_load(struct scan_calib *calib, const char *path, uint32_t light_count, char *err,
-               size_t err_len);
-
-/** Write @p calib as a calibration file calib_load reads back, durably (temp, fsync, rename),
- *  under the comment lines @p comment (each line starts "; "; may be NULL).
- *  @retval 0 @retval -errno */
-int calib_save(const struct hal_storage *st, const char *path, const struct scan_calib *calib,
-               const char *comment);
-
-/** The reprojection RMS scanner calibrate recorded in a calibration file's comment
- *  ("; quality: camera_rms_px = C, projector_rms_px = P", written by calib_solve.c), px; -1 for
- *  each when the file has none. */
-void calib_read_quality(const char *path, double *camera_rms_px, double *projector_rms_px);
-
 /** The devices' settings of @p cfg for board_init and board_selftest (pointers into @p cfg). */
 void config_board(const struct app_config *cfg, struct board_config *out);
+
+/** The first key of how views are taken (views, passes, start angle, resolution, exposures,
+ *  gain, patterns, lights, colour frames) on which @p now differs from @p taken, the settings a
+ *  scan was taken with: a resume or a re-processing must keep them, or its views would not fit
+ *  together. @param capturing  1: the colour method too (a resume takes its frames)
+ *  @param what  out: "[section] key = taken's value, not now's value" when they differ
+ *  @retval 0 the same @retval -EINVAL they differ */
+int config_plan_differs(const struct app_config *taken, const struct app_config *now, int capturing,
+                        char *what, size_t what_len);
 
 /** Write the documentation of every key (Markdown) to @p out. */
 void config_print_doc(FILE *out);

@@ -116,8 +116,13 @@ int frame_writer_put(const char *dir, uint32_t view, uint32_t frame, const uint8
         /* the slot after the queued ones is free: the writer only touches queued slots */
         uint32_t k = (w.head + w.count) % FRAME_WRITER_SLOTS;
         pthread_mutex_unlock(&w.lock);
-        slots[k] = (struct slot){.pixels = pixels, .view = view, .frame = frame, .width = width,
-                                 .height = height, .channels = channels, .format = format};
+        slots[k] = (struct slot){.pixels = pixels,
+                                 .view = view,
+                                 .frame = frame,
+                                 .width = width,
+                                 .height = height,
+                                 .channels = channels,
+                                 .format = format};
         snprintf(slots[k].dir, sizeof(slots[k].dir), "%s", dir);
         pthread_mutex_lock(&w.lock);
         w.count++;

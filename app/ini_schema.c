@@ -2,6 +2,8 @@
 #define _POSIX_C_SOURCE 200809L
 #include "ini_schema.h"
 
+#include "file_posix.h"
+
 #include "hal_gpio.h"
 
 #include <errno.h>
@@ -42,8 +44,8 @@ static char *counting_reader(char *str, int num, void *stream)
     st->line++;
     size_t n = strlen(r);
     if (n + 1 == (size_t)num && r[n - 1] != '\n' && !feof(st->file)) {
-        snprintf(st->err, st->err_len, "%s:%d: line longer than %d characters", st->path,
-                 st->line, num - 2);
+        snprintf(st->err, st->err_len, "%s:%d: line longer than %d characters", st->path, st->line,
+                 num - 2);
         st->failed = 1;
         return NULL;
     }
@@ -54,21 +56,20 @@ static char *counting_reader(char *str, int num, void *stream)
  * /dev/zero, a FIFO or a directory is not a config). @retval 0 @retval -errno, said in @p err */
 static int open_regular(const char *path, FILE **out, char *err, size_t err_len)
 {
-    /* O_NONBLOCK: opening a FIFO must not wait for a writer */
-    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    int fd = file_open_regular_fd(path);
     struct stat st;
-    int rc = 0;
-    if (fd < 0 || fstat(fd, &st) != 0) {
-        rc = -errno;
-        snprintf(err, err_len, "%s: cannot open: %s", path, strerror(-rc));
-    } else if (!S_ISREG(st.st_mode)) {
-        rc = S_ISDIR(st.st_mode) ? -EISDIR : -EINVAL;
+    int rc = fd < 0 ? fd : fstat(fd, &st) != 0 ? -errno : 0;
+    if (rc == -EISDIR || rc == -EINVAL) {
         snprintf(err, err_len, "%s: not a regular file (%s)", path,
-                 S_ISDIR(st.st_mode) ? "a directory" : "a device, pipe or socket");
+                 rc == -EISDIR ? "a directory" : "a device, pipe or socket");
+    } else if (rc != 0) {
+        snprintf(err, err_len, "%s: cannot open: %s", path, strerror(-rc));
     } else if (st.st_size > (off_t)INI_MAX_FILE_BYTES) {
         rc = -EFBIG;
-        snprintf(err, err_len, "%s: %lld bytes, too large for a config or calibration (at most "
-                 "%u)", path, (long long)st.st_size, INI_MAX_FILE_BYTES);
+        snprintf(err, err_len,
+                 "%s: %lld bytes, too large for a config or calibration (at most "
+                 "%u)",
+                 path, (long long)st.st_size, INI_MAX_FILE_BYTES);
     } else if ((*out = fdopen(fd, "r")) == NULL) {
         rc = -errno;
         snprintf(err, err_len, "%s: cannot open: %s", path, strerror(-rc));

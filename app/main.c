@@ -1,8 +1,8 @@
 /* The scanner command-line program: config, board, one scan, and a safe rig on every exit. */
 #define _POSIX_C_SOURCE 200809L
 #include "board.h"
-#include "calibrate.h"
 #include "config.h"
+#include "rig.h"
 #include "scan.h"
 #include "scan_job.h"
 #include "white_cal.h"
@@ -25,125 +25,15 @@
 #define SCANNER_VERSION "0.1.0"
 #endif
 
-static volatile sig_atomic_t stop_flag;
-static struct hal the_hal;
-static int hal_ready;
-
-static void app_log(enum hal_log_level level, const char *fmt, ...)
-{
-    static const char *const tag[] = {"error", "warning", "info", "debug"};
-    va_list ap;
-    if (level == HAL_LOG_DEBUG && getenv("SCANNER_DEBUG") == NULL)
-        return;
-    fprintf(stderr, "scanner: %s: ", tag[level]);
-    va_start(ap, fmt);
-    vfprintf(stderr, fmt, ap);
-    va_end(ap);
-    fputc('\n', stderr);
-}
-
-/* A stop signal, or standard output that can no longer be written: its reader went away (a
- * --json consumer that exited: SIGPIPE is ignored, so the write failed with EPIPE), and a scan
- * nobody can follow stops as it would on a dropped session. */
-static int app_stop_requested(void)
-{
-    if (stop_flag == 0 && ferror(stdout)) {
-        stop_flag = 1;
-        app_log(HAL_LOG_WARN, "standard output cannot be written (its reader went away?): "
-                              "stopping");
-    }
-    return stop_flag != 0;
-}
-
-static void on_stop_signal(int sig)
-{
-    (void)sig;
-    stop_flag = 1; /* the scan loop sees it between frames and shuts down in order */
-}
-
-/* Fatal signals: one shutdown that leaves lights and projector off, then die as asked. */
-static void on_fatal_signal(int sig)
-{
-    if (hal_ready)
-        hal_safe_state(&the_hal);
-    signal(sig, SIG_DFL);
-    raise(sig);
-}
-
-static void install_signals(void)
-{
-    struct sigaction sa;
-    memset(&sa, 0, sizeof(sa));
-    sa.sa_handler = on_stop_signal;
-    sigemptyset(&sa.sa_mask);
-    /* Each of these ends a scan the same way: between frames, then the one shutdown path that
-     * puts the rig in its safe state. SIGHUP: the session (ssh, terminal) went away; SIGTSTP
-     * (Ctrl-Z) would otherwise freeze the process with the rig lit. */
-    const int stops[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGTSTP};
-    for (size_t i = 0; i < sizeof(stops) / sizeof(stops[0]); i++)
-        sigaction(stops[i], &sa, NULL);
-    /* A closed pipe on stdout is an error of the write (EPIPE, see app_stop_requested), not a
-     * death without the safe state. */
-    sa.sa_handler = SIG_IGN;
-    sigaction(SIGPIPE, &sa, NULL);
-    sa.sa_handler = on_fatal_signal;
-    sigaction(SIGSEGV, &sa, NULL);
-    sigaction(SIGBUS, &sa, NULL);
-    sigaction(SIGFPE, &sa, NULL);
-    sigaction(SIGABRT, &sa, NULL);
-}
-
-static int load_all(const char *config_path, struct app_config *cfg, struct scan_calib *calib)
-{
-    char err[512];
-    int rc = config_load(cfg, config_path, err, sizeof(err));
-    if (rc == 0)
-        rc = calib_load(calib, cfg->calibration_file, cfg->light_count, err, sizeof(err));
-    if (rc == 0)
-        rc = scan_check(&cfg->scan, calib, err, sizeof(err));
-    if (rc != 0)
-        fprintf(stderr, "scanner: error: %s\n", err);
-    return rc;
-}
-
-/* Devices up: logging, signals, the board, the camera; lights and projector off. The one
- * shutdown, rig_down, must follow whatever this returns. @retval 0 or the error (reported) */
-static int rig_up(const struct app_config *cfg, const struct scan_calib *calib)
-{
-    char err[512];
-    the_hal.log = app_log;
-    the_hal.stop_requested = app_stop_requested;
-    install_signals();
-    struct board_config bc;
-    config_board(cfg, &bc);
-    int rc = board_init(&the_hal, &bc, calib, err, sizeof(err));
-    if (rc != 0) {
-        fprintf(stderr, "scanner: error: %s\n", err);
-        return rc;
-    }
-    hal_ready = 1;
-    return scan_open(&the_hal, &cfg->camera);
-}
-
-/* Safe state, camera closed, board released (nothing to do when rig_up failed early). */
-static void rig_down(void)
-{
-    if (!hal_ready)
-        return;
-    scan_close(&the_hal);
-    board_shutdown(&the_hal);
-    hal_ready = 0;
-}
-
 static int cmd_scan(const char *config_path, const struct scan_job_opts *opts)
 {
     static struct app_config cfg;
     static struct scan_calib calib;
-    if (load_all(config_path, &cfg, &calib) != 0)
+    if (rig_load_all(config_path, &cfg, &calib) != 0)
         return 2;
     int rc = rig_up(&cfg, &calib);
     if (rc == 0)
-        rc = scan_job_live(&the_hal, &cfg, &calib, opts);
+        rc = scan_job_live(rig_hal(), &cfg, &calib, opts);
     rig_down();
     return rc == 0 ? 0 : 1;
 }
@@ -154,11 +44,11 @@ static int cmd_snapshot(const char *config_path, const char *out)
     static struct app_config cfg;
     static struct scan_calib calib;
     const uint8_t *rgb = NULL;
-    if (load_all(config_path, &cfg, &calib) != 0)
+    if (rig_load_all(config_path, &cfg, &calib) != 0)
         return 2;
     int rc = rig_up(&cfg, &calib);
     if (rc == 0)
-        rc = scan_snapshot(&the_hal, &cfg.scan, &calib, &rgb);
+        rc = scan_snapshot(rig_hal(), &cfg.scan, &calib, &rgb);
     rig_down();
     if (rc == 0) {
         struct hal_storage st;
@@ -175,7 +65,7 @@ static int cmd_calibrate_white(const char *config_path, double target_albedo)
 {
     static struct app_config cfg;
     static struct scan_calib calib;
-    if (load_all(config_path, &cfg, &calib) != 0)
+    if (rig_load_all(config_path, &cfg, &calib) != 0)
         return 2;
     if (cfg.light_count == 0) {
         fprintf(stderr, "scanner: error: %s: [lights] count: the white calibration needs lights\n",
@@ -188,13 +78,13 @@ static int cmd_calibrate_white(const char *config_path, double target_albedo)
     struct white_cal wc;
     int rc = rig_up(&cfg, &calib);
     if (rc == 0)
-        rc = hal_table_home(&the_hal.turntable);
+        rc = hal_table_home(&rig_hal()->turntable);
     if (rc == 0)
-        rc = scan_take_view(&the_hal, &cfg.scan, &calib, 0, NULL, &view, &info);
+        rc = scan_take_view(rig_hal(), &cfg.scan, &calib, 0, NULL, &view, &info);
     if (rc == 0) {
         rc = white_cal_from_view(&cfg, &calib, &view, target_albedo, &wc);
         if (rc != 0)
-            app_log(HAL_LOG_ERROR, "no usable white pixels: is the target in view, and not "
+            rig_log(HAL_LOG_ERROR, "no usable white pixels: is the target in view, and not "
                                    "saturated (lower [camera] exposure_us)?");
     }
     rig_down();
@@ -230,7 +120,7 @@ static int cmd_selftest(const char *config_path)
         fprintf(stderr, "scanner: error: %s\n", err);
         return 2;
     }
-    the_hal.log = app_log;
+    rig_hal()->log = rig_log;
     printf("%-11s %-32s %-7s %s\n", "device", "where", "status", "detail");
     /* A new rig has no calibration yet: say so, and try the devices all the same. */
     int calib_rc = calib_load(&calib, cfg.calibration_file, cfg.light_count, err, sizeof(err));
@@ -239,7 +129,7 @@ static int cmd_selftest(const char *config_path)
     selftest_row(NULL, "calibration", cfg.calibration_file, calib_rc, calib_rc ? err : "loaded");
     struct board_config bc;
     config_board(&cfg, &bc);
-    int rc = board_selftest(&the_hal, &bc, &calib, selftest_row, NULL);
+    int rc = board_selftest(rig_hal(), &bc, &calib, selftest_row, NULL);
     return rc == 0 && calib_rc == 0 ? 0 : 1;
 }
 
@@ -248,9 +138,9 @@ static int cmd_process(const char *scan_dir, const struct scan_job_opts *opts)
 {
     struct hal hal;
     memset(&hal, 0, sizeof(hal));
-    hal.log = app_log;
-    hal.stop_requested = app_stop_requested; /* also while resume processes */
-    install_signals();
+    hal.log = rig_log;
+    hal.stop_requested = rig_stop_requested; /* also while resume processes */
+    rig_install_signals();
     storage_posix_init(&hal.storage);
     clock_posix_init(&hal.clock);
     return scan_job_process(&hal, scan_dir, opts) == 0 ? 0 : 1;
@@ -263,13 +153,14 @@ static int cmd_resume(const char *scan_dir, const struct scan_job_opts *opts)
     static struct app_config cfg;
     static struct scan_calib calib;
     char err[512];
-    if (scan_job_load_settings(scan_dir, opts->config_path, &cfg, &calib, err, sizeof(err)) != 0) {
+    if (scan_job_load_settings(scan_dir, opts->config_path, 1, &cfg, &calib, err, sizeof(err)) !=
+        0) {
         fprintf(stderr, "scanner: error: %s\n", err);
         return 2;
     }
     int rc = rig_up(&cfg, &calib);
     if (rc == 0)
-        rc = scan_job_resume(&the_hal, &cfg, &calib, scan_dir, opts);
+        rc = scan_job_resume(rig_hal(), &cfg, &calib, scan_dir, opts);
     rig_down();
     if (rc != 0)
         return 1;
@@ -296,74 +187,6 @@ static int exec_beside(const char *program, char **argv, const char *hint)
     return 1;
 }
 
-#ifdef SCANNER_CALIBRATE
-/* scanner calibrate [verify | board] --config F [--out P] [--dir D | --from D] */
-static int cmd_calibrate(int argc, char **argv)
-{
-    static struct app_config cfg;
-    static struct scan_calib calib;
-    const char *config_path = NULL, *out = NULL, *dir = NULL, *from = NULL, *what = "";
-    int first = 2;
-    if (argc > 2 && (strcmp(argv[2], "verify") == 0 || strcmp(argv[2], "board") == 0))
-        what = argv[first++];
-    for (int i = first; i < argc; i++) {
-        if (strcmp(argv[i], "--config") == 0 && i + 1 < argc)
-            config_path = argv[++i];
-        else if (strcmp(argv[i], "--out") == 0 && i + 1 < argc)
-            out = argv[++i];
-        else if (strcmp(argv[i], "--dir") == 0 && i + 1 < argc)
-            dir = argv[++i];
-        else if (strcmp(argv[i], "--from") == 0 && i + 1 < argc)
-            from = argv[++i];
-        else {
-            fprintf(stderr, "scanner: calibrate: unknown argument '%s'\n", argv[i]);
-            return 2;
-        }
-    }
-    char err[512];
-    if (config_path == NULL || (what[0] != 'v' && out == NULL)) {
-        fprintf(stderr, "scanner: calibrate: --config FILE%s is required\n",
-                what[0] == 'v' ? "" : " and --out FILE");
-        return 2;
-    }
-    if (config_load(&cfg, config_path, err, sizeof(err)) != 0) {
-        fprintf(stderr, "scanner: error: %s\n", err);
-        return 2;
-    }
-    struct hal_storage st;
-    storage_posix_init(&st);
-    if (strcmp(what, "board") == 0)
-        return calibrate_print_board(&st, &cfg, out) == 0 ? 0 : 1;
-    if (from != NULL)
-        return calibrate_solve(&st, &cfg, from, out) == 0 ? 0 : 1;
-    int rc = calib_load(&calib, cfg.calibration_file, cfg.light_count, err, sizeof(err));
-    if (rc == -ENOENT && what[0] != 'v') {
-        calibrate_guess(&cfg, &calib); /* a new rig: nothing calibrated yet */
-        rc = 0;
-    }
-    if (rc == 0)
-        rc = scan_check(&cfg.scan, &calib, err, sizeof(err));
-    if (rc != 0) {
-        fprintf(stderr, "scanner: error: %s\n", err);
-        return 2;
-    }
-    if (what[0] != 'v') /* the projector's sequence is the calibration's: rows too */
-        calib_capture_params(&cfg, &cfg.scan);
-    char dir_buf[HAL_MAX_PATH];
-    if (dir == NULL && out != NULL) {
-        calibrate_path_beside(out, "-captures", dir_buf, sizeof(dir_buf));
-        dir = dir_buf;
-    }
-    rc = rig_up(&cfg, &calib);
-    if (rc == 0)
-        rc = what[0] == 'v' ? calibrate_verify(&the_hal, &cfg, &calib)
-                            : calibrate_capture(&the_hal, &cfg, &calib, dir);
-    rig_down();
-    if (rc == 0 && what[0] != 'v')
-        rc = calibrate_solve(&st, &cfg, dir, out);
-    return rc == 0 ? 0 : 1;
-}
-#else
 /* The calibration (OpenCV) is its own program beside this one, so that a scan never loads it. */
 static int cmd_calibrate(int argc, char **argv)
 {
@@ -372,7 +195,6 @@ static int cmd_calibrate(int argc, char **argv)
                        "the calibration needs OpenCV: install Debian's libopencv-dev and "
                        "libopencv-contrib-dev and rebuild");
 }
-#endif
 
 /* The commands: name, what each takes (its usage lines), and what it cannot go without. */
 enum needs { NEEDS_NOTHING, NEEDS_CONFIG, NEEDS_DIR };
@@ -400,8 +222,8 @@ static const struct command {
      "scanner calibrate board --config FILE --out BASE  the board to print\n"
      "    (BASE.png at 300 dpi, BASE.svg at true size)\n",
      NEEDS_CONFIG},
-    {"calibrate-white", "scanner calibrate-white --config FILE [--albedo A]  white reference scales\n",
-     NEEDS_CONFIG},
+    {"calibrate-white",
+     "scanner calibrate-white --config FILE [--albedo A]  white reference scales\n", NEEDS_CONFIG},
     {"check-config",
      "scanner check-config --config FILE    check a config, its calibration and the files it "
      "names\n",
@@ -471,8 +293,7 @@ static int check_command_line(int argc, char **argv, const struct command **cmd)
     if (is_help(argv[1]) || strcmp(argv[1], "help") == 0) {
         const struct command *c = argc > 2 ? find_command(argv[2]) : NULL;
         if (argc > 2 && c == NULL) {
-            fprintf(stderr, "scanner: unknown command '%s' (scanner --help lists them)\n",
-                    argv[2]);
+            fprintf(stderr, "scanner: unknown command '%s' (scanner --help lists them)\n", argv[2]);
             return 2;
         }
         usage_of(stdout, c);
@@ -580,7 +401,7 @@ int main(int argc, char **argv)
         static struct app_config cfg;
         static struct scan_calib calib;
         char err[1024];
-        if (load_all(config_path, &cfg, &calib) != 0)
+        if (rig_load_all(config_path, &cfg, &calib) != 0)
             return 2;
         if (config_check_files(&cfg, err, sizeof(err)) != 0) {
             fprintf(stderr, "scanner: error: %s\n", err);
@@ -595,7 +416,7 @@ int main(int argc, char **argv)
         struct hal_storage st;
         if (opts.out_dir == NULL)
             return missing(cmd, "--out DIR");
-        if (load_all(config_path, &cfg, &calib) != 0)
+        if (rig_load_all(config_path, &cfg, &calib) != 0)
             return 2;
         storage_posix_init(&st);
         return patterns_write(&st, &cfg, &calib, opts.out_dir) == 0 ? 0 : 1;

@@ -31,8 +31,10 @@ static void describe(const struct gray_layout *l, uint32_t index, char *out, siz
     if (rides)
         snprintf(rides_on, sizeof(rides_on), " XOR bit %u", bits - 1u);
     snprintf(out, len, "%s bit %u of %u%s%s%s", row ? "row" : "column", bit + 1u, bits,
-             bit == 0 ? " (coarsest)" : bit + 1u == bits ? " (finest)" : "", rides_on,
-             inverse ? ", inverse" : "");
+             bit == 0           ? " (coarsest)"
+             : bit + 1u == bits ? " (finest)"
+                                : "",
+             rides_on, inverse ? ", inverse" : "");
 }
 
 static int write_listing(const struct hal_storage *st, const char *dir,

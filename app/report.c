@@ -3,6 +3,7 @@
  * tool's job, run after the scan: it allocates as it needs, outside the firmware's memory. */
 #define _POSIX_C_SOURCE 200809L
 #include "report.h"
+#include "file_posix.h"
 
 #include "decode.h"
 #include "image_io.h"
@@ -138,7 +139,12 @@ static int kv_read(struct kvs *k, const char *dir, int view, const char *name)
     k->n = 0;
     if (scan_dir_path(path, sizeof(path), dir, view, name) != 0)
         return -ENAMETOOLONG;
-    return ini_parse(path, kv_add, k) == -1 ? -ENOENT : 0;
+    FILE *f = file_open_regular(path, "r"); /* a pipe planted there must not hang the report */
+    if (f == NULL)
+        return -errno;
+    ini_parse_file(f, kv_add, k);
+    fclose(f);
+    return 0;
 }
 
 static const char *kv_get(const struct kvs *k, const char *section, const char *key)
@@ -181,16 +187,17 @@ static void reason_rgb(unsigned reason, uint8_t rgb[3])
 /* The view's colour frame: the one view.ini names "the view's colour". @retval -ENOENT none */
 static int colour_frame_of(const char *dir, uint32_t view, uint32_t *frame)
 {
-    static struct scan_dir_view v;
+    struct scan_dir_view *v = malloc(sizeof(*v)); /* large; the web server's threads ask too */
     char err[256];
-    if (scan_dir_read_view(dir, view, &v, err, sizeof(err)) != 0)
-        return -ENOENT;
-    for (uint32_t f = 0; f < v.frame_count; f++)
-        if (strstr(v.frame_name[f], "the view's colour") != NULL) {
-            *frame = f;
-            return 0;
-        }
-    return -ENOENT;
+    int rc = -ENOENT;
+    if (v != NULL && scan_dir_read_view(dir, view, v, err, sizeof(err)) == 0)
+        for (uint32_t f = 0; rc != 0 && f < v->frame_count; f++)
+            if (strstr(v->frame_name[f], "the view's colour") != NULL) {
+                *frame = f;
+                rc = 0;
+            }
+    free(v);
+    return rc;
 }
 
 /* What a view's thumbnails are made of: its range image's reasons and colours (linear x 255),
@@ -282,15 +289,19 @@ static int thumb_of(const struct view_images *vi, enum report_thumb kind, uint8_
 int report_thumb_png(const char *dir, uint32_t view, enum report_thumb kind, uint8_t **png,
                      size_t *png_len)
 {
-    static uint8_t pixels[3u * REPORT_THUMB_WIDTH * REPORT_THUMB_WIDTH];
+    uint8_t *pixels =
+        malloc(3u * REPORT_THUMB_WIDTH * REPORT_THUMB_WIDTH); /* reentrant: the
+                                                                 web server's threads */
     struct view_images vi;
     uint32_t tw, th;
-    int rc = view_images_read(dir, view, kind == REPORT_THUMB_RAW, &vi);
+    int rc = pixels != NULL ? view_images_read(dir, view, kind == REPORT_THUMB_RAW, &vi) : -ENOMEM;
     if (rc == 0)
         rc = thumb_of(&vi, kind, pixels, &tw, &th);
     if (rc == 0)
         rc = image_encode_png(pixels, tw, th, 3, png, png_len);
-    view_images_free(&vi);
+    if (pixels != NULL)
+        view_images_free(&vi);
+    free(pixels);
     return rc;
 }
 
@@ -329,7 +340,7 @@ static int model_read(const char *dir, struct model *m)
     *m = (struct model){0};
     if (scan_dir_path(path, sizeof(path), dir, -1, "mesh.ply") != 0)
         return -ENAMETOOLONG;
-    FILE *fp = fopen(path, "rb");
+    FILE *fp = file_open_regular(path, "rb");
     if (fp == NULL)
         return -errno;
     while (fgets(line, sizeof(line), fp) != NULL && strcmp(line, "end_header\n") != 0) {

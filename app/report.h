@@ -19,7 +19,7 @@ enum report_thumb {
 };
 
 /** A view's thumbnail as a PNG in memory, made from what its directory keeps (range.bin; the
- *  colour frame for REPORT_THUMB_RAW).
+ *  colour frame for REPORT_THUMB_RAW). Reentrant: threads may ask at once.
  *  @param png  out: the PNG, the caller's to free()
  *  @retval 0 @retval -ENOENT the view has no such data (yet) @retval -EINVAL damaged
  *  @retval -ENOMEM */

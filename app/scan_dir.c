@@ -1,6 +1,7 @@
 /* The scan directory's layout and its small files, read and written in one place. */
 #define _DEFAULT_SOURCE /* flock */
 #include "scan_dir.h"
+#include "file_posix.h"
 #include "reflect.h"
 
 #include "scan.h"
@@ -11,6 +12,7 @@
 
 #include <dirent.h>
 #include <ini.h>
+#include <pthread.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <stddef.h>
@@ -19,6 +21,7 @@
 #include <string.h>
 #include <sys/file.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 int scan_dir_path(char *buf, size_t len, const char *dir, int view, const char *name)
@@ -66,6 +69,8 @@ int scan_dir_find_frame(char *buf, size_t len, const char *dir, uint32_t view, u
             return rc;
         if (stat(buf, &sb) == 0)
             return 0;
+        if (errno != ENOENT && errno != ENOTDIR)
+            return -errno; /* a link loop, no permission: there, but unreadable; said */
     }
     snprintf(name, sizeof(name), "frame_%02u", (unsigned)frame);
     int rc = scan_dir_path(buf, len, dir, (int)view, name);
@@ -94,8 +99,9 @@ static void pattern_name(uint32_t pattern, const struct gray_layout *l, int hdr,
                          size_t len)
 {
     uint32_t k = (pattern - GRAY_PATTERN_FIRST_BIT) / 2u;
-    const char *grey = hdr ? (l->code == GRAY_CODE_XOR04 ? "XOR-04, grey, HDR merged" : "grey, HDR merged")
-                           : (l->code == GRAY_CODE_XOR04 ? "XOR-04, grey" : "grey");
+    const char *grey =
+        hdr ? (l->code == GRAY_CODE_XOR04 ? "XOR-04, grey, HDR merged" : "grey, HDR merged")
+            : (l->code == GRAY_CODE_XOR04 ? "XOR-04, grey" : "grey");
     if (pattern == GRAY_PATTERN_WHITE)
         snprintf(buf, len, hdr ? "white, grey, HDR merged" : "white, RGB (the view's colour)");
     else if (pattern == GRAY_PATTERN_BLACK)
@@ -176,12 +182,11 @@ static struct ini_key view_keys[VIEW_FIXED_KEYS + SCAN_DIR_MAX_FRAMES] = {
     {"capture", "gain_milli", INI_U32, V(gain_milli), 0, 0, 1e6, 0, "0", NULL, "gain"},
 };
 
-static void view_keys_complete(void)
+/* The reason and frame keys are made once, whichever thread reads a view.ini first (the web
+ * server's threads read them too). */
+static char frame_keys[SCAN_DIR_MAX_FRAMES][12];
+static void make_view_keys(void)
 {
-    static char frame_keys[SCAN_DIR_MAX_FRAMES][12];
-    static int done;
-    if (done)
-        return;
     for (unsigned r = 0; r < SCAN_REASON_COUNT; r++)
         view_keys[10 + r] = (struct ini_key){"pixels",
                                              scan_reason_name(r),
@@ -208,7 +213,12 @@ static void view_keys_complete(void)
                                                           NULL,
                                                           "what the frame shows"};
     }
-    done = 1;
+}
+
+static void view_keys_complete(void)
+{
+    static pthread_once_t once = PTHREAD_ONCE_INIT;
+    pthread_once(&once, make_view_keys);
 }
 
 int scan_dir_read_view(const char *dir, uint32_t view, struct scan_dir_view *v, char *err,
@@ -269,9 +279,40 @@ int scan_dir_view_count(const char *dir, uint32_t *views)
 
 int scan_dir_view_complete(const char *dir, uint32_t view)
 {
-    static struct scan_dir_view v; /* large; one caller at a time */
+    struct scan_dir_view *v = malloc(sizeof(*v)); /* large; the web server's threads ask too */
     char err[512];
-    return scan_dir_read_view(dir, view, &v, err, sizeof(err)) == 0;
+    int done = v != NULL && scan_dir_read_view(dir, view, v, err, sizeof(err)) == 0;
+    free(v);
+    return done;
+}
+
+int scan_dir_make_new(const char *parent, char *out, size_t len, const char **name)
+{
+    char stamp[32];
+    time_t now = time(NULL);
+    struct tm tm;
+    gmtime_r(&now, &tm);
+    strftime(stamp, sizeof(stamp), "%Y-%m-%d_%H%M%S", &tm);
+    for (int k = 1; k < 100; k++) {
+        int n = k == 1 ? snprintf(out, len, "%s/%s", parent, stamp)
+                       : snprintf(out, len, "%s/%s-%d", parent, stamp, k);
+        if (n < 0 || (size_t)n >= len)
+            return -ENAMETOOLONG;
+        if (mkdir(out, 0755) == 0) {
+            *name = out + strlen(parent) + 1;
+            return 0;
+        }
+        if (errno != EEXIST)
+            return -errno;
+    }
+    return -EEXIST;
+}
+
+int scan_dir_finished(const char *dir)
+{
+    char path[SCAN_DIR_PATH_MAX];
+    return scan_dir_path(path, sizeof(path), dir, -1, "summary.ini") == 0 &&
+           access(path, F_OK) == 0;
 }
 
 /* ---- frames ---- */
@@ -344,8 +385,11 @@ int scan_dir_write_range(const struct hal_storage *st, const char *dir, uint32_t
     uint32_t valid = 0;
     for (size_t i = 0; i < n; i++)
         valid += v->maps.reason[i] == SCAN_VALID;
-    struct range_header h = {.width = v->width, .height = v->height, .valid_count = valid,
-                             .colour_method = v->colour_method, .angle_mdeg = v->angle_mdeg};
+    struct range_header h = {.width = v->width,
+                             .height = v->height,
+                             .valid_count = valid,
+                             .colour_method = v->colour_method,
+                             .angle_mdeg = v->angle_mdeg};
     memcpy(h.magic, range_magic, sizeof(h.magic));
     int rc = scan_dir_path(path, sizeof(path), dir, (int)view, "range.bin");
     if (rc == 0)
@@ -383,7 +427,7 @@ static int range_open(const char *dir, uint32_t view, char *path, size_t path_le
                       struct range_header *h, FILE **fp)
 {
     int rc = scan_dir_path(path, path_len, dir, (int)view, "range.bin");
-    *fp = rc == 0 ? fopen(path, "rb") : NULL;
+    *fp = rc == 0 ? file_open_regular(path, "rb") : NULL;
     if (*fp == NULL)
         return rc != 0 ? rc : -errno;
     if (fread(h, sizeof(*h), 1, *fp) == 1 && memcmp(h->magic, range_magic, sizeof(h->magic)) == 0)
@@ -399,9 +443,10 @@ static int read_range_points(FILE *fp, const uint8_t *reason, size_t n,
                              void (*each)(void *priv, size_t i, const struct range_point *p),
                              void *priv)
 {
-    static struct range_point chunk[RANGE_CHUNK];
+    struct range_point *chunk = malloc(RANGE_CHUNK * sizeof(*chunk)); /* callers in threads */
     size_t have = 0, next = 0;
-    for (size_t i = 0; i < n; i++) {
+    int rc = chunk != NULL ? 0 : -ENOMEM;
+    for (size_t i = 0; i < n && rc == 0; i++) {
         if (reason[i] != SCAN_VALID) {
             each(priv, i, NULL);
             continue;
@@ -409,12 +454,17 @@ static int read_range_points(FILE *fp, const uint8_t *reason, size_t n,
         if (next == have) {
             have = fread(chunk, sizeof(chunk[0]), RANGE_CHUNK, fp);
             next = 0;
-            if (have == 0)
-                return -EINVAL;
+            if (have == 0) {
+                rc = -EINVAL;
+                break;
+            }
         }
         each(priv, i, &chunk[next++]);
     }
-    return next == have && fgetc(fp) == EOF ? 0 : -EINVAL; /* nothing left over */
+    if (rc == 0 && (next != have || fgetc(fp) != EOF))
+        rc = -EINVAL; /* nothing left over */
+    free(chunk);
+    return rc;
 }
 
 /* A point into the firmware's buffers (scan_dir_read_range). */
@@ -620,7 +670,7 @@ int scan_dir_read_pose(const char *dir, uint32_t view, struct frame_xform *pose)
     double origin[3];
     int have_rot = 0, have_origin = 0;
     int rc = scan_dir_path(path, sizeof(path), dir, (int)view, "registration.ini");
-    FILE *f = rc == 0 ? fopen(path, "r") : NULL;
+    FILE *f = rc == 0 ? file_open_regular(path, "r") : NULL;
     if (f == NULL)
         return rc != 0 ? rc : -errno;
     while (fgets(line, sizeof(line), f) != NULL) {
@@ -635,7 +685,7 @@ int scan_dir_read_pose(const char *dir, uint32_t view, struct frame_xform *pose)
 int scan_dir_copy_file(const struct hal_storage *st, const char *from, const char *to)
 {
     static char buf[1 << 16]; /* config and calibration files are small */
-    FILE *f = fopen(from, "rb");
+    FILE *f = file_open_regular(from, "rb");
     if (f == NULL)
         return -errno;
     size_t n = fread(buf, 1, sizeof(buf), f);

@@ -53,7 +53,8 @@ int scan_dir_frame_path(char *buf, size_t len, const char *dir, uint32_t view, u
 
 /** Path of the file frame @p frame of view @p view is kept in, whatever its format.
  *  @retval 0 @retval -ENOENT none (@p buf: the frame's path without an ending)
- *  @retval -ENAMETOOLONG */
+ *  @retval -ENAMETOOLONG @retval -errno there but not to be looked at (-ELOOP a link loop,
+ *  -EACCES; @p buf: that path) */
 int scan_dir_find_frame(char *buf, size_t len, const char *dir, uint32_t view, uint32_t frame);
 
 /** Describe every frame a view of @p params and @p calib takes, in order, into
@@ -80,8 +81,18 @@ int scan_dir_read_view_file(const char *path, uint32_t view, struct scan_dir_vie
  *  @retval 0 @retval -ENOENT no config.ini: not a scan directory */
 int scan_dir_view_count(const char *dir, uint32_t *views);
 
-/** @retval 1 when view @p view finished (its view.ini is there and reads) */
+/** @retval 1 when view @p view finished (its view.ini is there and reads). Thread-safe. */
 int scan_dir_view_complete(const char *dir, uint32_t view);
+
+/** A new scan's folder under @p parent (which exists), named by when it began, UTC
+ *  (2026-12-03_080907, then -2, -3 ... in the same second), made at once so that no two scans,
+ *  nor a scan and the web server, take the same. @param out  its path @param name  out: its
+ *  name, within @p out @retval 0 @retval -EEXIST a hundred this second @retval -errno */
+int scan_dir_make_new(const char *parent, char *out, size_t len, const char **name);
+
+/** @retval 1 when the scan in @p dir finished: every output written (summary.ini is written
+ *  last; process in place removes it first) */
+int scan_dir_finished(const char *dir);
 
 /** Keep frame @p frame of view @p view (8 bits, @p channels 1 or 3) in @p format, atomically.
  *  @retval 0 @retval -errno */
@@ -90,8 +101,9 @@ int scan_dir_write_frame(const struct hal_storage *st, const char *dir, uint32_t
                          uint32_t channels, enum scan_frame_format format);
 
 /** Read frame @p frame of view @p view into @p pixels as @p channels (1 or 3), whatever format
- *  it was kept in; it must be 8 bits without alpha, @p width x @p height. @p err names the file and says what is
- *  wrong (libpng's own words for a damaged file). @retval 0 @retval -ENOENT @retval -EINVAL */
+ *  it was kept in; it must be 8 bits without alpha, @p width x @p height. @p err names the file and
+ * says what is wrong (libpng's own words for a damaged file). @retval 0 @retval -ENOENT @retval
+ * -EINVAL */
 int scan_dir_read_frame(const char *dir, uint32_t view, uint32_t frame, uint8_t *pixels,
                         size_t capacity, uint32_t width, uint32_t height, uint32_t channels,
                         char *err, size_t err_len);

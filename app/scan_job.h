@@ -9,8 +9,8 @@
 #include "scan_dir.h"
 
 struct scan_job_opts {
-    int json;           /**< one JSON status line per event instead of the terminal display */
-    const char *out_dir; /**< results go here (process: default the scan directory itself) */
+    int json;                /**< one JSON status line per event instead of the terminal display */
+    const char *out_dir;     /**< results go here (process: default the scan directory itself) */
     const char *config_path; /**< process: settings from this file instead of the scan's own
                                   config.ini (e.g. another [colour] method); NULL: the scan's */
     int clear_alarm; /**< resume: clear the turntable's alarm before homing (the operator has
@@ -26,9 +26,13 @@ int scan_job_live(const struct hal *hal, const struct app_config *cfg,
 
 /** Load the settings of the interrupted scan in @p scan_dir: its config (or @p config_path,
  *  when the scan's own names files relative to where it was) and always its kept calibration.
+ *  @p config_path may change how views are processed, never how they are taken
+ *  (config_plan_differs names the key). @param capturing  1: for a resume (the colour method,
+ *  whose frames it takes, is kept too)
  *  @retval 0 @retval -errno with the message in @p err */
-int scan_job_load_settings(const char *scan_dir, const char *config_path, struct app_config *cfg,
-                           struct scan_calib *calib, char *err, size_t err_len);
+int scan_job_load_settings(const char *scan_dir, const char *config_path, int capturing,
+                           struct app_config *cfg, struct scan_calib *calib, char *err,
+                           size_t err_len);
 
 /** Take the views of the scan in @p scan_dir that did not finish (no view.ini: a view is
  *  complete only once its view.ini is on disk), from the first unfinished one on, homing the

@@ -70,9 +70,8 @@ static int run(uint32_t width, uint32_t height)
     size_t n = (size_t)width * height;
 
     int cv_count = 0;
-    long bad = opencv_graycode_pattern_mismatches((int)t.calib.proj_width,
-                                                  (int)t.calib.proj_height, &cv_count, our_lit,
-                                                  &layout);
+    long bad = opencv_graycode_pattern_mismatches((int)t.calib.proj_width, (int)t.calib.proj_height,
+                                                  &cv_count, our_lit, &layout);
     uint8_t *reason = malloc(n);
     struct decode_maps maps;
     if (reason == NULL)
@@ -94,11 +93,10 @@ static int run(uint32_t width, uint32_t height)
     decode_pixels(reason, &maps); /* maps without the neighbour check, as OpenCV's */
     uint16_t *cv_col = malloc(n * 2), *cv_row = malloc(n * 2);
     uint8_t *cv_ok = malloc(n);
-    double cv_ms = opencv_graycode_decode(frames + GRAY_PATTERN_FIRST_BIT, (int)patterns,
-                                          (int)width, (int)height, (int)t.calib.proj_width,
-                                          (int)t.calib.proj_height,
-                                          (int)t.cfg.scan.min_bit_diff_dn + 1, cv_col, cv_row,
-                                          cv_ok);
+    double cv_ms =
+        opencv_graycode_decode(frames + GRAY_PATTERN_FIRST_BIT, (int)patterns, (int)width,
+                               (int)height, (int)t.calib.proj_width, (int)t.calib.proj_height,
+                               (int)t.cfg.scan.min_bit_diff_dn + 1, cv_col, cv_row, cv_ok);
     const struct decode_maps *m = &maps;
     size_t both = 0, differ = 0, ours_valid = 0, cv_valid = 0;
     for (size_t i = 0; i < n; i++) {
@@ -113,8 +111,7 @@ static int run(uint32_t width, uint32_t height)
     printf("| %ux%u | %u | %.1f | %.2f | %.2f | %.2f | **%.0fx** | **%.2fx** | %zu | %zu | %zu | "
            "%zu | %ld |\n",
            (unsigned)width, (unsigned)height, (unsigned)patterns, cv_ms, ours_ms, ours_full_ms,
-           floor_ms, cv_ms / ours_ms, ours_ms / floor_ms, cv_valid, ours_valid, both, differ,
-           bad);
+           floor_ms, cv_ms / ours_ms, ours_ms / floor_ms, cv_valid, ours_valid, both, differ, bad);
     free(cv_col);
     free(cv_row);
     free(cv_ok);

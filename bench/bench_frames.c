@@ -109,7 +109,9 @@ static size_t png_up_rle(const struct frame *f, uint8_t *o, size_t c)
 static size_t spng_encode(const struct frame *f, uint8_t *out, size_t cap)
 {
     spng_ctx *ctx = spng_ctx_new(SPNG_CTX_ENCODER);
-    struct spng_ihdr ihdr = {.width = width, .height = height, .bit_depth = 8,
+    struct spng_ihdr ihdr = {.width = width,
+                             .height = height,
+                             .bit_depth = 8,
                              .color_type = f->channels == 3 ? SPNG_COLOR_TYPE_TRUECOLOR
                                                             : SPNG_COLOR_TYPE_GRAYSCALE};
     size_t len = 0;
@@ -219,8 +221,8 @@ static int render_view(const char *config, struct test_rig *t)
         struct sim_sources src = {.projector_on = !colour || k == 0,
                                   .pattern_index = colour ? 0 : i,
                                   .lights_mask = !colour || k == 0 ? 0
-                                                 : k == 1      ? 0xfu
-                                                               : 1u << (k - 2),
+                                                 : k == 1          ? 0xfu
+                                                                   : 1u << (k - 2),
                                   .exposure_us = t->cfg.camera.exposure_us,
                                   .gain_milli = 1000};
         sim_rig_render(rig, &src, i, rgb);
@@ -271,8 +273,8 @@ int main(int argc, char **argv)
                 if (encoded_len[i] == 0 ||
                     codecs[c].decode(encoded[i], encoded_len[i], &frames[i]) != 0 ||
                     memcmp(decoded, frames[i].pixels, n) != 0) {
-                    fprintf(stderr, "%s: frame %u does not come back as it was\n",
-                            codecs[c].name, (unsigned)i);
+                    fprintf(stderr, "%s: frame %u does not come back as it was\n", codecs[c].name,
+                            (unsigned)i);
                     return 1;
                 }
             }

@@ -18,6 +18,7 @@
 
 #define REPEAT 5
 
+static struct reg_ctx reg; /* the registration the view is kept for */
 static double now_ms(void)
 {
     struct timespec ts;
@@ -43,19 +44,20 @@ __attribute__((noinline)) void process_view_once(struct test_rig *t, const uint8
     /* the stages one by one, as scan_finish_view runs them (no colour: grey zero) */
     static uint8_t reason[HAL_MAX_PIXELS], rgb[HAL_MAX_PIXELS * 3];
     static float confidence[HAL_MAX_PIXELS];
-    struct scan_view view = {.width = t->cfg.scan.width, .height = t->cfg.scan.height,
-                             .rgb = rgb, .confidence = confidence};
+    struct scan_view view = {.width = t->cfg.scan.width,
+                             .height = t->cfg.scan.height,
+                             .rgb = rgb,
+                             .confidence = confidence};
     decode_finish(reason, &view.maps);
     s[2] = now_ms();
     refine_columns(&view.maps, (int)t->cfg.scan.refine, &view.column);
     s[3] = now_ms();
     tri_range_image(&t->calib, view.width, view.height, view.column, reason, &view.range);
     s[4] = now_ms();
-    tri_normals(&view.range, reason, t->cfg.scan.normal_radius_px,
-                t->cfg.scan.max_depth_jump_mm);
+    tri_normals(&view.range, reason, t->cfg.scan.normal_radius_px, t->cfg.scan.max_depth_jump_mm);
     s[5] = now_ms();
     /* the joint registration keeps each view's samples now and solves once at the end */
-    scan_keep_for_registration(0, &view);
+    scan_keep_for_registration(&reg, 0, &view);
     s[6] = now_ms();
     struct frame_xform pose;
     frame_object_from_camera(&t->calib, view.angle_mdeg, &pose);
@@ -89,8 +91,8 @@ int main(int argc, char **argv)
     }
     double t_render = now_ms() - t0;
     double best[8] = {1e9, 1e9, 1e9, 1e9, 1e9, 1e9, 1e9, 1e9};
-    if (fusion_begin(&t.cfg.fusion) != 0 ||
-        reg_begin(&t.cfg.registration, &t.calib, t.cfg.views, 1, rig->width, rig->height) != 0)
+    if (fusion_begin(&t.cfg.fusion) != 0 || reg_begin(&reg, &t.cfg.registration, &t.calib,
+                                                      t.cfg.views, 1, rig->width, rig->height) != 0)
         return 1;
     int repeat = getenv("BENCH_REPEAT") ? atoi(getenv("BENCH_REPEAT")) : REPEAT;
     for (int r = 0; r < repeat; r++) {
@@ -105,8 +107,13 @@ int main(int argc, char **argv)
     printf("| simulator: ray casting (once per angle) | %.1f |\n", t_geometry);
     printf("| simulator: rendering %u frames | %.1f |\n", (unsigned)count, t_render);
     const char *names[8] = {"camera RGB to grey (22 frames; a mono camera skips it)",
-                            "decode", "sub-stripe refinement", "triangulation", "normals",
-                            "registration (samples kept)", "fusion (TSDF)", "point cloud PLY write"};
+                            "decode",
+                            "sub-stripe refinement",
+                            "triangulation",
+                            "normals",
+                            "registration (samples kept)",
+                            "fusion (TSDF)",
+                            "point cloud PLY write"};
     double total = 0.0;
     for (int k = 0; k < 8; k++) {
         printf("| firmware: %s | %.1f |\n", names[k], best[k]);

@@ -13,15 +13,15 @@ struct tt_client_config; /* hal/modbus/turntable_modbus.h */
 
 /** The devices' settings, as the config file gave them. */
 struct board_config {
-    const char *config_path; /**< the config file: named in messages; the simulator resolves
-                                  relative paths against its directory */
-    const char *camera_backend;              /**< sim | v4l2 | libcamera */
+    const char *config_path;    /**< the config file: named in messages; the simulator resolves
+                                     relative paths against its directory */
+    const char *camera_backend; /**< sim | v4l2 | libcamera */
     const struct hal_camera_config *camera;
     const struct hal_gpio_config *gpio;
     const struct tt_client_config *turntable;
-    const struct scan_params *scan;          /**< the simulator shows the view's patterns */
-    const char *projector_backend;           /**< gpio | drm */
-    const char *projector_device;            /**< the DRM device (drm) */
+    const struct scan_params *scan; /**< the simulator shows the view's patterns */
+    const char *projector_backend;  /**< gpio | drm */
+    const char *projector_device;   /**< the DRM device (drm) */
     const struct sim_config *sim;
 };
 
@@ -50,16 +50,17 @@ struct board_target {
     const uint8_t *sheet;               /**< board: the printed sheet, grey, row-major */
     uint32_t sheet_width, sheet_height; /**< pixels */
     double sheet_px_per_mm;
-    double thickness_mm; /**< board: the plate under the sheet */
-    double tilt_deg;     /**< board: from upright (facing the camera), leaning back; 90 flat */
-    double diameter_mm;  /**< sphere */
+    double thickness_mm;   /**< board: the plate under the sheet */
+    double tilt_deg;       /**< board: from upright (facing the camera), leaning back; 90 flat */
+    double diameter_mm;    /**< sphere */
     double position_mm[2]; /**< on the table at angle 0 (x towards the camera, y to its right) */
-    uint32_t pass;       /**< object: the scan's pass (1: as it stands; 2: laid another way,
-                              which the simulator does by [sim] second_pass_pose) */
+    uint32_t pass;         /**< object: the scan's pass (1: as it stands; 2: laid another way,
+                                which the simulator does by [sim] second_pass_pose) */
 };
 
 /** The person's part of a calibration step, or of a scan's second pass. The simulator places
- *  the target itself; on a rig the person must be asked. @retval 0 placed @retval -ENOSYS ask the person
+ *  the target itself; on a rig the person must be asked. @retval 0 placed @retval -ENOSYS ask the
+ * person
  *  @retval -errno (with @p err) */
 int board_place_target(struct hal *hal, const struct board_target *target, char *err,
                        size_t err_len);
@@ -82,7 +83,7 @@ typedef void (*board_selftest_row)(void *ctx, const char *device, const char *wh
  *  the configured size, the GPIO lines requested, the turntable's status), releasing each
  *  before the next, so that nothing stays requested. Reports every device through @p row.
  *  @retval 0 all work @retval -ENODEV at least one does not */
-int board_selftest(struct hal *hal, const struct board_config *cfg,
-                   const struct scan_calib *calib, board_selftest_row row, void *ctx);
+int board_selftest(struct hal *hal, const struct board_config *cfg, const struct scan_calib *calib,
+                   board_selftest_row row, void *ctx);
 
 #endif

@@ -84,10 +84,9 @@ static const struct hal_gpio_ops display_ops = {
     .safe_state = display_safe_state,
 };
 
-int board_display_open(struct board_display *d, const char *device,
-                       const struct scan_params *scan, const struct scan_calib *calib,
-                       const struct hal_gpio *lights, struct hal_gpio *out, char *err,
-                       size_t err_len)
+int board_display_open(struct board_display *d, const char *device, const struct scan_params *scan,
+                       const struct scan_calib *calib, const struct hal_gpio *lights,
+                       struct hal_gpio *out, char *err, size_t err_len)
 {
     memset(d, 0, sizeof(*d));
     d->lights = *lights;

@@ -19,10 +19,9 @@ struct board_display {
 /** Take the display at the calibration's projector size, showing black, and give a GPIO
  *  interface whose projector lines drive it and whose other lines go to @p lights.
  *  @retval 0 ok @retval -errno with @p err saying why (no display, no such mode) */
-int board_display_open(struct board_display *d, const char *device,
-                       const struct scan_params *scan, const struct scan_calib *calib,
-                       const struct hal_gpio *lights, struct hal_gpio *out, char *err,
-                       size_t err_len);
+int board_display_open(struct board_display *d, const char *device, const struct scan_params *scan,
+                       const struct scan_calib *calib, const struct hal_gpio *lights,
+                       struct hal_gpio *out, char *err, size_t err_len);
 
 /** Black, the display given back. */
 void board_display_close(struct board_display *d);

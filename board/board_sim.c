@@ -25,9 +25,9 @@ static struct {
     struct gpio_sim gpio;
     struct clock_sim clock;
     struct camera_sim camera;
-    struct tt_server server;  /* the simulated controller, a Modbus slave in its own thread */
-    struct pty_link link;     /* RTU: the serial cable between client and controller */
-    struct tt_client client;  /* the scanner's real Modbus client */
+    struct tt_server server; /* the simulated controller, a Modbus slave in its own thread */
+    struct pty_link link;    /* RTU: the serial cable between client and controller */
+    struct tt_client client; /* the scanner's real Modbus client */
     int server_open, link_open;
     int ready;
 } sim;
@@ -50,8 +50,8 @@ static int start_turntable(struct hal *hal, const struct board_config *cfg, char
     struct tt_client_config cc = *cfg->turntable;
     int rc;
     if (strcmp(cc.transport, "tcp") == 0) {
-        rc = tt_server_open_tcp(&sim.server, cc.host, (int)cc.port, clock_sim_now, &sim.clock,
-                                err, err_len);
+        rc = tt_server_open_tcp(&sim.server, cc.host, (int)cc.port, clock_sim_now, &sim.clock, err,
+                                err_len);
         cc.port = (uint32_t)sim.server.port;
     } else {
         rc = pty_link_open(&sim.link, err, err_len);
@@ -69,8 +69,7 @@ static int start_turntable(struct hal *hal, const struct board_config *cfg, char
     sim.server.ctrl.angle_error_mdeg = (int32_t)cfg->sim->table_angle_error_mdeg;
     rc = tt_server_start(&sim.server);
     if (rc == 0)
-        rc = tt_client_open(&sim.client, &cc, &hal->clock, hal->log, &hal->turntable, err,
-                            err_len);
+        rc = tt_client_open(&sim.client, &cc, &hal->clock, hal->log, &hal->turntable, err, err_len);
     if (rc != 0)
         return rc;
     sim.camera.table_angle = table_angle;
@@ -196,8 +195,10 @@ static int write_truth(const struct hal *hal, const char *dir)
         goto out_free;
     /* where the table really stood (a table with [sim] table_angle_error_mdeg misses) */
     char text[128];
-    int len = snprintf(text, sizeof(text), "; the table's true angle for this view\n[truth]\n"
-                       "angle_mdeg = %d\n", (int)rig->truth_angle_mdeg);
+    int len = snprintf(text, sizeof(text),
+                       "; the table's true angle for this view\n[truth]\n"
+                       "angle_mdeg = %d\n",
+                       (int)rig->truth_angle_mdeg);
     snprintf(path, sizeof(path), "%s/truth_angle.ini", dir);
     rc = hal_storage_write_file(&hal->storage, path, text, (size_t)len);
 out_free:

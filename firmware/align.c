@@ -9,12 +9,12 @@
 #include <errno.h>
 #include <string.h>
 
-#define SEARCH_POINTS 1200u  /* second-pass points that score an orientation */
-#define SEARCH_AXES 72u      /* rotation axes, spread over the sphere */
-#define SEARCH_ANGLES 6u     /* 30, 60, ... 180 degrees about each */
-#define REFINED 8u           /* best orientations refined by ICP */
-#define FIELD_CELL_MM 2.0    /* the nearest-point field's cell, grown to fit ALIGN_MAX_CELLS */
-#define SCORE_CAP_MM 10.0    /* a point farther than this from the first pass counts this */
+#define SEARCH_POINTS 1200u /* second-pass points that score an orientation */
+#define SEARCH_AXES 72u     /* rotation axes, spread over the sphere */
+#define SEARCH_ANGLES 6u    /* 30, 60, ... 180 degrees about each */
+#define REFINED 8u          /* best orientations refined by ICP */
+#define FIELD_CELL_MM 2.0   /* the nearest-point field's cell, grown to fit ALIGN_MAX_CELLS */
+#define SCORE_CAP_MM 10.0   /* a point farther than this from the first pass counts this */
 
 static float pts[2][ALIGN_MAX_POINTS][3], nrm[2][ALIGN_MAX_POINTS][3];
 static uint32_t npts[2];

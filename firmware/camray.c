@@ -9,7 +9,6 @@
 /* x/z and y/z of each pixel's ray; float is ample (a 1e-7 relative error is 0.06 um at 600 mm) */
 static float ray_xy[HAL_MAX_PIXELS * 2];
 static struct scan_calib table_calib; /* the calibration the table belongs to */
-static const struct scan_calib *table_owner;
 static int table_ready;
 
 static vec3 pinhole_ray(const struct scan_calib *c, double x, double y)
@@ -17,14 +16,19 @@ static vec3 pinhole_ray(const struct scan_calib *c, double x, double y)
     return v3((x - c->cam_cx_px) / c->cam_fx_px, (y - c->cam_cy_px) / c->cam_fy_px, 1.0);
 }
 
-int camray_prepare(const struct scan_calib *c)
+struct camray camray_lookup(const struct scan_calib *c)
 {
-    if (lens_is_pinhole(c->cam_dist))
+    struct camray r = {NULL};
+    if (!lens_is_pinhole(c->cam_dist) && table_ready && memcmp(&table_calib, c, sizeof(*c)) == 0)
+        r.xy = ray_xy;
+    return r;
+}
+
+int camray_prepare(const struct scan_calib *c, struct camray *out)
+{
+    *out = camray_lookup(c);
+    if (lens_is_pinhole(c->cam_dist) || out->xy != NULL)
         return 0;
-    if (table_ready && memcmp(&table_calib, c, sizeof(*c)) == 0) {
-        table_owner = c;
-        return 0;
-    }
     if ((size_t)c->cam_width * c->cam_height > HAL_MAX_PIXELS)
         return -EINVAL;
     table_ready = 0;
@@ -40,18 +44,18 @@ int camray_prepare(const struct scan_calib *c)
         }
     }
     table_calib = *c;
-    table_owner = c;
     table_ready = 1;
+    out->xy = ray_xy;
     return 0;
 }
 
-vec3 camray_at(const struct scan_calib *c, uint32_t x, uint32_t y)
+vec3 camray_at(const struct scan_calib *c, struct camray rays, uint32_t x, uint32_t y)
 {
     if (lens_is_pinhole(c->cam_dist))
         return pinhole_ray(c, x, y);
-    if (table_ready && c == table_owner) {
+    if (rays.xy != NULL) {
         size_t i = (size_t)y * c->cam_width + x;
-        return v3(ray_xy[2 * i], ray_xy[2 * i + 1], 1.0);
+        return v3(rays.xy[2 * i], rays.xy[2 * i + 1], 1.0);
     }
     vec3 d = pinhole_ray(c, x, y);
     double ux = d.x, uy = d.y;

@@ -252,6 +252,7 @@ static double pixel_estimate(const struct frame_ctx *f, const struct scan_calib 
 /* What fit_pixel needs across the pixels of a pass: the model (NULL before it is fitted) and,
  * while the pool collects, every how many valid pixels a sample is taken. */
 struct fit_state {
+    struct reflect_pool *pool; /* where samples go while it collects; NULL: no reflectance */
     const struct reflect_model *model;
     int collect;
     uint32_t stride, seen;
@@ -279,8 +280,9 @@ static vec3 lobe_normal(const struct decode_maps *m, const struct tri_range *r, 
 
 /* One sample for the pool: pixel at @p p (normal @p nn) with each used light's white-referenced
  * signal and its angles (reflect.h). */
-static void add_sample(const struct colour_params *prm, const struct scan_calib *c, vec3 p, vec3 nn,
-                       const struct light_signals *ls, const double rho0[3])
+static void add_sample(struct reflect_pool *pool, const struct colour_params *prm,
+                       const struct scan_calib *c, vec3 p, vec3 nn, const struct light_signals *ls,
+                       const double rho0[3])
 {
     struct reflect_obs o;
     memset(&o, 0, sizeof(o));
@@ -297,7 +299,7 @@ static void add_sample(const struct colour_params *prm, const struct scan_calib 
         for (int ch = 0; ch < 3; ch++)
             o.signal[l][ch] = (float)(ls->lit[l][ch] * prm->white_scale[ch]);
     }
-    reflect_add(&o);
+    reflect_add(pool, &o);
 }
 
 /* [colour] method = fit at valid pixel i: before the lobes are known, the multi estimate (and a
@@ -329,7 +331,7 @@ static void fit_pixel(const struct frame_ctx *f, const struct scan_calib *c, str
         for (int ch = 0; ch < 3; ch++)
             out[ch] = albedo_byte(rho0[ch]);
         if (fs->collect && !relaxed && fs->seen++ % fs->stride == 0)
-            add_sample(prm, c, p, lobe_normal(m, r, i), &ls, rho0);
+            add_sample(fs->pool, prm, c, p, lobe_normal(m, r, i), &ls, rho0);
         return;
     }
     const struct reflect_cluster *cl = &fs->model->cluster[reflect_cluster_of(fs->model, rho0)];
@@ -371,13 +373,15 @@ static void fit_pixel(const struct frame_ctx *f, const struct scan_calib *c, str
 /* One pass over the pixels with the Ca of @p f: albedo and confidence of every valid pixel. */
 static void compute_pass(const struct frame_ctx *f, const struct scan_calib *c,
                          const struct decode_maps *m, const struct tri_range *r,
-                         const uint8_t *white, uint8_t *albedo, float *confidence, int last)
+                         const uint8_t *white, uint8_t *albedo, float *confidence,
+                         struct reflect_pool *pool, int last)
 {
     const struct colour_params *prm = f->prm;
     size_t n = (size_t)m->width * m->height;
     vec3 proj = v3_scale(m3_tmul(c->proj_rot, v3_from(c->proj_trans_mm)), -1.0);
-    struct fit_state fs = {reflect_model(), last && reflect_collecting(),
-                           reflect_stride(r->valid_count), 0};
+    struct fit_state fs = {pool, pool != NULL ? reflect_model(pool) : NULL,
+                           pool != NULL && last && reflect_collecting(pool),
+                           pool != NULL ? reflect_stride(pool, r->valid_count) : UINT32_MAX, 0};
     for (size_t i = 0; i < n; i++) {
         if (prm->method == COLOUR_NONE || m->reason[i] != SCAN_VALID) {
             memcpy(&albedo[3 * i], &white[3 * i], 3); /* the raw colour */
@@ -444,7 +448,8 @@ static void fit_ambient(struct frame_ctx *f, const struct decode_maps *m, const 
 
 int colour_compute(const struct colour_params *prm, const struct scan_calib *c,
                    const struct decode_maps *m, const struct tri_range *r, const uint8_t *white,
-                   const uint8_t *const *lights, uint8_t *albedo, float *confidence)
+                   const uint8_t *const *lights, uint8_t *albedo, float *confidence,
+                   struct reflect_pool *pool)
 {
     static struct frame_ctx f; /* static: the firmware keeps large state off the stack */
     static struct colour_layout lay;
@@ -463,12 +468,12 @@ int colour_compute(const struct colour_params *prm, const struct scan_calib *c,
             channel_offset(m, lights[k], f.ca_channel[k]);
     }
     int two = prm->method != COLOUR_NONE && prm->ca == COLOUR_CA_ALBEDO;
-    compute_pass(&f, c, m, r, white, albedo, confidence, !two);
+    compute_pass(&f, c, m, r, white, albedo, confidence, pool, !two);
     if (!two)
         return 0;
     for (uint32_t k = 0; k < lay.count; k++)
         if (lights[k] != NULL && lay.dark_of[k] == k)
             fit_ambient(&f, m, albedo, confidence, k);
-    compute_pass(&f, c, m, r, white, albedo, confidence, 1);
+    compute_pass(&f, c, m, r, white, albedo, confidence, pool, 1);
     return 0;
 }

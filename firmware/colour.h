@@ -13,6 +13,8 @@
 #include "decode.h"
 #include "tri.h"
 
+struct reflect_pool;
+
 /** Light frames after the Gray-code patterns: dark, all lights, then each light alone. */
 #define COLOUR_FRAME_DARK 0u
 #define COLOUR_FRAME_ALL 1u
@@ -46,10 +48,12 @@ void colour_layout(const struct colour_params *p, uint32_t light_count, struct c
  *  colour_layout() order, NULL entries allowed when the method does not need them. A pixel
  *  with only a weak estimate (grazing or saturated light) gets it with confidence 0 (used where
  *  no view has better); one with none gets colour 0 and COLOUR_NO_ESTIMATE.
+ *  @param pool  method fit: the reflectance (its model, once fitted, is taken off each light;
+ *  while it collects, the last pass adds samples to it); NULL: none (fit gives multi's estimate)
  *  @retval 0 @retval -EINVAL a needed frame missing */
 int colour_compute(const struct colour_params *p, const struct scan_calib *calib,
                    const struct decode_maps *maps, const struct tri_range *range,
                    const uint8_t *white, const uint8_t *const *lights, uint8_t *albedo_rgb,
-                   float *confidence);
+                   float *confidence, struct reflect_pool *pool);
 
 #endif

@@ -138,7 +138,7 @@ static void accumulate(uint32_t first, uint32_t bits, size_t start, size_t len,
     for (size_t i = 0; i < len; i++) {
         uint16_t g = (uint16_t)(((unsigned)plane_hi[i] << lo_bits) | plane_lo[i]);
         g ^= (uint16_t)(-((g >> 1) & 1u) & xor_mask); /* XOR-04: the base bit off again */
-        g ^= (uint16_t)(g >> 1); /* Gray to binary: prefix XOR */
+        g ^= (uint16_t)(g >> 1);                      /* Gray to binary: prefix XOR */
         g ^= (uint16_t)(g >> 2);
         g ^= (uint16_t)(g >> 4);
         g ^= (uint16_t)(g >> 8);
@@ -350,8 +350,8 @@ static void resolve_unclear(uint8_t *reason)
                 !nearest_reading(dec.layout.col_bits, column_map[i], unclear_col[i], ref_col,
                                  dec.proj_width, &col) ||
                 (rows && (!neighbourhood_code(reason, row_map, x, y, &ref_row) ||
-                          !nearest_reading(dec.layout.row_bits, row_map[i], unclear_row[i],
-                                           ref_row, dec.proj_height, &row))))
+                          !nearest_reading(dec.layout.row_bits, row_map[i], unclear_row[i], ref_row,
+                                           dec.proj_height, &row))))
                 continue;
             if (pending) { /* not a reference of this pass: its maps can change now */
                 column_map[i] = col;
@@ -413,9 +413,8 @@ static void check_neighbours(uint8_t *reason)
             if (valid - agree > agree || agree == 0 ||
                 !neighbourhood_code(reason, column_map, x, y, &ref_col) ||
                 fabs(column_map[i] - ref_col) > RESOLVE_FIT_COLUMNS ||
-                (dec.layout.row_bits > 0 &&
-                 (!neighbourhood_code(reason, row_map, x, y, &ref_row) ||
-                  fabs(row_map[i] - ref_row) > RESOLVE_FIT_COLUMNS)))
+                (dec.layout.row_bits > 0 && (!neighbourhood_code(reason, row_map, x, y, &ref_row) ||
+                                             fabs(row_map[i] - ref_row) > RESOLVE_FIT_COLUMNS)))
                 scratch[i] = SCAN_INCONSISTENT;
         }
     }
@@ -449,9 +448,9 @@ static uint16_t reference_bits(const uint8_t *const *frames, uint32_t code, uint
     return (uint16_t)gray_code_value(code, bits, word);
 }
 
-void decode_reference(const struct scan_params *p, const struct gray_layout *l,
-                      uint32_t proj_width, uint32_t proj_height, const uint8_t *const *frames,
-                      size_t n, uint16_t *column, uint16_t *row, uint8_t *reason)
+void decode_reference(const struct scan_params *p, const struct gray_layout *l, uint32_t proj_width,
+                      uint32_t proj_height, const uint8_t *const *frames, size_t n,
+                      uint16_t *column, uint16_t *row, uint8_t *reason)
 {
     for (size_t i = 0; i < n; i++) {
         unsigned unclear_c = 0, unclear_r = 0;
@@ -467,9 +466,9 @@ void decode_reference(const struct scan_params *p, const struct gray_layout *l,
         if (row != NULL)
             row[i] = r;
         int out = column[i] >= proj_width || (l->row_bits > 0 && r >= proj_height);
-        reason[i] = classify(p, white, black, sat,
-                             unclear_count(unclear_c, gray_code_xor_mask(l->code, l->col_bits)),
-                             unclear_count(unclear_r, gray_code_xor_mask(l->code, l->row_bits)),
-                             out);
+        reason[i] =
+            classify(p, white, black, sat,
+                     unclear_count(unclear_c, gray_code_xor_mask(l->code, l->col_bits)),
+                     unclear_count(unclear_r, gray_code_xor_mask(l->code, l->row_bits)), out);
     }
 }

@@ -45,11 +45,12 @@ int fusion_begin(const struct fusion_params *p)
         return rc;
     fusion_vol.p = *p;
     fusion_vol.origin = v3(-p->radius_mm, -p->radius_mm, p->bottom_mm);
-    memset(fusion_grid, 0, (size_t)fusion_vol.dims[0] * fusion_vol.dims[1] * fusion_vol.dims[2] * sizeof(fusion_grid[0]));
+    memset(fusion_grid, 0,
+           (size_t)fusion_vol.dims[0] * fusion_vol.dims[1] * fusion_vol.dims[2] *
+               sizeof(fusion_grid[0]));
     mc_table_build();
     return 0;
 }
-
 
 /* The rectangle of pixels a view's work covers: its valid pixels and a ring of one pixel
  * around them (within the image), x0 <= x < x1, y0 <= y < y1. The object fills a part of the
@@ -124,6 +125,7 @@ static int pixel_weights(const struct scan_calib *c, const struct decode_maps *m
                          const struct tri_range *r)
 {
     const double fade = fusion_vol.p.edge_fade_px > 0 ? (double)fusion_vol.p.edge_fade_px : 1.0;
+    const struct camray rays = camray_lookup(c); /* the table, where it is this calibration's */
     memset(weight_map, 0, (size_t)m->width * m->height * sizeof(weight_map[0]));
     if (!find_rect(m))
         return 0;
@@ -133,7 +135,7 @@ static int pixel_weights(const struct scan_calib *c, const struct decode_maps *m
             size_t i = (size_t)y * m->width + x;
             if (m->reason[i] != SCAN_VALID)
                 continue;
-            vec3 ray = v3_norm(camray_at(c, x, y));
+            vec3 ray = v3_norm(camray_at(c, rays, x, y));
             vec3 n = v3(r->normal[3 * i], r->normal[3 * i + 1], r->normal[3 * i + 2]);
             double head_on = -v3_dot(n, ray), z = r->xyz_mm[3 * i + 2];
             double w = head_on * (600.0 / z) * (600.0 / z) * fmin(1.0, edge_dist[i] / fade);
@@ -149,8 +151,8 @@ static int pixel_weights(const struct scan_calib *c, const struct decode_maps *m
  * x COLOUR_WEIGHT_SCALE. */
 static void fuse_colour(struct voxel *vx, double cw, const uint8_t *rgb)
 {
-    double old_cw = vx->colour_weight > COLOUR_BEST_EFFORT ? vx->colour_weight / COLOUR_WEIGHT_SCALE
-                                                           : 0.0;
+    double old_cw =
+        vx->colour_weight > COLOUR_BEST_EFFORT ? vx->colour_weight / COLOUR_WEIGHT_SCALE : 0.0;
     double new_cw = old_cw + cw;
     if (new_cw <= 0.0) {
         memcpy(vx->rgb, rgb, 3);
@@ -315,8 +317,8 @@ int fusion_integrate(const struct scan_calib *c, const struct frame_xform *obj_f
                 while (bx < nb[0] && marks[bx])
                     bx++;
                 uint32_t x1 = bx * BLOCK < dims[0] ? bx * BLOCK : dims[0];
-                integrate_run(c, obj_from_cam, m, r, rgb, confidence, step_x, first * BLOCK, x1,
-                              y, z, pinhole);
+                integrate_run(c, obj_from_cam, m, r, rgb, confidence, step_x, first * BLOCK, x1, y,
+                              z, pinhole);
             }
         }
     return 0;
@@ -328,7 +330,8 @@ int fusion_fill(double (*sdf_mm)(vec3 p, void *ctx), void *ctx)
         for (uint32_t y = 0; y < fusion_vol.dims[1]; y++)
             for (uint32_t x = 0; x < fusion_vol.dims[0]; x++) {
                 struct voxel *v = &fusion_grid[vidx(x, y, z)];
-                double d = sdf_mm(v3_add(fusion_vol.origin, v3_scale(v3(x, y, z), fusion_vol.p.voxel_mm)), ctx);
+                double d = sdf_mm(
+                    v3_add(fusion_vol.origin, v3_scale(v3(x, y, z), fusion_vol.p.voxel_mm)), ctx);
                 if (isnan(d)) { /* never observed */
                     memset(v, 0, sizeof(*v));
                     continue;
@@ -353,11 +356,13 @@ static double sdf_at(uint32_t x, uint32_t y, uint32_t z)
 static vec3 gradient(uint32_t x, uint32_t y, uint32_t z)
 {
     uint32_t lo[3] = {x ? x - 1 : x, y ? y - 1 : y, z ? z - 1 : z};
-    uint32_t hi[3] = {x + 1 < fusion_vol.dims[0] ? x + 1 : x, y + 1 < fusion_vol.dims[1] ? y + 1 : y,
+    uint32_t hi[3] = {x + 1 < fusion_vol.dims[0] ? x + 1 : x,
+                      y + 1 < fusion_vol.dims[1] ? y + 1 : y,
                       z + 1 < fusion_vol.dims[2] ? z + 1 : z};
-    return v3((sdf_at(hi[0], y, z) - sdf_at(lo[0], y, z)) / (double)(hi[0] - lo[0] + (hi[0] == lo[0])),
-              (sdf_at(x, hi[1], z) - sdf_at(x, lo[1], z)) / (double)(hi[1] - lo[1] + (hi[1] == lo[1])),
-              (sdf_at(x, y, hi[2]) - sdf_at(x, y, lo[2])) / (double)(hi[2] - lo[2] + (hi[2] == lo[2])));
+    return v3(
+        (sdf_at(hi[0], y, z) - sdf_at(lo[0], y, z)) / (double)(hi[0] - lo[0] + (hi[0] == lo[0])),
+        (sdf_at(x, hi[1], z) - sdf_at(x, lo[1], z)) / (double)(hi[1] - lo[1] + (hi[1] == lo[1])),
+        (sdf_at(x, y, hi[2]) - sdf_at(x, y, lo[2])) / (double)(hi[2] - lo[2] + (hi[2] == lo[2])));
 }
 
 struct extract_state {
@@ -375,7 +380,8 @@ static int edge_vertex(struct extract_state *st, const uint32_t s[3], int axis, 
     }
     uint32_t t[3] = {s[0], s[1], s[2]};
     t[axis]++;
-    const struct voxel *va = &fusion_grid[vidx(s[0], s[1], s[2])], *vb = &fusion_grid[vidx(t[0], t[1], t[2])];
+    const struct voxel *va = &fusion_grid[vidx(s[0], s[1], s[2])],
+                       *vb = &fusion_grid[vidx(t[0], t[1], t[2])];
     double da = sdf_at(s[0], s[1], s[2]), db = sdf_at(t[0], t[1], t[2]);
     /* Strictly inside the edge: a zero distance at a sample would otherwise put the vertices of
      * several edges on the same point (degenerate triangles, non-manifold fans). */

@@ -8,17 +8,19 @@
 #include "hal.h"
 #include "tri.h"
 
+struct reflect_model;
+
 /* The grid is sized in the config and bounded by FUSION_MAX_DIM and FUSION_MAX_VOXELS
  * (hal_limits.h): 8 bytes a voxel. */
 
 struct fusion_params {
-    double voxel_mm;        /**< edge of a voxel */
-    double radius_mm;       /**< grid spans [-radius, radius] in x and y (object frame) */
+    double voxel_mm;          /**< edge of a voxel */
+    double radius_mm;         /**< grid spans [-radius, radius] in x and y (object frame) */
     double bottom_mm, top_mm; /**< and [bottom, top] in z */
-    double truncation_mm;   /**< distances are clamped to +-this */
-    double max_weight;      /**< a voxel's weight stops growing here (older views fade) */
-    uint32_t edge_fade_px;  /**< view weights ramp up over this many pixels from its edge */
-    double min_weight;      /**< pixels weighing less are not fused (grazing views) */
+    double truncation_mm;     /**< distances are clamped to +-this */
+    double max_weight;        /**< a voxel's weight stops growing here (older views fade) */
+    uint32_t edge_fade_px;    /**< view weights ramp up over this many pixels from its edge */
+    double min_weight;        /**< pixels weighing less are not fused (grazing views) */
 };
 
 /** Grid dimensions for @p p. @retval 0 ok @retval -E2BIG above FUSION_MAX_* */
@@ -109,9 +111,11 @@ int fusion_write_obj(const struct hal_storage *st, const char *path);
 int fusion_write_stl(const struct hal_storage *st, const char *path);
 
 /** Write the prepared mesh as glTF 2.0 binary (firmware/mesh_glb.c): metres, +Y up, linear vertex
- *  colours, one material, atomically. @retval 0 @retval -EINVAL not prepared @retval -E2BIG the
+ *  colours, atomically; one material, or one per cluster of @p model (the reflectance fitted, or
+ *  NULL). @retval 0 @retval -EINVAL not prepared @retval -E2BIG the
  *  mesh did not fit MESH_MAX_VERTICES @retval -ENODATA no vertex @retval -EFBIG over 4 GiB
  *  @retval -errno from storage */
-int fusion_write_glb(const struct hal_storage *st, const char *path);
+int fusion_write_glb(const struct hal_storage *st, const char *path,
+                     const struct reflect_model *model);
 
 #endif

@@ -263,13 +263,13 @@ int fusion_close_watertight(double max_hole_mm, int one_pass, uint32_t *inside)
             for (uint32_t x = 0; x < d[0]; x++) {
                 size_t i = vidx(x, y, z);
                 struct voxel *v = &fusion_grid[i];
-                int border = x == 0 || y == 0 || z == 0 || x + 1 == d[0] || y + 1 == d[1] ||
-                             z + 1 == d[2];
+                int border =
+                    x == 0 || y == 0 || z == 0 || x + 1 == d[0] || y + 1 == d[1] || z + 1 == d[2];
                 double h = layer_height(z);
                 if (h <= 0.0 || border) { /* the table plane and the grid's walls close it */
                     double below = -h / fusion_vol.p.truncation_mm * 32767.0;
-                    v->sdf = h <= 0.0 && !border && below < out_sdf ? (int16_t)lround(below)
-                                                                    : out_sdf;
+                    v->sdf =
+                        h <= 0.0 && !border && below < out_sdf ? (int16_t)lround(below) : out_sdf;
                     if (v->weight == 0)
                         v->weight = 1;
                 } else if (v->weight == 0 || (v->sdf > 0 && !marked(i))) {

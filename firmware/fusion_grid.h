@@ -18,7 +18,6 @@ struct voxel {
 };
 _Static_assert(sizeof(struct voxel) == 8, "voxel layout");
 
-
 #define WEIGHT_SCALE 1000.0
 #define COLOUR_WEIGHT_SCALE 32.0
 #define COLOUR_BEST_EFFORT 1u /* colour_weight of a voxel coloured by weightless estimates only */

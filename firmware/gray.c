@@ -71,11 +71,12 @@ int gray_layout_lit(const struct gray_layout *l, uint32_t index, uint32_t column
         return 0;
     uint32_t k = (index - GRAY_PATTERN_FIRST_BIT) / 2u; /* bit, most significant first */
     int inverse = (int)((index - GRAY_PATTERN_FIRST_BIT) % 2u);
-    int lit = k < l->col_bits
-                  ? (int)((gray_code_word(l->code, l->col_bits, column) >> (l->col_bits - 1u - k)) & 1u)
-                  : (int)((gray_code_word(l->code, l->row_bits, row) >>
-                           (l->row_bits - 1u - (k - l->col_bits))) &
-                          1u);
+    int lit =
+        k < l->col_bits
+            ? (int)((gray_code_word(l->code, l->col_bits, column) >> (l->col_bits - 1u - k)) & 1u)
+            : (int)((gray_code_word(l->code, l->row_bits, row) >>
+                     (l->row_bits - 1u - (k - l->col_bits))) &
+                    1u);
     return inverse ? !lit : lit;
 }
 

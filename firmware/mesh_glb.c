@@ -236,7 +236,8 @@ static int index_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
     return ip->o->rc;
 }
 
-int fusion_write_glb(const struct hal_storage *st, const char *path)
+int fusion_write_glb(const struct hal_storage *st, const char *path,
+                     const struct reflect_model *model)
 {
     struct mesh_summary ms;
     struct outbuf o;
@@ -245,9 +246,8 @@ int fusion_write_glb(const struct hal_storage *st, const char *path)
         return rc;
     if (ms.kept_vertices == 0)
         return -ENODATA; /* an accessor must count at least one element */
-    struct glb_scan gs = {{{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}},
-                          {1, {0}, reflect_model()},
-                          0};
+    struct glb_scan gs = {
+        {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}}, {1, {0}, model}, 0};
     if (gs.parts.model != NULL)
         gs.parts.count = gs.parts.model->count;
     struct mesh_sink scan_pass = {scan_vertex, scan_triangle, &gs};

@@ -1,55 +1,52 @@
-/* Reflectance parameters: a pool of light x view observations, k-means clusters on the diffuse
+/* Reflectance parameters: a pool of light x view observations (the caller's struct
+ * reflect_pool), k-means clusters on the diffuse
  * colour, and per cluster a GGX lobe (reflect.h). */
 #include "reflect.h"
 
 #include "lsq.h"
 
 #include <errno.h>
+#include <stddef.h>
 #include <math.h>
 #include <string.h>
 
-static struct reflect_obs pool[REFLECT_MAX_SAMPLES];
-static float pool_rho[REFLECT_MAX_SAMPLES][3]; /* each sample's diffuse colour as fitted */
-static uint8_t pool_cluster[REFLECT_MAX_SAMPLES];
-static uint32_t pool_used[REFLECT_MAX_SAMPLES]; /* lights kept after the outliers are out */
-
-static struct {
-    uint32_t count, per_view;
-    int collecting, fitted;
-    struct reflect_model model;
-} rs;
-
-void reflect_begin(uint32_t views)
+/* The pool's state and model; not its samples (each is written before it is read). */
+static void clear(struct reflect_pool *pl)
 {
-    memset(&rs, 0, sizeof(rs));
-    rs.per_view = REFLECT_MAX_SAMPLES / (views > 0 ? views : 1);
-    rs.collecting = 1;
+    memset(&pl->count, 0, sizeof(*pl) - offsetof(struct reflect_pool, count));
 }
 
-void reflect_forget(void)
+void reflect_begin(struct reflect_pool *pl, uint32_t views)
 {
-    memset(&rs, 0, sizeof(rs));
+    clear(pl);
+    pl->per_view = REFLECT_MAX_SAMPLES / (views > 0 ? views : 1);
+    pl->collecting = 1;
 }
 
-int reflect_collecting(void)
+void reflect_forget(struct reflect_pool *pl)
 {
-    return rs.collecting;
+    clear(pl);
 }
 
-uint32_t reflect_stride(uint32_t valid_pixels)
+int reflect_collecting(const struct reflect_pool *pl)
 {
-    return rs.per_view == 0 ? UINT32_MAX : valid_pixels / rs.per_view + 1;
+    return pl->collecting;
 }
 
-void reflect_add(const struct reflect_obs *obs)
+uint32_t reflect_stride(const struct reflect_pool *pl, uint32_t valid_pixels)
 {
-    if (rs.collecting && rs.count < REFLECT_MAX_SAMPLES)
-        pool[rs.count++] = *obs;
+    return pl->per_view == 0 ? UINT32_MAX : valid_pixels / pl->per_view + 1;
 }
 
-const struct reflect_model *reflect_model(void)
+void reflect_add(struct reflect_pool *pl, const struct reflect_obs *obs)
 {
-    return rs.fitted ? &rs.model : NULL;
+    if (pl->collecting && pl->count < REFLECT_MAX_SAMPLES)
+        pl->obs[pl->count++] = *obs;
+}
+
+const struct reflect_model *reflect_model(const struct reflect_pool *pl)
+{
+    return pl->fitted ? &pl->model : NULL;
 }
 
 double reflect_lobe(double roughness, double alpha, double cos_r)
@@ -118,42 +115,42 @@ uint32_t reflect_cluster_of(const struct reflect_model *m, const double rho[3])
     return best;
 }
 
-static void kmeans_rounds(struct reflect_model *m, int rounds);
+static void kmeans_rounds(struct reflect_pool *pl, struct reflect_model *m, int rounds);
 
 /* Colours nearer than this (feature_dist2; 0.17 in square-root units) are one paint: make
  * eval's nearest two paints, green and blue, are 0.19 apart. */
 #define SAME_PAINT 0.03
 
 /* k-means on the multi method's colour: seeds by farthest point (deterministic), ten rounds. */
-static uint32_t cluster_samples(uint32_t wanted, struct reflect_model *m)
+static uint32_t cluster_samples(struct reflect_pool *pl, uint32_t wanted, struct reflect_model *m)
 {
     uint32_t k = 0;
     double mean[3] = {0, 0, 0}; /* the first seed: the mean colour (an outlier would pull the
                                    next seed into the bulk and split one paint in two) */
-    for (uint32_t i = 0; i < rs.count; i++)
+    for (uint32_t i = 0; i < pl->count; i++)
         for (int c = 0; c < 3; c++)
-            mean[c] += pool[i].rho0[c] / rs.count;
+            mean[c] += pl->obs[i].rho0[c] / pl->count;
     memcpy(m->cluster[0].centre, mean, sizeof(mean));
     for (k = 1; k < wanted; k++) { /* the sample farthest from every seed so far */
         double far = 0.0;
         uint32_t at = 0;
-        for (uint32_t i = 0; i < rs.count; i++) {
+        for (uint32_t i = 0; i < pl->count; i++) {
             double d = 1e30;
             for (uint32_t j = 0; j < k; j++)
-                d = fmin(d, feature_dist2(pool[i].rho0, m->cluster[j].centre));
+                d = fmin(d, feature_dist2(pl->obs[i].rho0, m->cluster[j].centre));
             if (d > far)
                 far = d, at = i;
         }
         if (far < SAME_PAINT) /* no other colour there: fewer clusters */
             break;
         for (int c = 0; c < 3; c++)
-            m->cluster[k].centre[c] = pool[at].rho0[c];
+            m->cluster[k].centre[c] = pl->obs[at].rho0[c];
     }
     m->count = k;
-    kmeans_rounds(m, 10);
+    kmeans_rounds(pl, m, 10);
     /* a cluster of a few samples would fit its lobe to their noise: its samples join the
      * nearest cluster (they keep their own diffuse colour; only the lobe is shared) */
-    uint32_t least = rs.count / 50 > 200 ? rs.count / 50 : 200;
+    uint32_t least = pl->count / 50 > 200 ? pl->count / 50 : 200;
     for (;;) {
         uint32_t small = 0;
         for (uint32_t c = 1; c < m->count; c++)
@@ -162,7 +159,7 @@ static uint32_t cluster_samples(uint32_t wanted, struct reflect_model *m)
         if (m->count == 1 || m->cluster[small].samples >= least)
             break;
         m->cluster[small] = m->cluster[--m->count];
-        kmeans_rounds(m, 3);
+        kmeans_rounds(pl, m, 3);
     }
     /* one paint is one cluster: the multi colours of a single paint spread (what the weights
      * leave of the lobe, the noise), and a sample far out seeds a cluster of its own that then
@@ -183,21 +180,21 @@ static uint32_t cluster_samples(uint32_t wanted, struct reflect_model *m)
         if (m->count < 2 || nearest >= SAME_PAINT)
             break;
         m->cluster[q] = m->cluster[--m->count];
-        kmeans_rounds(m, 3);
+        kmeans_rounds(pl, m, 3);
     }
     return m->count;
 }
 
 /* @p rounds of k-means over the pool from @p m's centres; each cluster's sample count. */
-static void kmeans_rounds(struct reflect_model *m, int rounds)
+static void kmeans_rounds(struct reflect_pool *pl, struct reflect_model *m, int rounds)
 {
     for (int round = 0; round < rounds; round++) {
         double sum[REFLECT_MAX_CLUSTERS][3] = {{0}};
         uint32_t n[REFLECT_MAX_CLUSTERS] = {0};
-        for (uint32_t i = 0; i < rs.count; i++) {
-            double rho[3] = {pool[i].rho0[0], pool[i].rho0[1], pool[i].rho0[2]};
+        for (uint32_t i = 0; i < pl->count; i++) {
+            double rho[3] = {pl->obs[i].rho0[0], pl->obs[i].rho0[1], pl->obs[i].rho0[2]};
             uint32_t c = reflect_cluster_of(m, rho);
-            pool_cluster[i] = (uint8_t)c;
+            pl->cluster[i] = (uint8_t)c;
             n[c]++;
             for (int ch = 0; ch < 3; ch++)
                 sum[c][ch] += rho[ch];
@@ -228,13 +225,13 @@ static double along_cos(const double *c, const double *v, uint32_t n)
 }
 
 /* Sample @p i's kept lights: their cosines, lobe angles and signals (@retval how many). */
-static uint32_t kept_lights(uint32_t i, double cos_l[HAL_MAX_LIGHTS], double alpha[HAL_MAX_LIGHTS],
-                            double sig[3][HAL_MAX_LIGHTS])
+static uint32_t kept_lights(struct reflect_pool *pl, uint32_t i, double cos_l[HAL_MAX_LIGHTS],
+                            double alpha[HAL_MAX_LIGHTS], double sig[3][HAL_MAX_LIGHTS])
 {
-    const struct reflect_obs *o = &pool[i];
+    const struct reflect_obs *o = &pl->obs[i];
     uint32_t n = 0;
     for (uint32_t l = 0; l < HAL_MAX_LIGHTS; l++) {
-        if (!(pool_used[i] >> l & 1u))
+        if (!(pl->used[i] >> l & 1u))
             continue;
         cos_l[n] = o->cos_i[l], alpha[n] = o->alpha[l];
         for (int ch = 0; ch < 3; ch++)
@@ -247,17 +244,18 @@ static uint32_t kept_lights(uint32_t i, double cos_l[HAL_MAX_LIGHTS], double alp
 /* The lobe's K for the shape of @p shape (its GGX roughness, or its measured shape) over
  * cluster @p c's kept observations, the diffuse colours free (along_cos), per channel, not
  * below 0; @retval the squared error */
-static double fit_k(uint32_t c, const struct reflect_cluster *shape, double k_out[3])
+static double fit_k(struct reflect_pool *pl, uint32_t c, const struct reflect_cluster *shape,
+                    double k_out[3])
 {
     double sgg = 0.0, srg[3] = {0, 0, 0}, srr = 0.0;
-    for (uint32_t i = 0; i < rs.count; i++) {
+    for (uint32_t i = 0; i < pl->count; i++) {
         double cos_l[HAL_MAX_LIGHTS], alpha[HAL_MAX_LIGHTS], sig[3][HAL_MAX_LIGHTS];
         double g[HAL_MAX_LIGHTS];
-        uint32_t n = pool_cluster[i] == c ? kept_lights(i, cos_l, alpha, sig) : 0;
+        uint32_t n = pl->cluster[i] == c ? kept_lights(pl, i, cos_l, alpha, sig) : 0;
         if (n < 2) /* one light: its diffuse colour explains it all */
             continue;
         for (uint32_t l = 0; l < n; l++)
-            g[l] = lobe_shape(shape, alpha[l], pool[i].cos_r);
+            g[l] = lobe_shape(shape, alpha[l], pl->obs[i].cos_r);
         double mg = along_cos(cos_l, g, n), ms[3];
         for (int ch = 0; ch < 3; ch++)
             ms[ch] = along_cos(cos_l, sig[ch], n);
@@ -280,60 +278,61 @@ static double fit_k(uint32_t c, const struct reflect_cluster *shape, double k_ou
 }
 
 /* K for GGX of @p roughness. @retval the squared error */
-static double fit_specular(uint32_t c, double roughness, double k_out[3])
+static double fit_specular(struct reflect_pool *pl, uint32_t c, double roughness, double k_out[3])
 {
     struct reflect_cluster ggx;
     memset(&ggx, 0, sizeof(ggx));
     ggx.roughness = roughness;
-    return fit_k(c, &ggx, k_out);
+    return fit_k(pl, c, &ggx, k_out);
 }
 
 /* Each sample's diffuse colour given its cluster's lobe, for judging outliers: least squares
  * over its kept lights, rho = sum (S_l - K g_l) cos_l / sum cos_l^2 (along_cos). */
-static void fit_diffuse(const struct reflect_model *m)
+static void fit_diffuse(struct reflect_pool *pl, const struct reflect_model *m)
 {
-    for (uint32_t i = 0; i < rs.count; i++) {
+    for (uint32_t i = 0; i < pl->count; i++) {
         double cos_l[HAL_MAX_LIGHTS], alpha[HAL_MAX_LIGHTS], sig[3][HAL_MAX_LIGHTS];
-        uint32_t n = kept_lights(i, cos_l, alpha, sig);
+        uint32_t n = kept_lights(pl, i, cos_l, alpha, sig);
         for (uint32_t l = 0; l < n; l++) {
             double sp[3];
-            reflect_specular(&m->cluster[pool_cluster[i]], alpha[l], pool[i].cos_r, sp);
+            reflect_specular(&m->cluster[pl->cluster[i]], alpha[l], pl->obs[i].cos_r, sp);
             for (int ch = 0; ch < 3; ch++)
                 sig[ch][l] -= sp[ch];
         }
         for (int ch = 0; ch < 3; ch++)
-            pool_rho[i][ch] =
-                n > 0 ? (float)fmax(0.0, along_cos(cos_l, sig[ch], n)) : pool[i].rho0[ch];
+            pl->rho[i][ch] =
+                n > 0 ? (float)fmax(0.0, along_cos(cos_l, sig[ch], n)) : pl->obs[i].rho0[ch];
     }
 }
 
 /* Sample @p i's light @p l less the model of cluster @p cl (luminance). */
-static double residual(const struct reflect_cluster *cl, uint32_t i, uint32_t l)
+static double residual(struct reflect_pool *pl, const struct reflect_cluster *cl, uint32_t i,
+                       uint32_t l)
 {
-    const struct reflect_obs *o = &pool[i];
+    const struct reflect_obs *o = &pl->obs[i];
     double sp[3], r = 0.0;
     reflect_specular(cl, o->alpha[l], o->cos_r, sp);
     for (int ch = 0; ch < 3; ch++)
-        r += (o->signal[l][ch] - pool_rho[i][ch] * o->cos_i[l] - sp[ch]) / 3.0;
+        r += (o->signal[l][ch] - pl->rho[i][ch] * o->cos_i[l] - sp[ch]) / 3.0;
     return r;
 }
 
 /* Observations far off the model (a shadow edge, a neighbour's paint, a wrong normal) are left
  * out: more than 4 x the cluster's median absolute residual (luminance), and at least 0.02. */
-static void drop_outliers(const struct reflect_model *m)
+static void drop_outliers(struct reflect_pool *pl, const struct reflect_model *m)
 {
     for (uint32_t c = 0; c < m->count; c++) {
         double hist[64] = {0}; /* |residual| in steps of 0.005: the median without a sort */
         uint32_t n = 0;
         const struct reflect_cluster *cl = &m->cluster[c];
-        for (uint32_t i = 0; i < rs.count; i++) {
-            if (pool_cluster[i] != c)
+        for (uint32_t i = 0; i < pl->count; i++) {
+            if (pl->cluster[i] != c)
                 continue;
-            const struct reflect_obs *o = &pool[i];
+            const struct reflect_obs *o = &pl->obs[i];
             for (uint32_t l = 0; l < HAL_MAX_LIGHTS; l++) {
                 if (!(o->lights >> l & 1u))
                     continue;
-                hist[(int)fmin(63.0, fabs(residual(cl, i, l)) / 0.005)]++;
+                hist[(int)fmin(63.0, fabs(residual(pl, cl, i, l)) / 0.005)]++;
                 n++;
             }
         }
@@ -341,16 +340,16 @@ static void drop_outliers(const struct reflect_model *m)
         for (int b = 0; b < 64 && seen < n / 2.0; b++)
             seen += hist[b], median = (b + 0.5) * 0.005;
         double limit = fmax(0.02, 4.0 * median);
-        for (uint32_t i = 0; i < rs.count; i++) {
-            if (pool_cluster[i] != c)
+        for (uint32_t i = 0; i < pl->count; i++) {
+            if (pl->cluster[i] != c)
                 continue;
-            const struct reflect_obs *o = &pool[i];
-            pool_used[i] = 0;
+            const struct reflect_obs *o = &pl->obs[i];
+            pl->used[i] = 0;
             for (uint32_t l = 0; l < HAL_MAX_LIGHTS; l++) {
                 if (!(o->lights >> l & 1u))
                     continue;
-                if (fabs(residual(cl, i, l)) <= limit)
-                    pool_used[i] |= 1u << l;
+                if (fabs(residual(pl, cl, i, l)) <= limit)
+                    pl->used[i] |= 1u << l;
             }
         }
     }
@@ -358,12 +357,12 @@ static void drop_outliers(const struct reflect_model *m)
 
 /* Cluster @p c's roughness: the grid value with the least error, then a golden-section search
  * between its neighbours. */
-static void fit_lobe(struct reflect_cluster *cl, uint32_t c)
+static void fit_lobe(struct reflect_pool *pl, struct reflect_cluster *cl, uint32_t c)
 {
     enum { GRID = 24 };
     double best_s = 0.1, best_e = 1e300, k[3];
     for (int g = 0; g < GRID; g++) { /* 0.02 .. 1 rad, evenly in log */
-        double s = 0.02 * pow(50.0, g / (GRID - 1.0)), e = fit_specular(c, s, k);
+        double s = 0.02 * pow(50.0, g / (GRID - 1.0)), e = fit_specular(pl, c, s, k);
         if (e < best_e)
             best_e = e, best_s = s;
     }
@@ -371,24 +370,24 @@ static void fit_lobe(struct reflect_cluster *cl, uint32_t c)
     const double phi = 0.6180339887498949;
     for (int it = 0; it < 20; it++) {
         double a = hi - phi * (hi - lo), b = lo + phi * (hi - lo);
-        if (fit_specular(c, a, k) < fit_specular(c, b, k))
+        if (fit_specular(pl, c, a, k) < fit_specular(pl, c, b, k))
             hi = b;
         else
             lo = a;
     }
     cl->roughness = 0.5 * (lo + hi);
-    double e = fit_specular(c, cl->roughness, cl->specular);
+    double e = fit_specular(pl, c, cl->roughness, cl->specular);
     uint32_t n = 0;
-    for (uint32_t i = 0; i < rs.count; i++)
-        for (uint32_t l = 0; pool_cluster[i] == c && l < HAL_MAX_LIGHTS; l++)
-            n += pool_used[i] >> l & 1u;
+    for (uint32_t i = 0; i < pl->count; i++)
+        for (uint32_t l = 0; pl->cluster[i] == c && l < HAL_MAX_LIGHTS; l++)
+            n += pl->used[i] >> l & 1u;
     cl->rms = n > 0 ? sqrt(fmax(0.0, e) / (3.0 * n)) : 0.0;
 }
 
 /* Cluster @p c's lobe shape at the nodes for its K (least squares over its kept observations,
  * the diffuse colours free (along_cos), a little smoothness between neighbours, not below 0, 1
  * at alpha = 0), then K for the shape. */
-static void fit_measured(struct reflect_cluster *cl, uint32_t c)
+static void fit_measured(struct reflect_pool *pl, struct reflect_cluster *cl, uint32_t c)
 {
     enum { N = REFLECT_LOBE_NODES };
     static double a[N * N], b[N], x[N], g[N][HAL_MAX_LIGHTS]; /* static: off the stack */
@@ -396,13 +395,13 @@ static void fit_measured(struct reflect_cluster *cl, uint32_t c)
     memset(b, 0, sizeof(b));
     const double *k = cl->lobe_specular;
     double kk = k[0] * k[0] + k[1] * k[1] + k[2] * k[2];
-    for (uint32_t i = 0; i < rs.count; i++) {
+    for (uint32_t i = 0; i < pl->count; i++) {
         double cos_l[HAL_MAX_LIGHTS], alpha[HAL_MAX_LIGHTS], sig[3][HAL_MAX_LIGHTS];
         double s[HAL_MAX_LIGHTS];
-        uint32_t n = pool_cluster[i] == c ? kept_lights(i, cos_l, alpha, sig) : 0;
+        uint32_t n = pl->cluster[i] == c ? kept_lights(pl, i, cos_l, alpha, sig) : 0;
         if (n < 2)
             continue;
-        double inv = 1.0 / (pool[i].cos_r > 0.05 ? pool[i].cos_r : 0.05), mg[N];
+        double inv = 1.0 / (pl->obs[i].cos_r > 0.05 ? pl->obs[i].cos_r : 0.05), mg[N];
         memset(g, 0, sizeof(g));
         for (uint32_t l = 0; l < n; l++) { /* light l: the nodes around its alpha */
             uint32_t k0;
@@ -440,32 +439,33 @@ static void fit_measured(struct reflect_cluster *cl, uint32_t c)
     for (int ch = 0; ch < 3; ch++)
         cl->lobe_specular[ch] *= x[0];
     cl->measured = 1;
-    fit_k(c, cl, cl->lobe_specular); /* K for this shape */
+    fit_k(pl, c, cl, cl->lobe_specular); /* K for this shape */
 }
 
-int reflect_fit(uint32_t clusters, struct reflect_model *out)
+int reflect_fit(struct reflect_pool *pl, uint32_t clusters, struct reflect_model *out)
 {
-    rs.collecting = 0;
-    if (rs.count < 100)
+    pl->collecting = 0;
+    if (pl->count < 100)
         return -ENODATA;
-    struct reflect_model *m = &rs.model;
+    struct reflect_model *m = &pl->model;
     memset(m, 0, sizeof(*m));
-    cluster_samples(clusters < 1                      ? 1
+    cluster_samples(pl,
+                    clusters < 1                      ? 1
                     : clusters > REFLECT_MAX_CLUSTERS ? REFLECT_MAX_CLUSTERS
                                                       : clusters,
                     m);
-    for (uint32_t i = 0; i < rs.count; i++)
-        pool_used[i] = pool[i].lights;
+    for (uint32_t i = 0; i < pl->count; i++)
+        pl->used[i] = pl->obs[i].lights;
     for (uint32_t c = 0; c < m->count; c++)
         m->cluster[c].roughness = 0.1;
     /* the lobes (the diffuse colours free: along_cos); the outliers judged on that model and
      * its diffuse colours, twice (a first model leans towards them) */
     for (int round = 0; round < 3; round++) {
         for (uint32_t c = 0; c < m->count; c++)
-            fit_lobe(&m->cluster[c], c);
+            fit_lobe(pl, &m->cluster[c], c);
         if (round < 2) {
-            fit_diffuse(m);
-            drop_outliers(m);
+            fit_diffuse(pl, m);
+            drop_outliers(pl, m);
         }
     }
     /* then the lobe's shape as measured, from GGX's: real materials' tails are not GGX's, and
@@ -479,8 +479,8 @@ int reflect_fit(uint32_t clusters, struct reflect_model *out)
     }
     for (int round = 0; round < 6; round++) /* K's colour and the shape settle together */
         for (uint32_t c = 0; c < m->count; c++)
-            fit_measured(&m->cluster[c], c);
-    rs.fitted = 1;
+            fit_measured(pl, &m->cluster[c], c);
+    pl->fitted = 1;
     *out = *m;
     return 0;
 }

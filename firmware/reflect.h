@@ -63,28 +63,41 @@ struct reflect_model {
     struct reflect_cluster cluster[REFLECT_MAX_CLUSTERS];
 };
 
-/** Empty the pool and start collecting: each of @p views views may add its share. */
-void reflect_begin(uint32_t views);
+/** The pool of samples and the model fitted to it: its owner (the job, a test) keeps it, static
+ *  (about REFLECT_MAX_SAMPLES x 200 bytes), and passes it to the colour of method fit and to
+ *  the glTF writer; two pools are two independent fits. The fields are reflect.c's. */
+struct reflect_pool {
+    struct reflect_obs obs[REFLECT_MAX_SAMPLES];
+    float rho[REFLECT_MAX_SAMPLES][3]; /**< each sample's diffuse colour as fitted */
+    uint8_t cluster[REFLECT_MAX_SAMPLES];
+    uint32_t used[REFLECT_MAX_SAMPLES]; /**< lights kept after the outliers are out */
+    uint32_t count, per_view;
+    int collecting, fitted;
+    struct reflect_model model;
+};
 
-/** Forget the pool and the model (a new scan): colouring with fit gives the multi estimate. */
-void reflect_forget(void);
+/** Empty @p pl and start collecting: each of @p views views may add its share. */
+void reflect_begin(struct reflect_pool *pl, uint32_t views);
+
+/** Forget the samples and the model (a new scan): colouring with fit gives the multi estimate. */
+void reflect_forget(struct reflect_pool *pl);
 
 /** Collecting (after reflect_begin, before reflect_fit)? */
-int reflect_collecting(void);
+int reflect_collecting(const struct reflect_pool *pl);
 
 /** Every how many valid pixels a view of @p valid_pixels valid pixels gives a sample. */
-uint32_t reflect_stride(uint32_t valid_pixels);
+uint32_t reflect_stride(const struct reflect_pool *pl, uint32_t valid_pixels);
 
-/** Add one sample (dropped when the pool is full). */
-void reflect_add(const struct reflect_obs *obs);
+/** Add one sample (dropped when the pool is full or not collecting). */
+void reflect_add(struct reflect_pool *pl, const struct reflect_obs *obs);
 
 /** Cluster the pool into at most @p clusters and fit each cluster's lobe; the model is kept
  *  for reflect_model() and collecting stops. @param out  the model
  *  @retval 0 @retval -ENODATA too few samples (fewer than 100) */
-int reflect_fit(uint32_t clusters, struct reflect_model *out);
+int reflect_fit(struct reflect_pool *pl, uint32_t clusters, struct reflect_model *out);
 
 /** The fitted model, or NULL before reflect_fit (or after reflect_begin). */
-const struct reflect_model *reflect_model(void);
+const struct reflect_model *reflect_model(const struct reflect_pool *pl);
 
 /** The cluster nearest to diffuse colour @p rho (linear). */
 uint32_t reflect_cluster_of(const struct reflect_model *m, const double rho[3]);

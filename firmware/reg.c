@@ -1,4 +1,4 @@
-/* Joint registration of a turntable scan's views (reg.h), in static buffers.
+/* Joint registration of a turntable scan's views (reg.h), in the caller's struct reg_ctx.
  *
  * The camera stays put and the object turns, so view j sees view i's points turned about the
  * table axis (point a, unit direction d) by theta_j - theta_i:
@@ -19,118 +19,84 @@
 #include "vec3.h"
 
 #include <errno.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <string.h>
 
-#define REG_PARAMS (REG_MAX_VIEWS + 4u) /* every angle, two shifts, two tilts */
-#define REG_EDGES REG_MAX_VIEWS         /* a ring: one edge per view */
-
-/* One kept pixel of a view, in its camera frame. */
-struct reg_cell {
-    float xyz[3];
-    float normal[3];
-    uint8_t rgb[3];
-    uint8_t valid;
-};
-_Static_assert(sizeof(struct reg_cell) == 28, "cell layout");
-
-static struct reg_cell cells[REG_MAX_CELLS];
-static double normal_a[REG_PARAMS * REG_PARAMS], normal_b[REG_PARAMS], step_x[REG_PARAMS];
-
-/* What the pairs of one edge (both directions) gave in the last pass. */
-struct edge_stats {
-    uint32_t overlap, coupled;
-    double sq, trunc_sq; /* squared residuals of coupled pairs; truncated over the overlap */
-};
-
-static struct {
-    struct reg_params p;
-    struct scan_calib calib;
-    uint32_t views, passes, per_pass, stride, gw, gh;
-    int32_t reported_mdeg[REG_MAX_VIEWS];
-    uint8_t present[REG_MAX_VIEWS];
-    double theta[REG_MAX_VIEWS]; /* radians */
-    vec3 a, d;                   /* the axis */
-    int use_solution;            /* poses from theta, a, d rather than the turntable's */
-    uint32_t edges, edge_from[REG_EDGES], edge_to[REG_EDGES];
-    struct edge_stats stats[REG_EDGES];
-    int second_aligned;          /* the second pass's views go through first_from_second */
-    struct frame_xform first_from_second;
-} rg;
-
-static size_t cell_count(void)
+static size_t cell_count(struct reg_ctx *r)
 {
-    return (size_t)rg.gw * rg.gh;
+    return (size_t)r->gw * r->gh;
 }
 
-static struct reg_cell *view_cells(uint32_t v)
+static struct reg_cell *view_cells(struct reg_ctx *r, uint32_t v)
 {
-    return &cells[(size_t)v * cell_count()];
+    return &r->cells[(size_t)v * cell_count(r)];
 }
 
-int reg_begin(const struct reg_params *p, const struct scan_calib *c, uint32_t views,
-              uint32_t passes, uint32_t width, uint32_t height)
+int reg_begin(struct reg_ctx *r, const struct reg_params *p, const struct scan_calib *c,
+              uint32_t views, uint32_t passes, uint32_t width, uint32_t height)
 {
     if (views == 0 || views > REG_MAX_VIEWS || width == 0 || height == 0 || passes == 0 ||
         passes > 2 || views % passes != 0)
         return -E2BIG;
-    memset(&rg, 0, sizeof(rg));
-    rg.p = *p;
-    rg.calib = *c;
-    rg.views = views;
-    rg.passes = passes;
-    rg.per_pass = views / passes;
-    rg.stride = p->sample_stride > 0 ? p->sample_stride : 1;
+    /* the solution and the views' bookkeeping; not the samples (each view writes its own) */
+    memset(&r->p, 0, sizeof(*r) - offsetof(struct reg_ctx, p));
+    r->p = *p;
+    r->calib = *c;
+    r->views = views;
+    r->passes = passes;
+    r->per_pass = views / passes;
+    r->stride = p->sample_stride > 0 ? p->sample_stride : 1;
     for (;;) {
-        rg.gw = (width + rg.stride - 1) / rg.stride;
-        rg.gh = (height + rg.stride - 1) / rg.stride;
-        if ((uint64_t)rg.gw * rg.gh * views <= REG_MAX_CELLS)
+        r->gw = (width + r->stride - 1) / r->stride;
+        r->gh = (height + r->stride - 1) / r->stride;
+        if ((uint64_t)r->gw * r->gh * views <= REG_MAX_CELLS)
             break;
-        rg.stride++; /* terminates: REG_MAX_CELLS / REG_MAX_VIEWS >= 64 (hal_limits.h) */
+        r->stride++; /* terminates: REG_MAX_CELLS / REG_MAX_VIEWS >= 64 (hal_limits.h) */
     }
-    rg.a = v3_from(c->axis_point_mm);
-    rg.d = v3_norm(v3_from(c->axis_dir));
+    r->a = v3_from(c->axis_point_mm);
+    r->d = v3_norm(v3_from(c->axis_dir));
     return 0;
 }
 
-int reg_add_view(uint32_t index, int32_t angle_mdeg, const struct decode_maps *m,
-                 const struct tri_range *r, const uint8_t *rgb)
+int reg_add_view(struct reg_ctx *r, uint32_t index, int32_t angle_mdeg, const struct decode_maps *m,
+                 const struct tri_range *range, const uint8_t *rgb)
 {
-    if (index >= rg.views || (m->width + rg.stride - 1) / rg.stride != rg.gw ||
-        (m->height + rg.stride - 1) / rg.stride != rg.gh)
+    if (index >= r->views || (m->width + r->stride - 1) / r->stride != r->gw ||
+        (m->height + r->stride - 1) / r->stride != r->gh)
         return -EINVAL;
-    struct reg_cell *out = view_cells(index);
-    for (uint32_t y = 0; y < rg.gh; y++) {
-        for (uint32_t x = 0; x < rg.gw; x++) {
-            size_t i = (size_t)y * rg.stride * m->width + (size_t)x * rg.stride;
-            struct reg_cell *cl = &out[(size_t)y * rg.gw + x];
+    struct reg_cell *out = view_cells(r, index);
+    for (uint32_t y = 0; y < r->gh; y++) {
+        for (uint32_t x = 0; x < r->gw; x++) {
+            size_t i = (size_t)y * r->stride * m->width + (size_t)x * r->stride;
+            struct reg_cell *cl = &out[(size_t)y * r->gw + x];
             cl->valid = m->reason[i] == SCAN_VALID;
-            memcpy(cl->xyz, &r->xyz_mm[3 * i], sizeof(cl->xyz));
-            memcpy(cl->normal, &r->normal[3 * i], sizeof(cl->normal));
+            memcpy(cl->xyz, &range->xyz_mm[3 * i], sizeof(cl->xyz));
+            memcpy(cl->normal, &range->normal[3 * i], sizeof(cl->normal));
             memcpy(cl->rgb, &rgb[3 * i], 3);
         }
     }
-    rg.reported_mdeg[index] = angle_mdeg;
-    rg.present[index] = 1;
+    r->reported_mdeg[index] = angle_mdeg;
+    r->present[index] = 1;
     return 0;
 }
 
 /* Neighbouring views of each pass: each with the next, the last with the first (the views of
  * a pass go round). */
-static void make_edges(void)
+static void make_edges(struct reg_ctx *r)
 {
-    rg.edges = 0;
-    uint32_t n = rg.per_pass;
-    for (uint32_t pass = 0; pass < rg.passes; pass++)
+    r->edges = 0;
+    uint32_t n = r->per_pass;
+    for (uint32_t pass = 0; pass < r->passes; pass++)
         for (uint32_t k = 0; k < n && n >= 2; k++) {
             uint32_t i = pass * n + k, j = pass * n + (k + 1) % n;
             if (n == 2 && k == 1)
                 break; /* two views: one pair */
-            if (!rg.present[i] || !rg.present[j])
+            if (!r->present[i] || !r->present[j])
                 continue;
-            rg.edge_from[rg.edges] = i;
-            rg.edge_to[rg.edges] = j;
-            rg.edges++;
+            r->edge_from[r->edges] = i;
+            r->edge_to[r->edges] = j;
+            r->edges++;
         }
 }
 
@@ -153,60 +119,61 @@ static void across(vec3 d, vec3 *e1, vec3 *e2)
 
 /* Unknowns: the angle of each view but the first of its pass (the gauge of that pass's frame),
  * then the axis. @retval the unknown of view @p v's angle, -1 for a first view */
-static int angle_param(uint32_t v)
+static int angle_param(struct reg_ctx *r, uint32_t v)
 {
-    uint32_t pass = v / rg.per_pass;
-    return v % rg.per_pass == 0 ? -1 : (int)(v - 1 - pass);
+    uint32_t pass = v / r->per_pass;
+    return v % r->per_pass == 0 ? -1 : (int)(v - 1 - pass);
 }
 
-static uint32_t n_params(void)
+static uint32_t n_params(struct reg_ctx *r)
 {
-    return rg.views - rg.passes + 4;
+    return r->views - r->passes + 4;
 }
 
 /* Add one residual with @p jac entries at @p idx (negative: a fixed angle) to the equations. */
-static void add_residual(const int idx[6], const double jac[6], double res, double weight)
+static void add_residual(struct reg_ctx *r, const int idx[6], const double jac[6], double res,
+                         double weight)
 {
-    const uint32_t n = n_params();
+    const uint32_t n = n_params(r);
     for (int s = 0; s < 6; s++) {
         if (idx[s] < 0)
             continue;
         for (int t = 0; t < 6; t++)
             if (idx[t] >= 0)
-                normal_a[(size_t)idx[s] * n + (size_t)idx[t]] += weight * jac[s] * jac[t];
-        normal_b[idx[s]] += weight * jac[s] * res;
+                r->normal_a[(size_t)idx[s] * n + (size_t)idx[t]] += weight * jac[s] * jac[t];
+        r->normal_b[idx[s]] += weight * jac[s] * res;
     }
 }
 
 /* The pairs from view @p src to view @p dst at the current unknowns, gated at @p gate_mm:
  * counted into @p st and, when @p solve, added to the normal equations. */
-static void pair_views(uint32_t src, uint32_t dst, double gate_mm, int solve,
-                       struct edge_stats *st)
+static void pair_views(struct reg_ctx *r, uint32_t src, uint32_t dst, double gate_mm, int solve,
+                       struct reg_edge_stats *st)
 {
-    const double min_cos = cos(rg.p.max_normal_deg * M_PI / 180.0);
-    const double huber = rg.p.max_pair_mm / 3.0;
+    const double min_cos = cos(r->p.max_normal_deg * M_PI / 180.0);
+    const double huber = r->p.max_pair_mm / 3.0;
     double rot[9];
-    axis_rotation(rg.d, rg.theta[dst] - rg.theta[src], rot);
+    axis_rotation(r->d, r->theta[dst] - r->theta[src], rot);
     vec3 e1, e2;
-    across(rg.d, &e1, &e2);
+    across(r->d, &e1, &e2);
     vec3 r_e1 = m3_mul(rot, e1), r_e2 = m3_mul(rot, e2);
-    const int axis = (int)(rg.views - rg.passes);
-    int idx[6] = {angle_param(src), angle_param(dst), axis, axis + 1, axis + 2, axis + 3};
-    const struct reg_cell *from = view_cells(src), *to = view_cells(dst);
-    for (size_t k = 0; k < cell_count(); k++) {
+    const int axis = (int)(r->views - r->passes);
+    int idx[6] = {angle_param(r, src), angle_param(r, dst), axis, axis + 1, axis + 2, axis + 3};
+    const struct reg_cell *from = view_cells(r, src), *to = view_cells(r, dst);
+    for (size_t k = 0; k < cell_count(r); k++) {
         const struct reg_cell *cp = &from[k];
         if (!cp->valid)
             continue;
-        vec3 pa = v3_sub(v3(cp->xyz[0], cp->xyz[1], cp->xyz[2]), rg.a);
-        vec3 rpa = m3_mul(rot, pa), p = v3_add(rg.a, rpa);
+        vec3 pa = v3_sub(v3(cp->xyz[0], cp->xyz[1], cp->xyz[2]), r->a);
+        vec3 rpa = m3_mul(rot, pa), p = v3_add(r->a, rpa);
         if (p.z <= 1.0)
             continue;
         double fu, fv;
-        camray_project(&rg.calib, p, &fu, &fv);
-        long u = lround(fu / rg.stride), v = lround(fv / rg.stride);
-        if (u < 0 || v < 0 || u >= (long)rg.gw || v >= (long)rg.gh)
+        camray_project(&r->calib, p, &fu, &fv);
+        long u = lround(fu / r->stride), v = lround(fv / r->stride);
+        if (u < 0 || v < 0 || u >= (long)r->gw || v >= (long)r->gh)
             continue;
-        const struct reg_cell *cq = &to[(size_t)v * rg.gw + (size_t)u];
+        const struct reg_cell *cq = &to[(size_t)v * r->gw + (size_t)u];
         vec3 nq = v3(cq->normal[0], cq->normal[1], cq->normal[2]);
         vec3 n = m3_mul(rot, v3(cp->normal[0], cp->normal[1], cp->normal[2]));
         /* The overlap: samples landing on a surface of the other view that faces the same way.
@@ -219,18 +186,18 @@ static void pair_views(uint32_t src, uint32_t dst, double gate_mm, int solve,
         vec3 diff = v3_sub(p, q);
         double dist = v3_len(diff);
         int ok = dist <= gate_mm;
-        for (int c = 0; c < 3 && ok && rg.p.use_colour; c++)
-            ok = fabs((double)cp->rgb[c] - cq->rgb[c]) <= rg.p.max_colour_dn;
+        for (int c = 0; c < 3 && ok && r->p.use_colour; c++)
+            ok = fabs((double)cp->rgb[c] - cq->rgb[c]) <= r->p.max_colour_dn;
         double res = v3_dot(diff, nq);
-        double cap = fmin(res * res, rg.p.max_pair_mm * rg.p.max_pair_mm);
-        st->trunc_sq += ok ? cap : rg.p.max_pair_mm * rg.p.max_pair_mm;
+        double cap = fmin(res * res, r->p.max_pair_mm * r->p.max_pair_mm);
+        st->trunc_sq += ok ? cap : r->p.max_pair_mm * r->p.max_pair_mm;
         if (!ok)
             continue;
         st->coupled++;
         st->sq += res * res;
         if (!solve)
             continue;
-        double dth = v3_dot(nq, v3_cross(rg.d, rpa));
+        double dth = v3_dot(nq, v3_cross(r->d, rpa));
         vec3 tilt1 = v3_sub(v3_cross(e1, rpa), m3_mul(rot, v3_cross(e1, pa)));
         vec3 tilt2 = v3_sub(v3_cross(e2, rpa), m3_mul(rot, v3_cross(e2, pa)));
         double jac[6] = {-dth,
@@ -240,130 +207,130 @@ static void pair_views(uint32_t src, uint32_t dst, double gate_mm, int solve,
                          v3_dot(nq, tilt1),
                          v3_dot(nq, tilt2)};
         double w = fabs(res) <= huber ? 1.0 : huber / fabs(res);
-        add_residual(idx, jac, res, w);
+        add_residual(r, idx, jac, res, w);
     }
 }
 
 /* One pass over every edge, both directions. */
-static void pass(double gate_mm, int solve)
+static void pass(struct reg_ctx *r, double gate_mm, int solve)
 {
     if (solve) {
-        uint32_t n = n_params();
-        memset(normal_a, 0, (size_t)n * n * sizeof(double));
-        memset(normal_b, 0, n * sizeof(double));
+        uint32_t n = n_params(r);
+        memset(r->normal_a, 0, (size_t)n * n * sizeof(double));
+        memset(r->normal_b, 0, n * sizeof(double));
     }
-    for (uint32_t e = 0; e < rg.edges; e++) {
-        memset(&rg.stats[e], 0, sizeof(rg.stats[e]));
-        pair_views(rg.edge_from[e], rg.edge_to[e], gate_mm, solve, &rg.stats[e]);
-        pair_views(rg.edge_to[e], rg.edge_from[e], gate_mm, solve, &rg.stats[e]);
+    for (uint32_t e = 0; e < r->edges; e++) {
+        memset(&r->stats[e], 0, sizeof(r->stats[e]));
+        pair_views(r, r->edge_from[e], r->edge_to[e], gate_mm, solve, &r->stats[e]);
+        pair_views(r, r->edge_to[e], r->edge_from[e], gate_mm, solve, &r->stats[e]);
     }
 }
 
 /* sqrt(mean truncated squared residual) over every overlap: lower is better, and dropping
  * pairs does not lower it (a dropped pair counts max_pair_mm). */
-static double score(void)
+static double score(struct reg_ctx *r)
 {
     double sum = 0.0;
     uint64_t n = 0;
-    for (uint32_t e = 0; e < rg.edges; e++) {
-        sum += rg.stats[e].trunc_sq;
-        n += rg.stats[e].overlap;
+    for (uint32_t e = 0; e < r->edges; e++) {
+        sum += r->stats[e].trunc_sq;
+        n += r->stats[e].overlap;
     }
     return n > 0 ? sqrt(sum / (double)n) : 0.0;
 }
 
 /* Solve and apply one Gauss-Newton step. @retval the largest angle change (rad) */
-static double gauss_newton_step(void)
+static double gauss_newton_step(struct reg_ctx *r)
 {
-    const uint32_t n = n_params();
+    const uint32_t n = n_params(r);
     /* A little damping keeps unknowns the data barely see (the axis of two views) in place. */
     double trace = 0.0;
     for (uint32_t i = 0; i < n; i++)
-        trace += normal_a[(size_t)i * n + i];
+        trace += r->normal_a[(size_t)i * n + i];
     for (uint32_t i = 0; i < n; i++)
-        normal_a[(size_t)i * n + i] += 1e-6 * trace / n + 1e-3 * normal_a[(size_t)i * n + i];
+        r->normal_a[(size_t)i * n + i] += 1e-6 * trace / n + 1e-3 * r->normal_a[(size_t)i * n + i];
     for (uint32_t i = 0; i < n; i++)
-        normal_b[i] = -normal_b[i];
-    if (lsq_solve(n, normal_a, normal_b, step_x) != 0)
+        r->normal_b[i] = -r->normal_b[i];
+    if (lsq_solve(n, r->normal_a, r->normal_b, r->step_x) != 0)
         return 0.0;
     double largest = 0.0;
-    for (uint32_t v = 0; v < rg.views; v++) {
-        if (angle_param(v) < 0)
+    for (uint32_t v = 0; v < r->views; v++) {
+        if (angle_param(r, v) < 0)
             continue;
-        rg.theta[v] += step_x[angle_param(v)];
-        largest = fmax(largest, fabs(step_x[angle_param(v)]));
+        r->theta[v] += r->step_x[angle_param(r, v)];
+        largest = fmax(largest, fabs(r->step_x[angle_param(r, v)]));
     }
     vec3 e1, e2;
-    across(rg.d, &e1, &e2);
-    const double *ax = &step_x[rg.views - rg.passes];
-    rg.a = v3_add(rg.a, v3_add(v3_scale(e1, ax[0]), v3_scale(e2, ax[1])));
-    rg.d = v3_norm(v3_add(rg.d, v3_cross(v3_add(v3_scale(e1, ax[2]), v3_scale(e2, ax[3])), rg.d)));
+    across(r->d, &e1, &e2);
+    const double *ax = &r->step_x[r->views - r->passes];
+    r->a = v3_add(r->a, v3_add(v3_scale(e1, ax[0]), v3_scale(e2, ax[1])));
+    r->d = v3_norm(v3_add(r->d, v3_cross(v3_add(v3_scale(e1, ax[2]), v3_scale(e2, ax[3])), r->d)));
     return fmax(largest, fmax(fabs(ax[2]), fabs(ax[3])));
 }
 
 /* The angle the table reported for view @p v, in radians. */
-static double reported_rad(uint32_t v)
+static double reported_rad(struct reg_ctx *r, uint32_t v)
 {
-    return rg.reported_mdeg[v] * (M_PI / 180000.0);
+    return r->reported_mdeg[v] * (M_PI / 180000.0);
 }
 
 /* The unknowns at the turntable's answer. */
-static void start_from_table(void)
+static void start_from_table(struct reg_ctx *r)
 {
-    for (uint32_t v = 0; v < rg.views; v++)
-        rg.theta[v] = reported_rad(v);
-    rg.a = v3_from(rg.calib.axis_point_mm);
-    rg.d = v3_norm(v3_from(rg.calib.axis_dir));
+    for (uint32_t v = 0; v < r->views; v++)
+        r->theta[v] = reported_rad(r, v);
+    r->a = v3_from(r->calib.axis_point_mm);
+    r->d = v3_norm(v3_from(r->calib.axis_dir));
 }
 
 /* How far the solution is from the calibrated axis; "" or why it is refused. */
-static void check_bounds(struct reg_report *rep)
+static void check_bounds(struct reg_ctx *r, struct reg_report *rep)
 {
-    vec3 a0 = v3_from(rg.calib.axis_point_mm), d0 = v3_norm(v3_from(rg.calib.axis_dir));
-    vec3 da = v3_sub(rg.a, a0);
+    vec3 a0 = v3_from(r->calib.axis_point_mm), d0 = v3_norm(v3_from(r->calib.axis_dir));
+    vec3 da = v3_sub(r->a, a0);
     da = v3_sub(da, v3_scale(d0, v3_dot(da, d0))); /* along the axis changes nothing */
     rep->axis_shift_mm = v3_len(da);
-    double c = v3_dot(rg.d, d0);
+    double c = v3_dot(r->d, d0);
     rep->axis_tilt_deg = acos(c > 1.0 ? 1.0 : c) * 180.0 / M_PI;
     rep->refused[0] = '\0';
-    for (uint32_t v = 0; v < rg.views; v++) {
-        double corr = (rg.theta[v] - reported_rad(v)) * 180.0 / M_PI;
-        if (rg.present[v] && fabs(corr) > rg.p.max_correction_deg) {
+    for (uint32_t v = 0; v < r->views; v++) {
+        double corr = (r->theta[v] - reported_rad(r, v)) * 180.0 / M_PI;
+        if (r->present[v] && fabs(corr) > r->p.max_correction_deg) {
             snprintf(rep->refused, sizeof(rep->refused),
                      "view %u would turn %.2f deg from its reported angle, more than "
                      "max_correction_deg = %g",
-                     (unsigned)v, corr, rg.p.max_correction_deg);
+                     (unsigned)v, corr, r->p.max_correction_deg);
             return;
         }
     }
-    if (rep->axis_shift_mm > rg.p.max_axis_shift_mm)
+    if (rep->axis_shift_mm > r->p.max_axis_shift_mm)
         snprintf(rep->refused, sizeof(rep->refused),
                  "the axis would move %.2f mm, more than max_axis_shift_mm = %g",
-                 rep->axis_shift_mm, rg.p.max_axis_shift_mm);
-    else if (rep->axis_tilt_deg > rg.p.max_axis_tilt_deg)
+                 rep->axis_shift_mm, r->p.max_axis_shift_mm);
+    else if (rep->axis_tilt_deg > r->p.max_axis_tilt_deg)
         snprintf(rep->refused, sizeof(rep->refused),
                  "the axis would tilt %.2f deg, more than max_axis_tilt_deg = %g",
-                 rep->axis_tilt_deg, rg.p.max_axis_tilt_deg);
+                 rep->axis_tilt_deg, r->p.max_axis_tilt_deg);
 }
 
 /* Per-view numbers, the worst view, the loop closure and the first pair that does not match,
  * from the last pass. */
-static void summarise(struct reg_report *rep)
+static void summarise(struct reg_ctx *r, struct reg_report *rep)
 {
     uint64_t coupled = 0, loop_coupled = 0;
     double sq = 0.0, loop_sq = 0.0;
     rep->failed_view = rep->failed_against = -1;
-    for (uint32_t e = 0; e < rg.edges; e++) {
-        const struct edge_stats *st = &rg.stats[e];
+    for (uint32_t e = 0; e < r->edges; e++) {
+        const struct reg_edge_stats *st = &r->stats[e];
         coupled += st->coupled;
         sq += st->sq;
         double share = st->overlap > 0 ? (double)st->coupled / st->overlap : 0.0;
-        if (rep->failed_view < 0 && share < rg.p.min_coupled_share) {
-            rep->failed_view = (int)rg.edge_to[e];
-            rep->failed_against = (int)rg.edge_from[e];
+        if (rep->failed_view < 0 && share < r->p.min_coupled_share) {
+            rep->failed_view = (int)r->edge_to[e];
+            rep->failed_against = (int)r->edge_from[e];
             rep->failed_share = share;
         }
-        if (rg.edge_to[e] % rg.per_pass == 0 && rg.per_pass > 2) { /* a closing pair */
+        if (r->edge_to[e] % r->per_pass == 0 && r->per_pass > 2) { /* a closing pair */
             loop_sq += st->sq;
             loop_coupled += st->coupled;
         }
@@ -371,9 +338,10 @@ static void summarise(struct reg_report *rep)
     rep->loop_rms_mm = loop_coupled > 0 ? sqrt(loop_sq / (double)loop_coupled) : 0.0;
     rep->rms_mm = coupled > 0 ? sqrt(sq / (double)coupled) : 0.0;
     rep->worst_rms_mm = -1.0;
-    for (uint32_t v = 0; v < rg.views; v++) {
+    for (uint32_t v = 0; v < r->views; v++) {
         struct reg_view rv;
-        if (reg_view_pose(v, NULL, &rv) == 0 && rv.coupled > 0 && rv.rms_mm > rep->worst_rms_mm) {
+        if (reg_view_pose(r, v, NULL, &rv) == 0 && rv.coupled > 0 &&
+            rv.rms_mm > rep->worst_rms_mm) {
             rep->worst_rms_mm = rv.rms_mm;
             rep->worst_view = v;
         }
@@ -391,22 +359,22 @@ static void cell_in_object(const struct reg_cell *cl, const struct frame_xform *
 }
 
 /* Hand both passes' samples (object frames) to the alignment, spread to fit ALIGN_MAX_POINTS. */
-static void feed_alignment(void)
+static void feed_alignment(struct reg_ctx *r)
 {
     uint64_t valid[2] = {0, 0};
-    for (uint32_t v = 0; v < rg.views; v++)
-        for (size_t k = 0; k < cell_count() && rg.present[v]; k++)
-            valid[v / rg.per_pass] += view_cells(v)[k].valid;
+    for (uint32_t v = 0; v < r->views; v++)
+        for (size_t k = 0; k < cell_count(r) && r->present[v]; k++)
+            valid[v / r->per_pass] += view_cells(r, v)[k].valid;
     align_begin();
-    for (uint32_t v = 0; v < rg.views; v++) {
-        uint32_t pass = v / rg.per_pass;
+    for (uint32_t v = 0; v < r->views; v++) {
+        uint32_t pass = v / r->per_pass;
         uint64_t step = valid[pass] / ALIGN_MAX_POINTS + 1, seen = 0;
         struct frame_xform pose;
         struct reg_view rv;
-        if (reg_view_pose(v, &pose, &rv) != 0)
+        if (reg_view_pose(r, v, &pose, &rv) != 0)
             continue;
-        for (size_t k = 0; k < cell_count(); k++) {
-            const struct reg_cell *cl = &view_cells(v)[k];
+        for (size_t k = 0; k < cell_count(r); k++) {
+            const struct reg_cell *cl = &view_cells(r, v)[k];
             if (!cl->valid || seen++ % step != 0)
                 continue;
             vec3 p, n;
@@ -419,38 +387,38 @@ static void feed_alignment(void)
 /* The second pass's samples against the first pass's views, projectively, as the views of a
  * pass are paired: one point-to-plane step of first_from_second per call (object frame 1).
  * @retval pairs coupled; @p rms their residual */
-static uint32_t refine_second_step(double gate_mm, double *rms)
+static uint32_t refine_second_step(struct reg_ctx *r, double gate_mm, double *rms)
 {
-    const double min_cos = cos(rg.p.max_normal_deg * M_PI / 180.0);
+    const double min_cos = cos(r->p.max_normal_deg * M_PI / 180.0);
     struct lsq_rigid eq;
     lsq_rigid_clear(&eq);
     static struct frame_xform first[REG_MAX_VIEWS], cam_of[REG_MAX_VIEWS]; /* too big for a stack */
     struct reg_view rv;
-    for (uint32_t j = 0; j < rg.per_pass; j++)
-        if (reg_view_pose(j, &first[j], &rv) == 0)
+    for (uint32_t j = 0; j < r->per_pass; j++)
+        if (reg_view_pose(r, j, &first[j], &rv) == 0)
             frame_invert(&first[j], &cam_of[j]);
-    for (uint32_t v = rg.per_pass; v < rg.views; v++) {
+    for (uint32_t v = r->per_pass; v < r->views; v++) {
         struct frame_xform pose;
-        if (reg_view_pose(v, &pose, &rv) != 0)
+        if (reg_view_pose(r, v, &pose, &rv) != 0)
             continue;
-        for (size_t k = 0; k < cell_count(); k += 2) {
-            const struct reg_cell *cl = &view_cells(v)[k];
+        for (size_t k = 0; k < cell_count(r); k += 2) {
+            const struct reg_cell *cl = &view_cells(r, v)[k];
             if (!cl->valid)
                 continue;
             vec3 p, n;
             cell_in_object(cl, &pose, &p, &n);
-            for (uint32_t j = 0; j < rg.per_pass; j++) {
-                if (!rg.present[j])
+            for (uint32_t j = 0; j < r->per_pass; j++) {
+                if (!r->present[j])
                     continue;
                 vec3 c = frame_point(&cam_of[j], p);
                 if (c.z <= 1.0 || v3_dot(frame_dir(&cam_of[j], n), c) >= 0.0)
                     continue; /* behind the camera, or facing away from it */
                 double fu, fv;
-                camray_project(&rg.calib, c, &fu, &fv);
-                long u = lround(fu / rg.stride), w = lround(fv / rg.stride);
-                if (u < 0 || w < 0 || u >= (long)rg.gw || w >= (long)rg.gh)
+                camray_project(&r->calib, c, &fu, &fv);
+                long u = lround(fu / r->stride), w = lround(fv / r->stride);
+                if (u < 0 || w < 0 || u >= (long)r->gw || w >= (long)r->gh)
                     continue;
-                const struct reg_cell *cq = &view_cells(j)[(size_t)w * rg.gw + (size_t)u];
+                const struct reg_cell *cq = &view_cells(r, j)[(size_t)w * r->gw + (size_t)u];
                 if (!cq->valid)
                     continue;
                 vec3 q, nq;
@@ -466,105 +434,106 @@ static uint32_t refine_second_step(double gate_mm, double *rms)
     *rms = coupled > 0 ? sqrt(eq.sq / coupled) : 0.0;
     struct frame_xform s, moved;
     if (lsq_rigid_step(&eq, &s) == 0) {
-        frame_compose(&s, &rg.first_from_second, &moved);
-        rg.first_from_second = moved;
+        frame_compose(&s, &r->first_from_second, &moved);
+        r->first_from_second = moved;
     }
     return coupled;
 }
 
 /* Two passes: the second found in the first (align.h), then refined against the first pass's
  * views; a second pass that matches nothing fails the registration at its first view. */
-static void align_second_pass(struct reg_report *rep)
+static void align_second_pass(struct reg_ctx *r, struct reg_report *rep)
 {
-    struct align_params ap = {rg.p.max_pair_mm, rg.p.max_normal_deg, rg.p.min_coupled_share};
+    struct align_params ap = {r->p.max_pair_mm, r->p.max_normal_deg, r->p.min_coupled_share};
     struct align_report ar;
-    rg.second_aligned = 0; /* the second pass's points in its own frame */
-    feed_alignment();
-    if (align_solve(&ap, &rg.first_from_second, &ar) != 0 || !ar.found) {
-        rep->failed_view = (int)rg.per_pass;
+    r->second_aligned = 0; /* the second pass's points in its own frame */
+    feed_alignment(r);
+    if (align_solve(&ap, &r->first_from_second, &ar) != 0 || !ar.found) {
+        rep->failed_view = (int)r->per_pass;
         rep->failed_against = -1;
         rep->failed_share = ar.coupled_share;
         return;
     }
-    rg.second_aligned = 1;
+    r->second_aligned = 1;
     double rms = 0.0;
     for (int it = 0; it < 15; it++)
-        rep->second_coupled = refine_second_step(rg.p.max_pair_mm, &rms);
+        rep->second_coupled = refine_second_step(r, r->p.max_pair_mm, &rms);
     rep->second_rms_mm = rms;
     rep->second_turned_deg = ar.turned_deg;
     rep->second_share = ar.coupled_share;
 }
 
-int reg_solve(struct reg_report *rep)
+int reg_solve(struct reg_ctx *r, struct reg_report *rep)
 {
     memset(rep, 0, sizeof(*rep));
-    rep->stride = rg.stride;
-    for (uint32_t v = 0; v < rg.views; v++)
-        rep->views += rg.present[v];
-    make_edges();
-    start_from_table();
-    rg.use_solution = 0;
-    pass(rg.p.max_pair_mm, 0);
-    rep->score_before_mm = rep->score_after_mm = score();
-    if (rg.p.enabled && rg.edges > 0 && rg.present[0] && rg.present[rg.views - rg.per_pass]) {
+    rep->stride = r->stride;
+    for (uint32_t v = 0; v < r->views; v++)
+        rep->views += r->present[v];
+    make_edges(r);
+    start_from_table(r);
+    r->use_solution = 0;
+    pass(r, r->p.max_pair_mm, 0);
+    rep->score_before_mm = rep->score_after_mm = score(r);
+    if (r->p.enabled && r->edges > 0 && r->present[0] && r->present[r->views - r->per_pass]) {
         rep->solved = 1;
-        for (uint32_t it = 0; it < rg.p.iterations; it++) {
+        for (uint32_t it = 0; it < r->p.iterations; it++) {
             /* wide pairs first, to reach errors of a degree or two, then the working gate */
-            double gate = rg.p.max_pair_mm * fmax(1.0, 4.0 / (double)(1u << (it < 8 ? it : 8)));
-            pass(gate, 1);
+            double gate = r->p.max_pair_mm * fmax(1.0, 4.0 / (double)(1u << (it < 8 ? it : 8)));
+            pass(r, gate, 1);
             rep->iterations = it + 1;
-            if (gauss_newton_step() < 1e-5 && gate <= rg.p.max_pair_mm) /* 0.0006 deg */
+            if (gauss_newton_step(r) < 1e-5 && gate <= r->p.max_pair_mm) /* 0.0006 deg */
                 break;
         }
-        pass(rg.p.max_pair_mm, 0);
-        rep->score_after_mm = score();
-        check_bounds(rep);
+        pass(r, r->p.max_pair_mm, 0);
+        rep->score_after_mm = score(r);
+        check_bounds(r, rep);
         rep->accepted = rep->refused[0] == '\0' && rep->score_after_mm < rep->score_before_mm;
         if (rep->refused[0] == '\0' && !rep->accepted)
             snprintf(rep->refused, sizeof(rep->refused),
                      "the residual did not improve (%.3f mm -> %.3f mm)", rep->score_before_mm,
                      rep->score_after_mm);
         if (!rep->accepted) {
-            start_from_table();
-            pass(rg.p.max_pair_mm, 0);
+            start_from_table(r);
+            pass(r, r->p.max_pair_mm, 0);
         }
-        rg.use_solution = rep->accepted;
+        r->use_solution = rep->accepted;
     }
-    summarise(rep);
-    if (rg.passes == 2)
-        align_second_pass(rep);
+    summarise(r, rep);
+    if (r->passes == 2)
+        align_second_pass(r, rep);
     return 0;
 }
 
-int reg_view_pose(uint32_t v, struct frame_xform *obj_from_cam, struct reg_view *out)
+int reg_view_pose(struct reg_ctx *r, uint32_t v, struct frame_xform *obj_from_cam,
+                  struct reg_view *out)
 {
-    if (v >= rg.views || !rg.present[v])
+    if (v >= r->views || !r->present[v])
         return -EINVAL;
     memset(out, 0, sizeof(*out));
     out->present = 1;
-    out->reported_mdeg = rg.reported_mdeg[v];
-    double theta = rg.use_solution ? rg.theta[v] : reported_rad(v);
+    out->reported_mdeg = r->reported_mdeg[v];
+    double theta = r->use_solution ? r->theta[v] : reported_rad(r, v);
     out->angle_deg = theta * 180.0 / M_PI;
-    out->correction_deg = out->angle_deg - rg.reported_mdeg[v] / 1000.0;
+    out->correction_deg = out->angle_deg - r->reported_mdeg[v] / 1000.0;
     double sq = 0.0;
-    for (uint32_t e = 0; e < rg.edges; e++) {
-        if (rg.edge_from[e] != v && rg.edge_to[e] != v)
+    for (uint32_t e = 0; e < r->edges; e++) {
+        if (r->edge_from[e] != v && r->edge_to[e] != v)
             continue;
-        out->overlap += rg.stats[e].overlap;
-        out->coupled += rg.stats[e].coupled;
-        sq += rg.stats[e].sq;
+        out->overlap += r->stats[e].overlap;
+        out->coupled += r->stats[e].coupled;
+        sq += r->stats[e].sq;
     }
     out->rms_mm = out->coupled > 0 ? sqrt(sq / out->coupled) : 0.0;
     if (obj_from_cam != NULL) {
-        struct scan_calib c = rg.calib;
-        if (rg.use_solution) {
-            c.axis_point_mm[0] = rg.a.x, c.axis_point_mm[1] = rg.a.y, c.axis_point_mm[2] = rg.a.z;
-            c.axis_dir[0] = rg.d.x, c.axis_dir[1] = rg.d.y, c.axis_dir[2] = rg.d.z;
+        struct scan_calib c = r->calib;
+        if (r->use_solution) {
+            c.axis_point_mm[0] = r->a.x, c.axis_point_mm[1] = r->a.y, c.axis_point_mm[2] = r->a.z;
+            c.axis_dir[0] = r->d.x, c.axis_dir[1] = r->d.y, c.axis_dir[2] = r->d.z;
         }
         frame_object_from_camera_rad(&c, theta, obj_from_cam);
-        if (v >= rg.per_pass && rg.second_aligned) { /* into the first pass's object frame */
+        if (v >= r->per_pass && r->second_aligned) { /* into the first pass's object frame */
             struct frame_xform in_second = *obj_from_cam;
-            frame_compose(&rg.first_from_second, &in_second, obj_from_cam);
+            frame_compose(&r->first_from_second, &in_second, obj_from_cam);
         }
     }
     return 0;

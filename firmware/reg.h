@@ -1,13 +1,14 @@
 /* Joint registration of all views of a turntable scan: the views as turns about one axis, the
  * axis re-estimated from the scan's own data and each view's angle free, every neighbouring pair
  * of views (the last back to the first: the loop closure) pulled together by point-to-plane
- * residuals at once, in static memory. */
+ * residuals at once, in a context its owner keeps (struct reg_ctx). */
 #ifndef REG_H
 #define REG_H
 
 #include "decode.h"
 #include "frames.h"
 #include "tri.h"
+#include "vec3.h"
 
 struct reg_params {
     uint32_t enabled;          /**< 0: keep the turntable poses */
@@ -36,26 +37,64 @@ struct reg_view {
 
 /** The whole scan's registration. */
 struct reg_report {
-    uint32_t views, stride;    /**< views added; pixel stride of the kept samples */
-    int solved;                /**< 1: the joint adjustment ran (icp = 1, two views or more) */
-    int accepted;              /**< 1: its poses are used; 0: the turntable's */
-    uint32_t iterations;       /**< steps taken */
+    uint32_t views, stride; /**< views added; pixel stride of the kept samples */
+    int solved;             /**< 1: the joint adjustment ran (icp = 1, two views or more) */
+    int accepted;           /**< 1: its poses are used; 0: the turntable's */
+    uint32_t iterations;    /**< steps taken */
     double score_before_mm, score_after_mm; /**< truncated residual over every overlap: the
                                                  square root of mean(min(r, max_pair)^2) */
-    double rms_mm;             /**< point-to-plane residual of all coupled pairs, final */
-    double loop_rms_mm;        /**< of the closing pair (last view back to the first) */
-    double axis_shift_mm, axis_tilt_deg;   /**< the axis against the calibrated one */
-    uint32_t worst_view;       /**< the view with the largest residual */
+    double rms_mm;                       /**< point-to-plane residual of all coupled pairs, final */
+    double loop_rms_mm;                  /**< of the closing pair (last view back to the first) */
+    double axis_shift_mm, axis_tilt_deg; /**< the axis against the calibrated one */
+    uint32_t worst_view;                 /**< the view with the largest residual */
     double worst_rms_mm;
-    int failed_view;           /**< -1, or a view that does not match the one before it (or
-                                    the first view of a second pass that matches nothing) */
-    int failed_against;        /**< the view it was compared with (-1: the first pass) */
-    double failed_share;       /**< the share of their overlap that coupled */
-    char refused[160];         /**< why a solved adjustment was not accepted ("" when it was) */
-    double second_turned_deg;  /**< two passes: how far the object was turned between them */
-    double second_share;       /**< the share of the second pass's points the search paired */
-    uint32_t second_coupled;   /**< pairs of the final refinement against the first pass */
-    double second_rms_mm;      /**< and their residual */
+    int failed_view;          /**< -1, or a view that does not match the one before it (or
+                                   the first view of a second pass that matches nothing) */
+    int failed_against;       /**< the view it was compared with (-1: the first pass) */
+    double failed_share;      /**< the share of their overlap that coupled */
+    char refused[160];        /**< why a solved adjustment was not accepted ("" when it was) */
+    double second_turned_deg; /**< two passes: how far the object was turned between them */
+    double second_share;      /**< the share of the second pass's points the search paired */
+    uint32_t second_coupled;  /**< pairs of the final refinement against the first pass */
+    double second_rms_mm;     /**< and their residual */
+};
+
+#define REG_PARAMS (REG_MAX_VIEWS + 4u) /* every angle, two shifts, two tilts */
+#define REG_EDGES REG_MAX_VIEWS         /* a ring: one edge per view */
+
+/** One kept pixel of a view, in its camera frame. */
+struct reg_cell {
+    float xyz[3];
+    float normal[3];
+    uint8_t rgb[3];
+    uint8_t valid;
+};
+_Static_assert(sizeof(struct reg_cell) == 28, "cell layout");
+
+/** What the pairs of one edge (both directions) gave in the last pass. */
+struct reg_edge_stats {
+    uint32_t overlap, coupled;
+    double sq, trunc_sq; /**< squared residuals of coupled pairs; truncated over the overlap */
+};
+
+/** A registration: every view's samples and the joint solution, in one place (about
+ *  REG_MAX_CELLS x 28 bytes). Its owner declares it static (a job, a test) and passes it to
+ *  every call; two of them are two independent registrations. The fields are reg.c's. */
+struct reg_ctx {
+    struct reg_cell cells[REG_MAX_CELLS];
+    double normal_a[REG_PARAMS * REG_PARAMS], normal_b[REG_PARAMS], step_x[REG_PARAMS];
+    struct reg_params p;
+    struct scan_calib calib;
+    uint32_t views, passes, per_pass, stride, gw, gh;
+    int32_t reported_mdeg[REG_MAX_VIEWS];
+    uint8_t present[REG_MAX_VIEWS];
+    double theta[REG_MAX_VIEWS]; /**< radians */
+    vec3 a, d;                   /**< the axis */
+    int use_solution;            /**< poses from theta, a, d rather than the turntable's */
+    uint32_t edges, edge_from[REG_EDGES], edge_to[REG_EDGES];
+    struct reg_edge_stats stats[REG_EDGES];
+    int second_aligned; /**< the second pass's views go through first_from_second */
+    struct frame_xform first_from_second;
 };
 
 /** Forget every view and size the samples for @p views views of @p width x @p height in
@@ -63,20 +102,21 @@ struct reg_report {
  *  which is found in the first without a starting pose, align.h): the stride grows beyond
  *  params->sample_stride until they fit REG_MAX_CELLS.
  *  @retval 0 @retval -E2BIG more views than REG_MAX_VIEWS, or not passes x views per pass */
-int reg_begin(const struct reg_params *params, const struct scan_calib *calib, uint32_t views,
-              uint32_t passes, uint32_t width, uint32_t height);
+int reg_begin(struct reg_ctx *r, const struct reg_params *params, const struct scan_calib *calib,
+              uint32_t views, uint32_t passes, uint32_t width, uint32_t height);
 
 /** Keep samples of view @p index (camera frame) taken at the reported @p angle_mdeg.
  *  @retval 0 @retval -EINVAL index or size outside what reg_begin was given */
-int reg_add_view(uint32_t index, int32_t angle_mdeg, const struct decode_maps *maps,
-                 const struct tri_range *range, const uint8_t *rgb);
+int reg_add_view(struct reg_ctx *r, uint32_t index, int32_t angle_mdeg,
+                 const struct decode_maps *maps, const struct tri_range *range, const uint8_t *rgb);
 
 /** Register every added view jointly. @param report out
  *  @retval 0 (a failed match is reported in report->failed_view, not as an error) */
-int reg_solve(struct reg_report *report);
+int reg_solve(struct reg_ctx *r, struct reg_report *report);
 
 /** View @p index after reg_solve: its pose (camera frame to object frame) and numbers.
  *  @retval 0 @retval -EINVAL not added */
-int reg_view_pose(uint32_t index, struct frame_xform *obj_from_cam, struct reg_view *view);
+int reg_view_pose(struct reg_ctx *r, uint32_t index, struct frame_xform *obj_from_cam,
+                  struct reg_view *view);
 
 #endif

@@ -20,11 +20,11 @@ static uint8_t light_rgb[COLOUR_MAX_FRAMES][HAL_MAX_PIXELS * 3];
 static int light_present[COLOUR_MAX_FRAMES];
 static uint8_t view_rgb[HAL_MAX_PIXELS * 3]; /* the view's colour: compensated, or raw */
 static float view_confidence[HAL_MAX_PIXELS];
-static uint8_t view_reason[HAL_MAX_PIXELS];  /* decoded, then refined by each later stage */
-static uint8_t hdr_choice[HAL_MAX_PIXELS];   /* HDR: the exposure each pixel is read at */
-static uint8_t hdr_grey[HAL_MAX_PIXELS];     /* HDR: one exposure of the pattern being merged */
-static struct scan_params view_params;        /* of the view being fed */
-static uint32_t view_patterns, view_lights;    /* its pattern and colour frames */
+static uint8_t view_reason[HAL_MAX_PIXELS]; /* decoded, then refined by each later stage */
+static uint8_t hdr_choice[HAL_MAX_PIXELS];  /* HDR: the exposure each pixel is read at */
+static uint8_t hdr_grey[HAL_MAX_PIXELS];    /* HDR: one exposure of the pattern being merged */
+static struct scan_params view_params;      /* of the view being fed */
+static uint32_t view_patterns, view_lights; /* its pattern and colour frames */
 
 int scan_check(const struct scan_params *p, const struct scan_calib *c, char *msg, size_t len)
 {
@@ -194,9 +194,10 @@ int scan_feed_frame(uint32_t pattern, const uint8_t *pixels, uint32_t channels,
     /* The white frame is kept in colour (its grey is derived again offline); the others are
      * kept exactly as the decoder saw them. */
     if (rc == 0 && sink != NULL && sink->save != NULL)
-        rc = colour ? sink->save(sink->priv, pattern, colour_rgb, view_params.width,
-                                 view_params.height, 3)
-                    : sink->save(sink->priv, pattern, grey, view_params.width, view_params.height, 1);
+        rc = colour
+                 ? sink->save(sink->priv, pattern, colour_rgb, view_params.width,
+                              view_params.height, 3)
+                 : sink->save(sink->priv, pattern, grey, view_params.width, view_params.height, 1);
     return rc;
 }
 
@@ -263,13 +264,13 @@ int scan_finish_view(const struct scan_calib *c, int32_t angle_mdeg, struct scan
     if (rc == 0)
         rc = refine_columns(&view->maps, (int)view_params.refine, &view->column);
     if (rc == 0)
-        rc = tri_range_image(c, view->width, view->height, view->column, view_reason,
-                             &view->range);
+        rc = tri_range_image(c, view->width, view->height, view->column, view_reason, &view->range);
     if (rc == 0)
         rc = tri_normals(&view->range, view_reason, view_params.normal_radius_px,
                          view_params.max_depth_jump_mm);
     if (rc == 0)
-        rc = scan_recolour(&view_params.colour, c, view);
+        rc = scan_recolour(&view_params.colour, c, view, NULL); /* fit: multi's, until the
+                                                                   job's model colours it */
     if (rc != 0)
         return rc;
     info->angle_mdeg = angle_mdeg;
@@ -398,7 +399,6 @@ static int capture_patterns(const struct hal *hal, const struct scan_params *p, 
     return rc;
 }
 
-
 /* The colour frames (colour_layout): projector off, each with its lights and exposure; lights off
  * and the camera back at its own exposure after, also on failure. */
 static int capture_lights(const struct hal *hal, const struct scan_params *p,
@@ -439,8 +439,8 @@ static int capture_lights(const struct hal *hal, const struct scan_params *p,
     return rc != 0 ? rc : rc_off;
 }
 
-int scan_snapshot(const struct hal *hal, const struct scan_params *p,
-                  const struct scan_calib *c, const uint8_t **rgb)
+int scan_snapshot(const struct hal *hal, const struct scan_params *p, const struct scan_calib *c,
+                  const uint8_t **rgb)
 {
     struct scan_view_info info;
     memset(&info, 0, sizeof(info));
@@ -494,9 +494,9 @@ int scan_take_view(const struct hal *hal, const struct scan_params *p, const str
     return rc != 0 ? rc : scan_finish_view(c, angle_mdeg, view, info);
 }
 
-int scan_keep_for_registration(uint32_t index, const struct scan_view *view)
+int scan_keep_for_registration(struct reg_ctx *reg, uint32_t index, const struct scan_view *view)
 {
-    return reg_add_view(index, view->angle_mdeg, &view->maps, &view->range, view->rgb);
+    return reg_add_view(reg, index, view->angle_mdeg, &view->maps, &view->range, view->rgb);
 }
 
 int scan_fuse_view(const struct scan_calib *calib, const struct scan_view *view,
@@ -527,11 +527,11 @@ void scan_attach_colour(struct scan_view *view)
 }
 
 int scan_recolour(const struct colour_params *colour, const struct scan_calib *c,
-                  struct scan_view *view)
+                  struct scan_view *view, struct reflect_pool *pool)
 {
     view->colour_method = colour->method;
     return colour_compute(colour, c, &view->maps, &view->range, view->white_rgb, view->lights,
-                          view->rgb, view->confidence);
+                          view->rgb, view->confidence, pool);
 }
 
 void scan_close(const struct hal *hal)

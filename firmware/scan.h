@@ -41,10 +41,10 @@ struct scan_view {
 /** Where a view restored from its kept range image goes (scan_restore_view): the firmware's
  *  own buffers, to be filled by the caller. */
 struct scan_view_fill {
-    uint8_t *reason;  /**< width * height reason codes */
-    float *xyz_mm;    /**< 3 per pixel (valid pixels) */
-    float *normal;    /**< 3 per pixel (valid pixels) */
-    uint8_t *rgb;     /**< 3 per pixel */
+    uint8_t *reason; /**< width * height reason codes */
+    float *xyz_mm;   /**< 3 per pixel (valid pixels) */
+    float *normal;   /**< 3 per pixel (valid pixels) */
+    uint8_t *rgb;    /**< 3 per pixel */
     float *confidence;
 };
 
@@ -125,8 +125,9 @@ uint8_t *scan_frame_buffer(uint32_t frame);
 int scan_finish_view(const struct scan_calib *calib, int32_t angle_mdeg, struct scan_view *view,
                      struct scan_view_info *info);
 
-/** Keep samples of @p view as view @p index of the joint registration (reg_begin first). */
-int scan_keep_for_registration(uint32_t index, const struct scan_view *view);
+/** Keep samples of @p view as view @p index of the joint registration @p reg (reg_begin
+ *  first). */
+int scan_keep_for_registration(struct reg_ctx *reg, uint32_t index, const struct scan_view *view);
 
 /** Fuse @p view into the volume (fusion_begin first) seen through @p obj_from_cam. */
 int scan_fuse_view(const struct scan_calib *calib, const struct scan_view *view,
@@ -138,9 +139,10 @@ int scan_save_cloud(const struct hal *hal, const struct scan_view *view,
                     const struct frame_xform *obj_from_cam, const char *path);
 
 /** Recompute @p view's colour and confidence with other colour parameters (same frames, same
- *  geometry): the white calibration compares the methods on one view. @retval 0 or -EINVAL */
+ *  geometry): the white calibration compares the methods on one view; method fit colours with
+ *  @p pool (colour_compute; NULL: none). @retval 0 or -EINVAL */
 int scan_recolour(const struct colour_params *colour, const struct scan_calib *calib,
-                  struct scan_view *view);
+                  struct scan_view *view, struct reflect_pool *pool);
 
 /** Point @p view (restored from its range image) at the colour frames fed since
  *  scan_begin_view (scan_feed_light_frame, and the white colour read into scan_frame_buffer),

@@ -13,15 +13,15 @@ struct scan_calib {
     double cam_dist[5]; /**< camera lens distortion k1, k2, p1, p2, k3 (firmware/lens.h) */
     double proj_fx_px, proj_fy_px, proj_cx_px, proj_cy_px; /**< projector pinhole intrinsics */
     uint32_t proj_width, proj_height;                      /**< projector resolution */
-    double proj_dist[5]; /**< projector lens distortion k1, k2, p1, p2, k3 */
+    double proj_dist[5];     /**< projector lens distortion k1, k2, p1, p2, k3 */
     double proj_rot[9];      /**< rotation camera -> projector, row-major: p_proj = R p_cam + t */
     double proj_trans_mm[3]; /**< translation camera -> projector */
     double axis_point_mm[3]; /**< a point on the turntable axis, on the table surface */
     double axis_dir[3];      /**< unit direction of the axis, pointing up */
     uint32_t light_count;    /**< number of white lights */
     double light_pos_mm[HAL_MAX_LIGHTS][3]; /**< light positions */
-    double light_gain[HAL_MAX_LIGHTS]; /**< each light's intensity relative to their mean (1:
-                                            equal lights); the multi method divides by it */
+    double light_gain[HAL_MAX_LIGHTS];      /**< each light's intensity relative to their mean (1:
+                                                 equal lights); the multi method divides by it */
 };
 
 enum colour_method { COLOUR_NONE = 0, COLOUR_SINGLE, COLOUR_UNIFORM, COLOUR_MULTI, COLOUR_FIT };
@@ -45,11 +45,11 @@ struct colour_params {
     uint32_t exposure_us, gain_milli; /**< the camera's: patterns, projector white, dark */
     uint32_t all_lights_exposure_us;  /**< the all-lights frame (0: exposure_us) */
     uint32_t light_exposure_us;       /**< each single-light frame (0: exposure_us) */
-    uint32_t bracket;     /**< multi: each light also at this x its exposure (0, 1: not) */
-    double shadow_ratio;  /**< multi: a light estimating below this x the best one is shadowed */
-    uint32_t clusters;    /**< fit: material clusters at most (reflect.h) */
-    uint32_t taken_with;  /**< the method the colour frames were taken with, when processing
-                               with another (0: this one): method none reads a scan that has them */
+    uint32_t bracket;    /**< multi: each light also at this x its exposure (0, 1: not) */
+    double shadow_ratio; /**< multi: a light estimating below this x the best one is shadowed */
+    uint32_t clusters;   /**< fit: material clusters at most (reflect.h) */
+    uint32_t taken_with; /**< the method the colour frames were taken with, when processing
+                              with another (0: this one): method none reads a scan that has them */
 };
 
 /** Exposures an HDR pattern can be captured at. */

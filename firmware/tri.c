@@ -28,7 +28,8 @@ static int distorted_column_depth(const struct scan_calib *c, vec3 d, double col
         double xn = q.x / q.z, yn = q.y / q.z, xd, yd, j[4];
         lens_distort(c->proj_dist, xn, yn, &xd, &yd);
         lens_jacobian(c->proj_dist, xn, yn, j);
-        double dxn = (a.x * q.z - q.x * a.z) / (q.z * q.z), dyn = (a.y * q.z - q.y * a.z) / (q.z * q.z);
+        double dxn = (a.x * q.z - q.x * a.z) / (q.z * q.z),
+               dyn = (a.y * q.z - q.y * a.z) / (q.z * q.z);
         double deriv = j[0] * dxn + j[1] * dyn;
         if (deriv == 0.0)
             return 0;
@@ -47,7 +48,8 @@ int tri_range_image(const struct scan_calib *c, uint32_t width, uint32_t height,
 {
     if (width != c->cam_width || height != c->cam_height)
         return -EINVAL;
-    int rc = camray_prepare(c);
+    struct camray rays;
+    int rc = camray_prepare(c, &rays);
     if (rc != 0)
         return rc;
     const int proj_pinhole = lens_is_pinhole(c->proj_dist);
@@ -66,7 +68,7 @@ int tri_range_image(const struct scan_calib *c, uint32_t width, uint32_t height,
             size_t i = (size_t)y * width + x;
             if (reason[i] != SCAN_VALID)
                 continue;
-            vec3 ray = camray_at(c, x, y);
+            vec3 ray = camray_at(c, rays, x, y);
             double a = ((double)column[i] - c->proj_cx_px) / c->proj_fx_px;
             vec3 normal = v3_sub(rt_ex, v3_scale(rt_ez, a));
             double denom = v3_dot(normal, ray);
@@ -112,8 +114,8 @@ static uint32_t reach(const uint8_t *reason, size_t i, long step, uint32_t max_s
 /* Tangent along one image axis between the farthest continuous neighbours on either side.
  * Column quantisation makes the range image a staircase; a wide stencil averages it out.
  * @p before / @p after: how many steps exist in the image on each side. Returns 0 if none. */
-static int tangent(const uint8_t *reason, size_t i, uint32_t before, uint32_t after,
-                   long step, uint32_t radius, double max_jump, vec3 *out)
+static int tangent(const uint8_t *reason, size_t i, uint32_t before, uint32_t after, long step,
+                   uint32_t radius, double max_jump, vec3 *out)
 {
     uint32_t back = reach(reason, i, -step, before < radius ? before : radius, max_jump);
     uint32_t fwd = reach(reason, i, step, after < radius ? after : radius, max_jump);
@@ -158,8 +160,11 @@ int tri_restore(uint32_t width, uint32_t height, uint32_t valid_count, struct tr
 {
     if ((uint64_t)width * height > HAL_MAX_PIXELS)
         return -E2BIG;
-    *range = (struct tri_range){.xyz_mm = xyz_map, .normal = normal_map, .width = width,
-                                .height = height, .valid_count = valid_count};
+    *range = (struct tri_range){.xyz_mm = xyz_map,
+                                .normal = normal_map,
+                                .width = width,
+                                .height = height,
+                                .valid_count = valid_count};
     *xyz_mm = xyz_map;
     *normal = normal_map;
     return 0;

@@ -254,7 +254,8 @@ double sim_bvh_closest(const struct sim_bvh *b, vec3 p, double max_dist, vec3 *c
         }
         for (uint32_t i = n->first; i < n->first + n->count; i++) {
             uint32_t t = b->tri_order[i];
-            const float *a = vert(b->mesh, t, 0), *bb = vert(b->mesh, t, 1), *c = vert(b->mesh, t, 2);
+            const float *a = vert(b->mesh, t, 0), *bb = vert(b->mesh, t, 1),
+                        *c = vert(b->mesh, t, 2);
             vec3 q = closest_on_triangle(p, v3(a[0], a[1], a[2]), v3(bb[0], bb[1], bb[2]),
                                          v3(c[0], c[1], c[2]));
             double d = v3_len(v3_sub(p, q));

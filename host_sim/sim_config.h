@@ -14,12 +14,12 @@ struct sim_config {
     char mesh_file[HAL_MAX_PATH];
     double object_height_mm;
     double second_pass_pose_deg[3]; /**< the object_pose of a scan's second pass */
-    double object_pose_deg[3]; /**< turned about x, then y, then z before it is stood on the
-                                    table (90, 0, 0: an upright object on its side) */
-    double slip_mm[3];   /**< the object slips on the table by this (object frame) ... */
-    double slip_at_deg;  /**< ... from this table angle on */
-    uint32_t segments; /**< tessellation of analytic shapes */
-    char material[16]; /**< lambert | phong | merl */
+    double object_pose_deg[3];      /**< turned about x, then y, then z before it is stood on the
+                                         table (90, 0, 0: an upright object on its side) */
+    double slip_mm[3];              /**< the object slips on the table by this (object frame) ... */
+    double slip_at_deg;             /**< ... from this table angle on */
+    uint32_t segments;              /**< tessellation of analytic shapes */
+    char material[16];              /**< lambert | phong | merl */
     char merl_file[HAL_MAX_PATH];
     char merl_name[64];
     double phong_ks, phong_ke;
@@ -29,10 +29,10 @@ struct sim_config {
     uint32_t table_angle_error_mdeg;
     double black_offset_dn, ambient_dn, read_noise_dn, electrons_per_dn;
     double projector_intensity_dn, projector_black_level, projector_blur_px;
-    double camera_blur_px;  /**< sigma of the camera lens's Gaussian point spread */
-    double frame_rate_hz;   /**< the sensor's streaming rate (0: a frame takes its exposure) */
-    uint32_t readout_us;    /**< from a frame's end to its arrival */
-    uint32_t jpeg_quality;  /**< 1..100: every frame goes through a JPEG round trip; 0: off */
+    double camera_blur_px;   /**< sigma of the camera lens's Gaussian point spread */
+    double frame_rate_hz;    /**< the sensor's streaming rate (0: a frame takes its exposure) */
+    uint32_t readout_us;     /**< from a frame's end to its arrival */
+    uint32_t jpeg_quality;   /**< 1..100: every frame goes through a JPEG round trip; 0: off */
     uint32_t bounce_samples; /**< one bounce of the projector's light: directions per point */
     double light_intensity_dn, light_diffuser_mm, reference_distance_mm;
     uint32_t reference_exposure_us;

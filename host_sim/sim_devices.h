@@ -30,7 +30,7 @@ struct camera_sim {
     int32_t (*table_angle)(void *priv); /* where the turntable is, if there is one */
     void *table_priv;
     int is_open;
-    uint64_t frames; /* captures attempted since open */
+    uint64_t frames;   /* captures attempted since open */
     uint64_t last_key; /* what the last frame showed, and how many in a row did (noise_id) */
     uint32_t repeat;
     struct sim_sources shown; /* what the last frame showed, when and at what table angle: */

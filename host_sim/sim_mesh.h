@@ -6,11 +6,11 @@
 
 struct sim_mesh {
     uint32_t vert_count, tri_count;
-    float *pos;    /**< 3 per vertex, object frame, mm (z up, base on z = 0 once placed) */
-    float *normal; /**< 3 per vertex, area-weighted smooth normals */
-    uint32_t *tri; /**< 3 vertex indices per triangle, counter-clockwise seen from outside */
-    uint8_t *rgb;  /**< 3 per vertex when the PLY file has vertex colours, else NULL; the linear
-                      floats (red_linear...) where the file has them, else its bytes as they are */
+    float *pos;     /**< 3 per vertex, object frame, mm (z up, base on z = 0 once placed) */
+    float *normal;  /**< 3 per vertex, area-weighted smooth normals */
+    uint32_t *tri;  /**< 3 vertex indices per triangle, counter-clockwise seen from outside */
+    uint8_t *rgb;   /**< 3 per vertex when the PLY file has vertex colours, else NULL; the linear
+                       floats (red_linear...) where the file has them, else its bytes as they are */
     float *quality; /**< per vertex when the PLY file has `quality` (clouds: colour confidence) */
 };
 
@@ -29,8 +29,8 @@ int sim_mesh_corner(struct sim_mesh *m, double side_mm, uint32_t segments);
 int sim_mesh_groove(struct sim_mesh *m, double side_mm, double opening_deg, uint32_t segments);
 int sim_mesh_torus(struct sim_mesh *m, double major_mm, double minor_mm, uint32_t segments);
 /** Load an ASCII or binary little-endian PLY (vertex x y z, uchar red green blue when present,
- *  faces as lists; other properties are skipped). @param err out: what is wrong, with the file name @retval 0 ok @retval -EINVAL -ENOMEM
- * -errno */
+ *  faces as lists; other properties are skipped). @param err out: what is wrong, with the file name
+ * @retval 0 ok @retval -EINVAL -ENOMEM -errno */
 int sim_mesh_load_ply(struct sim_mesh *m, const char *path, char *err, unsigned err_len);
 /** The same for a point cloud: faces are optional. */
 int sim_mesh_load_ply_points(struct sim_mesh *m, const char *path, char *err, unsigned err_len);

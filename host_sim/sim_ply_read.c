@@ -121,10 +121,14 @@ struct ply_header {
 /* The role of a vertex property (enum ply_role); -1 for one that is skipped. */
 static int vertex_role(const char *name)
 {
-    static const char *const names[] = {[ROLE_X] = "x",       [ROLE_Y] = "y",
-                                        [ROLE_Z] = "z",       [ROLE_FACE] = "",
-                                        [ROLE_RED] = "red",   [ROLE_GREEN] = "green",
-                                        [ROLE_BLUE] = "blue", [ROLE_QUALITY] = "quality",
+    static const char *const names[] = {[ROLE_X] = "x",
+                                        [ROLE_Y] = "y",
+                                        [ROLE_Z] = "z",
+                                        [ROLE_FACE] = "",
+                                        [ROLE_RED] = "red",
+                                        [ROLE_GREEN] = "green",
+                                        [ROLE_BLUE] = "blue",
+                                        [ROLE_QUALITY] = "quality",
                                         [ROLE_RED_LINEAR] = "red_linear",
                                         [ROLE_GREEN_LINEAR] = "green_linear",
                                         [ROLE_BLUE_LINEAR] = "blue_linear"};
@@ -250,7 +254,9 @@ static int read_element(FILE *f, const struct ply_header *h, const struct ply_el
                                                                                               : v);
                 else if (is_vertex && p->role >= ROLE_RED_LINEAR && m->rgb != NULL)
                     m->rgb[3 * r + (unsigned long)(p->role - ROLE_RED_LINEAR)] =
-                        (uint8_t)(v < 0 ? 0 : v > 1 ? 255 : v * 255.0 + 0.5);
+                        (uint8_t)(v < 0   ? 0
+                                  : v > 1 ? 255
+                                          : v * 255.0 + 0.5);
                 continue;
             }
             double cnt;
@@ -278,8 +284,9 @@ static size_t min_row_bytes(const struct ply_header *h, const struct ply_element
     size_t n = 0;
     for (int k = 0; k < el->prop_count; k++) {
         const struct ply_prop *p = &el->props[k];
-        n += !h->binary ? 2 : ply_type_size(p->list_count_type != PT_NONE ? p->list_count_type
-                                                                         : p->type);
+        n += !h->binary
+                 ? 2
+                 : ply_type_size(p->list_count_type != PT_NONE ? p->list_count_type : p->type);
     }
     return n;
 }

@@ -202,10 +202,11 @@ int sim_rig_init(struct sim_rig *rig, const struct sim_config *cfg, const struct
             goto out_free;
         }
     }
-    rig->blur_line = calloc((size_t)3 * (rig->width > rig->height ? rig->width : rig->height),
-                            sizeof(float));
-    if (!t->hit || !t->pos_cam || !t->normal_cam || !t->albedo || !t->proj_u || !t->proj_v || !t->proj_lit ||
-        !t->dark || !rig->proj_radiance || !rig->light_vis || !rig->gauss || !rig->signal || !rig->blur_line) {
+    rig->blur_line =
+        calloc((size_t)3 * (rig->width > rig->height ? rig->width : rig->height), sizeof(float));
+    if (!t->hit || !t->pos_cam || !t->normal_cam || !t->albedo || !t->proj_u || !t->proj_v ||
+        !t->proj_lit || !t->dark || !rig->proj_radiance || !rig->light_vis || !rig->gauss ||
+        !rig->signal || !rig->blur_line) {
         rc = -ENOMEM;
         snprintf(err, len, "sim: out of memory for a %ux%u frame", (unsigned)rig->width,
                  (unsigned)rig->height);
@@ -332,7 +333,8 @@ static void target_albedo(const struct sim_rig *rig, const struct frame_xform *o
     const struct scan_calib *c = &rig->calib;
     const struct sim_sheet_frame *f = &rig->sheet;
     double a = 0.9; /* the matte white sphere, the plate's edges */
-    if (rig->target.kind == SIM_TARGET_BOARD && fabs(v3_dot(v3_sub(p_obj, f->origin), f->n)) < 0.01) {
+    if (rig->target.kind == SIM_TARGET_BOARD &&
+        fabs(v3_dot(v3_sub(p_obj, f->origin), f->n)) < 0.01) {
         double j[4] = {1, 0, 0, 1}, inv[4];
         if (!lens_is_pinhole(c->cam_dist))
             lens_jacobian(c->cam_dist, d_cam.x, d_cam.y, j);
@@ -344,8 +346,8 @@ static void target_albedo(const struct sim_rig *rig, const struct frame_xform *o
             for (int sx = 0; sx < SHEET_SAMPLES; sx++) {
                 double dx = ((sx + 0.5) / SHEET_SAMPLES - 0.5) / c->cam_fx_px;
                 double dy = ((sy + 0.5) / SHEET_SAMPLES - 0.5) / c->cam_fy_px;
-                vec3 d = v3(d_cam.x + inv[0] * dx + inv[1] * dy, d_cam.y + inv[2] * dx + inv[3] * dy,
-                            1.0);
+                vec3 d = v3(d_cam.x + inv[0] * dx + inv[1] * dy,
+                            d_cam.y + inv[2] * dx + inv[3] * dy, 1.0);
                 vec3 dir = frame_dir(obj, d);
                 double den = v3_dot(dir, f->n);
                 if (den == 0.0)
@@ -367,9 +369,9 @@ struct surface_point {
 /* Where @p sp falls in the projector image (u, v: NAN behind it), and the light it sends
  * towards @p to_viewer (camera frame, unit) under the projector's full white, in grey levels.
  * @retval 1 the projector lights it (in its image, facing it, not shadowed) @retval 0 not */
-static int projector_light(const struct sim_rig *rig, const struct surface_point *sp,
-                           vec3 proj_cam, vec3 proj_obj, const double albedo[3], vec3 to_viewer,
-                           double *u, double *v, double rad[3])
+static int projector_light(const struct sim_rig *rig, const struct surface_point *sp, vec3 proj_cam,
+                           vec3 proj_obj, const double albedo[3], vec3 to_viewer, double *u,
+                           double *v, double rad[3])
 {
     const struct scan_calib *c = &rig->calib;
     rad[0] = rad[1] = rad[2] = 0.0;
@@ -468,7 +470,6 @@ static double pattern_light(const struct sim_rig *rig, uint32_t pattern, double 
 
 /* ---- one bounce of the projector's light between surfaces ([sim] bounce_samples) ---- */
 
-
 /* For every grid point (every SIM_BOUNCE_STEP-th pixel each way) on the object: what the surface
  * around it sees in bounce_samples cosine-weighted directions, where that is in the projector
  * image and how much of the projector's full white it sends back (towards the grid point). Once
@@ -482,7 +483,8 @@ static void bounce_update(struct sim_rig *rig, const struct frame_xform *obj, ve
         for (uint32_t gx = 0; gx < rig->bounce_w; gx++) {
             size_t g = (size_t)gy * rig->bounce_w + gx;
             uint32_t x = gx * SIM_BOUNCE_STEP < rig->width ? gx * SIM_BOUNCE_STEP : rig->width - 1;
-            uint32_t y = gy * SIM_BOUNCE_STEP < rig->height ? gy * SIM_BOUNCE_STEP : rig->height - 1;
+            uint32_t y =
+                gy * SIM_BOUNCE_STEP < rig->height ? gy * SIM_BOUNCE_STEP : rig->height - 1;
             size_t i = (size_t)y * rig->width + x;
             for (uint32_t k = 0; k < k_count; k++)
                 rig->bounce_u[g * k_count + k] = NAN;
@@ -553,7 +555,8 @@ static void bounce_at(const struct sim_rig *rig, uint32_t x, uint32_t y, double 
             uint32_t cx = gx + dx < rig->bounce_w ? gx + dx : rig->bounce_w - 1;
             uint32_t cy = gy + dy < rig->bounce_h ? gy + dy : rig->bounce_h - 1;
             uint32_t px = cx * SIM_BOUNCE_STEP < rig->width ? cx * SIM_BOUNCE_STEP : rig->width - 1;
-            uint32_t py = cy * SIM_BOUNCE_STEP < rig->height ? cy * SIM_BOUNCE_STEP : rig->height - 1;
+            uint32_t py =
+                cy * SIM_BOUNCE_STEP < rig->height ? cy * SIM_BOUNCE_STEP : rig->height - 1;
             if (!rig->truth.hit[(size_t)py * rig->width + px])
                 continue;
             double w = (dx ? ax : 1.0 - ax) * (dy ? ay : 1.0 - ay);
@@ -622,8 +625,8 @@ static void ensure_light(struct sim_rig *rig, uint32_t li)
 static double pattern_light(const struct sim_rig *rig, uint32_t pattern, double u, double v)
 {
     const struct gray_layout *l = &rig->layout;
-    int is_row = pattern >= GRAY_PATTERN_FIRST_BIT &&
-                 (pattern - GRAY_PATTERN_FIRST_BIT) / 2u >= l->col_bits;
+    int is_row =
+        pattern >= GRAY_PATTERN_FIRST_BIT && (pattern - GRAY_PATTERN_FIRST_BIT) / 2u >= l->col_bits;
     double x = is_row ? v : u, b = rig->cfg.projector_blur_px, lo = x - 0.5 * b, hi = x + 0.5 * b;
     int limit = (int)(is_row ? rig->calib.proj_height : rig->calib.proj_width);
     double c0 = floor(lo + 0.5), c1 = floor(hi + 0.5), lit;

@@ -27,7 +27,7 @@ struct sim_truth {
     float *normal_cam; /**< 3 per pixel: unit shading normal, camera frame */
     float *albedo;     /**< 3 per pixel: diffuse colour (linear, 0..1) */
     float *proj_u;     /**< continuous projector column of the point (pixel centres at integers) */
-    float *proj_v;       /**< continuous projector row of the point */
+    float *proj_v;     /**< continuous projector row of the point */
     uint8_t *proj_lit; /**< the projector reaches the point (in frustum, facing, not shadowed) */
     uint8_t *dark;     /**< the point lies on the very dark paint */
 };
@@ -43,8 +43,8 @@ struct sim_rig {
     struct sim_material material;
     uint32_t width, height;
     struct gray_layout layout; /**< the projector's stored pattern sequence */
-    double object_height_mm;  /**< height of the object standing (its paint is laid out by it) */
-    double pose_rot[9];       /**< [sim] object_pose: standing -> as placed, p = R q + shift */
+    double object_height_mm;   /**< height of the object standing (its paint is laid out by it) */
+    double pose_rot[9];        /**< [sim] object_pose: standing -> as placed, p = R q + shift */
     vec3 pose_shift;
     int32_t table_angle_mdeg; /**< where the turntable is; the camera renders at this angle */
     int32_t truth_angle_mdeg; /**< angle the truth buffers belong to */
@@ -61,10 +61,10 @@ struct sim_rig {
                                       the projector image (NAN: nothing lit) */
     float *bounce_rad;   /**< 3 per grid point and sample: that surface's light at full white */
     float *bounce_light; /**< 3 per grid point: the bounced light of the frame being rendered */
-    struct sim_target target;      /**< what stands on the table (SIM_TARGET_OBJECT: the object) */
-    struct sim_sheet_frame sheet;  /**< a board's printed sheet, object frame */
-    uint8_t *sheet_pixels;         /**< the rig's copy of the sheet */
-    char dir[HAL_MAX_PATH];        /**< where relative paths of the config are resolved */
+    struct sim_target target;     /**< what stands on the table (SIM_TARGET_OBJECT: the object) */
+    struct sim_sheet_frame sheet; /**< a board's printed sheet, object frame */
+    uint8_t *sheet_pixels;        /**< the rig's copy of the sheet */
+    char dir[HAL_MAX_PATH];       /**< where relative paths of the config are resolved */
 };
 
 /** Build the object, material and buffers. Allocates; nothing allocates after this.

@@ -45,8 +45,8 @@ int sim_target_mesh(const struct sim_target *t, struct sim_mesh *m, struct sim_s
     f->n = n;
     f->ex = across;
     f->ey = v3_scale(up, -1.0);
-    f->origin = v3_add(base, v3_add(v3_scale(n, th), v3_add(v3_scale(across, -0.5 * w),
-                                                             v3_scale(up, h))));
+    f->origin =
+        v3_add(base, v3_add(v3_scale(n, th), v3_add(v3_scale(across, -0.5 * w), v3_scale(up, h))));
     return 0;
 }
 

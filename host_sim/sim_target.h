@@ -12,16 +12,16 @@ enum sim_target_kind { SIM_TARGET_OBJECT = 0, SIM_TARGET_BOARD, SIM_TARGET_SPHER
 
 /** A target as placed: what it is, the printed sheet, and where it stands on the table. */
 struct sim_target {
-    uint32_t kind;           /**< enum sim_target_kind */
-    const uint8_t *sheet;    /**< board: the printed sheet, grey, row-major, top-left first */
+    uint32_t kind;        /**< enum sim_target_kind */
+    const uint8_t *sheet; /**< board: the printed sheet, grey, row-major, top-left first */
     uint32_t sheet_width, sheet_height; /**< pixels */
-    double sheet_px_per_mm;  /**< print resolution */
-    double thickness_mm;     /**< board: the plate the sheet is glued to */
-    double tilt_deg;         /**< board: 0 upright facing the camera, leaning back by this; 90
-                                  lies flat, face up */
-    double diameter_mm;      /**< sphere */
-    double position_mm[2];   /**< table frame at angle 0 (x towards the camera): the plate's
-                                  bottom-edge centre, or the sphere's foot */
+    double sheet_px_per_mm;             /**< print resolution */
+    double thickness_mm;                /**< board: the plate the sheet is glued to */
+    double tilt_deg;       /**< board: 0 upright facing the camera, leaning back by this; 90
+                                lies flat, face up */
+    double diameter_mm;    /**< sphere */
+    double position_mm[2]; /**< table frame at angle 0 (x towards the camera): the plate's
+                                bottom-edge centre, or the sphere's foot */
 };
 
 /** The sheet's frame in the object frame: origin at its top-left, x along its rows, y down its

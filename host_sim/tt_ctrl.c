@@ -77,12 +77,12 @@ void tt_ctrl_update(struct tt_ctrl *c, uint64_t now_us)
         double t = (double)(now_us - c->start_us) / 1e6;
         double d = fabs(c->target_mdeg - c->start_mdeg);
         double dir = c->target_mdeg >= c->start_mdeg ? 1.0 : -1.0;
-        double next = t >= c->duration_s ? c->target_mdeg
-                                         : c->start_mdeg + dir * profile(d, c->speed_mdeg_s,
-                                                                         c->accel_mdeg_s2, t);
+        double next = t >= c->duration_s
+                          ? c->target_mdeg
+                          : c->start_mdeg + dir * profile(d, c->speed_mdeg_s, c->accel_mdeg_s2, t);
         double stall = c->stall_at_mdeg;
-        if (c->stall_at_mdeg != INT32_MIN &&
-            ((c->pos_mdeg - stall) * (next - stall) <= 0.0) && next != c->pos_mdeg) {
+        if (c->stall_at_mdeg != INT32_MIN && ((c->pos_mdeg - stall) * (next - stall) <= 0.0) &&
+            next != c->pos_mdeg) {
             next = stall; /* blocked: the following error trips the drive */
             c->moving = 0;
             c->alarm = TT_ALARM_STALL;

@@ -28,7 +28,7 @@ struct tt_ctrl {
     /* fault injection (tests): a controller that acts on a command only this long after it
      * came, reporting idle and the previous LAST_ID meanwhile (0: at once) */
     uint32_t command_delay_us;
-    int pending;              /* a command received, not yet executed */
+    int pending; /* a command received, not yet executed */
     uint16_t pending_cmd, pending_id;
     uint64_t pending_due_us;
 };

@@ -141,6 +141,15 @@ void tt_server_run(struct tt_server *s)
         if (len > 0 && s->is_tcp && s->drop_at_request != 0 &&
             s->requests + 1 == s->drop_at_request) {
             s->drop_at_request = 0; /* once: the controller is back for the reconnect */
+            if (s->restart_on_drop) {
+                pthread_mutex_lock(&s->lock);
+                double physical = tt_ctrl_physical_mdeg(&s->ctrl);
+                tt_ctrl_init(&s->ctrl, 0, s->now(s->now_priv)); /* reports 0 ... */
+                s->ctrl.physical_offset_mdeg = physical;        /* ... where it stands */
+                s->ctrl.homed = s->restart_homed;
+                pthread_mutex_unlock(&s->lock);
+                s->restart_on_drop = 0;
+            }
             close(modbus_get_socket(s->ctx));
             modbus_set_socket(s->ctx, -1);
             connected = 0;

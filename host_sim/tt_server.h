@@ -12,11 +12,11 @@
 typedef uint64_t (*tt_now_fn)(void *priv);
 
 struct tt_server {
-    void *ctx;            /* modbus_t *, owned by the server thread once started */
-    void *mapping;        /* modbus_mapping_t * */
-    int listen_fd;        /* TCP only */
+    void *ctx;     /* modbus_t *, owned by the server thread once started */
+    void *mapping; /* modbus_mapping_t * */
+    int listen_fd; /* TCP only */
     int is_tcp;
-    int port;             /* TCP: the port actually bound */
+    int port; /* TCP: the port actually bound */
     struct tt_ctrl ctrl;
     pthread_mutex_t lock; /* guards ctrl: the camera reads the position from another thread */
     tt_now_fn now;
@@ -28,12 +28,17 @@ struct tt_server {
     /* fault injection (tests, TCP): after this many requests in all, drop the client without
      * answering, as a pulled cable or a rebooting controller does (0: never) */
     unsigned long drop_at_request;
+    /* with drop_at_request: the controller restarts as the link drops (a power glitch): it
+     * comes back not homed, counting from where the table stands, its command counter at 0 */
+    int restart_on_drop;
+    int restart_homed; /* ... and, set, comes back reporting itself homed at 0 (re-zeroed) */
     /* fault injection (tests): answer the next this many requests with exception 6, "server
      * busy", as a controller does while it is occupied */
     unsigned long busy_replies;
 };
 
-/** Listen on @p host:@p port (0: any free port, see ->port). @retval 0 or -errno (message in err) */
+/** Listen on @p host:@p port (0: any free port, see ->port). @retval 0 or -errno (message in err)
+ */
 int tt_server_open_tcp(struct tt_server *s, const char *host, int port, tt_now_fn now,
                        void *now_priv, char *err, size_t err_len);
 /** Serve RTU on the serial device @p device as slave @p unit_id. @retval 0 or -errno */

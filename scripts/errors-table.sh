@@ -120,6 +120,31 @@ squares_y = 8'
 row "square chessboard" "squares_x = squares_y = 8" "$sim" check-config --config "$w/squareboard.ini"
 mkdir -p "$w/nocaptures"
 row "calibration from no captures" "calibrate --from an empty directory" "$sim" calibrate --config "$w/one.ini" --from "$w/nocaptures" --out "$w/cal.ini"
+sed 's/^cx_px = 639.5/cx_px = 99999/' config/sim-calib.ini > "$w/calib-cx.ini"
+cfg badcx '' && sed -i "s|^calibration = .*|calibration = calib-cx.ini|" "$w/badcx.ini"
+row "principal point off the image" "cx_px = 99999" "$sim" check-config --config "$w/badcx.ini"
+sed 's/^height = 960/height = 960\ndistortion = 100, 0, 0, 0, 0/' config/sim-calib.ini > "$w/calib-dist.ini"
+cfg baddist '' && sed -i "s|^calibration = .*|calibration = calib-dist.ini|" "$w/baddist.ini"
+row "distortion no lens has" "distortion = 100, 0, 0, 0, 0" "$sim" check-config --config "$w/baddist.ini"
+# resume and process keep how the views were taken (a one-view scan, then other settings)
+"$sim" scan --config "$w/one.ini" --out "$w/taken" >/dev/null 2>&1
+cfg two '[scan]
+views = 2'
+PATTERN='error:' row "resume with other views" "resume --config F, F: views = 2" "$sim" resume "$w/taken" --config "$w/two.ini"
+cfg brighter '[scan]
+views = 1' && sed -i 's/^exposure_us = 10000/exposure_us = 12000/' "$w/brighter.ini"
+PATTERN='error:' row "process with another exposure" "process --config F, F: exposure_us = 12000" "$sim" process "$w/taken" --config "$w/brighter.ini" --out "$w/taken2"
+mkdir -p "$w/manycaptures"
+for i in $(seq 100 200); do mkdir -p "$w/manycaptures/view_$i" && : > "$w/manycaptures/view_$i/frame_00.png"; done
+row "calibration from over 96 captures" "calibrate --from a directory of 101" "$sim" calibrate --config "$w/one.ini" --from "$w/manycaptures" --out "$w/cal.ini"
+mkdir -p "$w/loop/view_000" && ln -sf frame_00.png "$w/loop/view_000/frame_00.png"
+row "capture frame a link loop" "view_000/frame_00.png -> itself" "$sim" calibrate --config "$w/one.ini" --from "$w/loop" --out "$w/cal.ini"
+row "board file without a name" 'calibrate board --out ""' "$sim" calibrate board --config "$w/one.ini" --out ""
+PATTERN="scanner serve" row "web server on the network, no token" "--listen 127.0.0.1:P,0.0.0.0:Q" "$sim" serve --config "$w/one.ini" --listen 127.0.0.1:18744,0.0.0.0:18745
+printf '%0300d\n' 0 > "$w/long-token"
+row "token too long" "a 300-character token" "$sim" serve --config "$w/one.ini" --listen 0.0.0.0:18745 --token-file "$w/long-token"
+echo 'abcdefgh;ijklmnop' > "$w/semicolon-token"
+row "token a cookie cannot carry" "abcdefgh;ijklmnop" "$sim" serve --config "$w/one.ini" --listen 0.0.0.0:18745 --token-file "$w/semicolon-token"
 if [ -x "$dev" ]; then
     PATTERN='^camera' row "camera missing (V4L2)" "/dev/video0 absent" "$dev" selftest --config config/pi-v4l2.ini
     PATTERN='^gpio' row "GPIO chip missing" "gpiochip0 absent" "$dev" selftest --config config/pi-v4l2.ini
@@ -128,4 +153,25 @@ if [ -x "$dev" ]; then
     PATTERN='^camera' row "not a V4L2 device" "device = /dev/null" "$dev" selftest --config "$w/nodev.ini"
     sed -e 's/^transport = rtu/transport = tcp\nhost = 127.0.0.1\nport = 1/' -e '/^device = \/dev\/ttyUSB0/d' config/pi-v4l2.ini > "$w/tcp.ini"
     PATTERN='^turntable' row "turntable not answering (TCP)" "127.0.0.1:1, nothing listening" "$dev" selftest --config "$w/tcp.ini"
+fi
+
+# The web server's refusals (scanner serve on loopback; docs/api.md): each request, its answer.
+if [ -x "$build/scanner-web" ]; then
+    cat <<'EOF'
+
+## Requests the web server refuses
+
+`scanner serve` on loopback without a token, each request sent as written
+(`tests/web_hostile.py` tries these and more).
+
+| bad request | what was sent | answer |
+|---|---|---|
+EOF
+    port=$((40000 + $$ % 20000))
+    mkdir -p "$w/web-scans"
+    "$sim" serve --config "$w/one.ini" --listen "127.0.0.1:$port" --scans "$w/web-scans" >/dev/null 2>&1 &
+    web=$!
+    /usr/bin/python3 scripts/errors-web.py "$port" "$w/web-scans"
+    kill -TERM "$web"
+    wait "$web" 2>/dev/null
 fi

@@ -24,7 +24,7 @@ if [ "${1:-}" = "node" ]; then
     pkgs="nodejs npm"
 fi
 [ "${1:-}" = "gpio-chip" ] && pkgs="qemu-system-arm cpio systemd socat python3"
-[ "${1:-}" = "test" ] && pkgs="$pkgs python3 python3-numpy python3-open3d python3-pymodbus python3-serial python3-serial-asyncio socat g++ libcamera-dev libopencv-dev libopencv-contrib-dev systemd valgrind"
+[ "${1:-}" = "test" ] && pkgs="$pkgs python3 python3-numpy python3-open3d python3-pymodbus python3-serial python3-serial-asyncio socat g++ clang-format libcamera-dev libopencv-dev libopencv-contrib-dev systemd valgrind"
 # A cross build's target (make CROSS_COMPILE=aarch64-linux-gnu-): its compiler, its -dev
 # packages through Debian's multiarch, and qemu-user to run its tests.
 case "${1:-}" in

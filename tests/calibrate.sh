@@ -140,6 +140,73 @@ check camera_alone_from_white_frames camera_only_test
 check board_to_print sh -c "$bin calibrate board --config $cfg --out $out/board &&
     test \"\$(od -An -tu1 -j16 -N8 $out/board.png | awk '{ print \$3 * 256 + \$4, \$7 * 256 + \$8 }')\" = '2360 1888' &&
     grep -q 'width=\"200.000mm\" height=\"160.000mm\"' $out/board.svg"
+# issue 28: a board capture marked as the ball (target.ini says sphere) fits no sphere: it is
+# rejected, not used to place the lights (before: fit RMS 60.7 mm, lights 250 m away, a file
+# that did not load put in place of the good one, which was renamed aside).
+mislabel_test() {
+    copy_views "$out/mislabel" "0 1 2 3 4 5 6 7"
+    sed -i 's/^target = .*/target = sphere/' "$out/mislabel/view_002/target.ini"
+    "$bin" calibrate --config $cfg --from "$out/mislabel" --out "$out/mislabel.ini" >"$out/mislabel.txt" 2>&1
+    rc=$?
+    cat "$out/mislabel.txt"
+    [ $rc -eq 0 ] && grep -q '^view_002: rejected: the surface is no sphere of' "$out/mislabel.txt" &&
+        sed "s|^calibration = .*|calibration = $PWD/$out/mislabel.ini|; s|^rig = ../|rig = $PWD/|" $cfg >"$out/mislabel-cfg.ini" &&
+        "$bin" check-config --config "$out/mislabel-cfg.ini"
+}
+check board_marked_sphere_rejected mislabel_test
+# ... and when it is the only "ball": refused, the file in use untouched and not renamed.
+only_mislabel_test() {
+    copy_views "$out/onlyball" "0 1 2 3 4 5"
+    sed -i 's/^target = .*/target = sphere/' "$out/onlyball/view_005/target.ini"
+    cp config/sim-calib.ini "$out/onlyball.ini"
+    "$bin" calibrate --config $cfg --from "$out/onlyball" --out "$out/onlyball.ini" >"$out/onlyball.txt" 2>&1
+    rc=$?
+    cat "$out/onlyball.txt"
+    [ $rc -ne 0 ] && grep -q 'the sphere was seen in too few captures' "$out/onlyball.txt" &&
+        cmp -s config/sim-calib.ini "$out/onlyball.ini" &&
+        test "$(ls "$out" | grep -c '^onlyball.ini')" -eq 1
+}
+check only_ball_mislabelled_keeps_calibration only_mislabel_test
+# calibrate --from: captures numbered from 100 are found; more than 96 are refused, not cut
+# short; a frame that is a link loop, and a missing pattern frame, are errors (rc 1), not
+# skipped with rc 0.
+from_dir_test() {
+    copy_views "$out/high" "0 1 2 3 4 5" white
+    for i in 0 1 2 3 4 5; do mv "$out/high/view_00$i" "$out/high/view_10$i"; done
+    "$bin" calibrate --config $cfg --from "$out/high" --out "$out/high.ini" >"$out/high.txt" 2>&1 ||
+        { cat "$out/high.txt"; return 1; }
+    grep -q 'the camera alone is calibrated' "$out/high.txt" || { cat "$out/high.txt"; return 1; }
+    rm -rf "$out/many" && mkdir -p "$out/many"
+    for i in $(seq 0 99); do
+        mkdir "$out/many/view_$(printf %03d "$i")"
+        ln "$out/high/view_10$((i % 6))/frame_00.png" "$out/many/view_$(printf %03d "$i")/"
+    done
+    "$bin" calibrate --config $cfg --from "$out/many" --out "$out/many.ini" >"$out/many.txt" 2>&1
+    rc=$?
+    cat "$out/many.txt"
+    [ $rc -ne 0 ] && grep -q 'holds 100 captures; a calibration takes at most 96' "$out/many.txt" || return 1
+    ln -sf frame_00.png "$out/high/view_103/frame_00.png"
+    "$bin" calibrate --config $cfg --from "$out/high" --out "$out/loop.ini" >"$out/loop.txt" 2>&1
+    rc=$?
+    cat "$out/loop.txt"
+    [ $rc -ne 0 ] && grep -q 'view_103/frame_00.png: Too many levels of symbolic links' "$out/loop.txt" || return 1
+    copy_views "$out/holes" "0 1 2 3 4 5"
+    rm "$out/holes/view_002/frame_05.png"
+    "$bin" calibrate --config $cfg --from "$out/holes" --out "$out/holes.ini" >"$out/holes.txt" 2>&1
+    rc=$?
+    cat "$out/holes.txt"
+    [ $rc -ne 0 ] && grep -q 'error: .*view_002.*frame_05' "$out/holes.txt" && ! test -e "$out/holes.ini"
+}
+check calibrate_from_dir_hostile from_dir_test
+# calibrate board: no --out "" (it wrote .png and .svg in the working directory), and a name
+# with '"' or '<' is percent-encoded in the SVG's reference to the picture.
+board_out_test() {
+    ! "$bin" calibrate board --config $cfg --out "" 2>"$out/board-empty.txt" &&
+        grep -q 'give a file name' "$out/board-empty.txt" && ! test -e .png && ! test -e .svg &&
+        "$bin" calibrate board --config $cfg --out "$out/b\"<&x" >/dev/null &&
+        grep -q 'xlink:href="b%22%3C%26x.png"' "$out/b\"<&x.svg"
+}
+check board_out_names_checked board_out_test
 # The verification scan with the calibration found: the sphere's diameter within 0.3 mm.
 check verify_sphere sh -c "$bin calibrate verify --config $out/calibrated.ini > $out/verify.txt &&
     cat $out/verify.txt && awk '/^diameter:/ { e = \$9 + 0; if (e < 0) e = -e; ok = e <= 0.3 }

@@ -1,4 +1,5 @@
-/* CIELAB and CIEDE2000, following Sharma, Wu and Dalal (2005), including its notes on hue angles. */
+/* CIELAB and CIEDE2000, following Sharma, Wu and Dalal (2005), including its notes on hue angles.
+ */
 #include "colour_metrics.h"
 
 #include <math.h>

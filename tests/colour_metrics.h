@@ -1,4 +1,5 @@
-/* Colour differences for measuring albedo: linear RGB (sRGB primaries, D65) to CIELAB, CIEDE2000. */
+/* Colour differences for measuring albedo: linear RGB (sRGB primaries, D65) to CIELAB, CIEDE2000.
+ */
 #ifndef COLOUR_METRICS_H
 #define COLOUR_METRICS_H
 

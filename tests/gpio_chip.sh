@@ -7,10 +7,10 @@
 # default build on a 1 GB machine, the LIMITS=small build on a 512 MB one (where the default
 # build cannot start). Run by `make test-gpio-chip`, which cross-builds both.
 # The same VM (default build) loads vivid, the kernel's virtual video driver, and runs the V4L2
-# backend on it (tests/vivid_capture.c: format, the mmap ring, drop_frames, frame timestamps,
+# backend on it (tools/vivid_capture.c: format, the mmap ring, drop_frames, frame timestamps,
 # binning, a timeout when frames stop) and the selftest with it as the rig's camera; and it has
 # a virtio-gpu display, on which the HDMI projector backend steps through the pattern sequence
-# (tests/drm_show.c) while this script takes qemu's screendump of each pattern on screen and
+# (tools/drm_show.c) while this script takes qemu's screendump of each pattern on screen and
 # compares it with the pattern.
 # Ends with cmocka's summary lines so that tests/run.sh counts it.
 set -eu
@@ -76,7 +76,7 @@ add_module() { # module name, as depends= writes it
 add_module vivid
 add_module virtio_pci
 add_module virtio-gpu
-# The installed unit's system-call filter, and a runner that enforces it (tests/seccomp_run.c).
+# The installed unit's system-call filter, and a runner that enforces it (tools/seccomp_run.c).
 cp "$SECCOMP_RUN" "$R/bin/seccomp-run"
 scripts/syscall-list.sh config/deploy/scanner@.service > "$R/etc/scanner/syscalls"
 libdirs="/usr/lib/$TRIPLET /lib/$TRIPLET $WORK/unpacked/usr/lib/$TRIPLET $WORK/unpacked/lib/$TRIPLET"
@@ -256,7 +256,7 @@ check "V4L2 on vivid: a timeout when frames stop" "vivid capture" \
 check "virtio-gpu makes a DRM device" "display" "^card0"
 check "the HDMI projector: 1024x768 taken, the whole sequence stepped" "drm show" \
     "^open 1024x768: ok$" "^sequence: ok \(22 patterns\)$" "^done$"
-shots=$(/usr/bin/python3 tests/drm_screendumps.py "$WORK" 2>&1)
+shots=$(/usr/bin/python3 tools/drm_screendumps.py "$WORK" 2>&1)
 printf '%s\n' "$shots" | sed 's/^/    /'
 for name in "pattern 0" "pattern 1" "pattern 2" "pattern 3" "pattern 12" "pattern 21" "off 0"; do
     if printf '%s\n' "$shots" | grep -q "^$name: 1024x768, 0 pixels differ"; then

@@ -8,12 +8,13 @@ cd "$(dirname "$0")/.."
 pass=0
 fail=0
 probe=layer_probe_
-trap 'rm -f firmware/$probe.c hal/posix/$probe.c hal/modbus/$probe.c hal/linux/$probe.c host_sim/$probe.c board/$probe.c app/$probe.c web/$probe.c' EXIT
+trap 'rm -f firmware/$probe.c hal/posix/$probe.c hal/modbus/$probe.c hal/linux/$probe.c host_sim/$probe.c board/$probe.c app/$probe.c calib/$probe.c web/$probe.c' EXIT
 # dir, header, expect (fail | ok)
 try() {
     dir=$1 header=$2 expect=$3
     printf '/* layer probe */\n#include "%s"\nint layer_probe_(void);\nint layer_probe_(void) { return 0; }\n' \
         "$header" > "$dir/$probe.c"
+    rm -f "build/layer-probe/$dir/$probe.o" # an object of the try before would be taken as this one
     log=$(make -s "build/layer-probe/$dir/$probe.o" BUILD=build/layer-probe 2>&1)
     rc=$?
     rm -f "$dir/$probe.c"
@@ -52,6 +53,12 @@ try firmware api.h fail
 try web gpio_gpiod.h fail       # the web server never drives a device: scanner does
 try web camera_v4l2.h fail
 try web report.h ok             # it shows the report's pictures
+try app calibrate.h fail        # the calibration is its own layer on app/, and its own program
+try web calibrate.h fail        # (config.h holds only its [calibrate] settings)
+try app calib_cv.h fail
+try calib web.h fail
+try calib config.h ok           # it loads configs and scans with app/'s code
+try calib scan_job.h ok
 echo "[==========] $((pass + fail)) test(s) run."
 echo "[  PASSED  ] $pass test(s)."
 [ $fail -eq 0 ] || echo "[  FAILED  ] $fail test(s)."

@@ -19,18 +19,18 @@ struct mesh_visibility {
 
 struct mesh_comparison {
     uint32_t result_triangles;
-    uint32_t result_pieces;     /**< connected pieces of the result (1: no floating fragment) */
+    uint32_t result_pieces; /**< connected pieces of the result (1: no floating fragment) */
     uint32_t holes, holes_under_10mm; /**< boundary loops of the result (bounding box diagonal) */
     double largest_hole_mm;
     uint32_t boundary_edges;    /**< edges of one triangle: 0 with nonmanifold_edges 0 is */
     uint32_t nonmanifold_edges; /**< watertight (every edge shared by exactly two faces) */
     double result_to_truth_mean_mm, result_to_truth_p95_mm, result_to_truth_max_mm;
     double truth_to_result_mean_mm;
-    double truth_within_1mm;          /**< share of the true surface within 1 mm of the result */
-    double truth_seen_within_1mm;     /**< the same without the face on the table (z < 1 mm) */
+    double truth_within_1mm;      /**< share of the true surface within 1 mm of the result */
+    double truth_seen_within_1mm; /**< the same without the face on the table (z < 1 mm) */
     double truth_seen_to_result_mean_mm;
-    double symmetric_mean_mm;         /**< mean of the two directed means (truth: seen part) */
-    double observable_share;          /**< share of the true surface the rig can observe */
+    double symmetric_mean_mm;           /**< mean of the two directed means (truth: seen part) */
+    double observable_share;            /**< share of the true surface the rig can observe */
     double truth_observable_within_1mm; /**< of the observable surface, share within 1 mm */
     double truth_observable_to_result_mean_mm;
     double symmetric_observable_mean_mm; /**< result->truth and observable truth->result */

@@ -28,8 +28,7 @@ static int reaches(const struct sim_bvh *self, vec3 p, vec3 n, vec3 src, double 
 }
 
 /* Can some view's camera and projector both reach p (object frame, normal n)? */
-static int observable(const struct mesh_visibility *vis, const struct sim_bvh *self, vec3 p,
-                      vec3 n)
+static int observable(const struct mesh_visibility *vis, const struct sim_bvh *self, vec3 p, vec3 n)
 {
     double min_cos = cos(vis->max_incidence_deg * M_PI / 180.0);
     for (uint32_t k = 0; k < vis->views; k++) {
@@ -37,9 +36,9 @@ static int observable(const struct mesh_visibility *vis, const struct sim_bvh *s
         /* the table turned the object by +a: devices are at Rz(-a) in the object frame */
         vec3 cam = v3(c * vis->camera_table.x + s * vis->camera_table.y,
                       -s * vis->camera_table.x + c * vis->camera_table.y, vis->camera_table.z);
-        vec3 proj = v3(c * vis->projector_table.x + s * vis->projector_table.y,
-                       -s * vis->projector_table.x + c * vis->projector_table.y,
-                       vis->projector_table.z);
+        vec3 proj =
+            v3(c * vis->projector_table.x + s * vis->projector_table.y,
+               -s * vis->projector_table.x + c * vis->projector_table.y, vis->projector_table.z);
         if (reaches(self, p, n, cam, min_cos) && reaches(self, p, n, proj, min_cos))
             return 1;
     }
@@ -74,8 +73,8 @@ static int sample_distances(const struct sim_mesh *from, const struct sim_bvh *t
         }
         double r1 = sqrt(sim_random_unit(&seed)), r2 = sim_random_unit(&seed);
         vec3 a = vtx(from, lo, 0), b = vtx(from, lo, 1), c = vtx(from, lo, 2);
-        vec3 p = v3_add(v3_scale(a, 1.0 - r1), v3_add(v3_scale(b, r1 * (1.0 - r2)),
-                                                      v3_scale(c, r1 * r2)));
+        vec3 p = v3_add(v3_scale(a, 1.0 - r1),
+                        v3_add(v3_scale(b, r1 * (1.0 - r2)), v3_scale(c, r1 * r2)));
         dist[i] = sim_bvh_distance(to, p, 1e9);
         z[i] = p.z;
         if (seen != NULL) {
@@ -90,8 +89,7 @@ static int sample_distances(const struct sim_mesh *from, const struct sim_bvh *t
 /* Move @p m rigidly onto the surface of @p truth: point-to-plane ICP of its vertices against
  * their closest true points (the plane through the closest point, across p - q), pairs over
  * 3 mm left out (a fringe, a fragment). @p deg, @p mm: how far it moved. */
-static void align_to_truth(struct sim_mesh *m, const struct sim_bvh *truth, double *deg,
-                           double *mm)
+static void align_to_truth(struct sim_mesh *m, const struct sim_bvh *truth, double *deg, double *mm)
 {
     uint32_t step = m->vert_count / 20000u + 1u;
     struct frame_xform total = {{1, 0, 0, 0, 1, 0, 0, 0, 1}, {0, 0, 0}};
@@ -109,7 +107,8 @@ static void align_to_truth(struct sim_mesh *m, const struct sim_bvh *truth, doub
             break;
         for (uint32_t i = 0; i < m->vert_count; i++) {
             vec3 p = frame_point(&step_x, v3(m->pos[3 * i], m->pos[3 * i + 1], m->pos[3 * i + 2]));
-            m->pos[3 * i] = (float)p.x, m->pos[3 * i + 1] = (float)p.y, m->pos[3 * i + 2] = (float)p.z;
+            m->pos[3 * i] = (float)p.x, m->pos[3 * i + 1] = (float)p.y,
+                       m->pos[3 * i + 2] = (float)p.z;
         }
         frame_compose(&step_x, &total, &moved);
         total = moved;
@@ -304,8 +303,8 @@ int mesh_compare_files(const char *result_ply, const char *truth_ply, uint32_t n
         out->truth_within_1mm = (double)within / n;
         out->truth_seen_within_1mm = seen ? (double)seen_within / seen : 0.0;
         out->truth_seen_to_result_mean_mm = seen ? s2_seen / seen : 0.0;
-        out->symmetric_mean_mm = 0.5 * (out->result_to_truth_mean_mm +
-                                        out->truth_seen_to_result_mean_mm);
+        out->symmetric_mean_mm =
+            0.5 * (out->result_to_truth_mean_mm + out->truth_seen_to_result_mean_mm);
     } else {
         snprintf(err, err_len, "out of memory");
     }

@@ -86,5 +86,31 @@ awk '/^result -> truth: mean/ { a = $5 } /^truth -> result: mean/ { b = $5; w = 
      END { exit !(w + 0 >= 98 && (a + b) / 2 < 0.1) }' "$out/two.compare" ||
     fail "the two-pass model resumed in its second pass is not whole: $(sed -n 4,5p "$out/two.compare")"
 echo "[       OK ] two_pass_killed_in_second_pass_resumes"
-echo "[  PASSED  ] 2 test(s)."
+# Resume and process keep how the views were taken (issue 28): a config with another number of
+# views, passes or exposure is refused, naming the key, and the scan is left as it was (before:
+# 13 more views and a spoiled folder, views silently ignored, views at two exposures).
+rm -rf "$out/other"
+cp -r "$ref" "$out/other"
+rm -f "$out/other/mesh.ply" "$out/other/mesh.obj" "$out/other/mesh.stl" "$out/other"/view_01[012345]/view.ini
+for change in "views = 12|\\[scan\\] views = 8, not 12" "passes = 1|\\[scan\\] passes = 2, not 1" \
+    "exposure_us = 12000|\\[camera\\] exposure_us = 10000, not 12000"; do
+    key=${change%%|*}
+    sed "s|^${key%% *} = .*|$key|" "$out/two.ini" > "$out/other.ini"
+    grep -q "^$key\$" "$out/other.ini" || fail "the test could not set $key"
+    "$bin" resume "$out/other" --config "$out/other.ini" >"$out/other.log" 2>&1
+    rc=$?
+    [ $rc -eq 2 ] && grep -q "${change#*|}" "$out/other.log" &&
+        grep -q 'a resume keeps how the views are taken' "$out/other.log" ||
+        fail "resume with $key: rc $rc, $(tail -n 2 "$out/other.log")"
+    [ ! -e "$out/other/view_010/view.ini" ] && [ ! -e "$out/other/view_016" ] ||
+        fail "resume with $key touched the scan"
+done
+sed "s|^exposure_us = .*|exposure_us = 12000|" "$out/two.ini" > "$out/other.ini"
+"$bin" process "$ref" --config "$out/other.ini" --out "$out/other-processed" >"$out/other.log" 2>&1
+rc=$?
+[ $rc -ne 0 ] && grep -q '\[camera\] exposure_us = 10000, not 12000' "$out/other.log" &&
+    grep -q 'a re-processing keeps how the views are taken' "$out/other.log" ||
+    fail "process with another exposure: rc $rc, $(tail -n 2 "$out/other.log")"
+echo "[       OK ] resume_and_process_keep_how_views_were_taken"
+echo "[  PASSED  ] 3 test(s)."
 rm -rf "$out" # passed: its scans need not stay on the disk

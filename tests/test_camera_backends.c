@@ -40,8 +40,8 @@ static void test_yuyv_to_rgb(void **state)
     /* two pixels per 4 bytes: Y0 U Y1 V */
     const uint8_t yuyv[] = {16, 128, 235, 128, 81, 90, 81, 240, 145, 54, 145, 34, 41, 240, 41, 110};
     uint8_t rgb[8 * 3];
-    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_YUYV, yuyv, sizeof(yuyv), 0, 4, 2, 1, rgb, sizeof(rgb)),
-                     0);
+    assert_int_equal(
+        v4l2_to_rgb(V4L2_PIX_FMT_YUYV, yuyv, sizeof(yuyv), 0, 4, 2, 1, rgb, sizeof(rgb)), 0);
     const uint8_t want[8][3] = {{0, 0, 0},   {255, 255, 255}, {255, 0, 0}, {255, 0, 0},
                                 {0, 255, 1}, {0, 255, 1},     {0, 0, 255}, {0, 0, 255}};
     for (int p = 0; p < 8; p++)
@@ -59,8 +59,8 @@ static void test_rows_with_padding_and_grey(void **state)
     const uint8_t want[12] = {1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12};
     assert_memory_equal(out, want, sizeof(want));
     const uint8_t grey[8] = {10, 20, 0, 0, 30, 40, 0, 0};
-    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_GREY, grey, sizeof(grey), 4, 2, 2, 1, out, sizeof(out)),
-                     0);
+    assert_int_equal(
+        v4l2_to_rgb(V4L2_PIX_FMT_GREY, grey, sizeof(grey), 4, 2, 2, 1, out, sizeof(out)), 0);
     assert_int_equal(out[0], 10);
     assert_int_equal(out[2], 10);
     assert_int_equal(out[9], 40);
@@ -80,8 +80,9 @@ static void test_binning_a_sensor_above_the_limit(void **state)
     for (uint32_t y = 0; y < sh; y++)
         for (uint32_t x = 0; x < sw; x++)
             grey[(size_t)y * sw + x] = (uint8_t)((x * 7u + y * 31u) & 0xFFu);
-    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_GREY, grey, (size_t)sw * sh, sw, w, h, 2, out,
-                                 (size_t)w * h * 3), 0);
+    assert_int_equal(
+        v4l2_to_rgb(V4L2_PIX_FMT_GREY, grey, (size_t)sw * sh, sw, w, h, 2, out, (size_t)w * h * 3),
+        0);
     for (uint32_t y = 0; y < h; y++)
         for (uint32_t x = 0; x < w; x++) {
             uint32_t sum = 0;
@@ -92,17 +93,19 @@ static void test_binning_a_sensor_above_the_limit(void **state)
                 assert_int_equal(out[3 * ((size_t)y * w + x) + (size_t)c], (sum + 2) / 4);
         }
     assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_GREY, grey, (size_t)sw * sh - 1, sw, w, h, 2, out,
-                                 (size_t)w * h * 3), -EIO);
+                                 (size_t)w * h * 3),
+                     -EIO);
     assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_GREY, grey, (size_t)sw * sh, sw, w / 4, h / 3,
-                                 HAL_MAX_BINNING + 1, out, (size_t)w * h * 3), -EINVAL);
+                                 HAL_MAX_BINNING + 1, out, (size_t)w * h * 3),
+                     -EINVAL);
     /* YUYV, 8 x 4 sensor pixels to 4 x 2 */
     uint8_t yuyv[8 * 4 * 2], full[8 * 4 * 3], binned[4 * 2 * 3];
     for (size_t k = 0; k < sizeof(yuyv); k++)
         yuyv[k] = (uint8_t)(40 + (k * 37u) % 180u);
-    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_YUYV, yuyv, sizeof(yuyv), 16, 8, 4, 1, full,
-                                 sizeof(full)), 0);
-    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_YUYV, yuyv, sizeof(yuyv), 16, 4, 2, 2, binned,
-                                 sizeof(binned)), 0);
+    assert_int_equal(
+        v4l2_to_rgb(V4L2_PIX_FMT_YUYV, yuyv, sizeof(yuyv), 16, 8, 4, 1, full, sizeof(full)), 0);
+    assert_int_equal(
+        v4l2_to_rgb(V4L2_PIX_FMT_YUYV, yuyv, sizeof(yuyv), 16, 4, 2, 2, binned, sizeof(binned)), 0);
     for (uint32_t y = 0; y < 2; y++)
         for (uint32_t x = 0; x < 4; x++)
             for (uint32_t c = 0; c < 3; c++) {
@@ -124,8 +127,10 @@ static void test_short_frame_and_small_buffer(void **state)
     assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_YUYV, src, 31, 8, 4, 4, 1, out, sizeof(out)), -EIO);
     assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_YUYV, src, 32, 8, 4, 4, 1, out, sizeof(out)), 0);
     assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_YUYV, src, 32, 8, 4, 4, 1, out, 47), -ENOSPC);
-    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_MJPEG, src, 64, 0, 4, 4, 1, out, sizeof(out)), -EINVAL);
-    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_YUYV, src, 64, 0, 3, 2, 1, out, sizeof(out)), -EINVAL);
+    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_MJPEG, src, 64, 0, 4, 4, 1, out, sizeof(out)),
+                     -EINVAL);
+    assert_int_equal(v4l2_to_rgb(V4L2_PIX_FMT_YUYV, src, 64, 0, 3, 2, 1, out, sizeof(out)),
+                     -EINVAL);
     char text[5];
     assert_string_equal(v4l2_fourcc_text(v4l2_fourcc_of(HAL_PIX_YUYV), text), "YUYV");
 }
@@ -144,7 +149,8 @@ static void test_controls_turn_automatics_off_first(void **state)
     size_t n;
     int fixed;
     char err[160];
-    assert_int_equal(v4l2_plan_controls(uvc, 6, 10000, 2000, plan, &n, &fixed, err, sizeof(err)), 0);
+    assert_int_equal(v4l2_plan_controls(uvc, 6, 10000, 2000, plan, &n, &fixed, err, sizeof(err)),
+                     0);
     assert_int_equal(n, 4);
     assert_int_equal(plan[0].id, V4L2_CID_EXPOSURE_AUTO);
     assert_int_equal(plan[0].value, V4L2_EXPOSURE_MANUAL);
@@ -163,16 +169,19 @@ static void test_controls_out_of_range_are_named(void **state)
     size_t n;
     int fixed;
     char err[160];
-    assert_int_equal(v4l2_plan_controls(uvc, 6, 300000, 1000, plan, &n, &fixed, err, sizeof(err)), -ERANGE);
+    assert_int_equal(v4l2_plan_controls(uvc, 6, 300000, 1000, plan, &n, &fixed, err, sizeof(err)),
+                     -ERANGE);
     assert_non_null(strstr(err, "exposure 300000 us is outside the camera's 300..204700 us"));
-    assert_int_equal(v4l2_plan_controls(uvc, 6, 10000, 8000, plan, &n, &fixed, err, sizeof(err)), -ERANGE);
+    assert_int_equal(v4l2_plan_controls(uvc, 6, 10000, 8000, plan, &n, &fixed, err, sizeof(err)),
+                     -ERANGE);
     assert_non_null(strstr(err, "gain"));
     /* an automatic exposure with no manual one: not a camera the scanner can use */
-    assert_int_equal(v4l2_plan_controls(uvc, 3, 10000, 1000, plan, &n, &fixed, err, sizeof(err)), -ENOTSUP);
+    assert_int_equal(v4l2_plan_controls(uvc, 3, 10000, 1000, plan, &n, &fixed, err, sizeof(err)),
+                     -ENOTSUP);
     assert_non_null(strstr(err, "no manual exposure"));
     /* no exposure control at all (vivid, a fixed-exposure module): its own, fixed */
-    assert_int_equal(v4l2_plan_controls(uvc + 1, 2, 10000, 1000, plan, &n, &fixed, err,
-                                        sizeof(err)), 0);
+    assert_int_equal(
+        v4l2_plan_controls(uvc + 1, 2, 10000, 1000, plan, &n, &fixed, err, sizeof(err)), 0);
     assert_int_equal(fixed, 1);
     assert_int_equal(n, 1); /* white balance off; no exposure, no gain to set */
     assert_int_equal(plan[0].id, V4L2_CID_AUTO_WHITE_BALANCE);

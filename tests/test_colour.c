@@ -19,9 +19,9 @@
 #include "vec3.h"
 
 struct colour_stats {
-    double spread;      /**< mean over channels of std / mean of the colour */
-    double highlight;   /**< share of pixels brighter than 1.5 x the median */
-    double red_green;   /**< mean red / mean green (truth: 0.6 / 0.45) */
+    double spread;    /**< mean over channels of std / mean of the colour */
+    double highlight; /**< share of pixels brighter than 1.5 x the median */
+    double red_green; /**< mean red / mean green (truth: 0.6 / 0.45) */
     size_t pixels;
 };
 
@@ -308,8 +308,8 @@ static void test_light_exposure_is_normalised(void **state)
     double full[3], short_exp[3];
     uniform_mean(5000, full); /* at the camera's 10 ms four lights saturate much of the paint */
     uniform_mean(2500, short_exp);
-    print_message("uniform, all lights at 5 ms: %.1f %.1f %.1f; at 2.5 ms: %.1f %.1f %.1f\n", full[0],
-                  full[1], full[2], short_exp[0], short_exp[1], short_exp[2]);
+    print_message("uniform, all lights at 5 ms: %.1f %.1f %.1f; at 2.5 ms: %.1f %.1f %.1f\n",
+                  full[0], full[1], full[2], short_exp[0], short_exp[1], short_exp[2]);
     for (int k = 0; k < 3; k++) /* half the light, twice the gain: the same colour */
         assert_true(fabs(short_exp[k] / full[k] - 1.0) < 0.03);
 }

@@ -205,9 +205,9 @@ static void test_not_a_regular_file(void **state)
 static void test_empty_calibration_and_zero_baseline(void **state)
 {
     (void)state;
-    const char *path = write_file(
-        "empty-calib.ini", "[camera]\nbackend = sim\nwidth = 1280\nheight = 960\n"
-                           "exposure_us = 10000\n[scan]\ncalibration =\n");
+    const char *path =
+        write_file("empty-calib.ini", "[camera]\nbackend = sim\nwidth = 1280\nheight = 960\n"
+                                      "exposure_us = 10000\n[scan]\ncalibration =\n");
     assert_int_equal(config_load(&cfg, path, err, sizeof(err)), -EINVAL);
     assert_non_null(strstr(err, "[scan] calibration: empty"));
     struct scan_calib calib;
@@ -220,6 +220,55 @@ static void test_empty_calibration_and_zero_baseline(void **state)
     assert_int_equal(calib_load(&calib, path, 0, err, sizeof(err)), -EINVAL);
     assert_non_null(strstr(err, "[projector] translation_mm: the projector is 0.0 mm from the "
                                 "camera"));
+}
+
+/* A calibration of another rig, or none: config/sim-calib.ini with one value changed. */
+static int load_changed_calibration(const char *from, const char *to)
+{
+    static char text[8192];
+    FILE *f = fopen("config/sim-calib.ini", "r");
+    assert_non_null(f);
+    size_t n = fread(text, 1, sizeof(text) - 1, f);
+    fclose(f);
+    text[n] = '\0';
+    char *at = strstr(text, from), changed[8192];
+    assert_non_null(at);
+    snprintf(changed, sizeof(changed), "%.*s%s%s", (int)(at - text), text, to, at + strlen(from));
+    struct scan_calib calib;
+    err[0] = '\0';
+    return calib_load(&calib, write_file("changed-calib.ini", changed), 4, err, sizeof(err));
+}
+
+/* Calibration values a lens cannot have are refused with their key (issue 28: cx_px = 99999
+ * passed check-config; a distortion of +-100 made the scan fail with "did the object move?"). */
+static void test_calibration_values_within_bounds(void **state)
+{
+    (void)state;
+    assert_int_equal(load_changed_calibration("cx_px = 639.5", "cx_px = 639.5"), 0);
+    assert_int_equal(load_changed_calibration("cx_px = 639.5", "cx_px = 99999"), -EINVAL);
+    assert_non_null(
+        strstr(err, "changed-calib.ini: [camera] cx_px: 99999.0 is off the 1280x960 image"));
+    assert_int_equal(load_changed_calibration("cy_px = 479.5", "cy_px = -3"), -EINVAL);
+    assert_non_null(strstr(err, "[camera] cy_px: -3.0 is off"));
+    assert_int_equal(load_changed_calibration("fy_px = 2400", "fy_px = 9000"), -EINVAL);
+    assert_non_null(strstr(err, "[camera] fx_px = 2400.0, fy_px = 9000.0: no lens"));
+    assert_int_equal(
+        load_changed_calibration("height = 960\n", "height = 960\ndistortion = 100, 0, 0, 0, 0\n"),
+        -EINVAL);
+    assert_non_null(strstr(err, "[camera] distortion: k1 100"));
+    assert_int_equal(
+        load_changed_calibration("height = 960\n", "height = 960\ndistortion = -100, 0, 0, 0, 0\n"),
+        -EINVAL);
+    assert_non_null(strstr(err, "[camera] distortion: k1 -100"));
+    /* a real lens's distortion loads (a wide-angle k1 and k2, a little tangential) */
+    assert_int_equal(load_changed_calibration("height = 960\n",
+                                              "height = 960\ndistortion = "
+                                              "-0.28, 0.09, 0.001, -0.0005, -0.01\n"),
+                     0);
+    /* a projector's lens shift puts its principal point at the image's edge or beyond */
+    assert_int_equal(load_changed_calibration("cy_px = 383.5", "cy_px = 800"), 0);
+    assert_int_equal(load_changed_calibration("cy_px = 383.5", "cy_px = 99999"), -EINVAL);
+    assert_non_null(strstr(err, "[projector] cy_px: 99999.0 is off the 1024x768 image by more"));
 }
 
 /* A HAL=sim build refuses a real-hardware backend rather than faking it. */
@@ -278,6 +327,7 @@ int main(void)
         cmocka_unit_test(test_overlong_line_refused),
         cmocka_unit_test(test_not_a_regular_file),
         cmocka_unit_test(test_empty_calibration_and_zero_baseline),
+        cmocka_unit_test(test_calibration_values_within_bounds),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

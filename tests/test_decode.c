@@ -140,7 +140,8 @@ static void test_size_above_limit_rejected(void **state)
     assert_int_equal(begin(&p, 6), -EINVAL);
     p = params();
     assert_int_equal(begin(&p, 17), -EINVAL);
-    struct gray_layout too_many = {16, 16, GRAY_CODE_GRAY}; /* more patterns than the frame store holds */
+    struct gray_layout too_many = {16, 16,
+                                   GRAY_CODE_GRAY}; /* more patterns than the frame store holds */
     assert_int_equal(decode_begin(&p, &too_many, PROJ_W, 1), -EINVAL);
 }
 

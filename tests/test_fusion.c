@@ -80,8 +80,13 @@ static long check_closed(const struct collected *c)
 
 static struct fusion_params grid_params(void)
 {
-    struct fusion_params p = {.voxel_mm = 1.0, .radius_mm = 30, .bottom_mm = 0, .top_mm = 60,
-                              .truncation_mm = 3.0, .max_weight = 50, .edge_fade_px = 10};
+    struct fusion_params p = {.voxel_mm = 1.0,
+                              .radius_mm = 30,
+                              .bottom_mm = 0,
+                              .top_mm = 60,
+                              .truncation_mm = 3.0,
+                              .max_weight = 50,
+                              .edge_fade_px = 10};
     return p;
 }
 
@@ -138,7 +143,8 @@ static void test_sphere_is_closed_genus_0(void **state)
         assert_true(v3_dot(n, v3(a[0] - 0.3, a[1] + 0.2, a[2] - 30.1)) > 0.0);
     }
     for (uint32_t v = 0; v < c.nv; v++)
-        assert_true(fabs(sphere(v3(c.pos[3 * v], c.pos[3 * v + 1], c.pos[3 * v + 2]), NULL)) < 0.05);
+        assert_true(fabs(sphere(v3(c.pos[3 * v], c.pos[3 * v + 1], c.pos[3 * v + 2]), NULL)) <
+                    0.05);
     free(c.pos);
     free(c.tri);
 }

@@ -88,11 +88,12 @@ static int setup(void **state)
 static void test_camera_rays_project_back(void **state)
 {
     (void)state;
-    assert_int_equal(camray_prepare(&rig), 0);
+    struct camray rays;
+    assert_int_equal(camray_prepare(&rig, &rays), 0);
     double worst = 0.0;
     for (uint32_t y = 0; y < rig.cam_height; y += 7) {
         for (uint32_t x = 0; x < rig.cam_width; x += 7) {
-            vec3 d = camray_at(&rig, x, y);
+            vec3 d = camray_at(&rig, rays, x, y);
             double xd, yd;
             opencv_distort(rig.cam_dist, d.x, d.y, &xd, &yd);
             double u = rig.cam_fx_px * xd + rig.cam_cx_px, v = rig.cam_fy_px * yd + rig.cam_cy_px;
@@ -105,6 +106,25 @@ static void test_camera_rays_project_back(void **state)
 static float column[HAL_MAX_PIXELS];
 static uint8_t reason[HAL_MAX_PIXELS];
 static double true_z[HAL_MAX_PIXELS];
+
+/* The ray table belongs to a calibration by what it says, not by where it is kept (issue 29):
+ * a copy elsewhere finds it; the same place holding another calibration does not. */
+static void test_ray_table_keyed_by_content(void **state)
+{
+    (void)state;
+    static struct scan_calib copy, other;
+    struct camray rays;
+    assert_int_equal(camray_prepare(&rig, &rays), 0);
+    assert_non_null(rays.xy);
+    copy = rig;
+    assert_ptr_equal(camray_lookup(&copy).xy, rays.xy);
+    other = rig;
+    other.cam_dist[0] += 0.01; /* changed in place: its rays are no longer the table's */
+    assert_null(camray_lookup(&other).xy);
+    vec3 a = camray_at(&other, camray_lookup(&other), 10, 10);
+    vec3 b = camray_at(&rig, rays, 10, 10);
+    assert_true(fabs(a.x - b.x) > 1e-6);
+}
 
 /* The projector's distorted column of a camera-frame point (forward model only). */
 static double proj_column(const struct scan_calib *c, vec3 p)
@@ -126,7 +146,8 @@ static void test_triangulates_through_both_lenses(void **state)
         for (uint32_t x = 0; x < w; x++) {
             size_t i = (size_t)y * w + x;
             true_z[i] = 580.0 + 60.0 * x / w + 20.0 * y / h;
-            double u = proj_column(&rig, v3_scale(camray_at(&rig, x, y), true_z[i]));
+            double u =
+                proj_column(&rig, v3_scale(camray_at(&rig, camray_lookup(&rig), x, y), true_z[i]));
             reason[i] = (u >= 0 && u < rig.proj_width - 0.5) ? SCAN_VALID : SCAN_SHADOW;
             column[i] = (float)u;
         }
@@ -161,6 +182,7 @@ int main(void)
         cmocka_unit_test(test_jacobian_matches_differences),
         cmocka_unit_test(test_undistort_refuses_a_fold),
         cmocka_unit_test(test_camera_rays_project_back),
+        cmocka_unit_test(test_ray_table_keyed_by_content),
         cmocka_unit_test(test_triangulates_through_both_lenses),
     };
     return cmocka_run_group_tests(tests, setup, NULL);

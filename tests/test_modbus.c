@@ -7,6 +7,7 @@
 #include <cmocka.h>
 
 #include <errno.h>
+#include <math.h>
 #include <modbus.h>
 #include <stdio.h>
 #include <string.h>
@@ -261,6 +262,66 @@ static void test_restart_noticed_before_the_move(void **state)
     assert_int_equal(tt_server_position(&server), 0);
 }
 
+/* The controller restarts (a power glitch) as the link drops, before the move command is
+ * executed: the reconnect must not send the move to a controller that counts from where the
+ * table stood (before: exit 0, the view recorded at 240 deg while the table stood at 120). */
+static void restart_as_the_link_drops(unsigned long at_request, int rezeroed, const char *expect)
+{
+    assert_int_equal(hal_table_home(&table), 0);
+    assert_int_equal(hal_table_move_to(&table, 120000), 0);
+    pthread_mutex_lock(&server.lock);
+    double physical = tt_ctrl_physical_mdeg(&server.ctrl);
+    pthread_mutex_unlock(&server.lock);
+    server.restart_on_drop = 1;
+    server.restart_homed = rezeroed;
+    server.drop_at_request = server.requests + at_request;
+    errors_logged = 0;
+    assert_int_equal(hal_table_move_to(&table, 240000), -EIO);
+    assert_int_equal(server.drop_at_request, 0); /* the drop happened */
+    assert_int_equal(errors_logged, 1);
+    if (strstr(last_log, expect) == NULL)
+        fail_msg("%s", last_log);
+    pthread_mutex_lock(&server.lock);
+    assert_true(fabs(tt_ctrl_physical_mdeg(&server.ctrl) - physical) < 1.0); /* not moved */
+    pthread_mutex_unlock(&server.lock);
+    assert_int_equal(hal_table_move_to(&table, 240000), -EIO); /* homing again is the way on */
+    assert_int_equal(hal_table_home(&table), 0);
+    assert_int_equal(hal_table_move_to(&table, 240000), 0);
+}
+
+/* the drop on the move command (request 3: the status check, the target, the command); the
+ * controller back not homed, or re-zeroed and saying it is homed (which before went unnoticed) */
+static void test_restart_while_sending_the_move(void **state)
+{
+    (void)state;
+    restart_as_the_link_drops(3, 0, "the controller restarted (no longer homed");
+    restart_as_the_link_drops(3, 1, "the controller restarted (homed, last command 0 where");
+}
+
+/* the drop on the target (request 2): the command is not sent to the restarted controller */
+static void test_restart_while_writing_the_target(void **state)
+{
+    (void)state;
+    restart_as_the_link_drops(2, 0, "the controller restarted (no longer homed");
+    restart_as_the_link_drops(2, 1, "the controller restarted (homed, last command 0 where");
+}
+
+/* the drop while the move is polled (request 5): the restarted controller is not homed, and the
+ * wait says so at once (before: polled to the move timeout, then "still moving") */
+static void test_restart_during_the_move(void **state)
+{
+    (void)state;
+    assert_int_equal(hal_table_home(&table), 0);
+    server.restart_on_drop = 1;
+    server.drop_at_request = server.requests + 5;
+    errors_logged = 0;
+    assert_int_equal(hal_table_move_to(&table, 90000), -EIO);
+    assert_int_equal(errors_logged, 1);
+    if (strstr(last_log, "the controller restarted during the move (no longer homed") == NULL)
+        fail_msg("%s", last_log);
+    assert_int_equal(hal_table_move_to(&table, 90000), -EIO); /* until homed again */
+}
+
 /* The table turned by hand (or re-zeroed, counter kept) between two views: the same. */
 static void test_table_moved_noticed_before_the_move(void **state)
 {
@@ -434,7 +495,8 @@ static void test_connection_refused(void **state)
     struct tt_client_config c = base_config();
     char err[256];
     c.port = 1; /* privileged, nothing listens there */
-    assert_int_not_equal(tt_client_open(&c0, &c, &vhal_clock, log_capture, &t0, err, sizeof(err)), 0);
+    assert_int_not_equal(tt_client_open(&c0, &c, &vhal_clock, log_capture, &t0, err, sizeof(err)),
+                         0);
     assert_non_null(strstr(err, "cannot connect to 127.0.0.1:1"));
     assert_null(t0.ops);
 }
@@ -446,6 +508,9 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_move_before_home_raises_alarm, open_tcp, close_all),
         cmocka_unit_test_setup_teardown(test_stall_reported_with_position, open_tcp, close_all),
         cmocka_unit_test_setup_teardown(test_restart_noticed_before_the_move, open_tcp, close_all),
+        cmocka_unit_test_setup_teardown(test_restart_while_sending_the_move, open_tcp, close_all),
+        cmocka_unit_test_setup_teardown(test_restart_while_writing_the_target, open_tcp, close_all),
+        cmocka_unit_test_setup_teardown(test_restart_during_the_move, open_tcp, close_all),
         cmocka_unit_test_setup_teardown(test_table_moved_noticed_before_the_move, open_tcp,
                                         close_all),
         cmocka_unit_test_setup_teardown(test_busy_controller_asked_again, open_tcp, close_all),

@@ -18,6 +18,8 @@
 
 #include <stdio.h>
 
+static struct reflect_pool pool; /* the reflectance under test */
+
 /* A small deterministic generator (xorshift), uniform in [0, 1). */
 static uint64_t rng = 88172645463325252ull;
 static double uniform(void)
@@ -37,7 +39,13 @@ struct truth {
 /* A sample of paint @p t seen from a random angle under 8 lights at random angles: each light
  * at alpha (normal to half vector) and theta_i; the signal as the model gives it. With
  * @p shadowed, light 0 gives a tenth of it (light from other surfaces). */
+static void add_sample_to(struct reflect_pool *to, const struct truth *t, int shadowed);
 static void add_sample(const struct truth *t, int shadowed)
+{
+    add_sample_to(&pool, t, shadowed);
+}
+
+static void add_sample_to(struct reflect_pool *to, const struct truth *t, int shadowed)
 {
     struct reflect_obs o;
     memset(&o, 0, sizeof(o));
@@ -54,7 +62,7 @@ static void add_sample(const struct truth *t, int shadowed)
             o.signal[l][c] = (float)(s * (shadowed && l == 0 ? 0.1 : 1.0));
         }
     }
-    reflect_add(&o);
+    reflect_add(to, &o);
 }
 
 static void test_two_materials_recovered(void **state)
@@ -62,17 +70,17 @@ static void test_two_materials_recovered(void **state)
     (void)state;
     static const struct truth gold = {{0.30, 0.20, 0.05}, {0.40, 0.30, 0.10}, 0.12};
     static const struct truth plastic = {{0.10, 0.40, 0.60}, {0.20, 0.20, 0.20}, 0.05};
-    reflect_begin(1);
-    assert_true(reflect_collecting());
-    assert_null(reflect_model());
+    reflect_begin(&pool, 1);
+    assert_true(reflect_collecting(&pool));
+    assert_null(reflect_model(&pool));
     for (int i = 0; i < 6000; i++) {
         add_sample(&gold, i % 10 == 0);
         add_sample(&plastic, 0);
     }
     struct reflect_model m;
-    assert_int_equal(reflect_fit(4, &m), 0);
-    assert_false(reflect_collecting());
-    assert_non_null(reflect_model());
+    assert_int_equal(reflect_fit(&pool, 4, &m), 0);
+    assert_false(reflect_collecting(&pool));
+    assert_non_null(reflect_model(&pool));
     assert_int_equal(m.count, 2); /* two colours: two clusters, though four were allowed */
     const struct truth *truths[2] = {&gold, &plastic};
     for (int t = 0; t < 2; t++) {
@@ -92,6 +100,34 @@ static void test_two_materials_recovered(void **state)
     }
 }
 
+/* Two pools side by side (two jobs in one process, issue 29): samples of gold into one and of
+ * plastic into the other, in turn; each fits its own paint, and forgetting one leaves the other's
+ * model. */
+static void test_two_pools_are_independent(void **state)
+{
+    (void)state;
+    static const struct truth gold = {{0.30, 0.20, 0.05}, {0.40, 0.30, 0.10}, 0.12};
+    static const struct truth plastic = {{0.10, 0.40, 0.60}, {0.20, 0.20, 0.20}, 0.05};
+    static struct reflect_pool other;
+    reflect_begin(&pool, 1);
+    reflect_begin(&other, 1);
+    for (int i = 0; i < 4000; i++) {
+        add_sample_to(&pool, &gold, 0);
+        add_sample_to(&other, &plastic, 0);
+    }
+    struct reflect_model a, b;
+    assert_int_equal(reflect_fit(&pool, 4, &a), 0);
+    assert_true(reflect_collecting(&other)); /* the other still collects */
+    assert_int_equal(reflect_fit(&other, 4, &b), 0);
+    assert_int_equal(a.count, 1);
+    assert_int_equal(b.count, 1);
+    assert_true(fabs(a.cluster[0].roughness - gold.roughness) < 0.05 * gold.roughness);
+    assert_true(fabs(b.cluster[0].roughness - plastic.roughness) < 0.05 * plastic.roughness);
+    reflect_forget(&other);
+    assert_null(reflect_model(&other));
+    assert_non_null(reflect_model(&pool));
+}
+
 /* A lobe with tails GGX does not have (the simulator's ABC form for measured materials, here
  * heavy-tailed: 1 / (1 + 40 (1 - cos alpha))^0.8) on dark paint: the measured shape follows it
  * far closer than the GGX fit can. */
@@ -104,7 +140,7 @@ static void test_measured_lobe_shape(void **state)
 {
     (void)state;
     static const double rho[3] = {0.05, 0.04, 0.03}, k[3] = {0.5, 0.35, 0.15};
-    reflect_begin(1);
+    reflect_begin(&pool, 1);
     for (int i = 0; i < 8000; i++) {
         struct reflect_obs o;
         memset(&o, 0, sizeof(o));
@@ -119,10 +155,10 @@ static void test_measured_lobe_shape(void **state)
                 o.signal[l][c] =
                     (float)(rho[c] * o.cos_i[l] + k[c] * heavy_tail(o.alpha[l]) / o.cos_r);
         }
-        reflect_add(&o);
+        reflect_add(&pool, &o);
     }
     struct reflect_model m;
-    assert_int_equal(reflect_fit(1, &m), 0);
+    assert_int_equal(reflect_fit(&pool, 1, &m), 0);
     const struct reflect_cluster *c = &m.cluster[0];
     assert_true(c->measured);
     double worst = 0.0, ggx_worst = 0.0;
@@ -155,7 +191,7 @@ static void test_one_paint_one_cluster(void **state)
 {
     (void)state;
     static const struct truth paint = {{0.18, 0.32, 0.62}, {0.06, 0.06, 0.06}, 0.3};
-    reflect_begin(1);
+    reflect_begin(&pool, 1);
     for (int i = 0; i < 6000; i++) {
         struct truth seen = paint;
         double spread = 1.0 + 0.4 * pow(uniform(), 3.0); /* a long tail: the sheen */
@@ -164,7 +200,7 @@ static void test_one_paint_one_cluster(void **state)
         add_sample(&seen, 0);
     }
     struct reflect_model m;
-    assert_int_equal(reflect_fit(4, &m), 0);
+    assert_int_equal(reflect_fit(&pool, 4, &m), 0);
     print_message("one paint: %u cluster(s)\n", m.count);
     assert_int_equal(m.count, 1);
 }
@@ -174,14 +210,14 @@ static void test_too_few_samples(void **state)
 {
     (void)state;
     static const struct truth grey = {{0.5, 0.5, 0.5}, {0.1, 0.1, 0.1}, 0.1};
-    reflect_begin(8);
+    reflect_begin(&pool, 8);
     for (int i = 0; i < 50; i++)
         add_sample(&grey, 0);
     struct reflect_model m;
-    assert_int_equal(reflect_fit(4, &m), -ENODATA);
-    assert_null(reflect_model());
-    reflect_forget();
-    assert_false(reflect_collecting());
+    assert_int_equal(reflect_fit(&pool, 4, &m), -ENODATA);
+    assert_null(reflect_model(&pool));
+    reflect_forget(&pool);
+    assert_false(reflect_collecting(&pool));
 }
 
 static double sphere(vec3 p, void *ctx)
@@ -195,7 +231,7 @@ static double sphere(vec3 p, void *ctx)
 static void test_glb_with_every_cluster(void **state)
 {
     (void)state;
-    reflect_begin(1);
+    reflect_begin(&pool, 1);
     for (int i = 0; i < 8 * 400; i++) {
         int corner = i % 8;
         struct truth t = {
@@ -205,7 +241,7 @@ static void test_glb_with_every_cluster(void **state)
         add_sample(&t, 0);
     }
     struct reflect_model m;
-    assert_int_equal(reflect_fit(REFLECT_MAX_CLUSTERS, &m), 0);
+    assert_int_equal(reflect_fit(&pool, REFLECT_MAX_CLUSTERS, &m), 0);
     assert_int_equal(m.count, REFLECT_MAX_CLUSTERS);
     struct fusion_params p = {.voxel_mm = 1.0,
                               .radius_mm = 30,
@@ -231,7 +267,7 @@ static void test_glb_with_every_cluster(void **state)
     assert_int_equal(fusion_mesh_prepare(0.0, &ms), 0);
     struct hal_storage st;
     storage_posix_init(&st);
-    assert_int_equal(fusion_write_glb(&st, "build/test_reflect.glb"), 0);
+    assert_int_equal(fusion_write_glb(&st, "build/test_reflect.glb", reflect_model(&pool)), 0);
     FILE *f = fopen("build/test_reflect.glb", "rb");
     assert_non_null(f);
     static char buf[16384];
@@ -245,14 +281,17 @@ static void test_glb_with_every_cluster(void **state)
         primitives++;
     assert_int_equal(materials, REFLECT_MAX_CLUSTERS);
     assert_int_equal(primitives, REFLECT_MAX_CLUSTERS); /* every cluster has triangles */
-    reflect_forget();
+    reflect_forget(&pool);
 }
 
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_two_materials_recovered), cmocka_unit_test(test_measured_lobe_shape),
-        cmocka_unit_test(test_one_paint_one_cluster),   cmocka_unit_test(test_too_few_samples),
+        cmocka_unit_test(test_two_materials_recovered),
+        cmocka_unit_test(test_two_pools_are_independent),
+        cmocka_unit_test(test_measured_lobe_shape),
+        cmocka_unit_test(test_one_paint_one_cluster),
+        cmocka_unit_test(test_too_few_samples),
         cmocka_unit_test(test_glb_with_every_cluster),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

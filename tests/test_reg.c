@@ -23,6 +23,9 @@ static const double sphere_c[SPHERES][3] = {{30, 0, 40}, {-20, 25, 60}, {-10, -3
 static const double sphere_r[SPHERES] = {25, 20, 18, 22};
 
 static struct scan_calib calib;
+static struct reg_ctx reg;        /* the registration under test */
+static struct reg_ctx other;      /* a second one beside it */
+static struct reg_ctx *to = &reg; /* where add_view adds */
 static uint8_t reason[HAL_MAX_PIXELS], rgb[HAL_MAX_PIXELS * 3];
 static float xyz[HAL_MAX_PIXELS * 3], normal[HAL_MAX_PIXELS * 3];
 
@@ -48,7 +51,7 @@ static void add_view(uint32_t v, double angle_deg, double reported_deg, vec3 sli
     memset(reason, SCAN_SHADOW, (size_t)w * h);
     for (uint32_t y = 0; y < h; y += s) {
         for (uint32_t x = 0; x < w; x += s) {
-            vec3 ray = camray_at(&calib, x, y), dir = frame_dir(&obj, ray);
+            vec3 ray = camray_at(&calib, camray_lookup(&calib), x, y), dir = frame_dir(&obj, ray);
             double best = 1e30;
             int hit = -1;
             for (int k = 0; k < SPHERES; k++) { /* |eye + t dir - c|^2 = r^2 */
@@ -80,16 +83,22 @@ static void add_view(uint32_t v, double angle_deg, double reported_deg, vec3 sli
     }
     struct decode_maps maps = {.reason = reason, .width = w, .height = h};
     struct tri_range range = {.xyz_mm = xyz, .normal = normal, .width = w, .height = h};
-    assert_int_equal(reg_add_view(v, (int32_t)lround(reported_deg * 1000.0), &maps, &range, rgb),
-                     0);
+    assert_int_equal(
+        reg_add_view(to, v, (int32_t)lround(reported_deg * 1000.0), &maps, &range, rgb), 0);
 }
 
 static struct reg_params params(void)
 {
-    return (struct reg_params){.enabled = 1, .sample_stride = 4, .iterations = 20,
-                               .max_pair_mm = 1.5, .max_normal_deg = 20, .use_colour = 1,
-                               .max_colour_dn = 40, .max_correction_deg = 3,
-                               .max_axis_shift_mm = 3, .max_axis_tilt_deg = 1,
+    return (struct reg_params){.enabled = 1,
+                               .sample_stride = 4,
+                               .iterations = 20,
+                               .max_pair_mm = 1.5,
+                               .max_normal_deg = 20,
+                               .use_colour = 1,
+                               .max_colour_dn = 40,
+                               .max_correction_deg = 3,
+                               .max_axis_shift_mm = 3,
+                               .max_axis_tilt_deg = 1,
                                .min_coupled_share = 0.2};
 }
 
@@ -98,7 +107,7 @@ static int setup(void **state)
     (void)state;
     char err[256];
     return calib_load(&calib, "config/sim-calib.ini", 4, err, sizeof(err)) ||
-           camray_prepare(&calib);
+           camray_prepare(&calib, &(struct camray){NULL});
 }
 
 /* Each view's registered angle, relative to view 0's, against the truth: worst error (deg). */
@@ -107,9 +116,9 @@ static double worst_angle_error(const double *truth_deg)
     double worst = 0.0;
     struct reg_view first, rv;
     struct frame_xform pose;
-    assert_int_equal(reg_view_pose(0, &pose, &first), 0);
+    assert_int_equal(reg_view_pose(&reg, 0, &pose, &first), 0);
     for (uint32_t v = 1; v < VIEWS; v++) {
-        assert_int_equal(reg_view_pose(v, &pose, &rv), 0);
+        assert_int_equal(reg_view_pose(&reg, v, &pose, &rv), 0);
         double rel = (rv.angle_deg - first.angle_deg) - (truth_deg[v] - truth_deg[0]);
         worst = fmax(worst, fabs(rel));
     }
@@ -123,13 +132,13 @@ static void test_table_errors_are_found(void **state)
     static const double err_deg[VIEWS] = {0.7, -1.9, 1.2, 0.4, -0.8, 2.0, -1.3, 1.6};
     double truth[VIEWS];
     struct reg_params p = params();
-    assert_int_equal(reg_begin(&p, &calib, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
+    assert_int_equal(reg_begin(&reg, &p, &calib, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
     for (uint32_t v = 0; v < VIEWS; v++) {
         truth[v] = 45.0 * v + err_deg[v];
         add_view(v, truth[v], 45.0 * v, v3(0, 0, 0));
     }
     struct reg_report rep;
-    assert_int_equal(reg_solve(&rep), 0);
+    assert_int_equal(reg_solve(&reg, &rep), 0);
     double worst = worst_angle_error(truth);
     print_message("table errors up to 2 deg: worst registered angle error %.4f deg; residual "
                   "%.3f mm, loop closure %.3f mm, %u steps\n",
@@ -152,20 +161,48 @@ static void test_axis_is_reestimated(void **state)
     d = v3_norm(v3_add(d, v3(0.007, 0, 0))); /* 0.4 degrees */
     wrong.axis_dir[0] = d.x, wrong.axis_dir[1] = d.y, wrong.axis_dir[2] = d.z;
     struct reg_params p = params();
-    assert_int_equal(reg_begin(&p, &wrong, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
+    assert_int_equal(reg_begin(&reg, &p, &wrong, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
     for (uint32_t v = 0; v < VIEWS; v++) {
         truth[v] = 45.0 * v;
         add_view(v, truth[v], truth[v], v3(0, 0, 0)); /* rendered with the true axis */
     }
     struct reg_report rep;
-    assert_int_equal(reg_solve(&rep), 0);
+    assert_int_equal(reg_solve(&reg, &rep), 0);
     vec3 da = v3_sub(v3_from(calib.axis_point_mm), v3_from(wrong.axis_point_mm));
     print_message("axis off by 1.5 mm, 0.4 deg: moved %.3f mm, tilted %.3f deg; residual "
-                  "%.3f mm -> %.3f mm\n", rep.axis_shift_mm, rep.axis_tilt_deg,
-                  rep.score_before_mm, rep.score_after_mm);
+                  "%.3f mm -> %.3f mm\n",
+                  rep.axis_shift_mm, rep.axis_tilt_deg, rep.score_before_mm, rep.score_after_mm);
     assert_true(rep.accepted);
     assert_true(fabs(rep.axis_tilt_deg - 0.4) < 0.1);
     assert_true(rep.axis_shift_mm > 0.5 * v3_len(da));
+    assert_true(worst_angle_error(truth) < 0.05);
+}
+
+/* Two registrations side by side (two jobs in one process, issue 29): their views added in
+ * turn, each solved on its own and each as it is alone: the scan whose object slipped names its
+ * view, the clean one with a table 2 degrees off finds its angles. */
+static void test_two_registrations_are_independent(void **state)
+{
+    (void)state;
+    static const double err_deg[VIEWS] = {0.7, -1.9, 1.2, 0.4, -0.8, 2.0, -1.3, 1.6};
+    double truth[VIEWS];
+    struct reg_params p = params();
+    assert_int_equal(reg_begin(&reg, &p, &calib, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
+    assert_int_equal(reg_begin(&other, &p, &calib, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
+    for (uint32_t v = 0; v < VIEWS; v++) {
+        truth[v] = 45.0 * v + err_deg[v];
+        to = &reg;
+        add_view(v, truth[v], 45.0 * v, v3(0, 0, 0));
+        to = &other;
+        add_view(v, 45.0 * v, 45.0 * v, v >= 4 ? v3(6, 0, 0) : v3(0, 0, 0));
+    }
+    to = &reg;
+    struct reg_report slipped, clean;
+    assert_int_equal(reg_solve(&other, &slipped), 0);
+    assert_int_equal(reg_solve(&reg, &clean), 0);
+    assert_int_equal(slipped.failed_view, 4);
+    assert_int_equal(clean.failed_view, -1);
+    assert_true(clean.solved && clean.accepted);
     assert_true(worst_angle_error(truth) < 0.05);
 }
 
@@ -175,11 +212,11 @@ static void test_slip_names_the_view_and_bounds_refuse(void **state)
 {
     (void)state;
     struct reg_params p = params();
-    assert_int_equal(reg_begin(&p, &calib, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
+    assert_int_equal(reg_begin(&reg, &p, &calib, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
     for (uint32_t v = 0; v < VIEWS; v++)
         add_view(v, 45.0 * v, 45.0 * v, v >= 4 ? v3(6, 0, 0) : v3(0, 0, 0));
     struct reg_report rep;
-    assert_int_equal(reg_solve(&rep), 0);
+    assert_int_equal(reg_solve(&reg, &rep), 0);
     print_message("slip at view 4: failed view %d against %d, %.0f%% coupled; %s\n",
                   rep.failed_view, rep.failed_against, 100.0 * rep.failed_share, rep.refused);
     assert_int_equal(rep.failed_view, 4);
@@ -187,15 +224,15 @@ static void test_slip_names_the_view_and_bounds_refuse(void **state)
     assert_true(rep.failed_share < p.min_coupled_share);
 
     p.max_correction_deg = 0.5; /* the table below misses by 1.5 degrees */
-    assert_int_equal(reg_begin(&p, &calib, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
+    assert_int_equal(reg_begin(&reg, &p, &calib, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
     for (uint32_t v = 0; v < VIEWS; v++)
         add_view(v, 45.0 * v + (v == 5 ? 1.5 : 0.0), 45.0 * v, v3(0, 0, 0));
-    assert_int_equal(reg_solve(&rep), 0);
+    assert_int_equal(reg_solve(&reg, &rep), 0);
     assert_true(rep.solved && !rep.accepted);
     assert_non_null(strstr(rep.refused, "view 5"));
     struct reg_view rv;
     struct frame_xform pose;
-    assert_int_equal(reg_view_pose(5, &pose, &rv), 0);
+    assert_int_equal(reg_view_pose(&reg, 5, &pose, &rv), 0);
     assert_true(fabs(rv.angle_deg - 225.0) < 1e-9); /* refused: the table's own angle */
 }
 
@@ -208,7 +245,8 @@ static void test_second_pass_found(void **state)
     const double ax = M_PI / 2.0, az = M_PI / 6.0; /* Rz(30) Rx(90), as [sim] second_pass_pose */
     double rx[9] = {1, 0, 0, 0, cos(ax), -sin(ax), 0, sin(ax), cos(ax)};
     double rz[9] = {cos(az), -sin(az), 0, sin(az), cos(az), 0, 0, 0, 1};
-    assert_int_equal(reg_begin(&p, &calib, 2 * VIEWS, 2, calib.cam_width, calib.cam_height), 0);
+    assert_int_equal(reg_begin(&reg, &p, &calib, 2 * VIEWS, 2, calib.cam_width, calib.cam_height),
+                     0);
     for (uint32_t v = 0; v < VIEWS; v++)
         add_view(v, 45.0 * v, 45.0 * v, v3(0, 0, 0));
     m3_mul_m3(rz, rx, placed_rot);
@@ -216,14 +254,14 @@ static void test_second_pass_found(void **state)
     for (uint32_t v = 0; v < VIEWS; v++) /* and the table misses a little, as ever */
         add_view(VIEWS + v, 45.0 * v + 0.3 * (v % 3), 45.0 * v, v3(0, 0, 0));
     struct reg_report rep;
-    assert_int_equal(reg_solve(&rep), 0);
+    assert_int_equal(reg_solve(&reg, &rep), 0);
     double worst = 0.0;
     for (uint32_t v = VIEWS; v < 2 * VIEWS; v++) {
         struct frame_xform pose, truth;
         struct reg_view rv;
-        assert_int_equal(reg_view_pose(v, &pose, &rv), 0);
-        frame_object_from_camera_rad(&calib, (45.0 * (v - VIEWS) + 0.3 * ((v - VIEWS) % 3)) *
-                                                 M_PI / 180.0, &truth);
+        assert_int_equal(reg_view_pose(&reg, v, &pose, &rv), 0);
+        frame_object_from_camera_rad(
+            &calib, (45.0 * (v - VIEWS) + 0.3 * ((v - VIEWS) % 3)) * M_PI / 180.0, &truth);
         for (int k = 0; k < SPHERES; k++) { /* a centre as this view's camera has it */
             vec3 cam = frame_point_inv(&truth, sphere_centre(k));
             worst = fmax(worst, v3_len(v3_sub(frame_point(&pose, cam), v3_from(sphere_c[k]))));
@@ -245,7 +283,8 @@ static void test_second_pass_of_another_object_fails(void **state)
 {
     (void)state;
     struct reg_params p = params();
-    assert_int_equal(reg_begin(&p, &calib, 2 * VIEWS, 2, calib.cam_width, calib.cam_height), 0);
+    assert_int_equal(reg_begin(&reg, &p, &calib, 2 * VIEWS, 2, calib.cam_width, calib.cam_height),
+                     0);
     for (uint32_t v = 0; v < VIEWS; v++)
         add_view(v, 45.0 * v, 45.0 * v, v3(0, 0, 0));
     radius_scale = 1.5;
@@ -253,7 +292,7 @@ static void test_second_pass_of_another_object_fails(void **state)
         add_view(VIEWS + v, 45.0 * v, 45.0 * v, v3(0, 0, 0));
     radius_scale = 1.0;
     struct reg_report rep;
-    assert_int_equal(reg_solve(&rep), 0);
+    assert_int_equal(reg_solve(&reg, &rep), 0);
     print_message("another object: %.0f%% of the second pass paired\n", 100.0 * rep.failed_share);
     assert_int_equal(rep.failed_view, (int)VIEWS);
     assert_int_equal(rep.failed_against, -1);
@@ -265,18 +304,19 @@ static void test_many_views_fit_in_the_cells(void **state)
     (void)state;
     struct reg_params p = params();
     struct reg_report rep;
-    assert_int_equal(reg_begin(&p, &calib, REG_MAX_VIEWS, 1, 2048, 1536), 0);
-    assert_int_equal(reg_solve(&rep), 0);
+    assert_int_equal(reg_begin(&reg, &p, &calib, REG_MAX_VIEWS, 1, 2048, 1536), 0);
+    assert_int_equal(reg_solve(&reg, &rep), 0);
     uint64_t cells = (uint64_t)((2048 + rep.stride - 1) / rep.stride) *
                      ((1536 + rep.stride - 1) / rep.stride) * REG_MAX_VIEWS;
     assert_true(rep.stride > 4 && cells <= REG_MAX_CELLS);
-    assert_int_equal(reg_begin(&p, &calib, REG_MAX_VIEWS + 1, 1, 2048, 1536), -E2BIG);
+    assert_int_equal(reg_begin(&reg, &p, &calib, REG_MAX_VIEWS + 1, 1, 2048, 1536), -E2BIG);
 }
 
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_table_errors_are_found),
+        cmocka_unit_test(test_two_registrations_are_independent),
         cmocka_unit_test(test_axis_is_reestimated),
         cmocka_unit_test(test_slip_names_the_view_and_bounds_refuse),
         cmocka_unit_test(test_second_pass_found),

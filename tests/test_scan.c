@@ -44,14 +44,14 @@ static void scan_and_compare(const char *object, const char *transport, uint32_t
     scan_dir_path(truth, sizeof(truth), dir, -1, "truth_mesh.ply");
     assert_int_equal(mesh_visibility_from_scan(dir, &vis, err, sizeof(err)), 0);
     assert_int_equal(mesh_compare_files(mesh, truth, 100000, &vis, align, r, err, sizeof(err)), 0);
-    print_message("%s over %s, table error up to %u mdeg: %u piece(s), result->truth mean %.3f mm%s; "
-                  "observable surface %.1f%%, within 1 mm %.2f%%; symmetric mean %.3f mm (all of "
-                  "the truth: within 1 mm %.1f%%)\n",
-                  object, transport, (unsigned)table_error_mdeg, (unsigned)r->result_pieces,
-                  r->result_to_truth_mean_mm,
-                  align ? " (aligned)" : "", 100.0 * r->observable_share,
-                  100.0 * r->truth_observable_within_1mm, r->symmetric_observable_mean_mm,
-                  100.0 * r->truth_within_1mm);
+    print_message(
+        "%s over %s, table error up to %u mdeg: %u piece(s), result->truth mean %.3f mm%s; "
+        "observable surface %.1f%%, within 1 mm %.2f%%; symmetric mean %.3f mm (all of "
+        "the truth: within 1 mm %.1f%%)\n",
+        object, transport, (unsigned)table_error_mdeg, (unsigned)r->result_pieces,
+        r->result_to_truth_mean_mm, align ? " (aligned)" : "", 100.0 * r->observable_share,
+        100.0 * r->truth_observable_within_1mm, r->symmetric_observable_mean_mm,
+        100.0 * r->truth_within_1mm);
     /* targets: symmetric mean surface distance below 0.3 mm; 95% within 1 mm */
     assert_true(r->symmetric_observable_mean_mm < 0.3);
     assert_true(r->truth_observable_within_1mm >= 0.95);
@@ -169,13 +169,14 @@ static void test_two_passes_make_the_whole_object(void **state)
     m3_mul_m3(rp_t, rz8, t1);
     m3_mul_m3(rz0, t1, m);
     double expected = acos((m[0] + m[4] + m[8] - 1.0) / 2.0) * 180.0 / M_PI;
-    double turned = ini_number("build/test_scan/two-pass/view_008/registration.ini",
-                               "second_pass_turned_deg");
+    double turned =
+        ini_number("build/test_scan/two-pass/view_008/registration.ini", "second_pass_turned_deg");
     print_message("second pass turned %.3f deg, truly %.3f deg\n", turned, expected);
     assert_true(fabs(turned - expected) < 0.1);
     double worst[2] = {worst_relative_angle_deg(dir, 0), worst_relative_angle_deg(dir, 8)};
     print_message("table 1 deg off: worst view angle after registration %.4f deg (first pass), "
-                  "%.4f deg (second)\n", worst[0], worst[1]);
+                  "%.4f deg (second)\n",
+                  worst[0], worst[1]);
     assert_true(worst[0] < 0.05 && worst[1] < 0.05);
     struct mesh_comparison r;
     char err[256];
@@ -185,8 +186,8 @@ static void test_two_passes_make_the_whole_object(void **state)
                      0);
     print_message("two passes: the whole true surface within 1 mm %.2f%% (one pass: ~86%%), "
                   "symmetric mean %.3f mm, result->truth %.3f mm, %u piece(s)\n",
-                  100.0 * r.truth_within_1mm, 0.5 * (r.result_to_truth_mean_mm +
-                                                       r.truth_to_result_mean_mm),
+                  100.0 * r.truth_within_1mm,
+                  0.5 * (r.result_to_truth_mean_mm + r.truth_to_result_mean_mm),
                   r.result_to_truth_mean_mm, (unsigned)r.result_pieces);
     assert_true(r.truth_within_1mm >= 0.98);
     assert_true(0.5 * (r.result_to_truth_mean_mm + r.truth_to_result_mean_mm) < 0.1);

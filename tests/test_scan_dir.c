@@ -233,13 +233,11 @@ static void test_pnm_frames_round_trip(void **state)
                                                   f == 4 ? 1 : 3, formats[k]),
                              0);
         memset(back, 0, sizeof(back));
-        assert_int_equal(scan_dir_read_frame(dir, 0, 4, back, sizeof(back), W, H, 1, err,
-                                             sizeof(err)),
-                         0);
+        assert_int_equal(
+            scan_dir_read_frame(dir, 0, 4, back, sizeof(back), W, H, 1, err, sizeof(err)), 0);
         assert_memory_equal(back, frame, (size_t)W * H);
-        assert_int_equal(scan_dir_read_frame(dir, 0, 5, back, sizeof(back), W, H, 3, err,
-                                             sizeof(err)),
-                         0);
+        assert_int_equal(
+            scan_dir_read_frame(dir, 0, 5, back, sizeof(back), W, H, 3, err, sizeof(err)), 0);
         assert_memory_equal(back, frame, sizeof(frame));
         for (uint32_t f = 4; f < 6; f++) {
             assert_int_equal(scan_dir_find_frame(path, sizeof(path), dir, 0, f), 0);
@@ -269,8 +267,8 @@ static void test_pnm_frames_round_trip(void **state)
     assert_non_null(strstr(err, "frame_04.pgm.zst: damaged zstd data"));
     print_message("truncated zstd: %s\n", err);
     unlink(path);
-    assert_int_equal(
-        scan_dir_write_frame(&hal.storage, dir, 0, 4, frame, W, H, 1, SCAN_FRAMES_PNM), 0);
+    assert_int_equal(scan_dir_write_frame(&hal.storage, dir, 0, 4, frame, W, H, 1, SCAN_FRAMES_PNM),
+                     0);
     assert_int_equal(scan_dir_find_frame(path, sizeof(path), dir, 0, 4), 0);
     assert_int_equal(truncate(path, 5000), 0);
     assert_int_equal(scan_dir_read_frame(dir, 0, 4, back, sizeof(back), W, H, 1, err, sizeof(err)),
@@ -299,9 +297,9 @@ static void fake_scan(const char *dir, const char *config_text, const void *fram
     v.frames = v.frame_count;
     assert_int_equal(scan_dir_write_view(&hal.storage, dir, 0, &v), 0);
     for (uint32_t f = 0; f < 3; f++)
-        assert_int_equal(scan_dir_write_frame(&hal.storage, dir, 0, f, black, W, H, f ? 1 : 3,
-                                                  SCAN_FRAMES_ZSTD),
-                         0);
+        assert_int_equal(
+            scan_dir_write_frame(&hal.storage, dir, 0, f, black, W, H, f ? 1 : 3, SCAN_FRAMES_ZSTD),
+            0);
     write_frame_bytes(dir, frame3, n);
 }
 
@@ -331,8 +329,9 @@ static void test_process_damaged_frame_one_error(void **state)
 }
 
 /* process --config with settings whose colour frames are not the scan's: refused before any
- * frame is read, naming the first frame that differs (before, frame 25 was taken as what the
- * config said it was). */
+ * frame is read, naming the key that differs from the scan's config.ini (issue 28), or, for
+ * frames captured elsewhere without one, the first frame that differs (before, frame 25 was
+ * taken as what the config said it was). */
 static void test_process_other_frames_refused(void **state)
 {
     (void)state;
@@ -341,6 +340,19 @@ static void test_process_other_frames_refused(void **state)
     const char *other = DIR "/multi_longer.ini";
     write_text(other, config_text("method = multi\nlight_exposure_us = 20000\n"));
     struct scan_job_opts opts = {.out_dir = DIR "/multi_out", .config_path = other, .replace = 1};
+    test_log_clear();
+    assert_int_equal(scan_job_process(&hal, DIR "/multi", &opts), -EINVAL);
+    assert_true(test_log_one_error("multi/config.ini was taken with [colour] light_exposure_us = "
+                                   "10000, not 20000: a re-processing keeps how the views are "
+                                   "taken"));
+    /* the same exposure said explicitly is the same plan */
+    write_text(other, config_text("method = multi\nlight_exposure_us = 10000\n"));
+    test_log_clear();
+    int rc = scan_job_process(&hal, DIR "/multi", &opts);
+    assert_null(strstr(test_last_log, "a re-processing keeps"));
+    (void)rc;
+    write_text(other, config_text("method = multi\nlight_exposure_us = 20000\n"));
+    unlink(DIR "/multi/config.ini");
     test_log_clear();
     assert_int_equal(scan_job_process(&hal, DIR "/multi", &opts), -EINVAL);
     assert_true(test_log_one_error(

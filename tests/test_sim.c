@@ -48,7 +48,7 @@ static void test_bvh_matches_brute_force(void **state)
 {
     (void)state;
     struct sim_mesh m;
-        load_mesh(&m, "data/bunny/bun_zipper_res3.ply");
+    load_mesh(&m, "data/bunny/bun_zipper_res3.ply");
     sim_mesh_place(&m, 150.0);
     struct sim_bvh bvh;
     assert_int_equal(sim_bvh_build(&bvh, &m), 0);
@@ -195,8 +195,8 @@ static void test_object_pose(void **state)
     posed_counts(none, 0, &hit0, &dark0, &h0);
     posed_counts(side, 0, &hit1, &dark1, &h1);
     posed_counts(turned, -90000, &hit2, &dark2, &h2);
-    print_message("standing %.1f mm, on its side %.1f mm; pixels %zu / %zu, dark %zu / %zu\n",
-                  h0, h1, hit0, hit2, dark0, dark2);
+    print_message("standing %.1f mm, on its side %.1f mm; pixels %zu / %zu, dark %zu / %zu\n", h0,
+                  h1, hit0, hit2, dark0, dark2);
     assert_true(fabs(h0 - 150.0) < 0.01 && fabs(h1 - 0.45 * 150.0) < 0.01);
     assert_true(fabs(h2 - 150.0) < 0.01);
     assert_true(dark0 > 1000);

@@ -217,8 +217,8 @@ void test_measure_view(const struct sim_rig *rig, const struct scan_view *view,
                 q->lit_head_on_correct += (uint32_t)correct;
                 q->lit_head_on_valid += (uint32_t)valid;
                 q->lit_head_on_off += (uint32_t)(valid && !correct);
-                q->lit_head_on_wrong += (uint32_t)(valid && !correct &&
-                                                   !near_column(rig, i, maps->column[i]));
+                q->lit_head_on_wrong +=
+                    (uint32_t)(valid && !correct && !near_column(rig, i, maps->column[i]));
                 q->head_on_reason[maps->reason[i]]++;
             }
         }

@@ -62,18 +62,18 @@ struct view_quality {
                                      (not a blurred pixel seeing its neighbour's surface) */
     uint32_t head_on_reason[SCAN_REASON_COUNT]; /**< lit_head_on pixels by reason */
     double stripe_px;           /**< finest projected stripe (2 columns) in camera pixels, median */
-    uint32_t valid;        /**< all valid pixels */
-    uint32_t valid_unlit;  /**< valid pixels the projector does not light (must be 0) */
-    uint32_t dark;         /**< lit pixels on the very dark paint */
-    uint32_t dark_flagged; /**< of those: rejected */
-    uint32_t dark_correct; /**< of those: valid and within +-1 column of the truth */
-    uint32_t saturated;    /**< lit pixels whose white frame (the view's colour) saturates */
+    uint32_t valid;             /**< all valid pixels */
+    uint32_t valid_unlit;       /**< valid pixels the projector does not light (must be 0) */
+    uint32_t dark;              /**< lit pixels on the very dark paint */
+    uint32_t dark_flagged;      /**< of those: rejected */
+    uint32_t dark_correct;      /**< of those: valid and within +-1 column of the truth */
+    uint32_t saturated;         /**< lit pixels whose white frame (the view's colour) saturates */
     uint32_t saturated_correct; /**< of those: valid and within +-1 column of the truth */
-    uint32_t outliers_2mm; /**< valid points farther than 2 mm from the true surface */
-    double normal_err_deg; /**< mean angle between estimated and true normals, valid pixels */
-    double depth_rms_mm;   /**< RMS of reconstructed minus true depth (z), valid pixels */
-    double max_surface_mm; /**< largest point-to-true-tangent-plane distance */
-    double distance_mm;    /**< mean camera-to-surface distance over lit pixels */
+    uint32_t outliers_2mm;      /**< valid points farther than 2 mm from the true surface */
+    double normal_err_deg;      /**< mean angle between estimated and true normals, valid pixels */
+    double depth_rms_mm;        /**< RMS of reconstructed minus true depth (z), valid pixels */
+    double max_surface_mm;      /**< largest point-to-true-tangent-plane distance */
+    double distance_mm;         /**< mean camera-to-surface distance over lit pixels */
 };
 
 /** Incidence limit of lit_head_on: beyond 75 degrees the projector's light is a few grey levels. */

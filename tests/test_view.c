@@ -188,8 +188,8 @@ static void test_blocked_decoder_matches_reference(void **state)
     size_t n = (size_t)m->width * m->height;
     static uint16_t col[HAL_MAX_PIXELS], row[HAL_MAX_PIXELS];
     static uint8_t reason[HAL_MAX_PIXELS];
-    decode_reference(&t.cfg.scan, &layout, t.calib.proj_width, t.calib.proj_height, frames, n,
-                     col, row, reason);
+    decode_reference(&t.cfg.scan, &layout, t.calib.proj_width, t.calib.proj_height, frames, n, col,
+                     row, reason);
     size_t valid = 0, row_right = 0;
     const struct sim_rig *rig = sim_ctl_rig();
     for (size_t i = 0; i < n; i++) {

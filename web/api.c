@@ -3,6 +3,8 @@
 #define _GNU_SOURCE
 #include "api.h"
 
+#include "config.h"
+#include "guard.h"
 #include "report.h"
 
 #include <cJSON.h>
@@ -42,6 +44,10 @@ static const char *reason_phrase(int status)
         return "Payload Too Large";
     case 415:
         return "Unsupported Media Type";
+    case 429:
+        return "Too Many Requests";
+    case 503:
+        return "Service Unavailable";
     default:
         return "Internal Server Error";
     }
@@ -74,34 +80,39 @@ static int send_error(struct mg_connection *conn, int status, const char *messag
 
 /* ---- who may ask ---- */
 
-/* Equal without telling by its timing how much of a guess was right. */
-static int token_equal(const char *a, const char *b)
+/* A script with the token in its Authorization header: no page of another site can send one. */
+static int bearer(const struct web_server *s, const struct mg_connection *conn)
 {
-    size_t la = strlen(a), lb = strlen(b);
-    unsigned diff = (unsigned)(la ^ lb);
-    for (size_t i = 0; i < lb; i++)
-        diff |= (unsigned)(unsigned char)(i < la ? a[i] : 0) ^ (unsigned char)b[i];
-    return diff == 0;
+    const char *h = mg_get_header(conn, "Authorization");
+    return s->token[0] != '\0' && h != NULL && strncmp(h, "Bearer ", 7) == 0 &&
+           guard_secret_equal(h + 7, s->token);
 }
 
 /* Off loopback every API request but the login carries the token: an "Authorization: Bearer"
  * header (scripts), or the cookie the login sets (the page, and its downloads). */
 static int authorised(const struct web_server *s, const struct mg_connection *conn)
 {
-    if (s->token[0] == '\0')
-        return 1;
-    const char *h = mg_get_header(conn, "Authorization");
-    if (h != NULL && strncmp(h, "Bearer ", 7) == 0 && token_equal(h + 7, s->token))
+    if (s->token[0] == '\0' || bearer(s, conn))
         return 1;
     const char *cookie = mg_get_header(conn, "Cookie");
     char value[sizeof(s->token)];
     return cookie != NULL && mg_get_cookie(cookie, "scanner_token", value, sizeof(value)) > 0 &&
-           token_equal(value, s->token);
+           guard_secret_equal(value, s->token);
 }
+
+/* A request that uses the rig carries the session key (or a Bearer token). */
+static int may_use_rig(const struct web_server *s, const struct mg_connection *conn)
+{
+    return guard_has_key(s, conn) || bearer(s, conn);
+}
+
+static int refuse_without_key(struct mg_connection *conn);
 
 /* A POST's JSON body: application/json (which a page of another site cannot send here without
  * the browser asking first, so that no other site can start the rig from a visitor's browser)
- * and at most WEB_MAX_BODY bytes. An empty body is {}. @retval 0 or the status to answer */
+ * and at most WEB_MAX_BODY bytes, nested at most GUARD_MAX_JSON_DEPTH deep (counted before
+ * parsing: cJSON recurses once a level), one JSON object and nothing after it. An empty body is
+ * {}. @retval 0 or the status to answer */
 static int read_body(struct mg_connection *conn, cJSON **body)
 {
     const struct mg_request_info *ri = mg_get_request_info(conn);
@@ -118,7 +129,12 @@ static int read_body(struct mg_connection *conn, cJSON **body)
     if (n > WEB_MAX_BODY)
         return 413;
     text[n] = '\0';
-    *body = n == 0 ? cJSON_CreateObject() : cJSON_Parse(text);
+    if (strlen(text) != (size_t)n) /* a NUL inside: what follows it would go unread */
+        return 400;
+    if (guard_json_too_deep(text, GUARD_MAX_JSON_DEPTH))
+        return 400;
+    const char *end = NULL;
+    *body = n == 0 ? cJSON_CreateObject() : cJSON_ParseWithOpts(text, &end, 1);
     return *body != NULL && cJSON_IsObject(*body) ? 0 : 400;
 }
 
@@ -161,26 +177,43 @@ static int by_name_newest_first(const void *a, const void *b)
     return strcmp(*(char *const *)b, *(char *const *)a);
 }
 
+/* Every scan folder, newest first: all names are read before sorting (the folder's own order
+ * is none), up to WEB_MAX_LISTED; beyond that the oldest are left out, and the answer says so. */
+#define WEB_MAX_LISTED 100000u
 static int list_scans(struct mg_connection *conn, struct web_server *s)
 {
     cJSON *list = cJSON_CreateArray();
     DIR *d = opendir(s->scans);
-    char *names[512];
-    size_t n = 0;
-    for (struct dirent *e; d != NULL && (e = readdir(d)) != NULL && n < 512;)
-        if (web_name_ok(e->d_name))
-            names[n++] = strdup(e->d_name);
+    char **names = NULL;
+    size_t n = 0, cap = 0, seen = 0;
+    for (struct dirent *e; d != NULL && (e = readdir(d)) != NULL;) {
+        if (!web_name_ok(e->d_name) || seen++ >= WEB_MAX_LISTED)
+            continue;
+        if (n == cap) {
+            size_t more = cap == 0 ? 256 : 2 * cap;
+            char **grown = realloc(names, more * sizeof(*names));
+            if (grown == NULL)
+                break;
+            names = grown;
+            cap = more;
+        }
+        if ((names[n] = strdup(e->d_name)) != NULL)
+            n++;
+    }
     if (d != NULL)
         closedir(d);
-    qsort(names, n, sizeof(names[0]), by_name_newest_first);
+    if (n > 0)
+        qsort(names, n, sizeof(names[0]), by_name_newest_first);
     for (size_t i = 0; i < n; i++) {
-        cJSON *o = names[i] != NULL ? job_json(s, names[i]) : NULL;
+        cJSON *o = job_json(s, names[i]);
         if (o != NULL)
             cJSON_AddItemToArray(list, o);
         free(names[i]);
     }
+    free(names);
     cJSON *body = cJSON_CreateObject();
     cJSON_AddItemToObject(body, "scans", list);
+    cJSON_AddBoolToObject(body, "complete", seen <= WEB_MAX_LISTED);
     return send_json(conn, 200, body);
 }
 
@@ -195,9 +228,48 @@ static const struct web_profile *find_profile(const struct web_server *s, const 
     return NULL;
 }
 
+/* The profile to resume scan @p id with: the first that takes views as the scan did (its own
+ * config.ini; the scanner refuses any other). @p why says what differs when none does. */
+static const struct web_profile *resume_profile(const struct web_server *s, const char *id,
+                                                char *why, size_t why_len)
+{
+    static struct app_config taken, profile;
+    static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER; /* the configs are static */
+    char path[WEB_PATH + 32], err[WEB_PATH + 128];
+    const struct web_profile *found = NULL;
+    pthread_mutex_lock(&lock);
+    if (jobs_scan_dir(s, id, path, sizeof(path)) != 0 ||
+        strlen(path) + sizeof("/config.ini") > sizeof(path)) {
+        snprintf(why, why_len, "no such scan");
+    } else {
+        strcat(path, "/config.ini");
+        int loaded = config_load(&taken, path, err, sizeof(err)) == 0;
+        if (!loaded)
+            snprintf(why, why_len, "the scan's settings do not load: %s", err);
+        for (unsigned i = 0; loaded && i < s->profiles && found == NULL; i++) {
+            char what[160];
+            if (config_load(&profile, s->profile[i].path, err, sizeof(err)) != 0)
+                continue;
+            if (config_plan_differs(&taken, &profile, 1, what, sizeof(what)) == 0)
+                found = &s->profile[i];
+            else if (why[0] == '\0')
+                snprintf(why, why_len,
+                         "no profile takes views as this scan did (%s: the scan "
+                         "has %s)",
+                         s->profile[i].name, what);
+        }
+        if (found != NULL)
+            why[0] = '\0';
+    }
+    pthread_mutex_unlock(&lock);
+    return found;
+}
+
 /* POST /api/scans (a new scan) or /api/scans/ID/resume. */
 static int start_scan(struct mg_connection *conn, struct web_server *s, const char *resume_id)
 {
+    if (!may_use_rig(s, conn))
+        return refuse_without_key(conn);
     cJSON *body = NULL;
     int status = read_body(conn, &body);
     if (status != 0) {
@@ -205,10 +277,17 @@ static int start_scan(struct mg_connection *conn, struct web_server *s, const ch
         return send_error(conn, status,
                           status == 415   ? "send the request as application/json"
                           : status == 413 ? "the request is too large"
-                                          : "the body is not a JSON object");
+                                          : "the body is not one JSON object (nested at most 32 "
+                                            "deep, nothing after it)");
     }
-    const struct web_profile *p = find_profile(s, body);
+    char why[WEB_PATH + 256] = "";
+    int named = cJSON_GetObjectItemCaseSensitive(body, "profile") != NULL;
+    const struct web_profile *p = resume_id != NULL && !named
+                                      ? resume_profile(s, resume_id, why, sizeof(why))
+                                      : find_profile(s, body);
     cJSON_Delete(body);
+    if (p == NULL && why[0] != '\0')
+        return send_error(conn, 409, why);
     if (p == NULL)
         return send_error(conn, 400, "no such profile (GET /api/status lists them)");
     char id[64], err[WEB_PATH + 128];
@@ -220,8 +299,8 @@ static int start_scan(struct mg_connection *conn, struct web_server *s, const ch
     return send_json(conn, 200, answer);
 }
 
-/* Server-Sent Events: the scan's state at every event, until it ends (or the client goes). */
-static int stream_events(struct mg_connection *conn, struct web_server *s, const char *id)
+/* stream_events once its stream is counted. */
+static int stream_events_counted(struct mg_connection *conn, struct web_server *s, const char *id)
 {
     struct web_job *j = &s->job;
     unsigned long seen = 0;
@@ -260,6 +339,25 @@ static int stream_events(struct mg_connection *conn, struct web_server *s, const
     return 200;
 }
 
+/* Server-Sent Events: the scan's state at every event, until it ends (or the client goes). Each
+ * stream holds a worker thread: at most WEB_MAX_STREAMS at once, so that open tabs never take
+ * the workers that status and stop need. */
+static int stream_events(struct mg_connection *conn, struct web_server *s, const char *id)
+{
+    struct web_job *j = &s->job;
+    pthread_mutex_lock(&j->lock);
+    int full = s->streams >= WEB_MAX_STREAMS;
+    s->streams += !full;
+    pthread_mutex_unlock(&j->lock);
+    if (full)
+        return send_error(conn, 503, "too many progress streams open (close a tab of the page)");
+    int rc = stream_events_counted(conn, s, id);
+    pthread_mutex_lock(&j->lock);
+    s->streams--;
+    pthread_mutex_unlock(&j->lock);
+    return rc;
+}
+
 /* A file of the scan: one name, or a view folder and a name; never anything outside it. */
 static int send_scan_file(struct mg_connection *conn, struct web_server *s, const char *id,
                           const char *rel)
@@ -278,8 +376,7 @@ static int send_scan_file(struct mg_connection *conn, struct web_server *s, cons
             break;
         p += len + 1;
     }
-    snprintf(path, sizeof(path), "%s/%s", s->scans, id);
-    if (realpath(path, root) == NULL)
+    if (jobs_scan_dir(s, id, path, sizeof(path)) != 0 || realpath(path, root) == NULL)
         return send_error(conn, 404, "no such scan");
     if (parts == 1)
         snprintf(path, sizeof(path), "%s/%s", root, part[0]);
@@ -307,8 +404,7 @@ static int send_scan_file(struct mg_connection *conn, struct web_server *s, cons
     return 200;
 }
 
-/* The thumbnails share the report's readers, which keep static buffers: one at a time. */
-static pthread_mutex_t thumb_lock = PTHREAD_MUTEX_INITIALIZER;
+/* A view's thumbnail, drawn by the report's reentrant reader (requests in parallel). */
 
 static int send_thumb(struct mg_connection *conn, struct web_server *s, const char *id,
                       const char *rest)
@@ -323,12 +419,11 @@ static int send_thumb(struct mg_connection *conn, struct web_server *s, const ch
     if (k == REPORT_THUMB_REASONS && strcmp(kind, "reasons") != 0)
         return send_error(conn, 404, "no such thumbnail (raw, colour or reasons)");
     char dir[WEB_PATH + 160];
-    snprintf(dir, sizeof(dir), "%s/%s", s->scans, id);
+    if (jobs_scan_dir(s, id, dir, sizeof(dir)) != 0)
+        return send_error(conn, 404, "no such scan");
     uint8_t *png = NULL;
     size_t len = 0;
-    pthread_mutex_lock(&thumb_lock);
     int rc = report_thumb_png(dir, view, k, &png, &len);
-    pthread_mutex_unlock(&thumb_lock);
     if (rc != 0)
         return send_error(conn, 404, "that view has no such picture (yet)");
     mg_printf(conn,
@@ -349,9 +444,12 @@ static int send_archive(struct mg_connection *conn, struct web_server *s, const 
     pthread_mutex_unlock(&j->lock);
     if (running)
         return send_error(conn, 409, "the scan is still running");
-    char name[160];
+    char name[160], dir[WEB_PATH + 160];
+    if (jobs_scan_dir(s, id, dir, sizeof(dir)) != 0)
+        return send_error(conn, 404, "no such scan");
     snprintf(name, sizeof(name), "%s/", id);
-    const char *args[] = {"/bin/tar", "-C", s->scans, "-cf", "-", name, NULL};
+    /* "--": a name is never an option of tar's, whatever it begins with */
+    const char *args[] = {"/bin/tar", "-C", s->scans, "-cf", "-", "--", name, NULL};
     int fd;
     pid_t pid = web_spawn(args, &fd, NULL);
     if (pid < 0)
@@ -375,7 +473,7 @@ static int send_archive(struct mg_connection *conn, struct web_server *s, const 
     return 200;
 }
 
-/* GET /api/selftest: the rig's devices, each tried (not while a scan runs: the rig is one). */
+/* POST /api/selftest: the rig's devices, each tried (not while a scan runs: the rig is one). */
 static int selftest(struct mg_connection *conn, struct web_server *s)
 {
     const char *args[] = {s->scanner, "selftest", "--config", s->profile[0].path, NULL};
@@ -395,7 +493,7 @@ static int selftest(struct mg_connection *conn, struct web_server *s)
     return send_json(conn, 200, body);
 }
 
-/* GET /api/snapshot.png: what the camera sees lit by the projector's white. */
+/* POST /api/snapshot.png: what the camera sees lit by the projector's white. */
 static int snapshot(struct mg_connection *conn, struct web_server *s)
 {
     char path[] = "/tmp/scanner-snapshot-XXXXXX.png", out[512];
@@ -443,19 +541,43 @@ static int status(struct mg_connection *conn, struct web_server *s)
     return send_json(conn, 200, body);
 }
 
-/* POST /api/login {"token": "..."}: the cookie the page's requests then carry. */
+/* GET /api/session: the key that requests using the rig carry (X-Scanner-Key). Only a page of
+ * this server can read the answer: a page of another site gets no CORS permission, and its
+ * requests are refused before they get here (guard_request). */
+static int session(struct mg_connection *conn, struct web_server *s)
+{
+    cJSON *body = cJSON_CreateObject();
+    cJSON_AddStringToObject(body, "key", s->key);
+    cJSON_AddStringToObject(body, "header", GUARD_KEY_HEADER);
+    return send_json(conn, 200, body);
+}
+
+static int refuse_without_key(struct mg_connection *conn)
+{
+    return send_error(conn, 403,
+                      "a request that uses the rig carries the session key "
+                      "(" GUARD_KEY_HEADER ": GET /api/session gives it)");
+}
+
+/* POST /api/login {"token": "..."}: the cookie the page's requests then carry. Its rate is
+ * bounded and every wrong token is logged. */
 static int login(struct mg_connection *conn, struct web_server *s)
 {
+    int st = guard_login_allowed(conn);
+    if (st != 0)
+        return send_error(conn, st, "too many wrong tokens just now: wait a few seconds");
     cJSON *body = NULL;
-    int st = read_body(conn, &body);
+    st = read_body(conn, &body);
     const cJSON *token = cJSON_GetObjectItemCaseSensitive(body, "token");
     int ok = st == 0 && cJSON_IsString(token) && s->token[0] != '\0' &&
-             token_equal(token->valuestring, s->token);
+             guard_secret_equal(token->valuestring, s->token);
     cJSON_Delete(body);
     if (st != 0)
         return send_error(conn, st, "send {\"token\": \"...\"} as application/json");
-    if (!ok)
+    if (!ok) {
+        guard_login_failed(conn);
         return send_error(conn, 401, "wrong token");
+    }
     mg_printf(conn,
               "HTTP/1.1 200 OK\r\nContent-Type: application/json\r\nContent-Length: 2\r\n"
               "Set-Cookie: scanner_token=%s; Path=/; HttpOnly; SameSite=Strict\r\n\r\n{}",
@@ -481,6 +603,8 @@ static int scan_route(struct mg_connection *conn, struct web_server *s, const ch
         cJSON *o = job_json(s, id);
         return o != NULL ? send_json(conn, 200, o) : send_error(conn, 404, "no such scan");
     }
+    if (strcmp(what, "stop") == 0 && is_post && !may_use_rig(s, conn))
+        return refuse_without_key(conn);
     if (strcmp(what, "stop") == 0 && is_post)
         return jobs_stop(s, id) == 0 ? send_json(conn, 200, cJSON_CreateObject())
                                      : send_error(conn, 409, "that scan is not running");
@@ -508,16 +632,29 @@ int api_handle(struct mg_connection *conn, void *cbdata)
     /* the path as sent, decoded: the checks below see a "..", civetweb's cleaning would hide it */
     const char *path = ri->local_uri_raw != NULL ? ri->local_uri_raw : ri->local_uri;
     const char *method = ri->request_method;
+    const char *why = NULL;
     int is_get = strcmp(method, "GET") == 0, is_post = strcmp(method, "POST") == 0;
+    int refused = guard_request(s, conn, &why);
+    if (refused != 0)
+        return send_error(conn, refused, why);
+    if (!is_get && !is_post) /* OPTIONS too: no CORS pre-flight is ever answered yes */
+        return send_error(conn, 405, "GET or POST only");
     if (strcmp(path, "/api/login") == 0 && is_post)
         return login(conn, s);
     if (!authorised(s, conn))
         return send_error(conn, 401, "this scanner wants its token (POST /api/login)");
     if (strcmp(path, "/api/status") == 0 && is_get)
         return status(conn, s);
-    if (strcmp(path, "/api/selftest") == 0 && is_get)
+    if (strcmp(path, "/api/session") == 0 && is_get)
+        return session(conn, s);
+    int device = strcmp(path, "/api/selftest") == 0 || strcmp(path, "/api/snapshot.png") == 0;
+    if (device && !is_post)
+        return send_error(conn, 405, "POST: it uses the rig");
+    if (device && !may_use_rig(s, conn))
+        return refuse_without_key(conn);
+    if (strcmp(path, "/api/selftest") == 0)
         return selftest(conn, s);
-    if (strcmp(path, "/api/snapshot.png") == 0 && is_get)
+    if (strcmp(path, "/api/snapshot.png") == 0)
         return snapshot(conn, s);
     if (strcmp(path, "/api/scans") == 0 && is_get)
         return list_scans(conn, s);

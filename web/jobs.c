@@ -5,7 +5,9 @@
 #define _GNU_SOURCE
 #include "web.h"
 
+#include "file_posix.h"
 #include "scan_dir.h"
+#include "scan_events.h"
 
 #include <cJSON.h>
 #include <errno.h>
@@ -102,7 +104,7 @@ static void on_event(struct web_job *j, const char *line)
      * thumbnails), decoded again, or fused; the fusion counts from 0 again: they only grow. */
     const char *e = event->valuestring;
     if (cJSON_IsNumber(done) &&
-        (strcmp(e, "saved") == 0 || strcmp(e, "decoded") == 0 || strcmp(e, "fused") == 0)) {
+        (strcmp(e, EV_SAVED) == 0 || strcmp(e, EV_DECODED) == 0 || strcmp(e, EV_FUSED) == 0)) {
         j->step_done = (unsigned)done->valuedouble;
         if (j->step_done > j->views_done)
             j->views_done = j->step_done;
@@ -113,8 +115,8 @@ static void on_event(struct web_job *j, const char *line)
         j->left_s = left->valuedouble;
     if (cJSON_IsString(detail))
         snprintf(j->detail, sizeof(j->detail), "%s", detail->valuestring);
-    if (strcmp(event->valuestring, "scan_done") == 0 ||
-        strcmp(event->valuestring, "process_done") == 0)
+    if (strcmp(event->valuestring, EV_SCAN_DONE) == 0 ||
+        strcmp(event->valuestring, EV_PROCESS_DONE) == 0)
         j->done_seen = 1;
     j->seq++;
     pthread_cond_broadcast(&j->changed);
@@ -199,6 +201,40 @@ static int run_to_end(const char *const *args, char *out, size_t out_len, int *s
     return 0;
 }
 
+/* failure.txt: the scanner's error of a scan that failed under this server, kept in its folder
+ * so that the page still says why after another scan or a restart (docs/scan-format.md). */
+#define FAILURE_FILE "failure.txt"
+
+static void write_failure(const char *dir, const char *error)
+{
+    char path[WEB_PATH + 32], tmp[WEB_PATH + 40];
+    snprintf(path, sizeof(path), "%s/" FAILURE_FILE, dir);
+    snprintf(tmp, sizeof(tmp), "%s.tmp", path);
+    int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC | O_NOFOLLOW, 0644);
+    size_t len = strlen(error);
+    int ok = fd >= 0 && write(fd, error, len) == (ssize_t)len && fsync(fd) == 0;
+    if (fd >= 0)
+        close(fd);
+    if (!ok || rename(tmp, path) != 0) {
+        fprintf(stderr, "scanner-web: cannot keep the error in %s: %s\n", path, strerror(errno));
+        unlink(tmp);
+    }
+}
+
+static int read_failure(const struct web_server *s, const char *id, char *error, size_t len)
+{
+    char path[WEB_PATH + 160];
+    snprintf(path, sizeof(path), "%s/%s/" FAILURE_FILE, s->scans, id);
+    FILE *f = file_open_regular(path, "r");
+    if (f == NULL)
+        return -errno;
+    size_t n = fread(error, 1, len - 1, f);
+    error[n] = '\0';
+    error[strcspn(error, "\n")] = '\0';
+    fclose(f);
+    return 0;
+}
+
 static void *reader_main(void *arg)
 {
     struct web_server *s = arg;
@@ -217,7 +253,16 @@ static void *reader_main(void *arg)
                 pf[k].fd = -1;
             }
     }
-    int status = wait_for(j->pid);
+    /* waited for without reaping, and forgotten under the lock before it is reaped: a stop
+     * never signals the number once it may be another process's */
+    siginfo_t info;
+    while (waitid(P_PID, (id_t)j->pid, &info, WEXITED | WNOWAIT) != 0 && errno == EINTR)
+        ;
+    pthread_mutex_lock(&j->lock);
+    pid_t pid = j->pid;
+    j->pid = 0;
+    pthread_mutex_unlock(&j->lock);
+    int status = wait_for(pid);
     pthread_mutex_lock(&j->lock);
     int finished = WIFEXITED(status) && WEXITSTATUS(status) == 0 && j->done_seen;
     char dir[WEB_PATH];
@@ -235,36 +280,13 @@ static void *reader_main(void *arg)
         snprintf(j->error, sizeof(j->error), "the scanner ended with %s %d",
                  WIFEXITED(status) ? "status" : "signal",
                  WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status));
-    j->pid = 0;
+    if (j->state == WEB_FAILED)
+        write_failure(dir, j->error);
     j->rig_busy = 0;
     j->seq++;
     pthread_cond_broadcast(&j->changed);
     pthread_mutex_unlock(&j->lock);
     return NULL;
-}
-
-/* A new folder named by the time (UTC), as the scanner names its own. */
-static int new_scan_dir(const struct web_server *s, char *id, size_t id_len, char *dir,
-                        size_t dir_len)
-{
-    char stamp[32];
-    time_t t = time(NULL);
-    struct tm tm;
-    gmtime_r(&t, &tm);
-    strftime(stamp, sizeof(stamp), "%Y-%m-%d_%H%M%S", &tm);
-    for (int k = 1; k < 100; k++) {
-        if (k == 1)
-            snprintf(id, id_len, "%s", stamp);
-        else
-            snprintf(id, id_len, "%s-%d", stamp, k);
-        if ((size_t)snprintf(dir, dir_len, "%s/%s", s->scans, id) >= dir_len)
-            return -ENAMETOOLONG;
-        if (mkdir(dir, 0755) == 0)
-            return 0;
-        if (errno != EEXIST)
-            return -errno;
-    }
-    return -EEXIST;
 }
 
 int jobs_start(struct web_server *s, const struct web_profile *p, const char *resume_id, char *id,
@@ -288,10 +310,16 @@ int jobs_start(struct web_server *s, const struct web_profile *p, const char *re
     dir[0] = '\0';
     if (resume_id != NULL) {
         snprintf(id, id_len, "%s", resume_id);
-        if ((size_t)snprintf(dir, sizeof(dir), "%s/%s", s->scans, resume_id) >= sizeof(dir))
-            rc = -ENAMETOOLONG;
+        rc = jobs_scan_dir(s, resume_id, dir, sizeof(dir));
+        char failure[WEB_PATH + 32];
+        snprintf(failure, sizeof(failure), "%s/" FAILURE_FILE, dir);
+        if (rc == 0 && unlink(failure) != 0 && errno != ENOENT)
+            rc = -errno;
     } else {
-        rc = new_scan_dir(s, id, id_len, dir, sizeof(dir));
+        const char *name = NULL;
+        rc = scan_dir_make_new(s->scans, dir, sizeof(dir), &name);
+        if (rc == 0)
+            snprintf(id, id_len, "%s", name);
     }
     const char *scan_args[] = {s->scanner, "scan", "--config", p->path,
                                "--out",    dir,    "--json",   NULL};
@@ -385,6 +413,16 @@ void jobs_shutdown(struct web_server *s)
     j->have_reader = 0;
 }
 
+int jobs_scan_dir(const struct web_server *s, const char *id, char *dir, size_t dir_len)
+{
+    struct stat sb;
+    if (!web_name_ok(id) || (size_t)snprintf(dir, dir_len, "%s/%s", s->scans, id) >= dir_len)
+        return -ENOENT;
+    /* lstat: a link planted among the scans (ln -s /etc scans/evil) is no scan, and nothing is
+     * served through it; the scanner's own 'latest' link is not listed twice either */
+    return lstat(dir, &sb) == 0 && S_ISDIR(sb.st_mode) ? 0 : -ENOENT;
+}
+
 int jobs_describe(struct web_server *s, const char *id, enum web_state *state, unsigned *views_done,
                   unsigned *views_total, char *error, size_t error_len)
 {
@@ -402,21 +440,19 @@ int jobs_describe(struct web_server *s, const char *id, enum web_state *state, u
     pthread_mutex_unlock(&j->lock);
     /* a scan of another time: what its folder holds (a view is complete with its view.ini) */
     char path[WEB_PATH + 64];
-    struct stat sb;
-    snprintf(path, sizeof(path), "%s/%s", s->scans, id);
-    if (!web_name_ok(id) || lstat(path, &sb) != 0 || !S_ISDIR(sb.st_mode))
+    if (jobs_scan_dir(s, id, path, sizeof(path)) != 0)
         return -ENOENT;
-    snprintf(path, sizeof(path), "%s/%s", s->scans, id);
     uint32_t total;
     if (scan_dir_view_count(path, &total) != 0)
         return -ENOENT; /* not a scan */
     *views_total = total;
     *views_done = 0;
-    for (unsigned v = 0; v < *views_total; v++) {
-        snprintf(path, sizeof(path), "%s/%s/view_%03u/view.ini", s->scans, id, v);
-        *views_done += access(path, F_OK) == 0;
-    }
-    snprintf(path, sizeof(path), "%s/%s/mesh.ply", s->scans, id);
-    *state = access(path, F_OK) == 0 ? WEB_FINISHED : WEB_STOPPED;
+    for (unsigned v = 0; v < *views_total; v++)
+        *views_done += (unsigned)scan_dir_view_complete(path, v);
+    /* finished: every output written (mesh.ply alone is there before mesh.stl has failed);
+     * failed: the server kept the scanner's error */
+    *state = scan_dir_finished(path) ? WEB_FINISHED : WEB_STOPPED;
+    if (*state == WEB_STOPPED && read_failure(s, id, error, error_len) == 0)
+        *state = WEB_FAILED;
     return 0;
 }

@@ -4,6 +4,8 @@
 #define _GNU_SOURCE
 #include "api.h"
 #include "config.h"
+#include "file_posix.h"
+#include "guard.h"
 #include "web.h"
 
 #include <civetweb.h>
@@ -25,38 +27,37 @@ static const char usage_text[] =
     "                     [--token-file FILE] [--scans DIR] [--www DIR]\n"
     "  --config      a config the page can scan with (a profile: its file name without .ini);\n"
     "                the first is the default and the rig's selftest and snapshot use it\n"
-    "  --listen      where to listen (default 127.0.0.1:8080); any address but loopback\n"
-    "                needs --token-file\n"
+    "  --listen      where to listen (default 127.0.0.1:8080; a comma-separated list\n"
+    "                too); any address but loopback needs --token-file\n"
     "  --token-file  a file holding the secret every API request must carry off loopback\n"
-    "                (16 characters or more; set at install: there is no default)\n"
+    "                (16 to 255 printable characters, no space , ; \" or \\; set at install:\n"
+    "                there is no default)\n"
     "  --scans       where scan folders are made and listed (default: the first config's\n"
     "                [output] dir)\n"
     "  --www         the page's files (default " WEB_WWW_DIR ")\n";
 
-static int is_loopback(const char *listen)
-{
-    return strncmp(listen, "127.", 4) == 0 || strncmp(listen, "localhost:", 10) == 0 ||
-           strncmp(listen, "[::1]:", 6) == 0;
-}
-
-/* The secret: the file's first line, without its line end. @retval 0 @retval -1 (said) */
+/* The secret: the file's first line, without its line end, whole (a longer one is refused, not
+ * cut: the real token would never match) and fit for a cookie. @retval 0 @retval -1 (said) */
 static int read_token(const char *path, char *token, size_t len)
 {
-    FILE *f = fopen(path, "r");
-    if (f == NULL || fgets(token, (int)len, f) == NULL) {
-        fprintf(stderr, "scanner serve: --token-file %s: %s\n", path,
-                f == NULL ? strerror(errno) : "empty");
-        if (f != NULL)
-            fclose(f);
+    char line[1024];
+    FILE *f = file_open_regular(path, "r");
+    const char *problem = NULL;
+    if (f == NULL || fgets(line, sizeof(line), f) == NULL) {
+        problem = f == NULL ? file_strerror(errno) : "empty";
+    } else {
+        line[strcspn(line, "\r\n")] = '\0';
+        problem = guard_token_problem(line);
+    }
+    if (f != NULL)
+        fclose(f);
+    if (problem == NULL && strlen(line) >= len)
+        problem = "the token is too long";
+    if (problem != NULL) {
+        fprintf(stderr, "scanner serve: --token-file %s: %s\n", path, problem);
         return -1;
     }
-    fclose(f);
-    token[strcspn(token, "\r\n")] = '\0';
-    if (strlen(token) < 16) {
-        fprintf(stderr, "scanner serve: --token-file %s: the token must be 16 characters or more\n",
-                path);
-        return -1;
-    }
+    memcpy(token, line, strlen(line) + 1); /* fits: checked above */
     return 0;
 }
 
@@ -196,15 +197,20 @@ int main(int argc, char **argv)
         fprintf(stderr, "scanner serve: --config FILE is required\n%s", usage_text);
         return 2;
     }
-    if (!is_loopback(listen) && token_file == NULL) {
+    if (!guard_listen_is_loopback(listen) && token_file == NULL) {
         fprintf(stderr,
                 "scanner serve: --listen %s is reachable from the network: give --token-file "
-                "FILE (a secret of 16 characters or more, set at install)\n",
+                "FILE (a secret of 16 to 255 characters, set at install)\n",
                 listen);
         return 2;
     }
     if (token_file != NULL && read_token(token_file, s.token, sizeof(s.token)) != 0)
         return 2;
+    if (guard_make_key(s.key, sizeof(s.key)) != 0) {
+        fprintf(stderr, "scanner serve: no random numbers for the session key: %s\n",
+                strerror(errno));
+        return 1;
+    }
     if (check_configs(&s, scans) != 0 || find_scanner(&s, www_given) != 0)
         return 2;
     char index[WEB_PATH + 16];
@@ -221,18 +227,29 @@ int main(int argc, char **argv)
     sigaddset(&stop, SIGHUP);
     pthread_sigmask(SIG_BLOCK, &stop, NULL);
     signal(SIGPIPE, SIG_IGN);
+    /* No CORS: civetweb answers pre-flights and adds Access-Control-Allow-Origin: * unless
+     * told otherwise, which let any page start the rig. A request gets 10 s to arrive whole
+     * and each write 10 s to drain (a slow or silent client frees its worker then). */
+    char threads[16];
+    snprintf(threads, sizeof(threads), "%u", WEB_THREADS);
     const char *options[] = {"listening_ports",
                              listen,
                              "document_root",
                              s.www,
                              "num_threads",
-                             "16",
+                             threads,
                              "enable_directory_listing",
                              "no",
                              "max_request_size",
                              "16384",
                              "request_timeout_ms",
-                             "30000",
+                             "10000",
+                             "access_control_allow_origin",
+                             "",
+                             "access_control_allow_methods",
+                             "",
+                             "access_control_allow_headers",
+                             "",
                              "additional_header",
                              "X-Content-Type-Options: nosniff",
                              NULL};

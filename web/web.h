@@ -11,6 +11,9 @@
 #define WEB_MAX_PROFILES 16u
 #define WEB_MAX_BODY 4096 /* bytes of a request body: a profile's name is all a POST carries */
 #define WEB_PATH 1024
+#define WEB_MAX_STREAMS 8 /* progress streams open at once: each holds a worker thread */
+/* civetweb's workers: a connection holds one until its request is whole (10 s at most) */
+#define WEB_THREADS 256
 
 struct web_profile {
     char name[64];       /* the config file's name without .ini */
@@ -51,7 +54,9 @@ struct web_server {
     char scans[WEB_PATH];   /* where scan folders are made and listed */
     struct web_profile profile[WEB_MAX_PROFILES];
     unsigned profiles;
-    char token[256]; /* "" on loopback: nothing to present */
+    char token[256];  /* "" on loopback: nothing to present */
+    char key[40];     /* the session key the rig's requests carry (guard.h), made at start */
+    unsigned streams; /* progress streams open now (at most WEB_MAX_STREAMS), under job.lock */
     struct web_job job;
 };
 
@@ -80,6 +85,10 @@ pid_t web_spawn(const char *const *args, int *fd_out, int *fd_err);
 
 /** Stop a running scan and wait for it (its own shutdown leaves the rig safe). */
 void jobs_shutdown(struct web_server *s);
+
+/** The folder of scan @p id: a directory (not a link) directly in the scans' folder.
+ *  @retval 0 @retval -ENOENT no such scan */
+int jobs_scan_dir(const struct web_server *s, const char *id, char *dir, size_t dir_len);
 
 /** The state of scan @p id: the running one's as its events say, another's from its folder.
  *  @retval 0 @retval -ENOENT no such scan */

@@ -20,7 +20,7 @@ struct hal_camera_config {
     enum hal_pixel_format pixel_format; /**< format requested from the device */
     uint32_t exposure_us;               /**< fixed exposure time */
     uint32_t gain_milli;                /**< fixed analogue gain, 1000 = unity */
-    uint32_t drop_frames; /**< stale frames to discard after a light or pattern change */
+    uint32_t drop_frames;      /**< stale frames to discard after a light or pattern change */
     uint32_t frame_timeout_ms; /**< a capture with no frame after this fails with -ETIMEDOUT */
     uint32_t red_gain_milli;   /**< fixed white-balance gain of red, 1000 = 1 (libcamera) */
     uint32_t blue_gain_milli;  /**< fixed white-balance gain of blue, 1000 = 1 (libcamera) */

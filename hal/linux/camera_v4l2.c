@@ -93,7 +93,8 @@ static int set_format(struct camera_v4l2 *cam)
 {
     char want[5], got[5];
     struct v4l2_format f = {.type = V4L2_BUF_TYPE_VIDEO_CAPTURE};
-    const uint32_t w = cam->cfg.width * binning_of(&cam->cfg), h = cam->cfg.height * binning_of(&cam->cfg);
+    const uint32_t w = cam->cfg.width * binning_of(&cam->cfg),
+                   h = cam->cfg.height * binning_of(&cam->cfg);
     f.fmt.pix.width = w; /* the sensor's mode: the frame's size times the binning */
     f.fmt.pix.height = h;
     f.fmt.pix.pixelformat = v4l2_fourcc_of(cam->cfg.pixel_format);

@@ -14,7 +14,7 @@ struct camera_v4l2 {
     int streaming;
     struct hal_camera_config cfg;
     uint32_t fourcc, bytes_per_line;
-    uint32_t frame_us; /* one frame interval (VIDIOC_G_PARM); 0: the driver does not say */
+    uint32_t frame_us;  /* one frame interval (VIDIOC_G_PARM); 0: the driver does not say */
     int exposure_fixed; /* the device has no exposure control: its own exposure is used */
     void *buf[CAMERA_V4L2_RING];
     size_t buf_len[CAMERA_V4L2_RING];

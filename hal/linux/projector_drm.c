@@ -40,8 +40,8 @@ static int create_buffer(struct projector_drm *p, struct projector_drm_buffer *b
     struct drm_mode_map_dumb map = {.handle = b->handle};
     if (drmIoctl(p->fd, DRM_IOCTL_MODE_MAP_DUMB, &map) != 0)
         return fail(p, -errno, "DRM_IOCTL_MODE_MAP_DUMB: %s", strerror(errno));
-    void *m = mmap(NULL, (size_t)b->size, PROT_READ | PROT_WRITE, MAP_SHARED, p->fd,
-                   (off_t)map.offset);
+    void *m =
+        mmap(NULL, (size_t)b->size, PROT_READ | PROT_WRITE, MAP_SHARED, p->fd, (off_t)map.offset);
     if (m == MAP_FAILED)
         return fail(p, -errno, "mmap of a dumb buffer: %s", strerror(errno));
     b->map = m;
@@ -165,9 +165,8 @@ static int draw(struct projector_drm *p, struct projector_drm_buffer *b, uint32_
     return p->render(p->render_ctx, pattern, b->map, p->width, p->height, b->pitch);
 }
 
-int projector_drm_open(struct projector_drm *p, const char *device, uint32_t width,
-                       uint32_t height, projector_render_fn render, void *render_ctx, char *err,
-                       size_t err_len)
+int projector_drm_open(struct projector_drm *p, const char *device, uint32_t width, uint32_t height,
+                       projector_render_fn render, void *render_ctx, char *err, size_t err_len)
 {
     memset(p, 0, sizeof(*p));
     p->width = width;
@@ -228,8 +227,8 @@ void projector_drm_close(struct projector_drm *p)
         wait_flip(p, 100); /* a buffer must not go while the display scans it out */
     drmModeCrtc *saved = p->saved_crtc;
     if (saved != NULL && saved->mode_valid) /* the console (or whatever was there) back */
-        drmModeSetCrtc(p->fd, saved->crtc_id, saved->buffer_id, saved->x, saved->y, &p->conn_id,
-                       1, &saved->mode);
+        drmModeSetCrtc(p->fd, saved->crtc_id, saved->buffer_id, saved->x, saved->y, &p->conn_id, 1,
+                       &saved->mode);
     drmModeFreeCrtc(saved);
     for (int k = 0; k < 2; k++)
         destroy_buffer(p, &p->buf[k]);

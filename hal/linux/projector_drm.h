@@ -27,9 +27,9 @@ struct projector_drm {
     void *mode;       /* drmModeModeInfo of the native mode (kept opaque here) */
     void *saved_crtc; /* drmModeCrtc as it was before: put back on close */
     struct projector_drm_buffer buf[2];
-    int front;          /* the buffer on screen */
-    int flip_pending;   /* a flip asked for, its event not yet read */
-    uint64_t flip_us;   /* when the last flip reached the screen, CLOCK_MONOTONIC */
+    int front;        /* the buffer on screen */
+    int flip_pending; /* a flip asked for, its event not yet read */
+    uint64_t flip_us; /* when the last flip reached the screen, CLOCK_MONOTONIC */
     projector_render_fn render;
     void *render_ctx;
     char error[256];
@@ -40,13 +40,13 @@ struct projector_drm {
  *  shows black. @param device  "/dev/dri/card0"
  *  @retval 0 ok @retval -ENODEV no such device or no connected display
  *  @retval -EINVAL no mode of that size (@p err lists the display's) @retval -errno */
-int projector_drm_open(struct projector_drm *p, const char *device, uint32_t width,
-                       uint32_t height, projector_render_fn render, void *render_ctx, char *err,
-                       size_t err_len);
+int projector_drm_open(struct projector_drm *p, const char *device, uint32_t width, uint32_t height,
+                       projector_render_fn render, void *render_ctx, char *err, size_t err_len);
 
 /** Draw @p pattern (PROJECTOR_DRM_BLACK: black) into the hidden buffer, flip to it at the next
  *  vertical blank and wait, up to @p timeout_ms, for the flip event: when this returns 0 the
- *  pattern is on screen, since flip_us. @retval 0 @retval -ETIMEDOUT no flip event @retval -errno */
+ *  pattern is on screen, since flip_us. @retval 0 @retval -ETIMEDOUT no flip event @retval -errno
+ */
 int projector_drm_show(struct projector_drm *p, uint32_t pattern, uint32_t timeout_ms);
 
 /** Black, the display given back as it was, buffers freed. Safe on a closed projector. */

@@ -28,8 +28,8 @@ static int translate(int e, char *msg, size_t len)
                  modbus_strerror(e));
         return -EIO;
     }
-    if (e == EMBBADCRC || e == EMBBADDATA || e == EMBBADEXC || e == EMBMDATA ||
-        e == EMBBADSLAVE || e == EMBUNKEXC) {
+    if (e == EMBBADCRC || e == EMBBADDATA || e == EMBBADEXC || e == EMBMDATA || e == EMBBADSLAVE ||
+        e == EMBUNKEXC) {
         snprintf(msg, len, "bad reply (%s)", modbus_strerror(e));
         return -EIO;
     }
@@ -50,6 +50,7 @@ static int retryable(int e)
  * leaves it behind. An exception was a matched reply, so nothing is left to drop. */
 static void recover(struct tt_client *c, int e)
 {
+    c->interrupted = 1; /* the controller may have restarted meanwhile: checked before a move */
     if (c->is_tcp && !is_exception(e)) {
         modbus_close(c->ctx);
         if (modbus_connect(c->ctx) != 0)
@@ -86,8 +87,12 @@ static int transfer(struct tt_client *c, const char *what, int write, int addr, 
     return rc;
 }
 
-/* Send a command once: if the reply is lost, LAST_ID tells whether it was executed. */
-static int send_command(struct tt_client *c, uint16_t cmd, const char *what)
+static int check_unchanged(struct tt_client *c, const char *what);
+
+/* Send a command once: if the reply is lost, LAST_ID tells whether it was executed. A move
+ * (@p verify) is sent again only to the controller it was meant for: one that restarted while
+ * the link was down counts from where the table stood, and the move would go elsewhere. */
+static int send_command(struct tt_client *c, uint16_t cmd, const char *what, int verify)
 {
     uint16_t id = c->next_id++;
     if (c->next_id == 0)
@@ -109,11 +114,12 @@ static int send_command(struct tt_client *c, uint16_t cmd, const char *what)
         recover(c, e);
         uint16_t last;
         if (modbus_read_registers(c->ctx, TT_REG_LAST_ID, 1, &last) == 1 && last == id) {
-            c->log(HAL_LOG_WARN, "turntable: %s: reply lost, but the controller executed it",
-                   what);
+            c->log(HAL_LOG_WARN, "turntable: %s: reply lost, but the controller executed it", what);
             c->last_id = id;
             return 0;
         }
+        if (verify && (rc = check_unchanged(c, what)) != 0)
+            return rc; /* said there */
         c->log(HAL_LOG_WARN, "turntable: %s: %s, try %u of %u", what, msg, (unsigned)attempt + 1,
                (unsigned)c->cfg.retries + 1);
     }
@@ -125,8 +131,8 @@ static int send_command(struct tt_client *c, uint16_t cmd, const char *what)
 static int read_status(struct tt_client *c, struct hal_turntable_status *st, uint16_t *last_id)
 {
     uint16_t r[TT_REG_LAST_ID - TT_REG_ACTUAL_HI + 1];
-    int rc = transfer(c, "reading the status", 0, TT_REG_ACTUAL_HI, (int)(sizeof(r) / sizeof(r[0])),
-                      r);
+    int rc =
+        transfer(c, "reading the status", 0, TT_REG_ACTUAL_HI, (int)(sizeof(r) / sizeof(r[0])), r);
     if (rc != 0)
         return rc;
     st->position_mdeg = (int32_t)(((uint32_t)r[0] << 16) | r[1]);
@@ -144,8 +150,10 @@ static int tt_get_status(void *priv, struct hal_turntable_status *st)
     return read_status(priv, st, NULL);
 }
 
-/* Poll until the table is idle; an alarm or the move timeout ends the wait with an error. */
-static int wait_idle(struct tt_client *c, const char *what, struct hal_turntable_status *st)
+/* Poll until the table is idle; an alarm, the move timeout or (@p moving) a controller that is
+ * no longer homed ends the wait with an error. */
+static int wait_idle(struct tt_client *c, const char *what, struct hal_turntable_status *st,
+                     int moving)
 {
     uint64_t start, now;
     hal_clock_now_us(c->clock, &start);
@@ -160,6 +168,14 @@ static int wait_idle(struct tt_client *c, const char *what, struct hal_turntable
                    st->position_mdeg / 1000.0);
             return -EIO;
         }
+        if (moving && !st->homed) { /* restarted under the move: its angles are not ours */
+            c->log(HAL_LOG_ERROR,
+                   "turntable: %s: the controller restarted during the move (no longer homed, "
+                   "at %.3f deg by its count); the table must be homed again",
+                   what, st->position_mdeg / 1000.0);
+            c->lost = 1;
+            return -EIO;
+        }
         /* Done once the controller has taken this command (LAST_ID) and is idle again: idle
          * before it took it means it has not started, not that it has arrived. */
         if (!st->busy && last_id == c->last_id)
@@ -168,7 +184,7 @@ static int wait_idle(struct tt_client *c, const char *what, struct hal_turntable
         if (now - start > (uint64_t)c->cfg.move_timeout_ms * 1000u) {
             c->log(HAL_LOG_ERROR, "turntable: %s: still moving after %u ms (at %.3f deg); stopped",
                    what, (unsigned)c->cfg.move_timeout_ms, st->position_mdeg / 1000.0);
-            send_command(c, TT_CMD_STOP, "stop");
+            send_command(c, TT_CMD_STOP, "stop", 0);
             return -ETIMEDOUT;
         }
         rc = hal_clock_sleep_us(c->clock, (uint64_t)c->cfg.poll_interval_ms * 1000u);
@@ -181,15 +197,16 @@ static int tt_home(void *priv)
 {
     struct tt_client *c = priv;
     struct hal_turntable_status st;
-    int rc = send_command(c, TT_CMD_HOME, "homing");
+    int rc = send_command(c, TT_CMD_HOME, "homing", 0);
     if (rc == 0)
-        rc = wait_idle(c, "homing", &st);
+        rc = wait_idle(c, "homing", &st, 0);
     if (rc == 0 && !st.homed) {
         c->log(HAL_LOG_ERROR, "turntable: homing ended without the homed flag");
         rc = -EIO;
     }
     c->homed = rc == 0;
     c->lost = 0;
+    c->interrupted = 0;
     c->position_known = rc == 0;
     if (rc == 0)
         c->position_mdeg = st.position_mdeg;
@@ -241,15 +258,18 @@ static int tt_move_to(void *priv, int32_t angle_mdeg)
     snprintf(what, sizeof(what), "move to %.3f deg", angle_mdeg / 1000.0);
     uint16_t target[2] = {(uint16_t)((uint32_t)angle_mdeg >> 16),
                           (uint16_t)((uint32_t)angle_mdeg & 0xFFFFu)};
+    c->interrupted = 0;
     int rc = check_unchanged(c, what);
     if (rc == 0)
         rc = transfer(c, "writing the target", 1, TT_REG_TARGET_HI, 2, target);
-    if (rc == 0) {
-        c->position_known = 0; /* until the move ends where it should */
-        rc = send_command(c, TT_CMD_MOVE, what);
-    }
+    /* the link went down and came back while the target was written: the same controller? */
+    if (rc == 0 && c->interrupted)
+        rc = check_unchanged(c, what);
     if (rc == 0)
-        rc = wait_idle(c, what, &st);
+        rc = send_command(c, TT_CMD_MOVE, what, 1);
+    c->position_known = 0; /* until the move ends where it should */
+    if (rc == 0)
+        rc = wait_idle(c, what, &st, c->homed);
     if (rc != 0)
         return rc;
     long miss = labs((long)st.position_mdeg - (long)angle_mdeg);
@@ -266,14 +286,14 @@ static int tt_move_to(void *priv, int32_t angle_mdeg)
 static int tt_safe_state(void *priv)
 {
     struct tt_client *c = priv;
-    return c->ctx != NULL ? send_command(c, TT_CMD_STOP, "stop") : 0;
+    return c->ctx != NULL ? send_command(c, TT_CMD_STOP, "stop", 0) : 0;
 }
 
 static int tt_clear_alarm(void *priv)
 {
     struct tt_client *c = priv;
     struct hal_turntable_status st;
-    int rc = send_command(c, TT_CMD_CLEAR_ALARM, "clearing the alarm");
+    int rc = send_command(c, TT_CMD_CLEAR_ALARM, "clearing the alarm", 0);
     if (rc == 0)
         rc = tt_get_status(c, &st);
     if (rc == 0 && st.alarm_code != 0) {
@@ -296,8 +316,9 @@ static modbus_t *new_context(const struct tt_client_config *cfg)
 {
     if (strcmp(cfg->transport, "tcp") == 0)
         return modbus_new_tcp(cfg->host, (int)cfg->port);
-    char parity = strcmp(cfg->parity, "even") == 0 ? 'E' : strcmp(cfg->parity, "odd") == 0 ? 'O'
-                                                                                          : 'N';
+    char parity = strcmp(cfg->parity, "even") == 0  ? 'E'
+                  : strcmp(cfg->parity, "odd") == 0 ? 'O'
+                                                    : 'N';
     return modbus_new_rtu(cfg->device, (int)cfg->baud, parity, 8, 1);
 }
 
@@ -344,8 +365,10 @@ int tt_client_open(struct tt_client *c, const struct tt_client_config *cfg,
     }
     if (ident[TT_REG_DEVICE_ID] != TT_DEVICE_ID) {
         rc = -ENODEV;
-        snprintf(err, err_len, "turntable: the device at %s is not a turntable controller "
-                 "(DEVICE_ID 0x%04x)", where, (unsigned)ident[TT_REG_DEVICE_ID]);
+        snprintf(err, err_len,
+                 "turntable: the device at %s is not a turntable controller "
+                 "(DEVICE_ID 0x%04x)",
+                 where, (unsigned)ident[TT_REG_DEVICE_ID]);
         goto out_close;
     }
     c->next_id = (uint16_t)(ident[TT_REG_LAST_ID] + 1u);

@@ -9,12 +9,12 @@
 #include <stdint.h>
 
 struct tt_client_config {
-    char transport[8];            /**< "tcp" or "rtu" */
+    char transport[8]; /**< "tcp" or "rtu" */
     char host[64];
     uint32_t port;
     char device[128];
     uint32_t baud;
-    char parity[8];               /**< none | even | odd */
+    char parity[8]; /**< none | even | odd */
     uint32_t unit_id;
     uint32_t response_timeout_ms; /**< wait for the first byte of a reply */
     uint32_t byte_timeout_ms;     /**< wait between bytes of a reply */
@@ -34,11 +34,13 @@ struct tt_client {
     uint16_t next_id;
     /* What the controller must still say before a move, once homed (a controller that restarts
      * forgets its reference and its command counter; a table turned by hand moves): */
-    int homed;                /**< 1 once homed through this client */
-    int lost;                 /**< 1 once a check failed: no move until homed again */
-    uint16_t last_id;         /**< COMMAND_ID of the last command it executed for us */
-    int position_known;       /**< 0 after a move that failed: where it stopped is its own */
-    int32_t position_mdeg;    /**< where the last move (or homing) left it */
+    int homed;             /**< 1 once homed through this client */
+    int lost;              /**< 1 once a check failed: no move until homed again */
+    uint16_t last_id;      /**< COMMAND_ID of the last command it executed for us */
+    int position_known;    /**< 0 after a move that failed: where it stopped is its own */
+    int32_t position_mdeg; /**< where the last move (or homing) left it */
+    int interrupted;       /**< 1 once a request was retried (the link dropped, a timeout):
+                                the controller may have restarted in between */
     int is_tcp;
     unsigned long retries_used; /**< requests repeated since open (for tests and reports) */
 };

@@ -2,6 +2,8 @@
 #define _POSIX_C_SOURCE 200809L
 #include "image_io.h"
 
+#include "file_posix.h"
+
 #include <errno.h>
 #include <png.h>
 #include <stdio.h>
@@ -97,12 +99,17 @@ int image_read_png(const char *path, uint8_t *pixels, size_t capacity, uint32_t 
     png_image img;
     memset(&img, 0, sizeof(img));
     img.version = PNG_IMAGE_VERSION;
-    errno = 0;
-    if (!png_image_begin_read_from_file(&img, path)) {
-        int missing = errno == ENOENT;
-        snprintf(why, why_len, "%s", missing ? strerror(ENOENT) : img.message);
+    FILE *fp = file_open_regular(path, "rb");
+    if (fp == NULL) {
+        int rc = -errno;
+        snprintf(why, why_len, "%s", file_strerror(-rc));
+        return rc;
+    }
+    if (!png_image_begin_read_from_stdio(&img, fp)) {
+        snprintf(why, why_len, "%s", img.message);
         png_image_free(&img);
-        return missing ? -ENOENT : -EINVAL;
+        fclose(fp);
+        return -EINVAL;
     }
     int rc = -EINVAL;
     if (img.format & PNG_FORMAT_FLAG_LINEAR)
@@ -122,6 +129,7 @@ int image_read_png(const char *path, uint8_t *pixels, size_t capacity, uint32_t 
         rc = -EINVAL;
     }
     png_image_free(&img);
+    fclose(fp);
     if (rc == 0) {
         *width = img.width;
         *height = img.height;
@@ -253,8 +261,8 @@ static int parse_pnm(const uint8_t *d, size_t len, uint32_t *w, uint32_t *h, int
     if (len < 2 || d[0] != 'P' || (d[1] != '5' && d[1] != '6'))
         return -EINVAL;
     for (int k = 0; k < 3; k++) {
-        while (i < len && (d[i] == ' ' || d[i] == '\t' || d[i] == '\r' || d[i] == '\n' ||
-                           d[i] == '#')) {
+        while (i < len &&
+               (d[i] == ' ' || d[i] == '\t' || d[i] == '\r' || d[i] == '\n' || d[i] == '#')) {
             if (d[i] == '#') /* a comment runs to the end of its line */
                 while (i < len && d[i] != '\n')
                     i++;
@@ -284,7 +292,7 @@ struct pnm_source {
     ZSTD_DCtx *dctx; /* NULL: a raw file */
     uint8_t *in;
     ZSTD_inBuffer ib; /* starts empty: the first read fills it */
-    int ended; /* the zstd frame is complete */
+    int ended;        /* the zstd frame is complete */
 };
 
 /* Up to @p len bytes into @p out. @retval bytes read @retval -1 damaged (@p why says) */
@@ -318,11 +326,11 @@ static long source_read(struct pnm_source *s, uint8_t *out, size_t len, char *wh
 int image_read_pnm(const char *path, uint8_t *pixels, size_t capacity, uint32_t *width,
                    uint32_t *height, int channels, char *why, size_t why_len)
 {
-    struct pnm_source src = {.fp = fopen(path, "rb")};
+    struct pnm_source src = {.fp = file_open_regular(path, "rb")};
     uint8_t head[64], magic[4];
     if (src.fp == NULL) {
         int rc = -errno;
-        snprintf(why, why_len, "%s", strerror(-rc));
+        snprintf(why, why_len, "%s", file_strerror(-rc));
         return rc;
     }
     int rc = -EINVAL;

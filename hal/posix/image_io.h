@@ -1,4 +1,5 @@
-/* Image files: PNG through libpng, PGM/PPM raw or zstd-compressed, PFM (portable float map) for range and normal images. */
+/* Image files: PNG through libpng, PGM/PPM raw or zstd-compressed, PFM (portable float map) for
+ * range and normal images. */
 #ifndef IMAGE_IO_H
 #define IMAGE_IO_H
 

@@ -44,8 +44,7 @@ static int posix_open_atomic(void *priv, struct hal_file *file, const char *path
     (void)priv;
     file->fd = -1;
     int n1 = snprintf(file->final_path, sizeof(file->final_path), "%s", path);
-    int n2 = snprintf(file->temp_path, sizeof(file->temp_path), "%s" TEMP_SUFFIX TEMP_RANDOM,
-                      path);
+    int n2 = snprintf(file->temp_path, sizeof(file->temp_path), "%s" TEMP_SUFFIX TEMP_RANDOM, path);
     if (n1 < 0 || n2 < 0 || (size_t)n2 >= sizeof(file->temp_path))
         return -ENAMETOOLONG;
     /* mkstemp creates a new file of a name of its own (O_CREAT | O_EXCL): a symlink or a file

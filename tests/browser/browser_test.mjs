@@ -68,6 +68,12 @@ function raw(url, method, rawPath, headers = {}, body = null) {
 }
 
 const json = { 'Content-Type': 'application/json' };
+// The session key a request that uses the rig carries (docs/api.md): what the page gets.
+const keyed = async (url) => {
+  const r = await raw(url, 'GET', '/api/session');
+  const s = JSON.parse(r.body);
+  return { ...json, [s.header]: s.key };
+};
 const port = 20000 + (process.pid % 20000);
 
 async function waitFor(what, fn, timeoutMs) {
@@ -104,7 +110,7 @@ async function pageTest(browser) {
   await page.click('#start'); // live is still on: the scan waits for the picture being taken
   await page.waitForFunction(() => /views/.test(document.getElementById('progress').textContent));
   check(!(await page.isChecked('#live')), 'starting a scan ends the live view');
-  const busy = await raw(s.url, 'POST', '/api/scans', json, '{}');
+  const busy = await raw(s.url, 'POST', '/api/scans', await keyed(s.url), '{}');
   check(busy.status === 409, `a second scan while one runs is refused with 409 (${busy.status})`);
   await page.waitForFunction(() => document.querySelectorAll('#thumbs figure').length >= 4 &&
     [...document.querySelectorAll('#thumbs img')].every((i) => i.complete), null, { timeout: 120000 });
@@ -155,7 +161,7 @@ async function pageTest(browser) {
     'report.html is served, with the model and every view\'s pictures');
   const tar = await raw(s.url, 'GET', `/api/scans/${id}/archive.tar`);
   check(tar.status === 200 && tar.body.includes(Buffer.from(`${id}/mesh.ply`)), `the scan folder downloads as one tar (${tar.body.length} bytes)`);
-  const snap = await raw(s.url, 'GET', '/api/snapshot.png');
+  const snap = await raw(s.url, 'POST', '/api/snapshot.png', await keyed(s.url), '{}');
   check(snap.status === 200 && snap.body.subarray(1, 4).toString() === 'PNG', 'the camera\'s picture is a PNG');
 
   // stop a scan from the page, then resume it to the end
@@ -178,9 +184,10 @@ async function pageTest(browser) {
   check(rows === 2, `the list of scans shows both (${rows})`);
 
   await pathTests(s.url, id);
+  await foreignPageTests(browser, s.url);
 
   // shutting the server down mid-scan stops the scan in order
-  const started = JSON.parse((await raw(s.url, 'POST', '/api/scans', json, '{}')).body);
+  const started = JSON.parse((await raw(s.url, 'POST', '/api/scans', await keyed(s.url), '{}')).body);
   await waitFor('a view', async () => (await scanState(s.url, started.id)).views_done >= 1, 60000);
   const code = await stopServer(s);
   check(code === 0, `the server shuts down cleanly during a scan (exit ${code})`);
@@ -209,14 +216,51 @@ async function pathTests(url, id) {
   const ok = await raw(url, 'GET', `/api/scans/${id}/files/view_000/view.ini`);
   check(ok.status === 200, 'a view\'s file is served (200)');
   const long = JSON.stringify({ profile: 'x'.repeat(5000) });
-  const big = await raw(url, 'POST', '/api/scans', { ...json, 'Content-Length': long.length }, long);
+  const key = await keyed(url);
+  const big = await raw(url, 'POST', '/api/scans', { ...key, 'Content-Length': long.length }, long);
   check(big.status === 413, `a request body over 4 KiB is refused (${big.status})`);
-  const chunked = await raw(url, 'POST', '/api/scans', json, long); // no length: chunked
+  const chunked = await raw(url, 'POST', '/api/scans', key, long); // no length: chunked
   check(chunked.status === 413, `so is one sent in chunks, without a length (${chunked.status})`);
-  const form = await raw(url, 'POST', '/api/scans', { 'Content-Type': 'text/plain' }, '{}');
+  const form = await raw(url, 'POST', '/api/scans', { ...key, 'Content-Type': 'text/plain' }, '{}');
   check(form.status === 415, `a POST that is not application/json is refused (${form.status}): no other site can start the rig`);
-  const bad = await raw(url, 'POST', '/api/scans', json, '{"profile": "nope"}');
+  const bad = await raw(url, 'POST', '/api/scans', key, '{"profile": "nope"}');
   check(bad.status === 400, `an unknown profile is refused (${bad.status})`);
+}
+
+// ---- a page of another site, open in the same browser, tries the rig (issue 28) ----
+async function foreignPageTests(browser, url) {
+  const before = JSON.parse((await raw(url, 'GET', '/api/scans')).body).scans.length;
+  const target = url.replace(/\/$/, '');
+  const evil = `<!doctype html><img id="snap" src="${target}/api/snapshot.png">
+<script>
+window.results = {};
+const post = (path, init) => fetch('${target}' + path, { method: 'POST', ...init })
+  .then((r) => r.status, (e) => 'blocked: ' + e.message);
+Promise.all([
+  post('/api/scans', { headers: { 'Content-Type': 'application/json' }, body: '{}' }),
+  post('/api/scans', { mode: 'no-cors', headers: { 'Content-Type': 'text/plain' }, body: '{}' }),
+  fetch('${target}/api/session').then((r) => r.text(), (e) => 'blocked: ' + e.message),
+]).then((r) => { window.results = { json: r[0], form: r[1], session: r[2] }; window.done = true; });
+</script>`;
+  const other = http.createServer((req, res) => { res.setHeader('Content-Type', 'text/html'); res.end(evil); });
+  await new Promise((r) => other.listen(0, '127.0.0.1', r));
+  const page = await browser.newPage();
+  try {
+    await page.goto(`http://localhost:${other.address().port}/`);
+    await page.waitForFunction(() => window.done, null, { timeout: 30000 });
+    const r = await page.evaluate(() => window.results);
+    await sleep(1000);
+    const after = JSON.parse((await raw(url, 'GET', '/api/scans')).body);
+    const st = JSON.parse((await raw(url, 'GET', '/api/status')).body);
+    check(after.scans.length === before && !st.scanning,
+      `a page of another site in the same browser starts no scan (${JSON.stringify(r)})`);
+    check(/^blocked/.test(String(r.session)), 'nor reads the session key');
+    const img = await page.evaluate(() => document.getElementById('snap').naturalWidth);
+    check(img === 0, 'its <img> of /api/snapshot.png gets no picture (the camera is not used)');
+  } finally {
+    await page.close();
+    other.close();
+  }
 }
 
 // ---- off loopback: a token, or nothing ----

@@ -59,8 +59,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     /* the same bytes as a PNG, a zstd PGM and a raw PPM frame: every reader sees them */
     static const enum scan_frame_format formats[3] = {SCAN_FRAMES_PNG, SCAN_FRAMES_ZSTD,
                                                       SCAN_FRAMES_PNM};
-    static const char *const names[3] = {"frame_00.png: ", "frame_01.pgm.zst: ",
-                                         "frame_02.ppm: "};
+    static const char *const names[3] = {"frame_00.png: ", "frame_01.pgm.zst: ", "frame_02.ppm: "};
     for (uint32_t f = 0; f < 3; f++) {
         scan_dir_frame_path(path, sizeof(path), dir, 0, f, formats[f], f == 2 ? 3 : 1);
         put(path, nul != NULL ? nul + 1 : data, nul != NULL ? size - ini_len - 1 : 0);

@@ -12,8 +12,21 @@ let shown = null;       // the scan whose views and model the page shows
 let thumbsShown = 0;
 let events = null;      // the EventSource following a running scan
 
+let session = null; // {key, header}: what a request that uses the rig carries (docs/api.md)
+
+// The session key, fetched once: only a page of this server can read it.
+async function sessionHeaders() {
+  if (!session) {
+    const res = await fetch(api('session'));
+    if (res.status === 401) showLogin();
+    if (!res.ok) throw new Error((await res.json().catch(() => ({}))).error || res.statusText);
+    session = await res.json();
+  }
+  return { [session.header]: session.key };
+}
+
 async function call(method, path, body) {
-  const init = { method, headers: {} };
+  const init = { method, headers: method === 'POST' ? await sessionHeaders() : {} };
   if (body !== undefined) {
     init.headers['Content-Type'] = 'application/json';
     init.body = JSON.stringify(body);
@@ -156,9 +169,9 @@ async function startScan(resumeId) {
   $('live').checked = false; // the scan needs the camera: the picture being taken ends first
   await inflight;
   try {
-    const body = { profile: $('profile').value };
-    const r = resumeId ? await call('POST', `scans/${resumeId}/resume`, body)
-      : await call('POST', 'scans', body);
+    // a resume takes views as the scan did: the server picks the profile that does
+    const r = resumeId ? await call('POST', `scans/${resumeId}/resume`, {})
+      : await call('POST', 'scans', { profile: $('profile').value });
     $('start').disabled = true;
     follow(r.id);
     refresh();
@@ -179,7 +192,7 @@ $('selftest-btn').addEventListener('click', async () => {
   pre.hidden = false;
   pre.textContent = 'trying each device…';
   try {
-    const r = await call('GET', 'selftest');
+    const r = await call('POST', 'selftest');
     pre.textContent = r.table + (r.ok ? '\nevery device answered' : '\nsome device is missing');
   } catch (err) {
     pre.textContent = err.message;
@@ -197,7 +210,7 @@ function snapshot() {
 
 async function takeSnapshot() {
   const img = $('snapshot');
-  const res = await fetch(api('snapshot.png'));
+  const res = await fetch(api('snapshot.png'), { method: 'POST', headers: await sessionHeaders() });
   if (!res.ok) {
     $('selftest').hidden = false;
     $('selftest').textContent = (await res.json().catch(() => ({}))).error || res.statusText;

@@ -78,14 +78,6 @@ int calib_read_target(const char *dir, uint32_t view, struct calib_target_info *
     return 0;
 }
 
-void calibrate_path_beside(const char *cal_path, const char *suffix, char *buf, size_t len)
-{
-    size_t l = strlen(cal_path);
-    if (l > 4 && strcmp(cal_path + l - 4, ".ini") == 0)
-        l -= 4;
-    snprintf(buf, len, "%.*s%s", (int)l, cal_path, suffix);
-}
-
 int calib_write_file(const struct hal_storage *st, const char *dir, const char *name,
                      const char *from)
 {
@@ -112,13 +104,25 @@ int calib_write_guess(const struct hal_storage *st, const char *dir, const struc
     return rc;
 }
 
-int calib_write_svg(const struct hal_storage *st, const char *base, const char *png_path,
-                    int width, int height, double px_per_mm)
+int calib_write_svg(const struct hal_storage *st, const char *base, const char *png_path, int width,
+                    int height, double px_per_mm)
 {
-    char path[HAL_MAX_PATH + 8], buf[1024];
+    char path[HAL_MAX_PATH + 8], buf[1024], href[3 * 256 + 1];
     double w = width / px_per_mm, h = height / px_per_mm;
     const char *name = strrchr(png_path, '/');
     name = name != NULL ? name + 1 : png_path;
+    /* the picture's name as a URI reference: percent-encoded (RFC 3986) but for the unreserved
+     * characters, so that no '"', '<' or '&' of a file name ends up in the XML as markup */
+    size_t k = 0;
+    for (const unsigned char *c = (const unsigned char *)name; *c != '\0' && k + 4 < sizeof(href);
+         c++) {
+        if ((*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') || (*c >= '0' && *c <= '9') ||
+            strchr("-._~", *c) != NULL)
+            href[k++] = (char)*c;
+        else
+            k += (size_t)snprintf(href + k, sizeof(href) - k, "%%%02X", *c);
+    }
+    href[k] = '\0';
     int n = snprintf(buf, sizeof(buf),
                      "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
                      "<!-- calibration board, true size: print at 100%% -->\n"
@@ -127,7 +131,7 @@ int calib_write_svg(const struct hal_storage *st, const char *base, const char *
                      "height=\"%.3fmm\" viewBox=\"0 0 %.3f %.3f\">\n"
                      "  <image x=\"0\" y=\"0\" width=\"%.3f\" height=\"%.3f\" "
                      "style=\"image-rendering:pixelated\" xlink:href=\"%s\"/>\n</svg>\n",
-                     w, h, w, h, w, h, name);
+                     w, h, w, h, w, h, href);
     snprintf(path, sizeof(path), "%s.svg", base);
     if (n < 0 || (size_t)n >= sizeof(buf))
         return -ENAMETOOLONG;

@@ -1,39 +1,18 @@
-/* `scanner calibrate`: lead a person through capturing a board and a sphere on the turntable,
- * keep every capture, and compute the rig's calibration file from them (docs/calibration.md). */
+/* `scanner calibrate` (its own program, scanner-calibrate: the calib/ layer): lead a person
+ * through capturing a board and a sphere on the turntable, keep every capture, and compute the
+ * rig's calibration file from them (docs/calibration.md). */
 #ifndef CALIBRATE_H
 #define CALIBRATE_H
 
+#include "config.h"
 #include "hal.h"
 #include "scan_types.h"
 
 #include <stddef.h>
 #include <stdint.h>
 
-#define CALIB_MAX_PLACEMENTS 8 /**< board placements one procedure lists */
-#define CALIB_MAX_VIEWS 96     /**< captures one calibration directory holds */
-
-/** [calibrate] of a config: the board, the procedure, and what is accepted. */
-struct calib_settings {
-    char board[16];      /**< chessboard | charuco */
-    uint32_t squares_x, squares_y;
-    double square_mm, marker_mm, margin_mm, board_thickness_mm;
-    char dictionary[16]; /**< ChArUco dictionary, e.g. 5x5_100 */
-    char placements[160]; /**< board placements, comma-separated: tilt from upright in degrees
-                               (90: flat), optionally @ sideways offset in mm ("20@-70") */
-    uint32_t placement_count;                /**< parsed from placements */
-    double tilt_deg[CALIB_MAX_PLACEMENTS];   /**< parsed from placements */
-    double offset_mm[CALIB_MAX_PLACEMENTS];  /**< to the camera's right of the table's centre */
-    uint32_t turns;       /**< table angles per placement */
-    double turn_step_deg; /**< between them, centred on 0 */
-    double sphere_diameter_mm, sphere_offset_mm;
-    uint32_t sphere_turns; /**< table angles of the sphere (0: lights not calibrated) */
-    uint32_t projector_width, projector_height; /**< used when no calibration exists yet */
-    uint32_t min_corners;
-    uint32_t fix_k3;
-    double max_camera_rms_px, max_projector_rms_px;
-};
-
-struct app_config;
+#define CALIB_SPHERE_MAX_RMS_SHARE 0.1 /**< a ball capture fits its sphere within this x radius */
+#define CALIB_LIGHT_MAX_MM 5000.0      /**< no light of a rig is farther from its table */
 
 /** The scan parameters every calibration capture is taken and decoded with (rows as well as
  *  columns; every light's frame): the projector must store this sequence. */
@@ -50,8 +29,8 @@ void calibrate_guess(const struct app_config *cfg, struct scan_calib *guess);
 /** Capture every step into @p dir (new, or an unfinished calibration directory: the steps
  *  already there are kept), telling the person what to do; the simulator places the targets.
  *  @retval 0 @retval -EINTR stopped (captures kept) @retval -errno (said) */
-int calibrate_capture(struct hal *hal, const struct app_config *cfg,
-                      const struct scan_calib *guess, const char *dir);
+int calibrate_capture(struct hal *hal, const struct app_config *cfg, const struct scan_calib *guess,
+                      const char *dir);
 
 /** Compute the calibration from the captures in @p dir and write @p out_path (an existing file
  *  is kept beside it) with its report. @param cfg  the config (board, limits, light count)

@@ -11,8 +11,10 @@
 #include "scan_job.h"
 #include "vec3.h"
 
+#include <dirent.h>
 #include <errno.h>
 #include <math.h>
+#include <unistd.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -73,8 +75,7 @@ static void say(struct solve *s, const char *fmt, ...)
     memcpy(s->report + s->report_len, line, (size_t)n + 1);
     s->report_len += (size_t)n;
     if (strncmp(line, "refused: ", 9) == 0)
-        snprintf(s->refusal, sizeof(s->refusal), "%.*s", (int)strcspn(line + 9, "\n"),
-                 line + 9);
+        snprintf(s->refusal, sizeof(s->refusal), "%.*s", (int)strcspn(line + 9, "\n"), line + 9);
 }
 
 static int frame_exists(const char *dir, uint32_t view, uint32_t frame)
@@ -84,7 +85,9 @@ static int frame_exists(const char *dir, uint32_t view, uint32_t frame)
     return scan_dir_find_frame(path, sizeof(path), dir, view, frame) == 0 && stat(path, &sb) == 0;
 }
 
-/* Feed a capture's pattern frames to the decoder. @retval 0 @retval -ENOENT not all there */
+/* Feed a capture's pattern frames to the decoder. @retval 0 @retval -ENOENT the last is not
+ * there (a capture of the white frame alone) @retval -EINVAL one before it is missing or
+ * unreadable: a damaged capture, said */
 static int feed_patterns(struct solve *s, uint32_t v, const struct scan_calib *calib)
 {
     struct gray_layout layout;
@@ -95,40 +98,7 @@ static int feed_patterns(struct solve *s, uint32_t v, const struct scan_calib *c
     int rc = scan_job_feed_view(s->dir, v, &s->params, calib, err, sizeof(err));
     if (rc != 0)
         fprintf(stderr, "scanner: error: %s\n", err);
-    return rc;
-}
-
-/* Solve the n x n system a x = b (row-major), Gauss-Jordan with partial pivoting; a and b are
- * destroyed. @retval 0 singular */
-static int solve_n(double *a, double *b, double *x, int n)
-{
-    for (int c = 0; c < n; c++) {
-        int p = c;
-        for (int k = c + 1; k < n; k++)
-            if (fabs(a[k * n + c]) > fabs(a[p * n + c]))
-                p = k;
-        if (fabs(a[p * n + c]) < 1e-30)
-            return 0;
-        for (int k = 0; k < n; k++) {
-            double t = a[c * n + k];
-            a[c * n + k] = a[p * n + k];
-            a[p * n + k] = t;
-        }
-        double t = b[c];
-        b[c] = b[p];
-        b[p] = t;
-        for (int k = 0; k < n; k++) {
-            if (k == c)
-                continue;
-            double f = a[k * n + c] / a[c * n + c];
-            for (int j = c; j < n; j++)
-                a[k * n + j] -= f * a[c * n + j];
-            b[k] -= f * b[c];
-        }
-    }
-    for (int k = 0; k < n; k++)
-        x[k] = b[k] / a[k * n + k];
-    return 1;
+    return rc == -ENOENT ? -EINVAL : rc;
 }
 
 /* The projector's column and row at camera point (x, y): a plane fitted by least squares to
@@ -137,7 +107,8 @@ static int solve_n(double *a, double *b, double *x, int n)
  * evaluated at the point; twice, the second fit without the codes more than 1.5 off the first.
  * The stair-steps of the codes average out over the window; the black squares (too dark to
  * decode) leave holes in it, which a plane bridges. Over a window of a few millimetres the
- * curvature of the map (perspective, the projector's lens) is far below a hundredth of a pixel. @retval 1 known @retval 0 too few decoded pixels around */
+ * curvature of the map (perspective, the projector's lens) is far below a hundredth of a pixel.
+ * @retval 1 known @retval 0 too few decoded pixels around */
 #define NB 3 /* the plane's coefficients: 1, dx, dy */
 static int projector_at(const struct decode_maps *m, double x, double y, double *u, double *v)
 {
@@ -184,7 +155,7 @@ static int projector_at(const struct decode_maps *m, double x, double y, double 
                     m[NB * j + k] = a[j][k];
                 rhs[j] = a[j][NB];
             }
-            if (!solve_n(m, rhs, first, NB))
+            if (!calib_solve_n(m, rhs, first, NB))
                 return 0;
         }
         out[which] = first[0];
@@ -249,11 +220,67 @@ static int load_board_view(struct solve *s, struct board_view *bv)
     return 0;
 }
 
+static int by_number(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* The captures in the directory: every view_NNN folder with a first frame, by number, however
+ * many digits (view_100 and on too). More than CALIB_MAX_VIEWS is refused, not cut short; a
+ * folder whose first frame cannot be looked at (a link loop) is said. @retval 0 @retval -errno */
+static int list_views(struct solve *s, uint32_t *views, uint32_t *count)
+{
+    DIR *d = opendir(s->dir);
+    uint32_t n = 0, over = 0;
+    int rc = 0;
+    if (d == NULL) {
+        rc = -errno;
+        fprintf(stderr, "scanner: error: %s: %s\n", s->dir, strerror(-rc));
+        return rc;
+    }
+    for (struct dirent *e; rc == 0 && (e = readdir(d)) != NULL;) {
+        unsigned long v;
+        char *end;
+        if (strncmp(e->d_name, "view_", 5) != 0 || e->d_name[5] < '0' || e->d_name[5] > '9')
+            continue;
+        v = strtoul(e->d_name + 5, &end, 10);
+        if (*end != '\0' || v > 999999)
+            continue;
+        char path[SCAN_DIR_PATH_MAX];
+        rc = scan_dir_find_frame(path, sizeof(path), s->dir, (uint32_t)v, 0);
+        if (rc == -ENOENT) {
+            rc = 0;
+            continue;
+        }
+        if (rc != 0) {
+            fprintf(stderr, "scanner: error: %s: %s\n", path, strerror(-rc));
+            break;
+        }
+        if (n < CALIB_MAX_VIEWS)
+            views[n++] = (uint32_t)v;
+        else
+            over++;
+    }
+    closedir(d);
+    if (rc == 0 && over > 0) {
+        say(s, "refused: %s holds %u captures; a calibration takes at most %u\n", s->dir,
+            (unsigned)(n + over), (unsigned)CALIB_MAX_VIEWS);
+        rc = -EINVAL;
+    }
+    qsort(views, n, sizeof(*views), by_number);
+    *count = n;
+    return rc;
+}
+
 static int load_views(struct solve *s)
 {
-    for (uint32_t v = 0; v < CALIB_MAX_VIEWS; v++) {
-        if (!frame_exists(s->dir, v, 0))
-            continue;
+    uint32_t views[CALIB_MAX_VIEWS], count = 0;
+    int listed = list_views(s, views, &count);
+    if (listed != 0)
+        return listed;
+    for (uint32_t k = 0; k < count; k++) {
+        uint32_t v = views[k];
         struct calib_target_info ti;
         char err[SCAN_DIR_PATH_MAX + 256];
         int rc = calib_read_target(s->dir, v, &ti, err, sizeof(err));
@@ -330,9 +357,10 @@ static int solve_camera(struct solve *s)
     for (uint32_t i = 0; i < s->view_count; i++)
         found += s->views[i].found;
     if (found < 3) {
-        say(s, "refused: too few views: the board was found in %d image%s; at least 3 in "
-            "different orientations are needed (10 or more give a good calibration)\n", found,
-            found == 1 ? "" : "s");
+        say(s,
+            "refused: too few views: the board was found in %d image%s; at least 3 in "
+            "different orientations are needed (10 or more give a good calibration)\n",
+            found, found == 1 ? "" : "s");
         return -EINVAL;
     }
     for (uint32_t i = 0; i < s->view_count; i++) {
@@ -343,7 +371,8 @@ static int solve_camera(struct solve *s)
     }
     double spread = orientation_spread_deg(s);
     if (spread < 5.0) {
-        say(s, "refused: degenerate placements: every board faces the same way (the normals "
+        say(s,
+            "refused: degenerate placements: every board faces the same way (the normals "
             "differ by %.1f deg at most); turn the table or tilt the board between captures\n",
             spread);
         return -EINVAL;
@@ -360,9 +389,10 @@ static int solve_camera(struct solve *s)
                 sel[n++] = s->views[i].cam;
             }
         if (n < 3) {
-            say(s, "refused: too few views: the board was found in %d image%s; at least 3 in "
-                "different orientations are needed (10 or more give a good calibration)\n", n,
-                n == 1 ? "" : "s");
+            say(s,
+                "refused: too few views: the board was found in %d image%s; at least 3 in "
+                "different orientations are needed (10 or more give a good calibration)\n",
+                n, n == 1 ? "" : "s");
             return -EINVAL;
         }
         int rc = calcv_calibrate(sel, n, (int)s->start.cam_width, (int)s->start.cam_height,
@@ -387,9 +417,10 @@ static int solve_camera(struct solve *s)
             memcpy(bv->tvec, &tv[3 * k], sizeof(bv->tvec));
             bv->rms = vr[k];
             if (attempt == 0 && vr[k] > 3.0 * median && vr[k] > 0.3) {
-                say(s, "view_%03u: rejected: reprojection RMS %.3f px, over 3x the median %.3f "
-                    "(blurred, or the board moved during the capture?)\n", (unsigned)bv->view,
-                    vr[k], median);
+                say(s,
+                    "view_%03u: rejected: reprojection RMS %.3f px, over 3x the median %.3f "
+                    "(blurred, or the board moved during the capture?)\n",
+                    (unsigned)bv->view, vr[k], median);
                 bv->found = bv->has_proj = 0;
                 dropped++;
             }
@@ -398,12 +429,16 @@ static int solve_camera(struct solve *s)
             break;
     }
     lens_to_calib(&lens, 0, &s->out);
-    say(s, "camera: reprojection RMS %.4f px over the boards found; orientations spread over "
-        "%.0f deg\n", s->cam_rms, spread);
+    say(s,
+        "camera: reprojection RMS %.4f px over the boards found; orientations spread over "
+        "%.0f deg\n",
+        s->cam_rms, spread);
     if (s->cam_rms > cs->max_camera_rms_px) {
-        say(s, "refused: the camera's reprojection RMS %.3f px is above [calibrate] "
+        say(s,
+            "refused: the camera's reprojection RMS %.3f px is above [calibrate] "
             "max_camera_rms_px = %.3f (blurred or moving captures, a board that is not flat, or "
-            "square_mm wrong?)\n", s->cam_rms, cs->max_camera_rms_px);
+            "square_mm wrong?)\n",
+            s->cam_rms, cs->max_camera_rms_px);
         return -EINVAL;
     }
     return 0;
@@ -425,7 +460,7 @@ static int solve_projector(struct solve *s)
     if (n == 0) {
         s->camera_only = 1;
         say(s, "projector: no capture has its patterns: the camera alone is calibrated (the "
-            "projector, the axis and the lights stay as the starting file has them)\n");
+               "projector, the axis and the lights stay as the starting file has them)\n");
         return 0;
     }
     if (n < 3) {
@@ -439,8 +474,8 @@ static int solve_projector(struct solve *s)
         return -EINVAL;
     }
     calib_to_lens(&s->out, 0, &cl);
-    if (calcv_stereo(cam, proj, n, (int)cs->fix_k3, &cl, &pl, s->out.proj_rot,
-                     s->out.proj_trans_mm, &s->stereo_rms) != 0) {
+    if (calcv_stereo(cam, proj, n, (int)cs->fix_k3, &cl, &pl, s->out.proj_rot, s->out.proj_trans_mm,
+                     &s->stereo_rms) != 0) {
         say(s, "refused: the joint camera-projector calibration did not converge\n");
         return -EINVAL;
     }
@@ -468,7 +503,8 @@ static int solve_projector(struct solve *s)
     say(s, "projector: reprojection RMS %.4f px (joint RMS %.4f px over %d views)\n", s->proj_rms,
         s->stereo_rms, n);
     if (s->proj_rms > cs->max_projector_rms_px) {
-        say(s, "refused: the projector's reprojection RMS %.3f px is above [calibrate] "
+        say(s,
+            "refused: the projector's reprojection RMS %.3f px is above [calibrate] "
             "max_projector_rms_px = %.3f (patterns out of focus, or the board moved?)\n",
             s->proj_rms, cs->max_projector_rms_px);
         return -EINVAL;
@@ -540,7 +576,7 @@ static int solve_axis(struct solve *s)
         if (pass == 0) {
             if (pairs == 0) {
                 say(s, "turntable: no placement was seen at two table angles: the axis stays as "
-                    "the starting file has it\n");
+                       "the starting file has it\n");
                 return 0;
             }
             vec3 a = v3_norm(v3(dir[0], dir[1], dir[2]));
@@ -552,7 +588,7 @@ static int solve_axis(struct solve *s)
         for (int y = 0; y < 3; y++)
             ata[3 * x + y] += dir[x] * dir[y];
     double c[3];
-    if (!solve_n(ata, atb, c, 3)) {
+    if (!calib_solve_n(ata, atb, c, 3)) {
         say(s, "refused: the axis cannot be located (the table turned too little?)\n");
         return -EINVAL;
     }
@@ -575,7 +611,7 @@ static int solve_axis(struct solve *s)
     vec3 point = v3_add(v3(c[0], c[1], c[2]), v3_scale(a, along));
     if (a.y > 0.0)
         say(s, "warning: the axis points down in the image: the table turns clockwise seen "
-            "from above for rising angles, which the scanner does not expect\n");
+               "from above for rising angles, which the scanner does not expect\n");
     memcpy(s->out.axis_dir, dir, sizeof(dir));
     s->out.axis_point_mm[0] = point.x;
     s->out.axis_point_mm[1] = point.y;
@@ -596,64 +632,19 @@ static int solve_axis(struct solve *s)
             double table = fabs((double)(q->ti.angle_mdeg - p->ti.angle_mdeg)) / 1000.0;
             worst_deg = fmax(worst_deg, fabs(turn - table));
         }
-    say(s, "turntable: axis from %d pairs of captures; the boards turned by the table's angles "
-        "within %.3f deg; the table's surface from %d board edges\n", pairs, worst_deg, n);
+    say(s,
+        "turntable: axis from %d pairs of captures; the boards turned by the table's angles "
+        "within %.3f deg; the table's surface from %d board edges\n",
+        pairs, worst_deg, n);
     return 0;
 }
 
 /* ---- lights: the matte white sphere's shading ---- */
 
 struct shade_sample {
-    float p[3], n[3]; /* surface point and normal (camera frame) */
+    float p[3], n[3];             /* surface point and normal (camera frame) */
     float signal[HAL_MAX_LIGHTS]; /* each light's frame less the dark frame, grey levels */
 };
-
-double calib_fit_sphere(const float *xyz, const uint8_t *reason, size_t n, int fit_radius,
-                        double *radius, vec3 *centre, uint32_t *used)
-{
-    vec3 c = v3(0, 0, 0);
-    uint32_t count = 0;
-    for (size_t i = 0; i < n; i++)
-        if (reason[i] == SCAN_VALID) {
-            c = v3_add(c, v3(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]));
-            count++;
-        }
-    *used = count;
-    if (count < 100)
-        return -1.0;
-    double r = *radius;
-    c = v3_scale(c, 1.0 / count);
-    c = v3_add(c, v3_scale(v3_norm(c), r)); /* the visible cap's centroid, pushed back */
-    double rms = 0.0;
-    const int np = fit_radius ? 4 : 3;
-    for (int it = 0; it < 50; it++) {
-        double a[16] = {0}, b[4] = {0}, sum = 0.0;
-        for (size_t i = 0; i < n; i++) {
-            if (reason[i] != SCAN_VALID)
-                continue;
-            vec3 d = v3_sub(v3(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]), c);
-            double len = v3_len(d), res = len - r;
-            double g[4] = {-d.x / len, -d.y / len, -d.z / len, -1.0}; /* d(res)/d(c, r) */
-            for (int x = 0; x < np; x++) {
-                for (int y = 0; y < np; y++)
-                    a[np * x + y] += g[x] * g[y];
-                b[x] -= g[x] * res;
-            }
-            sum += res * res;
-        }
-        rms = sqrt(sum / count);
-        double step[4] = {0, 0, 0, 0};
-        if (!solve_n(a, b, step, np))
-            return -1.0;
-        c = v3_add(c, v3(step[0], step[1], step[2]));
-        r += step[3];
-        if (fabs(step[0]) + fabs(step[1]) + fabs(step[2]) + fabs(step[3]) < 1e-8)
-            break;
-    }
-    *centre = c;
-    *radius = r;
-    return rms;
-}
 
 /* I = k max(0, n.(L - p)) / |L - p|^3: Lambert's cosine and the inverse-square law, as the
  * colour methods assume (docs/colour.md). */
@@ -715,7 +706,7 @@ static double fit_light(const struct shade_sample *smp, size_t n, uint32_t li, v
             memcpy(rhs, b, sizeof(rhs));
             for (int r = 0; r < 4; r++)
                 m[5 * r] *= 1.0 + lambda;
-            if (!solve_n(m, rhs, step, 4))
+            if (!calib_solve_n(m, rhs, step, 4))
                 break;
             double cand[4] = {x[0] + step[0], x[1] + step[1], x[2] + step[2], x[3] + step[3]};
             double cc = 0.0;
@@ -777,11 +768,20 @@ static int solve_lights(struct solve *s)
         vec3 centre;
         uint32_t used;
         double r = radius;
-        double rms = calib_fit_sphere(view.range.xyz_mm, view.maps.reason, npix, 0, &r, &centre,
-                                      &used);
+        double rms =
+            calib_fit_sphere(view.range.xyz_mm, view.maps.reason, npix, 0, &r, &centre, &used);
         if (rms < 0.0) {
             say(s, "view_%03u: sphere not seen (%u points): not used\n", (unsigned)v,
                 (unsigned)used);
+            continue;
+        }
+        /* a ball's surface within a tenth of its radius, or it is not the ball: a board
+         * capture marked sphere fitted 60 mm RMS and put the lights 250 m away */
+        if (rms > CALIB_SPHERE_MAX_RMS_SHARE * radius) {
+            say(s,
+                "view_%03u: rejected: the surface is no sphere of %.1f mm (fit RMS %.2f mm, "
+                "more than %.0f%% of its radius): not used\n",
+                (unsigned)v, 2.0 * radius, rms, 100.0 * CALIB_SPHERE_MAX_RMS_SHARE);
             continue;
         }
         say(s, "view_%03u: sphere centre (%.2f, %.2f, %.2f) mm from %u points, fit RMS %.3f mm\n",
@@ -848,14 +848,24 @@ static int solve_lights(struct solve *s)
             rc = -EINVAL;
             break;
         }
+        double from_axis = v3_len(v3_sub(l, v3_from(s->out.axis_point_mm)));
+        if (from_axis > CALIB_LIGHT_MAX_MM) {
+            say(s,
+                "refused: light %u comes out %.1f m from the table, farther than any rig's "
+                "%.0f m (does the sphere show its light?)\n",
+                (unsigned)li, from_axis / 1000.0, CALIB_LIGHT_MAX_MM / 1000.0);
+            rc = -EINVAL;
+            break;
+        }
         s->out.light_pos_mm[li][0] = l.x;
         s->out.light_pos_mm[li][1] = l.y;
         s->out.light_pos_mm[li][2] = l.z;
         intensity[li] = k;
         mean += k / lights;
-        say(s, "light %u: (%.2f, %.2f, %.2f) mm from %zu samples, shading RMS %.2f grey levels, "
-            "intensity %.4g (grey levels at 1 m, head-on)\n", (unsigned)li, l.x, l.y, l.z, m,
-            res, k * 1e-6);
+        say(s,
+            "light %u: (%.2f, %.2f, %.2f) mm from %zu samples, shading RMS %.2f grey levels, "
+            "intensity %.4g (grey levels at 1 m, head-on)\n",
+            (unsigned)li, l.x, l.y, l.z, m, res, k * 1e-6);
     }
     for (uint32_t li = 0; li < lights && rc == 0; li++) {
         s->out.light_gain[li] = intensity[li] / mean;
@@ -900,20 +910,33 @@ static int write_outputs(struct solve *s, const struct hal_storage *st, const ch
              "; quality: camera_rms_px = %.4f, projector_rms_px = %.4f, boards = %u\n"
              "; camera frame: x right, y down, z forward; millimetres\n",
              s->dir, s->cam_rms, s->proj_rms, (unsigned)s->view_count);
-    int rc = keep_old(out_path, kept, sizeof(kept));
-    if (rc == 0)
-        rc = calib_save(st, out_path, &s->out, comment);
+    /* Written beside it first, and what calib_load accepts is the test of what was written:
+     * only a file that loads replaces the one in use (which is then kept beside it). */
+    char fresh[HAL_MAX_PATH + 16];
+    calibrate_path_beside(out_path, ".new.ini", fresh, sizeof(fresh));
+    int rc = calib_save(st, fresh, &s->out, comment);
     if (rc != 0) {
-        fprintf(stderr, "scanner: error: cannot write %s: %s\n", out_path, strerror(-rc));
+        fprintf(stderr, "scanner: error: cannot write %s: %s\n", fresh, strerror(-rc));
         return rc;
     }
-    /* what calib_load accepts is the test of what was written */
     struct scan_calib back;
     char err[512];
-    if ((rc = calib_load(&back, out_path, s->out.light_count, err, sizeof(err))) != 0) {
-        fprintf(stderr, "scanner: error: the calibration written does not load: %s\n", err);
+    if ((rc = calib_load(&back, fresh, s->out.light_count, err, sizeof(err))) != 0) {
+        fprintf(stderr,
+                "scanner: error: the calibration computed does not load: %s; %s is "
+                "unchanged\n",
+                err, out_path);
+        unlink(fresh);
         return rc;
     }
+    rc = keep_old(out_path, kept, sizeof(kept));
+    if (rc == 0 && rename(fresh, out_path) != 0) {
+        rc = -errno;
+        fprintf(stderr, "scanner: error: cannot put %s in place of %s: %s\n", fresh, out_path,
+                strerror(-rc));
+    }
+    if (rc != 0)
+        return rc;
     calibrate_path_beside(out_path, ".report.txt", report_path, sizeof(report_path));
     rc = hal_storage_write_file(st, report_path, s->report, s->report_len);
     if (rc != 0)

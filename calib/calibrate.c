@@ -19,68 +19,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-void calibrate_guess(const struct app_config *cfg, struct scan_calib *g)
-{
-    memset(g, 0, sizeof(*g));
-    /* A 50-degree lens on each, the projector 200 mm to the camera's left and turned 20 degrees
-     * towards it, the table 600 mm away: only sizes matter for capturing. */
-    g->cam_width = cfg->camera.width;
-    g->cam_height = cfg->camera.height;
-    g->cam_fx_px = g->cam_fy_px = 1.07 * g->cam_width;
-    g->cam_cx_px = 0.5 * (g->cam_width - 1.0);
-    g->cam_cy_px = 0.5 * (g->cam_height - 1.0);
-    g->proj_width = cfg->calibrate.projector_width;
-    g->proj_height = cfg->calibrate.projector_height;
-    g->proj_fx_px = g->proj_fy_px = 1.07 * g->proj_width;
-    g->proj_cx_px = 0.5 * (g->proj_width - 1.0);
-    g->proj_cy_px = 0.5 * (g->proj_height - 1.0);
-    const double a = 20.0 * M_PI / 180.0;
-    const double rot[9] = {cos(a), 0, sin(a), 0, 1, 0, -sin(a), 0, cos(a)};
-    memcpy(g->proj_rot, rot, sizeof(rot));
-    g->proj_trans_mm[0] = -200.0;
-    g->axis_point_mm[1] = 75.0;
-    g->axis_point_mm[2] = 600.0;
-    g->axis_dir[1] = -1.0;
-    g->light_count = cfg->light_count;
-    for (uint32_t i = 0; i < cfg->light_count; i++) {
-        g->light_pos_mm[i][0] = 100.0 * i - 150.0;
-        g->light_pos_mm[i][1] = -200.0;
-        g->light_pos_mm[i][2] = 300.0;
-        g->light_gain[i] = 1.0;
-    }
-}
-
-void calib_board_from_settings(const struct calib_settings *s, struct calcv_board *b)
-{
-    static const struct {
-        const char *name;
-        int id; /* cv::aruco::PREDEFINED_DICTIONARY_NAME */
-    } dicts[] = {{"4x4_50", 0}, {"4x4_100", 1}, {"5x5_50", 4}, {"5x5_100", 5}, {"6x6_250", 10}};
-    memset(b, 0, sizeof(*b));
-    b->kind = strcmp(s->board, "chessboard") == 0 ? CALCV_CHESSBOARD : CALCV_CHARUCO;
-    b->squares_x = (int)s->squares_x;
-    b->squares_y = (int)s->squares_y;
-    b->square_mm = s->square_mm;
-    b->marker_mm = s->marker_mm;
-    b->margin_mm = s->margin_mm;
-    b->dictionary = -1;
-    for (size_t i = 0; i < sizeof(dicts) / sizeof(dicts[0]); i++)
-        if (strcmp(s->dictionary, dicts[i].name) == 0)
-            b->dictionary = dicts[i].id;
-}
-
-/* The scan parameters of a calibration capture: columns and rows (the projector's coordinates
- * at the board's corners), and with lights, every light's own frame (the sphere's shading). */
-void calib_capture_params(const struct app_config *cfg, struct scan_params *p)
-{
-    *p = cfg->scan;
-    p->decode_rows = 1;
-    p->refine = 1;
-    p->colour.method = cfg->light_count > 0 ? COLOUR_MULTI : COLOUR_NONE;
-    p->colour.all_lights_exposure_us = 0;
-    p->colour.light_exposure_us = 0;
-}
-
 /* ---- the person's steps ---- */
 
 struct capture {
@@ -102,11 +40,11 @@ static int save_frame(void *priv, uint32_t pattern, const uint8_t *pixels, uint3
 {
     struct capture *c = priv;
     /* PNG: calibration captures are few, and any image tool opens them */
-    int rc = scan_dir_write_frame(&c->hal->storage, c->dir, c->view, pattern, pixels, width,
-                                  height, channels, SCAN_FRAMES_PNG);
+    int rc = scan_dir_write_frame(&c->hal->storage, c->dir, c->view, pattern, pixels, width, height,
+                                  channels, SCAN_FRAMES_PNG);
     if (rc != 0)
-        c->hal->log(HAL_LOG_ERROR, "cannot write frame %u of %s/view_%03u: %s",
-                    (unsigned)pattern, c->dir, (unsigned)c->view, strerror(-rc));
+        c->hal->log(HAL_LOG_ERROR, "cannot write frame %u of %s/view_%03u: %s", (unsigned)pattern,
+                    c->dir, (unsigned)c->view, strerror(-rc));
     return rc;
 }
 
@@ -178,8 +116,8 @@ static int capture_one(struct capture *c, const struct calib_target_info *ti)
     static struct scan_dir_view meta;
     scan_job_view_meta(c->cfg, &c->params, c->guess, c->view, &info, &meta);
     if ((rc = scan_dir_write_view(&hal->storage, c->dir, c->view, &meta)) != 0) {
-        hal->log(HAL_LOG_ERROR, "cannot write %s/view_%03u/view.ini: %s", c->dir,
-                 (unsigned)c->view, strerror(-rc));
+        hal->log(HAL_LOG_ERROR, "cannot write %s/view_%03u/view.ini: %s", c->dir, (unsigned)c->view,
+                 strerror(-rc));
         return rc;
     }
     if (ti->kind == CALIB_TARGET_BOARD) {
@@ -187,9 +125,9 @@ static int capture_one(struct capture *c, const struct calib_target_info *ti)
         static uint8_t grey[HAL_MAX_PIXELS];
         char why[256];
         decode_rgb_to_grey(view.white_rgb, grey, (size_t)view.width * view.height, 256);
-        c->board_found = calcv_find_corners(&c->board, grey, (int)view.width, (int)view.height,
-                                            (int)c->cfg->calibrate.min_corners, &corners, why,
-                                            sizeof(why)) == 0;
+        c->board_found =
+            calcv_find_corners(&c->board, grey, (int)view.width, (int)view.height,
+                               (int)c->cfg->calibrate.min_corners, &corners, why, sizeof(why)) == 0;
         if (c->board_found)
             printf("    view_%03u at %7.2f deg: board found, %d corners\n", (unsigned)c->view,
                    st.position_mdeg / 1000.0, corners.count);
@@ -217,11 +155,13 @@ static int board_steps(struct capture *c)
             snprintf(where, sizeof(where), "its centre %.0f mm to the %s of the table's centre",
                      fabs(off), off > 0.0 ? "right (as the camera sees it)" : "left");
         if (tilt >= 80.0)
-            snprintf(what, sizeof(what), "Placement %u of %u: lay the board flat on the table, "
+            snprintf(what, sizeof(what),
+                     "Placement %u of %u: lay the board flat on the table, "
                      "%s, its top edge away from the camera.",
                      (unsigned)p + 1, (unsigned)s->placement_count, where);
         else
-            snprintf(what, sizeof(what), "Placement %u of %u: stand the board on the table "
+            snprintf(what, sizeof(what),
+                     "Placement %u of %u: stand the board on the table "
                      "facing the camera, %s, %s %.0f degrees.",
                      (unsigned)p + 1, (unsigned)s->placement_count, where,
                      tilt >= 0.0 ? "leaning back by" : "leaning forward by", fabs(tilt));
@@ -260,7 +200,8 @@ static int sphere_steps(struct capture *c)
     if (s->sphere_turns == 0 || c->cfg->light_count == 0)
         return 0;
     char what[256];
-    snprintf(what, sizeof(what), "Take the board off. Put the matte white sphere (%.0f mm) on "
+    snprintf(what, sizeof(what),
+             "Take the board off. Put the matte white sphere (%.0f mm) on "
              "the table, %.0f mm from its centre towards the camera.",
              s->sphere_diameter_mm, s->sphere_offset_mm);
     struct board_target t = {.kind = BOARD_TARGET_SPHERE,
@@ -270,18 +211,18 @@ static int sphere_steps(struct capture *c)
     if (rc == 0)
         rc = place(c, &t, what);
     for (uint32_t k = 0; k < s->sphere_turns && rc == 0; k++) {
-        struct calib_target_info ti = {
-            .kind = CALIB_TARGET_SPHERE,
-            .placement = s->placement_count,
-            .angle_mdeg = (int32_t)lround(360000.0 * k / s->sphere_turns)};
+        struct calib_target_info ti = {.kind = CALIB_TARGET_SPHERE,
+                                       .placement = s->placement_count,
+                                       .angle_mdeg =
+                                           (int32_t)lround(360000.0 * k / s->sphere_turns)};
         rc = capture_one(c, &ti);
         c->view += rc == 0;
     }
     return rc;
 }
 
-int calibrate_capture(struct hal *hal, const struct app_config *cfg,
-                      const struct scan_calib *guess, const char *dir)
+int calibrate_capture(struct hal *hal, const struct app_config *cfg, const struct scan_calib *guess,
+                      const char *dir)
 {
     struct capture c = {.hal = hal, .cfg = cfg, .guess = guess, .dir = dir};
     calib_capture_params(cfg, &c.params);
@@ -295,8 +236,10 @@ int calibrate_capture(struct hal *hal, const struct app_config *cfg,
     }
     rc = scan_dir_open(&hal->storage, dir, SCAN_DIR_NEW, &lock_fd, err, sizeof(err));
     if (rc != 0) {
-        hal->log(HAL_LOG_ERROR, "%s (captures already there are computed with "
-                 "'scanner calibrate --from %s')", err, dir);
+        hal->log(HAL_LOG_ERROR,
+                 "%s (captures already there are computed with "
+                 "'scanner calibrate --from %s')",
+                 err, dir);
         goto out_sheet;
     }
     /* The config as it was, and the guess the captures were taken with (its sizes matter). */
@@ -312,10 +255,12 @@ int calibrate_capture(struct hal *hal, const struct app_config *cfg,
     if (rc == 0)
         rc = hal_table_move_to(&hal->turntable, 0);
     if (rc != 0)
-        hal->log(HAL_LOG_WARN, "calibration captures stopped (%s); the %u finished ones are "
+        hal->log(HAL_LOG_WARN,
+                 "calibration captures stopped (%s); the %u finished ones are "
                  "kept in %s: 'scanner calibrate --config %s --from %s --out FILE' computes from "
-                 "them", rc == -EINTR ? "stopped by request" : strerror(-rc), (unsigned)c.view,
-                 dir, cfg->path, dir);
+                 "them",
+                 rc == -EINTR ? "stopped by request" : strerror(-rc), (unsigned)c.view, dir,
+                 cfg->path, dir);
 out_dir:
     scan_dir_close(lock_fd);
 out_sheet:
@@ -332,6 +277,14 @@ int calibrate_print_board(const struct hal_storage *st, const struct app_config 
     uint8_t *grey = NULL;
     int w, h;
     const double dpi = 300.0;
+    size_t len = strlen(base);
+    if (len == 0 || base[len - 1] == '/') { /* else ".png" in the working directory */
+        fprintf(stderr,
+                "scanner: error: calibrate board --out '%s': give a file name without its "
+                "ending (--out board writes board.png and board.svg)\n",
+                base);
+        return -EINVAL;
+    }
     calib_board_from_settings(&cfg->calibrate, &b);
     int rc = calcv_board_image(&b, dpi / 25.4, &grey, &w, &h);
     if (rc != 0) {
@@ -370,8 +323,10 @@ int calibrate_verify(struct hal *hal, const struct app_config *cfg, const struct
                              .diameter_mm = s->sphere_diameter_mm,
                              .position_mm = {s->sphere_offset_mm, 0.0}};
     char what[256];
-    snprintf(what, sizeof(what), "Put the %.3f mm ball on the table, %.0f mm from its centre "
-             "towards the camera.", s->sphere_diameter_mm, s->sphere_offset_mm);
+    snprintf(what, sizeof(what),
+             "Put the %.3f mm ball on the table, %.0f mm from its centre "
+             "towards the camera.",
+             s->sphere_diameter_mm, s->sphere_offset_mm);
     struct scan_params params = cfg->scan;
     params.colour.method = COLOUR_NONE;
     int rc = hal_table_home(&hal->turntable);
@@ -389,8 +344,10 @@ int calibrate_verify(struct hal *hal, const struct app_config *cfg, const struct
     double rms = calib_fit_sphere(view.range.xyz_mm, view.maps.reason,
                                   (size_t)view.width * view.height, 1, &radius, &centre, &used);
     if (rms < 0.0) {
-        hal->log(HAL_LOG_ERROR, "the ball was not seen (%u points): is it in view and lit by "
-                 "the projector?", (unsigned)used);
+        hal->log(HAL_LOG_ERROR,
+                 "the ball was not seen (%u points): is it in view and lit by "
+                 "the projector?",
+                 (unsigned)used);
         return -ENODATA;
     }
     double cam_rms, proj_rms;

@@ -30,8 +30,7 @@ static const struct hal_gpio_ops lights_ops = {.set = lights_set, .safe_state = 
 
 static void hold(const char *what, uint32_t pattern, const struct board_display *d)
 {
-    printf("shown %s %u at %llu us\n", what, (unsigned)pattern,
-           (unsigned long long)d->drm.flip_us);
+    printf("shown %s %u at %llu us\n", what, (unsigned)pattern, (unsigned long long)d->drm.flip_us);
     fflush(stdout);
     struct timespec ts = {2, 0}; /* the host's screendump */
     nanosleep(&ts, NULL);

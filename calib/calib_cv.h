@@ -1,5 +1,6 @@
 /* OpenCV 4.6 behind a C interface for calibration: the board's picture, its corners in an image,
- * Zhang's camera calibration and the stereo pose (app/calib_cv.cpp, the only C++ of calibration). */
+ * Zhang's camera calibration and the stereo pose (app/calib_cv.cpp, the only C++ of calibration).
+ */
 #ifndef CALIB_CV_H
 #define CALIB_CV_H
 
@@ -16,18 +17,18 @@ enum calcv_board_kind { CALCV_CHESSBOARD = 0, CALCV_CHARUCO = 1 };
 
 /** A printed board. The sheet's origin is its top-left corner; x right, y down, z into it. */
 struct calcv_board {
-    int kind;                  /**< enum calcv_board_kind */
-    int squares_x, squares_y;  /**< squares across and down */
-    double square_mm;          /**< side of a square */
-    double marker_mm;          /**< ChArUco: side of a marker inside a white square */
-    int dictionary;            /**< ChArUco: OpenCV's predefined dictionary id */
-    double margin_mm;          /**< white border around the squares */
+    int kind;                 /**< enum calcv_board_kind */
+    int squares_x, squares_y; /**< squares across and down */
+    double square_mm;         /**< side of a square */
+    double marker_mm;         /**< ChArUco: side of a marker inside a white square */
+    int dictionary;           /**< ChArUco: OpenCV's predefined dictionary id */
+    double margin_mm;         /**< white border around the squares */
 };
 
 /** The corners found in one image, and where each lies on the sheet. */
 struct calcv_corners {
     int count;
-    int id[CALCV_MAX_CORNERS];         /**< corner number on the board (row-major) */
+    int id[CALCV_MAX_CORNERS];          /**< corner number on the board (row-major) */
     double image[CALCV_MAX_CORNERS][2]; /**< pixel coordinates, centres at integers */
     double sheet[CALCV_MAX_CORNERS][3]; /**< on the sheet, mm (z = 0) */
 };

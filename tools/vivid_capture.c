@@ -84,8 +84,8 @@ static int capture_frames(const struct hal_camera *hc, uint32_t drop_frames)
         /* the frame began after the capture was asked for (the queued ones are dropped) and
          * before it came back */
         late += img.start_us == 0 || img.start_us > after || img.start_us + 500000u < before;
-        printf("frame %d: %ux%u sequence %llu began %lld us before it returned, levels %u..%u\n",
-               k, (unsigned)img.width, (unsigned)img.height, (unsigned long long)img.sequence,
+        printf("frame %d: %ux%u sequence %llu began %lld us before it returned, levels %u..%u\n", k,
+               (unsigned)img.width, (unsigned)img.height, (unsigned long long)img.sequence,
                (long long)after - (long long)img.start_us, (unsigned)lo, (unsigned)hi);
         last_seq = img.sequence;
     }
@@ -101,9 +101,14 @@ int main(int argc, char **argv)
     static struct camera_v4l2 cam;
     struct hal_camera hc;
     camera_v4l2_init(&cam, log_line, &hc);
-    struct hal_camera_config cfg = {.width = W, .height = H, .pixel_format = HAL_PIX_YUYV,
-                                    .exposure_us = 10000, .gain_milli = 1000, .drop_frames = 2,
-                                    .frame_timeout_ms = 2000, .binning = 1};
+    struct hal_camera_config cfg = {.width = W,
+                                    .height = H,
+                                    .pixel_format = HAL_PIX_YUYV,
+                                    .exposure_us = 10000,
+                                    .gain_milli = 1000,
+                                    .drop_frames = 2,
+                                    .frame_timeout_ms = 2000,
+                                    .binning = 1};
     snprintf(cfg.device, sizeof(cfg.device), "%s", device);
     int rc = hal_cam_open(&hc, &cfg);
     printf("open %ux%u yuyv: %s\n", (unsigned)cfg.width, (unsigned)cfg.height,
@@ -112,7 +117,7 @@ int main(int argc, char **argv)
         rc = capture_frames(&hc, cfg.drop_frames);
     int exp_rc = hal_cam_set_exposure(&hc, 20000, 1000);
     printf("other exposure: %s\n", exp_rc == -ENOSYS ? "refused (no exposure control)"
-                                    : exp_rc == 0    ? "accepted"
+                                   : exp_rc == 0     ? "accepted"
                                                      : strerror(-exp_rc));
     hal_cam_close(&hc);
 
@@ -140,7 +145,9 @@ int main(int argc, char **argv)
         uint64_t t0 = now_us();
         rc = hal_cam_capture(&hc, &img);
         printf("no frames (control %s): %s after %llu ms\n", set == 0 ? "set" : strerror(-set),
-               rc == -ETIMEDOUT ? "timed out" : rc == 0 ? "A FRAME" : strerror(-rc),
+               rc == -ETIMEDOUT ? "timed out"
+               : rc == 0        ? "A FRAME"
+                                : strerror(-rc),
                (unsigned long long)(now_us() - t0) / 1000u);
         set_control_named(device, "Percentage of Dropped Buffers", 0);
     }

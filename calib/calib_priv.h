@@ -44,8 +44,12 @@ int calib_write_guess(const struct hal_storage *st, const char *dir, const struc
 
 /** An SVG at true size showing the @p width x @p height picture @p png_path of the board, drawn
  *  at @p px_per_mm. @retval 0 @retval -errno */
-int calib_write_svg(const struct hal_storage *st, const char *base, const char *png_path,
-                    int width, int height, double px_per_mm);
+int calib_write_svg(const struct hal_storage *st, const char *base, const char *png_path, int width,
+                    int height, double px_per_mm);
+
+/** Solve the @p n x @p n system a x = b (row-major) by Gauss-Jordan with partial pivoting; @p a
+ *  and @p b are destroyed. @retval 0 singular @retval 1 solved */
+int calib_solve_n(double *a, double *b, double *x, int n);
 
 /** A sphere through the valid points of a range image: Gauss-Newton on sum (|p - c| - r)^2 from
  *  the visible cap's centroid pushed back by r. @param fit_radius  0: @p radius is known

@@ -40,8 +40,7 @@ static int measure_hdr(const char *config, const char *object, const char *mater
     t.cfg.scan.exposure_count = 0;
     for (; exposures != NULL && exposures[t.cfg.scan.exposure_count] != 0;
          t.cfg.scan.exposure_count++)
-        t.cfg.scan.exposures_us[t.cfg.scan.exposure_count] =
-            exposures[t.cfg.scan.exposure_count];
+        t.cfg.scan.exposures_us[t.cfg.scan.exposure_count] = exposures[t.cfg.scan.exposure_count];
     snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "%s", object);
     snprintf(t.cfg.sim.material, sizeof(t.cfg.sim.material), "%s", material);
     t.cfg.scan.refine = (uint32_t)refine;
@@ -129,7 +128,8 @@ static int table_hard(const char *config)
     const char *names[] = {"none", "10000, 40000", "2500, 10000, 40000"};
     const char *objects[] = {"sphere", "mesh", "torus"};
     printf("\n%s: very dark paint and highlights, HDR patterns ([scan] exposures_us)\n\n"
-           "| object | exposures_us | frames | dark paint px | decoded right (+-1) | glossy: saturated "
+           "| object | exposures_us | frames | dark paint px | decoded right (+-1) | glossy: "
+           "saturated "
            "px | decoded right (+-1) | view ms |\n|---|---|---|---|---|---|---|---|\n",
            config);
     for (size_t o = 0; o < sizeof(objects) / sizeof(objects[0]); o++)
@@ -172,9 +172,9 @@ static int table_concave(const char *config)
         if (measure_rig(&t, &q, &ms) != 0)
             return 1;
         printf("| %s | %s | %u | %u | %.2f%% | %.3f%% | %.3f%% | %.3f | %u | %.0f |\n",
-               t.cfg.sim.object, code ? "XOR-04" : "Gray", bounce, q.lit, 100.0 * q.lit_valid / q.lit,
-               100.0 * q.lit_wrong / q.lit, 100.0 * q.lit_off / q.lit, q.depth_rms_mm,
-               q.outliers_2mm, ms);
+               t.cfg.sim.object, code ? "XOR-04" : "Gray", bounce, q.lit,
+               100.0 * q.lit_valid / q.lit, 100.0 * q.lit_wrong / q.lit, 100.0 * q.lit_off / q.lit,
+               q.depth_rms_mm, q.outliers_2mm, ms);
     }
     return 0;
 }

@@ -3,7 +3,7 @@
 # tests/eval/ it takes one 8-view scan (every colour frame), processes it again with each
 # [colour] method (white-referenced by scanner calibrate-white), measures the fused colour against
 # the true albedo with build/colour-eval, and writes REPORT_DIR/colour-eval.csv and .md and the
-# close-up PNGs. Usage: tests/colour_eval.sh BUILD_DIR REPORT_DIR [SCENE...]
+# close-up PNGs. Usage: tools/colour_eval.sh BUILD_DIR REPORT_DIR [SCENE...]
 set -eu
 build=$1
 report=$2
@@ -75,5 +75,5 @@ for scene in $scenes; do
     "$build/colour-eval" closeup "$scan" "$report/closeup-$scene.png" \
         $(for m in $methods; do printf '%s ' "$work/$scene-$m"; done)
 done
-awk -F, -f tests/colour_eval_report.awk "$csv" "$relit" > "$report/colour-eval.md"
+awk -F, -f tools/colour_eval_report.awk "$csv" "$relit" > "$report/colour-eval.md"
 echo "eval: $report/colour-eval.md" >&2

@@ -74,8 +74,8 @@ int main(int argc, char **argv)
     calib_read_quality(argv[3], &cam_rms, &proj_rms);
     printf("| %-34s | %12s | %12s | %12s | %14s |\n", "parameter", "true", "nominal", "recovered",
            "error");
-    printf("|%s|%s|%s|%s|%s|\n", "------------------------------------",
-           "--------------", "--------------", "--------------", "----------------");
+    printf("|%s|%s|%s|%s|%s|\n", "------------------------------------", "--------------",
+           "--------------", "--------------", "----------------");
     row("camera reprojection RMS (px)", "px", 0.0, 0.0, cam_rms, cam_rms);
     row("projector reprojection RMS (px)", "px", 0.0, 0.0, proj_rms, proj_rms);
     row("camera fx (px)", "%", t.cam_fx_px, n.cam_fx_px, r.cam_fx_px,
@@ -84,12 +84,14 @@ int main(int argc, char **argv)
         100.0 * (r.cam_fy_px - t.cam_fy_px) / t.cam_fy_px);
     row("camera cx (px)", "px", t.cam_cx_px, n.cam_cx_px, r.cam_cx_px, r.cam_cx_px - t.cam_cx_px);
     row("camera cy (px)", "px", t.cam_cy_px, n.cam_cy_px, r.cam_cy_px, r.cam_cy_px - t.cam_cy_px);
-    row("camera k1", "", t.cam_dist[0], n.cam_dist[0], r.cam_dist[0], r.cam_dist[0] - t.cam_dist[0]);
-    row("camera k2", "", t.cam_dist[1], n.cam_dist[1], r.cam_dist[1], r.cam_dist[1] - t.cam_dist[1]);
+    row("camera k1", "", t.cam_dist[0], n.cam_dist[0], r.cam_dist[0],
+        r.cam_dist[0] - t.cam_dist[0]);
+    row("camera k2", "", t.cam_dist[1], n.cam_dist[1], r.cam_dist[1],
+        r.cam_dist[1] - t.cam_dist[1]);
     double cam_dn = distortion_error_px(t.cam_fx_px, t.cam_fy_px, t.cam_cx_px, t.cam_cy_px,
-                                      t.cam_width, t.cam_height, t.cam_dist, n.cam_dist);
+                                        t.cam_width, t.cam_height, t.cam_dist, n.cam_dist);
     double cam_dr = distortion_error_px(t.cam_fx_px, t.cam_fy_px, t.cam_cx_px, t.cam_cy_px,
-                                      t.cam_width, t.cam_height, t.cam_dist, r.cam_dist);
+                                        t.cam_width, t.cam_height, t.cam_dist, r.cam_dist);
     row("camera distortion, max over image", "px", 0.0, cam_dn, cam_dr, cam_dr);
     row("projector fx (px)", "%", t.proj_fx_px, n.proj_fx_px, r.proj_fx_px,
         100.0 * (r.proj_fx_px - t.proj_fx_px) / t.proj_fx_px);
@@ -102,9 +104,9 @@ int main(int argc, char **argv)
     row("projector k1", "", t.proj_dist[0], n.proj_dist[0], r.proj_dist[0],
         r.proj_dist[0] - t.proj_dist[0]);
     double proj_dn = distortion_error_px(t.proj_fx_px, t.proj_fy_px, t.proj_cx_px, t.proj_cy_px,
-                                      t.proj_width, t.proj_height, t.proj_dist, n.proj_dist);
+                                         t.proj_width, t.proj_height, t.proj_dist, n.proj_dist);
     double proj_dr = distortion_error_px(t.proj_fx_px, t.proj_fy_px, t.proj_cx_px, t.proj_cy_px,
-                                      t.proj_width, t.proj_height, t.proj_dist, r.proj_dist);
+                                         t.proj_width, t.proj_height, t.proj_dist, r.proj_dist);
     row("projector distortion, max over image", "px", 0.0, proj_dn, proj_dr, proj_dr);
     row3("projector translation (mm)", t.proj_trans_mm, n.proj_trans_mm, r.proj_trans_mm, "mm");
     row("projector rotation off the true (deg)", "deg", 0.0, rotation_deg(t.proj_rot, n.proj_rot),

@@ -13,7 +13,8 @@
 #include <cstring>
 #include <vector>
 
-namespace {
+namespace
+{
 
 cv::Ptr<cv::aruco::CharucoBoard> charuco(const calcv_board *b)
 {
@@ -64,16 +65,23 @@ void explain(const cv::Mat &img, int found, int need, char *why, size_t len)
     cv::minMaxLoc(small, &lo, &hi);
     int saturated = cv::countNonZero(img >= 250);
     if (hi - lo < 40.0)
-        snprintf(why, len, "too dark or too flat: the brightest and darkest areas differ by %.0f "
-                 "grey levels (light the board, or raise the exposure)", hi - lo);
+        snprintf(why, len,
+                 "too dark or too flat: the brightest and darkest areas differ by %.0f "
+                 "grey levels (light the board, or raise the exposure)",
+                 hi - lo);
     else if (saturated > (int)(img.total() / 50))
-        snprintf(why, len, "glare: %.1f%% of the image is saturated (tilt the board away from the "
-                 "light, or lower the exposure)", 100.0 * saturated / (double)img.total());
+        snprintf(why, len,
+                 "glare: %.1f%% of the image is saturated (tilt the board away from the "
+                 "light, or lower the exposure)",
+                 100.0 * saturated / (double)img.total());
     else if (found > 0)
-        snprintf(why, len, "too few corners: %d of the %d needed (is the board partly out of "
-                 "view, or covered?)", found, need);
+        snprintf(why, len,
+                 "too few corners: %d of the %d needed (is the board partly out of "
+                 "view, or covered?)",
+                 found, need);
     else
-        snprintf(why, len, "no board in view (is it partly out of view, too steep, or another "
+        snprintf(why, len,
+                 "no board in view (is it partly out of view, too steep, or another "
                  "board than the config describes?)");
 }
 
@@ -90,8 +98,8 @@ extern "C" void calcv_board_size_mm(const calcv_board *b, double *w, double *h)
     *h = b->squares_y * b->square_mm + 2.0 * b->margin_mm;
 }
 
-extern "C" int calcv_board_image(const calcv_board *b, double px_per_mm, uint8_t **grey,
-                                 int *width, int *height)
+extern "C" int calcv_board_image(const calcv_board *b, double px_per_mm, uint8_t **grey, int *width,
+                                 int *height)
 {
     if (!board_ok(b) || px_per_mm <= 0.0)
         return -EINVAL;
@@ -121,9 +129,8 @@ extern "C" int calcv_board_image(const calcv_board *b, double px_per_mm, uint8_t
     return 0;
 }
 
-extern "C" int calcv_find_corners(const calcv_board *b, const uint8_t *grey, int width,
-                                  int height, int min_corners, calcv_corners *out, char *why,
-                                  size_t why_len)
+extern "C" int calcv_find_corners(const calcv_board *b, const uint8_t *grey, int width, int height,
+                                  int min_corners, calcv_corners *out, char *why, size_t why_len)
 {
     if (!board_ok(b))
         return -EINVAL;
@@ -170,9 +177,9 @@ extern "C" int calcv_find_corners(const calcv_board *b, const uint8_t *grey, int
     // which pulls the corners (0.1% in focal length, a pixel in the principal point, measured on
     // the simulator); refine again over a window within the white borders.
     if (b->kind == CALCV_CHARUCO)
-        cv::cornerSubPix(img, pts, cv::Size(4, 4), cv::Size(-1, -1),
-                         cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 50,
-                                          1e-4));
+        cv::cornerSubPix(
+            img, pts, cv::Size(4, 4), cv::Size(-1, -1),
+            cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 50, 1e-4));
     for (size_t i = 0; i < ids.size() && i < CALCV_MAX_CORNERS; i++) {
         int id = ids[i];
         out->id[i] = id;
@@ -187,9 +194,9 @@ extern "C" int calcv_find_corners(const calcv_board *b, const uint8_t *grey, int
     return 0;
 }
 
-extern "C" int calcv_calibrate(const calcv_corners *views, int n, int width, int height,
-                               int fix_k3, calcv_lens *lens, double *rvec, double *tvec,
-                               double *view_rms, double *rms)
+extern "C" int calcv_calibrate(const calcv_corners *views, int n, int width, int height, int fix_k3,
+                               calcv_lens *lens, double *rvec, double *tvec, double *view_rms,
+                               double *rms)
 {
     if (n < 3)
         return -EINVAL;
@@ -203,10 +210,10 @@ extern "C" int calcv_calibrate(const calcv_corners *views, int n, int width, int
     cv::Mat k, d, per_view, sd_in, sd_ex;
     std::vector<cv::Mat> rv, tv;
     try {
-        *rms = cv::calibrateCamera(obj, img, cv::Size(width, height), k, d, rv, tv, sd_in, sd_ex,
-                                   per_view, fix_k3 ? cv::CALIB_FIX_K3 : 0,
-                                   cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS,
-                                                    100, 1e-12));
+        *rms = cv::calibrateCamera(
+            obj, img, cv::Size(width, height), k, d, rv, tv, sd_in, sd_ex, per_view,
+            fix_k3 ? cv::CALIB_FIX_K3 : 0,
+            cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 100, 1e-12));
     } catch (const cv::Exception &e) {
         fprintf(stderr, "calibrate: OpenCV: %s\n", e.what());
         return -EDOM;
@@ -238,11 +245,10 @@ extern "C" int calcv_stereo(const calcv_corners *cam, const calcv_corners *proj,
     d2 = d2.clone();
     cv::Mat r, t, e, f;
     try {
-        *rms = cv::stereoCalibrate(obj, img1, img2, k1, d1, k2, d2, cv::Size(1, 1), r, t, e, f,
-                                   cv::CALIB_USE_INTRINSIC_GUESS | (fix_k3 ? cv::CALIB_FIX_K3 : 0),
-                                   cv::TermCriteria(cv::TermCriteria::COUNT |
-                                                        cv::TermCriteria::EPS,
-                                                    200, 1e-12));
+        *rms = cv::stereoCalibrate(
+            obj, img1, img2, k1, d1, k2, d2, cv::Size(1, 1), r, t, e, f,
+            cv::CALIB_USE_INTRINSIC_GUESS | (fix_k3 ? cv::CALIB_FIX_K3 : 0),
+            cv::TermCriteria(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 200, 1e-12));
     } catch (const cv::Exception &ex) {
         fprintf(stderr, "calibrate: OpenCV: %s\n", ex.what());
         return -EDOM;
@@ -264,9 +270,8 @@ extern "C" void calcv_rodrigues(const double rvec[3], double rot[9])
         rot[i] = r.at<double>(i / 3, i % 3);
 }
 
-extern "C" void calcv_pose_through(const double rvec[3], const double tvec[3],
-                                   const double rot[9], const double trans[3], double rvec_out[3],
-                                   double tvec_out[3])
+extern "C" void calcv_pose_through(const double rvec[3], const double tvec[3], const double rot[9],
+                                   const double trans[3], double rvec_out[3], double tvec_out[3])
 {
     cv::Vec3d r2, r3, t3;
     cv::Rodrigues(cv::Matx33d(rot), r2);

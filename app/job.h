@@ -1,0 +1,108 @@
+/* The parts of a scan job (scan_job.h is its public face) and what they share: the job's state,
+ * passed to each part by pointer. A view is always named by its number (job_view_dir gives its
+ * folder); nothing remembers "the current view" between calls.
+ *   job.c          state, clocks, the output directory, a failed write said once
+ *   job_events.c   events (scan_events.h), the time left, stages, cost, summary and report
+ *   job_live.c     on the rig: homing, each view taken and processed while the table turns
+ *   job_model.c    registration, reflectance fit, fusion, the mesh's four files
+ *   job_offline.c  settings of a kept scan, resume, process from the kept frames */
+#ifndef JOB_H
+#define JOB_H
+
+#include "scan_events.h"
+#include "scan_job.h"
+
+#include <stddef.h>
+#include <stdint.h>
+
+#define JOB_MAX_STAGES 8u
+
+struct pending;
+
+struct job {
+    const struct hal *hal;
+    const struct app_config *cfg;
+    const struct scan_calib *calib;
+    const struct scan_job_opts *opts;
+    const char *out_dir;
+    uint32_t views;
+    double start_ms;
+    double start_cpu_s, start_sim_cpu_s; /* the process's CPU, and the simulator's part of it */
+    double start_thread_cpu_s;           /* this (the rig's) thread's CPU */
+    double views_cpu_s, last_view_cpu_s; /* the threads that processed views, and the last */
+    uint64_t start_rig_us;               /* the rig's clock (the simulator's: the modelled rig's) */
+    int tty;
+    struct reg_ctx *reg;       /* the registration of the job's views (job.c keeps the one) */
+    struct reflect_pool *pool; /* [colour] method = fit: the reflectance (job.c keeps it) */
+    struct pending *pending;   /* the view processed while the table turns, or NULL */
+    struct eta {               /* views finished of the current run, and when */
+        uint32_t first_done, last_done;
+        double first_ms, last_ms;
+    } eta;
+    struct stages { /* when each stage ended (summary.ini), in the order they first did */
+        const char *name[JOB_MAX_STAGES];
+        double end_s[JOB_MAX_STAGES];
+        unsigned n;
+    } stages;
+};
+
+/* ---- job.c ---- */
+double job_wall_ms(void);
+/** Now, UTC, as 2026-12-03T08:00:00Z. */
+void job_utc_now(char *buf, size_t len);
+void job_init(struct job *j, const struct hal *hal, const struct app_config *cfg,
+              const struct scan_calib *calib, const struct scan_job_opts *opts,
+              const char *out_dir);
+/** The CPU the scanner spent since the job began, the simulator's rendering (@p sim_s, out)
+ *  left out. */
+double job_own_cpu_s(const struct job *j, double *sim_s);
+/** The process's peak resident memory, MB. */
+double job_peak_memory_mb(void);
+/** View @p v's folder in the output directory. */
+void job_view_dir(const struct job *j, uint32_t v, char *buf, size_t len);
+/** A write of @p name into @p dir (or view @p v's folder) that failed, said once.
+ *  @retval @p rc */
+int job_write_failed_at(const struct job *j, const char *dir, const char *name, int rc);
+int job_write_failed(const struct job *j, uint32_t v, const char *name, int rc);
+/** View @p v's folder made. @retval 0 @retval -errno (said) */
+int job_make_view_dir(const struct job *j, uint32_t v);
+/** Lock the output directory (checked by @p mode) and sweep what a kill left there.
+ *  @retval 0 @retval -errno (said) */
+int job_open_out(struct job *j, enum scan_dir_mode mode, int *lock_fd);
+
+/* ---- job_events.c ---- */
+/** One event (scan_events.h) with its numbers as JSON fields too (@p fields: '"name":value,...'
+ *  or NULL). @p view < 0: not about a view. @p done: views finished so far, for the estimate. */
+void job_progress_with(struct job *j, const char *event, int view, uint32_t done,
+                       const char *fields, const char *detail);
+void job_progress(struct job *j, const char *event, int view, uint32_t done, const char *detail);
+/** The end of a job that made its model: what it cost (EV_COST, "@p what N s CPU ..."),
+ *  summary.ini and report.html (@p command: "scan" or "processing"), then @p event (EV_SCAN_DONE,
+ *  EV_PROCESS_DONE) saying where the results are. */
+void job_finished(struct job *j, const char *what, const char *command, const char *event);
+
+/* ---- job_live.c ---- */
+/** "N points at A deg -> DIR" of a view. */
+void job_describe(char *buf, size_t len, const struct scan_view_info *info, const char *dir);
+int job_start_storage(const struct job *j);
+/** Home the table, then take views @p first .. the last. @retval 0 @retval the first error */
+int job_home_and_take_views(struct job *j, uint32_t first);
+
+/* ---- job_model.c ---- */
+/** Before the first view: the registration sized for the scan's views. */
+int job_begin_model(struct job *j);
+/** Once every view is in: registration, reflectance, fusion, the mesh. */
+int job_make_model(struct job *j, const char *scan_dir);
+
+/* ---- job_offline.c ---- */
+/** Frame @p f of view @p v read from @p scan_dir into the firmware's buffer for it. */
+int job_read_into_buffer(const char *scan_dir, uint32_t v, uint32_t f, uint32_t channels,
+                         const struct scan_params *params, uint8_t **pixels, char *err,
+                         size_t err_len);
+/** View @p v as the model is made of it: its range.bin, else decoded from its frames. */
+int job_load_range(struct job *j, const char *scan_dir, uint32_t v, struct scan_view *view,
+                   struct scan_view_info *info);
+/** -EINTR (said) when a stop was asked for between views of offline work. */
+int job_stopped_offline(struct job *j, const char *scan_dir, uint32_t v);
+
+#endif

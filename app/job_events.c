@@ -1,0 +1,229 @@
+/* A scan job's events (job.h): a status line on a terminal, plain lines in a log, JSON for a
+ * front end (scan_events.h names them), the estimate of the time left, the stages' times, what
+ * the job cost, and summary.ini and report.html at its end. */
+#define _POSIX_C_SOURCE 200809L
+#include "job.h"
+
+#include "clock_posix.h"
+#include "frame_writer.h"
+#include "report.h"
+
+#include <errno.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <string.h>
+
+/* What the job cost: the rig's time (with the simulator, the modelled rig's: its turntable and
+ * frame rate) and the CPU the scanner spent, the simulator's rendering left out, split by what
+ * delays the scan (in line with the rig) and what runs beside it. make bench reads this line. */
+static void job_report_cost(struct job *j, const char *what)
+{
+    uint64_t now_us = j->start_rig_us;
+    hal_clock_now_us(&j->hal->clock, &now_us);
+    double sim, own = job_own_cpu_s(j, &sim);
+    uint32_t views = j->views ? j->views : 1;
+    char detail[400];
+    if (j->views_cpu_s <= 0.0) { /* offline: one thread */
+        char fields[96];
+        snprintf(detail, sizeof(detail), "%s %.2f s CPU for %u views (%.3f s a view)", what, own,
+                 (unsigned)j->views, own / views);
+        snprintf(fields, sizeof(fields), "\"cpu_s\":%.3f,\"cpu_per_view_s\":%.4f", own,
+                 own / views);
+        job_progress_with(j, EV_COST, -1, j->views, fields, detail);
+        return;
+    }
+    /* In line with the rig: this thread's work between its moves and captures, and the last
+     * view's processing (the others ran while the table turned) */
+    double in_line = clock_posix_thread_cpu_s() - j->start_thread_cpu_s - sim + j->last_view_cpu_s;
+    int n = snprintf(detail, sizeof(detail),
+                     "%s %.2f s CPU for %u views (%.3f s a view: storing frames %.2f s, "
+                     "processing views as the table turned %.2f s, in line with the rig %.2f s)",
+                     what, own, (unsigned)j->views, own / views, frame_writer_cpu_s(),
+                     j->views_cpu_s - j->last_view_cpu_s, in_line);
+    double rig_s = (double)(now_us - j->start_rig_us) / 1e6;
+    if (sim > 0.0 && n > 0 && (size_t)n < sizeof(detail))
+        snprintf(detail + n, sizeof(detail) - (size_t)n,
+                 ", the simulator's rendering (%.2f s) left out; %.1f s on the rig's clock", sim,
+                 rig_s);
+    char fields[256];
+    snprintf(fields, sizeof(fields),
+             "\"cpu_s\":%.3f,\"cpu_per_view_s\":%.4f,\"storage_cpu_s\":%.3f,"
+             "\"in_line_cpu_s\":%.3f,\"simulator_cpu_s\":%.3f,\"rig_s\":%.2f",
+             own, own / views, frame_writer_cpu_s(), in_line, sim, rig_s);
+    job_progress_with(j, EV_COST, -1, j->views, fields, detail);
+}
+
+static void json_string(FILE *out, const char *s)
+{
+    fputc('"', out);
+    for (; *s != '\0'; s++) {
+        if (*s == '"' || *s == '\\')
+            fprintf(out, "\\%c", *s);
+        else if ((unsigned char)*s < 0x20)
+            fprintf(out, "\\u%04x", (unsigned)(unsigned char)*s);
+        else
+            fputc(*s, out);
+    }
+    fputc('"', out);
+}
+
+/* @retval 1 for the event that ends a view's line (taken live; fused into the model). */
+static int view_finished(const char *event)
+{
+    return strcmp(event, EV_SAVED) == 0 || strcmp(event, EV_FUSED) == 0;
+}
+
+/* Seconds left of the current run of views (taken live, decoded, or fused after the
+ * registration): the measured time a view takes (from the first finished view of the run to the
+ * last, so that homing and start-up do not count) times the views left, less the time already
+ * spent since the last one finished. -1 until a view's time is known. Only the events that
+ * finish a view move it; @p done: views finished of the run. */
+static double time_left_s(struct job *j, const char *event, uint32_t done, double now_ms)
+{
+    struct eta *e = &j->eta;
+    int finishes = view_finished(event) || strcmp(event, EV_DECODED) == 0;
+    if (finishes && done < e->last_done) /* a new run of views (the fusion after the capture) */
+        e->first_done = e->last_done = 0;
+    if (finishes && done > e->last_done) {
+        if (e->first_done == 0) {
+            e->first_done = done;
+            e->first_ms = now_ms;
+        }
+        e->last_done = done;
+        e->last_ms = now_ms;
+    }
+    if (e->last_done >= j->views)
+        return 0.0;
+    if (e->first_done == 0 || e->last_done == e->first_done)
+        return -1.0;
+    double per_view_ms = (e->last_ms - e->first_ms) / (e->last_done - e->first_done);
+    double left_ms = per_view_ms * (j->views - e->last_done) - (now_ms - e->last_ms);
+    return left_ms > 0.0 ? left_ms / 1000.0 : 0.0;
+}
+
+/* The stage an event ends, if it ends one: the views taken (live) or decoded (process), then
+ * the registration, the reflectance fit, the fusion (which meshing follows), the mesh. */
+static void stage_ended(struct job *j, const char *event, double elapsed_s)
+{
+    static const char *const ends[][2] = {{EV_SAVED, "capture"},
+                                          {EV_DECODED, "decoding"},
+                                          {EV_REGISTRATION, "registration"},
+                                          {EV_REFLECTANCE, "reflectance fit"},
+                                          {EV_MESHING, "fusion"},
+                                          {EV_MESH, "meshing"}};
+    struct stages *st = &j->stages;
+    for (size_t k = 0; k < sizeof(ends) / sizeof(ends[0]); k++) {
+        if (strcmp(event, ends[k][0]) != 0)
+            continue;
+        unsigned i = 0;
+        while (i < st->n && st->name[i] != ends[k][1])
+            i++;
+        if (i == st->n && st->n < JOB_MAX_STAGES)
+            st->name[st->n++] = ends[k][1];
+        if (i < st->n)
+            st->end_s[i] = elapsed_s;
+    }
+}
+
+static void progress_line(struct job *j, const char *event, int view, uint32_t done,
+                          const char *fields, const char *detail)
+{
+    double now = job_wall_ms(), elapsed_s = (now - j->start_ms) / 1000.0;
+    double left_s = time_left_s(j, event, done, now);
+    stage_ended(j, event, elapsed_s);
+    if (j->opts->json) {
+        printf("{\"event\":\"%s\",\"view\":%d,\"views\":%u,\"views_done\":%u,"
+               "\"elapsed_s\":%.1f,\"left_s\":%.1f,%s%s\"detail\":",
+               event, view, (unsigned)j->views, (unsigned)done, elapsed_s, left_s,
+               fields != NULL ? fields : "", fields != NULL ? "," : "");
+        json_string(stdout, detail);
+        printf("}\n");
+    } else if (j->tty && view >= 0) {
+        /* one status line, rewritten in place; a finished view keeps its line, without the path */
+        const char *arrow = NULL; /* the last " -> " introduces the path */
+        for (const char *a = strstr(detail, " -> "); a != NULL; a = strstr(a + 1, " -> "))
+            arrow = a;
+        int shown = arrow != NULL ? (int)(arrow - detail) : (int)strlen(detail);
+        printf("\r\033[Kview %d/%u %4.0f s", view + 1, (unsigned)j->views, elapsed_s);
+        if (left_s >= 0)
+            printf(" (~%.0f s left)", left_s);
+        printf("  %s %.*s", event, shown, detail);
+        if (view_finished(event))
+            printf("\n");
+    } else if (view >= 0 && view_finished(event)) {
+        printf("view %d of %u: %s\n", view + 1, (unsigned)j->views, detail);
+    } else if (view < 0) {
+        static const char *const human[][2] = {
+            {EV_SCAN_START, "scanning into"},   {EV_SCAN_DONE, "scan finished:"},
+            {EV_SCAN_FAILED, "scan failed:"},   {EV_PROCESS_START, "processing"},
+            {EV_REGISTRATION, "registration:"}, {EV_COST, "cost:"},
+            {EV_PLACE_OBJECT, ">>>"},           {EV_PROCESS_DONE, "process finished:"}};
+        const char *text = event;
+        for (size_t k = 0; k < sizeof(human) / sizeof(human[0]); k++)
+            if (strcmp(event, human[k][0]) == 0)
+                text = human[k][1];
+        printf("%s %s\n", text, detail);
+    }
+    fflush(stdout);
+}
+
+/* One event with its numbers as JSON fields too (@p fields: '"name":value,...' or NULL, for
+ * --json). @p view < 0: not about a view. @p done: views finished so far, for the estimate. */
+void job_progress_with(struct job *j, const char *event, int view, uint32_t done,
+                       const char *fields, const char *detail)
+{
+    /* a line at a time: a view is saved by its own thread while the next is taken */
+    static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
+    pthread_mutex_lock(&lock);
+    progress_line(j, event, view, done, fields, detail);
+    pthread_mutex_unlock(&lock);
+}
+
+void job_progress(struct job *j, const char *event, int view, uint32_t done, const char *detail)
+{
+    job_progress_with(j, event, view, done, NULL, detail);
+}
+
+/* Where the results are, and the peak memory. */
+static const char *job_finished_detail(struct job *j, char *buf, size_t len)
+{
+    snprintf(buf, len, "%s (mesh: %s/mesh.ply, mesh.obj, mesh.stl, mesh.glb; peak memory %.1f MB)",
+             j->out_dir, j->out_dir, job_peak_memory_mb());
+    return buf;
+}
+
+/* summary.ini (what report.html shows of the job: its stages, time and memory), then
+ * report.html. Neither is the scan's result: a failure is said and the job goes on. */
+static void job_write_summary_and_report(struct job *j, const char *command)
+{
+    char text[1024], path[SCAN_DIR_PATH_MAX], finished[32], err[SCAN_DIR_PATH_MAX + 64];
+    job_utc_now(finished, sizeof(finished));
+    double sim, cpu = job_own_cpu_s(j, &sim);
+    int n = snprintf(text, sizeof(text),
+                     "; what the %s took, for report.html (docs/scan-format.md)\n[summary]\n"
+                     "command = %s\nfinished = %s\nviews = %u\nelapsed_s = %.1f\n"
+                     "cpu_s = %.2f\npeak_memory_mb = %.1f\n[stages]\n; seconds from the start "
+                     "at which each stage ended\n",
+                     command, command, finished, (unsigned)j->views,
+                     (job_wall_ms() - j->start_ms) / 1000.0, cpu, job_peak_memory_mb());
+    for (unsigned i = 0; i < j->stages.n && n > 0 && (size_t)n < sizeof(text); i++)
+        n += snprintf(text + n, sizeof(text) - (size_t)n, "%s = %.1f\n", j->stages.name[i],
+                      j->stages.end_s[i]);
+    int rc = n > 0 && (size_t)n < sizeof(text) ? 0 : -EOVERFLOW;
+    if (rc == 0)
+        rc = scan_dir_path(path, sizeof(path), j->out_dir, -1, "summary.ini");
+    if (rc == 0)
+        rc = hal_storage_write_file(&j->hal->storage, path, text, (size_t)n);
+    if (rc != 0)
+        j->hal->log(HAL_LOG_WARN, "cannot write %s/summary.ini: %s", j->out_dir, strerror(-rc));
+    if (report_write(&j->hal->storage, j->out_dir, err, sizeof(err)) != 0)
+        j->hal->log(HAL_LOG_WARN, "cannot write the report: %s", err);
+}
+
+void job_finished(struct job *j, const char *what, const char *command, const char *event)
+{
+    char path[HAL_MAX_PATH + 32];
+    job_report_cost(j, what);
+    job_write_summary_and_report(j, command);
+    job_progress(j, event, -1, j->views, job_finished_detail(j, path, sizeof(path)));
+}

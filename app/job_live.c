@@ -1,0 +1,400 @@
+/* A scan job on the rig (job.h): home the table, take each view and process it while the table
+ * turns to the next, the second pass, and the folder a new scan goes to. */
+#define _POSIX_C_SOURCE 200809L
+#include "job.h"
+
+#include "board.h"
+#include "clock_posix.h"
+#include "frame_writer.h"
+#include "thread_posix.h"
+
+#include <errno.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <string.h>
+#include <unistd.h>
+
+/* A captured view, processed and saved by a thread of its own while the table turns to the next
+ * view (the firmware is used by one thread at a time: the next capture waits for it). */
+struct pending {
+    struct job *j;
+    pthread_t thread;
+    uint32_t view;
+    char view_dir[SCAN_DIR_PATH_MAX];
+    char started[32];
+    double t0_ms;
+    struct scan_view_info info;
+    int rc;
+    double cpu_s; /* its thread's CPU */
+};
+
+/* Frames a scan keeps ([output] keep_frames): "colour" keeps the white pattern (the colour of
+ * method none, the white of the others), the light frames and an HDR scan's colour frame. */
+static int keeps_frame(const struct job *j, uint32_t frame)
+{
+    if (j->cfg->keep_frames != KEEP_FRAMES_COLOUR)
+        return j->cfg->keep_frames == KEEP_FRAMES_ALL;
+    return scan_frame_channels(&j->cfg->scan, j->calib, frame) == 3;
+}
+
+/* The view being captured, for the frame sink: its frames go to its folder. */
+struct capture {
+    struct job *j;
+    uint32_t view;
+    char dir[SCAN_DIR_PATH_MAX];
+};
+
+/* A frame goes to the storage thread; a write of an earlier frame that failed is said here,
+ * once, with its file. */
+static int save_frame(void *priv, uint32_t pattern, const uint8_t *pixels, uint32_t width,
+                      uint32_t height, uint32_t channels)
+{
+    const struct capture *c = priv;
+    const struct job *j = c->j;
+    char failed[SCAN_DIR_PATH_MAX] = "";
+    if (!keeps_frame(j, pattern))
+        return 0;
+    int rc = frame_writer_put(j->out_dir, c->view, pattern, pixels, width, height, channels,
+                              (enum scan_frame_format)j->cfg->frame_format, failed, sizeof(failed));
+    if (rc != 0)
+        j->hal->log(HAL_LOG_ERROR, "cannot write %s: %s", failed[0] ? failed : c->dir,
+                    strerror(-rc));
+    return rc;
+}
+
+/* Every frame of the view on disk (before its view.ini); a failed write said once. */
+static int flush_frames(const struct job *j)
+{
+    char failed[SCAN_DIR_PATH_MAX] = "";
+    int rc = frame_writer_flush(failed, sizeof(failed));
+    if (rc != 0)
+        j->hal->log(HAL_LOG_ERROR, "cannot write %s: %s", failed, strerror(-rc));
+    return rc;
+}
+
+void scan_job_view_meta(const struct app_config *cfg, const struct scan_params *params,
+                        const struct scan_calib *calib, uint32_t view,
+                        const struct scan_view_info *info, struct scan_dir_view *v)
+{
+    memset(v, 0, sizeof(*v));
+    v->index = view;
+    v->angle_mdeg = info->angle_mdeg;
+    v->frames = info->frames_captured;
+    v->capture_retries = info->capture_retries;
+    v->valid_points = info->valid_points;
+    v->exposure_us = cfg->camera.exposure_us;
+    v->gain_milli = cfg->camera.gain_milli;
+    scan_dir_describe_frames(params, calib, v);
+    memcpy(v->reason_count, info->reason_count, sizeof(v->reason_count));
+}
+
+static int write_view_meta(const struct pending *p, double ms)
+{
+    static struct scan_dir_view v; /* large; one view at a time */
+    const struct job *j = p->j;
+    scan_job_view_meta(j->cfg, &j->cfg->scan, j->calib, p->view, &p->info, &v);
+    snprintf(v.started, sizeof(v.started), "%s", p->started);
+    job_utc_now(v.finished, sizeof(v.finished));
+    v.wall_ms = ms;
+    return job_write_failed_at(j, p->view_dir, "view.ini",
+                               scan_dir_write_view(&j->hal->storage, j->out_dir, p->view, &v));
+}
+
+void job_describe(char *buf, size_t len, const struct scan_view_info *info, const char *dir)
+{
+    snprintf(buf, len, "%u points at %.1f deg -> %s", (unsigned)info->valid_points,
+             info->angle_mdeg / 1000.0, dir);
+}
+
+/* "the N finished views are kept in DIR: scanner resume DIR[ extra] takes the rest" */
+static const char *kept_views(const struct job *j, uint32_t v, const char *extra, char *buf,
+                              size_t len)
+{
+    snprintf(buf, len, "the %u finished views are kept in %s: 'scanner resume %s%s' takes the rest",
+             (unsigned)v, j->out_dir, j->out_dir, extra);
+    return buf;
+}
+
+/* The table did not get to view @p v. The turntable client has said why (the error, once);
+ * this says what is kept and how to go on, which depends on whether an alarm blocks the table. */
+static void table_failed(const struct job *j, uint32_t v, int32_t target_mdeg)
+{
+    const struct hal *hal = j->hal;
+    struct hal_turntable_status st;
+    char kept[2 * HAL_MAX_PATH + 96];
+    if (hal_table_get_status(&hal->turntable, &st) == 0 && st.alarm_code != 0)
+        hal->log(HAL_LOG_WARN,
+                 "view %u was not taken at %.3f deg: the table stopped at %.3f deg with alarm %u; "
+                 "once it turns freely, %s",
+                 (unsigned)v, target_mdeg / 1000.0, st.position_mdeg / 1000.0,
+                 (unsigned)st.alarm_code, kept_views(j, v, " --clear-alarm", kept, sizeof(kept)));
+    else
+        hal->log(HAL_LOG_WARN, "view %u was not taken at %.3f deg; %s", (unsigned)v,
+                 target_mdeg / 1000.0, kept_views(j, v, "", kept, sizeof(kept)));
+}
+
+/* A view that will not be complete: said once, with what is kept and how to go on. */
+static void view_not_finished(const struct job *j, uint32_t v, int32_t angle_mdeg, int rc)
+{
+    char kept[2 * HAL_MAX_PATH + 96];
+    j->hal->log(HAL_LOG_WARN, "view %u at %.3f deg was not finished (%s); %s", (unsigned)v,
+                angle_mdeg / 1000.0, rc == -EINTR ? "stopped by request" : strerror(-rc),
+                kept_views(j, v, "", kept, sizeof(kept)));
+}
+
+/* Decode a captured view, keep its frames and range image, then its view.ini last (its
+ * presence says the view is complete). @retval 0 @retval -errno (said) */
+static int save_view(struct pending *p)
+{
+    struct job *j = p->j;
+    const struct hal *hal = j->hal;
+    struct scan_view view;
+    char detail[HAL_MAX_PATH + 160], fields[96];
+    int rc = scan_finish_view(j->calib, p->info.angle_mdeg, &view, &p->info);
+    int rc_frames = flush_frames(j); /* nothing writes into the view's directory after this */
+    if (rc == 0)
+        rc = rc_frames;
+    if (rc != 0) { /* the layer that met the fault has said what it was */
+        view_not_finished(j, p->view, p->info.angle_mdeg, rc);
+        return rc;
+    }
+    job_progress(j, EV_SAVING, (int)p->view, p->view, "");
+    rc = scan_keep_for_registration(j->reg, p->view,
+                                    &view); /* the model is made once every view is in */
+    if (rc == 0) /* what the model is made of, so that it is not decoded again */
+        rc = job_write_failed_at(j, p->view_dir, "range.bin",
+                                 scan_dir_write_range(&hal->storage, j->out_dir, p->view, &view));
+    if (rc == 0)
+        rc = write_view_meta(p, job_wall_ms() - p->t0_ms);
+    if (rc != 0)
+        return rc;
+    job_describe(detail, sizeof(detail), &p->info, p->view_dir);
+    snprintf(fields, sizeof(fields), "\"points\":%u,\"angle_deg\":%.3f",
+             (unsigned)p->info.valid_points, p->info.angle_mdeg / 1000.0);
+    job_progress_with(j, EV_SAVED, (int)p->view, p->view + 1, fields, detail);
+    return 0;
+}
+
+/* The thread of a captured view: save_view, its result and CPU kept for finish_pending. */
+static void *process_view(void *arg)
+{
+    struct pending *p = arg;
+    double t0 = clock_posix_thread_cpu_s();
+    p->rc = save_view(p);
+    p->cpu_s = clock_posix_thread_cpu_s() - t0;
+    return NULL;
+}
+
+/* The view processed: its result, its CPU counted. @retval its error (said already) */
+static int view_processed(struct job *j, const struct pending *p)
+{
+    j->views_cpu_s += p->cpu_s;
+    j->last_view_cpu_s = p->cpu_s;
+    return p->rc;
+}
+
+/* Wait for the view being processed, if any. @retval 0 @retval its error (said already) */
+static int finish_pending(struct job *j)
+{
+    if (j->pending == NULL)
+        return 0;
+    pthread_join(j->pending->thread, NULL);
+    int rc = view_processed(j, j->pending);
+    j->pending = NULL;
+    return rc;
+}
+
+/* Process the view just captured on a thread of its own, so that the table turns meanwhile;
+ * without a thread, here. @retval 0 @retval what processing it met */
+static int start_processing(struct job *j, uint32_t v, const char *started, double t0_ms,
+                            const struct scan_view_info *info)
+{
+    static struct pending p; /* one at a time */
+    p = (struct pending){.j = j, .view = v, .t0_ms = t0_ms, .info = *info};
+    job_view_dir(j, v, p.view_dir, sizeof(p.view_dir));
+    snprintf(p.started, sizeof(p.started), "%s", started);
+    int rc = thread_posix_start(&p.thread, 0, process_view, &p);
+    if (rc == 0) {
+        j->pending = &p;
+        return 0;
+    }
+    j->hal->log(HAL_LOG_WARN,
+                "cannot start a thread (%s): view %u is processed before the "
+                "table turns",
+                strerror(-rc), (unsigned)v);
+    process_view(&p);
+    return view_processed(j, &p);
+}
+
+static int live_view(struct job *j, uint32_t v)
+{
+    const struct hal *hal = j->hal;
+    uint32_t k = v % j->cfg->views; /* the view's place in its pass */
+    int32_t target = (int32_t)((j->cfg->start_angle_deg + 360.0 * k / j->cfg->views) * 1000.0);
+    char detail[HAL_MAX_PATH + 160], started[32];
+    snprintf(detail, sizeof(detail), "to %.1f deg", target / 1000.0);
+    job_progress(j, EV_MOVING, (int)v, v, detail);
+    int rc = hal_table_move_to(&hal->turntable, target);
+    struct hal_turntable_status st;
+    if (rc == 0)
+        rc = hal_table_get_status(&hal->turntable, &st); /* the angle the controller reports */
+    int rc_before = finish_pending(j); /* the view before, processed while the table turned */
+    if (rc_before != 0)
+        return rc_before;
+    if (rc != 0) {
+        table_failed(j, v, target);
+        return rc;
+    }
+    static struct capture c; /* one view at a time; the frame sink's, while it is taken */
+    c = (struct capture){.j = j, .view = v};
+    job_view_dir(j, v, c.dir, sizeof(c.dir));
+    rc = scan_dir_begin_view(&hal->storage, j->out_dir, v); /* no view.ini of an earlier take */
+    if (rc != 0) {
+        hal->log(HAL_LOG_ERROR, "cannot prepare %s: %s", c.dir, strerror(-rc));
+        return rc;
+    }
+    job_utc_now(started, sizeof(started));
+    job_progress(j, EV_CAPTURING, (int)v, v, "");
+    struct scan_frame_sink sink = {save_frame, &c};
+    struct scan_view_info info;
+    double t0 = job_wall_ms();
+    rc = scan_capture_view(hal, &j->cfg->scan, j->calib, st.position_mdeg, &sink, &info);
+    /* the simulator's truth of this view while the table is still at its angle */
+    if (rc == 0)
+        rc = job_write_failed_at(j, c.dir, "(the simulator's truth)",
+                                 board_write_view_extras(hal, c.dir));
+    if (rc != 0) {       /* the layer that met the fault has said what it was */
+        flush_frames(j); /* nothing writes into the view's directory after this */
+        view_not_finished(j, v, st.position_mdeg, rc);
+        return rc;
+    }
+    return start_processing(j, v, started, t0, &info);
+}
+
+/* The person lays the object for the second pass (the simulated person does it at once).
+ * @retval 0 @retval -EINTR the person stopped (Ctrl-D) @retval -errno */
+static int ask_for_second_pass(struct job *j)
+{
+    char err[256];
+    const char *detail = "pass 2 of 2: lay the object on its side (another way than before), "
+                         "near the middle of the table";
+    struct board_target t = {.kind = BOARD_TARGET_OBJECT, .pass = 2};
+    job_progress(j, EV_PLACE_OBJECT, -1, 0, detail);
+    int rc = board_place_target((struct hal *)j->hal, &t, err, sizeof(err));
+    if (rc == 0)
+        return 0;
+    if (rc != -ENOSYS) {
+        j->hal->log(HAL_LOG_ERROR, "%s", err);
+        return rc;
+    }
+    printf("%s; press Enter when it is done (Ctrl-D stops; the views so far are kept).\n", detail);
+    fflush(stdout);
+    char line[64];
+    return fgets(line, sizeof(line), stdin) == NULL || hal_should_stop(j->hal) ? -EINTR : 0;
+}
+
+/* The storage thread that keeps the frames while the next are taken. */
+int job_start_storage(const struct job *j)
+{
+    int rc = frame_writer_start(&j->hal->storage);
+    if (rc != 0)
+        j->hal->log(HAL_LOG_ERROR, "cannot start the storage thread: %s", strerror(-rc));
+    return rc;
+}
+
+/* Home the table, then take views @p first .. the last, each processed and saved while the
+ * table turns to the next; a two-pass scan asks for the object to be laid for the second pass
+ * (the first pass saved), and homes again. */
+int job_home_and_take_views(struct job *j, uint32_t first)
+{
+    const struct hal *hal = j->hal;
+    int rc = 0;
+    if (j->cfg->passes == 2 && first >= j->cfg->views) /* resumed in the second pass */
+        rc = ask_for_second_pass(j);
+    if (rc == 0)
+        job_progress(j, EV_HOMING, (int)first, first, "");
+    if (rc == 0 && j->opts->clear_alarm && (rc = hal_table_clear_alarm(&hal->turntable)) == -ENOSYS)
+        hal->log(HAL_LOG_ERROR, "this turntable cannot clear its alarm over its link: clear it "
+                                "at the controller, then resume without --clear-alarm");
+    if (rc == 0 && (rc = hal_table_home(&hal->turntable)) != 0) /* the client said why */
+        hal->log(HAL_LOG_WARN, "the turntable did not home%s",
+                 j->opts->clear_alarm ? "" : " (if it reports an alarm: --clear-alarm)");
+    for (uint32_t v = first; v < j->views && rc == 0; v++) {
+        if (v == j->cfg->views && v != first) { /* the second pass begins */
+            rc = finish_pending(j);
+            if (rc == 0)
+                rc = ask_for_second_pass(j);
+            if (rc == 0 && (rc = hal_table_home(&hal->turntable)) != 0)
+                hal->log(HAL_LOG_WARN, "the turntable did not home for the second pass");
+        }
+        if (rc == 0)
+            rc = live_view(j, v);
+    }
+    int rc_last = finish_pending(j); /* on every path: a captured view is always saved */
+    return rc != 0 ? rc : rc_last;
+}
+
+/* [output] dir/latest: a link to the newest scan's folder, replaced atomically. A convenience:
+ * a failure is said and the scan goes on. */
+static void link_latest(const struct hal *hal, const char *parent, const char *name)
+{
+    char link[HAL_MAX_PATH + 16], temp[HAL_MAX_PATH + 32];
+    snprintf(link, sizeof(link), "%s/latest", parent);
+    snprintf(temp, sizeof(temp), "%s/.latest.%ld", parent, (long)getpid());
+    unlink(temp);
+    if (symlink(name, temp) != 0 || rename(temp, link) != 0) {
+        hal->log(HAL_LOG_WARN, "cannot point %s at %s: %s", link, name, strerror(errno));
+        unlink(temp);
+    }
+}
+
+int scan_job_live(const struct hal *hal, const struct app_config *cfg,
+                  const struct scan_calib *calib, const struct scan_job_opts *opts)
+{
+    static char auto_dir[HAL_MAX_PATH + 32];
+    const char *name = NULL;
+    if (opts->out_dir == NULL) {
+        int rc = hal_storage_mkdir_p(&hal->storage, cfg->output_dir);
+        if (rc == 0)
+            rc = scan_dir_make_new(cfg->output_dir, auto_dir, sizeof(auto_dir), &name);
+        if (rc != 0) {
+            hal->log(HAL_LOG_ERROR, "cannot name a new scan folder in %s: %s", cfg->output_dir,
+                     strerror(-rc));
+            return rc;
+        }
+    }
+    struct job j;
+    job_init(&j, hal, cfg, calib, opts, opts->out_dir ? opts->out_dir : auto_dir);
+    int lock_fd;
+    int rc = job_open_out(&j, opts->replace ? SCAN_DIR_REPLACE : SCAN_DIR_NEW, &lock_fd);
+    if (rc != 0)
+        return rc;
+    if (name != NULL)
+        link_latest(hal, cfg->output_dir, name);
+    rc = scan_dir_keep_settings(&hal->storage, cfg->path, cfg->calibration_file, j.out_dir);
+    if (rc != 0) {
+        hal->log(HAL_LOG_ERROR, "cannot set up the scan directory %s: %s", j.out_dir,
+                 strerror(-rc));
+        goto out_unlock;
+    }
+    rc = job_begin_model(&j);
+    if (rc == 0)
+        rc = job_write_failed_at(&j, j.out_dir, "(the simulator's truth)",
+                                 board_write_scan_extras(hal, j.out_dir));
+    if (rc != 0)
+        goto out_unlock;
+    job_progress(&j, EV_SCAN_START, -1, 0, j.out_dir);
+    rc = job_start_storage(&j);
+    if (rc == 0)
+        rc = job_home_and_take_views(&j, 0);
+    frame_writer_stop();
+    if (rc == 0)
+        rc = job_make_model(&j, j.out_dir);
+    if (rc == 0)
+        job_finished(&j, "the scan", "scan", EV_SCAN_DONE);
+    else if (opts->json)
+        job_progress(&j, EV_SCAN_FAILED, -1, 0, strerror(-rc));
+out_unlock:
+    scan_dir_close(lock_fd);
+    return rc;
+}

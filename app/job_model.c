@@ -1,0 +1,289 @@
+/* A scan job's model (job.h): once every view is in, the joint registration, the reflectance
+ * fit, each view fused at its registered pose, and the mesh in its four formats. */
+#define _POSIX_C_SOURCE 200809L
+#include "job.h"
+
+#include "clock_posix.h"
+#include "fusion.h"
+#include "gray.h"
+#include "reflect.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <string.h>
+
+/* Results of processed view @p v once the scan is registered: its registration.ini, its point
+ * cloud and its part of the fused model, all at the registered pose. @p rv: out, the view's
+ * part of the registration. */
+static int save_results(struct job *j, uint32_t v, const struct scan_view *view,
+                        const struct reg_report *rep, struct reg_view *rv)
+{
+    char path[HAL_MAX_PATH + 64];
+    struct frame_xform pose;
+    int rc = reg_view_pose(j->reg, v, &pose, rv);
+    if (rc == 0)
+        rc = job_write_failed(
+            j, v, "registration.ini",
+            scan_dir_write_registration(&j->hal->storage, j->out_dir, v, rep, rv, &pose));
+    if (rc == 0)
+        rc = scan_dir_path(path, sizeof(path), j->out_dir, (int)v, "cloud.ply");
+    if (rc == 0)
+        rc = scan_save_cloud(j->hal, view, &pose, path); /* says what failed itself */
+    if (rc == 0)
+        rc = scan_fuse_view(j->calib, view, &pose);
+    return rc;
+}
+
+/* The fused model: mesh.ply, mesh.obj, mesh.stl and mesh.glb in the scan directory, without
+ * floating fragments. */
+static int write_model(struct job *j)
+{
+    static const char *const names[] = {"mesh.ply", "mesh.obj", "mesh.stl", "mesh.glb"};
+    int (*const writers[])(const struct hal_storage *, const char *) = {
+        fusion_write_ply, fusion_write_obj, fusion_write_stl, NULL}; /* NULL: glb, below */
+    char path[SCAN_DIR_PATH_MAX], detail[HAL_MAX_PATH + 320];
+    struct mesh_summary ms;
+    uint32_t filled = 0, inside = 0;
+    job_progress(j, EV_MESHING, -1, j->views, "marching cubes");
+    int rc = fusion_fill_holes(j->cfg->max_hole_mm, &filled);
+    if (rc == 0 && j->cfg->watertight)
+        rc = fusion_close_watertight(j->cfg->max_hole_mm, j->cfg->passes == 1, &inside);
+    if (rc == 0)
+        rc = fusion_mesh_prepare(j->cfg->min_fragment_share, &ms);
+    int fits = rc == 0;
+    if (rc == -E2BIG)
+        j->hal->log(HAL_LOG_WARN,
+                    "the mesh has %u vertices, more than MESH_MAX_VERTICES (%u): it is written "
+                    "whole, fragments and all, and without mesh.stl and mesh.glb (a larger "
+                    "[fusion] voxel_mm "
+                    "makes a smaller mesh)",
+                    (unsigned)ms.vertices, MESH_MAX_VERTICES);
+    else if (rc != 0)
+        return rc;
+    rc = 0;
+    for (size_t k = 0; k < sizeof(names) / sizeof(names[0]) && rc == 0; k++) {
+        if (!fits && (writers[k] == fusion_write_stl || writers[k] == NULL))
+            continue;
+        rc = scan_dir_path(path, sizeof(path), j->out_dir, -1, names[k]);
+        if (rc == 0)
+            rc = writers[k] != NULL ? writers[k](&j->hal->storage, path)
+                                    : fusion_write_glb(&j->hal->storage, path,
+                                                       reflect_model(j->pool)); /* or matte */
+        if (rc != 0)
+            j->hal->log(HAL_LOG_ERROR, "cannot write %s: %s", path, strerror(-rc));
+    }
+    if (rc != 0)
+        return rc;
+    char closed[96] = "";
+    if (j->cfg->watertight)
+        snprintf(closed, sizeof(closed), ", closed watertight, %u unseen voxels made solid",
+                 (unsigned)inside);
+    char uncoloured[128] = "";
+    if (ms.colour_filled > 0 || ms.uncoloured > 0)
+        snprintf(uncoloured, sizeof(uncoloured),
+                 "; %u vertices no view could colour took their neighbours' colour, %u marked "
+                 "grey",
+                 (unsigned)ms.colour_filled, (unsigned)ms.uncoloured);
+    snprintf(detail, sizeof(detail),
+             "%u vertices, %u triangles (%u floating fragments of %u pieces left out; %u voxels "
+             "filled holes%s%s) -> %s/mesh.ply, mesh.obj%s",
+             (unsigned)ms.kept_vertices, (unsigned)ms.kept_triangles, (unsigned)ms.removed_pieces,
+             (unsigned)ms.pieces, (unsigned)filled, closed, uncoloured, j->out_dir,
+             fits ? ", mesh.stl and mesh.glb" : "");
+    char fields[192];
+    snprintf(fields, sizeof(fields),
+             "\"vertices\":%u,\"triangles\":%u,\"pieces_left_out\":%u,\"colour_filled\":%u,"
+             "\"uncoloured\":%u",
+             (unsigned)ms.kept_vertices, (unsigned)ms.kept_triangles, (unsigned)ms.removed_pieces,
+             (unsigned)ms.colour_filled, (unsigned)ms.uncoloured);
+    job_progress_with(j, EV_MESH, -1, j->views, fields, detail);
+    return 0;
+}
+
+/* Before the first view: the registration sized for the scan's views. */
+int job_begin_model(struct job *j)
+{
+    int rc = reg_begin(j->reg, &j->cfg->registration, j->calib, j->views, j->cfg->passes,
+                       j->cfg->scan.width, j->cfg->scan.height);
+    if (rc != 0)
+        j->hal->log(HAL_LOG_ERROR, "registration: %u views exceed the compiled limit %u",
+                    (unsigned)j->views, REG_MAX_VIEWS);
+    return rc;
+}
+
+/* The registration's one quality line, and a refused or failed one said plainly. */
+static int report_registration(struct job *j, const struct reg_report *r, double cpu_seconds,
+                               const char *scan_dir)
+{
+    char detail[512];
+    if (!r->solved)
+        snprintf(detail, sizeof(detail),
+                 "turntable angles kept ([registration] icp = 0 or one "
+                 "view)");
+    else
+        snprintf(detail, sizeof(detail),
+                 "residual %.3f mm, loop closure %.3f mm, worst view %u (%.3f mm); axis moved "
+                 "%.2f mm, tilted %.3f deg; %.2f s CPU; %s%s",
+                 r->rms_mm, r->loop_rms_mm, (unsigned)r->worst_view, r->worst_rms_mm,
+                 r->axis_shift_mm, r->axis_tilt_deg, cpu_seconds,
+                 r->accepted ? "the views' angles corrected" : "turntable angles kept: ",
+                 r->accepted ? "" : r->refused);
+    if (j->cfg->passes == 2 && r->failed_view < 0) {
+        size_t n = strlen(detail);
+        snprintf(detail + n, sizeof(detail) - n,
+                 "; second pass found turned %.1f deg, residual %.3f mm over %u pairs",
+                 r->second_turned_deg, r->second_rms_mm, (unsigned)r->second_coupled);
+    }
+    char fields[160];
+    snprintf(fields, sizeof(fields),
+             "\"solved\":%d,\"accepted\":%d,\"residual_mm\":%.4f,\"loop_closure_mm\":%.4f,"
+             "\"cpu_s\":%.3f",
+             r->solved, r->accepted, r->rms_mm, r->loop_rms_mm, cpu_seconds);
+    job_progress_with(j, EV_REGISTRATION, -1, j->views, fields, detail);
+    if (r->failed_view >= 0 && r->failed_against < 0) {
+        j->hal->log(HAL_LOG_ERROR,
+                    "registration failed: the second pass (from view %d) matches nothing of the "
+                    "first (%.0f%% of its points paired, at least %.0f%% needed): was it the same "
+                    "object? No model was made; the views are kept in %s",
+                    r->failed_view, 100.0 * r->failed_share,
+                    100.0 * j->cfg->registration.min_coupled_share, scan_dir);
+        return -EPROTO;
+    }
+    if (!r->solved || r->failed_view < 0)
+        return 0;
+    j->hal->log(HAL_LOG_ERROR,
+                "registration failed: view %d does not match view %d (%.0f%% of their overlap "
+                "couples, at least %.0f%% needed): did the object move on the table? No model "
+                "was made; the views are kept in %s. Scan again, or fuse them at the turntable's "
+                "angles with 'scanner process %s --config F' where F has [registration] icp = 0",
+                r->failed_view, r->failed_against, 100.0 * r->failed_share,
+                100.0 * j->cfg->registration.min_coupled_share, scan_dir, scan_dir);
+    return -EPROTO;
+}
+
+/* [colour] method = fit: view @p v's colour frames read back from @p scan_dir into the
+ * firmware's buffers (range.bin keeps the view's colour, not its frames), and its colour made
+ * again with them: while the pool collects, the multi estimate and samples; once the lobes are
+ * fitted, the diffuse colour under them. */
+static int recolour_from_frames(struct job *j, const char *scan_dir, uint32_t v,
+                                struct scan_view *view)
+{
+    const struct scan_params *p = &j->cfg->scan;
+    struct gray_layout layout;
+    scan_layout(p, j->calib, &layout);
+    uint32_t count = gray_layout_count(&layout), lights = scan_light_frame_count(p, j->calib);
+    uint32_t white = p->exposure_count > 0 ? count + lights : GRAY_PATTERN_WHITE;
+    char err[SCAN_DIR_PATH_MAX + 256];
+    int rc = scan_begin_view(p, j->calib);
+    for (uint32_t f = count; rc == 0 && f <= count + lights; f++) {
+        uint32_t frame = f < count + lights ? f : white; /* the lights, then the white colour */
+        uint8_t *pixels;
+        rc = job_read_into_buffer(scan_dir, v, frame, 3, p, &pixels, err, sizeof(err));
+        if (rc == 0 && f < count + lights)
+            rc = scan_feed_light_frame(f - count, pixels);
+    }
+    if (rc != 0) {
+        j->hal->log(HAL_LOG_ERROR, "[colour] method = fit needs the colour frames: %s", err);
+        return rc;
+    }
+    scan_attach_colour(view);
+    return scan_recolour(&p->colour, j->calib, view, j->pool);
+}
+
+/* View @p v as the model is made of it (load_range), coloured again from its frames while the
+ * reflectance pool collects or once its model is fitted (fit); stopped by request between
+ * views. */
+static int view_for_model(struct job *j, const char *scan_dir, uint32_t v, struct scan_view *view,
+                          struct scan_view_info *info)
+{
+    int rc = job_stopped_offline(j, scan_dir, v);
+    if (rc == 0)
+        rc = job_load_range(j, scan_dir, v, view, info);
+    if (rc == 0 && (reflect_collecting(j->pool) || reflect_model(j->pool) != NULL))
+        rc = recolour_from_frames(j, scan_dir, v, view);
+    return rc;
+}
+
+/* [colour] method = fit: the samples of every view (each view's colour frames read back), the
+ * clusters and their lobes fitted, said and kept in reflectance.ini. Too few samples: the views
+ * keep the multi estimate, said. */
+static int fit_reflectance(struct job *j, const char *scan_dir)
+{
+    reflect_forget(j->pool);
+    if (j->cfg->scan.colour.method != COLOUR_FIT)
+        return 0;
+    double t0 = clock_posix_thread_cpu_s();
+    reflect_begin(j->pool, j->views);
+    int rc = 0;
+    for (uint32_t v = 0; v < j->views && rc == 0; v++) {
+        struct scan_view view;
+        struct scan_view_info info;
+        rc = view_for_model(j, scan_dir, v, &view, &info);
+    }
+    struct reflect_model m;
+    if (rc == 0 && (rc = reflect_fit(j->pool, j->cfg->scan.colour.clusters, &m)) == -ENODATA) {
+        j->hal->log(HAL_LOG_WARN, "reflectance: too few samples to fit (lit, unsaturated "
+                                  "surface seen by two lights or more); the views keep the "
+                                  "multi method's colour");
+        return 0;
+    }
+    if (rc == 0)
+        rc = job_write_failed_at(j, j->out_dir, "reflectance.ini",
+                                 scan_dir_write_reflectance(&j->hal->storage, j->out_dir, &m));
+    if (rc != 0)
+        return rc;
+    char detail[128 + REFLECT_MAX_CLUSTERS * 96];
+    size_t len = (size_t)snprintf(detail, sizeof(detail),
+                                  "%u material clusters (%.2f s CPU):", (unsigned)m.count,
+                                  clock_posix_thread_cpu_s() - t0);
+    for (uint32_t k = 0; k < m.count && len < sizeof(detail); k++) {
+        const struct reflect_cluster *c = &m.cluster[k];
+        len +=
+            (size_t)snprintf(detail + len, sizeof(detail) - len,
+                             "%s diffuse %.2f %.2f %.2f, specular %.3f %.3f %.3f, roughness "
+                             "%.3f (%u samples)",
+                             k ? ";" : "", c->centre[0], c->centre[1], c->centre[2], c->specular[0],
+                             c->specular[1], c->specular[2], c->roughness, (unsigned)c->samples);
+    }
+    char fields[64];
+    snprintf(fields, sizeof(fields), "\"clusters\":%u", (unsigned)m.count);
+    job_progress_with(j, EV_REFLECTANCE, -1, j->views, fields, detail);
+    return 0;
+}
+
+/* Once every view is in: register them jointly, then fuse each at its registered pose. The
+ * fusion must wait for the registration, and the views' range images are not kept in memory
+ * (a view's are 40 MB): each is read back from its range.bin in the output directory, or, for a
+ * scan kept before range.bin existed, decoded again from its frames in @p scan_dir. */
+int job_make_model(struct job *j, const char *scan_dir)
+{
+    struct reg_report rep;
+    double t0 = clock_posix_thread_cpu_s();
+    reg_solve(j->reg, &rep);
+    int rc = report_registration(j, &rep, clock_posix_thread_cpu_s() - t0, scan_dir);
+    if (rc == 0)
+        rc = fit_reflectance(j, scan_dir);
+    if (rc == 0)
+        rc = fusion_begin(&j->cfg->fusion);
+    for (uint32_t v = 0; v < j->views && rc == 0; v++) {
+        struct scan_view view;
+        struct scan_view_info info;
+        rc = view_for_model(j, scan_dir, v, &view, &info);
+        if (rc == 0)
+            rc = job_make_view_dir(j, v);
+        struct reg_view rv;
+        if (rc == 0)
+            rc = save_results(j, v, &view, &rep, &rv);
+        if (rc == 0) {
+            char detail[HAL_MAX_PATH + 160], dir[SCAN_DIR_PATH_MAX];
+            char fields[96];
+            job_view_dir(j, v, dir, sizeof(dir));
+            snprintf(detail, sizeof(detail), "fused at %.3f deg (%+.3f deg from the table's) -> %s",
+                     rv.angle_deg, rv.correction_deg, dir);
+            snprintf(fields, sizeof(fields), "\"angle_deg\":%.4f,\"correction_deg\":%.4f",
+                     rv.angle_deg, rv.correction_deg);
+            job_progress_with(j, EV_FUSED, (int)v, v + 1, fields, detail);
+        }
+    }
+    return rc == 0 ? write_model(j) : rc;
+}

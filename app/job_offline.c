@@ -1,0 +1,292 @@
+/* A scan job from a scan directory (job.h): the settings it was taken with, resume, and
+ * process, which makes every result again from the kept frames or range images. */
+#define _POSIX_C_SOURCE 200809L
+#include "job.h"
+
+#include "frame_writer.h"
+#include "gray.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <string.h>
+#include <unistd.h>
+
+int scan_job_load_settings(const char *scan_dir, const char *config_path, int capturing,
+                           struct app_config *cfg, struct scan_calib *calib, char *err,
+                           size_t err_len)
+{
+    char path[SCAN_DIR_PATH_MAX];
+    int rc = scan_dir_path(path, sizeof(path), scan_dir, -1, "config.ini");
+    if (rc == 0 && config_path == NULL && access(path, F_OK) != 0) {
+        snprintf(err, err_len,
+                 "%s holds no scan (no config.ini; a scan stopped before its first file has "
+                 "nothing to go on with: take it again with 'scanner scan --config F --out %s "
+                 "--replace')",
+                 scan_dir, scan_dir);
+        return -ENOENT;
+    }
+    if (rc == 0)
+        rc = config_load(cfg, config_path ? config_path : path, err, err_len);
+    /* other settings: the colour frames are those the scan took (method none shows the raw
+     * colour of a scan taken with every light) */
+    static struct app_config taken;
+    char what[160];
+    if (rc == 0 && config_path != NULL && access(path, F_OK) == 0) {
+        rc = config_load(&taken, path, err, err_len);
+        if (rc == 0 && config_plan_differs(&taken, cfg, capturing, what, sizeof(what)) != 0) {
+            /* the scan's own config.ini fixes how its views are taken: views taken otherwise
+             * would not fit with those it has (another turn, exposure, pattern set ...) */
+            snprintf(err, err_len,
+                     "%s: %s was taken with %s: a %s keeps how the views are taken (views, "
+                     "passes, exposure, patterns, lights, resolution); leave out --config to "
+                     "use the scan's own, or take a new scan",
+                     config_path, path, what, capturing ? "resume" : "re-processing");
+            rc = -EINVAL;
+        }
+        if (rc == 0)
+            cfg->scan.colour.taken_with = taken.scan.colour.method;
+    }
+    /* the calibration is the copy kept with the scan, whatever the config named */
+    if (rc == 0)
+        rc = scan_dir_path(cfg->calibration_file, sizeof(cfg->calibration_file), scan_dir, -1,
+                           "calibration.ini");
+    return rc != 0 ? rc : calib_load(calib, cfg->calibration_file, cfg->light_count, err, err_len);
+}
+
+int scan_job_resume(const struct hal *hal, const struct app_config *cfg,
+                    const struct scan_calib *calib, const char *scan_dir,
+                    const struct scan_job_opts *opts)
+{
+    struct job j;
+    job_init(&j, hal, cfg, calib, opts, scan_dir);
+    char detail[64];
+    int lock_fd;
+    int rc = job_open_out(&j, SCAN_DIR_EXISTING, &lock_fd);
+    if (rc != 0)
+        return rc;
+    uint32_t first = 0;
+    while (first < j.views && scan_dir_view_complete(scan_dir, first))
+        first++;
+    snprintf(detail, sizeof(detail), "%u of %u views kept", (unsigned)first, (unsigned)j.views);
+    job_progress(&j, EV_RESUME, -1, first, detail);
+    if (first < j.views) {
+        rc = job_begin_model(&j); /* the model comes from scan_job_process afterwards */
+        if (rc == 0)
+            rc = job_start_storage(&j);
+        if (rc == 0)
+            rc = job_home_and_take_views(&j, first);
+        frame_writer_stop();
+    }
+    scan_dir_close(lock_fd);
+    return rc;
+}
+
+static int load_view(struct job *j, const char *scan_dir, uint32_t v, struct scan_view *view,
+                     struct scan_view_info *info);
+
+/* The frames the settings need must be the frames the view holds: a config with another
+ * exposure or another number of lights would feed the wrong frame to each step. */
+static int check_frames(const struct job *j, const char *scan_dir, uint32_t v,
+                        const struct scan_dir_view *have, char *err, size_t err_len)
+{
+    static struct scan_dir_view want;
+    scan_dir_describe_frames(&j->cfg->scan, j->calib, &want);
+    for (uint32_t f = 0; f < want.frame_count; f++) {
+        if (f < have->frame_count && strcmp(have->frame_name[f], want.frame_name[f]) == 0)
+            continue;
+        snprintf(err, err_len,
+                 "%s/view_%03u/view.ini: frame_%02u is '%s', but these settings need '%s' "
+                 "there (other [scan] or [colour] settings than the scan was taken with?)",
+                 scan_dir, (unsigned)v, (unsigned)f,
+                 f < have->frame_count ? have->frame_name[f] : "(none)", want.frame_name[f]);
+        return -EINVAL;
+    }
+    return 0;
+}
+
+/* Frame @p f of view @p v read from @p scan_dir straight into the firmware's buffer for it (fed
+ * without a copy), as @p channels channels. @p pixels: out, that buffer. @retval 0
+ * @retval -EINVAL no buffer for it (@p err says) @retval as scan_dir_read_frame */
+int job_read_into_buffer(const char *scan_dir, uint32_t v, uint32_t f, uint32_t channels,
+                         const struct scan_params *params, uint8_t **pixels, char *err,
+                         size_t err_len)
+{
+    *pixels = scan_frame_buffer(f);
+    if (*pixels == NULL) {
+        snprintf(err, err_len, "view %u: frame %u has no buffer in these settings", (unsigned)v,
+                 (unsigned)f);
+        return -EINVAL;
+    }
+    return scan_dir_read_frame(scan_dir, v, f, *pixels, (size_t)HAL_MAX_PIXELS * channels,
+                               params->width, params->height, channels, err, err_len);
+}
+
+int scan_job_feed_view(const char *scan_dir, uint32_t v, const struct scan_params *params,
+                       const struct scan_calib *calib, char *err, size_t err_len)
+{
+    struct gray_layout layout;
+    scan_layout(params, calib, &layout);
+    uint32_t count = gray_layout_count(&layout);
+    uint32_t lights = scan_light_frame_count(params, calib);
+    uint32_t channels;
+    int rc = scan_begin_view(params, calib);
+    for (uint32_t f = 0; rc == 0 && (channels = scan_frame_channels(params, calib, f)) != 0; f++) {
+        uint8_t *pixels;
+        rc = job_read_into_buffer(scan_dir, v, f, channels, params, &pixels, err, err_len);
+        if (rc == 0)
+            rc = f < count            ? scan_feed_frame(f, pixels, channels, NULL)
+                 : f < count + lights ? scan_feed_light_frame(f - count, pixels)
+                                      : scan_feed_white_colour(pixels);
+    }
+    return rc;
+}
+
+/* View @p v read back from its range.bin in @p dir, with what job_describe() says of it (the
+ * reader has checked that the valid pixels are the header's count). @retval 0 @retval -ENOENT
+ * none @retval -EINVAL (@p err says) */
+static int read_range(struct job *j, const char *dir, uint32_t v, struct scan_view *view,
+                      struct scan_view_info *info, char *err, size_t err_len)
+{
+    int rc =
+        scan_dir_read_range(dir, v, j->cfg->scan.width, j->cfg->scan.height, view, err, err_len);
+    if (rc == 0) {
+        memset(info, 0, sizeof(*info));
+        info->angle_mdeg = view->angle_mdeg;
+        info->valid_points = view->range.valid_count;
+    }
+    return rc;
+}
+
+/* View @p v of a scan that kept no pattern frames: its range.bin in @p scan_dir. */
+static int load_kept_range(struct job *j, const char *scan_dir, uint32_t v, struct scan_view *view,
+                           struct scan_view_info *info)
+{
+    char err[SCAN_DIR_PATH_MAX + 128];
+    int rc = read_range(j, scan_dir, v, view, info, err, sizeof(err));
+    if (rc != 0)
+        j->hal->log(HAL_LOG_ERROR, "%s; the scan kept no pattern frames to decode it from", err);
+    return rc;
+}
+
+/* View @p v as the model is made of it: its range.bin in the output directory, else (a scan
+ * from before range.bin) decoded again from its frames in @p scan_dir. */
+int job_load_range(struct job *j, const char *scan_dir, uint32_t v, struct scan_view *view,
+                   struct scan_view_info *info)
+{
+    char err[SCAN_DIR_PATH_MAX + 128];
+    int rc = read_range(j, j->out_dir, v, view, info, err, sizeof(err));
+    if (rc == 0)
+        return 0;
+    if (j->cfg->keep_frames != KEEP_FRAMES_ALL) {
+        j->hal->log(HAL_LOG_ERROR, "%s; the scan kept no pattern frames to decode it from", err);
+        return rc;
+    }
+    if (rc != -ENOENT)
+        j->hal->log(HAL_LOG_WARN, "%s: decoded again from its frames", err);
+    return load_view(j, scan_dir, v, view, info);
+}
+
+/* Decode view @p v of @p scan_dir from its kept frames, as it was decoded live. */
+static int load_view(struct job *j, const char *scan_dir, uint32_t v, struct scan_view *view,
+                     struct scan_view_info *info)
+{
+    static struct scan_dir_view meta;
+    const struct hal *hal = j->hal;
+    char err[SCAN_DIR_PATH_MAX + 256];
+    int rc = scan_dir_read_view(scan_dir, v, &meta, err, sizeof(err));
+    if (rc == -ENOENT)
+        snprintf(err, sizeof(err),
+                 "%s/view_%03u: the view did not finish (no view.ini); "
+                 "'scanner resume %s' takes it",
+                 scan_dir, (unsigned)v, scan_dir);
+    if (rc == 0)
+        rc = check_frames(j, scan_dir, v, &meta, err, sizeof(err));
+    if (rc == 0)
+        rc = scan_job_feed_view(scan_dir, v, &j->cfg->scan, j->calib, err, sizeof(err));
+    if (rc != 0) {
+        hal->log(HAL_LOG_ERROR, "%s", err);
+        return rc;
+    }
+    memset(info, 0, sizeof(*info));
+    return scan_finish_view(j->calib, meta.angle_mdeg, view, info);
+}
+
+/* Stopped by request between views of the offline work: nothing is lost. */
+int job_stopped_offline(struct job *j, const char *scan_dir, uint32_t v)
+{
+    if (!hal_should_stop(j->hal))
+        return 0;
+    j->hal->log(HAL_LOG_WARN,
+                "processing stopped by request before view %u; nothing of %s "
+                "is lost: 'scanner process %s' starts it again",
+                (unsigned)v, scan_dir, scan_dir);
+    return -EINTR;
+}
+
+int scan_job_process(const struct hal *hal, const char *scan_dir, const struct scan_job_opts *opts)
+{
+    static struct app_config cfg;
+    static struct scan_calib calib;
+    char path[HAL_MAX_PATH + 32], err[512];
+    int rc = scan_job_load_settings(scan_dir, opts->config_path, 0, &cfg, &calib, err, sizeof(err));
+    if (rc != 0) {
+        hal->log(HAL_LOG_ERROR, "%s", err);
+        return rc;
+    }
+    struct job j;
+    job_init(&j, hal, &cfg, &calib, opts, opts->out_dir ? opts->out_dir : scan_dir);
+    int elsewhere = opts->out_dir != NULL && strcmp(opts->out_dir, scan_dir) != 0;
+    int lock_fd;
+    rc = job_open_out(&j,
+                      !elsewhere      ? SCAN_DIR_EXISTING
+                      : opts->replace ? SCAN_DIR_REPLACE
+                                      : SCAN_DIR_NEW,
+                      &lock_fd);
+    if (rc != 0)
+        return rc;
+    /* summary.ini says every output is written (docs/scan-format.md): they are made again */
+    if (scan_dir_path(path, sizeof(path), j.out_dir, -1, "summary.ini") == 0)
+        unlink(path);
+    if (elsewhere && (rc = scan_dir_keep_settings(&hal->storage, cfg.path, cfg.calibration_file,
+                                                  j.out_dir)) != 0) /* how they were made */
+        hal->log(HAL_LOG_ERROR, "cannot keep the settings in %s: %s", j.out_dir, strerror(-rc));
+    if (rc == 0)
+        rc = job_begin_model(&j);
+    job_progress(&j, EV_PROCESS_START, -1, 0, scan_dir);
+    if (rc == 0 && cfg.keep_frames != KEEP_FRAMES_ALL)
+        hal->log(HAL_LOG_WARN,
+                 "%s kept %s of its camera frames ([output] keep_frames = %s): its views are "
+                 "registered and fused again from their range images (range.bin) as they were "
+                 "decoded and coloured; [scan] and [colour] settings cannot change them",
+                 scan_dir, cfg.keep_frames == KEEP_FRAMES_NONE ? "none" : "only the colour",
+                 cfg.keep_frames_name);
+    for (uint32_t v = 0; v < j.views && rc == 0; v++) {
+        struct scan_view view;
+        struct scan_view_info info;
+        rc = job_stopped_offline(&j, scan_dir, v);
+        if (rc == 0)
+            rc = cfg.keep_frames == KEEP_FRAMES_ALL
+                     ? load_view(&j, scan_dir, v, &view, &info)
+                     : load_kept_range(&j, scan_dir, v, &view, &info);
+        if (rc == 0)
+            rc = scan_keep_for_registration(j.reg, v, &view);
+        /* the model is made of this one, not of an older range.bin (one read back from where
+         * it goes is that one already) */
+        if (rc == 0 && (cfg.keep_frames == KEEP_FRAMES_ALL || elsewhere) &&
+            (rc = job_make_view_dir(&j, v)) == 0)
+            rc = job_write_failed(&j, v, "range.bin",
+                                  scan_dir_write_range(&hal->storage, j.out_dir, v, &view));
+        if (rc == 0) {
+            char detail[HAL_MAX_PATH + 160], dir[SCAN_DIR_PATH_MAX];
+            job_view_dir(&j, v, dir, sizeof(dir));
+            job_describe(detail, sizeof(detail), &info, dir);
+            job_progress(&j, EV_DECODED, (int)v, v + 1, detail);
+        }
+    }
+    if (rc == 0)
+        rc = job_make_model(&j, scan_dir);
+    if (rc == 0)
+        job_finished(&j, "processing", "processing", EV_PROCESS_DONE);
+    scan_dir_close(lock_fd);
+    return rc;
+}

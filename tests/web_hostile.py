@@ -1,0 +1,391 @@
+#!/usr/bin/env python3
+"""scanner serve against a hostile tester (issue 28): another site's page, DNS rebinding, GETs
+that would use the rig, deep JSON, a token-free server on the network, slow and silent clients,
+planted pipes and links, guessed names, resume with other settings, a failed scan remembered.
+Every request goes over real HTTP on loopback. Prints cmocka-style lines for tests/run.sh.
+    python3 tests/web_hostile.py BUILD"""
+import http.client
+import json
+import os
+import shutil
+import socket
+import subprocess
+import sys
+import threading
+import time
+
+BUILD = sys.argv[1] if len(sys.argv) > 1 else "build"
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SCANNER = os.path.join(ROOT, BUILD, "scanner")
+OUT = os.path.join(ROOT, BUILD, "web-hostile")
+passed = failed = 0
+
+
+def check(ok, name, detail=""):
+    global passed, failed
+    if ok:
+        passed += 1
+        print(f"[       OK ] {name}")
+    else:
+        failed += 1
+        print(f"[  FAILED  ] {name}")
+        if detail:
+            print("    " + str(detail).replace("\n", "\n    "))
+    sys.stdout.flush()
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def request(port, method, path, headers=None, body=None, timeout=20, host=None):
+    """(status, headers dict lower-cased, body bytes); the path goes out as written."""
+    c = http.client.HTTPConnection("127.0.0.1", port, timeout=timeout)
+    h = {"Host": host or f"127.0.0.1:{port}"}
+    h.update(headers or {})
+    if isinstance(body, str):
+        body = body.encode()
+    c.putrequest(method, path, skip_host=True, skip_accept_encoding=True)
+    for k, v in h.items():
+        c.putheader(k, v)
+    if body is not None:
+        c.putheader("Content-Length", str(len(body)))
+    c.endheaders(body)
+    r = c.getresponse()
+    data = r.read()
+    c.close()
+    return r.status, {k.lower(): v for k, v in r.getheaders()}, data
+
+
+class Server:
+    def __init__(self, args):
+        self.log = open(os.path.join(OUT, f"serve-{len(os.listdir(OUT))}.log"), "w+")
+        self.proc = subprocess.Popen([SCANNER, "serve"] + args, stdout=subprocess.PIPE,
+                                     stderr=self.log, text=True)
+        line = self.proc.stdout.readline()
+        if "http://" not in line:
+            raise RuntimeError(f"serve did not start: {line} {self.text()}")
+
+    def text(self):
+        self.log.flush()
+        with open(self.log.name) as f:
+            return f.read()
+
+    def stop(self):
+        if self.proc.poll() is None:
+            self.proc.terminate()
+        return self.proc.wait(timeout=120)
+
+
+def start_refused(args):
+    """rc and messages of a serve that must refuse to start."""
+    p = subprocess.run([SCANNER, "serve"] + args, capture_output=True, text=True, timeout=30)
+    return p.returncode, p.stderr
+
+
+def write_configs():
+    """fast: a sphere in 4 views at 320 x 240 (about a second); long: the same in 100 views."""
+    calib = open(os.path.join(ROOT, "config/sim-calib.ini")).read()
+    for a, b in [("fx_px = 2400", "fx_px = 600"), ("fy_px = 2400", "fy_px = 600"),
+                 ("cx_px = 639.5", "cx_px = 159.5"), ("cy_px = 479.5", "cy_px = 119.5"),
+                 ("width = 1280", "width = 320"), ("height = 960", "height = 240")]:
+        calib = calib.replace(a, b, 1)
+    with open(os.path.join(OUT, "calib.ini"), "w") as f:
+        f.write(calib)
+    base = ("[camera]\nbackend = sim\nwidth = 320\nheight = 240\nexposure_us = 10000\n"
+            "[lights]\ncount = 0\n[scan]\nviews = {views}\ncalibration = {out}/calib.ini\n"
+            "[output]\ndir = {out}/scans\n[turntable]\ntransport = tcp\nhost = 127.0.0.1\n"
+            "port = 0\n[registration]\nicp = 0\n[sim]\nobject = sphere\n")
+    for name, views in [("fast", 4), ("long", 100)]:
+        with open(os.path.join(OUT, f"{name}.ini"), "w") as f:
+            f.write(base.format(views=views, out=OUT))
+
+
+def wait_state(port, sid, states, timeout=120, key=None):
+    until = time.time() + timeout
+    while time.time() < until:
+        st, _, body = request(port, "GET", f"/api/scans/{sid}")
+        if st == 200 and json.loads(body)["state"] in states:
+            return json.loads(body)
+        time.sleep(0.2)
+    return None
+
+
+def admission(port, scans):
+    """Another site, another Host name, GETs that would use the rig, a missing key."""
+    js = {"Content-Type": "application/json"}
+    st, h, _ = request(port, "OPTIONS", "/api/scans", {
+        "Origin": "http://evil.example", "Access-Control-Request-Method": "POST",
+        "Access-Control-Request-Headers": "content-type"})
+    check(st >= 400 and "access-control-allow-origin" not in h
+          and "access-control-allow-methods" not in h,
+          f"a CORS pre-flight from another site is never answered yes ({st})", h)
+    st, h, _ = request(port, "GET", "/api/status", {"Origin": "http://evil.example"})
+    check(st == 403 and "access-control-allow-origin" not in h,
+          f"a request with another site's Origin is refused ({st})")
+    st, _, body = request(port, "GET", "/api/status", host="evil.example:80")
+    check(st == 403, f"a DNS-rebinding Host name is refused on a token-free server ({st})", body)
+    st, _, _ = request(port, "GET", "/api/status", host=f"localhost:{port}")
+    check(st == 200, f"the loopback names are answered (localhost: {st})")
+    st, _, _ = request(port, "GET", "/api/scans", {"Sec-Fetch-Site": "cross-site"})
+    check(st == 403, f"a cross-site fetch (Sec-Fetch-Site) is refused ({st})")
+    st, _, _ = request(port, "GET", "/api/snapshot.png")
+    check(st == 405, f"GET /api/snapshot.png (an <img> on any page) does not use the rig ({st})")
+    st, _, _ = request(port, "GET", "/api/selftest")
+    check(st == 405, f"nor does GET /api/selftest ({st})")
+    st, _, _ = request(port, "POST", "/api/snapshot.png", js, "{}")
+    check(st == 403, f"POST /api/snapshot.png without the session key is refused ({st})")
+    st, _, body = request(port, "POST", "/api/scans", js, "{}")
+    check(st == 403, f"POST /api/scans without the session key is refused ({st})", body)
+    st, _, body = request(port, "POST", "/api/scans", {**js, "X-Scanner-Key": "0" * 32}, "{}")
+    check(st == 403, f"and with a wrong key ({st})")
+    st, _, body = request(port, "GET", "/api/session", {"Sec-Fetch-Site": "same-origin"})
+    key = json.loads(body)["key"] if st == 200 else ""
+    check(st == 200 and len(key) == 32, "the page's own request gets the session key")
+    st, _, body = request(port, "GET", "/api/scans")
+    check(st == 200 and json.loads(body)["scans"] == [], "no scan was started by any of them")
+    deep = "[" * 800 + "]" * 800
+    st, _, _ = request(port, "POST", "/api/login", js, deep)
+    st2, _, _ = request(port, "GET", "/api/status")
+    check(st == 400 and st2 == 200, f"800-deep JSON is refused and the server lives ({st}, {st2})")
+    k = {**js, "X-Scanner-Key": key}
+    st, _, _ = request(port, "POST", "/api/scans", k, '{"profile": "fast"} junk')
+    check(st == 400, f"trailing junk after the JSON body is refused ({st})")
+    st, _, _ = request(port, "POST", "/api/scans", k, '{"a": ' + "[" * 33 + "]" * 33 + "}")
+    check(st == 400, f"JSON nested beyond 32 levels is refused ({st})")
+    return key
+
+
+def dos_and_stop(port, key, srv):
+    """A scan running; 100 slowloris sockets and 16 progress streams that never read; status and
+    Stop must still be answered at once."""
+    js = {"Content-Type": "application/json", "X-Scanner-Key": key}
+    st, _, body = request(port, "POST", "/api/scans", js, '{"profile": "long"}')
+    check(st == 200, f"a scan starts with the session key ({st})", body)
+    sid = json.loads(body)["id"]
+    until = time.time() + 60
+    while time.time() < until and json.loads(request(port, "GET", f"/api/scans/{sid}")[2])[
+            "views_done"] < 1:
+        time.sleep(0.1)
+    slow = []
+    for _ in range(100):
+        s = socket.create_connection(("127.0.0.1", port))
+        s.sendall(b"GET /api/status HTTP/1.1\r\nHost: 127.0.0.1\r\n")  # never finished
+        slow.append(s)
+    streams, refused = [], 0
+    for _ in range(16):
+        s = socket.create_connection(("127.0.0.1", port))
+        s.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1024)
+        s.sendall(f"GET /api/scans/{sid}/events HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n".encode())
+        streams.append(s)  # never read
+    time.sleep(1.0)
+    t0 = time.time()
+    st, _, body = request(port, "GET", "/api/status", timeout=10)
+    t_status = time.time() - t0
+    check(st == 200 and json.loads(body)["scanning"] and t_status < 3,
+          f"status is answered during a scan beside 100 slow sockets and 16 silent streams "
+          f"({t_status * 1000:.0f} ms)")
+    t0 = time.time()
+    st, _, body = request(port, "POST", f"/api/scans/{sid}/stop", js, "{}", timeout=10)
+    t_stop = time.time() - t0
+    check(st == 200 and t_stop < 3, f"so is Stop ({st}, {t_stop * 1000:.0f} ms)", body)
+    st, _, _ = request(port, "GET", f"/api/scans/{sid}/events", timeout=10)
+    check(st == 503, f"progress streams beyond 8 are refused, not queued ({st})")
+    for s in slow + streams:
+        s.close()
+    state = wait_state(port, sid, ("stopped",))
+    check(state is not None and 1 <= state["views_done"] < 100,
+          f"the scan stopped with its finished views kept ({state and state['views_done']})")
+    return sid
+
+
+def resume_cases(port, key, sid, scans):
+    """Resume picks the profile that takes views as the scan did, refuses any other; a scan
+    that fails writing mesh.stl is failed, with its error, also after a restart."""
+    js = {"Content-Type": "application/json", "X-Scanner-Key": key}
+    st, _, body = request(port, "POST", f"/api/scans/{sid}/resume", js, '{"profile": "fast"}')
+    state = wait_state(port, sid, ("failed", "stopped", "finished")) if st == 200 else None
+    check(state is not None and state["state"] == "failed" and "[scan] views" in state["error"]
+          and not os.path.exists(os.path.join(scans, sid, "view_099")),
+          "a resume with a profile of other settings is refused, naming the key",
+          state or body)
+    os.makedirs(os.path.join(scans, sid, "mesh.stl", "in-the-way"))
+    st, _, body = request(port, "POST", f"/api/scans/{sid}/resume", js, "{}")
+    state = wait_state(port, sid, ("failed", "finished"), timeout=180) if st == 200 else None
+    check(state is not None and state["state"] == "failed" and state["views_done"] == 100
+          and os.path.exists(os.path.join(scans, sid, "mesh.ply")),
+          "a resume without a profile takes the scan's own ('long'); failing at mesh.stl, it is "
+          "failed, not finished", state or body)
+    return state["error"] if state else ""
+
+
+def concurrent_thumbs(port, sid):
+    """Thumbnails drawn in parallel (the report's reader is reentrant, no lock): each the same
+    as when drawn alone."""
+    paths = [f"/api/scans/{sid}/thumbs/{v}/{k}.png" for v in (0, 1) for k in ("raw", "colour",
+                                                                             "reasons")]
+    alone = {p: request(port, "GET", p) for p in paths}
+    together, threads = {}, []
+    for n in range(3):
+        for p in paths:
+            t = threading.Thread(target=lambda p=p, n=n: together.__setitem__(
+                (p, n), request(port, "GET", p)))
+            threads.append(t)
+            t.start()
+    for t in threads:
+        t.join()
+    same = all(together[(p, n)][0] == 200 and together[(p, n)][2] == alone[p][2]
+               for p in paths for n in range(3))
+    check(same and all(alone[p][0] == 200 for p in paths),
+          f"18 thumbnails drawn at once are each the one drawn alone ({len(together)})")
+
+
+def fifo_cases(port, sid, scans):
+    view = os.path.join(scans, sid, "view_000")
+    for name in os.listdir(view):
+        if name.startswith("frame_"):
+            os.unlink(os.path.join(view, name))
+            os.mkfifo(os.path.join(view, name))
+    t0 = time.time()
+    codes = [request(port, "GET", f"/api/scans/{sid}/thumbs/0/{k}.png", timeout=15)[0]
+             for k in ("raw", "colour", "reasons")]
+    check(time.time() - t0 < 10 and codes[0] == 404,
+          f"a named pipe planted as a frame does not block the thumbnails ({codes})")
+    st, _, _ = request(port, "GET", f"/api/scans/{sid}/files/view_000/frame_00.ppm.zst")
+    check(st == 404, f"nor is it served as a file ({st})")
+    fifo = os.path.join(scans, sid, "summary.ini")
+    os.mkfifo(fifo)
+    try:
+        p = subprocess.run([SCANNER, "report", os.path.join(scans, sid)], capture_output=True,
+                           text=True, timeout=60)
+        check(p.returncode == 0, "scanner report passes over a planted pipe (summary.ini)",
+              p.stderr[-600:])
+    except subprocess.TimeoutExpired:
+        check(False, "scanner report passes over a planted pipe (it hung)")
+    os.unlink(fifo)
+    try:
+        p = subprocess.run([SCANNER, "process", os.path.join(scans, sid), "--out",
+                            os.path.join(OUT, "fifo-process")], capture_output=True, text=True,
+                           timeout=60)
+        check(p.returncode != 0 and "not a regular file" in p.stderr,
+              "scanner process refuses a planted pipe instead of hanging", p.stderr[-600:])
+    except subprocess.TimeoutExpired:
+        check(False, "scanner process refuses a planted pipe instead of hanging (it hung)")
+
+
+def path_cases(port, key, scans, sid):
+    js = {"Content-Type": "application/json", "X-Scanner-Key": key}
+    os.symlink("/etc", os.path.join(scans, "evil"))
+    st, _, body = request(port, "GET", "/api/scans/evil/files/passwd")
+    check(st in (403, 404) and b"root:" not in body, f"a linked scan folder serves nothing ({st})")
+    st, _, body = request(port, "GET", "/api/scans/evil/archive.tar")
+    check(st == 404 and b"root:" not in body, f"nor archives anything ({st})")
+    st, _, body = request(port, "GET", "/api/scans/-x/archive.tar")
+    check(st == 404, f"an id that reads like an option of tar's is no scan ({st})")
+    st, _, body = request(port, "GET", "/api/scans/2000-01-01_000000/archive.tar")
+    check(st == 404, f"a nonexistent scan's archive is 404, not an empty tar ({st})")
+    st, _, body = request(port, "POST", "/api/scans/evil/resume", js, "{}")
+    check(st in (404, 409), f"a linked folder cannot be resumed ({st})")
+    # 700 old folders, each a scan (a config.ini), that sort before the real ones
+    cfg = os.path.join(scans, sid, "config.ini")
+    for i in range(700):
+        d = os.path.join(scans, f"2000-01-01_{i:06d}")
+        os.mkdir(d)
+        shutil.copy(cfg, d)
+    st, _, body = request(port, "GET", "/api/scans", timeout=60)
+    ids = [s["id"] for s in json.loads(body)["scans"]] if st == 200 else []
+    check(len(ids) == 701 and ids[0] == sid,
+          f"the scan list sorts every folder, the newest first ({len(ids)})")
+    for i in range(700):
+        shutil.rmtree(os.path.join(scans, f"2000-01-01_{i:06d}"))
+
+
+def token_cases():
+    port = free_port()
+    fast = os.path.join(OUT, "fast.ini")
+    rc, err = start_refused(["--config", fast, "--listen", f"127.0.0.1:{port},0.0.0.0:{port + 1}"])
+    check(rc == 2 and "token-file" in err, "a token-free server refuses a list with a network "
+          "address", err)
+    rc, err = start_refused(["--config", fast, "--listen", str(port)])
+    check(rc == 2 and "token-file" in err, "and a bare port (every interface)", err)
+    tok = os.path.join(OUT, "token")
+    for bad, what in [("x" * 300, "255"), ("abcdefgh;ijklmnop", "cookie"),
+                      ("abcdefgh ijklmnop", "cookie")]:
+        with open(tok, "w") as f:
+            f.write(bad + "\n")
+        rc, err = start_refused(["--config", fast, "--listen", f"0.0.0.0:{port}",
+                                 "--token-file", tok])
+        check(rc == 2 and what in err, f"a token {bad[:20]!r}... is refused at start", err)
+    os.unlink(tok)
+    os.mkfifo(tok)
+    try:
+        rc, err = start_refused(["--config", fast, "--listen", f"0.0.0.0:{port}",
+                                 "--token-file", tok])
+        check(rc == 2 and "not a regular file" in err, "a pipe as the token file is refused", err)
+    except subprocess.TimeoutExpired:
+        check(False, "a pipe as the token file is refused (it hung)")
+    os.unlink(tok)
+    secret = "correct-horse-battery-staple"
+    with open(tok, "w") as f:
+        f.write(secret + "\n")
+    srv = Server(["--config", fast, "--listen", f"0.0.0.0:{port}", "--token-file", tok,
+                  "--scans", os.path.join(OUT, "scans-token")])
+    try:
+        js = {"Content-Type": "application/json"}
+        codes = [request(port, "POST", "/api/login", js, json.dumps({"token": f"guess-{i}"}))[0]
+                 for i in range(12)]
+        check(codes.count(401) <= 5 and codes[-1] == 429,
+              f"wrong tokens are limited: at most 5 in 10 s ({codes})")
+        check("wrong token from 127.0.0.1" in srv.text(), "and each is logged with its address")
+        st, _, _ = request(port, "POST", "/api/login", js, json.dumps({"token": secret}))
+        check(st == 429, f"even the right one waits its turn ({st})")
+        auth = {"Authorization": f"Bearer {secret}"}
+        st, _, _ = request(port, "GET", "/api/status", auth, host="scanner.local:8080")
+        check(st == 200, f"with a token any Host name is answered (the token protects) ({st})")
+        st, _, _ = request(port, "GET", "/api/status", {**auth, "Origin": "http://evil.example"})
+        check(st == 403, f"but never another site's Origin ({st})")
+        st, _, _ = request(port, "POST", "/api/login", js, "[" * 800 + "]" * 800)
+        st2, _, _ = request(port, "GET", "/api/status", auth)
+        check(st in (400, 429) and st2 == 200, f"deep JSON at the login does not crash it ({st})")
+    finally:
+        check(srv.stop() == 0, "the token server ends cleanly")
+
+
+def main():
+    shutil.rmtree(OUT, ignore_errors=True)
+    os.makedirs(OUT)
+    write_configs()
+    scans = os.path.join(OUT, "scans")
+    port = free_port()
+    args = ["--config", os.path.join(OUT, "fast.ini"), "--config", os.path.join(OUT, "long.ini"),
+            "--listen", f"127.0.0.1:{port}", "--scans", scans]
+    srv = Server(args)
+    sid = error = None
+    try:
+        key = admission(port, scans)
+        sid = dos_and_stop(port, key, srv)
+        error = resume_cases(port, key, sid, scans)
+        path_cases(port, key, scans, sid)
+    finally:
+        check(srv.stop() == 0, "the server ends cleanly")
+    srv = Server(args)
+    try:
+        st, _, body = request(port, "GET", f"/api/scans/{sid}")
+        s = json.loads(body) if st == 200 else {}
+        check(s.get("state") == "failed" and s.get("error") == error and "mesh.stl" in error,
+              f"after a restart the failed scan is still failed, with its error ({s})")
+        concurrent_thumbs(port, sid)
+        fifo_cases(port, sid, scans)
+    finally:
+        check(srv.stop() == 0, "the restarted server ends cleanly")
+    token_cases()
+    print(f"[  PASSED  ] {passed} test(s).")
+    if failed:
+        print(f"[  FAILED  ] {failed} test(s).")
+    sys.exit(1 if failed else 0)
+
+
+if __name__ == "__main__":
+    main()
