@@ -34,6 +34,16 @@ void job_utc_now(char *buf, size_t len)
 static struct reg_ctx registration;
 /* The reflectance's samples and model ([colour] method = fit), likewise. */
 static struct reflect_pool reflectance;
+/* One view's frames, maps and colour, likewise: the process's only one (the commands that take a
+ * single view outside a job borrow it through scan_job_views). */
+static struct scan_ctx views;
+/* The volume the views are fused in and the mesh made from, likewise. */
+static struct fusion_volume volume;
+
+struct scan_ctx *scan_job_views(void)
+{
+    return &views;
+}
 
 void job_init(struct job *j, const struct hal *hal, const struct app_config *cfg,
               const struct scan_calib *calib, const struct scan_job_opts *opts, const char *out_dir)
@@ -48,8 +58,10 @@ void job_init(struct job *j, const struct hal *hal, const struct app_config *cfg
                       .start_cpu_s = clock_posix_process_cpu_s(),
                       .start_sim_cpu_s = board_simulator_cpu_s(),
                       .start_thread_cpu_s = clock_posix_thread_cpu_s(),
+                      .scan = &views,
                       .reg = &registration,
                       .pool = &reflectance,
+                      .vol = &volume,
                       .tty = isatty(STDOUT_FILENO) && !opts->json};
     if (hal_clock_now_us(&hal->clock, &j->start_rig_us) != 0)
         j->start_rig_us = 0;

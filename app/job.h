@@ -32,8 +32,10 @@ struct job {
     double views_cpu_s, last_view_cpu_s; /* the threads that processed views, and the last */
     uint64_t start_rig_us;               /* the rig's clock (the simulator's: the modelled rig's) */
     int tty;
+    struct scan_ctx *scan;     /* the view being decoded (job.c keeps the one) */
     struct reg_ctx *reg;       /* the registration of the job's views (job.c keeps the one) */
     struct reflect_pool *pool; /* [colour] method = fit: the reflectance (job.c keeps it) */
+    struct fusion_volume *vol; /* the model's volume (job.c keeps it) */
     struct pending *pending;   /* the view processed while the table turns, or NULL */
     struct eta {               /* views finished of the current run, and when */
         uint32_t first_done, last_done;
@@ -96,9 +98,9 @@ int job_make_model(struct job *j, const char *scan_dir);
 
 /* ---- job_offline.c ---- */
 /** Frame @p f of view @p v read from @p scan_dir into the firmware's buffer for it. */
-int job_read_into_buffer(const char *scan_dir, uint32_t v, uint32_t f, uint32_t channels,
-                         const struct scan_params *params, uint8_t **pixels, char *err,
-                         size_t err_len);
+int job_read_into_buffer(struct scan_ctx *s, const char *scan_dir, uint32_t v, uint32_t f,
+                         uint32_t channels, const struct scan_params *params, uint8_t **pixels,
+                         char *err, size_t err_len);
 /** View @p v as the model is made of it: its range.bin, else decoded from its frames. */
 int job_load_range(struct job *j, const char *scan_dir, uint32_t v, struct scan_view *view,
                    struct scan_view_info *info);

@@ -150,7 +150,7 @@ static int save_view(struct pending *p)
     const struct hal *hal = j->hal;
     struct scan_view view;
     char detail[HAL_MAX_PATH + 160], fields[96];
-    int rc = scan_finish_view(j->calib, p->info.angle_mdeg, &view, &p->info);
+    int rc = scan_finish_view(j->scan, j->calib, p->info.angle_mdeg, &view, &p->info);
     int rc_frames = flush_frames(j); /* nothing writes into the view's directory after this */
     if (rc == 0)
         rc = rc_frames;
@@ -258,7 +258,7 @@ static int live_view(struct job *j, uint32_t v)
     struct scan_frame_sink sink = {save_frame, &c};
     struct scan_view_info info;
     double t0 = job_wall_ms();
-    rc = scan_capture_view(hal, &j->cfg->scan, j->calib, st.position_mdeg, &sink, &info);
+    rc = scan_capture_view(j->scan, hal, &j->cfg->scan, j->calib, st.position_mdeg, &sink, &info);
     /* the simulator's truth of this view while the table is still at its angle */
     if (rc == 0)
         rc = job_write_failed_at(j, c.dir, "(the simulator's truth)",

@@ -30,7 +30,7 @@ static int save_results(struct job *j, uint32_t v, const struct scan_view *view,
     if (rc == 0)
         rc = scan_save_cloud(j->hal, view, &pose, path); /* says what failed itself */
     if (rc == 0)
-        rc = scan_fuse_view(j->calib, view, &pose);
+        rc = scan_fuse_view(j->vol, j->calib, view, &pose);
     return rc;
 }
 
@@ -39,17 +39,17 @@ static int save_results(struct job *j, uint32_t v, const struct scan_view *view,
 static int write_model(struct job *j)
 {
     static const char *const names[] = {"mesh.ply", "mesh.obj", "mesh.stl", "mesh.glb"};
-    int (*const writers[])(const struct hal_storage *, const char *) = {
+    int (*const writers[])(struct fusion_volume *, const struct hal_storage *, const char *) = {
         fusion_write_ply, fusion_write_obj, fusion_write_stl, NULL}; /* NULL: glb, below */
     char path[SCAN_DIR_PATH_MAX], detail[HAL_MAX_PATH + 320];
     struct mesh_summary ms;
     uint32_t filled = 0, inside = 0;
     job_progress(j, EV_MESHING, -1, j->views, "marching cubes");
-    int rc = fusion_fill_holes(j->cfg->max_hole_mm, &filled);
+    int rc = fusion_fill_holes(j->vol, j->cfg->max_hole_mm, &filled);
     if (rc == 0 && j->cfg->watertight)
-        rc = fusion_close_watertight(j->cfg->max_hole_mm, j->cfg->passes == 1, &inside);
+        rc = fusion_close_watertight(j->vol, j->cfg->max_hole_mm, j->cfg->passes == 1, &inside);
     if (rc == 0)
-        rc = fusion_mesh_prepare(j->cfg->min_fragment_share, &ms);
+        rc = fusion_mesh_prepare(j->vol, j->cfg->min_fragment_share, &ms);
     int fits = rc == 0;
     if (rc == -E2BIG)
         j->hal->log(HAL_LOG_WARN,
@@ -66,8 +66,8 @@ static int write_model(struct job *j)
             continue;
         rc = scan_dir_path(path, sizeof(path), j->out_dir, -1, names[k]);
         if (rc == 0)
-            rc = writers[k] != NULL ? writers[k](&j->hal->storage, path)
-                                    : fusion_write_glb(&j->hal->storage, path,
+            rc = writers[k] != NULL ? writers[k](j->vol, &j->hal->storage, path)
+                                    : fusion_write_glb(j->vol, &j->hal->storage, path,
                                                        reflect_model(j->pool)); /* or matte */
         if (rc != 0)
             j->hal->log(HAL_LOG_ERROR, "cannot write %s: %s", path, strerror(-rc));
@@ -174,19 +174,19 @@ static int recolour_from_frames(struct job *j, const char *scan_dir, uint32_t v,
     uint32_t count = gray_layout_count(&layout), lights = scan_light_frame_count(p, j->calib);
     uint32_t white = p->exposure_count > 0 ? count + lights : GRAY_PATTERN_WHITE;
     char err[SCAN_DIR_PATH_MAX + 256];
-    int rc = scan_begin_view(p, j->calib);
+    int rc = scan_begin_view(j->scan, p, j->calib);
     for (uint32_t f = count; rc == 0 && f <= count + lights; f++) {
         uint32_t frame = f < count + lights ? f : white; /* the lights, then the white colour */
         uint8_t *pixels;
-        rc = job_read_into_buffer(scan_dir, v, frame, 3, p, &pixels, err, sizeof(err));
+        rc = job_read_into_buffer(j->scan, scan_dir, v, frame, 3, p, &pixels, err, sizeof(err));
         if (rc == 0 && f < count + lights)
-            rc = scan_feed_light_frame(f - count, pixels);
+            rc = scan_feed_light_frame(j->scan, f - count, pixels);
     }
     if (rc != 0) {
         j->hal->log(HAL_LOG_ERROR, "[colour] method = fit needs the colour frames: %s", err);
         return rc;
     }
-    scan_attach_colour(view);
+    scan_attach_colour(j->scan, view);
     return scan_recolour(&p->colour, j->calib, view, j->pool);
 }
 
@@ -264,7 +264,7 @@ int job_make_model(struct job *j, const char *scan_dir)
     if (rc == 0)
         rc = fit_reflectance(j, scan_dir);
     if (rc == 0)
-        rc = fusion_begin(&j->cfg->fusion);
+        rc = fusion_begin(j->vol, &j->cfg->fusion);
     for (uint32_t v = 0; v < j->views && rc == 0; v++) {
         struct scan_view view;
         struct scan_view_info info;

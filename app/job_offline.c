@@ -107,11 +107,11 @@ static int check_frames(const struct job *j, const char *scan_dir, uint32_t v,
 /* Frame @p f of view @p v read from @p scan_dir straight into the firmware's buffer for it (fed
  * without a copy), as @p channels channels. @p pixels: out, that buffer. @retval 0
  * @retval -EINVAL no buffer for it (@p err says) @retval as scan_dir_read_frame */
-int job_read_into_buffer(const char *scan_dir, uint32_t v, uint32_t f, uint32_t channels,
-                         const struct scan_params *params, uint8_t **pixels, char *err,
-                         size_t err_len)
+int job_read_into_buffer(struct scan_ctx *s, const char *scan_dir, uint32_t v, uint32_t f,
+                         uint32_t channels, const struct scan_params *params, uint8_t **pixels,
+                         char *err, size_t err_len)
 {
-    *pixels = scan_frame_buffer(f);
+    *pixels = scan_frame_buffer(s, f);
     if (*pixels == NULL) {
         snprintf(err, err_len, "view %u: frame %u has no buffer in these settings", (unsigned)v,
                  (unsigned)f);
@@ -121,22 +121,23 @@ int job_read_into_buffer(const char *scan_dir, uint32_t v, uint32_t f, uint32_t 
                                params->width, params->height, channels, err, err_len);
 }
 
-int scan_job_feed_view(const char *scan_dir, uint32_t v, const struct scan_params *params,
-                       const struct scan_calib *calib, char *err, size_t err_len)
+int scan_job_feed_view(struct scan_ctx *s, const char *scan_dir, uint32_t v,
+                       const struct scan_params *params, const struct scan_calib *calib, char *err,
+                       size_t err_len)
 {
     struct gray_layout layout;
     scan_layout(params, calib, &layout);
     uint32_t count = gray_layout_count(&layout);
     uint32_t lights = scan_light_frame_count(params, calib);
     uint32_t channels;
-    int rc = scan_begin_view(params, calib);
+    int rc = scan_begin_view(s, params, calib);
     for (uint32_t f = 0; rc == 0 && (channels = scan_frame_channels(params, calib, f)) != 0; f++) {
         uint8_t *pixels;
-        rc = job_read_into_buffer(scan_dir, v, f, channels, params, &pixels, err, err_len);
+        rc = job_read_into_buffer(s, scan_dir, v, f, channels, params, &pixels, err, err_len);
         if (rc == 0)
-            rc = f < count            ? scan_feed_frame(f, pixels, channels, NULL)
-                 : f < count + lights ? scan_feed_light_frame(f - count, pixels)
-                                      : scan_feed_white_colour(pixels);
+            rc = f < count            ? scan_feed_frame(s, f, pixels, channels, NULL)
+                 : f < count + lights ? scan_feed_light_frame(s, f - count, pixels)
+                                      : scan_feed_white_colour(s, pixels);
     }
     return rc;
 }
@@ -147,8 +148,8 @@ int scan_job_feed_view(const char *scan_dir, uint32_t v, const struct scan_param
 static int read_range(struct job *j, const char *dir, uint32_t v, struct scan_view *view,
                       struct scan_view_info *info, char *err, size_t err_len)
 {
-    int rc =
-        scan_dir_read_range(dir, v, j->cfg->scan.width, j->cfg->scan.height, view, err, err_len);
+    int rc = scan_dir_read_range(j->scan, dir, v, j->cfg->scan.width, j->cfg->scan.height, view,
+                                 err, err_len);
     if (rc == 0) {
         memset(info, 0, sizeof(*info));
         info->angle_mdeg = view->angle_mdeg;
@@ -202,13 +203,13 @@ static int load_view(struct job *j, const char *scan_dir, uint32_t v, struct sca
     if (rc == 0)
         rc = check_frames(j, scan_dir, v, &meta, err, sizeof(err));
     if (rc == 0)
-        rc = scan_job_feed_view(scan_dir, v, &j->cfg->scan, j->calib, err, sizeof(err));
+        rc = scan_job_feed_view(j->scan, scan_dir, v, &j->cfg->scan, j->calib, err, sizeof(err));
     if (rc != 0) {
         hal->log(HAL_LOG_ERROR, "%s", err);
         return rc;
     }
     memset(info, 0, sizeof(*info));
-    return scan_finish_view(j->calib, meta.angle_mdeg, view, info);
+    return scan_finish_view(j->scan, j->calib, meta.angle_mdeg, view, info);
 }
 
 /* Stopped by request between views of the offline work: nothing is lost. */

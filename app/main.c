@@ -48,7 +48,7 @@ static int cmd_snapshot(const char *config_path, const char *out)
         return 2;
     int rc = rig_up(&cfg, &calib);
     if (rc == 0)
-        rc = scan_snapshot(rig_hal(), &cfg.scan, &calib, &rgb);
+        rc = scan_snapshot(scan_job_views(), rig_hal(), &cfg.scan, &calib, &rgb);
     rig_down();
     if (rc == 0) {
         struct hal_storage st;
@@ -80,7 +80,7 @@ static int cmd_calibrate_white(const char *config_path, double target_albedo)
     if (rc == 0)
         rc = hal_table_home(&rig_hal()->turntable);
     if (rc == 0)
-        rc = scan_take_view(rig_hal(), &cfg.scan, &calib, 0, NULL, &view, &info);
+        rc = scan_take_view(scan_job_views(), rig_hal(), &cfg.scan, &calib, 0, NULL, &view, &info);
     if (rc == 0) {
         rc = white_cal_from_view(&cfg, &calib, &view, target_albedo, &wc);
         if (rc != 0)

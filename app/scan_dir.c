@@ -520,8 +520,8 @@ out_close:
     return rc;
 }
 
-int scan_dir_read_range(const char *dir, uint32_t view, uint32_t width, uint32_t height,
-                        struct scan_view *v, char *err, size_t err_len)
+int scan_dir_read_range(struct scan_ctx *s, const char *dir, uint32_t view, uint32_t width,
+                        uint32_t height, struct scan_view *v, char *err, size_t err_len)
 {
     char path[SCAN_DIR_PATH_MAX];
     struct range_header h;
@@ -539,8 +539,8 @@ int scan_dir_read_range(const char *dir, uint32_t view, uint32_t width, uint32_t
     if (h.width != width || h.height != height || h.valid_count > n)
         goto out_close;
     why = "larger than the compiled frame limit";
-    if (scan_restore_view(width, height, h.angle_mdeg, h.valid_count, h.colour_method, v, &fill) !=
-        0)
+    if (scan_restore_view(s, width, height, h.angle_mdeg, h.valid_count, h.colour_method, v,
+                          &fill) != 0)
         goto out_close;
     why = "cut short or damaged";
     if (fread(fill.reason, 1, n, fp) != n)

@@ -115,11 +115,11 @@ int scan_dir_read_frame(const char *dir, uint32_t view, uint32_t frame, uint8_t 
 int scan_dir_write_range(const struct hal_storage *st, const char *dir, uint32_t view,
                          const struct scan_view *v);
 
-/** Read view @p view's range.bin into the firmware's buffers (scan_restore_view); @p v points
- *  at them. It must be @p width x @p height. @retval 0 @retval -ENOENT none @retval -EINVAL
- *  damaged or of another size (@p err names the file and says what) */
-int scan_dir_read_range(const char *dir, uint32_t view, uint32_t width, uint32_t height,
-                        struct scan_view *v, char *err, size_t err_len);
+/** Read view @p view's range.bin into @p s's buffers (scan_restore_view); @p v points at them.
+ *  It must be @p width x @p height. @retval 0 @retval -ENOENT none @retval -EINVAL damaged or
+ *  of another size (@p err names the file and says what) */
+int scan_dir_read_range(struct scan_ctx *s, const char *dir, uint32_t view, uint32_t width,
+                        uint32_t height, struct scan_view *v, char *err, size_t err_len);
 
 /** What a view's range.bin shows, as pictures (report.html, the web page's thumbnails): its
  *  size, then, in the caller's buffers of @p capacity pixels, the reason code of every pixel and

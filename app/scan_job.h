@@ -42,22 +42,27 @@ int scan_job_resume(const struct hal *hal, const struct app_config *cfg,
                     const struct scan_calib *calib, const char *scan_dir,
                     const struct scan_job_opts *opts);
 
-/** Recompute every result of the scan in @p scan_dir from its kept frames alone.
- *  @param hal  storage, clock and log only; no device is touched
- *  @retval 0 ok @retval -errno with the file named in the log */
 /** What view.ini records of a view just taken with @p params (started, finished and wall_ms are
  *  the caller's to set). */
 void scan_job_view_meta(const struct app_config *cfg, const struct scan_params *params,
                         const struct scan_calib *calib, uint32_t view,
                         const struct scan_view_info *info, struct scan_dir_view *v);
 
-/** Feed view @p v's kept frames in @p scan_dir to the firmware as the live view fed them: the
- *  patterns of @p params, then its colour frames (scan_begin_view first; finish with
- *  scan_finish_view or decode_finish). @p err names a frame that is missing or wrong.
+/** Feed view @p v's kept frames in @p scan_dir to @p s as the live view fed them: the patterns
+ *  of @p params, then its colour frames (begins the view; finish with scan_finish_view or
+ *  decode_finish). @p err names a frame that is missing or wrong.
  *  @retval 0 @retval -ENOENT @retval -EINVAL */
-int scan_job_feed_view(const char *scan_dir, uint32_t v, const struct scan_params *params,
-                       const struct scan_calib *calib, char *err, size_t err_len);
+int scan_job_feed_view(struct scan_ctx *s, const char *scan_dir, uint32_t v,
+                       const struct scan_params *params, const struct scan_calib *calib, char *err,
+                       size_t err_len);
 
+/** Recompute every result of the scan in @p scan_dir from its kept frames alone.
+ *  @param hal  storage, clock and log only; no device is touched
+ *  @retval 0 ok @retval -errno with the file named in the log */
 int scan_job_process(const struct hal *hal, const char *scan_dir, const struct scan_job_opts *opts);
+
+/** The process's view buffers (one struct scan_ctx, kept with the job's other state): a command
+ *  that takes a single view outside a job (snapshot, the white calibration) uses these. */
+struct scan_ctx *scan_job_views(void);
 
 #endif

@@ -59,14 +59,14 @@ static int run(uint32_t width, uint32_t height)
         return 1;
     struct scan_view view;
     struct scan_view_info info;
-    if (scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info) != 0)
+    if (scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info) != 0)
         return 1;
     struct gray_layout layout;
     scan_layout(&t.cfg.scan, &t.calib, &layout);
     uint32_t count = gray_layout_count(&layout), patterns = count - GRAY_PATTERN_FIRST_BIT;
     const uint8_t *frames[DECODE_MAX_PATTERNS];
     for (uint32_t p = 0; p < count; p++)
-        frames[p] = decode_frame_slot(p);
+        frames[p] = decode_frame_slot(&t.scan->decode, p);
     size_t n = (size_t)width * height;
 
     int cv_count = 0;
@@ -82,15 +82,16 @@ static int run(uint32_t width, uint32_t height)
         double t0 = now_ms();
         sink += read_all(frames + GRAY_PATTERN_FIRST_BIT, patterns, n);
         double t1 = now_ms();
-        decode_pixels(reason, &maps);
+        decode_pixels(&t.scan->decode, reason, &maps);
         double t2 = now_ms();
-        decode_finish(reason, &maps);
+        decode_finish(&t.scan->decode, reason, &maps);
         double t3 = now_ms();
         floor_ms = t1 - t0 < floor_ms ? t1 - t0 : floor_ms;
         ours_ms = t2 - t1 < ours_ms ? t2 - t1 : ours_ms;
         ours_full_ms = t3 - t2 < ours_full_ms ? t3 - t2 : ours_full_ms;
     }
-    decode_pixels(reason, &maps); /* maps without the neighbour check, as OpenCV's */
+    decode_pixels(&t.scan->decode, reason,
+                  &maps); /* maps without the neighbour check, as OpenCV's */
     uint16_t *cv_col = malloc(n * 2), *cv_row = malloc(n * 2);
     uint8_t *cv_ok = malloc(n);
     double cv_ms =

@@ -18,6 +18,9 @@
 #include <string.h>
 #include <time.h>
 
+static struct scan_ctx view_buffers; /* each view read back from its range.bin */
+static struct fusion_volume vol;     /* the views fused */
+
 static double cpu_ms(void)
 {
     struct timespec ts;
@@ -93,19 +96,19 @@ int main(int argc, char **argv)
     struct mesh_summary ms;
     for (int run = 0; run < 3; run++) {
         double integrate = 0.0;
-        if (fusion_begin(&cfg.fusion) != 0)
+        if (fusion_begin(&vol, &cfg.fusion) != 0)
             return 1;
         for (uint32_t v = 0; v < views; v++) {
             struct scan_view view;
             struct frame_xform pose;
-            if (scan_dir_read_range(dir, v, calib.cam_width, calib.cam_height, &view, err,
-                                    sizeof(err)) != 0 ||
+            if (scan_dir_read_range(&view_buffers, dir, v, calib.cam_width, calib.cam_height, &view,
+                                    err, sizeof(err)) != 0 ||
                 scan_dir_read_pose(dir, v, &pose) != 0) {
                 fprintf(stderr, "view %u: %s\n", (unsigned)v, err);
                 return 1;
             }
             double t0 = cpu_ms();
-            scan_fuse_view(&calib, &view, &pose);
+            scan_fuse_view(&vol, &calib, &view, &pose);
             integrate += cpu_ms() - t0;
             if (run == 0) {
                 const double *r = pose.rot;
@@ -118,14 +121,14 @@ int main(int argc, char **argv)
             }
         }
         double t0 = cpu_ms();
-        fusion_mesh_prepare(0.0, &ms); /* every piece, as Open3D keeps them */
+        fusion_mesh_prepare(&vol, 0.0, &ms); /* every piece, as Open3D keeps them */
         double extract = cpu_ms() - t0;
         best_integrate = integrate < best_integrate ? integrate : best_integrate;
         best_extract = extract < best_extract ? extract : best_extract;
     }
     fclose(poses);
     snprintf(path, sizeof(path), "%s/mesh.ply", out);
-    if (fusion_write_ply(&st, path) != 0)
+    if (fusion_write_ply(&vol, &st, path) != 0)
         return 1;
     /* one line for the table bench/fusion_open3d.py prints */
     printf("scanner %u %.1f %.1f %u %u\n", (unsigned)views, best_integrate, best_extract,

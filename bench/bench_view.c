@@ -18,7 +18,8 @@
 
 #define REPEAT 5
 
-static struct reg_ctx reg; /* the registration the view is kept for */
+static struct reg_ctx reg;          /* the registration the view is kept for */
+static struct fusion_volume volume; /* and the volume it is fused in */
 static double now_ms(void)
 {
     struct timespec ts;
@@ -34,11 +35,12 @@ __attribute__((noinline)) void process_view_once(struct test_rig *t, const uint8
     struct gray_layout layout;
     scan_layout(&t->cfg.scan, &t->calib, &layout);
     s[0] = now_ms();
-    decode_begin(&t->cfg.scan, &layout, t->calib.proj_width, t->calib.proj_height);
+    struct scan_ctx *sc = t->scan;
+    decode_begin(&sc->decode, &t->cfg.scan, &layout, t->calib.proj_width, t->calib.proj_height);
     for (uint32_t i = 0; i < count; i++) {
-        decode_rgb_to_grey(frames + frame_bytes * i, decode_frame_slot(i), frame_bytes / 3,
-                           t->cfg.scan.saturation_dn);
-        decode_frame(i, decode_frame_slot(i));
+        decode_rgb_to_grey(frames + frame_bytes * i, decode_frame_slot(&sc->decode, i),
+                           frame_bytes / 3, t->cfg.scan.saturation_dn);
+        decode_frame(&sc->decode, i, decode_frame_slot(&sc->decode, i));
     }
     s[1] = now_ms();
     /* the stages one by one, as scan_finish_view runs them (no colour: grey zero) */
@@ -48,20 +50,22 @@ __attribute__((noinline)) void process_view_once(struct test_rig *t, const uint8
                              .height = t->cfg.scan.height,
                              .rgb = rgb,
                              .confidence = confidence};
-    decode_finish(reason, &view.maps);
+    decode_finish(&sc->decode, reason, &view.maps);
     s[2] = now_ms();
-    refine_columns(&view.maps, (int)t->cfg.scan.refine, &view.column);
+    refine_columns(&view.maps, (int)t->cfg.scan.refine, sc->column);
+    view.column = sc->column;
     s[3] = now_ms();
-    tri_range_image(&t->calib, view.width, view.height, view.column, reason, &view.range);
+    tri_range_image(&t->calib, &sc->tri, view.width, view.height, view.column, reason, &view.range);
     s[4] = now_ms();
-    tri_normals(&view.range, reason, t->cfg.scan.normal_radius_px, t->cfg.scan.max_depth_jump_mm);
+    tri_normals(&sc->tri, &view.range, reason, t->cfg.scan.normal_radius_px,
+                t->cfg.scan.max_depth_jump_mm);
     s[5] = now_ms();
     /* the joint registration keeps each view's samples now and solves once at the end */
     scan_keep_for_registration(&reg, 0, &view);
     s[6] = now_ms();
     struct frame_xform pose;
     frame_object_from_camera(&t->calib, view.angle_mdeg, &pose);
-    scan_fuse_view(&t->calib, &view, &pose);
+    scan_fuse_view(&volume, &t->calib, &view, &pose);
     s[7] = now_ms();
     scan_save_cloud_at_turntable_pose(t, &view, "build/bench_view.ply");
     s[8] = now_ms();
@@ -91,8 +95,9 @@ int main(int argc, char **argv)
     }
     double t_render = now_ms() - t0;
     double best[8] = {1e9, 1e9, 1e9, 1e9, 1e9, 1e9, 1e9, 1e9};
-    if (fusion_begin(&t.cfg.fusion) != 0 || reg_begin(&reg, &t.cfg.registration, &t.calib,
-                                                      t.cfg.views, 1, rig->width, rig->height) != 0)
+    if (fusion_begin(&volume, &t.cfg.fusion) != 0 ||
+        reg_begin(&reg, &t.cfg.registration, &t.calib, t.cfg.views, 1, rig->width, rig->height) !=
+            0)
         return 1;
     int repeat = getenv("BENCH_REPEAT") ? atoi(getenv("BENCH_REPEAT")) : REPEAT;
     for (int r = 0; r < repeat; r++) {

@@ -95,7 +95,7 @@ static int feed_patterns(struct solve *s, uint32_t v, const struct scan_calib *c
     scan_layout(&s->params, calib, &layout);
     if (!frame_exists(s->dir, v, gray_layout_count(&layout) - 1))
         return -ENOENT;
-    int rc = scan_job_feed_view(s->dir, v, &s->params, calib, err, sizeof(err));
+    int rc = scan_job_feed_view(scan_job_views(), s->dir, v, &s->params, calib, err, sizeof(err));
     if (rc != 0)
         fprintf(stderr, "scanner: error: %s\n", err);
     return rc == -ENOENT ? -EINVAL : rc;
@@ -195,7 +195,7 @@ static int load_board_view(struct solve *s, struct board_view *bv)
         return rc == -ENOENT ? 0 : rc;
     }
     struct decode_maps maps;
-    if ((rc = decode_finish(reason, &maps)) != 0)
+    if ((rc = decode_finish(&scan_job_views()->decode, reason, &maps)) != 0)
         return rc;
     if (maps.row == NULL) {
         say(s, "view_%03u: no projector rows were captured: camera only\n", (unsigned)bv->view);
@@ -763,7 +763,7 @@ static int solve_lights(struct solve *s)
         struct scan_view view;
         struct scan_view_info info;
         if ((rc = feed_patterns(s, v, &s->out)) != 0 ||
-            (rc = scan_finish_view(&s->out, 0, &view, &info)) != 0)
+            (rc = scan_finish_view(scan_job_views(), &s->out, 0, &view, &info)) != 0)
             break;
         vec3 centre;
         uint32_t used;

@@ -106,7 +106,8 @@ static int capture_one(struct capture *c, const struct calib_target_info *ti)
     struct scan_frame_sink sink = {save_frame, c};
     struct scan_view view;
     struct scan_view_info info;
-    rc = scan_take_view(hal, &c->params, c->guess, st.position_mdeg, &sink, &view, &info);
+    rc = scan_take_view(scan_job_views(), hal, &c->params, c->guess, st.position_mdeg, &sink, &view,
+                        &info);
     if (rc != 0)
         return rc;
     struct calib_target_info done = *ti;
@@ -335,7 +336,7 @@ int calibrate_verify(struct hal *hal, const struct app_config *cfg, const struct
     struct scan_view view;
     struct scan_view_info info;
     if (rc == 0)
-        rc = scan_take_view(hal, &params, calib, 0, NULL, &view, &info);
+        rc = scan_take_view(scan_job_views(), hal, &params, calib, 0, NULL, &view, &info);
     if (rc != 0)
         return rc;
     vec3 centre;

@@ -7,26 +7,6 @@
 #include <math.h>
 #include <string.h>
 
-/* One block of pixels: its accumulators stay in the first-level cache while every frame streams
- * through once. */
-#define DECODE_BLOCK 4096u
-
-static uint8_t frame_store[DECODE_MAX_PATTERNS][HAL_MAX_PIXELS];
-static uint16_t column_map[HAL_MAX_PIXELS];
-static uint16_t row_map[HAL_MAX_PIXELS];
-static uint16_t unclear_col[HAL_MAX_PIXELS]; /* bit k: Gray bit k of the column was unclear */
-static uint16_t unclear_row[HAL_MAX_PIXELS];
-static uint8_t scratch[HAL_MAX_PIXELS]; /* the neighbourhood stages' verdicts, applied after */
-
-static struct {
-    struct scan_params params;
-    struct gray_layout layout;
-    uint32_t proj_width, proj_height;
-    uint32_t next_pattern;
-    uint8_t bit_threshold[256]; /* |I - I_inverse| at or below this is unclear, per contrast */
-    uint32_t xor_col, xor_row;  /* gray_code_xor_mask of the columns and rows */
-} dec;
-
 const char *scan_reason_name(unsigned reason)
 {
     static const char *const names[SCAN_REASON_COUNT] = {
@@ -68,37 +48,37 @@ uint32_t decode_bit_threshold(const struct scan_params *p, uint32_t contrast_dn)
     return t > 254.0 ? 254u : (uint32_t)t;
 }
 
-int decode_begin(const struct scan_params *params, const struct gray_layout *layout,
-                 uint32_t proj_width, uint32_t proj_height)
+int decode_begin(struct decode_ctx *d, const struct scan_params *params,
+                 const struct gray_layout *layout, uint32_t proj_width, uint32_t proj_height)
 {
     if (params->width == 0 || params->height == 0 || params->width > HAL_MAX_WIDTH ||
         params->height > HAL_MAX_HEIGHT || layout->col_bits == 0 || layout->col_bits > 16 ||
         layout->row_bits > 16 || gray_layout_count(layout) > DECODE_MAX_PATTERNS)
         return -EINVAL;
-    dec.params = *params;
-    dec.layout = *layout;
-    dec.proj_width = proj_width;
-    dec.proj_height = proj_height;
-    dec.next_pattern = 0;
+    d->params = *params;
+    d->layout = *layout;
+    d->proj_width = proj_width;
+    d->proj_height = proj_height;
+    d->next_pattern = 0;
     for (uint32_t c = 0; c < 256; c++)
-        dec.bit_threshold[c] = (uint8_t)decode_bit_threshold(params, c);
-    dec.xor_col = gray_code_xor_mask(layout->code, layout->col_bits);
-    dec.xor_row = gray_code_xor_mask(layout->code, layout->row_bits);
+        d->bit_threshold[c] = (uint8_t)decode_bit_threshold(params, c);
+    d->xor_col = gray_code_xor_mask(layout->code, layout->col_bits);
+    d->xor_row = gray_code_xor_mask(layout->code, layout->row_bits);
     return 0;
 }
 
-uint8_t *decode_frame_slot(uint32_t pattern)
+uint8_t *decode_frame_slot(struct decode_ctx *d, uint32_t pattern)
 {
-    return pattern < gray_layout_count(&dec.layout) ? frame_store[pattern] : NULL;
+    return pattern < gray_layout_count(&d->layout) ? d->frame_store[pattern] : NULL;
 }
 
-int decode_frame(uint32_t pattern, const uint8_t *grey)
+int decode_frame(struct decode_ctx *d, uint32_t pattern, const uint8_t *grey)
 {
-    if (pattern != dec.next_pattern || pattern >= gray_layout_count(&dec.layout))
+    if (pattern != d->next_pattern || pattern >= gray_layout_count(&d->layout))
         return -EINVAL;
-    if (grey != frame_store[pattern])
-        memcpy(frame_store[pattern], grey, (size_t)dec.params.width * dec.params.height);
-    dec.next_pattern++;
+    if (grey != d->frame_store[pattern])
+        memcpy(d->frame_store[pattern], grey, (size_t)d->params.width * d->params.height);
+    d->next_pattern++;
     return 0;
 }
 
@@ -109,20 +89,20 @@ int decode_frame(uint32_t pattern, const uint8_t *grey)
  * compared with the pixel's own threshold, and a pair is saturated when both frames reached
  * DECODE_SATURATED (one saturated frame still says which is brighter). decode_reference is the
  * same, plainly. */
-static void accumulate(uint32_t first, uint32_t bits, size_t start, size_t len,
-                       const uint8_t *threshold, uint16_t *code, uint16_t *unclear,
+static void accumulate(struct decode_ctx *d, uint32_t first, uint32_t bits, size_t start,
+                       size_t len, const uint8_t *threshold, uint16_t *code, uint16_t *unclear,
                        uint8_t *both_saturated)
 {
-    const uint16_t xor_mask = (uint16_t)gray_code_xor_mask(dec.layout.code, bits);
-    static uint8_t plane_hi[DECODE_BLOCK], plane_lo[DECODE_BLOCK];
-    static uint8_t unclear_hi[DECODE_BLOCK], unclear_lo[DECODE_BLOCK];
+    const uint16_t xor_mask = (uint16_t)gray_code_xor_mask(d->layout.code, bits);
+    uint8_t *plane_hi = d->block.plane_hi, *plane_lo = d->block.plane_lo;
+    uint8_t *unclear_hi = d->block.unclear_hi, *unclear_lo = d->block.unclear_lo;
     memset(plane_hi, 0, len);
     memset(plane_lo, 0, len);
     memset(unclear_hi, 0, len);
     memset(unclear_lo, 0, len);
     for (uint32_t k = 0; k < bits; k++) {
-        const uint8_t *restrict pos = frame_store[first + 2u * k] + start;
-        const uint8_t *restrict neg = frame_store[first + 2u * k + 1u] + start;
+        const uint8_t *restrict pos = d->frame_store[first + 2u * k] + start;
+        const uint8_t *restrict neg = d->frame_store[first + 2u * k + 1u] + start;
         uint8_t *restrict plane = k < 8 ? plane_hi : plane_lo;
         uint8_t *restrict unc = k < 8 ? unclear_hi : unclear_lo;
         uint8_t *restrict sat = both_saturated;
@@ -170,7 +150,7 @@ static unsigned unclear_count(uint32_t unclear, uint32_t xor_mask)
 /* The reasons, in order of precedence; shared by the blocked decoder and the reference. A pixel
  * with too many unclear bits may still be resolved by its neighbourhood (resolve_unclear). */
 static uint8_t classify(const struct scan_params *p, int white, int black, int both_saturated,
-                        unsigned unclear_col, unsigned unclear_row, int out_of_range)
+                        unsigned unclear_c, unsigned unclear_r, int out_of_range)
 {
     int contrast = white - black;
     if (black == DECODE_SATURATED) /* no contrast to judge by */
@@ -181,56 +161,56 @@ static uint8_t classify(const struct scan_params *p, int white, int black, int b
         return SCAN_DARK;
     /* One unclear bit per coordinate is a pixel on the edge between two columns (rows): adjacent
      * Gray codes differ in one bit, so either reading is one of the two. */
-    if (unclear_col > p->max_ambiguous_bits || unclear_row > p->max_ambiguous_bits)
+    if (unclear_c > p->max_ambiguous_bits || unclear_r > p->max_ambiguous_bits)
         return both_saturated ? SCAN_SATURATED : SCAN_LOW_CONTRAST;
     return out_of_range ? SCAN_INCONSISTENT : SCAN_VALID;
 }
 
-static void decode_block(size_t start, size_t len, uint8_t *reason)
+static void decode_block(struct decode_ctx *d, size_t start, size_t len, uint8_t *reason)
 {
-    static uint16_t code_col[DECODE_BLOCK], code_row[DECODE_BLOCK];
-    static uint8_t threshold[DECODE_BLOCK], sat[DECODE_BLOCK];
-    const uint8_t *white = frame_store[GRAY_PATTERN_WHITE] + start;
-    const uint8_t *black = frame_store[GRAY_PATTERN_BLACK] + start;
-    const struct gray_layout *l = &dec.layout;
+    uint16_t *code_col = d->block.code_col, *code_row = d->block.code_row;
+    uint8_t *threshold = d->block.threshold, *sat = d->block.sat;
+    const uint8_t *white = d->frame_store[GRAY_PATTERN_WHITE] + start;
+    const uint8_t *black = d->frame_store[GRAY_PATTERN_BLACK] + start;
+    const struct gray_layout *l = &d->layout;
     for (size_t i = 0; i < len; i++) {
-        threshold[i] = dec.bit_threshold[white[i] > black[i] ? white[i] - black[i] : 0];
+        threshold[i] = d->bit_threshold[white[i] > black[i] ? white[i] - black[i] : 0];
         sat[i] = 0;
     }
-    accumulate(GRAY_PATTERN_FIRST_BIT, l->col_bits, start, len, threshold, code_col,
-               unclear_col + start, sat);
+    accumulate(d, GRAY_PATTERN_FIRST_BIT, l->col_bits, start, len, threshold, code_col,
+               d->unclear_col + start, sat);
     if (l->row_bits > 0)
-        accumulate(GRAY_PATTERN_FIRST_BIT + 2u * l->col_bits, l->row_bits, start, len, threshold,
-                   code_row, unclear_row + start, sat);
+        accumulate(d, GRAY_PATTERN_FIRST_BIT + 2u * l->col_bits, l->row_bits, start, len, threshold,
+                   code_row, d->unclear_row + start, sat);
     else
-        memset(unclear_row + start, 0, len * sizeof(uint16_t));
+        memset(d->unclear_row + start, 0, len * sizeof(uint16_t));
     /* Locals: the stores to reason[] (bytes) may alias anything, and would make the compiler
      * read the settings again for every pixel. */
-    const struct scan_params params = dec.params;
-    const uint32_t xor_col = dec.xor_col, xor_row = dec.xor_row, rows = l->row_bits;
-    const uint32_t width = dec.proj_width, height = dec.proj_height;
+    const struct scan_params params = d->params;
+    const uint32_t xor_col = d->xor_col, xor_row = d->xor_row, rows = l->row_bits;
+    const uint32_t width = d->proj_width, height = d->proj_height;
     for (size_t i = 0; i < len; i++) {
         int out = code_col[i] >= width || (rows > 0 && code_row[i] >= height);
         reason[start + i] = classify(&params, white[i], black[i], sat[i],
-                                     unclear_count(unclear_col[start + i], xor_col),
-                                     unclear_count(unclear_row[start + i], xor_row), out);
-        column_map[start + i] = code_col[i];
-        row_map[start + i] = rows > 0 ? code_row[i] : 0;
+                                     unclear_count(d->unclear_col[start + i], xor_col),
+                                     unclear_count(d->unclear_row[start + i], xor_row), out);
+        d->column_map[start + i] = code_col[i];
+        d->row_map[start + i] = rows > 0 ? code_row[i] : 0;
     }
 }
 
-int decode_pixels(uint8_t *reason, struct decode_maps *maps)
+int decode_pixels(struct decode_ctx *d, uint8_t *reason, struct decode_maps *maps)
 {
-    if (dec.next_pattern != gray_layout_count(&dec.layout))
+    if (d->next_pattern != gray_layout_count(&d->layout))
         return -EINVAL;
-    size_t n = (size_t)dec.params.width * dec.params.height;
+    size_t n = (size_t)d->params.width * d->params.height;
     for (size_t start = 0; start < n; start += DECODE_BLOCK)
-        decode_block(start, n - start < DECODE_BLOCK ? n - start : DECODE_BLOCK, reason);
-    maps->column = column_map;
-    maps->row = dec.layout.row_bits > 0 ? row_map : NULL;
+        decode_block(d, start, n - start < DECODE_BLOCK ? n - start : DECODE_BLOCK, reason);
+    maps->column = d->column_map;
+    maps->row = d->layout.row_bits > 0 ? d->row_map : NULL;
     maps->reason = reason;
-    maps->width = dec.params.width;
-    maps->height = dec.params.height;
+    maps->width = d->params.width;
+    maps->height = d->params.height;
     return 0;
 }
 
@@ -252,10 +232,10 @@ static int within(int a, int b, uint32_t jump)
  * c = a + b dx + e dy fitted to the pixels the per-pixel stage left valid, after dropping those
  * far from their median (a wrong bit), and trusted when at least min_consistent_neighbours lie
  * within RESOLVE_FIT_COLUMNS of it. @retval 1 found (a, in *ref) @retval 0 no agreement */
-static int neighbourhood_code(const uint8_t *reason, const uint16_t *map, uint32_t x, uint32_t y,
-                              double *ref)
+static int neighbourhood_code(const struct decode_ctx *d, const uint8_t *reason,
+                              const uint16_t *map, uint32_t x, uint32_t y, double *ref)
 {
-    const uint32_t w = dec.params.width, h = dec.params.height;
+    const uint32_t w = d->params.width, h = d->params.height;
     int v[RESOLVE_MAX], sorted[RESOLVE_MAX], ox[RESOLVE_MAX], oy[RESOLVE_MAX];
     uint32_t n = 0;
     for (int dy = -RESOLVE_RADIUS; dy <= RESOLVE_RADIUS; dy++)
@@ -275,7 +255,7 @@ static int neighbourhood_code(const uint8_t *reason, const uint16_t *map, uint32
                 sorted[k] = sorted[k - 1];
             sorted[k] = c;
         }
-    if (n < dec.params.min_consistent_neighbours || n < 3)
+    if (n < d->params.min_consistent_neighbours || n < 3)
         return 0;
     int median = sorted[n / 2];
     double a[9] = {0}, b[3] = {0}, coef[3]; /* normal equations of the plane */
@@ -298,7 +278,7 @@ static int neighbourhood_code(const uint8_t *reason, const uint16_t *map, uint32
     for (uint32_t k = 0; k < n; k++)
         agree += fabs(coef[0] + coef[1] * ox[k] + coef[2] * oy[k] - v[k]) <= RESOLVE_FIT_COLUMNS;
     *ref = coef[0];
-    return agree >= dec.params.min_consistent_neighbours;
+    return agree >= d->params.min_consistent_neighbours;
 }
 
 /* Of the values an unclear pixel can have, the one nearest @p ref: the values within
@@ -306,10 +286,9 @@ static int neighbourhood_code(const uint8_t *reason, const uint16_t *map, uint32
  * pattern (an unclear bit lies on a stripe edge and may read either way). The word the pixel
  * read is the word of its plain value (value and word are one to one).
  * @retval 1 found (in *value) @retval 0 none */
-static int nearest_reading(uint32_t bits, uint16_t plain, uint16_t unclear, double ref,
-                           uint32_t limit, uint16_t *value)
+static int nearest_reading(uint32_t code, uint32_t bits, uint16_t plain, uint16_t unclear,
+                           double ref, uint32_t limit, uint16_t *value)
 {
-    const uint32_t code = dec.layout.code;
     const uint32_t read = gray_code_word(code, bits, plain);
     long lo = (long)ceil(ref - RESOLVE_FIT_COLUMNS), hi = (long)floor(ref + RESOLVE_FIT_COLUMNS);
     int best = -1;
@@ -326,74 +305,76 @@ static int nearest_reading(uint32_t bits, uint16_t plain, uint16_t unclear, doub
 /* A pixel with unclear bits takes, of its possible readings, the one its decoded neighbourhood
  * predicts: one with more than max_ambiguous_bits (or decoding outside the projector) becomes
  * valid so; a valid one whose unclear bit read the wrong way (noise, not an edge) is corrected.
- * Verdicts go to scratch and corrections wait in the unclear maps (not needed after this) until
+ * Verdicts go to d->scratch and corrections wait in the unclear maps (not needed after this) until
  * the pass ends, so that what this pass changes is not the reference of others. */
-#define RESOLVE_CORRECTED SCAN_REASON_COUNT /* in scratch: valid, its reading replaced */
-static void resolve_unclear(uint8_t *reason)
+#define RESOLVE_CORRECTED SCAN_REASON_COUNT /* in d->scratch: valid, its reading replaced */
+static void resolve_unclear(struct decode_ctx *d, uint8_t *reason)
 {
-    const uint32_t w = dec.params.width, h = dec.params.height;
-    const uint32_t max_unclear = dec.params.max_unclear_bits;
-    const int rows = dec.layout.row_bits > 0;
+    const uint32_t w = d->params.width, h = d->params.height;
+    const uint32_t max_unclear = d->params.max_unclear_bits;
+    const int rows = d->layout.row_bits > 0;
     for (uint32_t y = 0; y < h; y++) {
         for (uint32_t x = 0; x < w; x++) {
             size_t i = (size_t)y * w + x;
             uint8_t r = reason[i];
-            scratch[i] = r;
+            d->scratch[i] = r;
             int pending = r == SCAN_LOW_CONTRAST || r == SCAN_SATURATED || r == SCAN_INCONSISTENT;
-            if ((!pending && r != SCAN_VALID) || (unclear_col[i] == 0 && unclear_row[i] == 0) ||
-                unclear_count(unclear_col[i], dec.xor_col) > max_unclear ||
-                unclear_count(unclear_row[i], dec.xor_row) > max_unclear)
+            if ((!pending && r != SCAN_VALID) ||
+                (d->unclear_col[i] == 0 && d->unclear_row[i] == 0) ||
+                unclear_count(d->unclear_col[i], d->xor_col) > max_unclear ||
+                unclear_count(d->unclear_row[i], d->xor_row) > max_unclear)
                 continue;
             double ref_col, ref_row = 0.0;
             uint16_t col, row = 0;
-            if (!neighbourhood_code(reason, column_map, x, y, &ref_col) ||
-                !nearest_reading(dec.layout.col_bits, column_map[i], unclear_col[i], ref_col,
-                                 dec.proj_width, &col) ||
-                (rows && (!neighbourhood_code(reason, row_map, x, y, &ref_row) ||
-                          !nearest_reading(dec.layout.row_bits, row_map[i], unclear_row[i], ref_row,
-                                           dec.proj_height, &row))))
+            if (!neighbourhood_code(d, reason, d->column_map, x, y, &ref_col) ||
+                !nearest_reading(d->layout.code, d->layout.col_bits, d->column_map[i],
+                                 d->unclear_col[i], ref_col, d->proj_width, &col) ||
+                (rows && (!neighbourhood_code(d, reason, d->row_map, x, y, &ref_row) ||
+                          !nearest_reading(d->layout.code, d->layout.row_bits, d->row_map[i],
+                                           d->unclear_row[i], ref_row, d->proj_height, &row))))
                 continue;
             if (pending) { /* not a reference of this pass: its maps can change now */
-                column_map[i] = col;
-                row_map[i] = row;
-                scratch[i] = SCAN_VALID;
-            } else if (col != column_map[i] || (rows && row != row_map[i])) {
-                unclear_col[i] = col;
-                unclear_row[i] = rows ? row : row_map[i];
-                scratch[i] = RESOLVE_CORRECTED;
+                d->column_map[i] = col;
+                d->row_map[i] = row;
+                d->scratch[i] = SCAN_VALID;
+            } else if (col != d->column_map[i] || (rows && row != d->row_map[i])) {
+                d->unclear_col[i] = col;
+                d->unclear_row[i] = rows ? row : d->row_map[i];
+                d->scratch[i] = RESOLVE_CORRECTED;
             }
         }
     }
     size_t n = (size_t)w * h;
     for (size_t i = 0; i < n; i++) {
-        if (scratch[i] == RESOLVE_CORRECTED) {
-            column_map[i] = unclear_col[i];
-            row_map[i] = unclear_row[i];
-            scratch[i] = SCAN_VALID;
+        if (d->scratch[i] == RESOLVE_CORRECTED) {
+            d->column_map[i] = d->unclear_col[i];
+            d->row_map[i] = d->unclear_row[i];
+            d->scratch[i] = SCAN_VALID;
         }
     }
-    memcpy(reason, scratch, n);
+    memcpy(reason, d->scratch, n);
 }
 
-static int codes_agree(const uint8_t *reason, size_t a, size_t b)
+static int codes_agree(const struct decode_ctx *d, const uint8_t *reason, size_t a, size_t b)
 {
     if (reason[b] != SCAN_VALID)
         return 0;
-    return within(column_map[a], column_map[b], dec.params.max_column_jump) &&
-           (dec.layout.row_bits == 0 || within(row_map[a], row_map[b], dec.params.max_column_jump));
+    return within(d->column_map[a], d->column_map[b], d->params.max_column_jump) &&
+           (d->layout.row_bits == 0 ||
+            within(d->row_map[a], d->row_map[b], d->params.max_column_jump));
 }
 
 /* A wrong bit makes a lone jump: a pixel is inconsistent when more of its valid neighbours
  * disagree with it than agree, or when fewer than min_consistent_neighbours agree and none of
  * its 5 x 5 neighbourhood backs it. A pixel with only a few valid neighbours, all agreeing (on
  * a thin part, beside a shadow), is kept: alone is not wrong. Columns and, when coded, rows. */
-static void check_neighbours(uint8_t *reason)
+static void check_neighbours(struct decode_ctx *d, uint8_t *reason)
 {
-    const uint32_t w = dec.params.width, h = dec.params.height;
+    const uint32_t w = d->params.width, h = d->params.height;
     for (uint32_t y = 0; y < h; y++) {
         for (uint32_t x = 0; x < w; x++) {
             size_t i = (size_t)y * w + x;
-            scratch[i] = reason[i];
+            d->scratch[i] = reason[i];
             if (reason[i] != SCAN_VALID)
                 continue;
             uint32_t agree = 0, valid = 0;
@@ -404,29 +385,30 @@ static void check_neighbours(uint8_t *reason)
                         continue;
                     size_t j = (size_t)ny * w + (size_t)nx;
                     valid += reason[j] == SCAN_VALID;
-                    agree += (uint32_t)codes_agree(reason, i, j);
+                    agree += (uint32_t)codes_agree(d, reason, i, j);
                 }
             }
-            if (agree >= dec.params.min_consistent_neighbours)
+            if (agree >= d->params.min_consistent_neighbours)
                 continue;
             double ref_col, ref_row;
             if (valid - agree > agree || agree == 0 ||
-                !neighbourhood_code(reason, column_map, x, y, &ref_col) ||
-                fabs(column_map[i] - ref_col) > RESOLVE_FIT_COLUMNS ||
-                (dec.layout.row_bits > 0 && (!neighbourhood_code(reason, row_map, x, y, &ref_row) ||
-                                             fabs(row_map[i] - ref_row) > RESOLVE_FIT_COLUMNS)))
-                scratch[i] = SCAN_INCONSISTENT;
+                !neighbourhood_code(d, reason, d->column_map, x, y, &ref_col) ||
+                fabs(d->column_map[i] - ref_col) > RESOLVE_FIT_COLUMNS ||
+                (d->layout.row_bits > 0 &&
+                 (!neighbourhood_code(d, reason, d->row_map, x, y, &ref_row) ||
+                  fabs(d->row_map[i] - ref_row) > RESOLVE_FIT_COLUMNS)))
+                d->scratch[i] = SCAN_INCONSISTENT;
         }
     }
-    memcpy(reason, scratch, (size_t)w * h);
+    memcpy(reason, d->scratch, (size_t)w * h);
 }
 
-int decode_finish(uint8_t *reason, struct decode_maps *maps)
+int decode_finish(struct decode_ctx *d, uint8_t *reason, struct decode_maps *maps)
 {
-    int rc = decode_pixels(reason, maps);
+    int rc = decode_pixels(d, reason, maps);
     if (rc == 0) {
-        resolve_unclear(reason);
-        check_neighbours(reason);
+        resolve_unclear(d, reason);
+        check_neighbours(d, reason);
     }
     return rc;
 }

@@ -1,6 +1,7 @@
 /* Structured-light decoding: per-pixel projector column (and row) and a reason code for every
- * rejected pixel. The frames of a view are kept in a static store and decoded together, in blocks
- * of pixels small enough for the first-level cache, so each frame is read from memory once. */
+ * rejected pixel. The frames of a view are kept in the decoder's store (struct decode_ctx) and
+ * decoded together, in blocks of pixels small enough for the first-level cache, so each frame is
+ * read from memory once. */
 #ifndef DECODE_H
 #define DECODE_H
 
@@ -32,6 +33,33 @@ struct decode_maps {
 
 /* Patterns a view can have: DECODE_MAX_PATTERNS (hal_limits.h). */
 
+/** Pixels decoded together: a block's accumulators stay in the first-level cache while every
+ *  frame streams through once. */
+#define DECODE_BLOCK 4096u
+
+/** One view's decoder: its frames, maps and settings (several MB at the compiled limits: kept
+ *  static by its owner, a struct scan_ctx, never on the stack). Fields are the decoder's own. */
+struct decode_ctx {
+    uint8_t frame_store[DECODE_MAX_PATTERNS][HAL_MAX_PIXELS];
+    uint16_t column_map[HAL_MAX_PIXELS];
+    uint16_t row_map[HAL_MAX_PIXELS];
+    uint16_t unclear_col[HAL_MAX_PIXELS]; /* bit k: Gray bit k of the column was unclear */
+    uint16_t unclear_row[HAL_MAX_PIXELS];
+    uint8_t scratch[HAL_MAX_PIXELS]; /* the neighbourhood stages' verdicts, applied after */
+    struct {                         /* one block's accumulators */
+        uint16_t code_col[DECODE_BLOCK], code_row[DECODE_BLOCK];
+        uint8_t threshold[DECODE_BLOCK], sat[DECODE_BLOCK];
+        uint8_t plane_hi[DECODE_BLOCK], plane_lo[DECODE_BLOCK];
+        uint8_t unclear_hi[DECODE_BLOCK], unclear_lo[DECODE_BLOCK];
+    } block;
+    struct scan_params params;
+    struct gray_layout layout;
+    uint32_t proj_width, proj_height;
+    uint32_t next_pattern;
+    uint8_t bit_threshold[256]; /* |I - I_inverse| at or below this is unclear, per contrast */
+    uint32_t xor_col, xor_row;  /* gray_code_xor_mask of the columns and rows */
+};
+
 /** Short name of a reason code, for logs and reports. */
 const char *scan_reason_name(unsigned reason);
 
@@ -48,24 +76,24 @@ void decode_rgb_to_grey(const uint8_t *rgb, uint8_t *grey, size_t n, uint32_t sa
  *  at this white-minus-black contrast, and never below min_bit_diff_dn. */
 uint32_t decode_bit_threshold(const struct scan_params *params, uint32_t contrast_dn);
 
-/** Start a view of a @p proj_width x @p proj_height projector coded as @p layout.
+/** Start a view of a @p proj_width x @p proj_height projector coded as @p layout in @p d.
  *  @retval 0 ok @retval -EINVAL size or pattern count above the compiled limits */
-int decode_begin(const struct scan_params *params, const struct gray_layout *layout,
-                 uint32_t proj_width, uint32_t proj_height);
+int decode_begin(struct decode_ctx *d, const struct scan_params *params,
+                 const struct gray_layout *layout, uint32_t proj_width, uint32_t proj_height);
 /** Where frame @p pattern is kept: a capture may write its grey frame there directly.
  *  @retval NULL when @p pattern is outside the layout */
-uint8_t *decode_frame_slot(uint32_t pattern);
+uint8_t *decode_frame_slot(struct decode_ctx *d, uint32_t pattern);
 /** Hand over the grey frame of pattern @p pattern, in sequence order (copied into its slot
  *  unless it already is the slot). @retval 0 ok @retval -EINVAL out of order */
-int decode_frame(uint32_t pattern, const uint8_t *grey);
+int decode_frame(struct decode_ctx *d, uint32_t pattern, const uint8_t *grey);
 /** Decode every pixel from the kept frames (decode_pixels); then pixels with several unclear
  *  bits take the reading their neighbourhood agrees with; then the neighbour check.
  *  @param reason  out: enum scan_reason per pixel (width * height, the caller's buffer)
  *  @param maps    out: the decoder's column and row maps, and @p reason
  *  @retval 0 ok @retval -EINVAL frames missing */
-int decode_finish(uint8_t *reason, struct decode_maps *maps);
+int decode_finish(struct decode_ctx *d, uint8_t *reason, struct decode_maps *maps);
 /** The per-pixel stage of decode_finish alone (for tests and benchmarks); same parameters. */
-int decode_pixels(uint8_t *reason, struct decode_maps *maps);
+int decode_pixels(struct decode_ctx *d, uint8_t *reason, struct decode_maps *maps);
 
 /** The plain per-pixel reference the blocked decoder must match (tests compare them): decode
  *  @p n pixels of @p frames (one pointer per pattern of @p layout) into @p column, @p row

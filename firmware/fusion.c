@@ -1,4 +1,5 @@
-/* Truncated signed distance fusion in a static voxel grid, and marching cubes over it. */
+/* Truncated signed distance fusion in a voxel grid (struct fusion_volume), and marching cubes
+ * over it. */
 #include "fusion.h"
 #include "fusion_grid.h"
 
@@ -10,16 +11,6 @@
 #include <errno.h>
 #include <stdio.h>
 #include <string.h>
-
-struct voxel fusion_grid[FUSION_MAX_VOXELS];
-static float weight_map[HAL_MAX_PIXELS];
-static uint16_t edge_dist[HAL_MAX_PIXELS];
-/* vertex numbers of the grid edges of two sample planes (x, y edges) and between them (z) */
-static uint32_t edge_vertex_x[2][FUSION_MAX_DIM * FUSION_MAX_DIM];
-static uint32_t edge_vertex_y[2][FUSION_MAX_DIM * FUSION_MAX_DIM];
-static uint32_t edge_vertex_z[FUSION_MAX_DIM * FUSION_MAX_DIM];
-
-struct fusion_state fusion_vol;
 
 #define NO_VERTEX 0xFFFFFFFFu
 
@@ -38,16 +29,14 @@ int fusion_dims(const struct fusion_params *p, uint32_t dims[3])
     return 0;
 }
 
-int fusion_begin(const struct fusion_params *p)
+int fusion_begin(struct fusion_volume *vol, const struct fusion_params *p)
 {
-    int rc = fusion_dims(p, fusion_vol.dims);
+    int rc = fusion_dims(p, vol->dims);
     if (rc != 0)
         return rc;
-    fusion_vol.p = *p;
-    fusion_vol.origin = v3(-p->radius_mm, -p->radius_mm, p->bottom_mm);
-    memset(fusion_grid, 0,
-           (size_t)fusion_vol.dims[0] * fusion_vol.dims[1] * fusion_vol.dims[2] *
-               sizeof(fusion_grid[0]));
+    vol->p = *p;
+    vol->origin = v3(-p->radius_mm, -p->radius_mm, p->bottom_mm);
+    memset(vol->grid, 0, (size_t)vol->dims[0] * vol->dims[1] * vol->dims[2] * sizeof(vol->grid[0]));
     mc_table_build();
     return 0;
 }
@@ -55,12 +44,9 @@ int fusion_begin(const struct fusion_params *p)
 /* The rectangle of pixels a view's work covers: its valid pixels and a ring of one pixel
  * around them (within the image), x0 <= x < x1, y0 <= y < y1. The object fills a part of the
  * frame; the passes over pixels stay inside. */
-static struct {
-    uint32_t x0, y0, x1, y1;
-} rect;
 
 /* @retval 0 when the view has no valid pixel */
-static int find_rect(const struct decode_maps *m)
+static int find_rect(struct fusion_volume *vol, const struct decode_maps *m)
 {
     const uint32_t w = m->width, h = m->height;
     uint32_t x0 = w, x1 = 0, y0 = h, y1 = 0;
@@ -79,41 +65,41 @@ static int find_rect(const struct decode_maps *m)
     }
     if (x1 == 0)
         return 0;
-    rect.x0 = x0 > 0 ? x0 - 1 : 0;
-    rect.y0 = y0 > 0 ? y0 - 1 : 0;
-    rect.x1 = x1 < w ? x1 + 1 : w;
-    rect.y1 = y1 < h ? y1 + 1 : h;
+    vol->rect.x0 = x0 > 0 ? x0 - 1 : 0;
+    vol->rect.y0 = y0 > 0 ? y0 - 1 : 0;
+    vol->rect.x1 = x1 < w ? x1 + 1 : w;
+    vol->rect.y1 = y1 < h ? y1 + 1 : h;
     return 1;
 }
 
 /* City-block distance of each valid pixel to the nearest invalid one (two passes), capped.
  * Inside the rectangle only: its ring holds no valid pixel, so nothing outside is read. */
-static void distance_to_edge(const struct decode_maps *m, uint16_t cap)
+static void distance_to_edge(struct fusion_volume *vol, const struct decode_maps *m, uint16_t cap)
 {
     const uint32_t w = m->width, h = m->height;
-    for (uint32_t y = rect.y0; y < rect.y1; y++) {
-        for (uint32_t x = rect.x0; x < rect.x1; x++) {
+    for (uint32_t y = vol->rect.y0; y < vol->rect.y1; y++) {
+        for (uint32_t x = vol->rect.x0; x < vol->rect.x1; x++) {
             size_t i = (size_t)y * w + x;
             uint16_t d = 0;
             if (m->reason[i] == SCAN_VALID) {
                 d = cap;
-                if (x > 0 && edge_dist[i - 1] + 1 < d)
-                    d = (uint16_t)(edge_dist[i - 1] + 1);
-                if (y > 0 && edge_dist[i - w] + 1 < d)
-                    d = (uint16_t)(edge_dist[i - w] + 1);
+                if (x > 0 && vol->edge_dist[i - 1] + 1 < d)
+                    d = (uint16_t)(vol->edge_dist[i - 1] + 1);
+                if (y > 0 && vol->edge_dist[i - w] + 1 < d)
+                    d = (uint16_t)(vol->edge_dist[i - w] + 1);
                 if (x == 0 || y == 0 || x + 1 == w || y + 1 == h)
                     d = 1;
             }
-            edge_dist[i] = d;
+            vol->edge_dist[i] = d;
         }
     }
-    for (uint32_t y = rect.y1; y-- > rect.y0;) {
-        for (uint32_t x = rect.x1; x-- > rect.x0;) {
+    for (uint32_t y = vol->rect.y1; y-- > vol->rect.y0;) {
+        for (uint32_t x = vol->rect.x1; x-- > vol->rect.x0;) {
             size_t i = (size_t)y * w + x;
-            if (x + 1 < w && edge_dist[i + 1] + 1 < edge_dist[i])
-                edge_dist[i] = (uint16_t)(edge_dist[i + 1] + 1);
-            if (y + 1 < h && edge_dist[i + w] + 1 < edge_dist[i])
-                edge_dist[i] = (uint16_t)(edge_dist[i + w] + 1);
+            if (x + 1 < w && vol->edge_dist[i + 1] + 1 < vol->edge_dist[i])
+                vol->edge_dist[i] = (uint16_t)(vol->edge_dist[i + 1] + 1);
+            if (y + 1 < h && vol->edge_dist[i + w] + 1 < vol->edge_dist[i])
+                vol->edge_dist[i] = (uint16_t)(vol->edge_dist[i + w] + 1);
         }
     }
 }
@@ -121,25 +107,25 @@ static void distance_to_edge(const struct decode_maps *m, uint16_t cap)
 /* How much a pixel is trusted: head-on, close (finer sampling), and away from the view's edge,
  * where depth is least reliable and colour seams would show (Jost et al., boundary filtering).
  * @retval 0 when no pixel is valid */
-static int pixel_weights(const struct scan_calib *c, const struct decode_maps *m,
-                         const struct tri_range *r)
+static int pixel_weights(struct fusion_volume *vol, const struct scan_calib *c,
+                         const struct decode_maps *m, const struct tri_range *r)
 {
-    const double fade = fusion_vol.p.edge_fade_px > 0 ? (double)fusion_vol.p.edge_fade_px : 1.0;
+    const double fade = vol->p.edge_fade_px > 0 ? (double)vol->p.edge_fade_px : 1.0;
     const struct camray rays = camray_lookup(c); /* the table, where it is this calibration's */
-    memset(weight_map, 0, (size_t)m->width * m->height * sizeof(weight_map[0]));
-    if (!find_rect(m))
+    memset(vol->weight_map, 0, (size_t)m->width * m->height * sizeof(vol->weight_map[0]));
+    if (!find_rect(vol, m))
         return 0;
-    distance_to_edge(m, (uint16_t)(fusion_vol.p.edge_fade_px > 0 ? fusion_vol.p.edge_fade_px : 1));
-    for (uint32_t y = rect.y0; y < rect.y1; y++) {
-        for (uint32_t x = rect.x0; x < rect.x1; x++) {
+    distance_to_edge(vol, m, (uint16_t)(vol->p.edge_fade_px > 0 ? vol->p.edge_fade_px : 1));
+    for (uint32_t y = vol->rect.y0; y < vol->rect.y1; y++) {
+        for (uint32_t x = vol->rect.x0; x < vol->rect.x1; x++) {
             size_t i = (size_t)y * m->width + x;
             if (m->reason[i] != SCAN_VALID)
                 continue;
             vec3 ray = v3_norm(camray_at(c, rays, x, y));
             vec3 n = v3(r->normal[3 * i], r->normal[3 * i + 1], r->normal[3 * i + 2]);
             double head_on = -v3_dot(n, ray), z = r->xyz_mm[3 * i + 2];
-            double w = head_on * (600.0 / z) * (600.0 / z) * fmin(1.0, edge_dist[i] / fade);
-            weight_map[i] = w >= fusion_vol.p.min_weight ? (float)w : 0.0f;
+            double w = head_on * (600.0 / z) * (600.0 / z) * fmin(1.0, vol->edge_dist[i] / fade);
+            vol->weight_map[i] = w >= vol->p.min_weight ? (float)w : 0.0f;
         }
     }
     return 1;
@@ -165,9 +151,10 @@ static void fuse_colour(struct voxel *vx, double cw, const uint8_t *rgb)
     vx->colour_weight = (uint8_t)fmax(new_cw + 0.5, COLOUR_BEST_EFFORT + 1);
 }
 
-static void fuse_voxel(struct voxel *vx, double sdf, double w, double cw, const uint8_t *rgb)
+static void fuse_voxel(struct fusion_volume *vol, struct voxel *vx, double sdf, double w, double cw,
+                       const uint8_t *rgb)
 {
-    double trunc = fusion_vol.p.truncation_mm;
+    double trunc = vol->p.truncation_mm;
     if (sdf > trunc)
         sdf = trunc;
     double old_w = vx->weight / WEIGHT_SCALE, old_s = vx->sdf / 32767.0 * trunc;
@@ -178,7 +165,7 @@ static void fuse_voxel(struct voxel *vx, double sdf, double w, double cw, const 
     /* rounded half away from zero, as lround, without a libm call per voxel */
     double q = s / trunc * 32767.0;
     vx->sdf = (int16_t)(q >= 0.0 ? q + 0.5 : q - 0.5);
-    vx->weight = (uint16_t)(fmin(new_w, fusion_vol.p.max_weight) * WEIGHT_SCALE + 0.5);
+    vx->weight = (uint16_t)(fmin(new_w, vol->p.max_weight) * WEIGHT_SCALE + 0.5);
 }
 
 /* Voxels this view can change: those near its fused points. The grid is cut in blocks of
@@ -187,10 +174,7 @@ static void fuse_voxel(struct voxel *vx, double sdf, double w, double cw, const 
  * the band of a point is in a marked block (as Open3D's ScalableTSDFVolume touches only the
  * blocks of the current frame's points). Voxels farther in front of the surface would only be
  * told "empty", which costs a projection each and changes no surface. */
-#define BLOCK 4u
-#define BLOCKS_MAX ((FUSION_MAX_DIM + BLOCK - 1) / BLOCK)
-static uint8_t block_mark[BLOCKS_MAX * BLOCKS_MAX * BLOCKS_MAX];
-static uint8_t block_grown[BLOCKS_MAX * BLOCKS_MAX * BLOCKS_MAX];
+#define BLOCK FUSION_BLOCK
 
 static size_t bidx(const uint32_t nb[3], uint32_t x, uint32_t y, uint32_t z)
 {
@@ -198,19 +182,19 @@ static size_t bidx(const uint32_t nb[3], uint32_t x, uint32_t y, uint32_t z)
 }
 
 /* Mark the blocks of the view's fused points. @retval 0 when the view has none */
-static int mark_blocks(const struct frame_xform *obj_from_cam, const struct decode_maps *m,
-                       const struct tri_range *r, const uint32_t nb[3])
+static int mark_blocks(struct fusion_volume *vol, const struct frame_xform *obj_from_cam,
+                       const struct decode_maps *m, const struct tri_range *r, const uint32_t nb[3])
 {
-    const double scale = 1.0 / (fusion_vol.p.voxel_mm * BLOCK);
+    const double scale = 1.0 / (vol->p.voxel_mm * BLOCK);
     int any = 0;
-    memset(block_mark, 0, (size_t)nb[0] * nb[1] * nb[2]);
-    for (size_t y = rect.y0; y < rect.y1; y++) {
-        for (size_t i = y * m->width + rect.x0; i < y * m->width + rect.x1; i++) {
-            if (weight_map[i] <= 0.0f)
+    memset(vol->block_mark, 0, (size_t)nb[0] * nb[1] * nb[2]);
+    for (size_t y = vol->rect.y0; y < vol->rect.y1; y++) {
+        for (size_t i = y * m->width + vol->rect.x0; i < y * m->width + vol->rect.x1; i++) {
+            if (vol->weight_map[i] <= 0.0f)
                 continue;
             vec3 p = v3_sub(frame_point(obj_from_cam, v3(r->xyz_mm[3 * i], r->xyz_mm[3 * i + 1],
                                                          r->xyz_mm[3 * i + 2])),
-                            fusion_vol.origin);
+                            vol->origin);
             double g[3] = {p.x * scale, p.y * scale, p.z * scale};
             uint32_t b[3];
             int inside = 1;
@@ -220,7 +204,7 @@ static int mark_blocks(const struct frame_xform *obj_from_cam, const struct deco
                 b[a] = g[a] < 0.0 ? 0u : g[a] >= nb[a] ? nb[a] - 1u : (uint32_t)g[a];
             }
             if (inside) {
-                block_mark[bidx(nb, b[0], b[1], b[2])] = 1;
+                vol->block_mark[bidx(nb, b[0], b[1], b[2])] = 1;
                 any = 1;
             }
         }
@@ -229,39 +213,40 @@ static int mark_blocks(const struct frame_xform *obj_from_cam, const struct deco
 }
 
 /* Grow the marks by @p reach blocks along each axis in turn (a cube of 2 reach + 1 blocks). */
-static void grow_blocks(const uint32_t nb[3], uint32_t reach)
+static void grow_blocks(struct fusion_volume *vol, const uint32_t nb[3], uint32_t reach)
 {
     for (int axis = 0; axis < 3; axis++) {
         size_t stride = axis == 0 ? 1 : axis == 1 ? nb[0] : (size_t)nb[0] * nb[1];
-        memcpy(block_grown, block_mark, (size_t)nb[0] * nb[1] * nb[2]);
+        memcpy(vol->block_grown, vol->block_mark, (size_t)nb[0] * nb[1] * nb[2]);
         for (uint32_t z = 0; z < nb[2]; z++)
             for (uint32_t y = 0; y < nb[1]; y++)
                 for (uint32_t x = 0; x < nb[0]; x++) {
                     uint32_t c[3] = {x, y, z};
                     size_t i = bidx(nb, x, y, z);
-                    if (!block_mark[i])
+                    if (!vol->block_mark[i])
                         continue;
                     for (uint32_t d = 1; d <= reach; d++) {
                         if (c[axis] >= d)
-                            block_grown[i - d * stride] = 1;
+                            vol->block_grown[i - d * stride] = 1;
                         if (c[axis] + d < nb[axis])
-                            block_grown[i + d * stride] = 1;
+                            vol->block_grown[i + d * stride] = 1;
                     }
                 }
-        memcpy(block_mark, block_grown, (size_t)nb[0] * nb[1] * nb[2]);
+        memcpy(vol->block_mark, vol->block_grown, (size_t)nb[0] * nb[1] * nb[2]);
     }
 }
 
 /* The voxels x0 .. x1 - 1 of row (y, z). @p step_x: one voxel along x, in the camera frame. */
-static void integrate_run(const struct scan_calib *c, const struct frame_xform *obj_from_cam,
-                          const struct decode_maps *m, const struct tri_range *r,
-                          const uint8_t *rgb, const float *confidence, vec3 step_x, uint32_t x0,
-                          uint32_t x1, uint32_t y, uint32_t z, int pinhole)
+static void integrate_run(struct fusion_volume *vol, const struct scan_calib *c,
+                          const struct frame_xform *obj_from_cam, const struct decode_maps *m,
+                          const struct tri_range *r, const uint8_t *rgb, const float *confidence,
+                          vec3 step_x, uint32_t x0, uint32_t x1, uint32_t y, uint32_t z,
+                          int pinhole)
 {
-    const double trunc = fusion_vol.p.truncation_mm, vox = fusion_vol.p.voxel_mm;
-    vec3 p_obj = v3_add(fusion_vol.origin, v3(x0 * vox, y * vox, z * vox));
+    const double trunc = vol->p.truncation_mm, vox = vol->p.voxel_mm;
+    vec3 p_obj = v3_add(vol->origin, v3(x0 * vox, y * vox, z * vox));
     vec3 p = frame_point_inv(obj_from_cam, p_obj); /* camera frame */
-    struct voxel *row = &fusion_grid[vidx(0, y, z)];
+    struct voxel *row = &vol->grid[vidx(vol, 0, y, z)];
     for (uint32_t x = x0; x < x1; x++, p = v3_add(p, step_x)) {
         if (p.z <= 1.0)
             continue;
@@ -277,37 +262,37 @@ static void integrate_run(const struct scan_calib *c, const struct frame_xform *
         if (u >= (long)m->width || v >= (long)m->height)
             continue;
         size_t i = (size_t)v * m->width + (size_t)u;
-        if (weight_map[i] <= 0.0f)
+        if (vol->weight_map[i] <= 0.0f)
             continue;
         /* distance along the ray from the voxel to the measured surface */
         double sdf = (r->xyz_mm[3 * i + 2] - p.z) * sqrt(1.0 + a * a + b * b);
         if (sdf < -trunc)
             continue; /* hidden behind the surface: this view knows nothing of it */
-        double w = weight_map[i], cw = confidence != NULL ? w * confidence[i] : w;
-        fuse_voxel(&row[x], sdf, w, cw, rgb + 3 * i);
+        double w = vol->weight_map[i], cw = confidence != NULL ? w * confidence[i] : w;
+        fuse_voxel(vol, &row[x], sdf, w, cw, rgb + 3 * i);
     }
 }
 
-int fusion_integrate(const struct scan_calib *c, const struct frame_xform *obj_from_cam,
-                     const struct decode_maps *m, const struct tri_range *r, const uint8_t *rgb,
-                     const float *confidence)
+int fusion_integrate(struct fusion_volume *vol, const struct scan_calib *c,
+                     const struct frame_xform *obj_from_cam, const struct decode_maps *m,
+                     const struct tri_range *r, const uint8_t *rgb, const float *confidence)
 {
-    if (!pixel_weights(c, m, r))
+    if (!pixel_weights(vol, c, m, r))
         return 0;
-    const uint32_t *dims = fusion_vol.dims;
+    const uint32_t *dims = vol->dims;
     const uint32_t nb[3] = {(dims[0] + BLOCK - 1) / BLOCK, (dims[1] + BLOCK - 1) / BLOCK,
                             (dims[2] + BLOCK - 1) / BLOCK};
     const int pinhole = lens_is_pinhole(c->cam_dist); /* the voxel loop's common case, inline */
-    const vec3 step_x = m3_tmul(obj_from_cam->rot, v3(fusion_vol.p.voxel_mm, 0, 0));
-    if (!mark_blocks(obj_from_cam, m, r, nb))
+    const vec3 step_x = m3_tmul(obj_from_cam->rot, v3(vol->p.voxel_mm, 0, 0));
+    if (!mark_blocks(vol, obj_from_cam, m, r, nb))
         return 0;
     /* a point's band reaches truncation / voxel voxels (and one for rounding) from its block */
-    double band = fusion_vol.p.truncation_mm / fusion_vol.p.voxel_mm + 1.0;
-    grow_blocks(nb, (uint32_t)ceil(band / BLOCK));
+    double band = vol->p.truncation_mm / vol->p.voxel_mm + 1.0;
+    grow_blocks(vol, nb, (uint32_t)ceil(band / BLOCK));
     /* Row by row in the grid's memory order; along a row, each run of marked blocks at once. */
     for (uint32_t z = 0; z < dims[2]; z++)
         for (uint32_t y = 0; y < dims[1]; y++) {
-            const uint8_t *marks = &block_mark[bidx(nb, 0, y / BLOCK, z / BLOCK)];
+            const uint8_t *marks = &vol->block_mark[bidx(nb, 0, y / BLOCK, z / BLOCK)];
             for (uint32_t bx = 0; bx < nb[0];) {
                 if (!marks[bx]) {
                     bx++;
@@ -317,27 +302,26 @@ int fusion_integrate(const struct scan_calib *c, const struct frame_xform *obj_f
                 while (bx < nb[0] && marks[bx])
                     bx++;
                 uint32_t x1 = bx * BLOCK < dims[0] ? bx * BLOCK : dims[0];
-                integrate_run(c, obj_from_cam, m, r, rgb, confidence, step_x, first * BLOCK, x1, y,
-                              z, pinhole);
+                integrate_run(vol, c, obj_from_cam, m, r, rgb, confidence, step_x, first * BLOCK,
+                              x1, y, z, pinhole);
             }
         }
     return 0;
 }
 
-int fusion_fill(double (*sdf_mm)(vec3 p, void *ctx), void *ctx)
+int fusion_fill(struct fusion_volume *vol, double (*sdf_mm)(vec3 p, void *ctx), void *ctx)
 {
-    for (uint32_t z = 0; z < fusion_vol.dims[2]; z++)
-        for (uint32_t y = 0; y < fusion_vol.dims[1]; y++)
-            for (uint32_t x = 0; x < fusion_vol.dims[0]; x++) {
-                struct voxel *v = &fusion_grid[vidx(x, y, z)];
-                double d = sdf_mm(
-                    v3_add(fusion_vol.origin, v3_scale(v3(x, y, z), fusion_vol.p.voxel_mm)), ctx);
+    for (uint32_t z = 0; z < vol->dims[2]; z++)
+        for (uint32_t y = 0; y < vol->dims[1]; y++)
+            for (uint32_t x = 0; x < vol->dims[0]; x++) {
+                struct voxel *v = &vol->grid[vidx(vol, x, y, z)];
+                double d = sdf_mm(v3_add(vol->origin, v3_scale(v3(x, y, z), vol->p.voxel_mm)), ctx);
                 if (isnan(d)) { /* never observed */
                     memset(v, 0, sizeof(*v));
                     continue;
                 }
-                d = fmax(-fusion_vol.p.truncation_mm, fmin(fusion_vol.p.truncation_mm, d));
-                v->sdf = (int16_t)lround(d / fusion_vol.p.truncation_mm * 32767.0);
+                d = fmax(-vol->p.truncation_mm, fmin(vol->p.truncation_mm, d));
+                v->sdf = (int16_t)lround(d / vol->p.truncation_mm * 32767.0);
                 v->weight = (uint16_t)WEIGHT_SCALE;
                 v->rgb[0] = v->rgb[1] = v->rgb[2] = 128;
                 v->colour_weight = (uint8_t)COLOUR_WEIGHT_SCALE;
@@ -347,22 +331,23 @@ int fusion_fill(double (*sdf_mm)(vec3 p, void *ctx), void *ctx)
 
 /* ---- marching cubes ---- */
 
-static double sdf_at(uint32_t x, uint32_t y, uint32_t z)
+static double sdf_at(struct fusion_volume *vol, uint32_t x, uint32_t y, uint32_t z)
 {
-    return fusion_grid[vidx(x, y, z)].sdf / 32767.0 * fusion_vol.p.truncation_mm;
+    return vol->grid[vidx(vol, x, y, z)].sdf / 32767.0 * vol->p.truncation_mm;
 }
 
 /* Distance gradient at a sample (central differences, one-sided at the border): it points out. */
-static vec3 gradient(uint32_t x, uint32_t y, uint32_t z)
+static vec3 gradient(struct fusion_volume *vol, uint32_t x, uint32_t y, uint32_t z)
 {
     uint32_t lo[3] = {x ? x - 1 : x, y ? y - 1 : y, z ? z - 1 : z};
-    uint32_t hi[3] = {x + 1 < fusion_vol.dims[0] ? x + 1 : x,
-                      y + 1 < fusion_vol.dims[1] ? y + 1 : y,
-                      z + 1 < fusion_vol.dims[2] ? z + 1 : z};
-    return v3(
-        (sdf_at(hi[0], y, z) - sdf_at(lo[0], y, z)) / (double)(hi[0] - lo[0] + (hi[0] == lo[0])),
-        (sdf_at(x, hi[1], z) - sdf_at(x, lo[1], z)) / (double)(hi[1] - lo[1] + (hi[1] == lo[1])),
-        (sdf_at(x, y, hi[2]) - sdf_at(x, y, lo[2])) / (double)(hi[2] - lo[2] + (hi[2] == lo[2])));
+    uint32_t hi[3] = {x + 1 < vol->dims[0] ? x + 1 : x, y + 1 < vol->dims[1] ? y + 1 : y,
+                      z + 1 < vol->dims[2] ? z + 1 : z};
+    return v3((sdf_at(vol, hi[0], y, z) - sdf_at(vol, lo[0], y, z)) /
+                  (double)(hi[0] - lo[0] + (hi[0] == lo[0])),
+              (sdf_at(vol, x, hi[1], z) - sdf_at(vol, x, lo[1], z)) /
+                  (double)(hi[1] - lo[1] + (hi[1] == lo[1])),
+              (sdf_at(vol, x, y, hi[2]) - sdf_at(vol, x, y, lo[2])) /
+                  (double)(hi[2] - lo[2] + (hi[2] == lo[2])));
 }
 
 struct extract_state {
@@ -371,8 +356,8 @@ struct extract_state {
 };
 
 /* The vertex on the grid edge from sample s along @p axis, made once and numbered. */
-static int edge_vertex(struct extract_state *st, const uint32_t s[3], int axis, uint32_t *slot,
-                       uint32_t *out)
+static int edge_vertex(struct fusion_volume *vol, struct extract_state *st, const uint32_t s[3],
+                       int axis, uint32_t *slot, uint32_t *out)
 {
     if (*slot != NO_VERTEX) {
         *out = *slot;
@@ -380,17 +365,17 @@ static int edge_vertex(struct extract_state *st, const uint32_t s[3], int axis, 
     }
     uint32_t t[3] = {s[0], s[1], s[2]};
     t[axis]++;
-    const struct voxel *va = &fusion_grid[vidx(s[0], s[1], s[2])],
-                       *vb = &fusion_grid[vidx(t[0], t[1], t[2])];
-    double da = sdf_at(s[0], s[1], s[2]), db = sdf_at(t[0], t[1], t[2]);
+    const struct voxel *va = &vol->grid[vidx(vol, s[0], s[1], s[2])],
+                       *vb = &vol->grid[vidx(vol, t[0], t[1], t[2])];
+    double da = sdf_at(vol, s[0], s[1], s[2]), db = sdf_at(vol, t[0], t[1], t[2]);
     /* Strictly inside the edge: a zero distance at a sample would otherwise put the vertices of
      * several edges on the same point (degenerate triangles, non-manifold fans). */
     double f = fmin(fmax(da / (da - db), 1e-3), 1.0 - 1e-3);
-    vec3 ga = gradient(s[0], s[1], s[2]), gb = gradient(t[0], t[1], t[2]);
+    vec3 ga = gradient(vol, s[0], s[1], s[2]), gb = gradient(vol, t[0], t[1], t[2]);
     vec3 n = v3_norm(v3_add(v3_scale(ga, 1.0 - f), v3_scale(gb, f)));
-    vec3 pos = v3_add(fusion_vol.origin, v3_scale(v3(s[0], s[1], s[2]), fusion_vol.p.voxel_mm));
+    vec3 pos = v3_add(vol->origin, v3_scale(v3(s[0], s[1], s[2]), vol->p.voxel_mm));
     double shift[3] = {0, 0, 0};
-    shift[axis] = f * fusion_vol.p.voxel_mm;
+    shift[axis] = f * vol->p.voxel_mm;
     pos = v3_add(pos, v3(shift[0], shift[1], shift[2]));
     struct mesh_vertex mv = {{(float)pos.x, (float)pos.y, (float)pos.z},
                              {(float)n.x, (float)n.y, (float)n.z},
@@ -405,23 +390,25 @@ static int edge_vertex(struct extract_state *st, const uint32_t s[3], int axis, 
     return rc;
 }
 
-static uint32_t *edge_slot(uint32_t x, uint32_t y, uint32_t z, int e)
+static uint32_t *edge_slot(struct fusion_volume *vol, uint32_t x, uint32_t y, uint32_t z, int e)
 {
     unsigned a = mc_edge_corner[e][0]; /* the lower corner of the edge */
     uint32_t sx = x + (a & 1u), sy = y + ((a >> 1) & 1u), sz = z + (a >> 2);
-    size_t i = (size_t)sy * fusion_vol.dims[0] + sx;
+    size_t i = (size_t)sy * vol->dims[0] + sx;
     if (e < 4)
-        return &edge_vertex_x[sz & 1u][i];
+        return &vol->edge_vertex_x[sz & 1u][i];
     if (e < 8)
-        return &edge_vertex_y[sz & 1u][i];
-    return &edge_vertex_z[i];
+        return &vol->edge_vertex_y[sz & 1u][i];
+    return &vol->edge_vertex_z[i];
 }
 
-static int extract_cell(struct extract_state *st, uint32_t x, uint32_t y, uint32_t z)
+static int extract_cell(struct fusion_volume *vol, struct extract_state *st, uint32_t x, uint32_t y,
+                        uint32_t z)
 {
     unsigned pattern = 0;
     for (unsigned c = 0; c < 8; c++) {
-        const struct voxel *v = &fusion_grid[vidx(x + (c & 1u), y + ((c >> 1) & 1u), z + (c >> 2))];
+        const struct voxel *v =
+            &vol->grid[vidx(vol, x + (c & 1u), y + ((c >> 1) & 1u), z + (c >> 2))];
         if (v->weight == 0)
             return 0; /* a corner no view has seen: no surface can be claimed here */
         pattern |= (v->sdf < 0 ? 1u : 0u) << c;
@@ -433,7 +420,7 @@ static int extract_cell(struct extract_state *st, uint32_t x, uint32_t y, uint32
             int e = mc->edge[t][k];
             unsigned a = mc_edge_corner[e][0];
             uint32_t s[3] = {x + (a & 1u), y + ((a >> 1) & 1u), z + (a >> 2)};
-            int rc = edge_vertex(st, s, e / 4, edge_slot(x, y, z, e), &idx[k]);
+            int rc = edge_vertex(vol, st, s, e / 4, edge_slot(vol, x, y, z, e), &idx[k]);
             if (rc != 0)
                 return rc;
         }
@@ -446,20 +433,20 @@ static int extract_cell(struct extract_state *st, uint32_t x, uint32_t y, uint32
     return 0;
 }
 
-int fusion_extract(const struct mesh_sink *sink)
+int fusion_extract(struct fusion_volume *vol, const struct mesh_sink *sink)
 {
     struct extract_state st = {sink, 0};
-    size_t plane = (size_t)fusion_vol.dims[0] * fusion_vol.dims[1];
-    memset(edge_vertex_x[0], 0xFF, plane * sizeof(uint32_t));
-    memset(edge_vertex_y[0], 0xFF, plane * sizeof(uint32_t));
-    for (uint32_t z = 0; z + 1 < fusion_vol.dims[2]; z++) {
+    size_t plane = (size_t)vol->dims[0] * vol->dims[1];
+    memset(vol->edge_vertex_x[0], 0xFF, plane * sizeof(uint32_t));
+    memset(vol->edge_vertex_y[0], 0xFF, plane * sizeof(uint32_t));
+    for (uint32_t z = 0; z + 1 < vol->dims[2]; z++) {
         /* plane z+1 starts empty; plane z keeps what the layer below made */
-        memset(edge_vertex_x[(z + 1) & 1u], 0xFF, plane * sizeof(uint32_t));
-        memset(edge_vertex_y[(z + 1) & 1u], 0xFF, plane * sizeof(uint32_t));
-        memset(edge_vertex_z, 0xFF, plane * sizeof(uint32_t));
-        for (uint32_t y = 0; y + 1 < fusion_vol.dims[1]; y++) {
-            for (uint32_t x = 0; x + 1 < fusion_vol.dims[0]; x++) {
-                int rc = extract_cell(&st, x, y, z);
+        memset(vol->edge_vertex_x[(z + 1) & 1u], 0xFF, plane * sizeof(uint32_t));
+        memset(vol->edge_vertex_y[(z + 1) & 1u], 0xFF, plane * sizeof(uint32_t));
+        memset(vol->edge_vertex_z, 0xFF, plane * sizeof(uint32_t));
+        for (uint32_t y = 0; y + 1 < vol->dims[1]; y++) {
+            for (uint32_t x = 0; x + 1 < vol->dims[0]; x++) {
+                int rc = extract_cell(vol, &st, x, y, z);
                 if (rc != 0)
                     return rc;
             }

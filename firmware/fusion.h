@@ -1,5 +1,6 @@
-/* Volumetric fusion of views (truncated signed distance, Curless and Levoy 1996) in a static grid,
- * with blended vertex colour, and the mesh of its zero level by marching cubes. */
+/* Volumetric fusion of views (truncated signed distance, Curless and Levoy 1996) in a voxel grid
+ * (struct fusion_volume), with blended vertex colour, and the mesh of its zero level by marching
+ * cubes. */
 #ifndef FUSION_H
 #define FUSION_H
 
@@ -9,6 +10,7 @@
 #include "tri.h"
 
 struct reflect_model;
+struct fusion_volume;
 
 /* The grid is sized in the config and bounded by FUSION_MAX_DIM and FUSION_MAX_VOXELS
  * (hal_limits.h): 8 bytes a voxel. */
@@ -26,27 +28,28 @@ struct fusion_params {
 /** Grid dimensions for @p p. @retval 0 ok @retval -E2BIG above FUSION_MAX_* */
 int fusion_dims(const struct fusion_params *p, uint32_t dims[3]);
 
-/** Empty grid. @retval 0 ok @retval -E2BIG the grid does not fit the compiled limits */
-int fusion_begin(const struct fusion_params *p);
+/** Empty the grid of @p vol for @p p. @retval 0 ok @retval -E2BIG the grid does not fit the
+ * compiled limits */
+int fusion_begin(struct fusion_volume *vol, const struct fusion_params *p);
 
 /** Fuse the last view: its range image, normals and colour, seen through @p obj_from_cam.
  *  Weight of a pixel: cos(view angle) x (600 mm / depth)^2 x edge fade; its colour weighs that
  *  times the colour's @p confidence per pixel when given (NULL: 1), so an unreliable colour
  *  estimate (a highlight, a grazing light) still gives its geometry.
  *  @retval 0 */
-int fusion_integrate(const struct scan_calib *calib, const struct frame_xform *obj_from_cam,
-                     const struct decode_maps *maps, const struct tri_range *range,
-                     const uint8_t *rgb, const float *confidence);
+int fusion_integrate(struct fusion_volume *vol, const struct scan_calib *calib,
+                     const struct frame_xform *obj_from_cam, const struct decode_maps *maps,
+                     const struct tri_range *range, const uint8_t *rgb, const float *confidence);
 
 /** Set every voxel from a signed distance function of the object-frame position (mm), weight 1
  *  and grey colour (NAN: never observed): synthetic objects and tests of the extraction.
  *  @retval 0 */
-int fusion_fill(double (*sdf_mm)(vec3 p, void *ctx), void *ctx);
+int fusion_fill(struct fusion_volume *vol, double (*sdf_mm)(vec3 p, void *ctx), void *ctx);
 
 /** Fill holes up to @p max_hole_mm across: the signed distance diffused into unobserved voxels
  *  from their observed neighbours, a voxel layer a pass (fusion_close.c). After the last
  *  fusion, before the mesh. @param filled  out: voxels filled @retval 0 @retval -EINVAL no grid */
-int fusion_fill_holes(double max_hole_mm, uint32_t *filled);
+int fusion_fill_holes(struct fusion_volume *vol, double max_hole_mm, uint32_t *filled);
 
 /** Decide every voxel still unobserved, so that the mesh is closed: outside when reachable from
  *  the grid's sides or top (sideways or down only when @p one_pass: what its cameras did not
@@ -54,7 +57,8 @@ int fusion_fill_holes(double max_hole_mm, uint32_t *filled);
  *  without crossing the object's observed inside or the table plane (object frame z = 0);
  *  inside otherwise; at and below the table plane, outside (the object is closed there).
  *  @param inside  out: voxels decided inside @retval 0 @retval -EINVAL no grid */
-int fusion_close_watertight(double max_hole_mm, int one_pass, uint32_t *inside);
+int fusion_close_watertight(struct fusion_volume *vol, double max_hole_mm, int one_pass,
+                            uint32_t *inside);
 
 /** A vertex of the mesh: object frame, mm; its colour linear (0..255), and whether any view gave
  *  the surface there a colour estimate (else rgb is 0 and the writers fill it from the mesh
@@ -75,7 +79,7 @@ struct mesh_sink {
 /** Marching cubes over the cells whose eight corners were all observed. Deterministic: two
  *  runs give the same vertices in the same order (writers count in a first pass).
  *  @retval 0 or what the sink returned */
-int fusion_extract(const struct mesh_sink *sink);
+int fusion_extract(struct fusion_volume *vol, const struct mesh_sink *sink);
 
 /** What fusion_mesh_prepare found. */
 struct mesh_summary {
@@ -92,30 +96,93 @@ struct mesh_summary {
  *  @param summary  out
  *  @retval 0 @retval -E2BIG more vertices than MESH_MAX_VERTICES: the writers keep every piece
  *  and no STL can be written (PLY and OBJ still can) */
-int fusion_mesh_prepare(double min_fragment_share, struct mesh_summary *summary);
+int fusion_mesh_prepare(struct fusion_volume *vol, double min_fragment_share,
+                        struct mesh_summary *summary);
 
 /** Marching cubes into @p sink as the writers see it: the pieces fusion_mesh_prepare left out
  *  are not given, the vertices renumbered. @retval 0 @retval -EINVAL not prepared */
-int fusion_extract_prepared(const struct mesh_sink *sink);
+int fusion_extract_prepared(struct fusion_volume *vol, const struct mesh_sink *sink);
 
 /** What fusion_mesh_prepare found, for a writer that needs the counts first.
  *  @retval 0 @retval -EINVAL not prepared @retval -E2BIG the mesh did not fit the tables */
-int fusion_mesh_counts(struct mesh_summary *summary);
+int fusion_mesh_counts(struct fusion_volume *vol, struct mesh_summary *summary);
 
 /** Write the prepared mesh as binary PLY (vertex x y z nx ny nz red green blue, faces), as OBJ
  *  (with vertex colours and normals) or as binary STL (for printing: triangles only), atomically,
  *  in millimetres. @retval 0 @retval -EINVAL not prepared @retval -E2BIG (STL) the mesh did not
  *  fit MESH_MAX_VERTICES @retval -errno from storage */
-int fusion_write_ply(const struct hal_storage *st, const char *path);
-int fusion_write_obj(const struct hal_storage *st, const char *path);
-int fusion_write_stl(const struct hal_storage *st, const char *path);
+int fusion_write_ply(struct fusion_volume *vol, const struct hal_storage *st, const char *path);
+int fusion_write_obj(struct fusion_volume *vol, const struct hal_storage *st, const char *path);
+int fusion_write_stl(struct fusion_volume *vol, const struct hal_storage *st, const char *path);
 
 /** Write the prepared mesh as glTF 2.0 binary (firmware/mesh_glb.c): metres, +Y up, linear vertex
  *  colours, atomically; one material, or one per cluster of @p model (the reflectance fitted, or
  *  NULL). @retval 0 @retval -EINVAL not prepared @retval -E2BIG the
  *  mesh did not fit MESH_MAX_VERTICES @retval -ENODATA no vertex @retval -EFBIG over 4 GiB
  *  @retval -errno from storage */
-int fusion_write_glb(const struct hal_storage *st, const char *path,
+int fusion_write_glb(struct fusion_volume *vol, const struct hal_storage *st, const char *path,
                      const struct reflect_model *model);
+
+/* ---- the volume: the grid and its work space, a model's worth ---- */
+
+/* 8 bytes: distance in units of truncation / 32767, weight in thousandths, colour, and the
+ * colour's own weight in 1/32 (it saturates at ~8: a voxel's colour stops changing once about
+ * eight good views agree). The colour has its own weight because a colour estimate can be
+ * unreliable (a highlight, a grazing light) where the geometry is fine. */
+struct voxel {
+    int16_t sdf;
+    uint16_t weight;
+    uint8_t rgb[3];
+    uint8_t colour_weight;
+};
+
+#define FUSION_BLOCK 4u /* voxels along a block's edge (fusion_integrate's blocks) */
+#define FUSION_BLOCKS_MAX ((FUSION_MAX_DIM + FUSION_BLOCK - 1) / FUSION_BLOCK)
+#define FUSION_BITMAP_BYTES ((FUSION_MAX_VOXELS + 7) / 8) /* a bit a voxel */
+#define FUSION_GLB_JSON_MAX 8192u                         /* mesh.glb's JSON chunk (mesh_glb.c) */
+
+/** One model's volume: the grid, the work space of the stages over it and the prepared mesh's
+ *  tables. Hundreds of MB at the compiled limits: its owner (the job) keeps it static and passes
+ *  it by pointer, so there is no allocation; two volumes are two independent models. Its fields
+ *  are the fusion's own (fusion.c, fusion_close.c, mesh_io.c, mesh_glb.c). */
+struct fusion_volume {
+    struct voxel grid[FUSION_MAX_VOXELS];
+    struct fusion_params p;
+    uint32_t dims[3];
+    vec3 origin; /* where voxel (0, 0, 0) is (object frame, mm) */
+    /* fusion_integrate's: a view's pixel weights, the rectangle of its pixels, its blocks */
+    float weight_map[HAL_MAX_PIXELS];
+    uint16_t edge_dist[HAL_MAX_PIXELS];
+    struct {
+        uint32_t x0, y0, x1, y1;
+    } rect;
+    uint8_t block_mark[FUSION_BLOCKS_MAX * FUSION_BLOCKS_MAX * FUSION_BLOCKS_MAX];
+    uint8_t block_grown[FUSION_BLOCKS_MAX * FUSION_BLOCKS_MAX * FUSION_BLOCKS_MAX];
+    /* fusion_extract's: vertex numbers of the grid edges of two sample planes (x, y edges) and
+     * between them (z) */
+    uint32_t edge_vertex_x[2][FUSION_MAX_DIM * FUSION_MAX_DIM];
+    uint32_t edge_vertex_y[2][FUSION_MAX_DIM * FUSION_MAX_DIM];
+    uint32_t edge_vertex_z[FUSION_MAX_DIM * FUSION_MAX_DIM];
+    /* fusion_close.c's bitmaps */
+    uint8_t mark[FUSION_BITMAP_BYTES], scratch_a[FUSION_BITMAP_BYTES],
+        scratch_b[FUSION_BITMAP_BYTES];
+    /* the prepared mesh (mesh_io.c) */
+    float mesh_pos[MESH_MAX_VERTICES * 3];
+    float mesh_nrm[MESH_MAX_VERTICES * 3];
+    uint8_t mesh_rgb[MESH_MAX_VERTICES * 3];
+    uint8_t mesh_coloured[MESH_MAX_VERTICES]; /* 1: a view gave the surface there a colour */
+    uint32_t mesh_tri[MESH_MAX_TRIANGLES * 3];
+    uint32_t mesh_index[MESH_MAX_VERTICES]; /* union-find parent; after prepare, new number */
+    uint32_t mesh_tris[MESH_MAX_VERTICES];  /* triangles of the piece rooted here */
+    struct {
+        int prepared, fits; /* fits: the whole mesh is in the tables (else nothing is dropped) */
+        struct mesh_summary s;
+    } mp;
+    struct mesh_vertex mv; /* the vertex a sink is handed from the tables */
+    /* mesh.glb's (mesh_glb.c): each vertex's material cluster, the JSON chunk */
+    uint8_t vertex_part[MESH_MAX_VERTICES];
+    char glb_json[FUSION_GLB_JSON_MAX];
+    int glb_json_len;
+};
 
 #endif

@@ -33,9 +33,9 @@
 #define GL_ARRAY_BUFFER 34962
 #define GL_ELEMENT_ARRAY_BUFFER 34963
 
-/* The JSON of one mesh: about 1 KB, and about 650 bytes more per material cluster (a material,
- * a primitive, a buffer view and an accessor each): REFLECT_MAX_CLUSTERS fit well within. */
-static char glb_json[8192];
+/* The JSON of one mesh (vol->glb_json): about 1 KB, and about 650 bytes more per material
+ * cluster (a material, a primitive, a buffer view and an accessor each): REFLECT_MAX_CLUSTERS fit
+ * well within FUSION_GLB_JSON_MAX. */
 
 /* Position in glTF's frame: metres, Y up. */
 static void gltf_position(const float p[3], float out[3])
@@ -91,14 +91,16 @@ struct glb_parts {
     const struct reflect_model *model;        /* NULL: matte */
 };
 
-static int json_len;
-static void json_put(const char *fmt, ...)
+static void json_put(struct fusion_volume *vol, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
-    if (json_len >= 0) {
-        int n = vsnprintf(glb_json + json_len, sizeof(glb_json) - (size_t)json_len, fmt, ap);
-        json_len = n < 0 || (size_t)n >= sizeof(glb_json) - (size_t)json_len ? -1 : json_len + n;
+    if (vol->glb_json_len >= 0) {
+        int n = vsnprintf(vol->glb_json + vol->glb_json_len,
+                          sizeof(vol->glb_json) - (size_t)vol->glb_json_len, fmt, ap);
+        vol->glb_json_len = n < 0 || (size_t)n >= sizeof(vol->glb_json) - (size_t)vol->glb_json_len
+                                ? -1
+                                : vol->glb_json_len + n;
     }
     va_end(ap);
 }
@@ -108,12 +110,13 @@ static void json_put(const char *fmt, ...)
  * rho cos(theta_i), is pi f cos(theta_i) of a microfacet BRDF f = D G F / (4 cos_i cos_o) with
  * the normalised GGX D (peak 1 / (pi a^2)) and G = 1: F0 = 4 a^2 K. glTF's GGX takes
  * alpha = roughness^2. Dielectric (metallic 0): a metal's tinted F0 is the specular colour. */
-static void json_material(const struct reflect_cluster *c, uint32_t k)
+static void json_material(struct fusion_volume *vol, const struct reflect_cluster *c, uint32_t k)
 {
     double a = c->roughness, f0[3];
     for (int ch = 0; ch < 3; ch++)
         f0[ch] = 4.0 * a * a * c->specular[ch];
-    json_put("%s{\"name\":\"cluster %u\",\"pbrMetallicRoughness\":{\"baseColorFactor\":"
+    json_put(vol,
+             "%s{\"name\":\"cluster %u\",\"pbrMetallicRoughness\":{\"baseColorFactor\":"
              "[1,1,1,1],\"metallicFactor\":0,\"roughnessFactor\":%.4f},\"extensions\":"
              "{\"KHR_materials_specular\":{\"specularFactor\":1,\"specularColorFactor\":"
              "[%.5f,%.5f,%.5f]}}}",
@@ -123,32 +126,36 @@ static void json_material(const struct reflect_cluster *c, uint32_t k)
 
 /* The JSON chunk's text for @p vertices and @p parts within @p b, padded with spaces to a
  * multiple of 4: buffer views positions, normals, colours, then each part's indices.
- * @retval its length @retval -EOVERFLOW it did not fit glb_json */
-static int glb_json_text(uint32_t vertices, const struct glb_parts *parts,
-                         const struct glb_bounds *b, uint64_t bin_len)
+ * @retval its length @retval -EOVERFLOW it did not fit vol->glb_json */
+static int glb_json_text(struct fusion_volume *vol, uint32_t vertices,
+                         const struct glb_parts *parts, const struct glb_bounds *b,
+                         uint64_t bin_len)
 {
     uint64_t v = vertices, pos_len = 12 * v, col_len = 4 * v, at = 2 * pos_len + col_len;
-    json_len = 0;
-    json_put("{\"asset\":{\"version\":\"2.0\",\"generator\":\"turntable colour scanner\"},");
+    vol->glb_json_len = 0;
+    json_put(vol, "{\"asset\":{\"version\":\"2.0\",\"generator\":\"turntable colour scanner\"},");
     if (parts->model != NULL)
-        json_put("\"extensionsUsed\":[\"KHR_materials_specular\"],");
-    json_put("\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0,\"name\":\"scan\"}],"
+        json_put(vol, "\"extensionsUsed\":[\"KHR_materials_specular\"],");
+    json_put(vol,
+             "\"scene\":0,\"scenes\":[{\"nodes\":[0]}],\"nodes\":[{\"mesh\":0,\"name\":\"scan\"}],"
              "\"meshes\":[{\"name\":\"fused mesh\",\"primitives\":[");
     /* a cluster without triangles has no primitive, view nor accessor (none may be empty) */
     for (uint32_t k = 0, n = 0; k < parts->count; k++)
         if (parts->triangles[k] > 0) {
-            json_put("%s{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"COLOR_0\":2},"
+            json_put(vol,
+                     "%s{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"COLOR_0\":2},"
                      "\"indices\":%u,\"material\":%u,\"mode\":4}",
                      n ? "," : "", (unsigned)(3 + n), (unsigned)k);
             n++;
         }
-    json_put("]}],\"materials\":[");
+    json_put(vol, "]}],\"materials\":[");
     if (parts->model == NULL)
-        json_put("{\"name\":\"matte\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,1,1,1],"
-                 "\"metallicFactor\":0,\"roughnessFactor\":1}}");
+        json_put(vol, "{\"name\":\"matte\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,1,1,1],"
+                      "\"metallicFactor\":0,\"roughnessFactor\":1}}");
     for (uint32_t k = 0; parts->model != NULL && k < parts->count; k++)
-        json_material(&parts->model->cluster[k], k);
-    json_put("],\"buffers\":[{\"byteLength\":%llu}],\"bufferViews\":["
+        json_material(vol, &parts->model->cluster[k], k);
+    json_put(vol,
+             "],\"buffers\":[{\"byteLength\":%llu}],\"bufferViews\":["
              "{\"buffer\":0,\"byteOffset\":0,\"byteLength\":%llu,\"target\":%d},"
              "{\"buffer\":0,\"byteOffset\":%llu,\"byteLength\":%llu,\"target\":%d},"
              "{\"buffer\":0,\"byteOffset\":%llu,\"byteLength\":%llu,\"target\":%d}",
@@ -158,11 +165,12 @@ static int glb_json_text(uint32_t vertices, const struct glb_parts *parts,
     for (uint32_t k = 0; k < parts->count; k++) {
         uint64_t len = 12 * (uint64_t)parts->triangles[k];
         if (len > 0)
-            json_put(",{\"buffer\":0,\"byteOffset\":%llu,\"byteLength\":%llu,\"target\":%d}",
+            json_put(vol, ",{\"buffer\":0,\"byteOffset\":%llu,\"byteLength\":%llu,\"target\":%d}",
                      (unsigned long long)at, (unsigned long long)len, GL_ELEMENT_ARRAY_BUFFER);
         at += len;
     }
-    json_put("],\"accessors\":["
+    json_put(vol,
+             "],\"accessors\":["
              "{\"bufferView\":0,\"componentType\":%d,\"count\":%u,\"type\":\"VEC3\","
              "\"min\":[%.9g,%.9g,%.9g],\"max\":[%.9g,%.9g,%.9g]},"
              "{\"bufferView\":1,\"componentType\":%d,\"count\":%u,\"type\":\"VEC3\"},"
@@ -173,23 +181,24 @@ static int glb_json_text(uint32_t vertices, const struct glb_parts *parts,
              GL_UNSIGNED_BYTE, (unsigned)vertices);
     for (uint32_t k = 0, n = 0; k < parts->count; k++)
         if (parts->triangles[k] > 0)
-            json_put(",{\"bufferView\":%u,\"componentType\":%d,\"count\":%llu,\"type\":"
+            json_put(vol,
+                     ",{\"bufferView\":%u,\"componentType\":%d,\"count\":%llu,\"type\":"
                      "\"SCALAR\"}",
                      (unsigned)(3 + n++), GL_UNSIGNED_INT,
                      (unsigned long long)(3 * (uint64_t)parts->triangles[k]));
-    json_put("]}");
-    if (json_len < 0 || (size_t)json_len + 4 > sizeof(glb_json))
+    json_put(vol, "]}");
+    if (vol->glb_json_len < 0 || (size_t)vol->glb_json_len + 4 > sizeof(vol->glb_json))
         return -EOVERFLOW;
-    while (json_len % 4 != 0)
-        glb_json[json_len++] = ' ';
-    return json_len;
+    while (vol->glb_json_len % 4 != 0)
+        vol->glb_json[vol->glb_json_len++] = ' ';
+    return vol->glb_json_len;
 }
 
 /* What the JSON, which precedes the data, must say, in one pass over the mesh (its vertices
  * come before its triangles): POSITION's min and max, each vertex's cluster (by its colour) and
  * each cluster's triangles (by their first vertex). */
-static uint8_t vertex_part[MESH_MAX_VERTICES];
 struct glb_scan {
+    uint8_t *vertex_part; /* each vertex's cluster */
     struct glb_bounds bounds;
     struct glb_parts parts;
     uint32_t vertices;
@@ -206,7 +215,7 @@ static int scan_vertex(void *priv, const struct mesh_vertex *v)
         gs->bounds.hi[k] = q[k] > gs->bounds.hi[k] ? q[k] : gs->bounds.hi[k];
     }
     double rho[3] = {v->rgb[0] / 255.0, v->rgb[1] / 255.0, v->rgb[2] / 255.0};
-    vertex_part[gs->vertices++] = m != NULL ? (uint8_t)reflect_cluster_of(m, rho) : 0;
+    gs->vertex_part[gs->vertices++] = m != NULL ? (uint8_t)reflect_cluster_of(m, rho) : 0;
     return 0;
 }
 
@@ -215,12 +224,13 @@ static int scan_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
     struct glb_scan *gs = priv;
     (void)b;
     (void)c;
-    gs->parts.triangles[vertex_part[a]]++;
+    gs->parts.triangles[gs->vertex_part[a]]++;
     return 0;
 }
 
 /* The indices of part @p part only. */
 struct index_pass {
+    const uint8_t *vertex_part;
     struct outbuf *o;
     uint8_t part;
 };
@@ -228,7 +238,7 @@ struct index_pass {
 static int index_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
 {
     struct index_pass *ip = priv;
-    if (vertex_part[a] != ip->part)
+    if (ip->vertex_part[a] != ip->part)
         return 0;
     outbuf_u32le(ip->o, a);
     outbuf_u32le(ip->o, b);
@@ -236,27 +246,29 @@ static int index_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
     return ip->o->rc;
 }
 
-int fusion_write_glb(const struct hal_storage *st, const char *path,
+int fusion_write_glb(struct fusion_volume *vol, const struct hal_storage *st, const char *path,
                      const struct reflect_model *model)
 {
     struct mesh_summary ms;
     struct outbuf o;
-    int rc = fusion_mesh_counts(&ms);
+    int rc = fusion_mesh_counts(vol, &ms);
     if (rc != 0)
         return rc;
     if (ms.kept_vertices == 0)
         return -ENODATA; /* an accessor must count at least one element */
-    struct glb_scan gs = {
-        {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}}, {1, {0}, model}, 0};
+    struct glb_scan gs = {vol->vertex_part,
+                          {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}},
+                          {1, {0}, model},
+                          0};
     if (gs.parts.model != NULL)
         gs.parts.count = gs.parts.model->count;
     struct mesh_sink scan_pass = {scan_vertex, scan_triangle, &gs};
-    fusion_extract_prepared(&scan_pass);
+    fusion_extract_prepared(vol, &scan_pass);
     const struct glb_parts parts = gs.parts;
     uint64_t bin_len = 28 * (uint64_t)ms.kept_vertices;
     for (uint32_t k = 0; k < parts.count; k++)
         bin_len += 12 * (uint64_t)parts.triangles[k];
-    int json = glb_json_text(ms.kept_vertices, &parts, &gs.bounds, bin_len);
+    int json = glb_json_text(vol, ms.kept_vertices, &parts, &gs.bounds, bin_len);
     if (json < 0)
         return json;
     uint64_t total = 12 + 8 + (uint64_t)json + 8 + bin_len; /* bin_len is 4-aligned */
@@ -269,18 +281,18 @@ int fusion_write_glb(const struct hal_storage *st, const char *path,
     outbuf_u32le(&o, (uint32_t)total);
     outbuf_u32le(&o, (uint32_t)json);
     outbuf_u32le(&o, GLB_CHUNK_JSON);
-    outbuf_put(&o, glb_json, (size_t)json);
+    outbuf_put(&o, vol->glb_json, (size_t)json);
     outbuf_u32le(&o, (uint32_t)bin_len);
     outbuf_u32le(&o, GLB_CHUNK_BIN);
     struct mesh_sink passes[3] = {
         {position_vertex, NULL, &o}, {normal_vertex, NULL, &o}, {colour_vertex, NULL, &o}};
     for (int k = 0; k < 3 && o.rc == 0; k++)
-        fusion_extract_prepared(&passes[k]);
+        fusion_extract_prepared(vol, &passes[k]);
     for (uint32_t k = 0; k < parts.count && o.rc == 0; k++) {
-        struct index_pass ip = {&o, (uint8_t)k};
+        struct index_pass ip = {vol->vertex_part, &o, (uint8_t)k};
         struct mesh_sink pass = {NULL, index_triangle, &ip};
         if (parts.triangles[k] > 0)
-            fusion_extract_prepared(&pass);
+            fusion_extract_prepared(vol, &pass);
     }
     return outbuf_close(&o);
 }

@@ -16,201 +16,193 @@
 
 #define DROPPED 0xFFFFFFFFu
 
-static float mesh_pos[MESH_MAX_VERTICES * 3];
-static float mesh_nrm[MESH_MAX_VERTICES * 3];
-static uint8_t mesh_rgb[MESH_MAX_VERTICES * 3];
-/* 1: a view gave the surface there a colour; 0: none did (colour_fill gives it one) */
-static uint8_t mesh_coloured[MESH_MAX_VERTICES];
-static uint32_t mesh_tri[MESH_MAX_TRIANGLES * 3];
-/* Union-find parent of each vertex; after prepare, the vertex's new number or DROPPED. */
-static uint32_t mesh_index[MESH_MAX_VERTICES];
-static uint32_t mesh_tris[MESH_MAX_VERTICES]; /* triangles of the piece rooted here */
+/* The tables (struct fusion_volume): vol->mesh_index is each vertex's union-find parent, and after
+ * prepare its new number or DROPPED; vol->mesh_coloured 0 where no view coloured the surface
+ * (colour_fill gives it one). */
 
-static struct {
-    int prepared, fits; /* fits: the whole mesh is in the tables (else nothing is dropped) */
-    struct mesh_summary s;
-} mp;
-
-static uint32_t find_root(uint32_t v)
+static uint32_t find_root(struct fusion_volume *vol, uint32_t v)
 {
-    while (mesh_index[v] != v) {
-        mesh_index[v] = mesh_index[mesh_index[v]]; /* path halving */
-        v = mesh_index[v];
+    while (vol->mesh_index[v] != v) {
+        vol->mesh_index[v] = vol->mesh_index[vol->mesh_index[v]]; /* path halving */
+        v = vol->mesh_index[v];
     }
     return v;
 }
 
-static void join(uint32_t a, uint32_t b)
+static void join(struct fusion_volume *vol, uint32_t a, uint32_t b)
 {
-    a = find_root(a);
-    b = find_root(b);
+    a = find_root(vol, a);
+    b = find_root(vol, b);
     if (a != b) /* the larger number under the smaller: deterministic */
-        mesh_index[a > b ? a : b] = a < b ? a : b;
+        vol->mesh_index[a > b ? a : b] = a < b ? a : b;
 }
 
 static int keep_vertex(void *priv, const struct mesh_vertex *mv)
 {
-    (void)priv;
-    uint32_t v = mp.s.vertices++;
+    struct fusion_volume *vol = priv;
+    uint32_t v = vol->mp.s.vertices++;
     if (v < MESH_MAX_VERTICES) {
-        memcpy(&mesh_pos[3 * (size_t)v], mv->pos, 3 * sizeof(float));
-        memcpy(&mesh_nrm[3 * (size_t)v], mv->normal, 3 * sizeof(float));
-        memcpy(&mesh_rgb[3 * (size_t)v], mv->rgb, 3);
-        mesh_coloured[v] = mv->coloured;
-        mesh_index[v] = v;
+        memcpy(&vol->mesh_pos[3 * (size_t)v], mv->pos, 3 * sizeof(float));
+        memcpy(&vol->mesh_nrm[3 * (size_t)v], mv->normal, 3 * sizeof(float));
+        memcpy(&vol->mesh_rgb[3 * (size_t)v], mv->rgb, 3);
+        vol->mesh_coloured[v] = mv->coloured;
+        vol->mesh_index[v] = v;
     }
     return 0;
 }
 
 static int keep_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
 {
-    (void)priv;
-    uint32_t t = mp.s.triangles++;
-    if (mp.s.vertices <= MESH_MAX_VERTICES && t < MESH_MAX_TRIANGLES) {
-        uint32_t *tri = &mesh_tri[3 * (size_t)t];
+    struct fusion_volume *vol = priv;
+    uint32_t t = vol->mp.s.triangles++;
+    if (vol->mp.s.vertices <= MESH_MAX_VERTICES && t < MESH_MAX_TRIANGLES) {
+        uint32_t *tri = &vol->mesh_tri[3 * (size_t)t];
         tri[0] = a;
         tri[1] = b;
         tri[2] = c;
-        join(a, b);
-        join(b, c);
+        join(vol, a, b);
+        join(vol, b, c);
     }
     return 0;
 }
 
 /* Number the vertices of the pieces kept (DROPPED for the others), counting what is kept. */
-static void drop_fragments(double min_fragment_share)
+static void drop_fragments(struct fusion_volume *vol, double min_fragment_share)
 {
-    uint32_t n = mp.s.vertices, largest = 0, next = 0;
-    memset(mesh_tris, 0, n * sizeof(uint32_t));
-    for (uint32_t t = 0; t < mp.s.triangles; t++)
-        mesh_tris[find_root(mesh_tri[3 * (size_t)t])]++;
+    uint32_t n = vol->mp.s.vertices, largest = 0, next = 0;
+    memset(vol->mesh_tris, 0, n * sizeof(uint32_t));
+    for (uint32_t t = 0; t < vol->mp.s.triangles; t++)
+        vol->mesh_tris[find_root(vol, vol->mesh_tri[3 * (size_t)t])]++;
     for (uint32_t v = 0; v < n; v++)
-        mesh_index[v] = find_root(v); /* every vertex straight to its root */
+        vol->mesh_index[v] = find_root(vol, v); /* every vertex straight to its root */
     for (uint32_t v = 0; v < n; v++)
-        if (mesh_index[v] == v && mesh_tris[v] > largest)
-            largest = mesh_tris[v];
+        if (vol->mesh_index[v] == v && vol->mesh_tris[v] > largest)
+            largest = vol->mesh_tris[v];
     double keep_from = min_fragment_share * largest;
-    mp.s.kept_triangles = 0;
+    vol->mp.s.kept_triangles = 0;
     for (uint32_t v = 0; v < n; v++) {
-        uint32_t root = mesh_index[v], tris = mesh_tris[root];
+        uint32_t root = vol->mesh_index[v], tris = vol->mesh_tris[root];
         int keep = tris > 0 && tris >= keep_from;
         if (root == v) {
-            mp.s.pieces++;
-            mp.s.removed_pieces += !keep;
-            mp.s.kept_triangles += keep ? tris : 0;
+            vol->mp.s.pieces++;
+            vol->mp.s.removed_pieces += !keep;
+            vol->mp.s.kept_triangles += keep ? tris : 0;
         }
-        mesh_index[v] = keep ? next++ : DROPPED; /* its root's entry is read before: root <= v */
+        vol->mesh_index[v] =
+            keep ? next++ : DROPPED; /* its root's entry is read before: root <= v */
     }
-    mp.s.kept_vertices = next;
+    vol->mp.s.kept_vertices = next;
 }
 
 /* Vertices no view coloured (every view that saw the surface there had no estimate, e.g. paint
  * too dark at every exposure) take the colour of a coloured neighbour along the kept triangles,
  * a ring a pass (a flood fill from the surface around), so the surface's own colour spreads in
  * rather than a raw or black one; what no coloured vertex reaches within COLOUR_FILL_PASSES
- * rings is marked mid grey. mesh_tris, free after drop_fragments, holds each one's source. */
+ * rings is marked mid grey. vol->mesh_tris, free after drop_fragments, holds each one's source. */
 #define COLOUR_FILL_PASSES 64
 #define GREY_LINEAR 55 /* sRGB 128 */
 #define NO_SOURCE 0xFFFFFFFFu
-static void colour_fill(void)
+static void colour_fill(struct fusion_volume *vol)
 {
-    uint32_t n = mp.s.vertices, missing = 0;
+    uint32_t n = vol->mp.s.vertices, missing = 0;
     for (uint32_t v = 0; v < n; v++)
-        missing += mesh_index[v] != DROPPED && !mesh_coloured[v];
+        missing += vol->mesh_index[v] != DROPPED && !vol->mesh_coloured[v];
     for (int pass = 0; pass < COLOUR_FILL_PASSES && missing > 0; pass++) {
         uint32_t filled = 0;
-        memset(mesh_tris, 0xFF, n * sizeof(uint32_t));
-        for (uint32_t t = 0; t < mp.s.triangles; t++) {
-            const uint32_t *tri = &mesh_tri[3 * (size_t)t];
-            for (int k = 0; k < 3 && mesh_index[tri[0]] != DROPPED; k++) {
+        memset(vol->mesh_tris, 0xFF, n * sizeof(uint32_t));
+        for (uint32_t t = 0; t < vol->mp.s.triangles; t++) {
+            const uint32_t *tri = &vol->mesh_tri[3 * (size_t)t];
+            for (int k = 0; k < 3 && vol->mesh_index[tri[0]] != DROPPED; k++) {
                 uint32_t a = tri[k], b = tri[(k + 1) % 3];
-                if (!mesh_coloured[a] && mesh_coloured[b])
-                    mesh_tris[a] = b;
-                else if (!mesh_coloured[b] && mesh_coloured[a])
-                    mesh_tris[b] = a;
+                if (!vol->mesh_coloured[a] && vol->mesh_coloured[b])
+                    vol->mesh_tris[a] = b;
+                else if (!vol->mesh_coloured[b] && vol->mesh_coloured[a])
+                    vol->mesh_tris[b] = a;
             }
         }
         for (uint32_t v = 0; v < n; v++) {
-            if (mesh_tris[v] == NO_SOURCE)
+            if (vol->mesh_tris[v] == NO_SOURCE)
                 continue;
             /* sources were coloured before this pass: one ring a pass, whatever the numbering */
-            memcpy(&mesh_rgb[3 * (size_t)v], &mesh_rgb[3 * (size_t)mesh_tris[v]], 3);
+            memcpy(&vol->mesh_rgb[3 * (size_t)v], &vol->mesh_rgb[3 * (size_t)vol->mesh_tris[v]], 3);
             filled++;
         }
         for (uint32_t v = 0; v < n; v++)
-            mesh_coloured[v] |= mesh_tris[v] != NO_SOURCE;
-        mp.s.colour_filled += filled;
+            vol->mesh_coloured[v] |= vol->mesh_tris[v] != NO_SOURCE;
+        vol->mp.s.colour_filled += filled;
         missing -= filled;
         if (filled == 0)
             break;
     }
     for (uint32_t v = 0; v < n && missing > 0; v++)
-        if (mesh_index[v] != DROPPED && !mesh_coloured[v]) {
-            memset(&mesh_rgb[3 * (size_t)v], GREY_LINEAR, 3);
-            mp.s.uncoloured++;
+        if (vol->mesh_index[v] != DROPPED && !vol->mesh_coloured[v]) {
+            memset(&vol->mesh_rgb[3 * (size_t)v], GREY_LINEAR, 3);
+            vol->mp.s.uncoloured++;
         }
 }
 
-int fusion_mesh_prepare(double min_fragment_share, struct mesh_summary *out)
+int fusion_mesh_prepare(struct fusion_volume *vol, double min_fragment_share,
+                        struct mesh_summary *out)
 {
-    memset(&mp, 0, sizeof(mp));
-    struct mesh_sink keep = {keep_vertex, keep_triangle, NULL};
-    int rc = fusion_extract(&keep);
+    memset(&vol->mp, 0, sizeof(vol->mp));
+    struct mesh_sink keep = {keep_vertex, keep_triangle, vol};
+    int rc = fusion_extract(vol, &keep);
     if (rc != 0)
         return rc;
-    mp.fits = mp.s.vertices <= MESH_MAX_VERTICES && mp.s.triangles <= MESH_MAX_TRIANGLES;
-    mp.s.kept_vertices = mp.s.vertices;
-    mp.s.kept_triangles = mp.s.triangles;
-    if (mp.fits) {
-        drop_fragments(min_fragment_share);
-        colour_fill();
+    vol->mp.fits =
+        vol->mp.s.vertices <= MESH_MAX_VERTICES && vol->mp.s.triangles <= MESH_MAX_TRIANGLES;
+    vol->mp.s.kept_vertices = vol->mp.s.vertices;
+    vol->mp.s.kept_triangles = vol->mp.s.triangles;
+    if (vol->mp.fits) {
+        drop_fragments(vol, min_fragment_share);
+        colour_fill(vol);
     }
-    mp.prepared = 1;
-    *out = mp.s;
-    return mp.fits ? 0 : -E2BIG;
+    vol->mp.prepared = 1;
+    *out = vol->mp.s;
+    return vol->mp.fits ? 0 : -E2BIG;
 }
 
 /* Vertex @p v of the tables as the sinks take it (valid until the next call). */
-static const struct mesh_vertex *mesh_vertex_at(uint32_t v)
+static const struct mesh_vertex *mesh_vertex_at(struct fusion_volume *vol, uint32_t v)
 {
-    static struct mesh_vertex mv;
-    memcpy(mv.pos, &mesh_pos[3 * (size_t)v], sizeof(mv.pos));
-    memcpy(mv.normal, &mesh_nrm[3 * (size_t)v], sizeof(mv.normal));
-    memcpy(mv.rgb, &mesh_rgb[3 * (size_t)v], sizeof(mv.rgb));
-    mv.coloured = mesh_coloured[v];
-    return &mv;
+    struct mesh_vertex *mv = &vol->mv;
+    memcpy(mv->pos, &vol->mesh_pos[3 * (size_t)v], sizeof(mv->pos));
+    memcpy(mv->normal, &vol->mesh_nrm[3 * (size_t)v], sizeof(mv->normal));
+    memcpy(mv->rgb, &vol->mesh_rgb[3 * (size_t)v], sizeof(mv->rgb));
+    mv->coloured = vol->mesh_coloured[v];
+    return mv;
 }
 
 /* The kept mesh from the tables: the vertices, then the triangles, renumbered. */
-static int emit_kept(const struct mesh_sink *sink)
+static int emit_kept(struct fusion_volume *vol, const struct mesh_sink *sink)
 {
     int rc = 0;
-    for (uint32_t v = 0; v < mp.s.vertices && sink->vertex != NULL && rc == 0; v++)
-        if (mesh_index[v] != DROPPED)
-            rc = sink->vertex(sink->priv, mesh_vertex_at(v));
-    for (uint32_t t = 0; t < mp.s.triangles && sink->triangle != NULL && rc == 0; t++) {
-        const uint32_t *tri = &mesh_tri[3 * (size_t)t];
-        if (mesh_index[tri[0]] != DROPPED)
-            rc = sink->triangle(sink->priv, mesh_index[tri[0]], mesh_index[tri[1]],
-                                mesh_index[tri[2]]);
+    for (uint32_t v = 0; v < vol->mp.s.vertices && sink->vertex != NULL && rc == 0; v++)
+        if (vol->mesh_index[v] != DROPPED)
+            rc = sink->vertex(sink->priv, mesh_vertex_at(vol, v));
+    for (uint32_t t = 0; t < vol->mp.s.triangles && sink->triangle != NULL && rc == 0; t++) {
+        const uint32_t *tri = &vol->mesh_tri[3 * (size_t)t];
+        if (vol->mesh_index[tri[0]] != DROPPED)
+            rc = sink->triangle(sink->priv, vol->mesh_index[tri[0]], vol->mesh_index[tri[1]],
+                                vol->mesh_index[tri[2]]);
     }
     return rc;
 }
 
-int fusion_extract_prepared(const struct mesh_sink *sink)
+int fusion_extract_prepared(struct fusion_volume *vol, const struct mesh_sink *sink)
 {
-    if (!mp.prepared)
+    if (!vol->mp.prepared)
         return -EINVAL;
     /* too large for the tables: marching cubes again, every piece kept */
-    return mp.fits ? emit_kept(sink) : fusion_extract(sink);
+    return vol->mp.fits ? emit_kept(vol, sink) : fusion_extract(vol, sink);
 }
 
-int fusion_mesh_counts(struct mesh_summary *summary)
+int fusion_mesh_counts(struct fusion_volume *vol, struct mesh_summary *summary)
 {
-    if (!mp.prepared)
+    if (!vol->mp.prepared)
         return -EINVAL;
-    *summary = mp.s;
-    return mp.fits ? 0 : -E2BIG;
+    *summary = vol->mp.s;
+    return vol->mp.fits ? 0 : -E2BIG;
 }
 
 static int ply_vertex(void *priv, const struct mesh_vertex *v)
@@ -232,19 +224,19 @@ static int ply_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
     return o->rc;
 }
 
-int fusion_write_ply(const struct hal_storage *st, const char *path)
+int fusion_write_ply(struct fusion_volume *vol, const struct hal_storage *st, const char *path)
 {
     struct outbuf o;
-    if (!mp.prepared)
+    if (!vol->mp.prepared)
         return -EINVAL;
     if (outbuf_open(&o, st, path) != 0)
         return o.rc;
     /* PLY wants its counts first and its vertices before its faces */
-    ply_put_header(&o, "fused mesh", mp.s.kept_vertices, mp.s.kept_triangles, 0);
+    ply_put_header(&o, "fused mesh", vol->mp.s.kept_vertices, vol->mp.s.kept_triangles, 0);
     struct mesh_sink vertex_pass = {ply_vertex, NULL, &o};
     struct mesh_sink face_pass = {NULL, ply_triangle, &o};
-    fusion_extract_prepared(&vertex_pass);
-    fusion_extract_prepared(&face_pass);
+    fusion_extract_prepared(vol, &vertex_pass);
+    fusion_extract_prepared(vol, &face_pass);
     return outbuf_close(&o);
 }
 
@@ -270,10 +262,10 @@ static int obj_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
     return o->rc;
 }
 
-int fusion_write_obj(const struct hal_storage *st, const char *path)
+int fusion_write_obj(struct fusion_volume *vol, const struct hal_storage *st, const char *path)
 {
     struct outbuf o;
-    if (!mp.prepared)
+    if (!vol->mp.prepared)
         return -EINVAL;
     if (outbuf_open(&o, st, path) != 0)
         return o.rc;
@@ -281,17 +273,17 @@ int fusion_write_obj(const struct hal_storage *st, const char *path)
                       "object frame's x, z, -y: its z, up the turntable's axis, is Y here); vertex "
                       "colours sRGB-encoded\n");
     struct mesh_sink sink = {obj_vertex, obj_triangle, &o};
-    fusion_extract_prepared(&sink);
+    fusion_extract_prepared(vol, &sink);
     return outbuf_close(&o);
 }
 
 /* One STL facet: its normal (right-handed from the vertex order), then the three corners, of
  * triangle @p t of the tables (vertex numbers before renumbering). */
-static void stl_triangle(struct outbuf *o, uint32_t t)
+static void stl_triangle(struct fusion_volume *vol, struct outbuf *o, uint32_t t)
 {
-    const uint32_t *tri = &mesh_tri[3 * (size_t)t];
-    const float *p[3] = {&mesh_pos[3 * (size_t)tri[0]], &mesh_pos[3 * (size_t)tri[1]],
-                         &mesh_pos[3 * (size_t)tri[2]]};
+    const uint32_t *tri = &vol->mesh_tri[3 * (size_t)t];
+    const float *p[3] = {&vol->mesh_pos[3 * (size_t)tri[0]], &vol->mesh_pos[3 * (size_t)tri[1]],
+                         &vol->mesh_pos[3 * (size_t)tri[2]]};
     vec3 e1 = v3(p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]);
     vec3 e2 = v3(p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]);
     vec3 n = v3_cross(e1, e2);
@@ -307,12 +299,12 @@ static void stl_triangle(struct outbuf *o, uint32_t t)
     outbuf_put(o, no_attribute, 2);
 }
 
-int fusion_write_stl(const struct hal_storage *st, const char *path)
+int fusion_write_stl(struct fusion_volume *vol, const struct hal_storage *st, const char *path)
 {
     struct outbuf o;
-    if (!mp.prepared)
+    if (!vol->mp.prepared)
         return -EINVAL;
-    if (!mp.fits)
+    if (!vol->mp.fits)
         return -E2BIG;
     if (outbuf_open(&o, st, path) != 0)
         return o.rc;
@@ -320,9 +312,9 @@ int fusion_write_stl(const struct hal_storage *st, const char *path)
     memset(header, 0, sizeof(header));
     strncpy(header, "turntable colour scanner: fused mesh, units millimetres", sizeof(header) - 1);
     outbuf_put(&o, header, sizeof(header));
-    outbuf_u32le(&o, mp.s.kept_triangles);
-    for (uint32_t t = 0; t < mp.s.triangles && o.rc == 0; t++)
-        if (mesh_index[mesh_tri[3 * (size_t)t]] != DROPPED)
-            stl_triangle(&o, t);
+    outbuf_u32le(&o, vol->mp.s.kept_triangles);
+    for (uint32_t t = 0; t < vol->mp.s.triangles && o.rc == 0; t++)
+        if (vol->mesh_index[vol->mesh_tri[3 * (size_t)t]] != DROPPED)
+            stl_triangle(vol, &o, t);
     return outbuf_close(&o);
 }

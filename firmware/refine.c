@@ -1,8 +1,6 @@
 /* Sub-stripe refinement by interpolating across runs of equal Gray codes along camera rows. */
 #include "refine.h"
 
-static float column_sub[HAL_MAX_PIXELS];
-
 /* Code of the run that ends just before x0 (dir -1) or starts just after x1 (dir +1), or -1 if
  * that pixel is not valid. */
 static int neighbour_code(const struct decode_maps *m, size_t row, uint32_t x, int dir)
@@ -13,7 +11,8 @@ static int neighbour_code(const struct decode_maps *m, size_t row, uint32_t x, i
     return m->column[row + (size_t)nx];
 }
 
-static void refine_run(const struct decode_maps *m, size_t row, uint32_t x0, uint32_t x1)
+static void refine_run(const struct decode_maps *m, float *column_sub, size_t row, uint32_t x0,
+                       uint32_t x1)
 {
     int c = m->column[row + x0];
     int left = neighbour_code(m, row, x0, -1), right = neighbour_code(m, row, x1, +1);
@@ -30,7 +29,7 @@ static void refine_run(const struct decode_maps *m, size_t row, uint32_t x0, uin
     }
 }
 
-int refine_columns(const struct decode_maps *m, int enabled, const float **columns)
+int refine_columns(const struct decode_maps *m, int enabled, float *column_sub)
 {
     for (uint32_t y = 0; y < m->height; y++) {
         size_t row = (size_t)y * m->width;
@@ -45,7 +44,7 @@ int refine_columns(const struct decode_maps *m, int enabled, const float **colum
                    m->column[row + end + 1] == m->column[row + x])
                 end++;
             if (enabled) {
-                refine_run(m, row, x, end);
+                refine_run(m, column_sub, row, x, end);
             } else {
                 for (uint32_t k = x; k <= end; k++)
                     column_sub[row + k] = (float)m->column[row + k];
@@ -53,6 +52,5 @@ int refine_columns(const struct decode_maps *m, int enabled, const float **colum
             x = end + 1;
         }
     }
-    *columns = column_sub;
     return 0;
 }

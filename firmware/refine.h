@@ -8,9 +8,9 @@
  *  run of pixels with code c that lies between runs coded c - 1 and c + 1 (either order) spans
  *  the projector interval [c - 0.5, c + 0.5]; each pixel gets its linear position in it. Other
  *  pixels keep c. With @p enabled = 0 every pixel keeps c.
- *  @param columns  out: the continuous column map (the refiner's static buffer, row-major,
- *                  meaningful where the pixel is valid), until the next call
+ *  @param columns  out: the continuous column map (width * height, row-major, meaningful where
+ *                  the pixel is valid)
  *  @retval 0 */
-int refine_columns(const struct decode_maps *maps, int enabled, const float **columns);
+int refine_columns(const struct decode_maps *maps, int enabled, float *columns);
 
 #endif

@@ -12,20 +12,6 @@
 #include <stdio.h>
 #include <string.h>
 
-static uint8_t
-    colour_rgb[HAL_MAX_PIXELS * 3];           /* projector-white frame, kept as the view's colour */
-static uint8_t frame_rgb[HAL_MAX_PIXELS * 3]; /* every other frame, consumed at once */
-/* Light frames for the colour (colour.h): dark, all lights, each light alone. */
-static uint8_t light_rgb[COLOUR_MAX_FRAMES][HAL_MAX_PIXELS * 3];
-static int light_present[COLOUR_MAX_FRAMES];
-static uint8_t view_rgb[HAL_MAX_PIXELS * 3]; /* the view's colour: compensated, or raw */
-static float view_confidence[HAL_MAX_PIXELS];
-static uint8_t view_reason[HAL_MAX_PIXELS]; /* decoded, then refined by each later stage */
-static uint8_t hdr_choice[HAL_MAX_PIXELS];  /* HDR: the exposure each pixel is read at */
-static uint8_t hdr_grey[HAL_MAX_PIXELS];    /* HDR: one exposure of the pattern being merged */
-static struct scan_params view_params;      /* of the view being fed */
-static uint32_t view_patterns, view_lights; /* its pattern and colour frames */
-
 int scan_check(const struct scan_params *p, const struct scan_calib *c, char *msg, size_t len)
 {
     if (p->width > HAL_MAX_WIDTH || p->height > HAL_MAX_HEIGHT) {
@@ -75,38 +61,36 @@ int scan_open(const struct hal *hal, const struct hal_camera_config *cam_cfg)
     return rc;
 }
 
-/* When the last light or pattern change had settled (HAL clock; 0: the clock cannot tell). */
-static uint64_t settled_us;
-
 /* Wait for a light or pattern change to take effect, and remember when it had. */
-static int settle(const struct hal *hal, const struct scan_params *p)
+static int settle(struct scan_ctx *s, const struct hal *hal, const struct scan_params *p)
 {
     int rc = hal_clock_sleep_us(&hal->clock, p->pattern_settle_us);
-    if (rc == 0 && hal_clock_now_us(&hal->clock, &settled_us) != 0)
-        settled_us = 0;
+    if (rc == 0 && hal_clock_now_us(&hal->clock, &s->settled_us) != 0)
+        s->settled_us = 0;
     return rc;
 }
 
 /* A frame whose exposure began before the change had settled shows the old pattern or lights
  * (a camera delivering a frame it had in flight): it is discarded like a corrupt one. */
-static int check_fresh(const struct hal *hal, const struct hal_image *img, uint32_t pattern)
+static int check_fresh(struct scan_ctx *s, const struct hal *hal, const struct hal_image *img,
+                       uint32_t pattern)
 {
-    if (img->start_us == 0 || settled_us == 0 || img->start_us >= settled_us)
+    if (img->start_us == 0 || s->settled_us == 0 || img->start_us >= s->settled_us)
         return 0;
     hal->log(HAL_LOG_WARN,
              "camera: frame %llu for pattern %u began %llu us before the change had settled "
              "(a stale frame); discarded",
              (unsigned long long)img->sequence, (unsigned)pattern,
-             (unsigned long long)(settled_us - img->start_us));
+             (unsigned long long)(s->settled_us - img->start_us));
     return -EAGAIN;
 }
 
 /* Capture into @p buf, retrying faults that a second try can cure (timeout, corrupt or stale
  * frame). */
-static int capture(const struct hal *hal, const struct scan_params *p, uint8_t *buf,
-                   uint32_t pattern, struct scan_view_info *info)
+static int capture(struct scan_ctx *s, const struct hal *hal, const struct scan_params *p,
+                   uint8_t *buf, uint32_t pattern, struct scan_view_info *info)
 {
-    struct hal_image img = {.rgb = buf, .capacity = sizeof(frame_rgb)};
+    struct hal_image img = {.rgb = buf, .capacity = sizeof(s->frame_rgb)};
     int rc = -EIO;
     for (uint32_t attempt = 0; attempt <= p->capture_retries; attempt++) {
         if (attempt > 0)
@@ -115,7 +99,7 @@ static int capture(const struct hal *hal, const struct scan_params *p, uint8_t *
         if (rc == 0 && (img.width != p->width || img.height != p->height))
             rc = -EIO; /* a frame of the wrong size is as bad as a corrupt one */
         if (rc == 0)
-            rc = check_fresh(hal, &img, pattern);
+            rc = check_fresh(s, hal, &img, pattern);
         if (rc == 0)
             return 0;
         if (rc != -EAGAIN)
@@ -146,7 +130,8 @@ static int lights_off(const struct hal *hal, uint32_t light_count)
 }
 
 /* Show pattern 0 (white) with only the projector lighting the object. */
-static int projector_start(const struct hal *hal, const struct scan_params *p, uint32_t lights)
+static int projector_start(struct scan_ctx *s, const struct hal *hal, const struct scan_params *p,
+                           uint32_t lights)
 {
     int rc = lights_off(hal, lights);
     if (rc == 0)
@@ -154,7 +139,7 @@ static int projector_start(const struct hal *hal, const struct scan_params *p, u
     if (rc == 0)
         rc = hal_gpio_pulse(&hal->gpio, &hal->clock, HAL_GPIO_PROJECTOR_RESET, p->trigger_pulse_us);
     if (rc == 0)
-        rc = settle(hal, p);
+        rc = settle(s, hal, p);
     return rc;
 }
 
@@ -164,40 +149,39 @@ void scan_layout(const struct scan_params *p, const struct scan_calib *c, struct
     l->code = p->code;
 }
 
-int scan_begin_view(const struct scan_params *p, const struct scan_calib *c)
+int scan_begin_view(struct scan_ctx *s, const struct scan_params *p, const struct scan_calib *c)
 {
     struct gray_layout layout;
-    view_params = *p;
-    memset(light_present, 0, sizeof(light_present));
+    s->params = *p;
+    memset(s->light_present, 0, sizeof(s->light_present));
     scan_layout(p, c, &layout);
-    view_patterns = gray_layout_count(&layout);
-    view_lights = scan_light_frame_count(p, c);
-    return decode_begin(p, &layout, c->proj_width, c->proj_height);
+    s->patterns = gray_layout_count(&layout);
+    s->lights = scan_light_frame_count(p, c);
+    return decode_begin(&s->decode, p, &layout, c->proj_width, c->proj_height);
 }
 
-int scan_feed_frame(uint32_t pattern, const uint8_t *pixels, uint32_t channels,
+int scan_feed_frame(struct scan_ctx *s, uint32_t pattern, const uint8_t *pixels, uint32_t channels,
                     const struct scan_frame_sink *sink)
 {
-    size_t n = (size_t)view_params.width * view_params.height;
+    size_t n = (size_t)s->params.width * s->params.height;
     const uint8_t *grey = pixels;
-    uint8_t *slot = decode_frame_slot(pattern);
+    uint8_t *slot = decode_frame_slot(&s->decode, pattern);
     if (slot == NULL)
         return -EINVAL;
     int colour = channels == 3 && pattern == GRAY_PATTERN_WHITE;
     if (channels == 3) {
-        if (colour && pixels != colour_rgb)
-            memcpy(colour_rgb, pixels, n * 3); /* the view's colour */
-        decode_rgb_to_grey(pixels, slot, n, view_params.saturation_dn);
+        if (colour && pixels != s->colour_rgb)
+            memcpy(s->colour_rgb, pixels, n * 3); /* the view's colour */
+        decode_rgb_to_grey(pixels, slot, n, s->params.saturation_dn);
         grey = slot; /* converted straight into the decoder's store */
     }
-    int rc = decode_frame(pattern, grey);
+    int rc = decode_frame(&s->decode, pattern, grey);
     /* The white frame is kept in colour (its grey is derived again offline); the others are
      * kept exactly as the decoder saw them. */
     if (rc == 0 && sink != NULL && sink->save != NULL)
-        rc = colour
-                 ? sink->save(sink->priv, pattern, colour_rgb, view_params.width,
-                              view_params.height, 3)
-                 : sink->save(sink->priv, pattern, grey, view_params.width, view_params.height, 1);
+        rc = colour ? sink->save(sink->priv, pattern, s->colour_rgb, s->params.width,
+                                 s->params.height, 3)
+                    : sink->save(sink->priv, pattern, grey, s->params.width, s->params.height, 1);
     return rc;
 }
 
@@ -213,21 +197,22 @@ uint32_t scan_frame_channels(const struct scan_params *p, const struct scan_cali
     return (frame == GRAY_PATTERN_WHITE && !hdr) || frame >= count ? 3u : 1u;
 }
 
-uint8_t *scan_frame_buffer(uint32_t frame)
+uint8_t *scan_frame_buffer(struct scan_ctx *s, uint32_t frame)
 {
-    uint32_t count = view_patterns, lights = view_lights;
-    int hdr = view_params.exposure_count > 0;
+    uint32_t count = s->patterns, lights = s->lights;
+    int hdr = s->params.exposure_count > 0;
     if (frame < count)
-        return frame == GRAY_PATTERN_WHITE && !hdr ? colour_rgb : decode_frame_slot(frame);
+        return frame == GRAY_PATTERN_WHITE && !hdr ? s->colour_rgb
+                                                   : decode_frame_slot(&s->decode, frame);
     if (frame < count + lights)
-        return frame - count < COLOUR_MAX_FRAMES ? light_rgb[frame - count] : NULL;
-    return hdr && frame == count + lights ? colour_rgb : NULL;
+        return frame - count < COLOUR_MAX_FRAMES ? s->light_rgb[frame - count] : NULL;
+    return hdr && frame == count + lights ? s->colour_rgb : NULL;
 }
 
-int scan_feed_white_colour(const uint8_t *rgb)
+int scan_feed_white_colour(struct scan_ctx *s, const uint8_t *rgb)
 {
-    if (rgb != colour_rgb)
-        memcpy(colour_rgb, rgb, (size_t)view_params.width * view_params.height * 3);
+    if (rgb != s->colour_rgb)
+        memcpy(s->colour_rgb, rgb, (size_t)s->params.width * s->params.height * 3);
     return 0;
 }
 
@@ -238,38 +223,40 @@ uint32_t scan_light_frame_count(const struct scan_params *p, const struct scan_c
     return lay.count;
 }
 
-int scan_feed_light_frame(uint32_t k, const uint8_t *rgb)
+int scan_feed_light_frame(struct scan_ctx *s, uint32_t k, const uint8_t *rgb)
 {
     if (k >= COLOUR_MAX_FRAMES)
         return -EINVAL;
-    if (rgb != light_rgb[k])
-        memcpy(light_rgb[k], rgb, (size_t)view_params.width * view_params.height * 3);
-    light_present[k] = 1;
+    if (rgb != s->light_rgb[k])
+        memcpy(s->light_rgb[k], rgb, (size_t)s->params.width * s->params.height * 3);
+    s->light_present[k] = 1;
     return 0;
 }
 
-int scan_finish_view(const struct scan_calib *c, int32_t angle_mdeg, struct scan_view *view,
-                     struct scan_view_info *info)
+int scan_finish_view(struct scan_ctx *s, const struct scan_calib *c, int32_t angle_mdeg,
+                     struct scan_view *view, struct scan_view_info *info)
 {
     memset(view, 0, sizeof(*view));
-    view->width = view_params.width;
-    view->height = view_params.height;
+    view->width = s->params.width;
+    view->height = s->params.height;
     view->angle_mdeg = angle_mdeg;
-    view->white_rgb = colour_rgb;
+    view->white_rgb = s->colour_rgb;
     for (uint32_t k = 0; k < COLOUR_MAX_FRAMES; k++)
-        view->lights[k] = light_present[k] ? light_rgb[k] : NULL;
-    view->rgb = view_rgb;
-    view->confidence = view_confidence;
-    int rc = decode_finish(view_reason, &view->maps);
+        view->lights[k] = s->light_present[k] ? s->light_rgb[k] : NULL;
+    view->rgb = s->view_rgb;
+    view->confidence = s->view_confidence;
+    int rc = decode_finish(&s->decode, s->view_reason, &view->maps);
     if (rc == 0)
-        rc = refine_columns(&view->maps, (int)view_params.refine, &view->column);
+        rc = refine_columns(&view->maps, (int)s->params.refine, s->column);
+    view->column = s->column;
     if (rc == 0)
-        rc = tri_range_image(c, view->width, view->height, view->column, view_reason, &view->range);
+        rc = tri_range_image(c, &s->tri, view->width, view->height, view->column, s->view_reason,
+                             &view->range);
     if (rc == 0)
-        rc = tri_normals(&view->range, view_reason, view_params.normal_radius_px,
-                         view_params.max_depth_jump_mm);
+        rc = tri_normals(&s->tri, &view->range, s->view_reason, s->params.normal_radius_px,
+                         s->params.max_depth_jump_mm);
     if (rc == 0)
-        rc = scan_recolour(&view_params.colour, c, view, NULL); /* fit: multi's, until the
+        rc = scan_recolour(&s->params.colour, c, view, NULL); /* fit: multi's, until the
                                                                    job's model colours it */
     if (rc != 0)
         return rc;
@@ -277,40 +264,43 @@ int scan_finish_view(const struct scan_calib *c, int32_t angle_mdeg, struct scan
     memset(info->reason_count, 0, sizeof(info->reason_count));
     size_t n = (size_t)view->width * view->height;
     for (size_t i = 0; i < n; i++)
-        info->reason_count[view_reason[i]]++;
+        info->reason_count[s->view_reason[i]]++;
     info->valid_points = info->reason_count[SCAN_VALID];
     return 0;
 }
 
-int scan_restore_view(uint32_t width, uint32_t height, int32_t angle_mdeg, uint32_t valid_count,
-                      uint32_t colour_method, struct scan_view *view, struct scan_view_fill *fill)
+int scan_restore_view(struct scan_ctx *s, uint32_t width, uint32_t height, int32_t angle_mdeg,
+                      uint32_t valid_count, uint32_t colour_method, struct scan_view *view,
+                      struct scan_view_fill *fill)
 {
     memset(view, 0, sizeof(*view));
-    int rc = tri_restore(width, height, valid_count, &view->range, &fill->xyz_mm, &fill->normal);
+    int rc = tri_restore(&s->tri, width, height, valid_count, &view->range);
     if (rc != 0)
         return rc;
+    fill->xyz_mm = s->tri.xyz_mm;
+    fill->normal = s->tri.normal;
     view->width = width;
     view->height = height;
     view->angle_mdeg = angle_mdeg;
-    view->maps = (struct decode_maps){.reason = view_reason, .width = width, .height = height};
-    view->rgb = fill->rgb = view_rgb;
-    view->confidence = fill->confidence = view_confidence;
+    view->maps = (struct decode_maps){.reason = s->view_reason, .width = width, .height = height};
+    view->rgb = fill->rgb = s->view_rgb;
+    view->confidence = fill->confidence = s->view_confidence;
     view->colour_method = colour_method;
-    fill->reason = view_reason;
+    fill->reason = s->view_reason;
     return 0;
 }
 
 /* HDR: pattern @p i at every exposure, merged in the decoder's slot before it is fed: each
- * pixel at the exposure hdr_choice holds, chosen on the white pattern as the longest whose
+ * pixel at the exposure s->hdr_choice holds, chosen on the white pattern as the longest whose
  * white is not saturated (the brightest unsaturated). The pixel's patterns, inverses, white and
  * black are then all read at one exposure, so the decoder's comparisons stay within it and
  * need no scaling. The white at the camera's own exposure is kept as the view's colour.
  * @p exposure_us  in/out: the camera's exposure now */
-static int capture_hdr(const struct hal *hal, const struct scan_params *p, uint32_t i,
-                       uint32_t *exposure_us, struct scan_view_info *info)
+static int capture_hdr(struct scan_ctx *s, const struct hal *hal, const struct scan_params *p,
+                       uint32_t i, uint32_t *exposure_us, struct scan_view_info *info)
 {
     const size_t n = (size_t)p->width * p->height;
-    uint8_t *slot = decode_frame_slot(i);
+    uint8_t *slot = decode_frame_slot(&s->decode, i);
     int rc = 0;
     for (uint32_t e = 0; e < p->exposure_count && rc == 0; e++) {
         if (p->exposures_us[e] != *exposure_us) {
@@ -318,49 +308,49 @@ static int capture_hdr(const struct hal *hal, const struct scan_params *p, uint3
             *exposure_us = p->exposures_us[e];
         }
         int colour = i == GRAY_PATTERN_WHITE && p->exposures_us[e] == p->colour.exposure_us;
-        uint8_t *buf = colour ? colour_rgb : frame_rgb;
+        uint8_t *buf = colour ? s->colour_rgb : s->frame_rgb;
         if (rc == 0)
-            rc = capture(hal, p, buf, i, info);
+            rc = capture(s, hal, p, buf, i, info);
         if (rc != 0)
             break;
         info->frames_captured++;
-        decode_rgb_to_grey(buf, hdr_grey, n, p->saturation_dn);
+        decode_rgb_to_grey(buf, s->hdr_grey, n, p->saturation_dn);
         if (i == GRAY_PATTERN_WHITE) /* ascending: a longer unsaturated exposure wins */
             for (size_t k = 0; k < n; k++)
-                if (e == 0 || hdr_grey[k] != DECODE_SATURATED)
-                    hdr_choice[k] = (uint8_t)e;
+                if (e == 0 || s->hdr_grey[k] != DECODE_SATURATED)
+                    s->hdr_choice[k] = (uint8_t)e;
         for (size_t k = 0; k < n; k++)
-            if (hdr_choice[k] == e)
-                slot[k] = hdr_grey[k];
+            if (s->hdr_choice[k] == e)
+                slot[k] = s->hdr_grey[k];
     }
     return rc;
 }
 
 /* One pattern as the decoder takes it: RGB at the camera's exposure, or merged HDR grey. */
-static int capture_pattern(const struct hal *hal, const struct scan_params *p, uint32_t i,
-                           const struct scan_frame_sink *sink, uint32_t *exposure_us,
+static int capture_pattern(struct scan_ctx *s, const struct hal *hal, const struct scan_params *p,
+                           uint32_t i, const struct scan_frame_sink *sink, uint32_t *exposure_us,
                            struct scan_view_info *info)
 {
     if (p->exposure_count > 0) {
-        int rc = capture_hdr(hal, p, i, exposure_us, info);
-        return rc != 0 ? rc : scan_feed_frame(i, decode_frame_slot(i), 1, sink);
+        int rc = capture_hdr(s, hal, p, i, exposure_us, info);
+        return rc != 0 ? rc : scan_feed_frame(s, i, decode_frame_slot(&s->decode, i), 1, sink);
     }
-    uint8_t *buf = i == GRAY_PATTERN_WHITE ? colour_rgb : frame_rgb;
-    int rc = capture(hal, p, buf, i, info);
+    uint8_t *buf = i == GRAY_PATTERN_WHITE ? s->colour_rgb : s->frame_rgb;
+    int rc = capture(s, hal, p, buf, i, info);
     if (rc != 0)
         return rc;
     info->frames_captured++;
-    return scan_feed_frame(i, buf, 3, sink);
+    return scan_feed_frame(s, i, buf, 3, sink);
 }
 
-static int capture_sequence(const struct hal *hal, const struct scan_params *p, uint32_t count,
-                            const struct scan_frame_sink *sink, uint32_t *exposure_us,
-                            struct scan_view_info *info)
+static int capture_sequence(struct scan_ctx *s, const struct hal *hal, const struct scan_params *p,
+                            uint32_t count, const struct scan_frame_sink *sink,
+                            uint32_t *exposure_us, struct scan_view_info *info)
 {
     for (uint32_t i = 0; i < count; i++) {
         if (hal_should_stop(hal))
             return -EINTR;
-        int rc = capture_pattern(hal, p, i, sink, exposure_us, info);
+        int rc = capture_pattern(s, hal, p, i, sink, exposure_us, info);
         if (rc != 0)
             return rc;
         if (i + 1 == count)
@@ -368,7 +358,7 @@ static int capture_sequence(const struct hal *hal, const struct scan_params *p, 
         rc = hal_gpio_pulse(&hal->gpio, &hal->clock, HAL_GPIO_PROJECTOR_TRIGGER,
                             p->trigger_pulse_us);
         if (rc == 0)
-            rc = settle(hal, p);
+            rc = settle(s, hal, p);
         if (rc != 0)
             return rc;
     }
@@ -386,11 +376,12 @@ static int camera_exposure_back(const struct hal *hal, const struct scan_params 
 }
 
 /* Every pattern of the sequence, the camera back at its own exposure after (also on failure). */
-static int capture_patterns(const struct hal *hal, const struct scan_params *p, uint32_t count,
-                            const struct scan_frame_sink *sink, struct scan_view_info *info)
+static int capture_patterns(struct scan_ctx *s, const struct hal *hal, const struct scan_params *p,
+                            uint32_t count, const struct scan_frame_sink *sink,
+                            struct scan_view_info *info)
 {
     uint32_t exposure_us = p->colour.exposure_us;
-    int rc = capture_sequence(hal, p, count, sink, &exposure_us, info);
+    int rc = capture_sequence(s, hal, p, count, sink, &exposure_us, info);
     int rc_exp = camera_exposure_back(hal, p, exposure_us);
     rc = rc != 0 ? rc : rc_exp;
     if (rc == -ENOSYS)
@@ -401,7 +392,7 @@ static int capture_patterns(const struct hal *hal, const struct scan_params *p, 
 
 /* The colour frames (colour_layout): projector off, each with its lights and exposure; lights off
  * and the camera back at its own exposure after, also on failure. */
-static int capture_lights(const struct hal *hal, const struct scan_params *p,
+static int capture_lights(struct scan_ctx *s, const struct hal *hal, const struct scan_params *p,
                           const struct scan_calib *c, uint32_t first_index,
                           const struct scan_frame_sink *sink, struct scan_view_info *info)
 {
@@ -418,17 +409,17 @@ static int capture_lights(const struct hal *hal, const struct scan_params *p,
             exposure_us = lay.exposure_us[k];
         }
         if (rc == 0)
-            rc = settle(hal, p);
+            rc = settle(s, hal, p);
         if (rc == 0 && hal_should_stop(hal))
             rc = -EINTR;
         if (rc == 0)
-            rc = capture(hal, p, light_rgb[k], first_index + k, info);
+            rc = capture(s, hal, p, s->light_rgb[k], first_index + k, info);
         if (rc == 0) {
             info->frames_captured++;
-            rc = scan_feed_light_frame(k, light_rgb[k]);
+            rc = scan_feed_light_frame(s, k, s->light_rgb[k]);
         }
         if (rc == 0 && sink != NULL && sink->save != NULL)
-            rc = sink->save(sink->priv, first_index + k, light_rgb[k], p->width, p->height, 3);
+            rc = sink->save(sink->priv, first_index + k, s->light_rgb[k], p->width, p->height, 3);
     }
     int rc_off = lights_off(hal, c->light_count);
     int rc_exp = camera_exposure_back(hal, p, exposure_us);
@@ -439,44 +430,44 @@ static int capture_lights(const struct hal *hal, const struct scan_params *p,
     return rc != 0 ? rc : rc_off;
 }
 
-int scan_snapshot(const struct hal *hal, const struct scan_params *p, const struct scan_calib *c,
-                  const uint8_t **rgb)
+int scan_snapshot(struct scan_ctx *s, const struct hal *hal, const struct scan_params *p,
+                  const struct scan_calib *c, const uint8_t **rgb)
 {
     struct scan_view_info info;
     memset(&info, 0, sizeof(info));
-    int rc = projector_start(hal, p, c->light_count);
+    int rc = projector_start(s, hal, p, c->light_count);
     if (rc == 0)
-        rc = capture(hal, p, frame_rgb, 0, &info);
+        rc = capture(s, hal, p, s->frame_rgb, 0, &info);
     /* the projector off again at once, and the rig safe on every failure */
     int rc_off = hal_gpio_set(&hal->gpio, HAL_GPIO_PROJECTOR_ENABLE, 0);
     if (rc != 0 || rc_off != 0)
         hal->gpio.ops->safe_state(hal->gpio.priv);
-    *rgb = frame_rgb;
+    *rgb = s->frame_rgb;
     return rc != 0 ? rc : rc_off;
 }
 
-int scan_capture_view(const struct hal *hal, const struct scan_params *p,
+int scan_capture_view(struct scan_ctx *s, const struct hal *hal, const struct scan_params *p,
                       const struct scan_calib *c, int32_t angle_mdeg,
                       const struct scan_frame_sink *sink, struct scan_view_info *info)
 {
     memset(info, 0, sizeof(*info));
     info->angle_mdeg = angle_mdeg;
-    int rc = scan_begin_view(p, c);
+    int rc = scan_begin_view(s, p, c);
     if (rc != 0)
         return rc;
     struct gray_layout layout;
     scan_layout(p, c, &layout);
     uint32_t count = gray_layout_count(&layout);
-    rc = projector_start(hal, p, c->light_count);
+    rc = projector_start(s, hal, p, c->light_count);
     if (rc == 0)
-        rc = capture_patterns(hal, p, count, sink, info);
+        rc = capture_patterns(s, hal, p, count, sink, info);
     /* Projector off as soon as the last frame is in, and on every failure. */
     int rc_off = hal_gpio_set(&hal->gpio, HAL_GPIO_PROJECTOR_ENABLE, 0);
     if (rc == 0 && rc_off == 0)
-        rc = capture_lights(hal, p, c, count, sink, info);
+        rc = capture_lights(s, hal, p, c, count, sink, info);
     /* HDR: the pattern frames are merged grey; the view's colour is kept after the lights. */
     if (rc == 0 && rc_off == 0 && p->exposure_count > 0 && sink != NULL && sink->save != NULL)
-        rc = sink->save(sink->priv, count + scan_light_frame_count(p, c), colour_rgb, p->width,
+        rc = sink->save(sink->priv, count + scan_light_frame_count(p, c), s->colour_rgb, p->width,
                         p->height, 3);
     if (rc != 0 || rc_off != 0)
         goto out_safe;
@@ -486,12 +477,13 @@ out_safe:
     return rc != 0 ? rc : rc_off;
 }
 
-int scan_take_view(const struct hal *hal, const struct scan_params *p, const struct scan_calib *c,
-                   int32_t angle_mdeg, const struct scan_frame_sink *sink, struct scan_view *view,
+int scan_take_view(struct scan_ctx *s, const struct hal *hal, const struct scan_params *p,
+                   const struct scan_calib *c, int32_t angle_mdeg,
+                   const struct scan_frame_sink *sink, struct scan_view *view,
                    struct scan_view_info *info)
 {
-    int rc = scan_capture_view(hal, p, c, angle_mdeg, sink, info);
-    return rc != 0 ? rc : scan_finish_view(c, angle_mdeg, view, info);
+    int rc = scan_capture_view(s, hal, p, c, angle_mdeg, sink, info);
+    return rc != 0 ? rc : scan_finish_view(s, c, angle_mdeg, view, info);
 }
 
 int scan_keep_for_registration(struct reg_ctx *reg, uint32_t index, const struct scan_view *view)
@@ -499,10 +491,10 @@ int scan_keep_for_registration(struct reg_ctx *reg, uint32_t index, const struct
     return reg_add_view(reg, index, view->angle_mdeg, &view->maps, &view->range, view->rgb);
 }
 
-int scan_fuse_view(const struct scan_calib *calib, const struct scan_view *view,
-                   const struct frame_xform *obj_from_cam)
+int scan_fuse_view(struct fusion_volume *vol, const struct scan_calib *calib,
+                   const struct scan_view *view, const struct frame_xform *obj_from_cam)
 {
-    return fusion_integrate(calib, obj_from_cam, &view->maps, &view->range, view->rgb,
+    return fusion_integrate(vol, calib, obj_from_cam, &view->maps, &view->range, view->rgb,
                             view->confidence);
 }
 
@@ -519,11 +511,11 @@ int scan_save_cloud(const struct hal *hal, const struct scan_view *view,
     return rc;
 }
 
-void scan_attach_colour(struct scan_view *view)
+void scan_attach_colour(struct scan_ctx *s, struct scan_view *view)
 {
-    view->white_rgb = colour_rgb;
+    view->white_rgb = s->colour_rgb;
     for (uint32_t k = 0; k < COLOUR_MAX_FRAMES; k++)
-        view->lights[k] = light_present[k] ? light_rgb[k] : NULL;
+        view->lights[k] = s->light_present[k] ? s->light_rgb[k] : NULL;
 }
 
 int scan_recolour(const struct colour_params *colour, const struct scan_calib *c,

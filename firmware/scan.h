@@ -11,6 +11,33 @@
 #include "reg.h"
 #include "tri.h"
 
+struct fusion_volume;
+
+/** One view's buffers and state, from its first frame to its range image and colour: what
+ *  scan_begin_view (or scan_capture_view) starts and scan_finish_view completes; the views it
+ *  hands out point into it. Tens of MB at the compiled limits: its owner (the job, the
+ *  calibration, a command) keeps it static and passes it by pointer, so there is no allocation;
+ *  two contexts are two independent views. Its fields are the firmware's own. */
+struct scan_ctx {
+    struct decode_ctx decode;               /* the pattern frames, decoded */
+    float column[HAL_MAX_PIXELS];           /* continuous projector column (refine.h) */
+    struct tri_maps tri;                    /* the range image */
+    uint8_t colour_rgb[HAL_MAX_PIXELS * 3]; /* projector-white frame, kept as the view's colour */
+    uint8_t frame_rgb[HAL_MAX_PIXELS * 3];  /* every other frame, consumed at once */
+    /* Light frames for the colour (colour.h): dark, all lights, each light alone. */
+    uint8_t light_rgb[COLOUR_MAX_FRAMES][HAL_MAX_PIXELS * 3];
+    int light_present[COLOUR_MAX_FRAMES];
+    uint8_t view_rgb[HAL_MAX_PIXELS * 3]; /* the view's colour: compensated, or raw */
+    float view_confidence[HAL_MAX_PIXELS];
+    uint8_t view_reason[HAL_MAX_PIXELS]; /* decoded, then refined by each later stage */
+    uint8_t hdr_choice[HAL_MAX_PIXELS];  /* HDR: the exposure each pixel is read at */
+    uint8_t hdr_grey[HAL_MAX_PIXELS];    /* HDR: one exposure of the pattern being merged */
+    struct scan_params params;           /* of the view being fed */
+    uint32_t patterns, lights;           /* its pattern and colour frames */
+    uint64_t settled_us; /* when the last light or pattern change had settled (HAL clock; 0: the
+                            clock cannot tell) */
+};
+
 /** What one view produced. */
 struct scan_view_info {
     int32_t angle_mdeg;                       /**< turntable angle of the view */
@@ -22,7 +49,7 @@ struct scan_view_info {
 
 /** One processed view, as a value: what scan_finish_view hands to the stages after it
  *  (registration, cloud, fusion, recolouring), each of which takes it as an argument. Its
- *  pointers lead into the firmware's static buffers (no allocation): valid until the next view
+ *  pointers lead into the struct scan_ctx it came from: valid until that context's next view
  *  begins. */
 struct scan_view {
     uint32_t width, height;   /**< frame size */
@@ -38,8 +65,8 @@ struct scan_view {
     uint32_t colour_method; /**< enum colour_method the colour was made with */
 };
 
-/** Where a view restored from its kept range image goes (scan_restore_view): the firmware's
- *  own buffers, to be filled by the caller. */
+/** Where a view restored from its kept range image goes (scan_restore_view): the context's
+ *  buffers, to be filled by the caller. */
 struct scan_view_fill {
     uint8_t *reason; /**< width * height reason codes */
     float *xyz_mm;   /**< 3 per pixel (valid pixels) */
@@ -49,11 +76,12 @@ struct scan_view_fill {
 };
 
 /** A view as the stages after decoding take it (registration, cloud, fusion), from a range
- *  image kept earlier instead of from frames: @p view points into the firmware's buffers, which
+ *  image kept earlier instead of from frames: @p view points into @p s's buffers, which
  *  @p fill gives to the caller to fill. No colour frames (recolouring needs frames).
  *  @retval 0 @retval -E2BIG larger than the compiled limits */
-int scan_restore_view(uint32_t width, uint32_t height, int32_t angle_mdeg, uint32_t valid_count,
-                      uint32_t colour_method, struct scan_view *view, struct scan_view_fill *fill);
+int scan_restore_view(struct scan_ctx *s, uint32_t width, uint32_t height, int32_t angle_mdeg,
+                      uint32_t valid_count, uint32_t colour_method, struct scan_view *view,
+                      struct scan_view_fill *fill);
 
 /** Check parameters and calibration against each other and the compiled limits.
  *  @param msg  out: a sentence saying what is wrong
@@ -77,16 +105,16 @@ struct scan_frame_sink {
  *  without turning the table; the projector is off again when it returns.
  *  @param rgb  out: the RGB24 frame (params' width x height), valid until the next capture
  *  @retval 0 ok @retval capture error */
-int scan_snapshot(const struct hal *hal, const struct scan_params *params,
+int scan_snapshot(struct scan_ctx *s, const struct hal *hal, const struct scan_params *params,
                   const struct scan_calib *calib, const uint8_t **rgb);
 
-/** Capture one view at the current turntable angle, without processing it: the frames wait in
- *  the firmware's buffers for scan_finish_view (which may run while the table turns to the
- *  next view; nothing else may use the firmware meanwhile). On any failure the projector and
+/** Capture one view at the current turntable angle into @p s, without processing it: the
+ *  frames wait there for scan_finish_view (which may run while the table turns to the
+ *  next view; nothing else may use @p s meanwhile). On any failure the projector and
  *  lights are off when it returns. @param sink  keeps every frame (NULL: not kept)
  *  @param info  out: frames and retries counted
  *  @retval 0 ok @retval -EINTR stop requested @retval capture error */
-int scan_capture_view(const struct hal *hal, const struct scan_params *params,
+int scan_capture_view(struct scan_ctx *s, const struct hal *hal, const struct scan_params *params,
                       const struct scan_calib *calib, int32_t angle_mdeg,
                       const struct scan_frame_sink *sink, struct scan_view_info *info);
 
@@ -95,7 +123,7 @@ int scan_capture_view(const struct hal *hal, const struct scan_params *params,
  *  @param sink  keeps every frame as captured (NULL: frames are not kept)
  *  @param view  out: the processed view
  *  @retval 0 ok @retval -EINTR stop requested @retval capture or processing error */
-int scan_take_view(const struct hal *hal, const struct scan_params *params,
+int scan_take_view(struct scan_ctx *s, const struct hal *hal, const struct scan_params *params,
                    const struct scan_calib *calib, int32_t angle_mdeg,
                    const struct scan_frame_sink *sink, struct scan_view *view,
                    struct scan_view_info *info);
@@ -104,11 +132,12 @@ int scan_take_view(const struct hal *hal, const struct scan_params *params,
  *  pattern in order (the white frame as RGB, channels 3; the others grey, channels 1, or RGB),
  *  then finish with the parameters given to begin. The live scan runs exactly this path.
  *  @retval 0 or -EINVAL */
-int scan_begin_view(const struct scan_params *params, const struct scan_calib *calib);
+int scan_begin_view(struct scan_ctx *s, const struct scan_params *params,
+                    const struct scan_calib *calib);
 /** The pattern sequence of a view (columns, and rows when params->decode_rows). */
 void scan_layout(const struct scan_params *params, const struct scan_calib *calib,
                  struct gray_layout *layout);
-int scan_feed_frame(uint32_t pattern, const uint8_t *pixels, uint32_t channels,
+int scan_feed_frame(struct scan_ctx *s, uint32_t pattern, const uint8_t *pixels, uint32_t channels,
                     const struct scan_frame_sink *sink);
 /** How frame @p frame of a view (kept-frame order: patterns, lights, HDR colour) is fed and
  *  kept: @retval 3 RGB (the white pattern, the colour frames) @retval 1 grey (the other
@@ -119,19 +148,19 @@ uint32_t scan_frame_channels(const struct scan_params *params, const struct scan
  *  kept once fed: reading a kept frame straight into it spares a copy. @retval the buffer, of
  *  HAL_MAX_PIXELS RGB pixels for the white and colour frames, HAL_MAX_PIXELS grey ones for the
  *  other patterns @retval NULL no such frame */
-uint8_t *scan_frame_buffer(uint32_t frame);
+uint8_t *scan_frame_buffer(struct scan_ctx *s, uint32_t frame);
 /** Decode, refine, triangulate, take normals and colour of the frames fed since
  *  scan_begin_view. @param view  out @param info  out: reasons counted, valid points */
-int scan_finish_view(const struct scan_calib *calib, int32_t angle_mdeg, struct scan_view *view,
-                     struct scan_view_info *info);
+int scan_finish_view(struct scan_ctx *s, const struct scan_calib *calib, int32_t angle_mdeg,
+                     struct scan_view *view, struct scan_view_info *info);
 
 /** Keep samples of @p view as view @p index of the joint registration @p reg (reg_begin
  *  first). */
 int scan_keep_for_registration(struct reg_ctx *reg, uint32_t index, const struct scan_view *view);
 
-/** Fuse @p view into the volume (fusion_begin first) seen through @p obj_from_cam. */
-int scan_fuse_view(const struct scan_calib *calib, const struct scan_view *view,
-                   const struct frame_xform *obj_from_cam);
+/** Fuse @p view into the volume @p vol (fusion_begin first) seen through @p obj_from_cam. */
+int scan_fuse_view(struct fusion_volume *vol, const struct scan_calib *calib,
+                   const struct scan_view *view, const struct frame_xform *obj_from_cam);
 
 /** Write @p view's point cloud as binary PLY, through @p obj_from_cam into the object frame.
  *  @retval 0 ok @retval -errno from storage */
@@ -147,16 +176,16 @@ int scan_recolour(const struct colour_params *colour, const struct scan_calib *c
 /** Point @p view (restored from its range image) at the colour frames fed since
  *  scan_begin_view (scan_feed_light_frame, and the white colour read into scan_frame_buffer),
  *  so that scan_recolour can colour it again. */
-void scan_attach_colour(struct scan_view *view);
+void scan_attach_colour(struct scan_ctx *s, struct scan_view *view);
 
 /** Offline, HDR: hand over the view's colour (the white pattern at the camera's exposure; the
  *  white fed to scan_feed_frame is then the merged grey). @retval 0 */
-int scan_feed_white_colour(const uint8_t *rgb);
+int scan_feed_white_colour(struct scan_ctx *s, const uint8_t *rgb);
 
 /** Colour frames a view takes after its patterns (0 when [colour] method = none). */
 uint32_t scan_light_frame_count(const struct scan_params *params, const struct scan_calib *calib);
 /** Offline: hand over colour frame @p k (colour.h numbering), RGB24. @retval 0 or -EINVAL */
-int scan_feed_light_frame(uint32_t k, const uint8_t *rgb);
+int scan_feed_light_frame(struct scan_ctx *s, uint32_t k, const uint8_t *rgb);
 
 /** Close the camera and put every device in its safe state. */
 void scan_close(const struct hal *hal);

@@ -1,4 +1,4 @@
-/* Camera-ray / projector-plane triangulation and range-image normals, in static buffers. */
+/* Camera-ray / projector-plane triangulation and range-image normals, into the caller's maps. */
 #include "tri.h"
 
 #include "camray.h"
@@ -6,9 +6,6 @@
 #include "vec3.h"
 
 #include <errno.h>
-
-static float xyz_map[HAL_MAX_PIXELS * 3];
-static float normal_map[HAL_MAX_PIXELS * 3];
 
 /* Depth s along camera ray d (z = 1) where the projector's distorted column is @p col_n
  * (normalised: (u - cx) / fx). The point s d lands at q = s R d + t in the projector frame, at
@@ -43,8 +40,8 @@ static int distorted_column_depth(const struct scan_calib *c, vec3 d, double col
     return 0;
 }
 
-int tri_range_image(const struct scan_calib *c, uint32_t width, uint32_t height,
-                    const float *column, uint8_t *reason, struct tri_range *range)
+int tri_range_image(const struct scan_calib *c, struct tri_maps *maps, uint32_t width,
+                    uint32_t height, const float *column, uint8_t *reason, struct tri_range *range)
 {
     if (width != c->cam_width || height != c->cam_height)
         return -EINVAL;
@@ -58,8 +55,9 @@ int tri_range_image(const struct scan_calib *c, uint32_t width, uint32_t height,
      * linear in a: R^T e_x - a R^T e_z. */
     const vec3 rt_ex = m3_tmul(c->proj_rot, v3(1, 0, 0)), rt_ez = m3_tmul(c->proj_rot, v3(0, 0, 1));
     const vec3 t = v3_from(c->proj_trans_mm);
-    range->xyz_mm = xyz_map;
-    range->normal = normal_map;
+    float *xyz_map = maps->xyz_mm;
+    range->xyz_mm = maps->xyz_mm;
+    range->normal = maps->normal;
     range->width = width;
     range->height = height;
     range->valid_count = 0;
@@ -88,15 +86,15 @@ int tri_range_image(const struct scan_calib *c, uint32_t width, uint32_t height,
     return 0;
 }
 
-static vec3 point_at(size_t i)
+static vec3 point_at(const float *xyz_map, size_t i)
 {
     return v3(xyz_map[3 * i], xyz_map[3 * i + 1], xyz_map[3 * i + 2]);
 }
 
 /* How far (in steps of @p step, at most @p max_steps) the surface continues from pixel i: every
  * pixel on the way must be valid and no depth step may exceed max_jump. */
-static uint32_t reach(const uint8_t *reason, size_t i, long step, uint32_t max_steps,
-                      double max_jump)
+static uint32_t reach(const float *xyz_map, const uint8_t *reason, size_t i, long step,
+                      uint32_t max_steps, double max_jump)
 {
     uint32_t k = 0;
     size_t cur = i;
@@ -114,22 +112,24 @@ static uint32_t reach(const uint8_t *reason, size_t i, long step, uint32_t max_s
 /* Tangent along one image axis between the farthest continuous neighbours on either side.
  * Column quantisation makes the range image a staircase; a wide stencil averages it out.
  * @p before / @p after: how many steps exist in the image on each side. Returns 0 if none. */
-static int tangent(const uint8_t *reason, size_t i, uint32_t before, uint32_t after, long step,
-                   uint32_t radius, double max_jump, vec3 *out)
+static int tangent(const float *xyz_map, const uint8_t *reason, size_t i, uint32_t before,
+                   uint32_t after, long step, uint32_t radius, double max_jump, vec3 *out)
 {
-    uint32_t back = reach(reason, i, -step, before < radius ? before : radius, max_jump);
-    uint32_t fwd = reach(reason, i, step, after < radius ? after : radius, max_jump);
+    uint32_t back = reach(xyz_map, reason, i, -step, before < radius ? before : radius, max_jump);
+    uint32_t fwd = reach(xyz_map, reason, i, step, after < radius ? after : radius, max_jump);
     if (back + fwd == 0)
         return 0;
-    *out = v3_sub(point_at((size_t)((long)i + step * (long)fwd)),
-                  point_at((size_t)((long)i - step * (long)back)));
+    *out = v3_sub(point_at(xyz_map, (size_t)((long)i + step * (long)fwd)),
+                  point_at(xyz_map, (size_t)((long)i - step * (long)back)));
     return 1;
 }
 
-int tri_normals(struct tri_range *range, uint8_t *reason, uint32_t radius_px,
+int tri_normals(struct tri_maps *maps, struct tri_range *range, uint8_t *reason, uint32_t radius_px,
                 double max_depth_jump_mm)
 {
     const uint32_t w = range->width, h = range->height;
+    const float *xyz_map = maps->xyz_mm;
+    float *normal_map = maps->normal;
     uint32_t valid = 0;
     for (uint32_t y = 0; y < h; y++) {
         for (uint32_t x = 0; x < w; x++) {
@@ -137,13 +137,14 @@ int tri_normals(struct tri_range *range, uint8_t *reason, uint32_t radius_px,
             if (reason[i] != SCAN_VALID)
                 continue;
             vec3 du, dv;
-            if (!tangent(reason, i, x, w - 1 - x, 1, radius_px, max_depth_jump_mm, &du) ||
-                !tangent(reason, i, y, h - 1 - y, (long)w, radius_px, max_depth_jump_mm, &dv)) {
+            if (!tangent(xyz_map, reason, i, x, w - 1 - x, 1, radius_px, max_depth_jump_mm, &du) ||
+                !tangent(xyz_map, reason, i, y, h - 1 - y, (long)w, radius_px, max_depth_jump_mm,
+                         &dv)) {
                 reason[i] = SCAN_INCONSISTENT;
                 continue;
             }
             vec3 n = v3_norm(v3_cross(du, dv));
-            if (v3_dot(n, point_at(i)) > 0.0) /* face the camera */
+            if (v3_dot(n, point_at(xyz_map, i)) > 0.0) /* face the camera */
                 n = v3_scale(n, -1.0);
             normal_map[3 * i + 0] = (float)n.x;
             normal_map[3 * i + 1] = (float)n.y;
@@ -155,17 +156,15 @@ int tri_normals(struct tri_range *range, uint8_t *reason, uint32_t radius_px,
     return 0;
 }
 
-int tri_restore(uint32_t width, uint32_t height, uint32_t valid_count, struct tri_range *range,
-                float **xyz_mm, float **normal)
+int tri_restore(const struct tri_maps *maps, uint32_t width, uint32_t height, uint32_t valid_count,
+                struct tri_range *range)
 {
     if ((uint64_t)width * height > HAL_MAX_PIXELS)
         return -E2BIG;
-    *range = (struct tri_range){.xyz_mm = xyz_map,
-                                .normal = normal_map,
+    *range = (struct tri_range){.xyz_mm = maps->xyz_mm,
+                                .normal = maps->normal,
                                 .width = width,
                                 .height = height,
                                 .valid_count = valid_count};
-    *xyz_mm = xyz_map;
-    *normal = normal_map;
     return 0;
 }

@@ -13,33 +13,41 @@ struct tri_range {
     uint32_t valid_count; /**< pixels left valid after triangulation and normals */
 };
 
+/** Where a range image is kept (several MB at the compiled limits: static in its owner, a
+ *  struct scan_ctx). */
+struct tri_maps {
+    float xyz_mm[HAL_MAX_PIXELS * 3]; /**< 3 floats per pixel */
+    float normal[HAL_MAX_PIXELS * 3]; /**< 3 floats per pixel */
+};
+
 /** Intersect every valid pixel's camera ray (camray.h: through the camera's lens model) with
  *  its projector column: for a pinhole projector the plane through the projector centre and
  *  column u_p, x_p / z_p = (u_p - cx_p) / fx_p in the projector frame; with projector distortion
  *  the surface of points whose distorted column is u_p (found along the ray by Newton's method).
+ *  @param maps  where the points go
  *  @param width, height  the frame's size (must be the calibration's)
  *  @param column  continuous projector column per pixel (see refine.h)
  *  @param reason  in/out: pixels whose ray misses (parallel, behind a device) become
  *                 SCAN_INCONSISTENT; only SCAN_VALID pixels are triangulated
- *  @param range   out: the points (the triangulator's static buffers), valid_count
+ *  @param range   out: the points (in @p maps), valid_count
  *  @retval 0 ok @retval -EINVAL calibration does not match the frame size
  *  @retval -EDOM the camera's distortion folds over inside the image */
-int tri_range_image(const struct scan_calib *calib, uint32_t width, uint32_t height,
-                    const float *column, uint8_t *reason, struct tri_range *range);
+int tri_range_image(const struct scan_calib *calib, struct tri_maps *maps, uint32_t width,
+                    uint32_t height, const float *column, uint8_t *reason, struct tri_range *range);
 /** Normals from differences across up to @p radius_px pixels each side along both image axes,
  *  stopping where the surface breaks (a depth step above @p max_depth_jump_mm between
  *  neighbours).
+ *  @param maps    the maps tri_range_image filled; the normals go there
  *  @param range   in/out: the points of tri_range_image; their normals and valid_count are set
  *  @param reason  in/out: pixels with no neighbour on their surface along an axis become
  *                 SCAN_INCONSISTENT
  *  @retval 0 */
-int tri_normals(struct tri_range *range, uint8_t *reason, uint32_t radius_px,
+int tri_normals(struct tri_maps *maps, struct tri_range *range, uint8_t *reason, uint32_t radius_px,
                 double max_depth_jump_mm);
 
-/** The triangulator's buffers, to be filled with a range image kept earlier (a view restored
- *  from its scan directory) instead of triangulated. @param range  out: points to them, with
- *  @p width, @p height and @p valid_count @param xyz_mm, normal  out: the same, writable
- *  @retval 0 @retval -E2BIG larger than the compiled limit */
-int tri_restore(uint32_t width, uint32_t height, uint32_t valid_count, struct tri_range *range,
-                float **xyz_mm, float **normal);
+/** A range image kept earlier (a view restored from its scan directory), filled into @p maps
+ *  by the caller instead of triangulated. @param range  out: points to @p maps, with @p width,
+ *  @p height and @p valid_count @retval 0 @retval -E2BIG larger than the compiled limit */
+int tri_restore(const struct tri_maps *maps, uint32_t width, uint32_t height, uint32_t valid_count,
+                struct tri_range *range);
 #endif

@@ -48,7 +48,8 @@ static void measure(const char *method, struct colour_stats *out)
     assert_int_equal(test_rig_start(&t), 0);
     struct scan_view view;
     struct scan_view_info info;
-    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), 0);
+    assert_int_equal(scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info),
+                     0);
     const struct decode_maps *m = &view.maps;
     const uint8_t *rgb = view.rgb;
     const struct sim_rig *rig = sim_ctl_rig();
@@ -132,7 +133,8 @@ static void test_white_reference_gives_albedo(void **state)
     t.cfg.sim.albedo[0] = t.cfg.sim.albedo[1] = t.cfg.sim.albedo[2] = 0.95;
     t.cfg.scan.colour.method = COLOUR_MULTI; /* every colour frame */
     assert_int_equal(test_rig_start(&t), 0);
-    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), 0);
+    assert_int_equal(scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info),
+                     0);
     assert_int_equal(white_cal_from_view(&t.cfg, &t.calib, &view, 0.95, &wc), 0);
     test_rig_stop(&t);
     /* the simulator's intensities are 170 (projector) and 120 (each light) grey levels */
@@ -145,7 +147,8 @@ static void test_white_reference_gives_albedo(void **state)
         t.cfg.scan.colour.method = method;
         memcpy(t.cfg.scan.colour.white_scale, wc.scale[method], sizeof(wc.scale[method]));
         assert_int_equal(test_rig_start(&t), 0);
-        assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), 0);
+        assert_int_equal(
+            scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), 0);
         const struct decode_maps *m = &view.maps;
         const uint8_t *rgb = view.rgb;
         const float *conf = view.confidence;
@@ -194,7 +197,8 @@ static void test_single_trusts_highlights_less(void **state)
     t.cfg.scan.colour.ke = 40.0; /* a narrow rejection, so that beyond 30 deg it weighs 1 */
     t.cfg.scan.colour.ko = 2.0;
     assert_int_equal(test_rig_start(&t), 0);
-    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), 0);
+    assert_int_equal(scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info),
+                     0);
     const struct decode_maps *m = &view.maps;
     const float *conf = view.confidence;
     const struct sim_rig *rig = sim_ctl_rig();
@@ -283,7 +287,8 @@ static void uniform_mean(uint32_t all_us, double mean[3])
     t.cfg.scan.colour.method = COLOUR_UNIFORM;
     t.cfg.scan.colour.all_lights_exposure_us = all_us;
     assert_int_equal(test_rig_start(&t), 0);
-    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), 0);
+    assert_int_equal(scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info),
+                     0);
     const struct decode_maps *m = &view.maps;
     const uint8_t *rgb = view.rgb;
     const float *conf = view.confidence;

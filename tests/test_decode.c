@@ -15,6 +15,7 @@
 #define H 8
 #define PROJ_W 64
 
+static struct decode_ctx dec; /* the decoder under test */
 static uint8_t frame[W * H * 3];
 static uint8_t grey[W * H];
 
@@ -22,7 +23,7 @@ static uint8_t grey[W * H];
 static int feed(uint32_t pattern)
 {
     decode_rgb_to_grey(frame, grey, W * H, 250);
-    return decode_frame(pattern, grey);
+    return decode_frame(&dec, pattern, grey);
 }
 
 static struct scan_params params(void)
@@ -70,7 +71,7 @@ static struct decode_maps maps_out;
 static int begin(struct scan_params *p, uint32_t bits)
 {
     struct gray_layout l = {bits, 0, render_code};
-    return decode_begin(p, &l, PROJ_W, 1);
+    return decode_begin(&dec, p, &l, PROJ_W, 1);
 }
 
 static void decode_all(uint32_t bits)
@@ -81,7 +82,7 @@ static void decode_all(uint32_t bits)
         render(i, bits);
         assert_int_equal(feed(i), 0);
     }
-    assert_int_equal(decode_finish(reason_out, &maps_out), 0);
+    assert_int_equal(decode_finish(&dec, reason_out, &maps_out), 0);
 }
 
 static void test_columns_and_reasons(void **state)
@@ -129,7 +130,7 @@ static void test_frames_out_of_order_rejected(void **state)
     render(0, 6);
     assert_int_equal(feed(1), -EINVAL);
     assert_int_equal(feed(0), 0);
-    assert_int_equal(decode_finish(reason_out, &maps_out), -EINVAL); /* frames missing */
+    assert_int_equal(decode_finish(&dec, reason_out, &maps_out), -EINVAL); /* frames missing */
 }
 
 static void test_size_above_limit_rejected(void **state)
@@ -142,7 +143,7 @@ static void test_size_above_limit_rejected(void **state)
     assert_int_equal(begin(&p, 17), -EINVAL);
     struct gray_layout too_many = {16, 16,
                                    GRAY_CODE_GRAY}; /* more patterns than the frame store holds */
-    assert_int_equal(decode_begin(&p, &too_many, PROJ_W, 1), -EINVAL);
+    assert_int_equal(decode_begin(&dec, &p, &too_many, PROJ_W, 1), -EINVAL);
 }
 
 /* Every pattern of the synthetic scene, with pixel 10 of row 0 ambiguous in bit 0 and pixel 20
@@ -170,7 +171,7 @@ static void test_ambiguous_bits(void **state)
     struct scan_params p = params();
     assert_int_equal(begin(&p, bits), 0);
     feed_ambiguous_scene(bits);
-    assert_int_equal(decode_finish(reason_out, &maps_out), 0);
+    assert_int_equal(decode_finish(&dec, reason_out, &maps_out), 0);
     const struct decode_maps *m = &maps_out;
     assert_int_equal(m->reason[10], SCAN_VALID);
     assert_int_equal(m->reason[20], SCAN_VALID);
@@ -178,7 +179,7 @@ static void test_ambiguous_bits(void **state)
     p.max_unclear_bits = 1;
     assert_int_equal(begin(&p, bits), 0);
     feed_ambiguous_scene(bits);
-    assert_int_equal(decode_finish(reason_out, &maps_out), 0);
+    assert_int_equal(decode_finish(&dec, reason_out, &maps_out), 0);
     assert_int_equal(m->reason[10], SCAN_VALID);
     assert_int_equal(m->reason[20], SCAN_LOW_CONTRAST);
 }
@@ -215,7 +216,7 @@ static void test_lone_wrong_code_inconsistent(void **state)
         }
         assert_int_equal(feed(i), 0);
     }
-    assert_int_equal(decode_finish(reason_out, &maps_out), 0);
+    assert_int_equal(decode_finish(&dec, reason_out, &maps_out), 0);
     const struct decode_maps *m = &maps_out;
     assert_int_equal(m->reason[2 * W + 10], SCAN_INCONSISTENT);
     assert_int_equal(m->reason[2 * W + 11], SCAN_VALID);
@@ -229,12 +230,12 @@ static void test_blocked_matches_reference(void **state)
     uint32_t bits = gray_bits_for_width(PROJ_W);
     struct scan_params p = params();
     struct gray_layout l = {bits, 0, render_code};
-    assert_int_equal(decode_begin(&p, &l, PROJ_W, 1), 0);
+    assert_int_equal(decode_begin(&dec, &p, &l, PROJ_W, 1), 0);
     feed_ambiguous_scene(bits);
-    assert_int_equal(decode_pixels(reason_out, &maps_out), 0);
+    assert_int_equal(decode_pixels(&dec, reason_out, &maps_out), 0);
     const uint8_t *frames[DECODE_MAX_PATTERNS];
     for (uint32_t i = 0; i < gray_pattern_count(bits); i++)
-        frames[i] = decode_frame_slot(i);
+        frames[i] = decode_frame_slot(&dec, i);
     uint16_t col[W * H];
     uint8_t reason[W * H];
     decode_reference(&p, &l, PROJ_W, 1, frames, W * H, col, NULL, reason);

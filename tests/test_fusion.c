@@ -12,7 +12,10 @@
 #include <string.h>
 
 #include "fusion.h"
+
+static struct fusion_volume vol; /* the volume under test */
 #include "fusion_grid.h"
+#include "test_util.h"
 #include "mc_table.h"
 #include "storage_posix.h"
 
@@ -120,11 +123,11 @@ static double blobs(vec3 p, void *ctx)
 static void extract(double (*fn)(vec3, void *), void *ctx, struct collected *c)
 {
     struct fusion_params p = grid_params();
-    assert_int_equal(fusion_begin(&p), 0);
-    assert_int_equal(fusion_fill(fn, ctx), 0);
+    assert_int_equal(fusion_begin(&vol, &p), 0);
+    assert_int_equal(fusion_fill(&vol, fn, ctx), 0);
     memset(c, 0, sizeof(*c));
     struct mesh_sink sink = {on_vertex, on_triangle, c};
-    assert_int_equal(fusion_extract(&sink), 0);
+    assert_int_equal(fusion_extract(&vol, &sink), 0);
 }
 
 static void test_sphere_is_closed_genus_0(void **state)
@@ -208,7 +211,7 @@ static void test_fragments_left_out_and_stl(void **state)
     struct collected whole;
     extract(sphere_and_crumb, NULL, &whole);
     struct mesh_summary ms;
-    assert_int_equal(fusion_mesh_prepare(0.05, &ms), 0);
+    assert_int_equal(fusion_mesh_prepare(&vol, 0.05, &ms), 0);
     assert_int_equal(ms.vertices, whole.nv);
     assert_int_equal(ms.triangles, whole.nt);
     assert_int_equal(ms.pieces, 2);
@@ -217,8 +220,8 @@ static void test_fragments_left_out_and_stl(void **state)
     struct hal_storage st;
     storage_posix_init(&st);
     assert_int_equal(system("mkdir -p build/test_fusion"), 0);
-    assert_int_equal(fusion_write_ply(&st, "build/test_fusion/mesh.ply"), 0);
-    assert_int_equal(fusion_write_stl(&st, "build/test_fusion/mesh.stl"), 0);
+    assert_int_equal(fusion_write_ply(&vol, &st, "build/test_fusion/mesh.ply"), 0);
+    assert_int_equal(fusion_write_stl(&vol, &st, "build/test_fusion/mesh.stl"), 0);
     assert_int_equal(ply_count("build/test_fusion/mesh.ply", "vertex"), ms.kept_vertices);
     assert_int_equal(ply_count("build/test_fusion/mesh.ply", "face"), ms.kept_triangles);
     FILE *f = fopen("build/test_fusion/mesh.stl", "rb");
@@ -242,7 +245,7 @@ static void test_fragments_left_out_and_stl(void **state)
     }
     assert_int_equal(fgetc(f), EOF);
     fclose(f);
-    assert_int_equal(fusion_mesh_prepare(0.0, &ms), 0); /* 0: every piece kept */
+    assert_int_equal(fusion_mesh_prepare(&vol, 0.0, &ms), 0); /* 0: every piece kept */
     assert_int_equal(ms.removed_pieces, 0);
     assert_int_equal(ms.kept_triangles, whole.nt);
     free(whole.pos);
@@ -270,14 +273,14 @@ static void test_small_hole_filled(void **state)
     uint32_t filled;
     extract(scanned_sphere, NULL, &c); /* with the hole: must not be closed */
     struct mesh_summary ms;
-    assert_int_equal(fusion_mesh_prepare(0.0, &ms), 0);
+    assert_int_equal(fusion_mesh_prepare(&vol, 0.0, &ms), 0);
     free(c.pos);
     free(c.tri);
-    assert_int_equal(fusion_fill_holes(10.0, &filled), 0);
+    assert_int_equal(fusion_fill_holes(&vol, 10.0, &filled), 0);
     assert_true(filled > 0);
     memset(&c, 0, sizeof(c));
     struct mesh_sink sink = {on_vertex, on_triangle, &c};
-    assert_int_equal(fusion_extract(&sink), 0);
+    assert_int_equal(fusion_extract(&vol, &sink), 0);
     assert_true(c.nt > ms.triangles);
     assert_int_equal(check_closed(&c), 2);
     free(c.pos);
@@ -294,17 +297,17 @@ static void test_watertight_closes_at_the_table(void **state)
     int standing = 1;
     struct fusion_params p = grid_params();
     p.bottom_mm = -3;
-    assert_int_equal(fusion_begin(&p), 0);
-    assert_int_equal(fusion_fill(scanned_sphere, &standing), 0);
-    assert_int_equal(fusion_fill_holes(10.0, &filled), 0);
-    assert_int_equal(fusion_close_watertight(10.0, 1, &inside), 0);
+    assert_int_equal(fusion_begin(&vol, &p), 0);
+    assert_int_equal(fusion_fill(&vol, scanned_sphere, &standing), 0);
+    assert_int_equal(fusion_fill_holes(&vol, 10.0, &filled), 0);
+    assert_int_equal(fusion_close_watertight(&vol, 10.0, 1, &inside), 0);
     /* the core no filling reached (radius 20 - 2.5 observed - 5 filled) is decided solid */
     assert_true(inside > 0.8 * 4.0 / 3.0 * M_PI * 12.5 * 12.5 * 12.5);
     struct mesh_summary ms; /* crumbs the opening leaves beside the surface are fragments */
-    assert_int_equal(fusion_mesh_prepare(0.01, &ms), 0);
+    assert_int_equal(fusion_mesh_prepare(&vol, 0.01, &ms), 0);
     memset(&c, 0, sizeof(c));
     struct mesh_sink sink = {on_vertex, on_triangle, &c};
-    assert_int_equal(fusion_extract_prepared(&sink), 0);
+    assert_int_equal(fusion_extract_prepared(&vol, &sink), 0);
     assert_int_equal(c.nt, ms.kept_triangles);
     assert_int_equal(check_closed(&c), 2); /* one closed surface: no hollow inside */
     for (uint32_t v = 0; v < c.nv; v++) {
@@ -337,36 +340,36 @@ static void test_uncoloured_surface_takes_its_neighbours_colour(void **state)
 {
     (void)state;
     struct fusion_params p = grid_params();
-    assert_int_equal(fusion_begin(&p), 0);
-    assert_int_equal(fusion_fill(sphere, NULL), 0);
+    assert_int_equal(fusion_begin(&vol, &p), 0);
+    assert_int_equal(fusion_fill(&vol, sphere, NULL), 0);
     uint32_t dims[3], cap = 0;
     assert_int_equal(fusion_dims(&p, dims), 0);
     for (uint32_t z = 0; z < dims[2]; z++)
         for (uint32_t y = 0; y < dims[1]; y++)
             for (uint32_t x = 0; x < dims[0]; x++) {
-                struct voxel *v = &fusion_grid[vidx(x, y, z)];
+                struct voxel *v = &vol.grid[vidx(&vol, x, y, z)];
                 static const uint8_t red[3] = {200, 30, 20};
                 memcpy(v->rgb, red, 3);
-                if (fusion_vol.origin.z + z * p.voxel_mm > 42.0) { /* the top 8 mm */
+                if (vol.origin.z + z * p.voxel_mm > 42.0) { /* the top 8 mm */
                     memset(v->rgb, 0, 3);
                     v->colour_weight = 0;
                     cap++;
                 }
             }
     struct mesh_summary ms;
-    assert_int_equal(fusion_mesh_prepare(0.0, &ms), 0);
+    assert_int_equal(fusion_mesh_prepare(&vol, 0.0, &ms), 0);
     assert_true(cap > 0 && ms.colour_filled > 100);
     assert_int_equal(ms.uncoloured, 0);
     struct colour_check c = {0, 0, 0};
     struct mesh_sink sink = {check_colour, NULL, &c};
-    assert_int_equal(fusion_extract_prepared(&sink), 0);
+    assert_int_equal(fusion_extract_prepared(&vol, &sink), 0);
     assert_int_equal(c.vertices, ms.kept_vertices);
     assert_int_equal(c.red, c.vertices); /* no black, no raw: the surface's own red */
     assert_int_equal(c.not_coloured, 0);
     /* nothing coloured at all: every vertex marked grey */
     for (size_t i = 0; i < (size_t)dims[0] * dims[1] * dims[2]; i++)
-        fusion_grid[i].colour_weight = 0;
-    assert_int_equal(fusion_mesh_prepare(0.0, &ms), 0);
+        vol.grid[i].colour_weight = 0;
+    assert_int_equal(fusion_mesh_prepare(&vol, 0.0, &ms), 0);
     assert_int_equal(ms.colour_filled, 0);
     assert_int_equal(ms.uncoloured, ms.kept_vertices);
 }
@@ -392,6 +395,32 @@ static void test_table_properties(void **state)
     }
 }
 
+/* Two volumes (struct fusion_volume) are two models: a torus fused and meshed in a second one
+ * between the sphere's preparation and its writing leaves the sphere's mesh.ply byte for byte
+ * what it was written as before. */
+static void test_two_volumes_are_independent(void **state)
+{
+    (void)state;
+    static struct fusion_volume other;
+    struct fusion_params p = grid_params();
+    struct hal_storage st;
+    storage_posix_init(&st);
+    assert_int_equal(system("mkdir -p build/test_fusion"), 0);
+    struct mesh_summary sphere_ms, torus_ms;
+    assert_int_equal(fusion_begin(&vol, &p), 0);
+    assert_int_equal(fusion_fill(&vol, sphere, NULL), 0);
+    assert_int_equal(fusion_mesh_prepare(&vol, 0.0, &sphere_ms), 0);
+    assert_int_equal(fusion_write_ply(&vol, &st, "build/test_fusion/alone.ply"), 0);
+    assert_int_equal(fusion_begin(&other, &p), 0);
+    assert_int_equal(fusion_fill(&other, torus, NULL), 0);
+    assert_int_equal(fusion_mesh_prepare(&other, 0.0, &torus_ms), 0);
+    assert_int_equal(fusion_write_ply(&other, &st, "build/test_fusion/torus.ply"), 0);
+    assert_int_equal(fusion_write_ply(&vol, &st, "build/test_fusion/beside.ply"), 0);
+    assert_true(sphere_ms.kept_vertices != torus_ms.kept_vertices);
+    assert_false(test_files_equal("build/test_fusion/alone.ply", "build/test_fusion/torus.ply"));
+    assert_true(test_files_equal("build/test_fusion/alone.ply", "build/test_fusion/beside.ply"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -403,6 +432,7 @@ int main(void)
         cmocka_unit_test(test_small_hole_filled),
         cmocka_unit_test(test_uncoloured_surface_takes_its_neighbours_colour),
         cmocka_unit_test(test_watertight_closes_at_the_table),
+        cmocka_unit_test(test_two_volumes_are_independent),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

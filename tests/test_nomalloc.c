@@ -97,7 +97,7 @@ static void test_no_allocation_during_a_view(void **state)
     struct scan_view_info info;
     alloc_calls = 0;
     counting = 1;
-    int rc = scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info);
+    int rc = scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info);
     int rc_save =
         rc == 0 ? scan_save_cloud_at_turntable_pose(&t, &view, "build/test_nomalloc.ply") : rc;
     counting = 0;

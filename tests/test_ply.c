@@ -25,8 +25,8 @@ static void test_ply_roundtrip(void **state)
     struct scan_view_info info;
     const int32_t angle_mdeg = 30000;
     assert_int_equal(hal_table_move_to(&t.hal.turntable, angle_mdeg), 0);
-    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, angle_mdeg, NULL, &view, &info),
-                     0);
+    assert_int_equal(
+        scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, angle_mdeg, NULL, &view, &info), 0);
     assert_int_equal(scan_save_cloud_at_turntable_pose(&t, &view, "build/test_ply.ply"), 0);
 
     FILE *f = fopen("build/test_ply.ply", "rb");

@@ -16,6 +16,8 @@
 #include "reflect.h"
 #include "storage_posix.h"
 
+static struct fusion_volume vol; /* mesh.glb's volume */
+
 #include <stdio.h>
 
 static struct reflect_pool pool; /* the reflectance under test */
@@ -250,24 +252,25 @@ static void test_glb_with_every_cluster(void **state)
                               .truncation_mm = 3.0,
                               .max_weight = 50,
                               .edge_fade_px = 10};
-    assert_int_equal(fusion_begin(&p), 0);
-    assert_int_equal(fusion_fill(sphere, NULL), 0);
+    assert_int_equal(fusion_begin(&vol, &p), 0);
+    assert_int_equal(fusion_fill(&vol, sphere, NULL), 0);
     /* each octant of the sphere painted with one corner's colour: every cluster has triangles */
     uint32_t dims[3];
     assert_int_equal(fusion_dims(&p, dims), 0);
     for (uint32_t z = 0; z < dims[2]; z++)
         for (uint32_t y = 0; y < dims[1]; y++)
             for (uint32_t x = 0; x < dims[0]; x++) {
-                vec3 q = v3_add(fusion_vol.origin, v3_scale(v3(x, y, z), p.voxel_mm));
+                vec3 q = v3_add(vol.origin, v3_scale(v3(x, y, z), p.voxel_mm));
                 int corner = (q.x > 0.0) | (q.y > 0.0) << 1 | (q.z > 30.0) << 2;
                 for (int c = 0; c < 3; c++)
-                    fusion_grid[vidx(x, y, z)].rgb[c] = corner >> c & 1 ? 153 : 13;
+                    vol.grid[vidx(&vol, x, y, z)].rgb[c] = corner >> c & 1 ? 153 : 13;
             }
     struct mesh_summary ms;
-    assert_int_equal(fusion_mesh_prepare(0.0, &ms), 0);
+    assert_int_equal(fusion_mesh_prepare(&vol, 0.0, &ms), 0);
     struct hal_storage st;
     storage_posix_init(&st);
-    assert_int_equal(fusion_write_glb(&st, "build/test_reflect.glb", reflect_model(&pool)), 0);
+    assert_int_equal(fusion_write_glb(&vol, &st, "build/test_reflect.glb", reflect_model(&pool)),
+                     0);
     FILE *f = fopen("build/test_reflect.glb", "rb");
     assert_non_null(f);
     static char buf[16384];

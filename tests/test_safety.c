@@ -37,7 +37,8 @@ static void test_transient_timeout_is_retried(void **state)
     struct scan_view view;
     struct scan_view_info info;
     sim_ctl_inject_camera_fault(SIM_FAULT_TIMEOUT, 5, 2); /* two bad captures, retries = 2 */
-    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), 0);
+    assert_int_equal(scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info),
+                     0);
     assert_int_equal(info.capture_retries, 2);
     /* the 22 stripe patterns and the colour frames of config/sim.ini's method, each once */
     assert_int_equal(info.frames_captured, 22 + scan_light_frame_count(&t.cfg.scan, &t.calib));
@@ -54,7 +55,8 @@ static void assert_view_stops(enum sim_cam_fault kind, uint64_t at, int want_rc,
     struct scan_view_info info;
     uint64_t start = sim_ctl_frames();
     sim_ctl_inject_camera_fault(kind, start + at, 100);
-    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), want_rc);
+    assert_int_equal(scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info),
+                     want_rc);
     assert_int_equal(sim_ctl_frames() - start, at + tries);
     assert_true(test_rig_dark());
     sim_ctl_inject_camera_fault(SIM_FAULT_NONE, 0, 0);
@@ -83,7 +85,8 @@ static struct scan_view view; /* the last view taken */
 static void scan_clean_view(void)
 {
     sim_ctl_inject_camera_fault(SIM_FAULT_NONE, 0, 0);
-    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &clean_info), 0);
+    assert_int_equal(
+        scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &clean_info), 0);
     size_t n = (size_t)t.cfg.scan.width * t.cfg.scan.height;
     memcpy(clean_colour, view.rgb, n * 3);
     memcpy(clean_column, view.maps.column, n * sizeof(clean_column[0]));
@@ -110,14 +113,16 @@ static void test_stale_frames_are_discarded(void **state)
     /* two in a row on a Gray-code pattern (within capture_retries = 2) */
     uint64_t start = sim_ctl_frames();
     sim_ctl_inject_camera_fault(SIM_FAULT_STALE, start + 6, 2);
-    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), 0);
+    assert_int_equal(scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info),
+                     0);
     assert_int_equal(info.capture_retries, 2);
     assert_non_null(strstr(test_last_log, "before the change had settled"));
     assert_view_is_clean(&info);
     /* the last colour frame, after its light changed */
     start = sim_ctl_frames();
     sim_ctl_inject_camera_fault(SIM_FAULT_STALE, start + clean_info.frames_captured - 1, 1);
-    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), 0);
+    assert_int_equal(scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info),
+                     0);
     assert_int_equal(info.capture_retries, 1);
     assert_view_is_clean(&info);
     assert_true(test_rig_dark());
@@ -145,7 +150,7 @@ static void test_stop_request_leaves_rig_dark(void **state)
     struct scan_view view;
     struct scan_view_info info;
     t.hal.stop_requested = stop_after_frames;
-    int rc = scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info);
+    int rc = scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info);
     t.hal.stop_requested = NULL;
     assert_int_equal(rc, -EINTR);
     assert_true(info.frames_captured < 22);

@@ -53,10 +53,11 @@ static void test_points_on_ray_and_plane(void **state)
             column[i] = reason[i] == SCAN_VALID ? (uint16_t)floor(u + 0.5) : 0;
         }
     }
-    const float *refined;
+    static float refined[HAL_MAX_PIXELS];
+    static struct tri_maps out;
     struct tri_range range;
-    assert_int_equal(refine_columns(&maps, 0, &refined), 0);
-    assert_int_equal(tri_range_image(&calib, w, h, refined, reason, &range), 0);
+    assert_int_equal(refine_columns(&maps, 0, refined), 0);
+    assert_int_equal(tri_range_image(&calib, &out, w, h, refined, reason, &range), 0);
     const struct tri_range *r = &range;
     uint32_t checked = 0;
     for (size_t i = 0; i < (size_t)w * h; i += 97) {
@@ -89,11 +90,12 @@ static double plane_normals(int refine)
             column[i] = reason[i] == SCAN_VALID ? (uint16_t)floor(u + 0.5) : 0;
         }
     }
-    const float *refined;
+    static float refined[HAL_MAX_PIXELS];
+    static struct tri_maps out;
     struct tri_range range;
-    assert_int_equal(refine_columns(&maps, refine, &refined), 0);
-    assert_int_equal(tri_range_image(&calib, w, h, refined, reason, &range), 0);
-    assert_int_equal(tri_normals(&range, reason, 4, 3.0), 0);
+    assert_int_equal(refine_columns(&maps, refine, refined), 0);
+    assert_int_equal(tri_range_image(&calib, &out, w, h, refined, reason, &range), 0);
+    assert_int_equal(tri_normals(&out, &range, reason, 4, 3.0), 0);
     const struct tri_range *r = &range;
     vec3 expect = v3_norm(v3(0.2, 0.0, -1.0));
     double sum = 0.0;

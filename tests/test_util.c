@@ -2,6 +2,8 @@
 #define _POSIX_C_SOURCE 200809L
 #include "test_util.h"
 
+#include "scan_job.h"
+
 #include "vec3.h"
 
 #include <dirent.h>
@@ -96,6 +98,7 @@ int test_rig_load(struct test_rig *t, const char *config_path)
 {
     char err[512];
     memset(t, 0, sizeof(*t));
+    t->scan = scan_job_views();
     int rc = config_load(&t->cfg, config_path, err, sizeof(err));
     if (rc == 0)
         rc = calib_load(&t->calib, t->cfg.calibration_file, t->cfg.light_count, err, sizeof(err));

@@ -11,6 +11,7 @@ struct test_rig {
     struct app_config cfg;
     struct scan_calib calib;
     struct hal hal;
+    struct scan_ctx *scan; /* the view buffers: the process's (scan_job_views) */
 };
 
 /** Last message logged through the test logger, and how many errors were logged. */

@@ -19,7 +19,8 @@ static void take_and_measure(struct test_rig *t, struct view_quality *q,
 {
     assert_int_equal(test_rig_start(t), 0);
     struct scan_view view;
-    assert_int_equal(scan_take_view(&t->hal, &t->cfg.scan, &t->calib, 0, NULL, &view, info), 0);
+    assert_int_equal(
+        scan_take_view(t->scan, &t->hal, &t->cfg.scan, &t->calib, 0, NULL, &view, info), 0);
     test_measure_view(sim_ctl_rig(), &view, q);
     test_rig_stop(t);
 }
@@ -172,18 +173,19 @@ static void test_blocked_decoder_matches_reference(void **state)
     assert_int_equal(test_rig_start(&t), 0);
     struct scan_view view;
     struct scan_view_info info;
-    assert_int_equal(scan_take_view(&t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info), 0);
+    assert_int_equal(scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info),
+                     0);
     /* rows and columns (42 patterns), then the colour frames of config/sim.ini's method */
     assert_int_equal(info.frames_captured, 42 + scan_light_frame_count(&t.cfg.scan, &t.calib));
     struct gray_layout layout;
     scan_layout(&t.cfg.scan, &t.calib, &layout);
     const uint8_t *frames[DECODE_MAX_PATTERNS];
     for (uint32_t p = 0; p < gray_layout_count(&layout); p++)
-        frames[p] = decode_frame_slot(p);
+        frames[p] = decode_frame_slot(&t.scan->decode, p);
     static uint8_t pixel_reason[HAL_MAX_PIXELS];
     struct decode_maps pixel_maps;
     /* again, without the neighbour check */
-    assert_int_equal(decode_pixels(pixel_reason, &pixel_maps), 0);
+    assert_int_equal(decode_pixels(&t.scan->decode, pixel_reason, &pixel_maps), 0);
     const struct decode_maps *m = &pixel_maps;
     size_t n = (size_t)m->width * m->height;
     static uint16_t col[HAL_MAX_PIXELS], row[HAL_MAX_PIXELS];
@@ -208,6 +210,43 @@ static void test_blocked_decoder_matches_reference(void **state)
     assert_true(row_right > 0.98 * valid);
 }
 
+/* Two views in two scan contexts (struct scan_ctx): the second, taken at another angle into
+ * its own context, leaves the first's reasons, points and colour exactly as they were, and the
+ * two share no buffer. */
+static void test_two_scan_contexts_are_independent(void **state)
+{
+    (void)state;
+    static struct test_rig t;
+    static struct scan_ctx other;
+    static uint8_t reason_a[HAL_MAX_PIXELS], rgb_a[HAL_MAX_PIXELS * 3];
+    static float xyz_a[HAL_MAX_PIXELS * 3];
+    assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
+    assert_int_equal(test_rig_start(&t), 0);
+    struct scan_view a, b;
+    struct scan_view_info info_a, info_b;
+    assert_int_equal(scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &a, &info_a),
+                     0);
+    size_t n = (size_t)a.width * a.height;
+    memcpy(reason_a, a.maps.reason, n);
+    memcpy(rgb_a, a.rgb, n * 3);
+    memcpy(xyz_a, a.range.xyz_mm, n * 3 * sizeof(float));
+    assert_int_equal(hal_table_move_to(&t.hal.turntable, 90000), 0);
+    assert_int_equal(
+        scan_take_view(&other, &t.hal, &t.cfg.scan, &t.calib, 90000, NULL, &b, &info_b), 0);
+    test_rig_stop(&t);
+    assert_true(info_a.valid_points > 10000 && info_b.valid_points > 10000);
+    assert_ptr_not_equal(a.range.xyz_mm, b.range.xyz_mm);
+    assert_ptr_not_equal(a.maps.reason, b.maps.reason);
+    assert_ptr_not_equal(a.rgb, b.rgb);
+    assert_true(memcmp(reason_a, b.maps.reason, n) != 0); /* another view indeed */
+    assert_memory_equal(reason_a, a.maps.reason, n);
+    assert_memory_equal(rgb_a, a.rgb, n * 3);
+    for (size_t i = 0; i < n; i++)
+        if (reason_a[i] == SCAN_VALID)
+            assert_memory_equal(&xyz_a[3 * i], &a.range.xyz_mm[3 * i], 3 * sizeof(float));
+    assert_int_equal(a.range.valid_count, info_a.valid_points);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -217,6 +256,7 @@ int main(void)
         cmocka_unit_test(test_dark_paint_with_hdr_and_highlights),
         cmocka_unit_test(test_interreflection_gray_against_xor04),
         cmocka_unit_test(test_blocked_decoder_matches_reference),
+        cmocka_unit_test(test_two_scan_contexts_are_independent),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -21,7 +21,7 @@ static int measure_rig(struct test_rig *t, struct view_quality *q, double *ms)
     struct scan_view view;
     struct scan_view_info info;
     double t0 = now_ms();
-    int rc = scan_take_view(&t->hal, &t->cfg.scan, &t->calib, 0, NULL, &view, &info);
+    int rc = scan_take_view(t->scan, &t->hal, &t->cfg.scan, &t->calib, 0, NULL, &view, &info);
     *ms = now_ms() - t0;
     if (rc == 0)
         test_measure_view(sim_ctl_rig(), &view, q);
