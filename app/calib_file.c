@@ -16,15 +16,15 @@
 #define K(member) offsetof(struct scan_calib, member)
 #define CF(sec, key, member, lo, hi, doc)                                                          \
     {                                                                                              \
-        sec, key, INI_F64, K(member), 0, lo, hi, 0, NULL, NULL, doc                                \
+        sec, key, INI_F64, K(member), 0, lo, hi, 0, NULL, NULL, doc, NULL, NULL                    \
     }
 #define CU(sec, key, member, hi, doc)                                                              \
     {                                                                                              \
-        sec, key, INI_U32, K(member), 0, 1, hi, 1, NULL, NULL, doc                                 \
+        sec, key, INI_U32, K(member), 0, 1, hi, 1, NULL, NULL, doc, NULL, NULL                     \
     }
 #define CV(sec, key, member, n, lo, hi, def, doc)                                                  \
     {                                                                                              \
-        sec, key, INI_VEC, K(member), n, lo, hi, 0, def, NULL, doc                                 \
+        sec, key, INI_VEC, K(member), n, lo, hi, 0, def, NULL, doc, NULL, NULL                     \
     }
 #define LIGHT(i)                                                                                   \
     CV("lights", "light_" #i "_mm", light_pos_mm[i], 3, -1e5, 1e5, "0, 0, 0",                      \
@@ -32,7 +32,8 @@
     {                                                                                              \
         "lights", "light_" #i "_gain", INI_F64, K(light_gain[i]), 0, 0.01, 100, 0, "1", NULL,      \
             "intensity of light " #i                                                               \
-            " relative to the lights' mean (scanner calibrate measures it)"                        \
+            " relative to the lights' mean (scanner calibrate measures it)",                       \
+            "%.6f", NULL                                                                           \
     }
 
 static const struct ini_key calib_keys[] = {
@@ -193,55 +194,25 @@ void calib_read_quality(const char *path, double *camera_rms_px, double *project
         fclose(f);
 }
 
-/* "a, b, c" to 12 significant digits (1e-12: far below any calibration's uncertainty; the
- * loader refuses lines over 198 characters) */
-static int put_vec(char *buf, size_t len, const char *key, const double *v, int n)
+/* The lights the calibration has (light_N_... keys of N < light_count) are written. */
+static int skip_absent_light(const struct ini_key *k, const void *target)
 {
-    int w = snprintf(buf, len, "%s = ", key);
-    for (int i = 0; i < n && w > 0 && (size_t)w < len; i++)
-        w += snprintf(buf + w, len - (size_t)w, "%s%.12g", i > 0 ? ", " : "", v[i]);
-    if (w > 0 && (size_t)w < len)
-        w += snprintf(buf + w, len - (size_t)w, "\n");
-    return w;
+    const struct scan_calib *c = target;
+    unsigned i;
+    return sscanf(k->name, "light_%u_", &i) == 1 && i >= c->light_count;
 }
 
+/* Numbers to 12 significant digits (1e-12: far below any calibration's uncertainty; the loader
+ * refuses lines over 198 characters), the lights' gains to 6 decimals: calib_keys' formats. */
 int calib_save(const struct hal_storage *st, const char *path, const struct scan_calib *c,
                const char *comment)
 {
-    static char buf[16384];
-    size_t n = 0;
-#define PUT(...) n += (size_t)snprintf(buf + n, n < sizeof(buf) ? sizeof(buf) - n : 0, __VA_ARGS__)
-#define VEC(key, v, k)                                                                             \
-    n += (size_t)put_vec(buf + n, n < sizeof(buf) ? sizeof(buf) - n : 0, key, v, k)
-    if (comment != NULL)
-        PUT("%s", comment);
-    PUT("[camera]\nfx_px = %.12g\nfy_px = %.12g\ncx_px = %.12g\ncy_px = %.12g\nwidth = %u\n"
-        "height = %u\n",
-        c->cam_fx_px, c->cam_fy_px, c->cam_cx_px, c->cam_cy_px, (unsigned)c->cam_width,
-        (unsigned)c->cam_height);
-    VEC("distortion", c->cam_dist, 5);
-    PUT("\n[projector]\nfx_px = %.12g\nfy_px = %.12g\ncx_px = %.12g\ncy_px = %.12g\n"
-        "width = %u\nheight = %u\n",
-        c->proj_fx_px, c->proj_fy_px, c->proj_cx_px, c->proj_cy_px, (unsigned)c->proj_width,
-        (unsigned)c->proj_height);
-    VEC("distortion", c->proj_dist, 5);
-    VEC("rotation", c->proj_rot, 9);
-    VEC("translation_mm", c->proj_trans_mm, 3);
-    PUT("\n[turntable]\n");
-    VEC("axis_point_mm", c->axis_point_mm, 3);
-    VEC("axis_dir", c->axis_dir, 3);
-    PUT("\n[lights]\n");
-    for (uint32_t i = 0; i < c->light_count && i < HAL_MAX_LIGHTS; i++) {
-        char key[32];
-        snprintf(key, sizeof(key), "light_%u_mm", (unsigned)i);
-        VEC(key, c->light_pos_mm[i], 3);
-        PUT("light_%u_gain = %.6f\n", (unsigned)i, c->light_gain[i]);
-    }
-#undef PUT
-#undef VEC
-    if (n >= sizeof(buf))
-        return -EFBIG;
-    return hal_storage_write_file(st, path, buf, n);
+    char buf[16384];
+    int n = ini_schema_write(calib_keys, sizeof(calib_keys) / sizeof(calib_keys[0]), c, comment,
+                             skip_absent_light, "\n", buf, sizeof(buf));
+    if (n < 0)
+        return n == -ENOSPC ? -EFBIG : n;
+    return hal_storage_write_file(st, path, buf, (size_t)n);
 }
 
 void calib_print_doc(FILE *out)

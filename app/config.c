@@ -21,28 +21,28 @@
 #define SZ(member) sizeof(((struct app_config *)0)->member)
 #define U32(sec, key, member, lo, hi, def, doc)                                                    \
     {                                                                                              \
-        sec, key, INI_U32, C(member), 0, lo, hi, 0, def, NULL, doc                                 \
+        sec, key, INI_U32, C(member), 0, lo, hi, 0, def, NULL, doc, NULL, NULL                     \
     }
 #define LIM(sec, key, member, lo, hi, def, doc)                                                    \
     {                                                                                              \
-        sec, key, INI_U32, C(member), 0, lo, hi, 1, def, NULL, doc                                 \
+        sec, key, INI_U32, C(member), 0, lo, hi, 1, def, NULL, doc, NULL, NULL                     \
     }
 #define F64(sec, key, member, lo, hi, def, doc)                                                    \
     {                                                                                              \
-        sec, key, INI_F64, C(member), 0, lo, hi, 0, def, NULL, doc                                 \
+        sec, key, INI_F64, C(member), 0, lo, hi, 0, def, NULL, doc, NULL, NULL                     \
     }
 #define STR(sec, key, member, def, doc)                                                            \
     {                                                                                              \
-        sec, key, INI_STR, C(member), SZ(member), 0, 0, 0, def, NULL, doc                          \
+        sec, key, INI_STR, C(member), SZ(member), 0, 0, 0, def, NULL, doc, NULL, NULL              \
     }
 #define ENUM(sec, key, member, choices, def, doc)                                                  \
     {                                                                                              \
-        sec, key, INI_ENUM, C(member), SZ(member), 0, 0, 0, def, choices, doc                      \
+        sec, key, INI_ENUM, C(member), SZ(member), 0, 0, 0, def, choices, doc, NULL, NULL          \
     }
 #define GPIO(key, which)                                                                           \
     {                                                                                              \
         "gpio", key, INI_LINE, C(gpio.line[which]), 0, -1, 1023, 0, "-1", NULL,                    \
-            "line offset on the chip, or the line's name (gpioinfo); -1 = not wired"               \
+            "line offset on the chip, or the line's name (gpioinfo); -1 = not wired", NULL, NULL   \
     }
 
 static const struct ini_key config_keys[] = {
@@ -96,7 +96,8 @@ static const struct ini_key config_keys[] = {
      NULL,
      "HDR patterns: every pattern captured at each of these exposures (ascending, one of them "
      "[camera] exposure_us), per pixel the longest whose white frame is not saturated; for "
-     "objects with dark and shiny parts. Empty: [camera] exposure_us alone"},
+     "objects with dark and shiny parts. Empty: [camera] exposure_us alone",
+     NULL, NULL},
     F64("scan", "start_angle_deg", start_angle_deg, -360, 360, "0", "turntable angle of view 0"),
     U32("scan", "min_contrast_dn", scan.min_contrast_dn, 1, 255, "10",
         "white minus black (grey levels) below this: too dark to decode, flagged 'dark'"),
@@ -233,7 +234,8 @@ static const struct ini_key config_keys[] = {
     {"colour", "white_scale", INI_VEC, C(scan.colour.white_scale), 3, 0, 1000, 0,
      "0.00392157, 0.00392157, 0.00392157", NULL,
      "per channel, grey levels to albedo: a white surface comes out as 1 (from scanner "
-     "calibrate-white; the default 1/255 keeps grey levels)"},
+     "calibrate-white; the default 1/255 keeps grey levels)",
+     NULL, NULL},
     U32("registration", "icp", registration.enabled, 0, 1, "1",
         "1: register all views jointly (turns about one axis, re-estimated; each view's angle "
         "free); 0: keep the turntable's angles and the calibrated axis"),
@@ -284,13 +286,16 @@ static const struct ini_key config_keys[] = {
     {"sim", "second_pass_pose", INI_VEC, C(sim.second_pass_pose_deg), 3, -360, 360, 0, "90, 0, 30",
      NULL,
      "[scan] passes = 2: how the simulated person lays the object for the second pass, as "
-     "object_pose (degrees about x, then y, then z, then stood on the table)"},
+     "object_pose (degrees about x, then y, then z, then stood on the table)",
+     NULL, NULL},
     {"sim", "object_pose", INI_VEC, C(sim.object_pose_deg), 3, -360, 360, 0, "0, 0, 0", NULL,
      "the object turned by these angles (degrees, about x, then y, then z) before it is stood on "
-     "the table at its lowest point: 90, 0, 0 lays an upright object on its side (a second pass)"},
+     "the table at its lowest point: 90, 0, 0 lays an upright object on its side (a second pass)",
+     NULL, NULL},
     {"sim", "slip_mm", INI_VEC, C(sim.slip_mm), 3, -100, 100, 0, "0, 0, 0", NULL,
      "the object slips on the table by this much (mm, table frame at angle 0) once the table "
-     "has reached slip_at_deg: a registration that must fail and name the view"},
+     "has reached slip_at_deg: a registration that must fail and name the view",
+     NULL, NULL},
     F64("sim", "slip_at_deg", sim.slip_at_deg, 0, 360, "180",
         "the table angle from which the object has slipped by slip_mm"),
     U32("sim", "segments", sim.segments, 8, 4096, "384", "tessellation of analytic shapes"),
@@ -302,7 +307,7 @@ static const struct ini_key config_keys[] = {
     ENUM("sim", "albedo_pattern", sim.albedo_pattern, "patches|uniform", "patches",
          "painted patches and stripes (with a very dark one), or one colour"),
     {"sim", "albedo", INI_VEC, C(sim.albedo), 3, 0, 1, 0, "0.8, 0.8, 0.8", NULL,
-     "albedo for albedo_pattern = uniform"},
+     "albedo for albedo_pattern = uniform", NULL, NULL},
     U32("sim", "seed", sim.seed, 0, 4294967295.0, "1", "noise seed (runs are repeatable)"),
     U32("sim", "table_angle_error_mdeg", sim.table_angle_error_mdeg, 0, 10000, "0",
         "the table ends each move up to this far from the angle it reports (open-loop stepper)"),

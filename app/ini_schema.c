@@ -10,6 +10,7 @@
 #include <fcntl.h>
 #include <ini.h>
 #include <math.h>
+#include <stdarg.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -378,4 +379,72 @@ void ini_schema_print_doc(const struct ini_key *keys, size_t key_count, FILE *ou
                 type_name(k, type_buf, sizeof(type_buf)),
                 k->def == NULL ? "**required**" : (k->def[0] ? k->def : "(empty)"), range, k->doc);
     }
+}
+
+/* ---- the writer ---- */
+
+/* Append to @p buf at *@p at; past the end only counts (the caller checks once). */
+__attribute__((format(printf, 4, 5))) static void put(char *buf, size_t len, size_t *at,
+                                                      const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(buf + (*at < len ? *at : len), *at < len ? len - *at : 0, fmt, ap);
+    va_end(ap);
+    *at += n > 0 ? (size_t)n : 0;
+}
+
+static int put_value(const struct ini_key *k, const void *target, char *buf, size_t len, size_t *at)
+{
+    const char *p = (const char *)target + k->offset;
+    switch (k->type) {
+    case INI_U32:
+        put(buf, len, at, k->fmt != NULL ? k->fmt : "%u", (unsigned)*(const uint32_t *)p);
+        return 0;
+    case INI_I32:
+        put(buf, len, at, k->fmt != NULL ? k->fmt : "%d", (int)*(const int32_t *)p);
+        return 0;
+    case INI_F64:
+        put(buf, len, at, k->fmt != NULL ? k->fmt : "%.12g", *(const double *)p);
+        return 0;
+    case INI_STR:
+    case INI_ENUM: /* a choice, kept as a string */
+        put(buf, len, at, "%s", p);
+        return 0;
+    case INI_VEC:
+        for (size_t i = 0; i < k->size; i++) {
+            if (i > 0)
+                put(buf, len, at, ", ");
+            put(buf, len, at, k->fmt != NULL ? k->fmt : "%.12g", ((const double *)p)[i]);
+        }
+        return 0;
+    default:
+        return -EINVAL;
+    }
+}
+
+int ini_schema_write(const struct ini_key *keys, size_t key_count, const void *target,
+                     const char *header, ini_schema_skip_fn skip, const char *section_gap,
+                     char *buf, size_t len)
+{
+    size_t at = 0;
+    if (header != NULL)
+        put(buf, len, &at, "%s", header);
+    const char *section = NULL;
+    for (size_t i = 0; i < key_count; i++) {
+        const struct ini_key *k = &keys[i];
+        if (k->name == NULL || (skip != NULL && skip(k, target)))
+            continue;
+        if (section == NULL || strcmp(section, k->section) != 0) {
+            put(buf, len, &at, "%s[%s]\n", section != NULL ? section_gap : "", k->section);
+            section = k->section;
+        }
+        if (k->note != NULL)
+            put(buf, len, &at, "; %s\n", k->note);
+        put(buf, len, &at, "%s = ", k->name);
+        if (put_value(k, target, buf, len, &at) != 0)
+            return -EINVAL;
+        put(buf, len, &at, "\n");
+    }
+    return at < len && at <= INT32_MAX ? (int)at : -ENOSPC;
 }

@@ -30,6 +30,9 @@ struct ini_key {
     const char *def;     /**< default, as it would be written in the file; NULL = required */
     const char *choices; /**< INI_ENUM: "a|b|c" */
     const char *doc;     /**< one sentence for docs/config.md */
+    /* for the files the scanner writes as well as reads (ini_schema_write): */
+    const char *fmt;  /**< a number's printf format (NULL: %u, %d, %.12g) */
+    const char *note; /**< a comment line written before the key, or NULL */
 };
 
 #define INI_MAX_KEYS 192
@@ -39,6 +42,21 @@ struct ini_key {
  *  @retval 0 ok @retval -ENOENT no file @retval -EINVAL bad content (message in @p err) */
 int ini_schema_load(const struct ini_key *keys, size_t key_count, void *target, const char *path,
                     char *err, size_t err_len);
+
+/** Which keys ini_schema_write leaves out: @retval 1 leave @p key out of @p target's file. */
+typedef int (*ini_schema_skip_fn)(const struct ini_key *key, const void *target);
+
+/** Write @p target as the file @p keys describe (the same table the reader takes, so the two
+ *  agree): @p header as it is (NULL: none), then "[section]" where the section changes, @p
+ * section_gap before every section but the first, "name = value" in the table's order, numbers with
+ * the key's fmt, vectors as "a, b, c". INI_U32, INI_I32, INI_F64, INI_STR, INI_ENUM and INI_VEC
+ * only.
+ *  @param skip  keys to leave out (NULL: none)
+ *  @retval the length written @retval -ENOSPC @p buf too small @retval -EINVAL a type it cannot
+ *  write */
+int ini_schema_write(const struct ini_key *keys, size_t key_count, const void *target,
+                     const char *header, ini_schema_skip_fn skip, const char *section_gap,
+                     char *buf, size_t len);
 
 /** Markdown documentation of a table: a section heading and a table per section. */
 void ini_schema_print_doc(const struct ini_key *keys, size_t key_count, FILE *out);

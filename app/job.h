@@ -12,12 +12,25 @@
 #include "scan_events.h"
 #include "scan_job.h"
 
+#include <pthread.h>
 #include <stddef.h>
 #include <stdint.h>
 
 #define JOB_MAX_STAGES 8u
 
-struct pending;
+/* A captured view, processed and saved by a thread of its own while the table turns to the next
+ * view (the firmware is used by one thread at a time: the next capture waits for it). */
+struct pending {
+    struct job *j;
+    pthread_t thread;
+    uint32_t view;
+    char view_dir[SCAN_DIR_PATH_MAX];
+    char started[32];
+    double t0_ms;
+    struct scan_view_info info;
+    int rc;
+    double cpu_s; /* its thread's CPU */
+};
 
 struct job {
     const struct hal *hal;
@@ -32,12 +45,13 @@ struct job {
     double views_cpu_s, last_view_cpu_s; /* the threads that processed views, and the last */
     uint64_t start_rig_us;               /* the rig's clock (the simulator's: the modelled rig's) */
     int tty;
-    struct scan_ctx *scan;     /* the view being decoded (job.c keeps the one) */
-    struct reg_ctx *reg;       /* the registration of the job's views (job.c keeps the one) */
-    struct reflect_pool *pool; /* [colour] method = fit: the reflectance (job.c keeps it) */
-    struct fusion_volume *vol; /* the model's volume (job.c keeps it) */
-    struct pending *pending;   /* the view processed while the table turns, or NULL */
-    struct eta {               /* views finished of the current run, and when */
+    struct scan_ctx *scan;       /* the view being decoded (job.c keeps the one) */
+    struct reg_ctx *reg;         /* the registration of the job's views (job.c keeps the one) */
+    struct reflect_pool *pool;   /* [colour] method = fit: the reflectance (job.c keeps it) */
+    struct fusion_volume *vol;   /* the model's volume (job.c keeps it) */
+    struct pending pending_view; /* where the view processed while the table turns is kept */
+    struct pending *pending;     /* that view while it is processed, or NULL */
+    struct eta {                 /* views finished of the current run, and when */
         uint32_t first_done, last_done;
         double first_ms, last_ms;
     } eta;

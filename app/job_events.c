@@ -211,7 +211,7 @@ static void job_write_summary_and_report(struct job *j, const char *command)
                       j->stages.end_s[i]);
     int rc = n > 0 && (size_t)n < sizeof(text) ? 0 : -EOVERFLOW;
     if (rc == 0)
-        rc = scan_dir_path(path, sizeof(path), j->out_dir, -1, "summary.ini");
+        rc = scan_dir_path(path, sizeof(path), j->out_dir, -1, SCAN_FILE_SUMMARY);
     if (rc == 0)
         rc = hal_storage_write_file(&j->hal->storage, path, text, (size_t)n);
     if (rc != 0)

@@ -14,20 +14,6 @@
 #include <string.h>
 #include <unistd.h>
 
-/* A captured view, processed and saved by a thread of its own while the table turns to the next
- * view (the firmware is used by one thread at a time: the next capture waits for it). */
-struct pending {
-    struct job *j;
-    pthread_t thread;
-    uint32_t view;
-    char view_dir[SCAN_DIR_PATH_MAX];
-    char started[32];
-    double t0_ms;
-    struct scan_view_info info;
-    int rc;
-    double cpu_s; /* its thread's CPU */
-};
-
 /* Frames a scan keeps ([output] keep_frames): "colour" keeps the white pattern (the colour of
  * method none, the white of the others), the light frames and an HDR scan's colour frame. */
 static int keeps_frame(const struct job *j, uint32_t frame)
@@ -90,13 +76,13 @@ void scan_job_view_meta(const struct app_config *cfg, const struct scan_params *
 
 static int write_view_meta(const struct pending *p, double ms)
 {
-    static struct scan_dir_view v; /* large; one view at a time */
+    struct scan_dir_view v;
     const struct job *j = p->j;
     scan_job_view_meta(j->cfg, &j->cfg->scan, j->calib, p->view, &p->info, &v);
     snprintf(v.started, sizeof(v.started), "%s", p->started);
     job_utc_now(v.finished, sizeof(v.finished));
     v.wall_ms = ms;
-    return job_write_failed_at(j, p->view_dir, "view.ini",
+    return job_write_failed_at(j, p->view_dir, SCAN_FILE_VIEW,
                                scan_dir_write_view(&j->hal->storage, j->out_dir, p->view, &v));
 }
 
@@ -162,7 +148,7 @@ static int save_view(struct pending *p)
     rc = scan_keep_for_registration(j->reg, p->view,
                                     &view); /* the model is made once every view is in */
     if (rc == 0) /* what the model is made of, so that it is not decoded again */
-        rc = job_write_failed_at(j, p->view_dir, "range.bin",
+        rc = job_write_failed_at(j, p->view_dir, SCAN_FILE_RANGE,
                                  scan_dir_write_range(&hal->storage, j->out_dir, p->view, &view));
     if (rc == 0)
         rc = write_view_meta(p, job_wall_ms() - p->t0_ms);
@@ -209,21 +195,21 @@ static int finish_pending(struct job *j)
 static int start_processing(struct job *j, uint32_t v, const char *started, double t0_ms,
                             const struct scan_view_info *info)
 {
-    static struct pending p; /* one at a time */
-    p = (struct pending){.j = j, .view = v, .t0_ms = t0_ms, .info = *info};
-    job_view_dir(j, v, p.view_dir, sizeof(p.view_dir));
-    snprintf(p.started, sizeof(p.started), "%s", started);
-    int rc = thread_posix_start(&p.thread, 0, process_view, &p);
+    struct pending *p = &j->pending_view; /* one at a time */
+    *p = (struct pending){.j = j, .view = v, .t0_ms = t0_ms, .info = *info};
+    job_view_dir(j, v, p->view_dir, sizeof(p->view_dir));
+    snprintf(p->started, sizeof(p->started), "%s", started);
+    int rc = thread_posix_start(&p->thread, 0, process_view, p);
     if (rc == 0) {
-        j->pending = &p;
+        j->pending = p;
         return 0;
     }
     j->hal->log(HAL_LOG_WARN,
                 "cannot start a thread (%s): view %u is processed before the "
                 "table turns",
                 strerror(-rc), (unsigned)v);
-    process_view(&p);
-    return view_processed(j, &p);
+    process_view(p);
+    return view_processed(j, p);
 }
 
 static int live_view(struct job *j, uint32_t v)
@@ -245,8 +231,7 @@ static int live_view(struct job *j, uint32_t v)
         table_failed(j, v, target);
         return rc;
     }
-    static struct capture c; /* one view at a time; the frame sink's, while it is taken */
-    c = (struct capture){.j = j, .view = v};
+    struct capture c = {.j = j, .view = v}; /* the frame sink's, while the view is taken */
     job_view_dir(j, v, c.dir, sizeof(c.dir));
     rc = scan_dir_begin_view(&hal->storage, j->out_dir, v); /* no view.ini of an earlier take */
     if (rc != 0) {
@@ -351,7 +336,7 @@ static void link_latest(const struct hal *hal, const char *parent, const char *n
 int scan_job_live(const struct hal *hal, const struct app_config *cfg,
                   const struct scan_calib *calib, const struct scan_job_opts *opts)
 {
-    static char auto_dir[HAL_MAX_PATH + 32];
+    char auto_dir[HAL_MAX_PATH + 32];
     const char *name = NULL;
     if (opts->out_dir == NULL) {
         int rc = hal_storage_mkdir_p(&hal->storage, cfg->output_dir);

@@ -23,10 +23,10 @@ static int save_results(struct job *j, uint32_t v, const struct scan_view *view,
     int rc = reg_view_pose(j->reg, v, &pose, rv);
     if (rc == 0)
         rc = job_write_failed(
-            j, v, "registration.ini",
+            j, v, SCAN_FILE_REGISTRATION,
             scan_dir_write_registration(&j->hal->storage, j->out_dir, v, rep, rv, &pose));
     if (rc == 0)
-        rc = scan_dir_path(path, sizeof(path), j->out_dir, (int)v, "cloud.ply");
+        rc = scan_dir_path(path, sizeof(path), j->out_dir, (int)v, SCAN_FILE_CLOUD);
     if (rc == 0)
         rc = scan_save_cloud(j->hal, view, &pose, path); /* says what failed itself */
     if (rc == 0)
@@ -38,7 +38,8 @@ static int save_results(struct job *j, uint32_t v, const struct scan_view *view,
  * floating fragments. */
 static int write_model(struct job *j)
 {
-    static const char *const names[] = {"mesh.ply", "mesh.obj", "mesh.stl", "mesh.glb"};
+    static const char *const names[] = {SCAN_FILE_MESH_PLY, SCAN_FILE_MESH_OBJ, SCAN_FILE_MESH_STL,
+                                        SCAN_FILE_MESH_GLB};
     int (*const writers[])(struct fusion_volume *, const struct hal_storage *, const char *) = {
         fusion_write_ply, fusion_write_obj, fusion_write_stl, NULL}; /* NULL: glb, below */
     char path[SCAN_DIR_PATH_MAX], detail[HAL_MAX_PATH + 320];
@@ -228,7 +229,7 @@ static int fit_reflectance(struct job *j, const char *scan_dir)
         return 0;
     }
     if (rc == 0)
-        rc = job_write_failed_at(j, j->out_dir, "reflectance.ini",
+        rc = job_write_failed_at(j, j->out_dir, SCAN_FILE_REFLECTANCE,
                                  scan_dir_write_reflectance(&j->hal->storage, j->out_dir, &m));
     if (rc != 0)
         return rc;

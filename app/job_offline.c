@@ -16,7 +16,7 @@ int scan_job_load_settings(const char *scan_dir, const char *config_path, int ca
                            size_t err_len)
 {
     char path[SCAN_DIR_PATH_MAX];
-    int rc = scan_dir_path(path, sizeof(path), scan_dir, -1, "config.ini");
+    int rc = scan_dir_path(path, sizeof(path), scan_dir, -1, SCAN_FILE_CONFIG);
     if (rc == 0 && config_path == NULL && access(path, F_OK) != 0) {
         snprintf(err, err_len,
                  "%s holds no scan (no config.ini; a scan stopped before its first file has "
@@ -29,7 +29,7 @@ int scan_job_load_settings(const char *scan_dir, const char *config_path, int ca
         rc = config_load(cfg, config_path ? config_path : path, err, err_len);
     /* other settings: the colour frames are those the scan took (method none shows the raw
      * colour of a scan taken with every light) */
-    static struct app_config taken;
+    struct app_config taken;
     char what[160];
     if (rc == 0 && config_path != NULL && access(path, F_OK) == 0) {
         rc = config_load(&taken, path, err, err_len);
@@ -49,7 +49,7 @@ int scan_job_load_settings(const char *scan_dir, const char *config_path, int ca
     /* the calibration is the copy kept with the scan, whatever the config named */
     if (rc == 0)
         rc = scan_dir_path(cfg->calibration_file, sizeof(cfg->calibration_file), scan_dir, -1,
-                           "calibration.ini");
+                           SCAN_FILE_CALIBRATION);
     return rc != 0 ? rc : calib_load(calib, cfg->calibration_file, cfg->light_count, err, err_len);
 }
 
@@ -89,7 +89,7 @@ static int load_view(struct job *j, const char *scan_dir, uint32_t v, struct sca
 static int check_frames(const struct job *j, const char *scan_dir, uint32_t v,
                         const struct scan_dir_view *have, char *err, size_t err_len)
 {
-    static struct scan_dir_view want;
+    struct scan_dir_view want = {0};
     scan_dir_describe_frames(&j->cfg->scan, j->calib, &want);
     for (uint32_t f = 0; f < want.frame_count; f++) {
         if (f < have->frame_count && strcmp(have->frame_name[f], want.frame_name[f]) == 0)
@@ -191,7 +191,7 @@ int job_load_range(struct job *j, const char *scan_dir, uint32_t v, struct scan_
 static int load_view(struct job *j, const char *scan_dir, uint32_t v, struct scan_view *view,
                      struct scan_view_info *info)
 {
-    static struct scan_dir_view meta;
+    struct scan_dir_view meta;
     const struct hal *hal = j->hal;
     char err[SCAN_DIR_PATH_MAX + 256];
     int rc = scan_dir_read_view(scan_dir, v, &meta, err, sizeof(err));
@@ -226,8 +226,8 @@ int job_stopped_offline(struct job *j, const char *scan_dir, uint32_t v)
 
 int scan_job_process(const struct hal *hal, const char *scan_dir, const struct scan_job_opts *opts)
 {
-    static struct app_config cfg;
-    static struct scan_calib calib;
+    struct app_config cfg;
+    struct scan_calib calib;
     char path[HAL_MAX_PATH + 32], err[512];
     int rc = scan_job_load_settings(scan_dir, opts->config_path, 0, &cfg, &calib, err, sizeof(err));
     if (rc != 0) {
@@ -246,7 +246,7 @@ int scan_job_process(const struct hal *hal, const char *scan_dir, const struct s
     if (rc != 0)
         return rc;
     /* summary.ini says every output is written (docs/scan-format.md): they are made again */
-    if (scan_dir_path(path, sizeof(path), j.out_dir, -1, "summary.ini") == 0)
+    if (scan_dir_path(path, sizeof(path), j.out_dir, -1, SCAN_FILE_SUMMARY) == 0)
         unlink(path);
     if (elsewhere && (rc = scan_dir_keep_settings(&hal->storage, cfg.path, cfg.calibration_file,
                                                   j.out_dir)) != 0) /* how they were made */
@@ -275,7 +275,7 @@ int scan_job_process(const struct hal *hal, const char *scan_dir, const struct s
          * it goes is that one already) */
         if (rc == 0 && (cfg.keep_frames == KEEP_FRAMES_ALL || elsewhere) &&
             (rc = job_make_view_dir(&j, v)) == 0)
-            rc = job_write_failed(&j, v, "range.bin",
+            rc = job_write_failed(&j, v, SCAN_FILE_RANGE,
                                   scan_dir_write_range(&hal->storage, j.out_dir, v, &view));
         if (rc == 0) {
             char detail[HAL_MAX_PATH + 160], dir[SCAN_DIR_PATH_MAX];

@@ -27,8 +27,8 @@
 
 static int cmd_scan(const char *config_path, const struct scan_job_opts *opts)
 {
-    static struct app_config cfg;
-    static struct scan_calib calib;
+    struct app_config cfg;
+    struct scan_calib calib;
     if (rig_load_all(config_path, &cfg, &calib) != 0)
         return 2;
     int rc = rig_up(&cfg, &calib);
@@ -41,8 +41,8 @@ static int cmd_scan(const char *config_path, const struct scan_job_opts *opts)
 /* One picture of the object lit by the projector's white, as a PNG (the web page's live view). */
 static int cmd_snapshot(const char *config_path, const char *out)
 {
-    static struct app_config cfg;
-    static struct scan_calib calib;
+    struct app_config cfg;
+    struct scan_calib calib;
     const uint8_t *rgb = NULL;
     if (rig_load_all(config_path, &cfg, &calib) != 0)
         return 2;
@@ -63,8 +63,8 @@ static int cmd_snapshot(const char *config_path, const char *out)
 /* One view of a white target with every colour frame: print each method's white_scale. */
 static int cmd_calibrate_white(const char *config_path, double target_albedo)
 {
-    static struct app_config cfg;
-    static struct scan_calib calib;
+    struct app_config cfg;
+    struct scan_calib calib;
     if (rig_load_all(config_path, &cfg, &calib) != 0)
         return 2;
     if (cfg.light_count == 0) {
@@ -113,8 +113,8 @@ static void selftest_row(void *ctx, const char *device, const char *where, int r
 /* First power-on: each configured device on its own, a table of what works. */
 static int cmd_selftest(const char *config_path)
 {
-    static struct app_config cfg;
-    static struct scan_calib calib;
+    struct app_config cfg;
+    struct scan_calib calib;
     char err[512];
     if (config_load(&cfg, config_path, err, sizeof(err)) != 0) {
         fprintf(stderr, "scanner: error: %s\n", err);
@@ -150,8 +150,8 @@ static int cmd_process(const char *scan_dir, const struct scan_job_opts *opts)
  * from the kept frames, as process does (the same model as an uninterrupted scan). */
 static int cmd_resume(const char *scan_dir, const struct scan_job_opts *opts)
 {
-    static struct app_config cfg;
-    static struct scan_calib calib;
+    struct app_config cfg;
+    struct scan_calib calib;
     char err[512];
     if (scan_job_load_settings(scan_dir, opts->config_path, 1, &cfg, &calib, err, sizeof(err)) !=
         0) {
@@ -398,8 +398,8 @@ int main(int argc, char **argv)
     if (config_path == NULL)
         return missing(cmd, "--config FILE");
     if (strcmp(argv[1], "check-config") == 0) {
-        static struct app_config cfg;
-        static struct scan_calib calib;
+        struct app_config cfg;
+        struct scan_calib calib;
         char err[1024];
         if (rig_load_all(config_path, &cfg, &calib) != 0)
             return 2;
@@ -411,8 +411,8 @@ int main(int argc, char **argv)
         return 0;
     }
     if (strcmp(argv[1], "patterns") == 0) {
-        static struct app_config cfg;
-        static struct scan_calib calib;
+        struct app_config cfg;
+        struct scan_calib calib;
         struct hal_storage st;
         if (opts.out_dir == NULL)
             return missing(cmd, "--out DIR");

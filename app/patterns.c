@@ -41,7 +41,7 @@ static int write_listing(const struct hal_storage *st, const char *dir,
                          const struct gray_layout *full, uint32_t scan_count, uint32_t w,
                          uint32_t h)
 {
-    static char text[16384];
+    char text[16384];
     size_t used = 0;
     uint32_t count = gray_layout_count(full);
     used += (size_t)snprintf(text + used, sizeof(text) - used,

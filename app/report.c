@@ -338,7 +338,7 @@ static int model_read(const char *dir, struct model *m)
     size_t stride = 0;
     int in_vertex = 0, rc = -EINVAL;
     *m = (struct model){0};
-    if (scan_dir_path(path, sizeof(path), dir, -1, "mesh.ply") != 0)
+    if (scan_dir_path(path, sizeof(path), dir, -1, SCAN_FILE_MESH_PLY) != 0)
         return -ENAMETOOLONG;
     FILE *fp = file_open_regular(path, "rb");
     if (fp == NULL)
@@ -527,9 +527,9 @@ static void model_section(struct text *t, const char *dir)
 
 static void timings_section(struct text *t, const char *dir)
 {
-    static struct kvs k;
+    struct kvs k;
     text_printf(t, "<h2>Timings</h2>\n");
-    if (kv_read(&k, dir, -1, "summary.ini") != 0) {
+    if (kv_read(&k, dir, -1, SCAN_FILE_SUMMARY) != 0) {
         text_printf(t, "<p class=missing>No summary.ini: the scan did not finish.</p>\n");
         return;
     }
@@ -554,9 +554,9 @@ static void timings_section(struct text *t, const char *dir)
 
 static void registration_section(struct text *t, const char *dir)
 {
-    static struct kvs k;
+    struct kvs k;
     text_printf(t, "<h2>Registration</h2>\n");
-    if (kv_read(&k, dir, 0, "registration.ini") != 0) {
+    if (kv_read(&k, dir, 0, SCAN_FILE_REGISTRATION) != 0) {
         text_printf(t, "<p class=missing>Not registered yet.</p>\n");
         return;
     }
@@ -585,7 +585,7 @@ static void registration_section(struct text *t, const char *dir)
 static void thumb_cell(struct text *t, const struct view_images *vi, enum report_thumb kind,
                        const char *alt)
 {
-    static uint8_t pixels[3u * REPORT_THUMB_WIDTH * REPORT_THUMB_WIDTH];
+    uint8_t pixels[3u * REPORT_THUMB_WIDTH * REPORT_THUMB_WIDTH];
     uint32_t tw, th;
     text_printf(t, "<td>");
     if (vi != NULL && thumb_of(vi, kind, pixels, &tw, &th) == 0)
@@ -597,8 +597,8 @@ static void thumb_cell(struct text *t, const struct view_images *vi, enum report
 
 static void views_section(struct text *t, const char *dir, uint32_t views, const char *method)
 {
-    static struct scan_dir_view v;
-    static struct kvs reg;
+    struct scan_dir_view v;
+    struct kvs reg;
     char err[256];
     text_printf(t, "<h2>Views</h2>\n<p class=legend>Reason map: ");
     for (unsigned r = 0; r < SCAN_REASON_COUNT; r++)
@@ -616,7 +616,7 @@ static void views_section(struct text *t, const char *dir, uint32_t views, const
             continue;
         }
         text_printf(t, "<tr><td>%u</td><td>%.3f", (unsigned)i, v.angle_mdeg / 1000.0);
-        if (kv_read(&reg, dir, (int)i, "registration.ini") == 0)
+        if (kv_read(&reg, dir, (int)i, SCAN_FILE_REGISTRATION) == 0)
             text_printf(t, " &rarr; %.3f<br>(%+.3f)</td><td>%u</td><td>%.3f</td>",
                         kv_num(&reg, "view", "angle_deg", 0),
                         kv_num(&reg, "view", "correction_deg", 0), (unsigned)v.valid_points,
@@ -657,10 +657,10 @@ static const char *dir_name(const char *dir)
 
 int report_write(const struct hal_storage *st, const char *dir, char *err, size_t err_len)
 {
-    static struct kvs cfg;
+    struct kvs cfg;
     struct text t = {0};
     char path[SCAN_DIR_PATH_MAX];
-    int rc = kv_read(&cfg, dir, -1, "config.ini");
+    int rc = kv_read(&cfg, dir, -1, SCAN_FILE_CONFIG);
     if (rc != 0) {
         snprintf(err, err_len, "%s/config.ini: %s (not a scan directory?)", dir, strerror(-rc));
         return rc;
@@ -677,8 +677,9 @@ int report_write(const struct hal_storage *st, const char *dir, char *err, size_
     text_html(&t, dir_name(dir));
     text_printf(&t, "</h1>\n<p class=state>%u of %u views taken. Files: ", (unsigned)done,
                 (unsigned)views);
-    static const char *const files[] = {"mesh.ply", "mesh.obj",   "mesh.stl",
-                                        "mesh.glb", "config.ini", "calibration.ini"};
+    static const char *const files[] = {SCAN_FILE_MESH_PLY, SCAN_FILE_MESH_OBJ,
+                                        SCAN_FILE_MESH_STL, SCAN_FILE_MESH_GLB,
+                                        SCAN_FILE_CONFIG,   SCAN_FILE_CALIBRATION};
     struct stat sb;
     for (size_t f = 0; f < sizeof(files) / sizeof(files[0]); f++)
         if (scan_dir_path(path, sizeof(path), dir, -1, files[f]) == 0 && stat(path, &sb) == 0)
@@ -690,7 +691,7 @@ int report_write(const struct hal_storage *st, const char *dir, char *err, size_
     registration_section(&t, dir);
     views_section(&t, dir, views, method);
     text_printf(&t, "</body></html>\n");
-    rc = t.failed ? -ENOMEM : scan_dir_path(path, sizeof(path), dir, -1, "report.html");
+    rc = t.failed ? -ENOMEM : scan_dir_path(path, sizeof(path), dir, -1, SCAN_FILE_REPORT);
     if (rc == 0)
         rc = hal_storage_write_file(st, path, t.s, t.len);
     if (rc != 0)

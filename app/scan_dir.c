@@ -135,84 +135,68 @@ void scan_dir_describe_frames(const struct scan_params *p, const struct scan_cal
 
 /* ---- view.ini ---- */
 
-int scan_dir_write_view(const struct hal_storage *st, const char *dir, uint32_t view,
-                        const struct scan_dir_view *v)
-{
-    char text[8192], path[SCAN_DIR_PATH_MAX];
-    int len = snprintf(
-        text, sizeof(text),
-        "; one view of a scan: see docs/scan-format.md\n[view]\nindex = %u\nangle_mdeg = %d\n"
-        "started = %s\nfinished = %s\nframes = %u\ncapture_retries = %u\nvalid_points = %u\n"
-        "wall_ms = %.1f\n[capture]\nexposure_us = %u\ngain_milli = %u\n"
-        "; patterns: projector on, lights off; colour frames as named below\n",
-        (unsigned)v->index, (int)v->angle_mdeg, v->started, v->finished, (unsigned)v->frames,
-        (unsigned)v->capture_retries, (unsigned)v->valid_points, v->wall_ms,
-        (unsigned)v->exposure_us, (unsigned)v->gain_milli);
-    for (uint32_t f = 0; f < v->frame_count && (size_t)len < sizeof(text); f++)
-        len += snprintf(text + len, sizeof(text) - (size_t)len, "frame_%02u = %s\n", (unsigned)f,
-                        v->frame_name[f]);
-    if ((size_t)len < sizeof(text))
-        len += snprintf(text + len, sizeof(text) - (size_t)len, "[pixels]\n");
-    for (unsigned r = 0; r < SCAN_REASON_COUNT && (size_t)len < sizeof(text); r++)
-        len += snprintf(text + len, sizeof(text) - (size_t)len, "%s = %u\n", scan_reason_name(r),
-                        (unsigned)v->reason_count[r]);
-    if ((size_t)len >= sizeof(text))
-        return -ENOSPC;
-    int rc = scan_dir_path(path, sizeof(path), dir, (int)view, "view.ini");
-    return rc != 0 ? rc : hal_storage_write_file(st, path, text, (size_t)len);
-}
-
 #define V(member) offsetof(struct scan_dir_view, member)
 #define VSZ(member) sizeof(((struct scan_dir_view *)0)->member)
 
-/* Every key view.ini may hold (frame_NN are added at first use). Angles within ten turns. */
-#define VIEW_FIXED_KEYS (10u + SCAN_REASON_COUNT)
-static struct ini_key view_keys[VIEW_FIXED_KEYS + SCAN_DIR_MAX_FRAMES] = {
-    {"view", "index", INI_U32, V(index), 0, 0, 99999, 0, NULL, NULL, "view number"},
+/* Every key view.ini may hold, in the order it is written: the one table its reader and writer
+ * share (the frame_NN and reason keys are added at first use). Angles within ten turns. */
+#define VIEW_FIXED_KEYS 10u
+#define VIEW_KEYS (VIEW_FIXED_KEYS + SCAN_DIR_MAX_FRAMES + SCAN_REASON_COUNT)
+static struct ini_key view_keys[VIEW_KEYS] = {
+    {"view", "index", INI_U32, V(index), 0, 0, 99999, 0, NULL, NULL, "view number", NULL, NULL},
     {"view", "angle_mdeg", INI_I32, V(angle_mdeg), 0, -3600000, 3600000, 0, NULL, NULL,
-     "turntable angle"},
-    {"view", "started", INI_STR, V(started), VSZ(started), 0, 0, 0, "", NULL, "UTC"},
-    {"view", "finished", INI_STR, V(finished), VSZ(finished), 0, 0, 0, "", NULL, "UTC"},
-    {"view", "frames", INI_U32, V(frames), 0, 0, SCAN_DIR_MAX_FRAMES, 0, NULL, NULL, "frames"},
-    {"view", "capture_retries", INI_U32, V(capture_retries), 0, 0, 1e6, 0, "0", NULL, "retries"},
-    {"view", "valid_points", INI_U32, V(valid_points), 0, 0, HAL_MAX_PIXELS, 0, "0", NULL,
-     "points"},
-    {"view", "wall_ms", INI_F64, V(wall_ms), 0, 0, 1e9, 0, "0", NULL, "time"},
-    {"capture", "exposure_us", INI_U32, V(exposure_us), 0, 0, 1e8, 0, "0", NULL, "exposure"},
-    {"capture", "gain_milli", INI_U32, V(gain_milli), 0, 0, 1e6, 0, "0", NULL, "gain"},
+     "turntable angle", NULL, NULL},
+    {"view", "started", INI_STR, V(started), VSZ(started), 0, 0, 0, "", NULL, "UTC", NULL, NULL},
+    {"view", "finished", INI_STR, V(finished), VSZ(finished), 0, 0, 0, "", NULL, "UTC", NULL, NULL},
+    {"view", "frames", INI_U32, V(frames), 0, 0, SCAN_DIR_MAX_FRAMES, 0, NULL, NULL, "frames", NULL,
+     NULL},
+    {"view", "capture_retries", INI_U32, V(capture_retries), 0, 0, 1e6, 0, "0", NULL, "retries",
+     NULL, NULL},
+    {"view", "valid_points", INI_U32, V(valid_points), 0, 0, HAL_MAX_PIXELS, 0, "0", NULL, "points",
+     NULL, NULL},
+    {"view", "wall_ms", INI_F64, V(wall_ms), 0, 0, 1e9, 0, "0", NULL, "time", "%.1f", NULL},
+    {"capture", "exposure_us", INI_U32, V(exposure_us), 0, 0, 1e8, 0, "0", NULL, "exposure", NULL,
+     NULL},
+    {"capture", "gain_milli", INI_U32, V(gain_milli), 0, 0, 1e6, 0, "0", NULL, "gain", NULL, NULL},
 };
 
-/* The reason and frame keys are made once, whichever thread reads a view.ini first (the web
- * server's threads read them too). */
+/* The frame and reason keys are made once, whichever thread reads or writes a view.ini first
+ * (the web server's threads read them too). */
 static char frame_keys[SCAN_DIR_MAX_FRAMES][12];
 static void make_view_keys(void)
 {
-    for (unsigned r = 0; r < SCAN_REASON_COUNT; r++)
-        view_keys[10 + r] = (struct ini_key){"pixels",
-                                             scan_reason_name(r),
-                                             INI_U32,
-                                             V(reason_count) + r * sizeof(uint32_t),
-                                             0,
-                                             0,
-                                             HAL_MAX_PIXELS,
-                                             0,
-                                             "0",
-                                             NULL,
-                                             "pixels"};
     for (unsigned f = 0; f < SCAN_DIR_MAX_FRAMES; f++) {
         snprintf(frame_keys[f], sizeof(frame_keys[f]), "frame_%02u", f);
-        view_keys[VIEW_FIXED_KEYS + f] = (struct ini_key){"capture",
-                                                          frame_keys[f],
-                                                          INI_STR,
-                                                          V(frame_name) + f * SCAN_DIR_FRAME_NAME,
-                                                          SCAN_DIR_FRAME_NAME,
-                                                          0,
-                                                          0,
-                                                          0,
-                                                          "",
-                                                          NULL,
-                                                          "what the frame shows"};
+        view_keys[VIEW_FIXED_KEYS + f] = (struct ini_key){
+            "capture",
+            frame_keys[f],
+            INI_STR,
+            V(frame_name) + f * SCAN_DIR_FRAME_NAME,
+            SCAN_DIR_FRAME_NAME,
+            0,
+            0,
+            0,
+            "",
+            NULL,
+            "what the frame shows",
+            NULL,
+            f == 0 ? "patterns: projector on, lights off; colour frames as named below" : NULL};
     }
+    for (unsigned r = 0; r < SCAN_REASON_COUNT; r++)
+        view_keys[VIEW_FIXED_KEYS + SCAN_DIR_MAX_FRAMES + r] =
+            (struct ini_key){"pixels",
+                             scan_reason_name(r),
+                             INI_U32,
+                             V(reason_count) + r * sizeof(uint32_t),
+                             0,
+                             0,
+                             HAL_MAX_PIXELS,
+                             0,
+                             "0",
+                             NULL,
+                             "pixels",
+                             NULL,
+                             NULL};
 }
 
 static void view_keys_complete(void)
@@ -221,11 +205,33 @@ static void view_keys_complete(void)
     pthread_once(&once, make_view_keys);
 }
 
+/* A view.ini names the frames the view has: frame_NN of NN < frame_count. */
+static int skip_absent_frame(const struct ini_key *k, const void *target)
+{
+    const struct scan_dir_view *v = target;
+    unsigned f;
+    return sscanf(k->name, "frame_%u", &f) == 1 && f >= v->frame_count;
+}
+
+int scan_dir_write_view(const struct hal_storage *st, const char *dir, uint32_t view,
+                        const struct scan_dir_view *v)
+{
+    static const char header[] = "; one view of a scan: see docs/scan-format.md\n";
+    char text[8192], path[SCAN_DIR_PATH_MAX];
+    view_keys_complete();
+    int len = ini_schema_write(view_keys, VIEW_KEYS, v, header, skip_absent_frame, "", text,
+                               sizeof(text));
+    if (len < 0)
+        return len;
+    int rc = scan_dir_path(path, sizeof(path), dir, (int)view, SCAN_FILE_VIEW);
+    return rc != 0 ? rc : hal_storage_write_file(st, path, text, (size_t)len);
+}
+
 int scan_dir_read_view(const char *dir, uint32_t view, struct scan_dir_view *v, char *err,
                        size_t err_len)
 {
     char path[SCAN_DIR_PATH_MAX];
-    int rc = scan_dir_path(path, sizeof(path), dir, (int)view, "view.ini");
+    int rc = scan_dir_path(path, sizeof(path), dir, (int)view, SCAN_FILE_VIEW);
     if (rc != 0) {
         snprintf(err, err_len, "%s/view_%03u: path too long", dir, (unsigned)view);
         return rc;
@@ -238,8 +244,7 @@ int scan_dir_read_view_file(const char *path, uint32_t view, struct scan_dir_vie
 {
     view_keys_complete();
     memset(v, 0, sizeof(*v));
-    int rc =
-        ini_schema_load(view_keys, sizeof(view_keys) / sizeof(view_keys[0]), v, path, err, err_len);
+    int rc = ini_schema_load(view_keys, VIEW_KEYS, v, path, err, err_len);
     if (rc == 0 && v->index != view) {
         snprintf(err, err_len, "%s: [view] index: %u, but this is view %u", path,
                  (unsigned)v->index, (unsigned)view);
@@ -270,7 +275,7 @@ int scan_dir_view_count(const char *dir, uint32_t *views)
 {
     char path[SCAN_DIR_PATH_MAX];
     struct view_count c = {1, 1}; /* the config's defaults of [scan] views and passes */
-    int rc = scan_dir_path(path, sizeof(path), dir, -1, "config.ini");
+    int rc = scan_dir_path(path, sizeof(path), dir, -1, SCAN_FILE_CONFIG);
     if (rc == 0 && ini_parse(path, view_count_key, &c) == -1)
         rc = -ENOENT;
     *views = c.views * c.passes;
@@ -311,7 +316,7 @@ int scan_dir_make_new(const char *parent, char *out, size_t len, const char **na
 int scan_dir_finished(const char *dir)
 {
     char path[SCAN_DIR_PATH_MAX];
-    return scan_dir_path(path, sizeof(path), dir, -1, "summary.ini") == 0 &&
+    return scan_dir_path(path, sizeof(path), dir, -1, SCAN_FILE_SUMMARY) == 0 &&
            access(path, F_OK) == 0;
 }
 
@@ -378,7 +383,7 @@ static const char range_magic[8] = {'S', 'C', 'A', 'N', 'R', 'N', 'G', '1'};
 int scan_dir_write_range(const struct hal_storage *st, const char *dir, uint32_t view,
                          const struct scan_view *v)
 {
-    static struct range_point chunk[RANGE_CHUNK];
+    struct range_point chunk[RANGE_CHUNK]; /* 64 KB */
     char path[SCAN_DIR_PATH_MAX];
     struct hal_file f;
     size_t n = (size_t)v->width * v->height, used = 0;
@@ -391,7 +396,7 @@ int scan_dir_write_range(const struct hal_storage *st, const char *dir, uint32_t
                              .colour_method = v->colour_method,
                              .angle_mdeg = v->angle_mdeg};
     memcpy(h.magic, range_magic, sizeof(h.magic));
-    int rc = scan_dir_path(path, sizeof(path), dir, (int)view, "range.bin");
+    int rc = scan_dir_path(path, sizeof(path), dir, (int)view, SCAN_FILE_RANGE);
     if (rc == 0)
         rc = hal_storage_open(st, &f, path);
     if (rc != 0)
@@ -426,7 +431,7 @@ int scan_dir_write_range(const struct hal_storage *st, const char *dir, uint32_t
 static int range_open(const char *dir, uint32_t view, char *path, size_t path_len,
                       struct range_header *h, FILE **fp)
 {
-    int rc = scan_dir_path(path, path_len, dir, (int)view, "range.bin");
+    int rc = scan_dir_path(path, path_len, dir, (int)view, SCAN_FILE_RANGE);
     *fp = rc == 0 ? file_open_regular(path, "rb") : NULL;
     if (*fp == NULL)
         return rc != 0 ? rc : -errno;
@@ -608,7 +613,7 @@ int scan_dir_write_reflectance(const struct hal_storage *st, const char *dir,
     }
     if (len >= sizeof(text))
         return -ENAMETOOLONG;
-    int rc = scan_dir_path(path, sizeof(path), dir, -1, "reflectance.ini");
+    int rc = scan_dir_path(path, sizeof(path), dir, -1, SCAN_FILE_REFLECTANCE);
     return rc != 0 ? rc : hal_storage_write_file(st, path, text, len);
 }
 
@@ -643,7 +648,7 @@ int scan_dir_write_registration(const struct hal_storage *st, const char *dir, u
                         pose->origin.y, pose->origin.z);
     if (len < 0 || (size_t)len >= sizeof(text))
         return -ENAMETOOLONG;
-    int rc = scan_dir_path(path, sizeof(path), dir, (int)view, "registration.ini");
+    int rc = scan_dir_path(path, sizeof(path), dir, (int)view, SCAN_FILE_REGISTRATION);
     return rc != 0 ? rc : hal_storage_write_file(st, path, text, (size_t)len);
 }
 
@@ -669,7 +674,7 @@ int scan_dir_read_pose(const char *dir, uint32_t view, struct frame_xform *pose)
     char path[SCAN_DIR_PATH_MAX], line[512];
     double origin[3];
     int have_rot = 0, have_origin = 0;
-    int rc = scan_dir_path(path, sizeof(path), dir, (int)view, "registration.ini");
+    int rc = scan_dir_path(path, sizeof(path), dir, (int)view, SCAN_FILE_REGISTRATION);
     FILE *f = rc == 0 ? file_open_regular(path, "r") : NULL;
     if (f == NULL)
         return rc != 0 ? rc : -errno;
@@ -684,7 +689,7 @@ int scan_dir_read_pose(const char *dir, uint32_t view, struct frame_xform *pose)
 
 int scan_dir_copy_file(const struct hal_storage *st, const char *from, const char *to)
 {
-    static char buf[1 << 16]; /* config and calibration files are small */
+    char buf[1 << 16]; /* config and calibration files are small */
     FILE *f = file_open_regular(from, "rb");
     if (f == NULL)
         return -errno;
@@ -701,11 +706,11 @@ int scan_dir_keep_settings(const struct hal_storage *st, const char *config_path
      * takes a directory with config.ini as a scan; a kill between the two left it without its
      * calibration). */
     char path[SCAN_DIR_PATH_MAX];
-    int rc = scan_dir_path(path, sizeof(path), dir, -1, "calibration.ini");
+    int rc = scan_dir_path(path, sizeof(path), dir, -1, SCAN_FILE_CALIBRATION);
     if (rc == 0)
         rc = scan_dir_copy_file(st, calibration_path, path);
     if (rc == 0)
-        rc = scan_dir_path(path, sizeof(path), dir, -1, "config.ini");
+        rc = scan_dir_path(path, sizeof(path), dir, -1, SCAN_FILE_CONFIG);
     return rc != 0 ? rc : scan_dir_copy_file(st, config_path, path);
 }
 
@@ -715,9 +720,10 @@ int scan_dir_keep_settings(const struct hal_storage *st, const char *config_path
  * (the simulator's ground truth among them) */
 static int scan_file(const char *name)
 {
-    static const char *const names[] = {"config.ini",      "calibration.ini", "mesh.ply",
-                                        "mesh.obj",        "mesh.stl",        "mesh.glb",
-                                        "reflectance.ini", "summary.ini",     "report.html"};
+    static const char *const names[] = {
+        SCAN_FILE_CONFIG,      SCAN_FILE_CALIBRATION, SCAN_FILE_MESH_PLY,
+        SCAN_FILE_MESH_OBJ,    SCAN_FILE_MESH_STL,    SCAN_FILE_MESH_GLB,
+        SCAN_FILE_REFLECTANCE, SCAN_FILE_SUMMARY,     SCAN_FILE_REPORT};
     for (size_t k = 0; k < sizeof(names) / sizeof(names[0]); k++)
         if (strcmp(name, names[k]) == 0)
             return 1;
@@ -733,9 +739,9 @@ static int view_file(const char *name)
         for (size_t k = 0; k < sizeof(frame_endings) / sizeof(frame_endings[0]); k++)
             if (strcmp(name + end, frame_endings[k]) == 0)
                 return 1;
-    return strcmp(name, "view.ini") == 0 || strcmp(name, "cloud.ply") == 0 ||
-           strcmp(name, "range.bin") == 0 || strcmp(name, "target.ini") == 0 ||
-           strcmp(name, "registration.ini") == 0 || strncmp(name, "truth_", 6) == 0;
+    return strcmp(name, SCAN_FILE_VIEW) == 0 || strcmp(name, SCAN_FILE_CLOUD) == 0 ||
+           strcmp(name, SCAN_FILE_RANGE) == 0 || strcmp(name, SCAN_FILE_TARGET) == 0 ||
+           strcmp(name, SCAN_FILE_REGISTRATION) == 0 || strncmp(name, "truth_", 6) == 0;
 }
 
 /* @retval 1 when @p name is a view's directory: view_NNN */
@@ -761,7 +767,7 @@ static int scan_entries(const struct hal_storage *storage, const char *dir, int 
     char path[SCAN_DIR_PATH_MAX];
     int rc = 0;
     if (remove && in_view) /* view.ini first: a view cut short here is never taken as finished */
-        unlinkat(dirfd(d), "view.ini", 0);
+        unlinkat(dirfd(d), SCAN_FILE_VIEW, 0);
     for (struct dirent *e = readdir(d); e != NULL && rc == 0; e = readdir(d)) {
         if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0)
             continue;
@@ -861,7 +867,7 @@ int scan_dir_begin_view(const struct hal_storage *st, const char *dir, uint32_t 
     if (rc == 0)
         rc = hal_storage_mkdir_p(st, path);
     if (rc == 0)
-        rc = scan_dir_path(path, sizeof(path), dir, (int)view, "view.ini");
+        rc = scan_dir_path(path, sizeof(path), dir, (int)view, SCAN_FILE_VIEW);
     if (rc == 0 && unlink(path) != 0 && errno != ENOENT)
         rc = -errno;
     return rc;

@@ -17,6 +17,23 @@
 #define SCAN_DIR_MAX_FRAMES (DECODE_MAX_PATTERNS + COLOUR_MAX_FRAMES + 1) /* + HDR colour */
 /** Longest description of a frame in view.ini ("light 3 alone, 20000 us, RGB"). */
 #define SCAN_DIR_FRAME_NAME 64u
+/* The files of a scan directory (docs/scan-format.md), named here only. At its top: */
+#define SCAN_FILE_CONFIG "config.ini"           /* the settings it was taken with */
+#define SCAN_FILE_CALIBRATION "calibration.ini" /* and the rig's calibration */
+#define SCAN_FILE_MESH_PLY "mesh.ply"           /* the model, in four formats */
+#define SCAN_FILE_MESH_OBJ "mesh.obj"
+#define SCAN_FILE_MESH_STL "mesh.stl"
+#define SCAN_FILE_MESH_GLB "mesh.glb"
+#define SCAN_FILE_REFLECTANCE "reflectance.ini" /* [colour] method = fit's materials */
+#define SCAN_FILE_SUMMARY "summary.ini"         /* last: the scan is complete */
+#define SCAN_FILE_REPORT "report.html"
+/* In each view's folder (view_NNN), beside its frames: */
+#define SCAN_FILE_VIEW "view.ini" /* last of a view's capture: the view is complete */
+#define SCAN_FILE_RANGE "range.bin"
+#define SCAN_FILE_REGISTRATION "registration.ini"
+#define SCAN_FILE_CLOUD "cloud.ply"
+#define SCAN_FILE_TARGET "target.ini" /* calibration captures: what stood on the table */
+
 /** Room for any path inside a scan directory. */
 #define SCAN_DIR_PATH_MAX (HAL_MAX_PATH + 64u)
 

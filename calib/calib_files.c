@@ -21,29 +21,32 @@ struct target_file {
 #define T(member) offsetof(struct target_file, member)
 static const struct ini_key target_keys[] = {
     {"target", "target", INI_ENUM, T(target), sizeof(((struct target_file *)0)->target), 0, 0, 0,
-     "board", "board|sphere", "what stood on the table"},
+     "board", "board|sphere", "what stood on the table", NULL, NULL},
     {"target", "placement", INI_U32, T(placement), 0, 0, 1000, 0, "0", NULL,
-     "board placement: captures of one placement differ only by the table's angle"},
+     "board placement: captures of one placement differ only by the table's angle", NULL, NULL},
     {"target", "tilt_deg", INI_F64, T(tilt_deg), 0, -90, 90, 0, "0", NULL,
-     "the placement's tilt from upright, as the person was asked"},
+     "the placement's tilt from upright, as the person was asked", "%.3f", NULL},
     {"target", "angle_mdeg", INI_I32, T(angle_mdeg), 0, -3600000, 3600000, 0, "0", NULL,
-     "the table's angle"},
+     "the table's angle", NULL, NULL},
     {"target", "has_angle", INI_U32, T(has_angle), 0, 0, 1, 0, "0", NULL,
-     "1: angle_mdeg is the table's (0: taken elsewhere, no turntable)"},
+     "1: angle_mdeg is the table's (0: taken elsewhere, no turntable)", NULL, NULL},
 };
 #undef T
 
 int calib_write_target(const struct hal_storage *st, const char *dir, uint32_t view,
                        const struct calib_target_info *t)
 {
-    char path[SCAN_DIR_PATH_MAX], buf[512];
-    int rc = scan_dir_path(path, sizeof(path), dir, (int)view, "target.ini");
-    int n = snprintf(buf, sizeof(buf),
-                     "; what this capture shows (scanner calibrate; docs/calibration.md)\n"
-                     "[target]\ntarget = %s\nplacement = %u\ntilt_deg = %.3f\nangle_mdeg = %d\n"
-                     "has_angle = 1\n",
-                     t->kind == CALIB_TARGET_SPHERE ? "sphere" : "board", (unsigned)t->placement,
-                     t->tilt_deg, (int)t->angle_mdeg);
+    static const char header[] =
+        "; what this capture shows (scanner calibrate; docs/calibration.md)\n";
+    char path[SCAN_DIR_PATH_MAX] = SCAN_FILE_TARGET, buf[512];
+    struct target_file f = {.placement = t->placement,
+                            .tilt_deg = t->tilt_deg,
+                            .angle_mdeg = t->angle_mdeg,
+                            .has_angle = 1};
+    snprintf(f.target, sizeof(f.target), "%s", t->kind == CALIB_TARGET_SPHERE ? "sphere" : "board");
+    int n = ini_schema_write(target_keys, sizeof(target_keys) / sizeof(target_keys[0]), &f, header,
+                             NULL, "", buf, sizeof(buf));
+    int rc = n < 0 ? n : scan_dir_path(path, sizeof(path), dir, (int)view, SCAN_FILE_TARGET);
     if (rc == 0)
         rc = hal_storage_write_file(st, path, buf, (size_t)n);
     if (rc != 0)
@@ -57,7 +60,7 @@ int calib_read_target(const char *dir, uint32_t view, struct calib_target_info *
     char path[SCAN_DIR_PATH_MAX];
     struct target_file f;
     memset(t, 0, sizeof(*t));
-    int rc = scan_dir_path(path, sizeof(path), dir, (int)view, "target.ini");
+    int rc = scan_dir_path(path, sizeof(path), dir, (int)view, SCAN_FILE_TARGET);
     if (rc == 0) {
         memset(&f, 0, sizeof(f));
         rc = ini_schema_load(target_keys, sizeof(target_keys) / sizeof(target_keys[0]), &f, path,
@@ -94,7 +97,7 @@ int calib_write_file(const struct hal_storage *st, const char *dir, const char *
 int calib_write_guess(const struct hal_storage *st, const char *dir, const struct scan_calib *g)
 {
     char path[SCAN_DIR_PATH_MAX];
-    int rc = scan_dir_path(path, sizeof(path), dir, -1, "calibration.ini");
+    int rc = scan_dir_path(path, sizeof(path), dir, -1, SCAN_FILE_CALIBRATION);
     if (rc == 0)
         rc = calib_save(st, path, g,
                         "; the calibration these captures were taken with (only its sizes and\n"

@@ -954,7 +954,7 @@ int calibrate_solve(const struct hal_storage *st, const struct app_config *cfg, 
     s.cfg = cfg;
     s.dir = dir;
     char path[SCAN_DIR_PATH_MAX], err[512];
-    scan_dir_path(path, sizeof(path), dir, -1, "calibration.ini");
+    scan_dir_path(path, sizeof(path), dir, -1, SCAN_FILE_CALIBRATION);
     int rc = calib_load(&s.start, path, cfg->light_count, err, sizeof(err));
     if (rc == -ENOENT) { /* captures made elsewhere: the config's calibration, or a guess */
         rc = calib_load(&s.start, cfg->calibration_file, cfg->light_count, err, sizeof(err));

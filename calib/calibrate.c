@@ -244,7 +244,7 @@ int calibrate_capture(struct hal *hal, const struct app_config *cfg, const struc
         goto out_sheet;
     }
     /* The config as it was, and the guess the captures were taken with (its sizes matter). */
-    if ((rc = calib_write_file(&hal->storage, dir, "config.ini", cfg->path)) != 0 ||
+    if ((rc = calib_write_file(&hal->storage, dir, SCAN_FILE_CONFIG, cfg->path)) != 0 ||
         (rc = calib_write_guess(&hal->storage, dir, guess)) != 0)
         goto out_dir;
     printf("Calibration: %u board placements x %u table angles, then %u sphere angles. Every "

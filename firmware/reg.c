@@ -365,7 +365,7 @@ static void feed_alignment(struct reg_ctx *r)
     for (uint32_t v = 0; v < r->views; v++)
         for (size_t k = 0; k < cell_count(r) && r->present[v]; k++)
             valid[v / r->per_pass] += view_cells(r, v)[k].valid;
-    align_begin();
+    align_begin(&r->align);
     for (uint32_t v = 0; v < r->views; v++) {
         uint32_t pass = v / r->per_pass;
         uint64_t step = valid[pass] / ALIGN_MAX_POINTS + 1, seen = 0;
@@ -379,7 +379,7 @@ static void feed_alignment(struct reg_ctx *r)
                 continue;
             vec3 p, n;
             cell_in_object(cl, &pose, &p, &n);
-            align_add_point(pass, p, n);
+            align_add_point(&r->align, pass, p, n);
         }
     }
 }
@@ -448,7 +448,7 @@ static void align_second_pass(struct reg_ctx *r, struct reg_report *rep)
     struct align_report ar;
     r->second_aligned = 0; /* the second pass's points in its own frame */
     feed_alignment(r);
-    if (align_solve(&ap, &r->first_from_second, &ar) != 0 || !ar.found) {
+    if (align_solve(&r->align, &ap, &r->first_from_second, &ar) != 0 || !ar.found) {
         rep->failed_view = (int)r->per_pass;
         rep->failed_against = -1;
         rep->failed_share = ar.coupled_share;

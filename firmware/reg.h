@@ -5,6 +5,7 @@
 #ifndef REG_H
 #define REG_H
 
+#include "align.h"
 #include "decode.h"
 #include "frames.h"
 #include "tri.h"
@@ -95,6 +96,7 @@ struct reg_ctx {
     struct reg_edge_stats stats[REG_EDGES];
     int second_aligned; /**< the second pass's views go through first_from_second */
     struct frame_xform first_from_second;
+    struct align_ctx align; /**< the second pass found in the first */
 };
 
 /** Forget every view and size the samples for @p views views of @p width x @p height in

@@ -6,6 +6,7 @@
 #include "config.h"
 #include "guard.h"
 #include "report.h"
+#include "scan_dir.h"
 
 #include <cJSON.h>
 #include <civetweb.h>
@@ -165,9 +166,9 @@ static cJSON *job_json(struct web_server *s, const char *id)
     }
     pthread_mutex_unlock(&j->lock);
     char path[WEB_PATH + 80];
-    snprintf(path, sizeof(path), "%s/%s/report.html", s->scans, id);
+    snprintf(path, sizeof(path), "%s/%s/" SCAN_FILE_REPORT, s->scans, id);
     cJSON_AddBoolToObject(o, "report", access(path, F_OK) == 0);
-    snprintf(path, sizeof(path), "%s/%s/mesh.glb", s->scans, id);
+    snprintf(path, sizeof(path), "%s/%s/" SCAN_FILE_MESH_GLB, s->scans, id);
     cJSON_AddBoolToObject(o, "glb", access(path, F_OK) == 0);
     return o;
 }
@@ -233,16 +234,14 @@ static const struct web_profile *find_profile(const struct web_server *s, const 
 static const struct web_profile *resume_profile(const struct web_server *s, const char *id,
                                                 char *why, size_t why_len)
 {
-    static struct app_config taken, profile;
-    static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER; /* the configs are static */
+    struct app_config taken, profile;
     char path[WEB_PATH + 32], err[WEB_PATH + 128];
     const struct web_profile *found = NULL;
-    pthread_mutex_lock(&lock);
     if (jobs_scan_dir(s, id, path, sizeof(path)) != 0 ||
-        strlen(path) + sizeof("/config.ini") > sizeof(path)) {
+        strlen(path) + sizeof("/" SCAN_FILE_CONFIG) > sizeof(path)) {
         snprintf(why, why_len, "no such scan");
     } else {
-        strcat(path, "/config.ini");
+        strcat(path, "/" SCAN_FILE_CONFIG);
         int loaded = config_load(&taken, path, err, sizeof(err)) == 0;
         if (!loaded)
             snprintf(why, why_len, "the scan's settings do not load: %s", err);
@@ -261,7 +260,6 @@ static const struct web_profile *resume_profile(const struct web_server *s, cons
         if (found != NULL)
             why[0] = '\0';
     }
-    pthread_mutex_unlock(&lock);
     return found;
 }
 
@@ -477,8 +475,8 @@ static int send_archive(struct mg_connection *conn, struct web_server *s, const 
 static int selftest(struct mg_connection *conn, struct web_server *s)
 {
     const char *args[] = {s->scanner, "selftest", "--config", s->profile[0].path, NULL};
-    static char out[8192];
-    static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
+    static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER; /* one self-test: the rig is one */
+    char out[8192];
     int status = -1;
     pthread_mutex_lock(&lock);
     int rc = jobs_run_tool(s, args, out, sizeof(out), &status);

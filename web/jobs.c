@@ -239,7 +239,7 @@ static void *reader_main(void *arg)
 {
     struct web_server *s = arg;
     struct web_job *j = &s->job;
-    static struct line_buf out, err;
+    struct line_buf out, err; /* 16 KB: the reader's own thread */
     out.len = err.len = 0;
     struct pollfd pf[2] = {{.fd = j->fd_out, .events = POLLIN},
                            {.fd = j->fd_err, .events = POLLIN}};

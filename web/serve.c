@@ -107,7 +107,7 @@ static int make_dirs(const char *path)
  * [output] dir holds the scans unless --scans says otherwise. */
 static int check_configs(struct web_server *s, const char *scans)
 {
-    static struct app_config cfg;
+    struct app_config cfg;
     char err[1024], first_output[WEB_PATH] = "";
     for (unsigned i = 0; i < s->profiles; i++) {
         if (config_load(&cfg, s->profile[i].path, err, sizeof(err)) != 0) {
