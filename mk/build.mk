@@ -43,7 +43,7 @@ $(BUILD)/scanner-calibrate: $(call obj,$(CALIB_SRC)) $(BUILD)/calib/calib_cv.o $
 	$(CXX) $(LDFLAGS_COMMON) -o $@ $^ $(LDLIBS_COMMON) $(BOARD_LIBS) $(OPENCV_LIBS)
 
 $(BUILD)/web/serve.o: HOST_CFLAGS += -DWEB_WWW_DIR='"$(CURDIR)/web/www"'
-$(BUILD)/scanner-web: $(call obj,$(WEB_SRC) app/report.c app/scan_dir.c $(CONFIG_SRC) hal/posix/image_io.c hal/posix/storage_posix.c) $(BUILD)/libfirmware.a
+$(BUILD)/scanner-web: $(call obj,$(WEB_SRC) app/report.c $(SCAN_DIR_SRC) $(CONFIG_SRC) hal/posix/image_io.c hal/posix/storage_posix.c) $(BUILD)/libfirmware.a
 	$(LINK) $(LDLIBS_COMMON) -lcivetweb -lcjson
 
 # The simulated controller as its own program, and the client as a command (interop tests).
@@ -65,10 +65,10 @@ vivid-tool: $(BUILD)/vivid-capture $(BUILD)/drm-show
 $(BUILD)/drm-show: $(call obj,tools/drm_show.c board/board_display.c hal/linux/projector_drm.c) $(BUILD)/libfirmware.a
 	$(LINK) $(shell $(PKG_CONFIG) --libs libdrm) -lm
 
-$(BUILD)/mesh-compare: $(call obj,tools/mesh_compare.c tests/mesh_compare_lib.c host_sim/sim_bvh.c host_sim/sim_mesh.c host_sim/sim_ply_read.c $(CONFIG_SRC) app/scan_dir.c hal/posix/image_io.c) $(BUILD)/libfirmware.a
+$(BUILD)/mesh-compare: $(call obj,tools/mesh_compare.c tests/mesh_compare_lib.c host_sim/sim_bvh.c host_sim/sim_mesh.c host_sim/sim_ply_read.c $(CONFIG_SRC) $(SCAN_DIR_SRC) hal/posix/image_io.c) $(BUILD)/libfirmware.a
 	$(LINK) $(LDLIBS_COMMON)
 
-EVAL_SIM_SRC := tests/colour_metrics.c host_sim/sim_bvh.c host_sim/sim_mesh.c host_sim/sim_ply_read.c host_sim/sim_rig.c host_sim/sim_jpeg.c host_sim/sim_target.c host_sim/sim_material.c $(CONFIG_SRC) app/scan_dir.c hal/posix/image_io.c hal/posix/storage_posix.c
+EVAL_SIM_SRC := tests/colour_metrics.c host_sim/sim_bvh.c host_sim/sim_mesh.c host_sim/sim_ply_read.c host_sim/sim_rig.c host_sim/sim_jpeg.c host_sim/sim_target.c host_sim/sim_material.c $(CONFIG_SRC) $(SCAN_DIR_SRC) hal/posix/image_io.c hal/posix/storage_posix.c
 $(BUILD)/colour-eval: $(call obj,tools/colour_eval.c $(EVAL_SIM_SRC)) $(BUILD)/libfirmware.a
 	$(LINK) $(LDLIBS_COMMON)
 $(BUILD)/relight-eval: $(call obj,tools/relight_eval.c $(EVAL_SIM_SRC)) $(BUILD)/libfirmware.a

@@ -30,7 +30,7 @@ interop-meshlab: deps $(BUILD)/scanner
 	tests/interop_meshlab.sh $(BUILD)/meshlab-scan
 
 # Each view's angle as reported, as registered and as true (tools/measure_registration.c).
-$(BUILD)/measure-registration: $(call obj,tools/measure_registration.c $(CONFIG_SRC) app/scan_dir.c hal/posix/image_io.c) $(BUILD)/libfirmware.a
+$(BUILD)/measure-registration: $(call obj,tools/measure_registration.c $(CONFIG_SRC) $(SCAN_DIR_SRC) hal/posix/image_io.c) $(BUILD)/libfirmware.a
 	$(LINK) $(LDLIBS_COMMON)
 
 # The calibration's accuracy (tools/measure_calib.c): a calibration against the true rig.

@@ -44,7 +44,7 @@ check-firmware: $(FW_OBJ)
 # make test replays the corpus and every crash kept (fuzz-replay-*, built like the suite).
 FUZZ_TARGETS := config calib view_ini scan_dir ply modbus
 FUZZ_SECONDS ?= 600
-FUZZ_LIB_SRC := $(CONFIG_SRC) app/scan_dir.c hal/posix/image_io.c \
+FUZZ_LIB_SRC := $(CONFIG_SRC) $(SCAN_DIR_SRC) hal/posix/image_io.c \
 	host_sim/sim_mesh.c host_sim/sim_ply_read.c hal/modbus/turntable_modbus.c host_sim/clock_sim.c
 FUZZ_CFLAGS = -std=c11 -g -O1 $(HOST_INC) -Itests/fuzz $(PKG_CFLAGS)
 FUZZ_LIBS = $(shell $(PKG_CONFIG) --libs inih libmodbus libpng libzstd 2>/dev/null) -lpthread -lm
