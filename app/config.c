@@ -184,6 +184,10 @@ static const struct ini_key config_keys[] = {
         "extra tries of a request with no valid reply (flush, and reconnect on TCP, in between)"),
     U32("turntable", "poll_interval_ms", turntable.poll_interval_ms, 1, 10000, "50",
         "status polling interval while the table moves"),
+    F64("turntable", "angle_accuracy_deg", registration.angle_accuracy_deg, 0.001, 45, "1",
+        "how far the table's reported angle may be from the true one (one standard deviation): "
+        "the registration keeps the table's angle where the object's shape cannot fix the turn "
+        "(a sphere, a cylinder, any surface of revolution about the axis)"),
     U32("turntable", "move_timeout_ms", turntable.move_timeout_ms, 100, 600000, "30000",
         "a move or homing must finish within this"),
     F64("turntable", "speed_dps", turntable.speed_dps, 0.1, 6000, "30", "table speed, deg/s"),

@@ -104,8 +104,10 @@ static int write_model(struct job *j)
 /* Before the first view: the registration sized for the scan's views. */
 int job_begin_model(struct job *j)
 {
-    int rc = reg_begin(j->reg, &j->cfg->registration, j->calib, j->views, j->cfg->passes,
-                       j->cfg->scan.width, j->cfg->scan.height);
+    struct reg_params p = j->cfg->registration;
+    p.colour_intrinsic = j->cfg->scan.colour.method != COLOUR_NONE; /* else raw: reg.c */
+    int rc = reg_begin(j->reg, &p, j->calib, j->views, j->cfg->passes, j->cfg->scan.width,
+                       j->cfg->scan.height);
     if (rc != 0)
         j->hal->log(HAL_LOG_ERROR, "registration: %u views exceed the compiled limit %u",
                     (unsigned)j->views, REG_MAX_VIEWS);
@@ -124,13 +126,30 @@ static int report_registration(struct job *j, const struct reg_report *r, double
     else
         snprintf(detail, sizeof(detail),
                  "residual %.3f mm, loop closure %.3f mm, worst view %u (%.3f mm); axis moved "
-                 "%.2f mm, tilted %.3f deg; %.2f s CPU; %s%s",
+                 "%.2f mm, tilted %.3f deg; %.2f s CPU; %s",
                  r->rms_mm, r->loop_rms_mm, (unsigned)r->worst_view, r->worst_rms_mm,
                  r->axis_shift_mm, r->axis_tilt_deg, cpu_seconds,
-                 r->accepted ? "the views' angles corrected" : "turntable angles kept: ",
-                 r->accepted ? "" : r->refused);
+                 r->accepted ? "" : "turntable angles kept: ");
+    size_t n = strlen(detail);
+    uint32_t turning = j->views - j->cfg->passes; /* the views whose angle is registered */
+    if (r->solved && r->accepted && r->turns_from_table == 0)
+        snprintf(detail + n, sizeof(detail) - n, "the views' angles corrected");
+    else if (r->solved && r->accepted && r->turns_from_table >= turning)
+        snprintf(detail + n, sizeof(detail) - n,
+                 "the object's shape does not fix the views' turns (a surface of revolution "
+                 "about the axis?): the table's angles kept, the axis registered");
+    else if (r->solved && r->accepted)
+        snprintf(detail + n, sizeof(detail) - n,
+                 "the views' angles corrected but for %u whose turn the object's shape does not "
+                 "fix (the table's angle kept there)",
+                 (unsigned)r->turns_from_table);
+    else if (r->solved)
+        snprintf(detail + n, sizeof(detail) - n, "%s%s", r->refused,
+                 r->turns_from_table > 0 ? " (the object's shape does not fix the turn of some "
+                                           "views: a surface of revolution about the axis?)"
+                                         : "");
     if (j->cfg->passes == 2 && r->failed_view < 0) {
-        size_t n = strlen(detail);
+        n = strlen(detail);
         snprintf(detail + n, sizeof(detail) - n,
                  "; second pass found turned %.1f deg, residual %.3f mm over %u pairs",
                  r->second_turned_deg, r->second_rms_mm, (unsigned)r->second_coupled);
@@ -138,8 +157,9 @@ static int report_registration(struct job *j, const struct reg_report *r, double
     char fields[160];
     snprintf(fields, sizeof(fields),
              "\"solved\":%d,\"accepted\":%d,\"residual_mm\":%.4f,\"loop_closure_mm\":%.4f,"
-             "\"cpu_s\":%.3f",
-             r->solved, r->accepted, r->rms_mm, r->loop_rms_mm, cpu_seconds);
+             "\"cpu_s\":%.3f,\"turns_from_table\":%u",
+             r->solved, r->accepted, r->rms_mm, r->loop_rms_mm, cpu_seconds,
+             (unsigned)r->turns_from_table);
     job_progress_with(j, EV_REGISTRATION, -1, j->views, fields, detail);
     if (r->failed_view >= 0 && r->failed_against < 0) {
         j->hal->log(HAL_LOG_ERROR,

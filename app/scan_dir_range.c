@@ -212,4 +212,3 @@ out_close:
     fclose(fp);
     return rc;
 }
-

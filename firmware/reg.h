@@ -19,11 +19,17 @@ struct reg_params {
     double max_normal_deg;     /**< nor one whose normals differ more */
     uint32_t use_colour;       /**< 1: colours must agree too (multi-feature matching) */
     double max_colour_dn;      /**< largest per-channel colour difference of a pair */
+    uint32_t colour_intrinsic; /**< 1: the views' colours are intrinsic (compensated for the
+                                    light) and compared as they are; 0: raw colours, whose
+                                    brightness follows the shading, compared at one
+                                    brightness (not a config key: the job sets it) */
     double max_correction_deg; /**< a view's angle may move this far from the reported one */
     double max_axis_shift_mm;  /**< the axis may move this far from the calibrated one */
     double max_axis_tilt_deg;  /**< and tilt this far */
     double min_coupled_share;  /**< two neighbouring views coupling less of their overlap do
                                     not match: the registration fails and names the view */
+    double angle_accuracy_deg; /**< the table's angles as a prior of this standard deviation: a
+                                    turn the geometry does not fix keeps the table's angle */
 };
 
 /** One view after registration. */
@@ -34,6 +40,8 @@ struct reg_view {
     double correction_deg;     /**< angle_deg - reported, relative to view 0's correction */
     uint32_t overlap, coupled; /**< with its neighbours, at the final poses */
     double rms_mm;             /**< point-to-plane residual of its coupled pairs */
+    int turn_from_table;       /**< 1: the geometry does not fix its turn (a surface of
+                                    revolution, a plane): the table's angle is kept */
 };
 
 /** The whole scan's registration. */
@@ -49,15 +57,16 @@ struct reg_report {
     double axis_shift_mm, axis_tilt_deg; /**< the axis against the calibrated one */
     uint32_t worst_view;                 /**< the view with the largest residual */
     double worst_rms_mm;
-    int failed_view;          /**< -1, or a view that does not match the one before it (or
-                                   the first view of a second pass that matches nothing) */
-    int failed_against;       /**< the view it was compared with (-1: the first pass) */
-    double failed_share;      /**< the share of their overlap that coupled */
-    char refused[160];        /**< why a solved adjustment was not accepted ("" when it was) */
-    double second_turned_deg; /**< two passes: how far the object was turned between them */
-    double second_share;      /**< the share of the second pass's points the search paired */
-    uint32_t second_coupled;  /**< pairs of the final refinement against the first pass */
-    double second_rms_mm;     /**< and their residual */
+    int failed_view;           /**< -1, or a view that does not match the one before it (or
+                                    the first view of a second pass that matches nothing) */
+    int failed_against;        /**< the view it was compared with (-1: the first pass) */
+    double failed_share;       /**< the share of their overlap that coupled */
+    char refused[160];         /**< why a solved adjustment was not accepted ("" when it was) */
+    double second_turned_deg;  /**< two passes: how far the object was turned between them */
+    double second_share;       /**< the share of the second pass's points the search paired */
+    uint32_t second_coupled;   /**< pairs of the final refinement against the first pass */
+    double second_rms_mm;      /**< and their residual */
+    uint32_t turns_from_table; /**< views whose turn the geometry does not fix (reg_view) */
 };
 
 #define REG_PARAMS (REG_MAX_VIEWS + 4u) /* every angle, two shifts, two tilts */
@@ -90,8 +99,14 @@ struct reg_ctx {
     int32_t reported_mdeg[REG_MAX_VIEWS];
     uint8_t present[REG_MAX_VIEWS];
     double theta[REG_MAX_VIEWS]; /**< radians */
-    vec3 a, d;                   /**< the axis */
-    int use_solution;            /**< poses from theta, a, d rather than the turntable's */
+    /** How much of a turn about the axis each view's pairs see: the sums over its pairs of
+     *  (n . (d x (p - a)))^2 and |d x (p - a)|^2, the motion across the surface and the whole
+     *  motion of a turn (their ratio is 0 on a surface of revolution about the axis, about 0.5
+     *  on a box). */
+    double turn_seen[REG_MAX_VIEWS], turn_whole[REG_MAX_VIEWS];
+    uint8_t from_table[REG_MAX_VIEWS]; /**< the turn kept at the table's angle */
+    vec3 a, d;                         /**< the axis */
+    int use_solution;                  /**< poses from theta, a, d rather than the turntable's */
     uint32_t edges, edge_from[REG_EDGES], edge_to[REG_EDGES];
     struct reg_edge_stats stats[REG_EDGES];
     int second_aligned; /**< the second pass's views go through first_from_second */

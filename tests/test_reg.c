@@ -33,6 +33,10 @@ static float xyz[HAL_MAX_PIXELS * 3], normal[HAL_MAX_PIXELS * 3];
 static double placed_rot[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
 static vec3 placed_shift;
 static double radius_scale = 1.0; /* another object altogether */
+/* 1: the views' colours are raw, an orange paint shaded by a light beside the camera, so a
+ * point's colour changes with its angle to the light as the table turns (method none) */
+static int raw_shading;
+static int only_sphere = -1; /* >= 0: that sphere alone (3 stands on the axis) */
 
 static vec3 sphere_centre(int k)
 {
@@ -55,6 +59,8 @@ static void add_view(uint32_t v, double angle_deg, double reported_deg, vec3 sli
             double best = 1e30;
             int hit = -1;
             for (int k = 0; k < SPHERES; k++) { /* |eye + t dir - c|^2 = r^2 */
+                if (only_sphere >= 0 && k != only_sphere)
+                    continue;
                 vec3 oc = v3_sub(eye, sphere_centre(k));
                 double a = v3_dot(dir, dir), b = v3_dot(oc, dir);
                 double r = sphere_r[k] * radius_scale;
@@ -78,6 +84,13 @@ static void add_view(uint32_t v, double angle_deg, double reported_deg, vec3 sli
             memcpy(&xyz[3 * i], pc, sizeof(pc));
             memcpy(&normal[3 * i], nc, sizeof(nc));
             memset(&rgb[3 * i], 128, 3);
+            if (raw_shading) {
+                static const double paint[3] = {230, 140, 70};
+                vec3 light = v3_norm(v3(-0.5, -0.3, -1.0)); /* towards the light, camera frame */
+                double shade = fmax(0.15, v3_dot(n_cam, light));
+                for (int c = 0; c < 3; c++)
+                    rgb[3 * i + c] = (uint8_t)lround(paint[c] * shade);
+            }
             reason[i] = SCAN_VALID;
         }
     }
@@ -95,11 +108,13 @@ static struct reg_params params(void)
                                .max_pair_mm = 1.5,
                                .max_normal_deg = 20,
                                .use_colour = 1,
+                               .colour_intrinsic = 1,
                                .max_colour_dn = 40,
                                .max_correction_deg = 3,
                                .max_axis_shift_mm = 3,
                                .max_axis_tilt_deg = 1,
-                               .min_coupled_share = 0.2};
+                               .min_coupled_share = 0.2,
+                               .angle_accuracy_deg = 1};
 }
 
 static int setup(void **state)
@@ -204,6 +219,89 @@ static void test_two_registrations_are_independent(void **state)
     assert_int_equal(clean.failed_view, -1);
     assert_true(clean.solved && clean.accepted);
     assert_true(worst_angle_error(truth) < 0.05);
+}
+
+/* Pairs coupled over every neighbouring pair of views, at the final poses. */
+static uint64_t coupled_pairs(struct reg_ctx *r)
+{
+    uint64_t n = 0;
+    for (uint32_t v = 0; v < VIEWS; v++) {
+        struct reg_view rv;
+        assert_int_equal(reg_view_pose(r, v, NULL, &rv), 0);
+        n += rv.coupled;
+    }
+    return n;
+}
+
+/* Raw colours (method none) follow the shading: compared as they are, a point turned 45 degrees
+ * towards or away from the light no longer matches itself and most pairs are lost; compared at
+ * one brightness (colour_intrinsic = 0, what the job asks for raw colour) they couple as grey
+ * ones do, and a table 2 degrees off is found. */
+static void test_raw_colour_compared_at_one_brightness(void **state)
+{
+    (void)state;
+    static const double err_deg[VIEWS] = {0.7, -1.9, 1.2, 0.4, -0.8, 2.0, -1.3, 1.6};
+    double truth[VIEWS];
+    struct reg_params as_is = params(), shading_free = params();
+    shading_free.colour_intrinsic = 0;
+    raw_shading = 1;
+    assert_int_equal(
+        reg_begin(&reg, &shading_free, &calib, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
+    assert_int_equal(reg_begin(&other, &as_is, &calib, VIEWS, 1, calib.cam_width, calib.cam_height),
+                     0);
+    for (uint32_t v = 0; v < VIEWS; v++) {
+        truth[v] = 45.0 * v + err_deg[v];
+        to = &reg;
+        add_view(v, truth[v], 45.0 * v, v3(0, 0, 0));
+        to = &other;
+        add_view(v, truth[v], 45.0 * v, v3(0, 0, 0));
+    }
+    to = &reg;
+    raw_shading = 0;
+    struct reg_report good, lost;
+    assert_int_equal(reg_solve(&reg, &good), 0);
+    assert_int_equal(reg_solve(&other, &lost), 0);
+    uint64_t coupled_good = coupled_pairs(&reg), coupled_lost = coupled_pairs(&other);
+    print_message("raw colour: %llu pairs coupled at one brightness, %llu as they are\n",
+                  (unsigned long long)coupled_good, (unsigned long long)coupled_lost);
+    assert_true(coupled_good > 2 * coupled_lost);
+    assert_int_equal(good.failed_view, -1);
+    assert_true(good.solved && good.accepted);
+    assert_true(worst_angle_error(truth) < 0.05);
+}
+
+/* A sphere standing on the axis turns into itself: no pair can see the table's error, so the
+ * registration neither fails nor invents a correction: every turn keeps the table's angle and
+ * the report says the shape does not fix it (issue 30). */
+static void test_surface_of_revolution_keeps_the_table(void **state)
+{
+    (void)state;
+    static const double err_deg[VIEWS] = {0.7, -1.9, 1.2, 0.4, -0.8, 2.0, -1.3, 1.6};
+    struct reg_params p = params();
+    only_sphere = 3;
+    assert_int_equal(reg_begin(&reg, &p, &calib, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
+    for (uint32_t v = 0; v < VIEWS; v++)
+        add_view(v, 45.0 * v + err_deg[v], 45.0 * v, v3(0, 0, 0));
+    only_sphere = -1;
+    struct reg_report rep;
+    assert_int_equal(reg_solve(&reg, &rep), 0);
+    print_message("sphere on the axis: %u of %u turns from the table; %s\n",
+                  (unsigned)rep.turns_from_table, VIEWS - 1,
+                  rep.accepted ? "accepted" : rep.refused);
+    assert_int_equal(rep.failed_view, -1);
+    assert_int_equal(rep.turns_from_table, VIEWS - 1);
+    for (uint32_t v = 1; v < VIEWS; v++) {
+        struct reg_view rv;
+        assert_int_equal(reg_view_pose(&reg, v, NULL, &rv), 0);
+        assert_true(rv.turn_from_table);
+        assert_true(fabs(rv.angle_deg - 45.0 * v) < 1e-9);
+    }
+    /* the same spheres with the others beside them: every turn is fixed by the shape */
+    assert_int_equal(reg_begin(&reg, &p, &calib, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
+    for (uint32_t v = 0; v < VIEWS; v++)
+        add_view(v, 45.0 * v + err_deg[v], 45.0 * v, v3(0, 0, 0));
+    assert_int_equal(reg_solve(&reg, &rep), 0);
+    assert_int_equal(rep.turns_from_table, 0);
 }
 
 /* The object slips 6 mm on the table between views 3 and 4: the registration does not hide it,
@@ -317,6 +415,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_table_errors_are_found),
         cmocka_unit_test(test_two_registrations_are_independent),
+        cmocka_unit_test(test_raw_colour_compared_at_one_brightness),
+        cmocka_unit_test(test_surface_of_revolution_keeps_the_table),
         cmocka_unit_test(test_axis_is_reestimated),
         cmocka_unit_test(test_slip_names_the_view_and_bounds_refuse),
         cmocka_unit_test(test_second_pass_found),
