@@ -18,6 +18,10 @@ eval: deps $(BUILD)/scanner $(BUILD)/colour-eval $(BUILD)/relight-eval
 # Full simulated scans measured against the true surface, with a turntable that misses its
 # angle by up to 1 and 2 degrees (each view's angle as reported, registered and true), and peak
 # memory for 8 and 24 views.
+## measure-objects: the object corpus at every view count, table error and slip, one table (long)
+measure-objects: deps $(BUILD)/scanner $(BUILD)/mesh-compare
+	@command -v openscad >/dev/null 2>&1 || scripts/install-deps.sh objects
+	scripts/measure-objects.sh $(BUILD)
 ## measure-scan: full scans against the true surface; the registration's targets (long)
 measure-scan: deps $(BUILD)/scanner $(BUILD)/mesh-compare $(BUILD)/measure-registration
 	scripts/measure-scan.sh $(BUILD)

@@ -15,6 +15,8 @@ case "${1:-}" in *-linux-gnu*) ;; *) pkgs="$pkgs libcivetweb-dev libcjson-dev" ;
 [ "${1:-}" = "bench" ] && pkgs="$pkgs g++ libopencv-dev libopencv-contrib-dev valgrind libspng-dev libzstd-dev python3-open3d"
 [ "${1:-}" = "fuzz" ] && pkgs="$pkgs clang libclang-rt-14-dev"
 [ "${1:-}" = "blender" ] && pkgs="blender"
+# make measure-objects: OpenSCAD makes the mechanical parts of data/objects
+[ "${1:-}" = "objects" ] && pkgs="openscad"
 # make test-browser: Debian's Chromium, driven by playwright-core (tests/browser)
 [ "${1:-}" = "browser" ] && pkgs="chromium"
 # Node.js and npm run the Khronos glTF validator (tests/gltf); a machine that has them from
