@@ -148,6 +148,14 @@ static int report_registration(struct job *j, const struct reg_report *r, double
                  r->turns_from_table > 0 ? " (the object's shape does not fix the turn of some "
                                            "views: a surface of revolution about the axis?)"
                                          : "");
+    if (r->moved_view >= 0) {
+        n = strlen(detail);
+        snprintf(detail + n, sizeof(detail) - n,
+                 "; the object moved on the table at view %d: %u view%s placed by the object's "
+                 "shape alone, as it had moved %.1f mm and turned %.1f deg",
+                 r->moved_view, (unsigned)r->moved_views, r->moved_views == 1 ? "" : "s",
+                 r->moved_mm, r->moved_deg);
+    }
     if (j->cfg->passes == 2 && r->failed_view < 0) {
         n = strlen(detail);
         snprintf(detail + n, sizeof(detail) - n,
@@ -157,9 +165,9 @@ static int report_registration(struct job *j, const struct reg_report *r, double
     char fields[160];
     snprintf(fields, sizeof(fields),
              "\"solved\":%d,\"accepted\":%d,\"residual_mm\":%.4f,\"loop_closure_mm\":%.4f,"
-             "\"cpu_s\":%.3f,\"turns_from_table\":%u",
+             "\"cpu_s\":%.3f,\"turns_from_table\":%u,\"moved_view\":%d",
              r->solved, r->accepted, r->rms_mm, r->loop_rms_mm, cpu_seconds,
-             (unsigned)r->turns_from_table);
+             (unsigned)r->turns_from_table, r->moved_view);
     job_progress_with(j, EV_REGISTRATION, -1, j->views, fields, detail);
     if (r->failed_view >= 0 && r->failed_against < 0) {
         j->hal->log(HAL_LOG_ERROR,
@@ -174,9 +182,10 @@ static int report_registration(struct job *j, const struct reg_report *r, double
         return 0;
     j->hal->log(HAL_LOG_ERROR,
                 "registration failed: view %d does not match view %d (%.0f%% of their overlap "
-                "couples, at least %.0f%% needed): did the object move on the table? No model "
-                "was made; the views are kept in %s. Scan again, or fuse them at the turntable's "
-                "angles with 'scanner process %s --config F' where F has [registration] icp = 0",
+                "couples, at least %.0f%% needed), and no placement of it fits the other views "
+                "either: was something else on the table, or nothing in view? No model was made; "
+                "the views are kept in %s. Scan again, or fuse them at the turntable's angles "
+                "with 'scanner process %s --config F' where F has [registration] icp = 0",
                 r->failed_view, r->failed_against, 100.0 * r->failed_share,
                 100.0 * j->cfg->registration.min_coupled_share, scan_dir, scan_dir);
     return -EPROTO;

@@ -42,6 +42,7 @@ struct reg_view {
     double rms_mm;             /**< point-to-plane residual of its coupled pairs */
     int turn_from_table;       /**< 1: the geometry does not fix its turn (a surface of
                                     revolution, a plane): the table's angle is kept */
+    int placed_freely;         /**< 1: the object had moved: placed by its shape alone */
 };
 
 /** The whole scan's registration. */
@@ -67,6 +68,10 @@ struct reg_report {
     uint32_t second_coupled;   /**< pairs of the final refinement against the first pass */
     double second_rms_mm;      /**< and their residual */
     uint32_t turns_from_table; /**< views whose turn the geometry does not fix (reg_view) */
+    int moved_view;            /**< -1, or the first view after the object moved on the table
+                                    (one pass): from it, moved_views views were placed freely */
+    uint32_t moved_views;
+    double moved_mm, moved_deg; /**< how far the object had moved, and turned */
 };
 
 #define REG_PARAMS (REG_MAX_VIEWS + 4u) /* every angle, two shifts, two tilts */
@@ -109,8 +114,14 @@ struct reg_ctx {
     int use_solution;                  /**< poses from theta, a, d rather than the turntable's */
     uint32_t edges, edge_from[REG_EDGES], edge_to[REG_EDGES];
     struct reg_edge_stats stats[REG_EDGES];
-    int second_aligned; /**< the second pass's views go through first_from_second */
+    /** The views placed through first_from_second (1): the second pass's, or those the object
+     *  moved for (a slip cuts the ring of views in two arcs; the one without view 0 is placed
+     *  freely, as a second pass is). */
+    uint8_t group[REG_MAX_VIEWS];
+    uint8_t cut_after[REG_MAX_VIEWS]; /**< the pair (v, v + 1) does not match: not an edge */
+    int second_aligned;               /**< the group-1 views go through first_from_second */
     struct frame_xform first_from_second;
+    struct frame_xform first_pose[REG_MAX_VIEWS], first_cam[REG_MAX_VIEWS]; /* refinement's */
     struct align_ctx align; /**< the second pass found in the first */
 };
 

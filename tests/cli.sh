@@ -253,15 +253,19 @@ check fit_keeps_reflectance_and_materials sh -c "$bin process $out/scan --config
     node tests/gltf/validate.mjs $out/fit/mesh.glb > $out/fit-glb.txt &&
     grep -q ' 0 errors, 0 warnings' $out/fit-glb.txt &&
     test \$(grep -a -o 'KHR_materials_specular' $out/fit/mesh.glb | wc -l) -ge 2"
-# The object slips on the table between two views: the scan fails, names the view, writes no
-# model and keeps every view.
+# The object slips 6 mm on the table between two views (issue 30): a view to place, not a failed
+# scan. The views after the slip are placed by the object's shape, the scan says which and how
+# far the object had moved, and the model is as close to the truth as a scan without a slip.
 sed -e 's/^views = .*/views = 4/' -e "s|^calibration = .*|calibration = $PWD/config/sim-calib.ini|" \
     -e "s|^mesh_file = ../|mesh_file = $PWD/|" config/sim.ini > "$out/slip.ini"
 printf 'slip_mm = 6, 0, 0\nslip_at_deg = 170\n' >> "$out/slip.ini"
 rm -rf "$out/slip"
-check slipped_object_names_the_view sh -c "! $bin scan --config $out/slip.ini --out $out/slip \
-    > $out/slip.log 2>&1 && grep -q 'registration failed: view 2 does not match view 1' \
-    $out/slip.log && test -s $out/slip/view_003/view.ini && test ! -e $out/slip/mesh.ply"
+check slipped_object_is_placed_and_said sh -c "$bin scan --config $out/slip.ini --out $out/slip \
+    > $out/slip.log 2>&1 && grep -q 'the object moved on the table at view 2: 2 views placed' \
+    $out/slip.log && grep -q '^placed_freely = 1' $out/slip/view_003/registration.ini &&
+    grep -q '^placed_freely = 0' $out/slip/view_001/registration.ini &&
+    ${BUILD:-build}/mesh-compare --align $out/slip/mesh.ply $out/slip/truth_mesh.ply |
+    awk '/^result -> truth: mean/ { ok = \$5 < 0.1 } END { exit !ok }'"
 # A closed model needs the widest hole to close.
 printf '[output]\nwatertight = 1\n' | cat config/sim.ini - > "$out/watertight.ini"
 check watertight_needs_max_hole sh -c "$bin check-config --config $out/watertight.ini 2>&1 |
