@@ -119,6 +119,8 @@ static int report_registration(struct job *j, const struct reg_report *r, double
                                const char *scan_dir)
 {
     char detail[512];
+    uint32_t turning = j->views - j->cfg->passes; /* the views whose angle is registered */
+    int no_turn_seen = r->solved && r->turns_from_table > 0 && r->turns_from_table >= turning;
     if (!r->solved)
         snprintf(detail, sizeof(detail),
                  "turntable angles kept ([registration] icp = 0 or one "
@@ -129,25 +131,27 @@ static int report_registration(struct job *j, const struct reg_report *r, double
                  "%.2f mm, tilted %.3f deg; %.2f s CPU; %s",
                  r->rms_mm, r->loop_rms_mm, (unsigned)r->worst_view, r->worst_rms_mm,
                  r->axis_shift_mm, r->axis_tilt_deg, cpu_seconds,
-                 r->accepted ? "" : "turntable angles kept: ");
+                 r->accepted || no_turn_seen ? "" : "turntable angles kept: ");
     size_t n = strlen(detail);
-    uint32_t turning = j->views - j->cfg->passes; /* the views whose angle is registered */
-    if (r->solved && r->accepted && r->turns_from_table == 0)
-        snprintf(detail + n, sizeof(detail) - n, "the views' angles corrected");
-    else if (r->solved && r->accepted && r->turns_from_table >= turning)
+    if (no_turn_seen) /* the table's answer, whatever the solve did */
         snprintf(detail + n, sizeof(detail) - n,
                  "the object's shape does not fix the views' turns (a surface of revolution "
-                 "about the axis?): the table's angles kept, the axis registered");
+                 "about the axis?): the table's angles kept, the axis %s",
+                 r->axis_from_calibration || !r->accepted ? "as calibrated" : "registered");
+    else if (r->solved && r->accepted && r->turns_from_table == 0)
+        snprintf(detail + n, sizeof(detail) - n, "the views' angles corrected");
     else if (r->solved && r->accepted)
         snprintf(detail + n, sizeof(detail) - n,
                  "the views' angles corrected but for %u whose turn the object's shape does not "
                  "fix (the table's angle kept there)",
                  (unsigned)r->turns_from_table);
     else if (r->solved)
-        snprintf(detail + n, sizeof(detail) - n, "%s%s", r->refused,
-                 r->turns_from_table > 0 ? " (the object's shape does not fix the turn of some "
-                                           "views: a surface of revolution about the axis?)"
-                                         : "");
+        snprintf(detail + n, sizeof(detail) - n, "%s", r->refused);
+    if (r->axis_from_calibration && !no_turn_seen) {
+        n = strlen(detail);
+        snprintf(detail + n, sizeof(detail) - n,
+                 "; the views share too little to place the axis: the calibrated one kept");
+    }
     if (r->moved_view >= 0) {
         n = strlen(detail);
         snprintf(detail + n, sizeof(detail) - n,

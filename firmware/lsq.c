@@ -83,3 +83,35 @@ int lsq_rigid_step(struct lsq_rigid *eq, struct frame_xform *step)
     frame_from_small_motion(x, step);
     return 0;
 }
+
+double lsq_rigid_shift_hold(const struct lsq_rigid *eq)
+{
+    /* The shift block of the normal equations (jac[3..5] = n): a symmetric 3 x 3 matrix, its
+     * eigenvalues in closed form (the trigonometric solution of its characteristic cubic). */
+    const double *a = eq->a;
+    double m[3][3];
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++)
+            m[r][c] = a[(r + 3) * 6 + (c + 3)];
+    double trace = m[0][0] + m[1][1] + m[2][2];
+    if (trace <= 0.0)
+        return 0.0;
+    double off = m[0][1] * m[0][1] + m[0][2] * m[0][2] + m[1][2] * m[1][2];
+    double q = trace / 3.0, smallest;
+    if (off == 0.0) {
+        smallest = fmin(m[0][0], fmin(m[1][1], m[2][2]));
+    } else {
+        double p2 = (m[0][0] - q) * (m[0][0] - q) + (m[1][1] - q) * (m[1][1] - q) +
+                    (m[2][2] - q) * (m[2][2] - q) + 2.0 * off;
+        double p = sqrt(p2 / 6.0), b[3][3];
+        for (int r = 0; r < 3; r++)
+            for (int c = 0; c < 3; c++)
+                b[r][c] = (m[r][c] - (r == c ? q : 0.0)) / p;
+        double det = b[0][0] * (b[1][1] * b[2][2] - b[1][2] * b[2][1]) -
+                     b[0][1] * (b[1][0] * b[2][2] - b[1][2] * b[2][0]) +
+                     b[0][2] * (b[1][0] * b[2][1] - b[1][1] * b[2][0]);
+        double r = fmin(1.0, fmax(-1.0, det / 2.0));
+        smallest = q + 2.0 * p * cos(acos(r) / 3.0 + 2.0 * M_PI / 3.0);
+    }
+    return fmax(0.0, smallest) / trace;
+}

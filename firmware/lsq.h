@@ -26,6 +26,12 @@ struct lsq_rigid {
 /** Empty equations. */
 void lsq_rigid_clear(struct lsq_rigid *eq);
 
+/** How well the pairs added hold a shift in every direction: the smallest eigenvalue of the sum
+ *  of n n^T over their normals, over its trace: 1/3 for normals spread evenly, 0 when every
+ *  normal lies in one plane (two parallel faces and a top), so that a shift at right angles to
+ *  that plane changes no residual. @retval 0 .. 1/3 */
+double lsq_rigid_shift_hold(const struct lsq_rigid *eq);
+
 /** Add the pair of point @p p and the plane through @p q with unit normal @p n. */
 void lsq_rigid_add(struct lsq_rigid *eq, vec3 p, vec3 q, vec3 n);
 

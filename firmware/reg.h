@@ -68,6 +68,7 @@ struct reg_report {
     uint32_t second_coupled;   /**< pairs of the final refinement against the first pass */
     double second_rms_mm;      /**< and their residual */
     uint32_t turns_from_table; /**< views whose turn the geometry does not fix (reg_view) */
+    int axis_from_calibration; /**< 1: the pairs do not see the axis's place: calibrated kept */
     int moved_view;            /**< -1, or the first view after the object moved on the table
                                     (one pass): from it, moved_views views were placed freely */
     uint32_t moved_views;
@@ -109,9 +110,11 @@ struct reg_ctx {
      *  motion of a turn (their ratio is 0 on a surface of revolution about the axis, about 0.5
      *  on a box). */
     double turn_seen[REG_MAX_VIEWS], turn_whole[REG_MAX_VIEWS];
-    uint8_t from_table[REG_MAX_VIEWS]; /**< the turn kept at the table's angle */
-    vec3 a, d;                         /**< the axis */
-    int use_solution;                  /**< poses from theta, a, d rather than the turntable's */
+    double shift_seen[2], shift_whole[2]; /**< the same for a shift of the axis across it */
+    int axis_from_calib;                  /**< the pairs do not see the axis: calibrated kept */
+    uint8_t from_table[REG_MAX_VIEWS];    /**< the turn kept at the table's angle */
+    vec3 a, d;                            /**< the axis */
+    int use_solution;                     /**< poses from theta, a, d rather than the turntable's */
     uint32_t edges, edge_from[REG_EDGES], edge_to[REG_EDGES];
     struct reg_edge_stats stats[REG_EDGES];
     /** The views placed through first_from_second (1): the second pass's, or those the object
@@ -120,6 +123,7 @@ struct reg_ctx {
     uint8_t group[REG_MAX_VIEWS];
     uint8_t cut_after[REG_MAX_VIEWS]; /**< the pair (v, v + 1) does not match: not an edge */
     int second_aligned;               /**< the group-1 views go through first_from_second */
+    double placed_hold; /**< how well the last placement's pairs held a shift (lsq.h) */
     struct frame_xform first_from_second;
     struct frame_xform first_pose[REG_MAX_VIEWS], first_cam[REG_MAX_VIEWS]; /* refinement's */
     struct align_ctx align; /**< the second pass found in the first */
