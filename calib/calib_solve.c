@@ -1,6 +1,9 @@
 /* The calibration computed from the captures of a calibration directory: camera and projector
- * lenses and pose (OpenCV, app/calib_cv.cpp), the turntable axis, the lights; the file and its
- * report (docs/calibration.md). A setup step: it allocates. */
+ * lenses and pose (OpenCV, calib/calib_cv.cpp), the turntable axis, the lights; the file and its
+ * report (docs/calibration.md). A setup step: it allocates. Longer than 800 lines on purpose:
+ * one procedure whose stages run top to bottom in the order they are written (the board views,
+ * the joint solve, the axis, the lights, the sphere check, the file), each a short function, so
+ * that a reader follows a calibration in one file. */
 #define _POSIX_C_SOURCE 200809L
 #include "calib_priv.h"
 
