@@ -181,6 +181,21 @@ static double huber_mm(const struct reg_ctx *r)
     return r->p.max_pair_mm / 3.0;
 }
 
+/* A surface facing up or down (a top, a plate lying flat) turns and slides into itself under a
+ * move across the table: its samples pair wherever the views stand. Whether two views match is
+ * judged on the surfaces that face sideways, normals more than REG_SIDE_COS (about 26 degrees)
+ * away from the axis, when there are REG_SIDE_MIN of them; else on all. Measured: a plate, a hex
+ * nut, a gear and a thin box slipped 6 mm still coupled over a fifth of all their overlap (their
+ * tops), so the slip went unseen and the model came out 0.4 to 1.5 mm off. */
+#define REG_SIDE_COS 0.9
+#define REG_SIDE_MIN 200u
+static double edge_share(const struct reg_edge_stats *st)
+{
+    if (st->side_overlap >= REG_SIDE_MIN)
+        return (double)st->side_coupled / st->side_overlap;
+    return st->overlap > 0 ? (double)st->coupled / st->overlap : 0.0;
+}
+
 /* A pair's weight: Huber's. */
 static double w_of(const struct reg_ctx *r, double res)
 {
@@ -222,7 +237,9 @@ static void pair_views(struct reg_ctx *r, uint32_t src, uint32_t dst, double gat
          * nothing about the match: a box seen from 90 degrees apart shares one face only. */
         if (!cq->valid || v3_dot(n, nq) < min_cos)
             continue;
+        int side = fabs(v3_dot(nq, r->d)) < REG_SIDE_COS;
         st->overlap++;
+        st->side_overlap += (uint32_t)side;
         vec3 q = v3(cq->xyz[0], cq->xyz[1], cq->xyz[2]);
         vec3 diff = v3_sub(p, q);
         double dist = v3_len(diff);
@@ -233,6 +250,7 @@ static void pair_views(struct reg_ctx *r, uint32_t src, uint32_t dst, double gat
         if (!ok)
             continue;
         st->coupled++;
+        st->side_coupled += (uint32_t)side;
         st->sq += res * res;
         if (!solve)
             continue;
@@ -467,7 +485,7 @@ static void summarise(struct reg_ctx *r, struct reg_report *rep)
         const struct reg_edge_stats *st = &r->stats[e];
         coupled += st->coupled;
         sq += st->sq;
-        double share = st->overlap > 0 ? (double)st->coupled / st->overlap : 0.0;
+        double share = edge_share(st);
         if (rep->failed_view < 0 && share < r->p.min_coupled_share) {
             rep->failed_view = (int)r->edge_to[e];
             rep->failed_against = (int)r->edge_from[e];
@@ -677,7 +695,7 @@ static int cut_at_the_move(struct reg_ctx *r)
     uint32_t cuts = 0, at[2] = {0, 0};
     for (uint32_t e = 0; e < r->edges; e++) {
         const struct reg_edge_stats *st = &r->stats[e];
-        double share = st->overlap > 0 ? (double)st->coupled / st->overlap : 0.0;
+        double share = edge_share(st);
         if (share >= r->p.min_coupled_share)
             continue;
         if (cuts < 2)

@@ -90,6 +90,7 @@ _Static_assert(sizeof(struct reg_cell) == 28, "cell layout");
 /** What the pairs of one edge (both directions) gave in the last pass. */
 struct reg_edge_stats {
     uint32_t overlap, coupled;
+    uint32_t side_overlap, side_coupled; /**< of them, on surfaces facing sideways (reg.c) */
     double sq, trunc_sq; /**< squared residuals of coupled pairs; truncated over the overlap */
 };
 
