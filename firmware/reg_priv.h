@@ -1,0 +1,35 @@
+/* What the registration's two files share (reg.c, reg_place.c): not for other modules, which go
+ * through reg.h. */
+#ifndef REG_PRIV_H
+#define REG_PRIV_H
+
+#include "reg.h"
+
+#include <stddef.h>
+
+/* The kept samples of one view: gw x gh cells. */
+static inline size_t reg_cell_count(const struct reg_ctx *r)
+{
+    return (size_t)r->gw * r->gh;
+}
+
+static inline struct reg_cell *reg_view_cells(struct reg_ctx *r, uint32_t v)
+{
+    return &r->cells[(size_t)v * reg_cell_count(r)];
+}
+
+/* The first view of group 1 in the ring's order. */
+uint32_t reg_first_of_group(const struct reg_ctx *r);
+
+/* Group 1 (the second pass, or the views the object moved for) found in group 0 without a
+ * starting pose, then refined against group 0's views; one that matches nothing fails the
+ * registration at its first view (@p rep). */
+void reg_align_group(struct reg_ctx *r, struct reg_report *rep);
+
+/* Group 1 placed by ICP from where the table put it. @retval 1 placed (second_aligned) */
+int reg_place_near_table(struct reg_ctx *r, double ring_rms_mm);
+
+/* @retval 1 the last placement's pairs hold a shift in every direction */
+int reg_placement_holds(const struct reg_ctx *r);
+
+#endif
