@@ -50,6 +50,13 @@ static int colours_agree(const struct reg_params *p, const uint8_t a[3], const u
     return 1;
 }
 
+/* The axis as calibrated: a point on it at the table (@p a0) and its unit direction (@p d0). */
+static void calibrated_axis(const struct reg_ctx *r, vec3 *a0, vec3 *d0)
+{
+    *a0 = v3_from(r->calib.axis_point_mm);
+    *d0 = v3_norm(v3_from(r->calib.axis_dir));
+}
+
 int reg_begin(struct reg_ctx *r, const struct reg_params *p, const struct scan_calib *c,
               uint32_t views, uint32_t passes, uint32_t width, uint32_t height)
 {
@@ -71,8 +78,7 @@ int reg_begin(struct reg_ctx *r, const struct reg_params *p, const struct scan_c
             break;
         r->stride++; /* terminates: REG_MAX_CELLS / REG_MAX_VIEWS >= 64 (hal_limits.h) */
     }
-    r->a = v3_from(c->axis_point_mm);
-    r->d = v3_norm(v3_from(c->axis_dir));
+    calibrated_axis(r, &r->a, &r->d);
     for (uint32_t v = 0; v < views; v++)
         r->group[v] = v >= r->per_pass; /* the second pass */
     return 0;
@@ -345,10 +351,10 @@ static void add_prior(struct reg_ctx *r)
         r->normal_a[(size_t)i * n + (size_t)i] += w_angle;
         r->normal_b[i] += w_angle * (r->theta[v] - reported_rad(r, v));
     }
-    vec3 e1, e2;
+    vec3 e1, e2, a0, d0;
     across(r->d, &e1, &e2);
-    vec3 da = v3_sub(r->a, v3_from(r->calib.axis_point_mm));
-    vec3 dd = v3_sub(r->d, v3_norm(v3_from(r->calib.axis_dir)));
+    calibrated_axis(r, &a0, &d0);
+    vec3 da = v3_sub(r->a, a0), dd = v3_sub(r->d, d0);
     /* the unknowns' own measures of how far the axis is: shifts along e1, e2 and the tilts
      * that gauss_newton_step applies (d += (e1 t1 + e2 t2) x d moves d by -t1 e2 + t2 e1) */
     const double off[4] = {v3_dot(da, e1), v3_dot(da, e2), -v3_dot(dd, e2), v3_dot(dd, e1)};
@@ -420,10 +426,8 @@ static void keep_unfixed_turns(struct reg_ctx *r)
         if (r->shift_whole[k] > 0.0 &&
             r->shift_seen[k] < REG_TURN_SEEN * REG_TURN_SEEN * r->shift_whole[k])
             r->axis_from_calib = 1;
-    if (r->axis_from_calib) {
-        r->a = v3_from(r->calib.axis_point_mm);
-        r->d = v3_norm(v3_from(r->calib.axis_dir));
-    }
+    if (r->axis_from_calib)
+        calibrated_axis(r, &r->a, &r->d);
 }
 
 /* The unknowns at the turntable's answer. */
@@ -431,14 +435,14 @@ static void start_from_table(struct reg_ctx *r)
 {
     for (uint32_t v = 0; v < r->views; v++)
         r->theta[v] = reported_rad(r, v);
-    r->a = v3_from(r->calib.axis_point_mm);
-    r->d = v3_norm(v3_from(r->calib.axis_dir));
+    calibrated_axis(r, &r->a, &r->d);
 }
 
 /* How far the solution is from the calibrated axis; "" or why it is refused. */
 static void check_bounds(struct reg_ctx *r, struct reg_report *rep)
 {
-    vec3 a0 = v3_from(r->calib.axis_point_mm), d0 = v3_norm(v3_from(r->calib.axis_dir));
+    vec3 a0, d0;
+    calibrated_axis(r, &a0, &d0);
     vec3 da = v3_sub(r->a, a0);
     da = v3_sub(da, v3_scale(d0, v3_dot(da, d0))); /* along the axis changes nothing */
     rep->axis_shift_mm = v3_len(da);

@@ -87,6 +87,8 @@ static void test_errors_name_file_line_and_key(void **state)
     expect_error("[sim]\nseed = abc\n", "bad.ini:9: [sim] seed: 'abc' is not a whole number");
     expect_error("[scan]\nmin_contrast_dn = 300\n",
                  "bad.ini:9: [scan] min_contrast_dn: 300 is out of range 1..255");
+    expect_error("[turntable]\nangle_accuracy_deg = 0\n",
+                 "bad.ini:9: [turntable] angle_accuracy_deg: 0 is out of range");
     expect_error("[camera]\npixel_format = bgr\n",
                  "bad.ini:9: [camera] pixel_format: 'bgr' is not one of rgb24|yuyv|grey");
     expect_error("[sim]\nalbedo = 0.5, 0.5\n", "bad.ini:9: [sim] albedo: '0.5, 0.5' is not a list");
