@@ -156,8 +156,10 @@ static int report_registration(struct job *j, const struct reg_report *r, double
         n = strlen(detail);
         snprintf(detail + n, sizeof(detail) - n,
                  "; the object moved on the table at view %d: %u view%s placed by the object's "
-                 "shape alone, as it had moved %.1f mm and turned %.1f deg",
+                 "%s, as it had moved %.1f mm and turned %.1f deg",
                  r->moved_view, (unsigned)r->moved_views, r->moved_views == 1 ? "" : "s",
+                 r->moved_by_colour ? "shape and colour (its shape alone lets them slide one way)"
+                                    : "shape alone",
                  r->moved_mm, r->moved_deg);
     }
     if (j->cfg->passes == 2 && r->failed_view < 0) {
@@ -184,14 +186,24 @@ static int report_registration(struct job *j, const struct reg_report *r, double
     }
     if (!r->solved || r->failed_view < 0)
         return 0;
-    j->hal->log(HAL_LOG_ERROR,
-                "registration failed: view %d does not match view %d (%.0f%% of their overlap "
-                "couples, at least %.0f%% needed), and no placement of it fits the other views "
-                "either: was something else on the table, or nothing in view? No model was made; "
-                "the views are kept in %s. Scan again, or fuse them at the turntable's angles "
-                "with 'scanner process %s --config F' where F has [registration] icp = 0",
-                r->failed_view, r->failed_against, 100.0 * r->failed_share,
-                100.0 * j->cfg->registration.min_coupled_share, scan_dir, scan_dir);
+    if (r->moved_unfixed)
+        j->hal->log(HAL_LOG_ERROR,
+                    "registration failed: the object moved on the table at view %d, and the "
+                    "views from it fit the others only up to a slide that neither the object's "
+                    "shape (flat faces, parallel) nor its colour fixes: there is no telling how "
+                    "far it moved. No model was made; the views are kept in %s. Scan again "
+                    "without touching the object, or with paint or a marker on its faces",
+                    r->failed_view, scan_dir);
+    else
+        j->hal->log(
+            HAL_LOG_ERROR,
+            "registration failed: view %d does not match view %d (%.0f%% of their overlap "
+            "couples, at least %.0f%% needed), and no placement of it fits the other views "
+            "either: was something else on the table, or nothing in view? No model was made; "
+            "the views are kept in %s. Scan again, or fuse them at the turntable's angles "
+            "with 'scanner process %s --config F' where F has [registration] icp = 0",
+            r->failed_view, r->failed_against, 100.0 * r->failed_share,
+            100.0 * j->cfg->registration.min_coupled_share, scan_dir, scan_dir);
     return -EPROTO;
 }
 

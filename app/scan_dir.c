@@ -427,6 +427,7 @@ int scan_dir_write_registration(const struct hal_storage *st, const char *dir, u
         "worst_view = %u\nworst_rms_mm = %.4f\nsecond_pass_turned_deg = %.3f\n"
         "second_pass_rms_mm = %.4f\nsecond_pass_pairs = %u\nturns_from_table = %u\n"
         "moved_at_view = %d\nmoved_views = %u\nmoved_mm = %.3f\nmoved_deg = %.3f\n"
+        "moved_placed_by = %s\n"
         "[view]\nreported_angle_deg = %.3f\nangle_deg = %.4f\ncorrection_deg = %.4f\n"
         "turn = %s\nplaced_freely = %d\noverlap = %u\ncoupled = %u\ncoupled_share = %.4f\n"
         "view_rms_mm = %.4f\n",
@@ -434,8 +435,11 @@ int scan_dir_write_registration(const struct hal_storage *st, const char *dir, u
         r->score_before_mm, r->score_after_mm, r->rms_mm, r->loop_rms_mm, r->axis_shift_mm,
         r->axis_tilt_deg, (unsigned)r->worst_view, r->worst_rms_mm, r->second_turned_deg,
         r->second_rms_mm, (unsigned)r->second_coupled, (unsigned)r->turns_from_table, r->moved_view,
-        (unsigned)r->moved_views, r->moved_mm, r->moved_deg, v->reported_mdeg / 1000.0,
-        v->angle_deg, v->correction_deg,
+        (unsigned)r->moved_views, r->moved_mm, r->moved_deg,
+        r->moved_view < 0    ? "-"
+        : r->moved_by_colour ? "shape and colour"
+                             : "shape",
+        v->reported_mdeg / 1000.0, v->angle_deg, v->correction_deg,
         v->turn_from_table ? "table (the shape does not fix it)" : "registered", v->placed_freely,
         (unsigned)v->overlap, (unsigned)v->coupled,
         v->overlap ? (double)v->coupled / v->overlap : 0.0, v->rms_mm);

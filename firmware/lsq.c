@@ -84,34 +84,61 @@ int lsq_rigid_step(struct lsq_rigid *eq, struct frame_xform *step)
     return 0;
 }
 
-double lsq_rigid_shift_hold(const struct lsq_rigid *eq)
+/* Cyclic Jacobi rotations (Golub and Van Loan, 8.5) on the 3 x 3 shift block (jac[3..5] = n):
+ * its eigenvalues, ascending, over its trace, and their unit eigenvectors. */
+int lsq_rigid_shift_axes(const struct lsq_rigid *eq, double share[3], vec3 axis[3])
 {
-    /* The shift block of the normal equations (jac[3..5] = n): a symmetric 3 x 3 matrix, its
-     * eigenvalues in closed form (the trigonometric solution of its characteristic cubic). */
-    const double *a = eq->a;
-    double m[3][3];
+    double m[3][3], v[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
     for (int r = 0; r < 3; r++)
         for (int c = 0; c < 3; c++)
-            m[r][c] = a[(r + 3) * 6 + (c + 3)];
+            m[r][c] = eq->a[(r + 3) * 6 + (c + 3)];
     double trace = m[0][0] + m[1][1] + m[2][2];
-    if (trace <= 0.0)
-        return 0.0;
-    double off = m[0][1] * m[0][1] + m[0][2] * m[0][2] + m[1][2] * m[1][2];
-    double q = trace / 3.0, smallest;
-    if (off == 0.0) {
-        smallest = fmin(m[0][0], fmin(m[1][1], m[2][2]));
-    } else {
-        double p2 = (m[0][0] - q) * (m[0][0] - q) + (m[1][1] - q) * (m[1][1] - q) +
-                    (m[2][2] - q) * (m[2][2] - q) + 2.0 * off;
-        double p = sqrt(p2 / 6.0), b[3][3];
-        for (int r = 0; r < 3; r++)
-            for (int c = 0; c < 3; c++)
-                b[r][c] = (m[r][c] - (r == c ? q : 0.0)) / p;
-        double det = b[0][0] * (b[1][1] * b[2][2] - b[1][2] * b[2][1]) -
-                     b[0][1] * (b[1][0] * b[2][2] - b[1][2] * b[2][0]) +
-                     b[0][2] * (b[1][0] * b[2][1] - b[1][1] * b[2][0]);
-        double r = fmin(1.0, fmax(-1.0, det / 2.0));
-        smallest = q + 2.0 * p * cos(acos(r) / 3.0 + 2.0 * M_PI / 3.0);
+    if (!(trace > 0.0))
+        return -EDOM;
+    for (int sweep = 0; sweep < 50; sweep++) {
+        double off = m[0][1] * m[0][1] + m[0][2] * m[0][2] + m[1][2] * m[1][2];
+        if (off <= 1e-30 * trace * trace)
+            break;
+        for (int p = 0; p < 2; p++) {
+            for (int q = p + 1; q < 3; q++) {
+                if (m[p][q] == 0.0)
+                    continue;
+                double theta = (m[q][q] - m[p][p]) / (2.0 * m[p][q]);
+                double t = (theta >= 0.0 ? 1.0 : -1.0) / (fabs(theta) + sqrt(theta * theta + 1.0));
+                double c = 1.0 / sqrt(t * t + 1.0), s = t * c;
+                for (int k = 0; k < 3; k++) { /* m <- m J (columns p, q) */
+                    double a = m[k][p], b = m[k][q];
+                    m[k][p] = c * a - s * b, m[k][q] = s * a + c * b;
+                }
+                for (int k = 0; k < 3; k++) { /* m <- J^T m (rows p, q) */
+                    double a = m[p][k], b = m[q][k];
+                    m[p][k] = c * a - s * b, m[q][k] = s * a + c * b;
+                }
+                for (int k = 0; k < 3; k++) { /* eigenvectors: the columns of v J */
+                    double a = v[k][p], b = v[k][q];
+                    v[k][p] = c * a - s * b, v[k][q] = s * a + c * b;
+                }
+            }
+        }
     }
-    return fmax(0.0, smallest) / trace;
+    int order[3] = {0, 1, 2};
+    for (int i = 0; i < 3; i++)
+        for (int j = i + 1; j < 3; j++)
+            if (m[order[j]][order[j]] < m[order[i]][order[i]]) {
+                int t = order[i];
+                order[i] = order[j], order[j] = t;
+            }
+    for (int i = 0; i < 3; i++) {
+        int k = order[i];
+        share[i] = fmax(0.0, m[k][k]) / trace;
+        axis[i] = v3(v[0][k], v[1][k], v[2][k]);
+    }
+    return 0;
+}
+
+double lsq_rigid_shift_hold(const struct lsq_rigid *eq)
+{
+    double share[3];
+    vec3 axis[3];
+    return lsq_rigid_shift_axes(eq, share, axis) == 0 ? share[0] : 0.0;
 }

@@ -32,6 +32,11 @@ void lsq_rigid_clear(struct lsq_rigid *eq);
  *  that plane changes no residual. @retval 0 .. 1/3 */
 double lsq_rigid_shift_hold(const struct lsq_rigid *eq);
 
+/** The directions the pairs hold a shift in, from the weakest: @p share the eigenvalues of the
+ *  sum of n n^T over its trace (ascending, summing to 1), @p axis their unit eigenvectors.
+ *  @retval 0 @retval -EDOM no pairs */
+int lsq_rigid_shift_axes(const struct lsq_rigid *eq, double share[3], vec3 axis[3]);
+
 /** Add the pair of point @p p and the plane through @p q with unit normal @p n. */
 void lsq_rigid_add(struct lsq_rigid *eq, vec3 p, vec3 q, vec3 n);
 

@@ -583,9 +583,11 @@ static void place_moved_views(struct reg_ctx *r, struct reg_report *rep)
     solve_joint(r, rep); /* each arc registered on its own */
     if (!reg_place_near_table(r, rep->rms_mm))
         reg_align_group(r, rep);
-    if (r->second_aligned && !reg_placement_holds(r))
-        r->second_aligned = 0; /* a shift the overlap does not see: it could be anywhere */
-    if (!r->second_aligned) {  /* nothing found: the failure as the ring showed it */
+    if (r->second_aligned && !reg_placement_holds(r) && !reg_place_by_colour(r)) {
+        r->second_aligned = 0; /* a slide neither shape nor colour sees: it could be anywhere */
+        rep->moved_unfixed = 1;
+    }
+    if (!r->second_aligned) { /* nothing found: the failure as the ring showed it */
         rep->failed_view = failed, rep->failed_against = against, rep->failed_share = share;
         return;
     }
@@ -597,6 +599,7 @@ static void place_moved_views(struct reg_ctx *r, struct reg_report *rep)
     double c = (m[0] + m[4] + m[8] - 1.0) / 2.0;
     rep->moved_deg = acos(c > 1.0 ? 1.0 : c < -1.0 ? -1.0 : c) * 180.0 / M_PI;
     rep->moved_mm = v3_len(r->first_from_second.origin); /* the frame's origin: on the axis */
+    rep->moved_by_colour = r->placed_by_colour;
     rep->second_turned_deg = rep->second_rms_mm = 0.0;
 }
 
@@ -609,6 +612,7 @@ int reg_solve(struct reg_ctx *r, struct reg_report *rep)
         rep->views += r->present[v];
     memset(r->cut_after, 0, sizeof(r->cut_after));
     r->second_aligned = 0;
+    r->placed_by_colour = 0;
     solve_joint(r, rep);
     if (r->passes == 2)
         reg_align_group(r, rep);

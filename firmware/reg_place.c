@@ -46,66 +46,97 @@ static void feed_alignment(struct reg_ctx *r)
     }
 }
 
-/* The group-1 samples against the group-0 views, projectively, as the views of a pass are
- * paired: one point-to-plane step of first_from_second per call (object frame 1).
+/* Group 0's poses, and their inverses, for landing samples on its views (r->first_pose and
+ * r->first_cam, too big for a stack). */
+static void prepare_landing(struct reg_ctx *r)
+{
+    struct reg_view rv;
+    for (uint32_t j = 0; j < r->views; j++)
+        if (!r->group[j] && reg_view_pose(r, j, &r->first_pose[j], &rv) == 0)
+            frame_invert(&r->first_pose[j], &r->first_cam[j]);
+}
+
+/* Where a group-1 sample (@p p, @p n in group 0's object frame) lands on group 0, projectively,
+ * as the views of a pass are paired: on a surface facing its way (@p landed) within @p gate_mm of
+ * it (@p q, @p nq), in the first group-0 view that sees one or, with @p most_facing, in the one
+ * that sees it most squarely (colour: at a glancing angle a pixel spreads over the surface).
+ * @retval its cell @retval NULL none */
+static const struct reg_cell *land(struct reg_ctx *r, vec3 p, vec3 n, double min_cos,
+                                   double gate_mm, int most_facing, int *landed, vec3 *q, vec3 *nq)
+{
+    const struct reg_cell *best = NULL;
+    double best_facing = 0.0;
+    *landed = 0;
+    for (uint32_t j = 0; j < r->views; j++) {
+        if (!r->present[j] || r->group[j])
+            continue;
+        vec3 c = frame_point(&r->first_cam[j], p);
+        double facing = -v3_dot(frame_dir(&r->first_cam[j], n), c);
+        if (c.z <= 1.0 || facing <= 0.0)
+            continue; /* behind the camera, or facing away from it */
+        double fu, fv;
+        camray_project(&r->calib, c, &fu, &fv);
+        long u = lround(fu / r->stride), w = lround(fv / r->stride);
+        if (u < 0 || w < 0 || u >= (long)r->gw || w >= (long)r->gh)
+            continue;
+        const struct reg_cell *cq = &reg_view_cells(r, j)[(size_t)w * r->gw + (size_t)u];
+        vec3 qj, nqj;
+        if (!cq->valid)
+            continue;
+        cell_in_object(cq, &r->first_pose[j], &qj, &nqj);
+        if (v3_dot(n, nqj) < min_cos)
+            continue;
+        *landed = 1;
+        facing /= v3_len(c);
+        if (v3_len(v3_sub(p, qj)) > gate_mm || (best != NULL && facing <= best_facing))
+            continue;
+        best = cq, best_facing = facing, *q = qj, *nq = nqj;
+        if (!most_facing)
+            break;
+    }
+    return best;
+}
+
+/* The group-1 samples against the group-0 views: one point-to-plane step of first_from_second
+ * per call (object frame 1); with @p frozen, a unit direction (group 0's frame) the step does
+ * not shift along (one the colour search has fixed and the shape does not hold).
  * @retval pairs coupled; @p rms their residual, @p overlap the samples that landed on a group-0
  * surface facing the same way (coupled or not), @p hold how well the pairs hold a shift in every
- * direction (lsq_rigid_shift_hold) */
-static uint32_t refine_second_step(struct reg_ctx *r, double gate_mm, double *rms,
-                                   uint32_t *overlap, double *hold)
+ * direction: @p share and @p axis as lsq_rigid_shift_axes gives them (share[0] is
+ * lsq_rigid_shift_hold) */
+static uint32_t refine_second_step(struct reg_ctx *r, double gate_mm, const vec3 *frozen,
+                                   double *rms, uint32_t *overlap, double share[3], vec3 axis[3])
 {
     *overlap = 0;
     const double min_cos = cos(r->p.max_normal_deg * M_PI / 180.0);
     struct lsq_rigid eq;
     lsq_rigid_clear(&eq);
-    struct frame_xform *first = r->first_pose, *cam_of = r->first_cam; /* too big for a stack */
-    struct reg_view rv;
-    for (uint32_t j = 0; j < r->views; j++)
-        if (!r->group[j] && reg_view_pose(r, j, &first[j], &rv) == 0)
-            frame_invert(&first[j], &cam_of[j]);
+    prepare_landing(r);
     for (uint32_t v = 0; v < r->views; v++) {
         struct frame_xform pose;
+        struct reg_view rv;
         if (!r->group[v] || reg_view_pose(r, v, &pose, &rv) != 0)
             continue;
         for (size_t k = 0; k < reg_cell_count(r); k += 2) {
             const struct reg_cell *cl = &reg_view_cells(r, v)[k];
+            vec3 p, n, q, nq;
+            int landed;
             if (!cl->valid)
                 continue;
-            vec3 p, n;
-            int landed = 0;
             cell_in_object(cl, &pose, &p, &n);
-            for (uint32_t j = 0; j < r->views; j++) {
-                if (!r->present[j] || r->group[j])
-                    continue;
-                vec3 c = frame_point(&cam_of[j], p);
-                if (c.z <= 1.0 || v3_dot(frame_dir(&cam_of[j], n), c) >= 0.0)
-                    continue; /* behind the camera, or facing away from it */
-                double fu, fv;
-                camray_project(&r->calib, c, &fu, &fv);
-                long u = lround(fu / r->stride), w = lround(fv / r->stride);
-                if (u < 0 || w < 0 || u >= (long)r->gw || w >= (long)r->gh)
-                    continue;
-                const struct reg_cell *cq = &reg_view_cells(r, j)[(size_t)w * r->gw + (size_t)u];
-                if (!cq->valid)
-                    continue;
-                vec3 q, nq;
-                cell_in_object(cq, &first[j], &q, &nq);
-                if (v3_dot(n, nq) < min_cos)
-                    continue;
-                landed = 1; /* on a surface of group 0 facing its way */
-                if (v3_len(v3_sub(p, q)) > gate_mm)
-                    continue;
+            if (land(r, p, n, min_cos, gate_mm, 0, &landed, &q, &nq) != NULL)
                 lsq_rigid_add(&eq, p, q, nq);
-                break; /* one pair a point: the first view that sees it */
-            }
             *overlap += (uint32_t)landed;
         }
     }
     uint32_t coupled = eq.pairs;
     *rms = coupled > 0 ? sqrt(eq.sq / coupled) : 0.0;
-    *hold = lsq_rigid_shift_hold(&eq);
+    if (lsq_rigid_shift_axes(&eq, share, axis) != 0)
+        memset(share, 0, 3 * sizeof(double)); /* no pairs: holds nothing */
     struct frame_xform s, moved;
     if (lsq_rigid_step(&eq, &s) == 0) {
+        if (frozen != NULL) /* the step's shift along it taken out: the colour has placed it */
+            s.origin = v3_sub(s.origin, v3_scale(*frozen, v3_dot(s.origin, *frozen)));
         frame_compose(&s, &r->first_from_second, &moved);
         r->first_from_second = moved;
     }
@@ -137,11 +168,11 @@ void reg_align_group(struct reg_ctx *r, struct reg_report *rep)
         return;
     }
     r->second_aligned = 1;
-    double rms = 0.0, hold;
+    double rms = 0.0;
     uint32_t overlap;
     for (int it = 0; it < 15; it++)
-        rep->second_coupled = refine_second_step(r, r->p.max_pair_mm, &rms, &overlap, &hold);
-    r->placed_hold = hold;
+        rep->second_coupled = refine_second_step(r, r->p.max_pair_mm, NULL, &rms, &overlap,
+                                                 r->placed_share, r->placed_axis);
     rep->second_rms_mm = rms;
     rep->second_turned_deg = ar.turned_deg;
     rep->second_share = ar.coupled_share;
@@ -157,16 +188,15 @@ void reg_align_group(struct reg_ctx *r, struct reg_report *rep)
  * @retval 1 placed */
 int reg_place_near_table(struct reg_ctx *r, double ring_rms_mm)
 {
-    double rms = 0.0, hold = 0.0;
+    double rms = 0.0;
     uint32_t coupled = 0, overlap = 0;
     r->first_from_second = (struct frame_xform){{1, 0, 0, 0, 1, 0, 0, 0, 1}, {0, 0, 0}};
     r->second_aligned = 1;
-    for (int it = 0; it < 20; it++) {
+    for (int it = 0; it <= 20; it++) {
         double gate = r->p.max_pair_mm * fmax(1.0, 8.0 / (double)(1u << (it < 8 ? it : 8)));
-        coupled = refine_second_step(r, gate, &rms, &overlap, &hold);
+        coupled = refine_second_step(r, it < 20 ? gate : r->p.max_pair_mm, NULL, &rms, &overlap,
+                                     r->placed_share, r->placed_axis);
     }
-    coupled = refine_second_step(r, r->p.max_pair_mm, &rms, &overlap, &hold);
-    r->placed_hold = hold;
     r->second_aligned = overlap > 0 && coupled >= 2.0 * r->p.min_coupled_share * overlap &&
                         rms <= 2.0 * ring_rms_mm + 0.02;
     return r->second_aligned;
@@ -180,5 +210,126 @@ int reg_place_near_table(struct reg_ctx *r, double ring_rms_mm)
 #define REG_PLACE_MIN_HOLD 0.015
 int reg_placement_holds(const struct reg_ctx *r)
 {
-    return r->placed_hold >= REG_PLACE_MIN_HOLD;
+    return r->placed_share[0] >= REG_PLACE_MIN_HOLD;
+}
+
+/* The colour search: a direction the shape does not hold is searched this far each way, in
+ * steps of REG_COLOUR_STEP_MM, then to a tenth of that about the best. */
+#define REG_COLOUR_SEARCH_MM 40.0
+#define REG_COLOUR_STEP_MM 0.5
+/* Two hues further apart than this (the chord between their unit vectors, 0.43: 25 degrees) are
+ * a miss: the palette's colours are 45 degrees and more apart. */
+#define REG_HUE_TAU 0.43
+/* A colour whose distance from grey is under this share of its brightness is grey. */
+#define REG_HUE_MIN_SATURATION 0.15
+/* Colours darker than this (the mean of the channels) have no hue to tell. */
+#define REG_HUE_MIN_DN 10.0
+
+/* A colour's hue: the unit direction of its distance from grey, in the plane across the grey
+ * axis. The same under any brightness of white light and under any grey added to it (ambient
+ * light, the projector's black), so that raw colours, shaded and lit differently in each view,
+ * compare as the paint's. A colour too close to grey has none: it is grey (hue 0, 0), which
+ * matches grey only (were it left out, a patch of white paint would match anything and pull
+ * the search towards it). @retval 0 too dark to tell */
+static int hue_of(const uint8_t rgb[3], double hue[2])
+{
+    double mean = ((double)rgb[0] + rgb[1] + rgb[2]) / 3.0;
+    double x = ((double)rgb[0] - rgb[1]) / sqrt(2.0);
+    double y = ((double)rgb[0] + rgb[1] - 2.0 * rgb[2]) / sqrt(6.0);
+    double len = sqrt(x * x + y * y);
+    if (mean < REG_HUE_MIN_DN)
+        return 0;
+    hue[0] = hue[1] = 0.0;
+    if (len >= REG_HUE_MIN_SATURATION * mean)
+        hue[0] = x / len, hue[1] = y / len;
+    return 1;
+}
+
+/* How badly group 1's colours agree with group 0's where they land with group 1 shifted by
+ * @p shift (group 0's frame): over every group-1 sample bright enough that lands on a group-0
+ * sample bright enough (@p compared), the mean squared distance of their hues truncated at
+ * REG_HUE_TAU (every sample: the boundaries of the paint are a few of them, every other pixel).
+ * @retval the misfit, 0 .. REG_HUE_TAU^2 (that when nothing was compared) */
+static double colour_misfit(struct reg_ctx *r, vec3 shift, uint64_t *compared)
+{
+    const double min_cos = cos(r->p.max_normal_deg * M_PI / 180.0);
+    const double tau_sq = REG_HUE_TAU * REG_HUE_TAU;
+    double sum = 0.0;
+    *compared = 0;
+    for (uint32_t v = 0; v < r->views; v++) {
+        struct frame_xform pose;
+        struct reg_view rv;
+        if (!r->group[v] || reg_view_pose(r, v, &pose, &rv) != 0)
+            continue;
+        for (size_t k = 0; k < reg_cell_count(r); k++) {
+            const struct reg_cell *cl = &reg_view_cells(r, v)[k];
+            double hp[2], hq[2];
+            vec3 p, n, q, nq;
+            int landed;
+            if (!cl->valid || !hue_of(cl->rgb, hp))
+                continue;
+            cell_in_object(cl, &pose, &p, &n);
+            const struct reg_cell *hit =
+                land(r, v3_add(p, shift), n, min_cos, r->p.max_pair_mm, 1, &landed, &q, &nq);
+            if (hit == NULL || !hue_of(hit->rgb, hq))
+                continue;
+            double dx = hp[0] - hq[0], dy = hp[1] - hq[1]; /* grey against a hue: a miss */
+            sum += fmin(dx * dx + dy * dy, tau_sq);
+            (*compared)++;
+        }
+    }
+    return *compared > 0 ? sum / (double)*compared : tau_sq;
+}
+
+/* The search's best place is taken when its misfit is under this share of the mean over the
+ * search (a clear dip where the paint lines up; a plain or evenly patterned object has none) with
+ * this many samples compared there. Measured on the slipped parts of data/objects and the
+ * simulator's box (painted in patches): 0.1 to 0.2; a box of one colour has no dip at all. */
+#define REG_COLOUR_MAX_DIP 0.5
+#define REG_COLOUR_MIN_COMPARED 200
+/* The colour search moves along one direction: the shape must hold the next weakest one at
+ * least this well (the box, bracket, plate, nut and stepped block of data/objects: 0.14 to 0.48;
+ * the gear 0.016, its teeth let it turn too). */
+#define REG_COLOUR_MIN_NEXT 0.05
+
+/* The placement moved along @p t by @p mm (the group-1 points, in group 0's frame). */
+static void shift_placement(struct reg_ctx *r, vec3 t, double mm)
+{
+    struct frame_xform shift = {{1, 0, 0, 0, 1, 0, 0, 0, 1}, v3_scale(t, -mm)}, moved;
+    frame_compose(&shift, &r->first_from_second, &moved); /* p -> p - origin = p + mm t */
+    r->first_from_second = moved;
+}
+
+int reg_place_by_colour(struct reg_ctx *r)
+{
+    const vec3 t = r->placed_axis[0];
+    if (!r->second_aligned || r->placed_share[1] < REG_COLOUR_MIN_NEXT)
+        return 0;
+    prepare_landing(r);
+    double best = 0.0, best_misfit = HUGE_VAL, mean = 0.0;
+    uint64_t compared, best_compared = 0;
+    int steps = (int)lround(REG_COLOUR_SEARCH_MM / REG_COLOUR_STEP_MM);
+    for (int k = -steps; k <= steps; k++) {
+        double m = colour_misfit(r, v3_scale(t, k * REG_COLOUR_STEP_MM), &compared);
+        mean += m / (2 * steps + 1);
+        if (m < best_misfit)
+            best_misfit = m, best = k * REG_COLOUR_STEP_MM, best_compared = compared;
+    }
+    double coarse = best;
+    for (int k = -10; k <= 10; k++) { /* to a tenth of a step about the best */
+        double s = coarse + k * REG_COLOUR_STEP_MM / 10.0;
+        double m = colour_misfit(r, v3_scale(t, s), &compared);
+        if (m < best_misfit)
+            best_misfit = m, best = s, best_compared = compared;
+    }
+    if (best_compared < REG_COLOUR_MIN_COMPARED || !(best_misfit < REG_COLOUR_MAX_DIP * mean))
+        return 0; /* no dip: plain paint (all grey: 0 everywhere) or nothing compared */
+    shift_placement(r, t, best);
+    double rms, share[3];
+    uint32_t overlap;
+    vec3 axis[3];
+    for (int it = 0; it < 5; it++) /* the shape refines the rest, the colour keeps t */
+        refine_second_step(r, r->p.max_pair_mm, &t, &rms, &overlap, share, axis);
+    r->placed_by_colour = 1;
+    return 1;
 }

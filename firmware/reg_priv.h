@@ -32,4 +32,10 @@ int reg_place_near_table(struct reg_ctx *r, double ring_rms_mm);
 /* @retval 1 the last placement's pairs hold a shift in every direction */
 int reg_placement_holds(const struct reg_ctx *r);
 
+/* The last placement, whose shape holds every direction but one (placed_axis[0]), moved along it
+ * to where the two groups' colours agree (their hues: raw colours compare as the paint's), then
+ * refined by the shape with that direction kept. @retval 1 placed (placed_by_colour)
+ * @retval 0 the colour does not fix it either: the placement is left as it was */
+int reg_place_by_colour(struct reg_ctx *r);
+
 #endif

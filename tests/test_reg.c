@@ -13,6 +13,7 @@
 
 #include "camray.h"
 #include "config.h"
+#include "lsq.h"
 #include "reg.h"
 
 #define VIEWS 8u
@@ -461,6 +462,36 @@ static void test_many_views_fit_in_the_cells(void **state)
     assert_int_equal(reg_begin(&reg, &p, &calib, REG_MAX_VIEWS + 1, 1, 2048, 1536), -E2BIG);
 }
 
+/* The directions a set of point-to-plane pairs holds a shift in (lsq_rigid_shift_axes, which the
+ * placement after a slip reads): two parallel faces and a top hold no shift along the faces; the
+ * weakest axis is that one, its share 0, the others split the rest; a third face holds all. */
+static void test_shift_axes_find_the_slide_of_parallel_faces(void **state)
+{
+    (void)state;
+    struct lsq_rigid eq;
+    lsq_rigid_clear(&eq);
+    const vec3 normals[3] = {v3(1, 0, 0), v3(-1, 0, 0), v3(0, 0, 1)};
+    for (int k = 0; k < 300; k++) {
+        vec3 n = normals[k % 3], p = v3(k % 7, k % 11, k % 5);
+        lsq_rigid_add(&eq, p, v3_sub(p, v3_scale(n, 0.01)), n);
+    }
+    double share[3];
+    vec3 axis[3];
+    assert_int_equal(lsq_rigid_shift_axes(&eq, share, axis), 0);
+    assert_true(share[0] < 1e-9);
+    assert_true(fabs(fabs(axis[0].y) - 1.0) < 1e-9);
+    assert_true(fabs(share[1] - 1.0 / 3.0) < 1e-9 && fabs(share[2] - 2.0 / 3.0) < 1e-9);
+    assert_true(fabs(fabs(axis[2].x) - 1.0) < 1e-9); /* two faces along x: the strongest */
+    assert_true(lsq_rigid_shift_hold(&eq) < 1e-9);
+    lsq_rigid_add(&eq, v3(0, 0, 0), v3(0, -0.01, 0), v3(0, 1, 0)); /* one pair on a side face */
+    assert_int_equal(lsq_rigid_shift_axes(&eq, share, axis), 0);
+    assert_true(share[0] > 0.0 && share[0] <= share[1] && share[1] <= share[2]);
+    assert_true(fabs(share[0] + share[1] + share[2] - 1.0) < 1e-9);
+    struct lsq_rigid none;
+    lsq_rigid_clear(&none);
+    assert_int_equal(lsq_rigid_shift_axes(&none, share, axis), -EDOM);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -473,6 +504,7 @@ int main(void)
         cmocka_unit_test(test_second_pass_found),
         cmocka_unit_test(test_second_pass_of_another_object_fails),
         cmocka_unit_test(test_many_views_fit_in_the_cells),
+        cmocka_unit_test(test_shift_axes_find_the_slide_of_parallel_faces),
     };
     return cmocka_run_group_tests(tests, setup, NULL);
 }
