@@ -139,8 +139,9 @@ static const struct ini_key config_keys[] = {
         "new folder here named by when it began (UTC, YYYY-MM-DD_HHMMSS), and 'latest' links "
         "to the newest; relative to the working directory"),
     F64("output", "max_hole_mm", max_hole_mm, 0, 100, "0",
-        "holes in the model up to this wide are filled (in the volume, from the surface around "
-        "them; the filling also extends open edges by half this); 0: none, nothing invented"),
+        "holes in the model narrower than this are closed (on the mesh: each boundary loop "
+        "whose extent is under this, fanned from its centre; with watertight also in the "
+        "volume first); 0: none, nothing invented"),
     U32("output", "watertight", watertight, 0, 1, "0",
         "1: close the model for printing: at the table plane, and what no camera saw under a "
         "surface or behind a hole up to max_hole_mm is solid (needs max_hole_mm > 0)"),

@@ -46,12 +46,19 @@ static int write_model(struct job *j)
     struct mesh_summary ms;
     uint32_t filled = 0, inside = 0;
     job_progress(j, EV_MESHING, -1, j->views, "marching cubes");
-    int rc = fusion_fill_holes(j->vol, j->cfg->max_hole_mm, &filled);
+    int rc = j->cfg->watertight ? fusion_fill_holes(j->vol, j->cfg->max_hole_mm, &filled) : 0;
     if (rc == 0 && j->cfg->watertight)
         rc = fusion_close_watertight(j->vol, j->cfg->max_hole_mm, j->cfg->passes == 1, &inside);
     if (rc == 0)
         rc = fusion_mesh_prepare(j->vol, j->cfg->min_fragment_share, &ms);
     int fits = rc == 0;
+    struct mesh_hole_report holes = {0, 0, 0};
+    if (fits && j->cfg->max_hole_mm > 0.0) {
+        rc = fusion_mesh_fill_holes(j->vol, j->cfg->max_hole_mm, &holes);
+        if (rc != 0) /* the mesh is whole either way: what was closed stays */
+            j->hal->log(HAL_LOG_WARN, "holes left on the mesh unclosed: %s", strerror(-rc));
+        rc = fusion_mesh_counts(j->vol, &ms);
+    }
     if (rc == -E2BIG)
         j->hal->log(HAL_LOG_WARN,
                     "the mesh has %u vertices, more than MESH_MAX_VERTICES (%u): it is written "
@@ -85,11 +92,15 @@ static int write_model(struct job *j)
                  "; %u vertices no view could colour took their neighbours' colour, %u marked "
                  "grey",
                  (unsigned)ms.colour_filled, (unsigned)ms.uncoloured);
+    char mesh_holes[96] = "";
+    if (holes.filled > 0)
+        snprintf(mesh_holes, sizeof(mesh_holes), ", %u holes on the mesh closed",
+                 (unsigned)holes.filled);
     snprintf(detail, sizeof(detail),
              "%u vertices, %u triangles (%u floating fragments of %u pieces left out; %u voxels "
-             "filled holes%s%s) -> %s/mesh.ply, mesh.obj%s",
+             "filled holes%s%s%s) -> %s/mesh.ply, mesh.obj%s",
              (unsigned)ms.kept_vertices, (unsigned)ms.kept_triangles, (unsigned)ms.removed_pieces,
-             (unsigned)ms.pieces, (unsigned)filled, closed, uncoloured, j->out_dir,
+             (unsigned)ms.pieces, (unsigned)filled, mesh_holes, closed, uncoloured, j->out_dir,
              fits ? ", mesh.stl and mesh.glb" : "");
     char fields[192];
     snprintf(fields, sizeof(fields),

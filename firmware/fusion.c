@@ -37,6 +37,7 @@ int fusion_begin(struct fusion_volume *vol, const struct fusion_params *p)
     vol->p = *p;
     vol->origin = v3(-p->radius_mm, -p->radius_mm, p->bottom_mm);
     memset(vol->grid, 0, (size_t)vol->dims[0] * vol->dims[1] * vol->dims[2] * sizeof(vol->grid[0]));
+    vol->mp.prepared = 0; /* an earlier model's mesh tables are no longer this one's */
     mc_table_build();
     return 0;
 }

@@ -99,6 +99,22 @@ struct mesh_summary {
 int fusion_mesh_prepare(struct fusion_volume *vol, double min_fragment_share,
                         struct mesh_summary *summary);
 
+/** What fusion_mesh_fill_holes did. */
+struct mesh_hole_report {
+    uint32_t boundary_edges; /**< edges of one kept triangle only, before */
+    uint32_t filled;         /**< loops closed */
+    uint32_t left;           /**< loops as wide as max_hole_mm or wider (the object's open
+                                  bottom), or not simple loops: left open */
+};
+
+/** Close the prepared mesh's holes narrower than @p max_hole_mm (the diagonal of a boundary
+ *  loop's bounding box): each loop fanned from a new vertex at its centre (firmware/mesh_holes.c).
+ *  After fusion_mesh_prepare, before the writers; a mesh too large for the tables is left as it
+ *  is. @param out  out @retval 0 @retval -EINVAL not prepared @retval -ENOSPC more open edges at
+ *  once than the work space holds @retval -E2BIG the tables are full (what was closed stays) */
+int fusion_mesh_fill_holes(struct fusion_volume *vol, double max_hole_mm,
+                           struct mesh_hole_report *out);
+
 /** Marching cubes into @p sink as the writers see it: the pieces fusion_mesh_prepare left out
  *  are not given, the vertices renumbered. @retval 0 @retval -EINVAL not prepared */
 int fusion_extract_prepared(struct fusion_volume *vol, const struct mesh_sink *sink);
@@ -140,6 +156,7 @@ struct voxel {
 #define FUSION_BLOCKS_MAX ((FUSION_MAX_DIM + FUSION_BLOCK - 1) / FUSION_BLOCK)
 #define FUSION_BITMAP_BYTES ((FUSION_MAX_VOXELS + 7) / 8) /* a bit a voxel */
 #define FUSION_GLB_JSON_MAX 8192u                         /* mesh.glb's JSON chunk (mesh_glb.c) */
+#define MESH_HOLE_MAX_LOOP 4096u /* a longer boundary loop is far wider than a hole to close */
 
 /** One model's volume: the grid, the work space of the stages over it and the prepared mesh's
  *  tables. Hundreds of MB at the compiled limits: its owner (the job) keeps it static and passes
@@ -150,8 +167,12 @@ struct fusion_volume {
     struct fusion_params p;
     uint32_t dims[3];
     vec3 origin; /* where voxel (0, 0, 0) is (object frame, mm) */
-    /* fusion_integrate's: a view's pixel weights, the rectangle of its pixels, its blocks */
-    float weight_map[HAL_MAX_PIXELS];
+    /* fusion_integrate's: a view's pixel weights, the rectangle of its pixels, its blocks; the
+     * weights' space holds mesh_holes.c's set of open edges once the views are fused */
+    union {
+        float weight_map[HAL_MAX_PIXELS];
+        uint64_t open_edge[HAL_MAX_PIXELS / 2];
+    };
     uint16_t edge_dist[HAL_MAX_PIXELS];
     struct {
         uint32_t x0, y0, x1, y1;
@@ -178,7 +199,8 @@ struct fusion_volume {
         int prepared, fits; /* fits: the whole mesh is in the tables (else nothing is dropped) */
         struct mesh_summary s;
     } mp;
-    struct mesh_vertex mv; /* the vertex a sink is handed from the tables */
+    struct mesh_vertex mv;                  /* the vertex a sink is handed from the tables */
+    uint32_t hole_loop[MESH_HOLE_MAX_LOOP]; /* mesh_holes.c: the loop being closed */
     /* mesh.glb's (mesh_glb.c): each vertex's material cluster, the JSON chunk */
     uint8_t vertex_part[MESH_MAX_VERTICES];
     char glb_json[FUSION_GLB_JSON_MAX];

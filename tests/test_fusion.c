@@ -6,6 +6,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -287,6 +288,42 @@ static void test_small_hole_filled(void **state)
     free(c.tri);
 }
 
+/* The same hole closed on the mesh (fusion_mesh_fill_holes, the volume untouched): one boundary
+ * loop fanned, the surface closed and consistently oriented (check_closed), a sphere again;
+ * a bound under the hole's size leaves it open; before prepare, refused. */
+static void test_small_hole_closed_on_the_mesh(void **state)
+{
+    (void)state;
+    struct collected c;
+    struct mesh_summary ms, after;
+    struct mesh_hole_report rep;
+    extract(scanned_sphere, NULL, &c);
+    free(c.pos);
+    free(c.tri);
+    assert_int_equal(fusion_mesh_fill_holes(&vol, 20.0, &rep), -EINVAL); /* not prepared */
+    assert_int_equal(fusion_mesh_prepare(&vol, 0.0, &ms), 0);
+    assert_int_equal(fusion_mesh_fill_holes(&vol, 5.0, &rep), 0); /* the hole is ~10 mm */
+    assert_true(rep.boundary_edges > 8);
+    assert_int_equal(rep.filled, 0);
+    assert_int_equal(rep.left, 1);
+    assert_int_equal(fusion_mesh_fill_holes(&vol, 20.0, &rep), 0);
+    uint32_t loop = rep.boundary_edges;
+    assert_int_equal(rep.filled, 1);
+    assert_int_equal(rep.left, 0);
+    assert_int_equal(fusion_mesh_counts(&vol, &after), 0);
+    assert_int_equal(after.kept_vertices, ms.kept_vertices + 1);
+    assert_int_equal(after.kept_triangles, ms.kept_triangles + loop);
+    memset(&c, 0, sizeof(c));
+    struct mesh_sink sink = {on_vertex, on_triangle, &c};
+    assert_int_equal(fusion_extract_prepared(&vol, &sink), 0);
+    assert_int_equal(check_closed(&c), 2);
+    free(c.pos);
+    free(c.tri);
+    assert_int_equal(fusion_mesh_fill_holes(&vol, 20.0, &rep), 0); /* nothing left to close */
+    assert_int_equal(rep.boundary_edges, 0);
+    assert_int_equal(rep.filled, 0);
+}
+
 /* Standing on the table, unseen below 6 mm and inside: closed watertight, solid (one surface,
  * no inner wall), nothing below the table. */
 static void test_watertight_closes_at_the_table(void **state)
@@ -430,6 +467,7 @@ int main(void)
         cmocka_unit_test(test_random_blobs_stay_closed),
         cmocka_unit_test(test_fragments_left_out_and_stl),
         cmocka_unit_test(test_small_hole_filled),
+        cmocka_unit_test(test_small_hole_closed_on_the_mesh),
         cmocka_unit_test(test_uncoloured_surface_takes_its_neighbours_colour),
         cmocka_unit_test(test_watertight_closes_at_the_table),
         cmocka_unit_test(test_two_volumes_are_independent),
