@@ -562,6 +562,13 @@ static int cut_at_the_move(struct reg_ctx *r)
             at[cuts] = r->edge_from[e];
         cuts++;
     }
+    if (cuts == 1 && at[0] + 1 < r->views - 1) {
+        /* A slip is one moment: the views after it part from those before across the closing
+         * pair as well, even where that pair shares only a face they slide along (a thin box's
+         * top: the pair couples, a shift along it unseen). The placement then tells. */
+        at[1] = r->views - 1;
+        cuts = 2;
+    }
     if (r->passes != 1 || r->views < 4 || cuts != 2 || r->edges != r->views)
         return 0;
     memset(r->group, 0, sizeof(r->group));
