@@ -116,7 +116,8 @@ static double loop_extent(const struct fusion_volume *vol, const uint32_t *loop,
             lo[c] = k == 0 || x < lo[c] ? x : lo[c];
             hi[c] = k == 0 || x > hi[c] ? x : hi[c];
         }
-    return sqrt((double)(hi[0] - lo[0]) * (hi[0] - lo[0]) + (double)(hi[1] - lo[1]) * (hi[1] - lo[1]) +
+    return sqrt((double)(hi[0] - lo[0]) * (hi[0] - lo[0]) +
+                (double)(hi[1] - lo[1]) * (hi[1] - lo[1]) +
                 (double)(hi[2] - lo[2]) * (hi[2] - lo[2]));
 }
 
@@ -145,8 +146,8 @@ static int fan_loop(struct fusion_volume *vol, const uint32_t *loop, uint32_t le
     for (int i = 0; i < 3; i++) {
         vol->mesh_pos[3 * (size_t)c + i] = (float)pos[i];
         vol->mesh_nrm[3 * (size_t)c + i] = nl > 0.0 ? (float)(nrm[i] / nl) : 0.0f;
-        vol->mesh_rgb[3 * (size_t)c + i] =
-            coloured > 0 ? (uint8_t)lround(rgb[i] / coloured) : vol->mesh_rgb[3 * (size_t)loop[0] + i];
+        vol->mesh_rgb[3 * (size_t)c + i] = coloured > 0 ? (uint8_t)lround(rgb[i] / coloured)
+                                                        : vol->mesh_rgb[3 * (size_t)loop[0] + i];
     }
     vol->mesh_coloured[c] = coloured > 0 || vol->mesh_coloured[loop[0]];
     vol->mesh_index[c] = s->kept_vertices++;

@@ -186,6 +186,13 @@ void reg_align_group(struct reg_ctx *r, struct reg_report *rep)
  * residual for a slipped bunny and a slipped group of spheres; another object from the slip on
  * (spheres 1.4 times as large) couples 0.52 at 60 times the residual.
  * @retval 1 placed */
+static int placement_fits(const struct reg_ctx *r, uint32_t coupled, uint32_t overlap, double rms,
+                          double ring_rms_mm)
+{
+    return overlap > 0 && coupled >= 2.0 * r->p.min_coupled_share * overlap &&
+           rms <= 2.0 * ring_rms_mm + 0.02;
+}
+
 int reg_place_near_table(struct reg_ctx *r, double ring_rms_mm)
 {
     double rms = 0.0;
@@ -197,8 +204,7 @@ int reg_place_near_table(struct reg_ctx *r, double ring_rms_mm)
         coupled = refine_second_step(r, it < 20 ? gate : r->p.max_pair_mm, NULL, &rms, &overlap,
                                      r->placed_share, r->placed_axis);
     }
-    r->second_aligned = overlap > 0 && coupled >= 2.0 * r->p.min_coupled_share * overlap &&
-                        rms <= 2.0 * ring_rms_mm + 0.02;
+    r->second_aligned = placement_fits(r, coupled, overlap, rms, ring_rms_mm);
     return r->second_aligned;
 }
 
@@ -286,6 +292,11 @@ static double colour_misfit(struct reg_ctx *r, vec3 shift, uint64_t *compared)
  * this many samples compared there. Measured on the slipped parts of data/objects and the
  * simulator's box (painted in patches): 0.1 to 0.2; a box of one colour has no dip at all. */
 #define REG_COLOUR_MAX_DIP 0.5
+/* And its misfit at most this share of a full miss: where the paint lines up, the pairs that
+ * disagree are those on its boundaries (mixed pixels), 0.07 to 0.10 of a full miss measured
+ * on the slipped parts of data/objects; a cup slipped 30 mm, its shape fitting a wrong place,
+ * lined up at 0.20. */
+#define REG_COLOUR_MAX_MISFIT 0.14
 #define REG_COLOUR_MIN_COMPARED 200
 /* The colour search moves along one direction: the shape must hold the next weakest one at
  * least this well (the box, bracket, plate, nut and stepped block of data/objects: 0.14 to 0.48;
@@ -300,7 +311,7 @@ static void shift_placement(struct reg_ctx *r, vec3 t, double mm)
     r->first_from_second = moved;
 }
 
-int reg_place_by_colour(struct reg_ctx *r)
+int reg_place_by_colour(struct reg_ctx *r, double ring_rms_mm)
 {
     const vec3 t = r->placed_axis[0];
     if (!r->second_aligned || r->placed_share[1] < REG_COLOUR_MIN_NEXT)
@@ -322,14 +333,20 @@ int reg_place_by_colour(struct reg_ctx *r)
         if (m < best_misfit)
             best_misfit = m, best = s, best_compared = compared;
     }
-    if (best_compared < REG_COLOUR_MIN_COMPARED || !(best_misfit < REG_COLOUR_MAX_DIP * mean))
+    if (best_compared < REG_COLOUR_MIN_COMPARED || !(best_misfit < REG_COLOUR_MAX_DIP * mean) ||
+        best_misfit > REG_COLOUR_MAX_MISFIT * REG_HUE_TAU * REG_HUE_TAU)
         return 0; /* no dip: plain paint (all grey: 0 everywhere) or nothing compared */
+    struct frame_xform before = r->first_from_second;
     shift_placement(r, t, best);
-    double rms, share[3];
-    uint32_t overlap;
+    double rms = 0.0, share[3];
+    uint32_t overlap = 0, coupled = 0;
     vec3 axis[3];
     for (int it = 0; it < 5; it++) /* the shape refines the rest, the colour keeps t */
-        refine_second_step(r, r->p.max_pair_mm, &t, &rms, &overlap, share, axis);
+        coupled = refine_second_step(r, r->p.max_pair_mm, &t, &rms, &overlap, share, axis);
+    if (!placement_fits(r, coupled, overlap, rms, ring_rms_mm)) {
+        r->first_from_second = before; /* where the paint agrees the shape does not */
+        return 0;
+    }
     r->placed_by_colour = 1;
     return 1;
 }

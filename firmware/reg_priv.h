@@ -34,8 +34,9 @@ int reg_placement_holds(const struct reg_ctx *r);
 
 /* The last placement, whose shape holds every direction but one (placed_axis[0]), moved along it
  * to where the two groups' colours agree (their hues: raw colours compare as the paint's), then
- * refined by the shape with that direction kept. @retval 1 placed (placed_by_colour)
+ * refined by the shape with that direction kept, and taken when the shape still fits there as
+ * a placement near the table must (@p ring_rms_mm). @retval 1 placed (placed_by_colour)
  * @retval 0 the colour does not fix it either: the placement is left as it was */
-int reg_place_by_colour(struct reg_ctx *r);
+int reg_place_by_colour(struct reg_ctx *r, double ring_rms_mm);
 
 #endif

@@ -4,11 +4,12 @@
 # (data/objects/*.scad, made into PLY at run time: openscad, then tools/off2ply.awk), the
 # simulator's sphere, cylinder and torus, and the Stanford bunny. For each object: every view
 # count with [colour] method none and multi and the table exact; at 8 views the table 1 and 2
-# degrees off; at 8 views a 6 mm slip after 170 degrees. Columns: finished or the error, the model
-# against the truth once aligned (mean, mm), the truth within 1 mm of the model (above the
-# table), holes and pieces of the model, and the registration's CPU.
+# degrees off; at 8 views a 6 mm and a 30 mm slip after 170 degrees. Columns: finished (and how
+# the views after a slip were placed) or the error, the model against the truth once aligned
+# (mean, mm), the truth within 1 mm of the model (above the table), holes and pieces of the
+# model, and the registration's CPU.
 # Usage: scripts/measure-objects.sh BUILD; OBJECTS="box gear", VIEWS="4 8", METHODS="none" and
-# CONDITIONS="exact" (exact table1 table2 slip) choose a subset.
+# CONDITIONS="exact" (exact table1 table2 slip slip30) choose a subset.
 set -eu
 build=$1
 out=$build/measure-objects
@@ -16,7 +17,7 @@ top=$(pwd)
 objects=${OBJECTS:-"box thin_box l_bracket plate_holes hex_nut gear stepped_block cup cone sphere cylinder torus bunny"}
 views_list=${VIEWS:-"3 4 6 8 12 24"}
 methods=${METHODS:-"none multi"}
-conditions=${CONDITIONS:-"exact table1 table2 slip"}
+conditions=${CONDITIONS:-"exact table1 table2 slip slip30"}
 mkdir -p "$out/parts"
 parts=$(cd "$out/parts" && pwd) # configs name files relative to themselves: absolute paths
 
@@ -47,6 +48,8 @@ row() { # object, views, method, table, name: scan it and print its row
     rm -rf "${out:?}/$5"
     if "$build/scanner" scan --config "$out/$5.ini" --out "$out/$5" >"$out/$5.log" 2>&1; then
         result=finished
+        placed=$(grep -o "moved on the table at view [0-9]*: [0-9]* views* placed by the object's [a-z ]*" "$out/$5.log" | head -n 1 || true)
+        [ -z "$placed" ] || result="finished; $(echo "$placed" | sed "s/ the object's / /")"
         "$build/mesh-compare" --align "$out/$5/mesh.ply" "$out/$5/truth_mesh.ply" >"$out/$5.compare" 2>&1 || true
         mean=$(sed -n 's/^result -> truth: mean \([0-9.]*\) mm.*/\1/p' "$out/$5.compare")
         within=$(sed -n 's/^truth above the table (z >= 1 mm) -> result: mean [0-9.]* mm, within 1 mm \([0-9.]*\)%.*/\1/p' "$out/$5.compare")
@@ -81,6 +84,8 @@ for obj in $objects; do
             row "$obj" 8 none "2 deg off" "$obj-table2" ;;
         slip) config "$obj" 8 none "slip_mm = 6, 0, 0\nslip_at_deg = 170\n" "$obj-slip"
             row "$obj" 8 none "6 mm slip" "$obj-slip" ;;
+        slip30) config "$obj" 8 none "slip_mm = 30, 0, 0\nslip_at_deg = 170\n" "$obj-slip30"
+            row "$obj" 8 none "30 mm slip" "$obj-slip30" ;;
         esac
     done
 done
