@@ -2,19 +2,19 @@
 # make measure-objects: the object corpus scanned as a new user would (tests/objects.ini: every
 # default, no [colour] section), one table (issue 30). Mechanical parts from OpenSCAD
 # (data/objects/*.scad, made into PLY at run time: openscad, then tools/off2ply.awk), the
-# simulator's sphere, cylinder and torus, and the Stanford bunny. For each object: every view
-# count with [colour] method none and multi and the table exact; at 8 views the table 1 and 2
-# degrees off; at 8 views a 6 mm and a 30 mm slip after 170 degrees. Columns: finished (and how
-# the views after a slip were placed) or the error, the model against the truth once aligned
-# (mean, mm), the truth within 1 mm of the model (above the table), holes and pieces of the
-# model, and the registration's CPU.
+# simulator's sphere, cylinder and torus, and two scanned meshes, the Stanford bunny and
+# armadillo. For each object: every view count with [colour] method none and multi and the table
+# exact; at 8 views the table 1 and 2 degrees off; at 8 views a 6 mm and a 30 mm slip after 170
+# degrees. Columns: finished (and how the views after a slip were placed) or the error, the
+# model against the truth once aligned (mean, mm), the truth within 1 mm of the model (above the
+# table), holes and pieces of the model, and the registration's CPU.
 # Usage: scripts/measure-objects.sh BUILD; OBJECTS="box gear", VIEWS="4 8", METHODS="none" and
 # CONDITIONS="exact" (exact table1 table2 slip slip30) choose a subset.
 set -eu
 build=$1
 out=$build/measure-objects
 top=$(pwd)
-objects=${OBJECTS:-"box thin_box l_bracket plate_holes hex_nut gear stepped_block cup cone sphere cylinder torus bunny"}
+objects=${OBJECTS:-"box thin_box l_bracket plate_holes hex_nut gear stepped_block cup cone sphere cylinder torus bunny armadillo"}
 views_list=${VIEWS:-"3 4 6 8 12 24"}
 methods=${METHODS:-"none multi"}
 conditions=${CONDITIONS:-"exact table1 table2 slip slip30"}
@@ -26,6 +26,7 @@ sim_lines() {
     case $1 in
     sphere | cylinder | torus) printf 'object = %s\nobject_height_mm = 100\n' "$1" ;;
     bunny) printf 'object = mesh\nmesh_file = %s/data/bunny/bun_zipper.ply\nobject_height_mm = 150\n' "$top" ;;
+    armadillo) printf 'object = mesh\nmesh_file = %s/data/armadillo/armadillo.ply\nobject_height_mm = 150\n' "$top" ;;
     *)
         if [ ! -f "$parts/$1.ply" ]; then
             openscad -o "$parts/$1.off" "data/objects/$1.scad" >"$parts/$1.log" 2>&1
