@@ -194,6 +194,23 @@ void calib_read_quality(const char *path, double *camera_rms_px, double *project
         fclose(f);
 }
 
+int calib_read_weak(const char *path, char *why, size_t why_len)
+{
+    char line[1024];
+    int weak = 0;
+    FILE *f = file_open_regular(path, "r");
+    while (f != NULL && !weak && fgets(line, sizeof(line), f) != NULL) {
+        if (strncmp(line, "; weak: ", 8) != 0)
+            continue;
+        line[strcspn(line, "\n")] = '\0';
+        snprintf(why, why_len, "%s", line + 8);
+        weak = 1;
+    }
+    if (f != NULL)
+        fclose(f);
+    return weak;
+}
+
 /* The lights the calibration has (light_N_... keys of N < light_count) are written. */
 static int skip_absent_light(const struct ini_key *k, const void *target)
 {

@@ -24,6 +24,10 @@ int calib_save(const struct hal_storage *st, const char *path, const struct scan
  *  each when the file has none. */
 void calib_read_quality(const char *path, double *camera_rms_px, double *projector_rms_px);
 
+/** Why scanner calibrate flagged the file at @p path weak (its "; weak: " comment), into @p why.
+ *  @retval 1 flagged @retval 0 not (or no such file) */
+int calib_read_weak(const char *path, char *why, size_t why_len);
+
 /** Markdown documentation of the calibration file's keys. */
 void calib_print_doc(FILE *out);
 

@@ -28,6 +28,8 @@ struct calib_settings {
     uint32_t min_corners;
     uint32_t fix_k3;
     double max_camera_rms_px, max_projector_rms_px;
+    double max_sigma_centre_px, max_sigma_focal_share;       /**< a lens this uncertain: weak */
+    double max_sigma_translation_mm, max_sigma_rotation_deg; /**< the pose this uncertain: weak */
 };
 
 #endif

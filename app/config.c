@@ -388,6 +388,15 @@ static const struct ini_key config_keys[] = {
         "a camera reprojection RMS above this refuses the calibration"),
     F64("calibrate", "max_projector_rms_px", calibrate.max_projector_rms_px, 0.01, 100, "1",
         "a projector reprojection RMS above this refuses the calibration"),
+    F64("calibrate", "max_sigma_centre_px", calibrate.max_sigma_centre_px, 0.01, 1000, "5",
+        "a principal point (camera or projector) less certain than this (one standard "
+        "deviation) writes the calibration flagged weak, saying what to capture next"),
+    F64("calibrate", "max_sigma_focal_share", calibrate.max_sigma_focal_share, 1e-5, 1, "0.005",
+        "a focal length less certain than this share of itself flags it weak"),
+    F64("calibrate", "max_sigma_translation_mm", calibrate.max_sigma_translation_mm, 0.001, 1000,
+        "1", "the camera -> projector translation less certain than this flags it weak"),
+    F64("calibrate", "max_sigma_rotation_deg", calibrate.max_sigma_rotation_deg, 1e-4, 90, "0.05",
+        "the camera -> projector rotation less certain than this flags it weak"),
 };
 
 #undef C

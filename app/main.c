@@ -407,6 +407,12 @@ int main(int argc, char **argv)
             fprintf(stderr, "scanner: error: %s\n", err);
             return 2;
         }
+        char why[1024];
+        if (calib_read_weak(cfg.calibration_file, why, sizeof(why)))
+            fprintf(stderr,
+                    "scanner: warning: %s: the calibration is weak: %s (scan with it, or "
+                    "calibrate again with those placements added)\n",
+                    cfg.calibration_file, why);
         printf("%s: ok\n", config_path);
         return 0;
     }

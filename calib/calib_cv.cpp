@@ -323,3 +323,144 @@ extern "C" int calcv_pose(const calcv_corners *v, const calcv_lens *lens, double
     *rms = calcv_reprojection_rms(v, lens, rvec, tvec);
     return 0;
 }
+
+namespace
+{
+
+// The unknowns of a calibration as one vector: camera lens (9), projector lens (9), the camera
+// -> projector rotation vector and translation (6), and each view's board -> camera pose (6).
+struct joint_problem {
+    const calcv_corners *cam, *proj;
+    int n;
+    std::vector<std::vector<cv::Point3f>> obj;
+    std::vector<std::vector<cv::Point2f>> img_cam, img_proj;
+};
+
+void lens_at(const std::vector<double> &x, int at, cv::Matx33d &k, cv::Mat &d)
+{
+    k = cv::Matx33d(x[at], 0, x[at + 2], 0, x[at + 1], x[at + 3], 0, 0, 1);
+    d = cv::Mat(1, 5, CV_64F);
+    for (int i = 0; i < 5; i++)
+        d.at<double>(i) = x[at + 4 + i];
+}
+
+// Every reprojection residual (x, y of each corner in the camera, then in the projector).
+void joint_residuals(const joint_problem &p, const std::vector<double> &x, std::vector<double> &r)
+{
+    r.clear();
+    cv::Matx33d kc, kp;
+    cv::Mat dc, dp;
+    lens_at(x, 0, kc, dc);
+    lens_at(x, 9, kp, dp);
+    cv::Vec3d rs(x[18], x[19], x[20]), ts(x[21], x[22], x[23]);
+    std::vector<cv::Point2f> out;
+    for (int v = 0; v < p.n; v++) {
+        const double *pose = &x[24 + 6 * (size_t)v];
+        cv::Vec3d rv(pose[0], pose[1], pose[2]), tv(pose[3], pose[4], pose[5]);
+        cv::projectPoints(p.obj[v], rv, tv, kc, dc, out);
+        for (size_t i = 0; i < out.size(); i++) {
+            r.push_back(out[i].x - p.img_cam[v][i].x);
+            r.push_back(out[i].y - p.img_cam[v][i].y);
+        }
+        if (p.proj == nullptr)
+            continue;
+        cv::Vec3d r3, t3;
+        cv::composeRT(rv, tv, rs, ts, r3, t3);
+        cv::projectPoints(p.obj[v], r3, t3, kp, dp, out);
+        for (size_t i = 0; i < out.size(); i++) {
+            r.push_back(out[i].x - p.img_proj[v][i].x);
+            r.push_back(out[i].y - p.img_proj[v][i].y);
+        }
+    }
+}
+
+} // namespace
+
+extern "C" int calcv_uncertainty(const calcv_corners *cam, const calcv_corners *proj, int n,
+                                 int fix_k3, const calcv_lens *cam_lens,
+                                 const calcv_lens *proj_lens, const double rot[9],
+                                 const double trans[3], calcv_sigma *sigma)
+{
+    std::memset(sigma, 0, sizeof(*sigma));
+    joint_problem p{cam, proj, n, {}, {}, {}};
+    std::vector<double> x(24 + 6 * (size_t)n, 0.0);
+    const calcv_lens *lenses[2] = {cam_lens, proj != nullptr ? proj_lens : cam_lens};
+    for (int l = 0; l < 2; l++) {
+        x[9 * l] = lenses[l]->fx, x[9 * l + 1] = lenses[l]->fy;
+        x[9 * l + 2] = lenses[l]->cx, x[9 * l + 3] = lenses[l]->cy;
+        for (int i = 0; i < 5; i++)
+            x[9 * l + 4 + i] = lenses[l]->dist[i];
+    }
+    if (proj != nullptr) {
+        cv::Vec3d rs;
+        cv::Rodrigues(cv::Matx33d(rot), rs);
+        for (int i = 0; i < 3; i++)
+            x[18 + i] = rs[i], x[21 + i] = trans[i];
+    }
+    p.obj.resize(n);
+    p.img_cam.resize(n);
+    p.img_proj.resize(n);
+    for (int v = 0; v < n; v++) {
+        split(cam[v], p.obj[v], p.img_cam[v]);
+        if (proj != nullptr) {
+            std::vector<cv::Point3f> o;
+            split(proj[v], o, p.img_proj[v]);
+        }
+        double rv[3], tv[3], rms;
+        if (calcv_pose(&cam[v], cam_lens, rv, tv, &rms) != 0)
+            return -EDOM;
+        for (int i = 0; i < 3; i++)
+            x[24 + 6 * (size_t)v + i] = rv[i], x[24 + 6 * (size_t)v + 3 + i] = tv[i];
+    }
+    // The unknowns solved for: the camera's lens, the projector's and the pose between them
+    // when there is a projector, k3 unless fixed, every board pose.
+    std::vector<int> free;
+    for (int i = 0; i < 24 + 6 * n; i++) {
+        bool projector_part = i >= 9 && i < 24;
+        bool k3 = i == 8 || i == 17;
+        if ((projector_part && proj == nullptr) || (k3 && fix_k3))
+            continue;
+        free.push_back(i);
+    }
+    std::vector<double> r0, rp, rm;
+    joint_residuals(p, x, r0);
+    const int m = (int)r0.size(), k = (int)free.size();
+    if (m <= k)
+        return -EINVAL;
+    cv::Mat jac(m, k, CV_64F);
+    for (int c = 0; c < k; c++) { // central differences, a step relative to the value
+        int i = free[c];
+        double h = 1e-6 * std::max(1.0, std::fabs(x[i]));
+        std::vector<double> xp = x, xm = x;
+        xp[i] += h;
+        xm[i] -= h;
+        joint_residuals(p, xp, rp);
+        joint_residuals(p, xm, rm);
+        for (int row = 0; row < m; row++)
+            jac.at<double>(row, c) = (rp[row] - rm[row]) / (2.0 * h);
+    }
+    double sse = 0.0;
+    for (double e : r0)
+        sse += e * e;
+    double var = sse / (double)(m - k);
+    cv::Mat cov;
+    if (cv::invert(jac.t() * jac, cov, cv::DECOMP_SVD) == 0.0)
+        return -EDOM;
+    cov *= var;
+    for (int c = 0; c < k; c++) {
+        int i = free[c];
+        double sd = std::sqrt(std::max(0.0, cov.at<double>(c, c)));
+        if (i < 9)
+            sigma->cam[i] = sd;
+        else if (i < 18)
+            sigma->proj[i - 9] = sd;
+        else if (i < 21)
+            sigma->rot_deg[i - 18] = sd * 180.0 / CV_PI;
+        else if (i < 24)
+            sigma->trans_mm[i - 21] = sd;
+    }
+    sigma->residual_px = std::sqrt(var);
+    sigma->residuals = m;
+    sigma->unknowns = k;
+    return 0;
+}

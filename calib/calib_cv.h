@@ -91,6 +91,25 @@ void calcv_pose_through(const double rvec[3], const double tvec[3], const double
 double calcv_reprojection_rms(const struct calcv_corners *v, const struct calcv_lens *lens,
                               const double rvec[3], const double tvec[3]);
 
+/** One standard deviation of each calibrated value (the solve's own covariance: the inverse of
+ *  JᵀJ of every reprojection residual over every unknown, board poses included, scaled by the
+ *  residuals' variance). Lens order: fx, fy, cx, cy, k1, k2, p1, p2, k3 (0 where fixed). */
+struct calcv_sigma {
+    double cam[9], proj[9];
+    double rot_deg[3];  /**< the camera -> projector rotation vector's components */
+    double trans_mm[3]; /**< its translation */
+    double residual_px; /**< the residuals' standard deviation the covariance is scaled by */
+    int residuals, unknowns;
+};
+
+/** The uncertainty of a calibration: @p cam corners (and, unless @p proj is NULL, the same
+ *  corners in the projector) of @p n views, through the lenses and the pose found.
+ *  @param sigma  out @retval 0 @retval -EINVAL fewer residuals than unknowns @retval -EDOM */
+int calcv_uncertainty(const struct calcv_corners *cam, const struct calcv_corners *proj, int n,
+                      int fix_k3, const struct calcv_lens *cam_lens,
+                      const struct calcv_lens *proj_lens, const double rot[9],
+                      const double trans[3], struct calcv_sigma *sigma);
+
 #ifdef __cplusplus
 }
 #endif

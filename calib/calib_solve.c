@@ -54,6 +54,10 @@ struct solve {
     char refusal[512]; /* the last "refused: ..." line, for the error message */
     double cam_rms, proj_rms, stereo_rms;
     int camera_only;
+    struct calcv_sigma sigma; /* one standard deviation of each value (have_sigma) */
+    int have_sigma;
+    char weak[192];   /* what is too uncertain ("" when nothing) ... */
+    char advice[192]; /* ... and what to capture next */
 };
 
 static void say(struct solve *s, const char *fmt, ...)
@@ -447,6 +451,93 @@ static int solve_camera(struct solve *s)
     return 0;
 }
 
+/* The uncertainty of what was solved (calcv_sigma), said in the report: a lens's focal lengths
+ * and principal point, its distortion, and the pose between camera and projector. */
+static void say_lens_sigma(struct solve *s, const char *name, const double sd[9])
+{
+    say(s,
+        "%s: 1 sigma: fx %.2f, fy %.2f, cx %.2f, cy %.2f px; k1 %.4f, k2 %.4f, p1 %.5f, "
+        "p2 %.5f, k3 %.4f\n",
+        name, sd[0], sd[1], sd[2], sd[3], sd[4], sd[5], sd[6], sd[7], sd[8]);
+}
+
+static void find_sigma(struct solve *s, const struct calcv_corners *cam,
+                       const struct calcv_corners *proj, int n, const struct calcv_lens *cl,
+                       const struct calcv_lens *pl)
+{
+    s->have_sigma = calcv_uncertainty(cam, proj, n, (int)s->cfg->calibrate.fix_k3, cl, pl,
+                                      s->out.proj_rot, s->out.proj_trans_mm, &s->sigma) == 0;
+    if (!s->have_sigma) {
+        say(s, "uncertainty: not computed (fewer corners than unknowns)\n");
+        return;
+    }
+    say_lens_sigma(s, "camera", s->sigma.cam);
+    if (proj == NULL)
+        return;
+    say_lens_sigma(s, "projector", s->sigma.proj);
+    say(s,
+        "pose camera -> projector: 1 sigma: rotation %.3f, %.3f, %.3f deg, translation %.2f, "
+        "%.2f, %.2f mm (%d residuals, %d unknowns, residual %.3f px)\n",
+        s->sigma.rot_deg[0], s->sigma.rot_deg[1], s->sigma.rot_deg[2], s->sigma.trans_mm[0],
+        s->sigma.trans_mm[1], s->sigma.trans_mm[2], s->sigma.residuals, s->sigma.unknowns,
+        s->sigma.residual_px);
+}
+
+/* Append to @p buf what of lens @p name (sigma @p sd, focal @p fx) is less certain than the
+ * bounds. @retval 1 something was */
+static int weak_lens(const struct calib_settings *cs, const char *name, const double sd[9],
+                     double fx, char *buf, size_t len)
+{
+    int weak = 0;
+    size_t n = strlen(buf);
+    double centre = fmax(sd[2], sd[3]), focal = fmax(sd[0], sd[1]);
+    if (centre > cs->max_sigma_centre_px && n < len) {
+        n += (size_t)snprintf(buf + n, len - n, "%s%s principal point +-%.2g px", n ? ", " : "",
+                              name, centre);
+        weak = 1;
+    }
+    if (focal > cs->max_sigma_focal_share * fx && n < len) {
+        snprintf(buf + n, len - n, "%s%s focal length +-%.2g%%", n ? ", " : "", name,
+                 100.0 * focal / fx);
+        weak = 1;
+    }
+    return weak;
+}
+
+/* A calibration whose values are less certain than [calibrate] max_sigma_* is written, but
+ * flagged weak (its file says so, check-config warns), with what would constrain them: a lens's
+ * principal point and focal length are fixed by boards seen tilted and off the image's centre;
+ * the projector's, and the pose between it and the camera, by boards tilted towards and away
+ * from the projector and at other distances. */
+static void judge_uncertainty(struct solve *s)
+{
+    const struct calib_settings *cs = &s->cfg->calibrate;
+    char what[sizeof(s->weak)] = "";
+    s->weak[0] = '\0';
+    if (!s->have_sigma)
+        return;
+    int cam = weak_lens(cs, "camera", s->sigma.cam, s->out.cam_fx_px, what, sizeof(what));
+    int proj = !s->camera_only &&
+               weak_lens(cs, "projector", s->sigma.proj, s->out.proj_fx_px, what, sizeof(what));
+    double t = fmax(s->sigma.trans_mm[0], fmax(s->sigma.trans_mm[1], s->sigma.trans_mm[2]));
+    double r = fmax(s->sigma.rot_deg[0], fmax(s->sigma.rot_deg[1], s->sigma.rot_deg[2]));
+    size_t n = strlen(what);
+    if (!s->camera_only && (t > cs->max_sigma_translation_mm || r > cs->max_sigma_rotation_deg)) {
+        snprintf(what + n, sizeof(what) - n, "%sprojector pose +-%.2g mm, +-%.2g deg",
+                 n ? ", " : "", t, r);
+        proj = 1;
+    }
+    if (!cam && !proj)
+        return;
+    snprintf(s->weak, sizeof(s->weak), "%s", what);
+    snprintf(s->advice, sizeof(s->advice), "add %s",
+             proj ? "placements tilted towards and away from the projector ([calibrate] "
+                    "placements with 35 and -35) and at other offsets (0@75, 0@-75)"
+                  : "placements tilted 30 to 45 deg and offset towards the image's corners "
+                    "([calibrate] placements with 35@75 and -35@-75)");
+    say(s, "weak: %s; %s\n", s->weak, s->advice);
+}
+
 /* The projector as an inverse camera (Zhang's method on the corners' projector coordinates),
  * then camera and projector refined together with the pose between them (stereoCalibrate). */
 static int solve_projector(struct solve *s)
@@ -464,6 +555,12 @@ static int solve_projector(struct solve *s)
         s->camera_only = 1;
         say(s, "projector: no capture has its patterns: the camera alone is calibrated (the "
                "projector, the axis and the lights stay as the starting file has them)\n");
+        for (uint32_t i = 0; i < s->view_count; i++)
+            if (s->views[i].found)
+                cam[n++] = s->views[i].cam;
+        struct calcv_lens cl;
+        calib_to_lens(&s->out, 0, &cl);
+        find_sigma(s, cam, NULL, n, &cl, NULL);
         return 0;
     }
     if (n < 3) {
@@ -505,6 +602,7 @@ static int solve_projector(struct solve *s)
     s->proj_rms = count > 0 ? sqrt(sum / count) : 0.0;
     say(s, "projector: reprojection RMS %.4f px (joint RMS %.4f px over %d views)\n", s->proj_rms,
         s->stereo_rms, n);
+    find_sigma(s, cam, proj, n, &cl, &pl);
     if (s->proj_rms > cs->max_projector_rms_px) {
         say(s,
             "refused: the projector's reprojection RMS %.3f px is above [calibrate] "
@@ -906,13 +1004,35 @@ static int keep_old(const char *path, char *kept, size_t len)
 
 static int write_outputs(struct solve *s, const struct hal_storage *st, const char *out_path)
 {
-    char comment[1024], kept[HAL_MAX_PATH + 40], report_path[HAL_MAX_PATH + 16];
-    /* the quality line is read back by calib_read_quality (verify, measure-calib) */
-    snprintf(comment, sizeof(comment),
-             "; written by scanner calibrate from %s\n"
-             "; quality: camera_rms_px = %.4f, projector_rms_px = %.4f, boards = %u\n"
-             "; camera frame: x right, y down, z forward; millimetres\n",
-             s->dir, s->cam_rms, s->proj_rms, (unsigned)s->view_count);
+    char comment[3072], kept[HAL_MAX_PATH + 40], report_path[HAL_MAX_PATH + 16];
+    /* the quality line is read back by calib_read_quality (verify, measure-calib), the weak
+     * line by calib_read_weak (check-config) */
+    int n = snprintf(comment, sizeof(comment),
+                     "; written by scanner calibrate from %s\n"
+                     "; quality: camera_rms_px = %.4f, projector_rms_px = %.4f, boards = %u\n",
+                     s->dir, s->cam_rms, s->proj_rms, (unsigned)s->view_count);
+    const double *c = s->sigma.cam, *p = s->sigma.proj;
+    if (s->have_sigma && n > 0 && (size_t)n < sizeof(comment)) /* lines under 198 characters */
+        n += snprintf(comment + n, sizeof(comment) - (size_t)n,
+                      "; uncertainty (one standard deviation):\n"
+                      ";   camera fx %.3g, fy %.3g, cx %.3g, cy %.3g px\n"
+                      ";   camera distortion %.2g, %.2g, %.2g, %.2g, %.2g\n",
+                      c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7], c[8]);
+    if (s->have_sigma && !s->camera_only && n > 0 && (size_t)n < sizeof(comment))
+        n += snprintf(
+            comment + n, sizeof(comment) - (size_t)n,
+            ";   projector fx %.3g, fy %.3g, cx %.3g, cy %.3g px\n"
+            ";   projector distortion %.2g, %.2g, %.2g, %.2g, %.2g\n"
+            ";   projector rotation %.2g, %.2g, %.2g deg, translation %.3g, %.3g, %.3g mm\n",
+            p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], p[8], s->sigma.rot_deg[0],
+            s->sigma.rot_deg[1], s->sigma.rot_deg[2], s->sigma.trans_mm[0], s->sigma.trans_mm[1],
+            s->sigma.trans_mm[2]);
+    if (s->weak[0] && n > 0 && (size_t)n < sizeof(comment))
+        n += snprintf(comment + n, sizeof(comment) - (size_t)n, "; weak: %s\n; to fix: %s\n",
+                      s->weak, s->advice);
+    if (n > 0 && (size_t)n < sizeof(comment))
+        snprintf(comment + n, sizeof(comment) - (size_t)n,
+                 "; camera frame: x right, y down, z forward; millimetres\n");
     /* Written beside it first, and what calib_load accepts is the test of what was written:
      * only a file that loads replaces the one in use (which is then kept beside it). */
     char fresh[HAL_MAX_PATH + 16];
@@ -996,6 +1116,8 @@ int calibrate_solve(const struct hal_storage *st, const struct app_config *cfg, 
         rc = solve_axis(&s);
     if (rc == 0)
         rc = solve_lights(&s);
+    if (rc == 0)
+        judge_uncertainty(&s);
     fputs(s.report != NULL ? s.report : "", stdout);
     if (rc == 0)
         rc = write_outputs(&s, st, out_path);

@@ -40,6 +40,32 @@ full_test() {
         "$bin" check-config --config "$out/calibrated.ini"
 }
 check calibrate_whole_procedure full_test
+# The uncertainty of the whole procedure's values (issue 31): said in the report and the file,
+# plausible (a focal length within 0.5% and not exactly known, the pose to the projector within a
+# millimetre), not weak; with bounds tighter than the captures can meet, the same captures give
+# a file flagged weak, naming what, saying what to capture, and check-config warns of it.
+sigma_line() { # the report's 1-sigma value $2 (1-based) of line $1
+    sed -n "s/^$1: 1 sigma: //p" "$out/cal.report.txt" | tr -d 'a-z,;' | awk -v f="$2" '{ print $f }'
+}
+uncertainty_test() {
+    grep '1 sigma' "$out/cal.report.txt" &&
+        grep -q '^; uncertainty (one standard deviation):' "$out/cal.ini" &&
+        grep -q '^;   projector rotation' "$out/cal.ini" && ! grep -q '^; weak' "$out/cal.ini" &&
+        awk -v s="$(sigma_line camera 1)" 'BEGIN { exit !(s > 0 && s < 0.005 * 2436) }' &&
+        awk -v s="$(sigma_line projector 3)" 'BEGIN { exit !(s > 0 && s < 5) }' || return 1
+    sed -e 's/^\[calibrate\]/[calibrate]\nmax_sigma_centre_px = 0.01/' \
+        -e "s|^calibration = ../|calibration = $PWD/|; s|^rig = ../|rig = $PWD/|" $cfg >"$out/tight-cfg.ini"
+    "$bin" calibrate --config "$out/tight-cfg.ini" --from "$out/cal-captures" \
+        --out "$out/tight.ini" >"$out/tight.txt" 2>&1
+    rc=$?
+    grep 'weak:' "$out/tight.txt" && [ $rc -eq 0 ] &&
+        grep -q '^; weak: camera principal point +-.*projector principal point' "$out/tight.ini" &&
+        grep -q '^; to fix: add placements' "$out/tight.ini" &&
+        sed "s|^calibration = .*|calibration = $PWD/$out/tight.ini|; s|^rig = ../|rig = $PWD/|" $cfg >"$out/tight-use.ini" &&
+        "$bin" check-config --config "$out/tight-use.ini" 2>"$out/tight-check.txt" &&
+        grep -q 'warning: .*the calibration is weak: camera principal point' "$out/tight-check.txt"
+}
+check calibration_states_its_uncertainty uncertainty_test
 # Killed after three captures: the finished ones are kept, nothing is written; --from finishes.
 kill_test() {
     "$bin" calibrate --config $cfg --out "$out/killed.ini" >"$out/killed.txt" 2>&1 &
