@@ -379,7 +379,8 @@ void joint_residuals(const joint_problem &p, const std::vector<double> &x, std::
 extern "C" int calcv_uncertainty(const calcv_corners *cam, const calcv_corners *proj, int n,
                                  int fix_k3, const calcv_lens *cam_lens,
                                  const calcv_lens *proj_lens, const double rot[9],
-                                 const double trans[3], calcv_sigma *sigma)
+                                 const double trans[3], calcv_sigma *sigma, calcv_draw *draws,
+                                 int draw_count)
 {
     std::memset(sigma, 0, sizeof(*sigma));
     joint_problem p{cam, proj, n, {}, {}, {}};
@@ -462,5 +463,38 @@ extern "C" int calcv_uncertainty(const calcv_corners *cam, const calcv_corners *
     sigma->residual_px = std::sqrt(var);
     sigma->residuals = m;
     sigma->unknowns = k;
+    // Draws from the lenses' and the pose's block of the covariance (the board poses' rows
+    // marginalised by leaving them out): its square root by eigen-decomposition, times N(0, I).
+    int q = 0;
+    while (q < k && free[q] < 24)
+        q++;
+    if (draws == nullptr || draw_count <= 0 || q == 0)
+        return 0;
+    cv::Mat block = cov(cv::Range(0, q), cv::Range(0, q)).clone(), w, u;
+    cv::eigen(block, w, u); // block = u^T diag(w) u
+    cv::RNG rng(31);
+    for (int d = 0; d < draw_count; d++) {
+        cv::Mat z(q, 1, CV_64F);
+        for (int i = 0; i < q; i++)
+            z.at<double>(i) = rng.gaussian(1.0) * std::sqrt(std::max(0.0, w.at<double>(i)));
+        cv::Mat delta = u.t() * z;
+        std::vector<double> y = x;
+        for (int c = 0; c < q; c++)
+            y[free[c]] += delta.at<double>(c);
+        calcv_draw *o = &draws[d];
+        calcv_lens *l[2] = {&o->cam, &o->proj};
+        for (int j = 0; j < 2; j++) {
+            l[j]->fx = y[9 * j], l[j]->fy = y[9 * j + 1], l[j]->cx = y[9 * j + 2];
+            l[j]->cy = y[9 * j + 3];
+            for (int i = 0; i < 5; i++)
+                l[j]->dist[i] = y[9 * j + 4 + i];
+        }
+        cv::Matx33d r;
+        cv::Rodrigues(cv::Vec3d(y[18], y[19], y[20]), r);
+        for (int i = 0; i < 9; i++)
+            o->rot[i] = r(i / 3, i % 3);
+        for (int i = 0; i < 3; i++)
+            o->trans[i] = y[21 + i];
+    }
     return 0;
 }

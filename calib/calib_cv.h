@@ -102,13 +102,23 @@ struct calcv_sigma {
     int residuals, unknowns;
 };
 
+/** A calibration drawn from the uncertainty (calcv_uncertainty's covariance of the lenses and
+ *  the pose, board poses marginalised): what the captures allow as well as the one found. */
+struct calcv_draw {
+    struct calcv_lens cam, proj;
+    double rot[9], trans[3]; /**< p_proj = rot p_cam + trans */
+};
+
 /** The uncertainty of a calibration: @p cam corners (and, unless @p proj is NULL, the same
  *  corners in the projector) of @p n views, through the lenses and the pose found.
- *  @param sigma  out @retval 0 @retval -EINVAL fewer residuals than unknowns @retval -EDOM */
+ *  @param sigma  out @param draws, draw_count  out: that many calibrations drawn from the
+ *  covariance (a fixed random sequence: the same captures give the same draws); NULL, 0: none
+ *  @retval 0 @retval -EINVAL fewer residuals than unknowns @retval -EDOM */
 int calcv_uncertainty(const struct calcv_corners *cam, const struct calcv_corners *proj, int n,
                       int fix_k3, const struct calcv_lens *cam_lens,
                       const struct calcv_lens *proj_lens, const double rot[9],
-                      const double trans[3], struct calcv_sigma *sigma);
+                      const double trans[3], struct calcv_sigma *sigma, struct calcv_draw *draws,
+                      int draw_count);
 
 #ifdef __cplusplus
 }

@@ -8,10 +8,12 @@
 #include "calib_priv.h"
 
 #include "decode.h"
+#include "camray.h"
 #include "lens.h"
 #include "scan.h"
 #include "scan_dir.h"
 #include "scan_job.h"
+#include "tri.h"
 #include "vec3.h"
 
 #include <dirent.h>
@@ -25,6 +27,8 @@
 #include <sys/stat.h>
 #include <time.h>
 
+/* Calibrations drawn from the uncertainty to see what it does to a scan. */
+#define CALIB_DEPTH_DRAWS 64
 /* Half the side of the window the projector's coordinates are interpolated over at a corner. */
 #define CORNER_WINDOW_PX 12
 
@@ -56,6 +60,9 @@ struct solve {
     int camera_only;
     struct calcv_sigma sigma; /* one standard deviation of each value (have_sigma) */
     int have_sigma;
+    struct calcv_draw *draws; /* calibrations drawn from the uncertainty (draw_count) */
+    int draw_count;
+    double depth_centre_mm, depth_worst_mm, length_100_mm; /* predict_depth_error's */
     char weak[192];   /* what is too uncertain ("" when nothing) ... */
     char advice[192]; /* ... and what to capture next */
 };
@@ -465,8 +472,12 @@ static void find_sigma(struct solve *s, const struct calcv_corners *cam,
                        const struct calcv_corners *proj, int n, const struct calcv_lens *cl,
                        const struct calcv_lens *pl)
 {
-    s->have_sigma = calcv_uncertainty(cam, proj, n, (int)s->cfg->calibrate.fix_k3, cl, pl,
-                                      s->out.proj_rot, s->out.proj_trans_mm, &s->sigma) == 0;
+    if (proj != NULL && s->draws == NULL)
+        s->draws = calloc(CALIB_DEPTH_DRAWS, sizeof(*s->draws));
+    s->draw_count = proj != NULL && s->draws != NULL ? CALIB_DEPTH_DRAWS : 0;
+    s->have_sigma =
+        calcv_uncertainty(cam, proj, n, (int)s->cfg->calibrate.fix_k3, cl, pl, s->out.proj_rot,
+                          s->out.proj_trans_mm, &s->sigma, s->draws, s->draw_count) == 0;
     if (!s->have_sigma) {
         say(s, "uncertainty: not computed (fewer corners than unknowns)\n");
         return;
@@ -536,6 +547,124 @@ static void judge_uncertainty(struct solve *s)
                   : "placements tilted 30 to 45 deg and offset towards the image's corners "
                     "([calibrate] placements with 35@75 and -35@-75)");
     say(s, "weak: %s; %s\n", s->weak, s->advice);
+}
+
+/* Pixels of the working volume looked at, every this many in x and y. */
+#define CALIB_DEPTH_STEP_PX 16
+
+/* Where the camera-frame point @p p falls in the projector of @p c: its column (pixel centres at
+ * integers, through the projector's distortion). @retval 0 outside its image or behind it */
+static int projector_column(const struct scan_calib *c, vec3 p, double *u)
+{
+    vec3 q = v3_add(m3_mul(c->proj_rot, p), v3_from(c->proj_trans_mm));
+    double xd, yd;
+    if (q.z <= 0.0)
+        return 0;
+    lens_distort(c->proj_dist, q.x / q.z, q.y / q.z, &xd, &yd);
+    *u = c->proj_fx_px * xd + c->proj_cx_px;
+    double v = c->proj_fy_px * yd + c->proj_cy_px;
+    return *u >= 0.0 && *u <= c->proj_width - 1.0 && v >= 0.0 && v <= c->proj_height - 1.0;
+}
+
+/* What the uncertainty means for a scan: the working volume's middle plane (through the table's
+ * axis, facing the camera, within [fusion] radius_mm of it and from the table to top_mm) seen
+ * pixel by pixel, each pixel's point given the projector column the calibration found puts on
+ * it, then triangulated again (tri_range_image, the scanner's own) by each calibration drawn
+ * from the uncertainty: the depth error at the volume's centre and its worst, and how much a
+ * 100 mm length across the middle changes. */
+static void predict_depth_error(struct solve *s)
+{
+    const struct scan_calib *c = &s->out;
+    const uint32_t w = c->cam_width, h = c->cam_height;
+    if (!s->have_sigma || s->camera_only || s->draw_count == 0)
+        return;
+    float *column = calloc((size_t)w * h, sizeof(float));
+    uint8_t *reason = malloc((size_t)w * h), *valid = malloc((size_t)w * h);
+    vec3 *truth = calloc((size_t)w * h, sizeof(vec3));
+    double *sq = calloc((size_t)w * h, sizeof(double));
+    struct tri_maps *maps = malloc(sizeof(*maps));
+    if (column == NULL || reason == NULL || valid == NULL || truth == NULL || sq == NULL ||
+        maps == NULL)
+        goto out_free;
+    memset(valid, SCAN_SHADOW, (size_t)w * h);
+    vec3 a0 = v3_from(c->axis_point_mm), ad = v3_norm(v3_from(c->axis_dir));
+    vec3 n = v3_norm(v3_sub(v3(0, 0, 1), v3_scale(ad, ad.z))); /* the plane faces the camera */
+    vec3 across = v3_norm(v3_cross(ad, n));
+    struct camray rays = camray_lookup(c);
+    size_t centre = 0, ends[2] = {0, 0};
+    double best_centre = HUGE_VAL, best_end[2] = {HUGE_VAL, HUGE_VAL};
+    double mid = 0.5 * s->cfg->fusion.top_mm, radius = s->cfg->fusion.radius_mm;
+    for (uint32_t y = 0; y < h; y += CALIB_DEPTH_STEP_PX)
+        for (uint32_t x = 0; x < w; x += CALIB_DEPTH_STEP_PX) {
+            vec3 ray = camray_at(c, rays, x, y);
+            double den = v3_dot(n, ray), u;
+            if (fabs(den) < 1e-9)
+                continue;
+            vec3 p = v3_scale(ray, v3_dot(n, a0) / den), d = v3_sub(p, a0);
+            double up = v3_dot(d, ad), side = v3_dot(d, across);
+            if (up < 0.0 || up > s->cfg->fusion.top_mm || fabs(side) > radius ||
+                !projector_column(c, p, &u))
+                continue;
+            size_t i = (size_t)y * w + x;
+            valid[i] = SCAN_VALID;
+            column[i] = (float)u;
+            truth[i] = p;
+            double dc = hypot(up - mid, side); /* the centre, and 50 mm either side of it */
+            double de[2] = {hypot(up - mid, side + 50.0), hypot(up - mid, side - 50.0)};
+            if (dc < best_centre)
+                best_centre = dc, centre = i;
+            for (int k = 0; k < 2; k++)
+                if (de[k] < best_end[k])
+                    best_end[k] = de[k], ends[k] = i;
+        }
+    double len_sq = 0.0, len0 = v3_len(v3_sub(truth[ends[0]], truth[ends[1]]));
+    int used = 0;
+    for (int k = 0; k < s->draw_count; k++) {
+        struct scan_calib ck = *c;
+        struct tri_range range;
+        const struct calcv_draw *d = &s->draws[k];
+        lens_to_calib(&d->cam, 0, &ck);
+        lens_to_calib(&d->proj, 1, &ck);
+        memcpy(ck.proj_rot, d->rot, sizeof(ck.proj_rot));
+        memcpy(ck.proj_trans_mm, d->trans, sizeof(ck.proj_trans_mm));
+        memcpy(reason, valid, (size_t)w * h);
+        if (tri_range_image(&ck, maps, w, h, column, reason, &range) != 0 ||
+            reason[centre] != SCAN_VALID || reason[ends[0]] != SCAN_VALID ||
+            reason[ends[1]] != SCAN_VALID)
+            continue; /* a lens that folds over: not one to judge by */
+        for (size_t i = 0; i < (size_t)w * h; i++)
+            if (valid[i] == SCAN_VALID && reason[i] == SCAN_VALID) {
+                vec3 q = v3(maps->xyz_mm[3 * i], maps->xyz_mm[3 * i + 1], maps->xyz_mm[3 * i + 2]);
+                sq[i] += v3_dot(v3_sub(q, truth[i]), v3_sub(q, truth[i]));
+            }
+        vec3 e0 = v3(maps->xyz_mm[3 * ends[0]], maps->xyz_mm[3 * ends[0] + 1],
+                     maps->xyz_mm[3 * ends[0] + 2]);
+        vec3 e1 = v3(maps->xyz_mm[3 * ends[1]], maps->xyz_mm[3 * ends[1] + 1],
+                     maps->xyz_mm[3 * ends[1] + 2]);
+        double dl = (v3_len(v3_sub(e0, e1)) - len0) * 100.0 / fmax(len0, 1e-9);
+        len_sq += dl * dl;
+        used++;
+    }
+    if (used == 0 || best_centre == HUGE_VAL)
+        goto out_free;
+    double worst = 0.0;
+    for (size_t i = 0; i < (size_t)w * h; i++)
+        if (valid[i] == SCAN_VALID)
+            worst = fmax(worst, sqrt(sq[i] / used));
+    s->depth_centre_mm = sqrt(sq[centre] / used);
+    s->depth_worst_mm = worst;
+    s->length_100_mm = sqrt(len_sq / used);
+    say(s,
+        "predicted depth error %.3g mm (centre) - %.3g mm (edge of the working volume); a 100 mm "
+        "length +-%.3g mm (%d calibrations drawn from the uncertainty)\n",
+        s->depth_centre_mm, s->depth_worst_mm, s->length_100_mm, used);
+out_free:
+    free(maps);
+    free(sq);
+    free(truth);
+    free(valid);
+    free(reason);
+    free(column);
 }
 
 /* The projector as an inverse camera (Zhang's method on the corners' projector coordinates),
@@ -1027,6 +1156,11 @@ static int write_outputs(struct solve *s, const struct hal_storage *st, const ch
             p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7], p[8], s->sigma.rot_deg[0],
             s->sigma.rot_deg[1], s->sigma.rot_deg[2], s->sigma.trans_mm[0], s->sigma.trans_mm[1],
             s->sigma.trans_mm[2]);
+    if (s->depth_worst_mm > 0.0 && n > 0 && (size_t)n < sizeof(comment))
+        n += snprintf(comment + n, sizeof(comment) - (size_t)n,
+                      "; predicted depth error %.3g mm (centre) - %.3g mm (edge); a 100 mm length "
+                      "+-%.3g mm\n",
+                      s->depth_centre_mm, s->depth_worst_mm, s->length_100_mm);
     if (s->weak[0] && n > 0 && (size_t)n < sizeof(comment))
         n += snprintf(comment + n, sizeof(comment) - (size_t)n, "; weak: %s\n; to fix: %s\n",
                       s->weak, s->advice);
@@ -1118,6 +1252,8 @@ int calibrate_solve(const struct hal_storage *st, const struct app_config *cfg, 
         rc = solve_lights(&s);
     if (rc == 0)
         judge_uncertainty(&s);
+    if (rc == 0)
+        predict_depth_error(&s);
     fputs(s.report != NULL ? s.report : "", stdout);
     if (rc == 0)
         rc = write_outputs(&s, st, out_path);
@@ -1125,6 +1261,7 @@ int calibrate_solve(const struct hal_storage *st, const struct app_config *cfg, 
         fprintf(stderr, "scanner: error: calibration refused: %s; %s is unchanged\n",
                 s.refusal[0] ? s.refusal : "see above", out_path);
     free(s.report);
+    free(s.draws);
     free(s.views);
     return rc;
 }

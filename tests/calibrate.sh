@@ -41,8 +41,9 @@ full_test() {
 }
 check calibrate_whole_procedure full_test
 # The uncertainty of the whole procedure's values (issue 31): said in the report and the file,
-# plausible (a focal length within 0.5% and not exactly known, the pose to the projector within a
-# millimetre), not weak; with bounds tighter than the captures can meet, the same captures give
+# plausible (a focal length within 0.5% and not exactly known, a projector principal point within
+# 5 px), not weak, with the depth error it predicts (positive, under 1 mm, the centre's no larger
+# than the worst); with bounds tighter than the captures can meet, the same captures give
 # a file flagged weak, naming what, saying what to capture, and check-config warns of it.
 sigma_line() { # the report's 1-sigma value $2 (1-based) of line $1
     sed -n "s/^$1: 1 sigma: //p" "$out/cal.report.txt" | tr -d 'a-z,;' | awk -v f="$2" '{ print $f }'
@@ -52,7 +53,10 @@ uncertainty_test() {
         grep -q '^; uncertainty (one standard deviation):' "$out/cal.ini" &&
         grep -q '^;   projector rotation' "$out/cal.ini" && ! grep -q '^; weak' "$out/cal.ini" &&
         awk -v s="$(sigma_line camera 1)" 'BEGIN { exit !(s > 0 && s < 0.005 * 2436) }' &&
-        awk -v s="$(sigma_line projector 3)" 'BEGIN { exit !(s > 0 && s < 5) }' || return 1
+        awk -v s="$(sigma_line projector 3)" 'BEGIN { exit !(s > 0 && s < 5) }' &&
+        grep -q '^; predicted depth error [0-9.e-]* mm (centre) - [0-9.e-]* mm (edge); a 100 mm length' "$out/cal.ini" &&
+        sed -n 's/^predicted depth error \([0-9.e-]*\) mm (centre) - \([0-9.e-]*\) mm.*/\1 \2/p' "$out/cal.report.txt" |
+        awk '{ ok = $1 > 0 && $1 <= $2 && $2 < 1 } END { exit !ok }' || return 1
     sed -e 's/^\[calibrate\]/[calibrate]\nmax_sigma_centre_px = 0.01/' \
         -e "s|^calibration = ../|calibration = $PWD/|; s|^rig = ../|rig = $PWD/|" $cfg >"$out/tight-cfg.ini"
     "$bin" calibrate --config "$out/tight-cfg.ini" --from "$out/cal-captures" \
