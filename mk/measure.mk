@@ -51,6 +51,9 @@ calibrate-demo: deps $(BUILD)/scanner $(BUILD)/scanner-calibrate $(BUILD)/mesh-c
 ## measure-calib: calibrate-demo, and scans with the true, nominal and pinhole calibrations
 measure-calib: deps $(BUILD)/scanner $(BUILD)/scanner-calibrate $(BUILD)/mesh-compare $(BUILD)/measure-calib
 	scripts/measure-calib.sh $(BUILD) measure
+## measure-calib-sigma: reported calibration sigma against the spread over 10 noise seeds (long)
+measure-calib-sigma: deps $(BUILD)/scanner $(BUILD)/scanner-calibrate
+	scripts/measure-calib-sigma.sh $(BUILD)
 
 # Time per view, split between the simulated capture and the firmware's processing.
 $(BUILD)/bench_view: $(BUILD)/bench/bench_view.o $(BUILD)/tests/test_util.o $(HOST_OBJ) $(BUILD)/libfirmware.a
