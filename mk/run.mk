@@ -55,7 +55,7 @@ errors-doc: deps $(BUILD)/scanner linux-build
 help:
 	@echo "make TARGET (README.md says more; the build's knobs: HAL=sim|linux, LIMITS=small,"
 	@echo "SAN=1, CROSS_COMPILE=aarch64-linux-gnu-, BUILD=DIR)"
-	@sed -n 's/^## \([^:]*\): /  \1\t/p' $(filter Makefile mk/%,$(MAKEFILE_LIST)) | expand -t 20
+	@sed -n 's/^## \([^:]*\): /  \1\t/p' $(filter Makefile mk/%,$(MAKEFILE_LIST)) | expand -t 24
 
 ## format-check: every C file as clang-format writes it (make test runs it)
 FORMATTED = $$(git ls-files '*.c' '*.h' '*.cpp')
