@@ -605,14 +605,15 @@ static int cut_at_the_move(struct reg_ctx *r)
     return 1;
 }
 
-/* The object had moved: group 1 placed freely, near where the table put it or, failing that,
- * by the search a second pass is found by (align_second_pass); how far it had moved. */
+/* The object had moved: group 1 placed freely, near where the table put it (a few millimetres,
+ * then a few centimetres away) or, failing that, by the search a second pass is found by
+ * (align_second_pass); along what its shape does not hold, by its colour; how far it had moved. */
 static void place_moved_views(struct reg_ctx *r, struct reg_report *rep)
 {
     int failed = rep->failed_view, against = rep->failed_against;
     double share = rep->failed_share;
     solve_joint(r, rep); /* each arc registered on its own */
-    if (!reg_place_near_table(r, rep->rms_mm))
+    if (!reg_place_near_table(r, rep->rms_mm, 8.0) && !reg_place_near_table(r, rep->rms_mm, 32.0))
         reg_align_group(r, rep);
     if (r->second_aligned && !reg_placement_holds(r) && !reg_place_by_colour(r, rep->rms_mm)) {
         r->second_aligned = 0; /* a slide neither shape nor colour sees: it could be anywhere */

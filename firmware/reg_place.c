@@ -98,14 +98,15 @@ static const struct reg_cell *land(struct reg_ctx *r, vec3 p, vec3 n, double min
 }
 
 /* The group-1 samples against the group-0 views: one point-to-plane step of first_from_second
- * per call (object frame 1); with @p frozen, a unit direction (group 0's frame) the step does
- * not shift along (one the colour search has fixed and the shape does not hold).
+ * per call (object frame 1); with @p frozen, @p frozen_count unit directions (group 0's frame)
+ * the step does not shift along (those the colour search has fixed and the shape does not hold).
  * @retval pairs coupled; @p rms their residual, @p overlap the samples that landed on a group-0
  * surface facing the same way (coupled or not), @p hold how well the pairs hold a shift in every
  * direction: @p share and @p axis as lsq_rigid_shift_axes gives them (share[0] is
  * lsq_rigid_shift_hold) */
 static uint32_t refine_second_step(struct reg_ctx *r, double gate_mm, const vec3 *frozen,
-                                   double *rms, uint32_t *overlap, double share[3], vec3 axis[3])
+                                   int frozen_count, double *rms, uint32_t *overlap,
+                                   double share[3], vec3 axis[3])
 {
     *overlap = 0;
     const double min_cos = cos(r->p.max_normal_deg * M_PI / 180.0);
@@ -135,8 +136,9 @@ static uint32_t refine_second_step(struct reg_ctx *r, double gate_mm, const vec3
         memset(share, 0, 3 * sizeof(double)); /* no pairs: holds nothing */
     struct frame_xform s, moved;
     if (lsq_rigid_step(&eq, &s) == 0) {
-        if (frozen != NULL) /* the step's shift along it taken out: the colour has placed it */
-            s.origin = v3_sub(s.origin, v3_scale(*frozen, v3_dot(s.origin, *frozen)));
+        for (int f = 0; f < frozen_count; f++) /* the step's shift along them taken out: the
+                                                   colour has placed them */
+            s.origin = v3_sub(s.origin, v3_scale(frozen[f], v3_dot(s.origin, frozen[f])));
         frame_compose(&s, &r->first_from_second, &moved);
         r->first_from_second = moved;
     }
@@ -171,7 +173,7 @@ void reg_align_group(struct reg_ctx *r, struct reg_report *rep)
     double rms = 0.0;
     uint32_t overlap;
     for (int it = 0; it < 15; it++)
-        rep->second_coupled = refine_second_step(r, r->p.max_pair_mm, NULL, &rms, &overlap,
+        rep->second_coupled = refine_second_step(r, r->p.max_pair_mm, NULL, 0, &rms, &overlap,
                                                  r->placed_share, r->placed_axis);
     rep->second_rms_mm = rms;
     rep->second_turned_deg = ar.turned_deg;
@@ -179,7 +181,8 @@ void reg_align_group(struct reg_ctx *r, struct reg_report *rep)
 }
 
 /* Group 1 placed by ICP against group 0's views from where the table put it, with pairs
- * searched 8 x max_pair_mm away first (an object knocked by a few millimetres, a few degrees).
+ * searched @p reach x max_pair_mm away first (8: an object knocked by a few millimetres, a few
+ * degrees; 32: pushed by a few centimetres).
  * A placement is taken when it fits as well as the views of one arc fit each other: twice
  * min_coupled_share of its overlap with group 0 coupled, their residual within twice the
  * arcs' own (@p ring_rms_mm) and 0.02 mm. Measured: 0.75 and 0.91 coupled at the arcs'
@@ -193,15 +196,15 @@ static int placement_fits(const struct reg_ctx *r, uint32_t coupled, uint32_t ov
            rms <= 2.0 * ring_rms_mm + 0.02;
 }
 
-int reg_place_near_table(struct reg_ctx *r, double ring_rms_mm)
+int reg_place_near_table(struct reg_ctx *r, double ring_rms_mm, double reach)
 {
     double rms = 0.0;
     uint32_t coupled = 0, overlap = 0;
     r->first_from_second = (struct frame_xform){{1, 0, 0, 0, 1, 0, 0, 0, 1}, {0, 0, 0}};
     r->second_aligned = 1;
     for (int it = 0; it <= 20; it++) {
-        double gate = r->p.max_pair_mm * fmax(1.0, 8.0 / (double)(1u << (it < 8 ? it : 8)));
-        coupled = refine_second_step(r, it < 20 ? gate : r->p.max_pair_mm, NULL, &rms, &overlap,
+        double gate = r->p.max_pair_mm * fmax(1.0, reach / (double)(1u << (it < 8 ? it : 8)));
+        coupled = refine_second_step(r, it < 20 ? gate : r->p.max_pair_mm, NULL, 0, &rms, &overlap,
                                      r->placed_share, r->placed_axis);
     }
     r->second_aligned = placement_fits(r, coupled, overlap, rms, ring_rms_mm);
@@ -220,7 +223,8 @@ int reg_placement_holds(const struct reg_ctx *r)
 }
 
 /* The colour search: a direction the shape does not hold is searched this far each way, in
- * steps of REG_COLOUR_STEP_MM, then to a tenth of that about the best. */
+ * steps of REG_COLOUR_STEP_MM, then to a tenth of that about the best; two directions on a grid
+ * from 4 mm steps down to 0.05 mm (reg_place_by_colour). */
 #define REG_COLOUR_SEARCH_MM 40.0
 #define REG_COLOUR_STEP_MM 0.5
 /* Two hues further apart than this (the chord between their unit vectors, 0.43: 25 degrees) are
@@ -298,51 +302,72 @@ static double colour_misfit(struct reg_ctx *r, vec3 shift, uint64_t *compared)
  * lined up at 0.20. */
 #define REG_COLOUR_MAX_MISFIT 0.14
 #define REG_COLOUR_MIN_COMPARED 200
-/* The colour search moves along one direction: the shape must hold the next weakest one at
- * least this well (the box, bracket, plate, nut and stepped block of data/objects: 0.14 to 0.48;
- * the gear 0.016, its teeth let it turn too). */
+/* The colour search moves along the one or two directions the shape holds less than this (the
+ * box, bracket, nut and stepped block of data/objects hold their second weakest 0.14 to 0.48, the
+ * gear 0.016 and a plate lying flat little more: two to search); the shape must hold the third. */
 #define REG_COLOUR_MIN_NEXT 0.05
 
-/* The placement moved along @p t by @p mm (the group-1 points, in group 0's frame). */
-static void shift_placement(struct reg_ctx *r, vec3 t, double mm)
+/* The placement moved by @p shift (the group-1 points, in group 0's frame). */
+static void shift_placement(struct reg_ctx *r, vec3 shift)
 {
-    struct frame_xform shift = {{1, 0, 0, 0, 1, 0, 0, 0, 1}, v3_scale(t, -mm)}, moved;
-    frame_compose(&shift, &r->first_from_second, &moved); /* p -> p - origin = p + mm t */
+    struct frame_xform move = {{1, 0, 0, 0, 1, 0, 0, 0, 1}, v3_scale(shift, -1.0)}, moved;
+    frame_compose(&move, &r->first_from_second, &moved); /* p -> p - origin = p + shift */
     r->first_from_second = moved;
+}
+
+/* One level of the colour search: the grid of 2 @p half + 1 places @p step apart about
+ * @p centre along each of the @p n axes; the best kept in @p at, @p best_misfit, @p compared.
+ * @retval the level's mean misfit */
+static double search_level(struct reg_ctx *r, const vec3 axes[2], int n, const double centre[2],
+                           double step, int half, double at[2], double *best_misfit,
+                           uint64_t *compared)
+{
+    double sum = 0.0;
+    int count = 0;
+    for (int i = -half; i <= half; i++)
+        for (int j = n > 1 ? -half : 0; j <= (n > 1 ? half : 0); j++) {
+            double a = centre[0] + i * step, b = centre[1] + j * step;
+            uint64_t c;
+            double m = colour_misfit(r, v3_add(v3_scale(axes[0], a), v3_scale(axes[1], b)), &c);
+            sum += m, count++;
+            if (m < *best_misfit)
+                *best_misfit = m, at[0] = a, at[1] = b, *compared = c;
+        }
+    return sum / count;
 }
 
 int reg_place_by_colour(struct reg_ctx *r, double ring_rms_mm)
 {
-    const vec3 t = r->placed_axis[0];
-    if (!r->second_aligned || r->placed_share[1] < REG_COLOUR_MIN_NEXT)
+    /* One free direction (two parallel faces and a top), or two (a plate: its top and little
+     * else), the shape holding the rest. */
+    int n = r->placed_share[1] >= REG_COLOUR_MIN_NEXT ? 1 : 2;
+    if (!r->second_aligned || r->placed_share[2] < REG_COLOUR_MIN_NEXT)
         return 0;
+    const vec3 axes[2] = {r->placed_axis[0], n > 1 ? r->placed_axis[1] : v3(0, 0, 0)};
+    /* Coarse to fine: a step, how many either way (the first level spans the search). */
+    static const double levels[2][4][2] = {
+        {{REG_COLOUR_STEP_MM, REG_COLOUR_SEARCH_MM / REG_COLOUR_STEP_MM},
+         {REG_COLOUR_STEP_MM / 10.0, 10}},
+        {{4.0, REG_COLOUR_SEARCH_MM / 4.0}, {1.0, 4}, {0.25, 4}, {0.05, 5}}};
     prepare_landing(r);
-    double best = 0.0, best_misfit = HUGE_VAL, mean = 0.0;
-    uint64_t compared, best_compared = 0;
-    int steps = (int)lround(REG_COLOUR_SEARCH_MM / REG_COLOUR_STEP_MM);
-    for (int k = -steps; k <= steps; k++) {
-        double m = colour_misfit(r, v3_scale(t, k * REG_COLOUR_STEP_MM), &compared);
-        mean += m / (2 * steps + 1);
-        if (m < best_misfit)
-            best_misfit = m, best = k * REG_COLOUR_STEP_MM, best_compared = compared;
-    }
-    double coarse = best;
-    for (int k = -10; k <= 10; k++) { /* to a tenth of a step about the best */
-        double s = coarse + k * REG_COLOUR_STEP_MM / 10.0;
-        double m = colour_misfit(r, v3_scale(t, s), &compared);
-        if (m < best_misfit)
-            best_misfit = m, best = s, best_compared = compared;
+    double at[2] = {0.0, 0.0}, best_misfit = HUGE_VAL, mean = 0.0;
+    uint64_t best_compared = 0;
+    for (int l = 0; l < 4 && levels[n - 1][l][0] > 0.0; l++) {
+        double centre[2] = {at[0], at[1]};
+        double m = search_level(r, axes, n, centre, levels[n - 1][l][0], (int)levels[n - 1][l][1],
+                                at, &best_misfit, &best_compared);
+        mean = l == 0 ? m : mean;
     }
     if (best_compared < REG_COLOUR_MIN_COMPARED || !(best_misfit < REG_COLOUR_MAX_DIP * mean) ||
         best_misfit > REG_COLOUR_MAX_MISFIT * REG_HUE_TAU * REG_HUE_TAU)
         return 0; /* no dip: plain paint (all grey: 0 everywhere) or nothing compared */
     struct frame_xform before = r->first_from_second;
-    shift_placement(r, t, best);
+    shift_placement(r, v3_add(v3_scale(axes[0], at[0]), v3_scale(axes[1], at[1])));
     double rms = 0.0, share[3];
     uint32_t overlap = 0, coupled = 0;
     vec3 axis[3];
-    for (int it = 0; it < 5; it++) /* the shape refines the rest, the colour keeps t */
-        coupled = refine_second_step(r, r->p.max_pair_mm, &t, &rms, &overlap, share, axis);
+    for (int it = 0; it < 5; it++) /* the shape refines the rest, the colour keeps its axes */
+        coupled = refine_second_step(r, r->p.max_pair_mm, axes, n, &rms, &overlap, share, axis);
     if (!placement_fits(r, coupled, overlap, rms, ring_rms_mm)) {
         r->first_from_second = before; /* where the paint agrees the shape does not */
         return 0;

@@ -26,16 +26,18 @@ uint32_t reg_first_of_group(const struct reg_ctx *r);
  * registration at its first view (@p rep). */
 void reg_align_group(struct reg_ctx *r, struct reg_report *rep);
 
-/* Group 1 placed by ICP from where the table put it. @retval 1 placed (second_aligned) */
-int reg_place_near_table(struct reg_ctx *r, double ring_rms_mm);
+/* Group 1 placed by ICP from where the table put it, pairs searched @p reach x max_pair_mm away
+ * first. @retval 1 placed (second_aligned) */
+int reg_place_near_table(struct reg_ctx *r, double ring_rms_mm, double reach);
 
 /* @retval 1 the last placement's pairs hold a shift in every direction */
 int reg_placement_holds(const struct reg_ctx *r);
 
-/* The last placement, whose shape holds every direction but one (placed_axis[0]), moved along it
- * to where the two groups' colours agree (their hues: raw colours compare as the paint's), then
- * refined by the shape with that direction kept, and taken when the shape still fits there as
- * a placement near the table must (@p ring_rms_mm). @retval 1 placed (placed_by_colour)
+/* The last placement, whose shape holds every direction but one or two (placed_axis[0], [1]),
+ * moved along them to where the two groups' colours agree (their hues: raw colours compare as
+ * the paint's), then refined by the shape with those directions kept, and taken when the shape
+ * still fits there as a placement near the table must (@p ring_rms_mm).
+ * @retval 1 placed (placed_by_colour)
  * @retval 0 the colour does not fix it either: the placement is left as it was */
 int reg_place_by_colour(struct reg_ctx *r, double ring_rms_mm);
 

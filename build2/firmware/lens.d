@@ -1,0 +1,2 @@
+build2/firmware/lens.o: firmware/lens.c firmware/lens.h
+firmware/lens.h:

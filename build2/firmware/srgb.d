@@ -1,0 +1,2 @@
+build2/firmware/srgb.o: firmware/srgb.c firmware/srgb.h
+firmware/srgb.h:

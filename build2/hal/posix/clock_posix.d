@@ -1,0 +1,12 @@
+build2/hal/posix/clock_posix.o: hal/posix/clock_posix.c \
+ hal/posix/clock_posix.h hal/include/hal.h hal/include/hal_camera.h \
+ hal/include/hal_clock.h hal/include/hal_gpio.h hal/include/hal_limits.h \
+ hal/include/hal_storage.h hal/include/hal_turntable.h
+hal/posix/clock_posix.h:
+hal/include/hal.h:
+hal/include/hal_camera.h:
+hal/include/hal_clock.h:
+hal/include/hal_gpio.h:
+hal/include/hal_limits.h:
+hal/include/hal_storage.h:
+hal/include/hal_turntable.h:
