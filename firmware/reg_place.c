@@ -330,7 +330,7 @@ static double search_level(struct reg_ctx *r, const vec3 axes[2], int n, const d
             uint64_t c;
             double m = colour_misfit(r, v3_add(v3_scale(axes[0], a), v3_scale(axes[1], b)), &c);
             sum += m, count++;
-            if (m < *best_misfit)
+            if (m < *best_misfit && c >= REG_COLOUR_MIN_COMPARED) /* not a place seen by few */
                 *best_misfit = m, at[0] = a, at[1] = b, *compared = c;
         }
     return sum / count;
