@@ -463,8 +463,8 @@ static int solve_camera(struct solve *s)
 static void say_lens_sigma(struct solve *s, const char *name, const double sd[9])
 {
     say(s,
-        "%s: 1 sigma: fx %.2f, fy %.2f, cx %.2f, cy %.2f px; k1 %.4f, k2 %.4f, p1 %.5f, "
-        "p2 %.5f, k3 %.4f\n",
+        "%s: 1 sigma: fx %.3g, fy %.3g, cx %.3g, cy %.3g px; k1 %.2g, k2 %.2g, p1 %.2g, "
+        "p2 %.2g, k3 %.2g\n",
         name, sd[0], sd[1], sd[2], sd[3], sd[4], sd[5], sd[6], sd[7], sd[8]);
 }
 
@@ -487,8 +487,8 @@ static void find_sigma(struct solve *s, const struct calcv_corners *cam,
         return;
     say_lens_sigma(s, "projector", s->sigma.proj);
     say(s,
-        "pose camera -> projector: 1 sigma: rotation %.3f, %.3f, %.3f deg, translation %.2f, "
-        "%.2f, %.2f mm (%d residuals, %d unknowns, residual %.3f px)\n",
+        "pose camera -> projector: 1 sigma: rotation %.2g, %.2g, %.2g deg, translation %.3g, "
+        "%.3g, %.3g mm (%d residuals, %d unknowns, residual %.3f px)\n",
         s->sigma.rot_deg[0], s->sigma.rot_deg[1], s->sigma.rot_deg[2], s->sigma.trans_mm[0],
         s->sigma.trans_mm[1], s->sigma.trans_mm[2], s->sigma.residuals, s->sigma.unknowns,
         s->sigma.residual_px);

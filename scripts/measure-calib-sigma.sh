@@ -20,9 +20,11 @@ value() {
     awk -v s="[$2]" -v k="$3" -v f="$4" '$0 == s { in_s = 1; next } /^\[/ { in_s = 0 }
         in_s && $1 == k { sub(/^[^=]*= */, ""); split($0, v, /, */); print v[f]; exit }' "$1"
 }
-# the reported 1-sigma number $2 (1-based, numbers only) of the report's line starting $1
+# the one standard deviation calibration file $1 states for word $3 on its uncertainty line
+# starting "$2" (e.g. "camera fx", fx), field $4 of the numbers after the word (1-based)
 sigma() {
-    sed -n "s/^$1: 1 sigma: //p" "$3" | tr -c '0-9.e\n-' ' ' | awk -v f="$2" '{ print $f }'
+    awk -v l=";   $2" -v w="$3" -v f="$4" 'index($0, l) == 1 {
+        for (i = 1; i <= NF; i++) if ($i == w) { v = $(i + f); sub(/,$/, "", v); print v; exit } }' "$1"
 }
 for s in $(seq 1 "$seeds"); do
     sed -e "s|^calibration = \.\./|calibration = $top/|" -e "s|^calibration = \([^/]\)|calibration = $dir/\1|" \
@@ -30,14 +32,16 @@ for s in $(seq 1 "$seeds"); do
         -e "/^seed = /d" -e "s/^\[sim\]/[sim]\nseed = $s/" "$cfg" >"$out/seed-$s.ini"
     "$build/scanner" calibrate --config "$out/seed-$s.ini" --out "$out/seed-$s.cal.ini" \
         >"$out/seed-$s.log" 2>&1 || { echo "seed $s: calibration failed (see $out/seed-$s.log)"; continue; }
-    r="$out/seed-$s.cal.report.txt" c="$out/seed-$s.cal.ini"
+    c="$out/seed-$s.cal.ini"
     # value and reported sigma, one row per seed: camera fx cx cy, projector fx cx cy, t1 t2 t3
-    echo "$(value "$c" camera fx_px 1) $(sigma camera 1 "$r") $(value "$c" camera cx_px 1) $(sigma camera 3 "$r")" \
-        "$(value "$c" camera cy_px 1) $(sigma camera 4 "$r") $(value "$c" projector fx_px 1) $(sigma projector 1 "$r")" \
-        "$(value "$c" projector cx_px 1) $(sigma projector 3 "$r") $(value "$c" projector cy_px 1) $(sigma projector 4 "$r")" \
-        "$(value "$c" projector translation_mm 1) $(sigma 'pose camera -> projector' 4 "$r")" \
-        "$(value "$c" projector translation_mm 2) $(sigma 'pose camera -> projector' 5 "$r")" \
-        "$(value "$c" projector translation_mm 3) $(sigma 'pose camera -> projector' 6 "$r")" >>"$out/rows.txt"
+    echo "$(value "$c" camera fx_px 1) $(sigma "$c" 'camera fx' fx 1) $(value "$c" camera cx_px 1)" \
+        "$(sigma "$c" 'camera fx' cx 1) $(value "$c" camera cy_px 1) $(sigma "$c" 'camera fx' cy 1)" \
+        "$(value "$c" projector fx_px 1) $(sigma "$c" 'projector fx' fx 1)" \
+        "$(value "$c" projector cx_px 1) $(sigma "$c" 'projector fx' cx 1)" \
+        "$(value "$c" projector cy_px 1) $(sigma "$c" 'projector fx' cy 1)" \
+        "$(value "$c" projector translation_mm 1) $(sigma "$c" 'projector rotation' translation 1)" \
+        "$(value "$c" projector translation_mm 2) $(sigma "$c" 'projector rotation' translation 2)" \
+        "$(value "$c" projector translation_mm 3) $(sigma "$c" 'projector rotation' translation 3)" >>"$out/rows.txt"
 done
 echo "| value | mean over $seeds seeds | spread (std) | reported 1 sigma (mean) | spread / reported |"
 echo "|---|---|---|---|---|"
