@@ -136,13 +136,17 @@ static int report_registration(struct job *j, const struct reg_report *r, double
         snprintf(detail, sizeof(detail),
                  "turntable angles kept ([registration] icp = 0 or one "
                  "view)");
-    else
+    else {
+        char loop[48] = "loop closure cut at the move"; /* the last view and the first: apart */
+        if (r->moved_view < 0 || r->loop_rms_mm > 0.0) /* no pair closes a ring cut there */
+            snprintf(loop, sizeof(loop), "loop closure %.3f mm", r->loop_rms_mm);
         snprintf(detail, sizeof(detail),
-                 "residual %.3f mm, loop closure %.3f mm, worst view %u (%.3f mm); axis moved "
-                 "%.2f mm, tilted %.3f deg; %.2f s CPU; %s",
-                 r->rms_mm, r->loop_rms_mm, (unsigned)r->worst_view, r->worst_rms_mm,
-                 r->axis_shift_mm, r->axis_tilt_deg, cpu_seconds,
+                 "residual %.3f mm, %s, worst view %u (%.3f mm); axis moved %.2f mm, tilted %.3f "
+                 "deg; %.2f s CPU; %s",
+                 r->rms_mm, loop, (unsigned)r->worst_view, r->worst_rms_mm, r->axis_shift_mm,
+                 r->axis_tilt_deg, cpu_seconds,
                  r->accepted || no_turn_seen ? "" : "turntable angles kept: ");
+    }
     size_t n = strlen(detail);
     if (no_turn_seen) /* the table's answer, whatever the solve did */
         snprintf(detail + n, sizeof(detail) - n,
