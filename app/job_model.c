@@ -138,7 +138,7 @@ static int report_registration(struct job *j, const struct reg_report *r, double
                  "view)");
     else {
         char loop[48] = "loop closure cut at the move"; /* the last view and the first: apart */
-        if (r->moved_view < 0 || r->loop_rms_mm > 0.0) /* no pair closes a ring cut there */
+        if (r->moved_view < 0 || r->loop_rms_mm > 0.0)  /* no pair closes a ring cut there */
             snprintf(loop, sizeof(loop), "loop closure %.3f mm", r->loop_rms_mm);
         snprintf(detail, sizeof(detail),
                  "residual %.3f mm, %s, worst view %u (%.3f mm); axis moved %.2f mm, tilted %.3f "

@@ -38,6 +38,14 @@ int calibrate_capture(struct hal *hal, const struct app_config *cfg, const struc
 int calibrate_solve(const struct hal_storage *st, const struct app_config *cfg, const char *dir,
                     const char *out_path);
 
+/** Rewrite captures made with OpenCV's GrayCodePattern (@p src: a folder a board pose, each with
+ *  its PNG images in OpenCV's order: column bits and inverses, row bits and inverses, white,
+ *  black) as the calibration directory @p dst (made new) that calibrate_solve reads; the
+ *  projector's size from the config's calibration file or [calibrate].
+ *  @retval 0 @retval -EINVAL a pose's image count is not the sequence's @retval -errno (said) */
+int calibrate_import_opencv(const struct hal_storage *st, const struct app_config *cfg,
+                            const char *src, const char *dst);
+
 /** Scan the sphere of [calibrate] sphere_diameter_mm once and print the diameter error and the
  *  sphere fit's RMS, with the calibration's reprojection RMS. @retval 0 @retval -errno */
 int calibrate_verify(struct hal *hal, const struct app_config *cfg, const struct scan_calib *calib);

@@ -11,14 +11,17 @@
 #include <stdio.h>
 #include <string.h>
 
-/* scanner calibrate [verify | board] --config F [--out P] [--dir D | --from D] */
+/* scanner calibrate [verify | board | import --opencv D] --config F [--out P] [--dir D |
+ * --from D] */
 int main(int argc, char **argv)
 {
     static struct app_config cfg;
     static struct scan_calib calib;
     const char *config_path = NULL, *out = NULL, *dir = NULL, *from = NULL, *what = "";
+    const char *opencv = NULL;
     int first = 2;
-    if (argc > 2 && (strcmp(argv[2], "verify") == 0 || strcmp(argv[2], "board") == 0))
+    if (argc > 2 && (strcmp(argv[2], "verify") == 0 || strcmp(argv[2], "board") == 0 ||
+                     strcmp(argv[2], "import") == 0))
         what = argv[first++];
     for (int i = first; i < argc; i++) {
         if (strcmp(argv[i], "--config") == 0 && i + 1 < argc)
@@ -29,6 +32,8 @@ int main(int argc, char **argv)
             dir = argv[++i];
         else if (strcmp(argv[i], "--from") == 0 && i + 1 < argc)
             from = argv[++i];
+        else if (strcmp(argv[i], "--opencv") == 0 && i + 1 < argc && what[0] == 'i')
+            opencv = argv[++i];
         else {
             fprintf(stderr, "scanner: calibrate: unknown argument '%s'\n", argv[i]);
             return 2;
@@ -48,6 +53,14 @@ int main(int argc, char **argv)
     storage_posix_init(&st);
     if (strcmp(what, "board") == 0)
         return calibrate_print_board(&st, &cfg, out) == 0 ? 0 : 1;
+    if (strcmp(what, "import") == 0) {
+        if (opencv == NULL) {
+            fprintf(stderr, "scanner: calibrate import: --opencv DIR is required (captures made "
+                            "with OpenCV's GrayCodePattern, a folder a board pose)\n");
+            return 2;
+        }
+        return calibrate_import_opencv(&st, &cfg, opencv, out) == 0 ? 0 : 1;
+    }
     if (from != NULL)
         return calibrate_solve(&st, &cfg, from, out) == 0 ? 0 : 1;
     int rc = calib_load(&calib, cfg.calibration_file, cfg.light_count, err, sizeof(err));

@@ -228,6 +228,37 @@ from_dir_test() {
     [ $rc -ne 0 ] && grep -q 'error: .*view_002.*frame_05' "$out/holes.txt" && ! test -e "$out/holes.ini"
 }
 check calibrate_from_dir_hostile from_dir_test
+# Captures in OpenCV's GrayCodePattern order (a folder a pose, patterns then white and black,
+# numbered without padding: image2 before image10) imported and computed from: the same
+# calibration as from the scanner's own captures; and what a person can get wrong.
+import_test() {
+    rm -rf "$out/opencv" "$out/imported" "$out/imported-again"
+    mkdir -p "$out/opencv"
+    for v in "$out"/cal-captures/view_*; do
+        grep -q 'target = board' "$v/target.ini" || continue
+        p="$out/opencv/pose_${v##*view_}"
+        mkdir -p "$p"
+        for i in $(seq 2 41); do cp "$v/frame_$(printf %02d "$i").png" "$p/image$((i - 2)).png"; done
+        cp "$v/frame_00.png" "$p/image40.png"
+        cp "$v/frame_01.png" "$p/image41.png"
+    done
+    "$bin" calibrate import --opencv "$out/opencv" --config $cfg --out "$out/imported" &&
+        cmp "$out/imported/view_002/frame_17.png" "$out/cal-captures/view_002/frame_17.png" &&
+        cmp "$out/imported/view_002/frame_00.png" "$out/cal-captures/view_002/frame_00.png" &&
+        "$bin" calibrate --config $cfg --from "$out/imported" --out "$out/imported.ini" >"$out/imported.txt" 2>&1 &&
+        near "$(value "$out/imported.ini" camera fx_px 1)" "$(value "$out/cal.ini" camera fx_px 1)" 0.5 &&
+        near "$(value "$out/imported.ini" projector translation_mm 1)" "$(value "$out/cal.ini" projector translation_mm 1)" 0.2 || return 1
+    ! "$bin" calibrate import --opencv "$out/opencv" --config $cfg --out "$out/imported" 2>"$out/import-exists.txt" &&
+        grep -q 'cannot make .*imported: File exists (give a new folder)' "$out/import-exists.txt" &&
+        ! "$bin" calibrate import --config $cfg --out "$out/imported-again" 2>"$out/import-usage.txt" &&
+        grep -q -- '--opencv DIR is required' "$out/import-usage.txt" &&
+        ! "$bin" calibrate import --opencv "$out/opencv/pose_000" --config $cfg --out "$out/imported-again" 2>"$out/import-flat.txt" &&
+        grep -q 'holds no folder of images' "$out/import-flat.txt" && ! test -e "$out/imported-again" &&
+        rm "$out/opencv/pose_003/image7.png" &&
+        ! "$bin" calibrate import --opencv "$out/opencv" --config $cfg --out "$out/imported-again" 2>"$out/import-short.txt" &&
+        grep -q 'pose_003: 41 PNG images, but OpenCV.s GrayCodePattern for this projector makes 42' "$out/import-short.txt" && ! test -e "$out/imported-again"
+}
+check import_opencv_graycode_captures import_test
 # calibrate board: no --out "" (it wrote .png and .svg in the working directory), and a name
 # with '"' or '<' is percent-encoded in the SVG's reference to the picture.
 board_out_test() {
