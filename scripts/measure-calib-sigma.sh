@@ -33,6 +33,7 @@ for s in $(seq 1 "$seeds"); do
     "$build/scanner" calibrate --config "$out/seed-$s.ini" --out "$out/seed-$s.cal.ini" \
         >"$out/seed-$s.log" 2>&1 || { echo "seed $s: calibration failed (see $out/seed-$s.log)"; continue; }
     c="$out/seed-$s.cal.ini"
+    rm -rf "$out/seed-$s.cal-captures" # half a gigabyte a calibration
     # value and reported sigma, one row per seed: camera fx cx cy, projector fx cx cy, t1 t2 t3
     echo "$(value "$c" camera fx_px 1) $(sigma "$c" 'camera fx' fx 1) $(value "$c" camera cx_px 1)" \
         "$(sigma "$c" 'camera fx' cx 1) $(value "$c" camera cy_px 1) $(sigma "$c" 'camera fx' cy 1)" \

@@ -44,6 +44,7 @@ config() {
     sim_lines "$1" | sed -i "/^\[sim\]/r /dev/stdin" "$out/$5.ini"
     printf "$4" | sed -i "/^\[sim\]/r /dev/stdin" "$out/$5.ini"
     [ "$3" = none ] || printf '\n[colour]\nmethod = %s\nwhite_scale = 0.008333, 0.008333, 0.008333\n' "$3" >>"$out/$5.ini"
+    printf '\n[output]\nkeep_frames = none\n' >>"$out/$5.ini" # 250 scans' frames would be 60 GB
 }
 row() { # object, views, method, table, name: scan it and print its row
     rm -rf "${out:?}/$5"
