@@ -20,8 +20,8 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#define IMPORT_MAX_NAME 256   /* a pose folder's or an image's name */
-#define IMPORT_MAX_FILES 1024 /* entries of one folder looked at */
+#define IMPORT_MAX_NAME 256           /* a pose folder's or an image's name */
+#define IMPORT_MAX_FILES 1024         /* entries of one folder looked at */
 #define IMPORT_MAX_BYTES (256u << 20) /* one image */
 
 /* Names compared as people number them: "image10" after "image9". */
@@ -68,7 +68,8 @@ static int list_entries(const char *dir, int folders, char **names, int max)
         snprintf(path, sizeof(path), "%s/%s", dir, de->d_name);
         if (lstat(path, &sb) != 0) /* a link is not followed: no loops, nothing outside */
             continue;
-        if (folders ? !S_ISDIR(sb.st_mode) : !(S_ISREG(sb.st_mode) && has_suffix(de->d_name, ".png")))
+        if (folders ? !S_ISDIR(sb.st_mode)
+                    : !(S_ISREG(sb.st_mode) && has_suffix(de->d_name, ".png")))
             continue;
         names[n] = strdup(de->d_name);
         if (names[n] == NULL)
