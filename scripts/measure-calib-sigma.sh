@@ -48,5 +48,5 @@ echo "| value | mean over $seeds seeds | spread (std) | reported 1 sigma (mean) 
 echo "|---|---|---|---|---|"
 awk 'BEGIN { split("camera fx_px,camera cx_px,camera cy_px,projector fx_px,projector cx_px,projector cy_px,translation x mm,translation y mm,translation z mm", name, ",") }
     { n++; for (k = 1; k <= 9; k++) { x = $(2 * k - 1); s[k] += x; q[k] += x * x; r[k] += $(2 * k) } }
-    END { for (k = 1; k <= 9; k++) { m = s[k] / n; sd = sqrt((q[k] - n * m * m) / (n - 1)); rs = r[k] / n
-          printf "| %s | %.4f | %.4f | %.4f | %.2f |\n", name[k], m, sd, rs, rs > 0 ? sd / rs : 0 } }' "$out/rows.txt"
+    END { for (k = 1; k <= 9; k++) { m = s[k] / n; v = (q[k] - n * m * m) / (n - 1); sd = sqrt(v > 0 ? v : 0); rs = r[k] / n
+          printf "| %s | %.4f | %.4f | %.4f | %.2f |\n", name[k], m, sd, rs, (rs > 0 ? sd / rs : 0) } }' "$out/rows.txt"
