@@ -156,7 +156,7 @@ static int import_pose(const struct hal_storage *st, const char *pose, uint32_t 
         uint32_t theirs = i == GRAY_PATTERN_WHITE   ? count - 2
                           : i == GRAY_PATTERN_BLACK ? count - 1
                                                     : i - GRAY_PATTERN_FIRST_BIT;
-        char from[HAL_MAX_PATH + 2 * IMPORT_MAX_NAME + 4], to[HAL_MAX_PATH + 32];
+        char from[HAL_MAX_PATH + 2 * IMPORT_MAX_NAME + 4], to[HAL_MAX_PATH + 48];
         snprintf(from, sizeof(from), "%s/%s", pose, names[theirs]);
         snprintf(to, sizeof(to), "%s/frame_%02u.png", dir, (unsigned)i);
         rc = copy_file(st, from, to);
