@@ -156,6 +156,7 @@ struct voxel {
 #define FUSION_BLOCKS_MAX ((FUSION_MAX_DIM + FUSION_BLOCK - 1) / FUSION_BLOCK)
 #define FUSION_BITMAP_BYTES ((FUSION_MAX_VOXELS + 7) / 8) /* a bit a voxel */
 #define FUSION_GLB_JSON_MAX 8192u                         /* mesh.glb's JSON chunk (mesh_glb.c) */
+#define MESH_DROPPED 0xFFFFFFFFu /* mesh_index of a vertex of a piece left out (mesh_io.c) */
 #define MESH_HOLE_MAX_LOOP 4096u /* a longer boundary loop is far wider than a hole to close */
 
 /** One model's volume: the grid, the work space of the stages over it and the prepared mesh's
@@ -193,7 +194,8 @@ struct fusion_volume {
     uint8_t mesh_rgb[MESH_MAX_VERTICES * 3];
     uint8_t mesh_coloured[MESH_MAX_VERTICES]; /* 1: a view gave the surface there a colour */
     uint32_t mesh_tri[MESH_MAX_TRIANGLES * 3];
-    uint32_t mesh_index[MESH_MAX_VERTICES]; /* union-find parent; after prepare, new number */
+    uint32_t mesh_index[MESH_MAX_VERTICES]; /* union-find parent; after prepare, new number or
+                                               MESH_DROPPED (a piece left out) */
     uint32_t mesh_tris[MESH_MAX_VERTICES];  /* triangles of the piece rooted here */
     struct {
         int prepared, fits; /* fits: the whole mesh is in the tables (else nothing is dropped) */

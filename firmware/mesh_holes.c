@@ -14,7 +14,6 @@
 #include <math.h>
 #include <string.h>
 
-#define DROPPED 0xFFFFFFFFu /* mesh_io.c: a vertex of a piece left out */
 #define SLOTS (sizeof(((struct fusion_volume *)0)->open_edge) / sizeof(uint64_t))
 #define USED (1ull << 63) /* a boundary edge already walked */
 
@@ -221,7 +220,7 @@ int fusion_mesh_fill_holes(struct fusion_volume *vol, double max_hole_mm,
     memset(vol->open_edge, 0, sizeof(vol->open_edge));
     for (uint32_t t = 0; t < triangles; t++) {
         const uint32_t *tri = &vol->mesh_tri[3 * (size_t)t];
-        if (vol->mesh_index[tri[0]] == DROPPED)
+        if (vol->mesh_index[tri[0]] == MESH_DROPPED)
             continue;
         for (int k = 0; k < 3; k++) {
             uint32_t a = tri[k], b = tri[(k + 1) % 3];

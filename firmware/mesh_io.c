@@ -14,10 +14,8 @@
 #include <errno.h>
 #include <string.h>
 
-#define DROPPED 0xFFFFFFFFu
-
 /* The tables (struct fusion_volume): vol->mesh_index is each vertex's union-find parent, and after
- * prepare its new number or DROPPED; vol->mesh_coloured 0 where no view coloured the surface
+ * prepare its new number or MESH_DROPPED; vol->mesh_coloured 0 where no view coloured the surface
  * (colour_fill gives it one). */
 
 static uint32_t find_root(struct fusion_volume *vol, uint32_t v)
@@ -66,7 +64,7 @@ static int keep_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
     return 0;
 }
 
-/* Number the vertices of the pieces kept (DROPPED for the others), counting what is kept. */
+/* Number the vertices of the pieces kept (MESH_DROPPED for the others), counting what is kept. */
 static void drop_fragments(struct fusion_volume *vol, double min_fragment_share)
 {
     uint32_t n = vol->mp.s.vertices, largest = 0, next = 0;
@@ -89,7 +87,7 @@ static void drop_fragments(struct fusion_volume *vol, double min_fragment_share)
             vol->mp.s.kept_triangles += keep ? tris : 0;
         }
         vol->mesh_index[v] =
-            keep ? next++ : DROPPED; /* its root's entry is read before: root <= v */
+            keep ? next++ : MESH_DROPPED; /* its root's entry is read before: root <= v */
     }
     vol->mp.s.kept_vertices = next;
 }
@@ -106,13 +104,13 @@ static void colour_fill(struct fusion_volume *vol)
 {
     uint32_t n = vol->mp.s.vertices, missing = 0;
     for (uint32_t v = 0; v < n; v++)
-        missing += vol->mesh_index[v] != DROPPED && !vol->mesh_coloured[v];
+        missing += vol->mesh_index[v] != MESH_DROPPED && !vol->mesh_coloured[v];
     for (int pass = 0; pass < COLOUR_FILL_PASSES && missing > 0; pass++) {
         uint32_t filled = 0;
         memset(vol->mesh_tris, 0xFF, n * sizeof(uint32_t));
         for (uint32_t t = 0; t < vol->mp.s.triangles; t++) {
             const uint32_t *tri = &vol->mesh_tri[3 * (size_t)t];
-            for (int k = 0; k < 3 && vol->mesh_index[tri[0]] != DROPPED; k++) {
+            for (int k = 0; k < 3 && vol->mesh_index[tri[0]] != MESH_DROPPED; k++) {
                 uint32_t a = tri[k], b = tri[(k + 1) % 3];
                 if (!vol->mesh_coloured[a] && vol->mesh_coloured[b])
                     vol->mesh_tris[a] = b;
@@ -135,7 +133,7 @@ static void colour_fill(struct fusion_volume *vol)
             break;
     }
     for (uint32_t v = 0; v < n && missing > 0; v++)
-        if (vol->mesh_index[v] != DROPPED && !vol->mesh_coloured[v]) {
+        if (vol->mesh_index[v] != MESH_DROPPED && !vol->mesh_coloured[v]) {
             memset(&vol->mesh_rgb[3 * (size_t)v], GREY_LINEAR, 3);
             vol->mp.s.uncoloured++;
         }
@@ -178,11 +176,11 @@ static int emit_kept(struct fusion_volume *vol, const struct mesh_sink *sink)
 {
     int rc = 0;
     for (uint32_t v = 0; v < vol->mp.s.vertices && sink->vertex != NULL && rc == 0; v++)
-        if (vol->mesh_index[v] != DROPPED)
+        if (vol->mesh_index[v] != MESH_DROPPED)
             rc = sink->vertex(sink->priv, mesh_vertex_at(vol, v));
     for (uint32_t t = 0; t < vol->mp.s.triangles && sink->triangle != NULL && rc == 0; t++) {
         const uint32_t *tri = &vol->mesh_tri[3 * (size_t)t];
-        if (vol->mesh_index[tri[0]] != DROPPED)
+        if (vol->mesh_index[tri[0]] != MESH_DROPPED)
             rc = sink->triangle(sink->priv, vol->mesh_index[tri[0]], vol->mesh_index[tri[1]],
                                 vol->mesh_index[tri[2]]);
     }
@@ -314,7 +312,7 @@ int fusion_write_stl(struct fusion_volume *vol, const struct hal_storage *st, co
     outbuf_put(&o, header, sizeof(header));
     outbuf_u32le(&o, vol->mp.s.kept_triangles);
     for (uint32_t t = 0; t < vol->mp.s.triangles && o.rc == 0; t++)
-        if (vol->mesh_index[vol->mesh_tri[3 * (size_t)t]] != DROPPED)
+        if (vol->mesh_index[vol->mesh_tri[3 * (size_t)t]] != MESH_DROPPED)
             stl_triangle(vol, &o, t);
     return outbuf_close(&o);
 }

@@ -24,9 +24,6 @@
 #include <stdio.h>
 #include <string.h>
 
-/* Raw colours darker than this (sum of the channels) have no chromaticity to compare. */
-#define REG_CHROMA_MIN_DN 30.0
-
 /* Whether two samples' colours let them pair (multi-feature matching). Intrinsic colours are the
  * surface's own: every channel within max_colour_dn. A raw colour is the surface's times its
  * shading, which changes with the angle to the light (a flat face seen 45 degrees apart differs
@@ -40,7 +37,7 @@ static int colours_agree(const struct reg_params *p, const uint8_t a[3], const u
     double scale = 1.0;
     if (!p->colour_intrinsic) {
         double sa = (double)a[0] + a[1] + a[2], sb = (double)b[0] + b[1] + b[2];
-        if (sa < REG_CHROMA_MIN_DN || sb < REG_CHROMA_MIN_DN)
+        if (sa < REG_COLOUR_MIN_DN || sb < REG_COLOUR_MIN_DN)
             return 1;
         scale = sb / sa;
     }

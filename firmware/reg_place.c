@@ -180,15 +180,8 @@ void reg_align_group(struct reg_ctx *r, struct reg_report *rep)
     rep->second_share = ar.coupled_share;
 }
 
-/* Group 1 placed by ICP against group 0's views from where the table put it, with pairs
- * searched @p reach x max_pair_mm away first (8: an object knocked by a few millimetres, a few
- * degrees; 32: pushed by a few centimetres).
- * A placement is taken when it fits as well as the views of one arc fit each other: twice
- * min_coupled_share of its overlap with group 0 coupled, their residual within twice the
- * arcs' own (@p ring_rms_mm) and 0.02 mm. Measured: 0.75 and 0.91 coupled at the arcs'
- * residual for a slipped bunny and a slipped group of spheres; another object from the slip on
- * (spheres 1.4 times as large) couples 0.52 at 60 times the residual.
- * @retval 1 placed */
+/* Whether a placement fits as well as the views of one arc fit each other (reg_place_near_table
+ * says why and what was measured). */
 static int placement_fits(const struct reg_ctx *r, uint32_t coupled, uint32_t overlap, double rms,
                           double ring_rms_mm)
 {
@@ -196,6 +189,15 @@ static int placement_fits(const struct reg_ctx *r, uint32_t coupled, uint32_t ov
            rms <= 2.0 * ring_rms_mm + 0.02;
 }
 
+/* Group 1 placed by ICP against group 0's views from where the table put it, with pairs
+ * searched @p reach x max_pair_mm away first (8: an object knocked by a few millimetres, a few
+ * degrees; 32: pushed by a few centimetres).
+ * A placement is taken when it fits as well as the views of one arc fit each other
+ * (placement_fits): twice min_coupled_share of its overlap with group 0 coupled, their residual
+ * within twice the arcs' own (@p ring_rms_mm) and 0.02 mm. Measured: 0.75 and 0.91 coupled at the
+ * arcs' residual for a slipped bunny and a slipped group of spheres; another object from the slip
+ * on (spheres 1.4 times as large) couples 0.52 at 60 times the residual.
+ * @retval 1 placed */
 int reg_place_near_table(struct reg_ctx *r, double ring_rms_mm, double reach)
 {
     double rms = 0.0;
@@ -232,8 +234,6 @@ int reg_placement_holds(const struct reg_ctx *r)
 #define REG_HUE_TAU 0.43
 /* A colour whose distance from grey is under this share of its brightness is grey. */
 #define REG_HUE_MIN_SATURATION 0.15
-/* Colours darker than this (the mean of the channels) have no hue to tell. */
-#define REG_HUE_MIN_DN 10.0
 
 /* A colour's hue: the unit direction of its distance from grey, in the plane across the grey
  * axis. The same under any brightness of white light and under any grey added to it (ambient
@@ -247,7 +247,7 @@ static int hue_of(const uint8_t rgb[3], double hue[2])
     double x = ((double)rgb[0] - rgb[1]) / sqrt(2.0);
     double y = ((double)rgb[0] + rgb[1] - 2.0 * rgb[2]) / sqrt(6.0);
     double len = sqrt(x * x + y * y);
-    if (mean < REG_HUE_MIN_DN)
+    if (3.0 * mean < REG_COLOUR_MIN_DN)
         return 0;
     hue[0] = hue[1] = 0.0;
     if (len >= REG_HUE_MIN_SATURATION * mean)

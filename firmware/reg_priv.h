@@ -7,6 +7,10 @@
 
 #include <stddef.h>
 
+/* Raw colours darker than this (sum of the channels) have no chromaticity or hue to compare
+ * (reg.c's colour gate, reg_place.c's colour search). */
+#define REG_COLOUR_MIN_DN 30.0
+
 /* The kept samples of one view: gw x gh cells. */
 static inline size_t reg_cell_count(const struct reg_ctx *r)
 {
