@@ -230,9 +230,11 @@ from_dir_test() {
 check calibrate_from_dir_hostile from_dir_test
 # Captures in OpenCV's GrayCodePattern order (a folder a pose, patterns then white and black,
 # numbered without padding: image2 before image10) imported and computed from: the same
-# calibration as from the scanner's own captures; and what a person can get wrong.
+# calibration as from the scanner's own captures; and what a person can get wrong, or a hostile
+# folder holds: a FIFO where an image belongs is not opened (no hang), a linked pose folder and
+# a linked image are not followed.
 import_test() {
-    rm -rf "$out/opencv" "$out/imported" "$out/imported-again"
+    rm -rf "$out/opencv" "$out/imported" "$out/imported-again" "$out/imported-fifo"
     mkdir -p "$out/opencv"
     for v in "$out"/cal-captures/view_*; do
         grep -q 'target = board' "$v/target.ini" || continue
@@ -254,6 +256,13 @@ import_test() {
         grep -q -- '--opencv DIR is required' "$out/import-usage.txt" &&
         ! "$bin" calibrate import --opencv "$out/opencv/pose_000" --config $cfg --out "$out/imported-again" 2>"$out/import-flat.txt" &&
         grep -q 'holds no folder of images' "$out/import-flat.txt" && ! test -e "$out/imported-again" &&
+        mkfifo "$out/opencv/pose_001/image99.png" && ln -s ../pose_000 "$out/opencv/pose_link" &&
+        timeout 120 "$bin" calibrate import --opencv "$out/opencv" --config $cfg --out "$out/imported-fifo" >"$out/import-fifo.txt" 2>&1 &&
+        ! test -e "$out/imported-fifo/view_006" && test -f "$out/imported-fifo/view_005/frame_41.png" &&
+        mv "$out/opencv/pose_002/image5.png" "$out/image5.png" && ln -s ../../image5.png "$out/opencv/pose_002/image5.png" &&
+        ! "$bin" calibrate import --opencv "$out/opencv" --config $cfg --out "$out/imported-again" 2>"$out/import-link.txt" &&
+        grep -q 'pose_002: 41 PNG images' "$out/import-link.txt" && ! test -e "$out/imported-again" &&
+        rm "$out/opencv/pose_002/image5.png" && mv "$out/image5.png" "$out/opencv/pose_002/image5.png" &&
         rm "$out/opencv/pose_003/image7.png" &&
         ! "$bin" calibrate import --opencv "$out/opencv" --config $cfg --out "$out/imported-again" 2>"$out/import-short.txt" &&
         grep -q 'pose_003: 41 PNG images, but OpenCV.s GrayCodePattern for this projector makes 42' "$out/import-short.txt" && ! test -e "$out/imported-again"
