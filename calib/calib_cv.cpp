@@ -46,13 +46,15 @@ void lens_from(const cv::Mat &k, const cv::Mat &d, calcv_lens *l)
         l->dist[i] = i < (int)d.total() ? d.at<double>(i) : 0.0;
 }
 
-void split(const calcv_corners &v, std::vector<cv::Point3f> &obj, std::vector<cv::Point2f> &img)
+// (float points for OpenCV's calibration, double where a Jacobian is taken by differences)
+template <typename P3, typename P2>
+void split(const calcv_corners &v, std::vector<P3> &obj, std::vector<P2> &img)
 {
     obj.clear();
     img.clear();
     for (int i = 0; i < v.count; i++) {
-        obj.emplace_back((float)v.sheet[i][0], (float)v.sheet[i][1], 0.0f);
-        img.emplace_back((float)v.image[i][0], (float)v.image[i][1]);
+        obj.emplace_back(v.sheet[i][0], v.sheet[i][1], 0.0);
+        img.emplace_back(v.image[i][0], v.image[i][1]);
     }
 }
 
@@ -329,11 +331,15 @@ namespace
 
 // The unknowns of a calibration as one vector: camera lens (9), projector lens (9), the camera
 // -> projector rotation vector and translation (6), and each view's board -> camera pose (6).
+// In double throughout: a step of 1e-6 of a principal point moves a corner by 6e-4 px, which
+// float coordinates (6e-5 px at 1000 px) would blur into noise, and noise in the Jacobian's
+// columns hides the near-degenerate directions (it said a camera's principal point to 0.006 px
+// where the calibration's spread over noise seeds was 0.4 px).
 struct joint_problem {
     const calcv_corners *cam, *proj;
     int n;
-    std::vector<std::vector<cv::Point3f>> obj;
-    std::vector<std::vector<cv::Point2f>> img_cam, img_proj;
+    std::vector<std::vector<cv::Point3d>> obj;
+    std::vector<std::vector<cv::Point2d>> img_cam, img_proj;
 };
 
 void lens_at(const std::vector<double> &x, int at, cv::Matx33d &k, cv::Mat &d)
@@ -353,7 +359,7 @@ void joint_residuals(const joint_problem &p, const std::vector<double> &x, std::
     lens_at(x, 0, kc, dc);
     lens_at(x, 9, kp, dp);
     cv::Vec3d rs(x[18], x[19], x[20]), ts(x[21], x[22], x[23]);
-    std::vector<cv::Point2f> out;
+    std::vector<cv::Point2d> out;
     for (int v = 0; v < p.n; v++) {
         const double *pose = &x[24 + 6 * (size_t)v];
         cv::Vec3d rv(pose[0], pose[1], pose[2]), tv(pose[3], pose[4], pose[5]);
@@ -371,6 +377,28 @@ void joint_residuals(const joint_problem &p, const std::vector<double> &x, std::
             r.push_back(out[i].x - p.img_proj[v][i].x);
             r.push_back(out[i].y - p.img_proj[v][i].y);
         }
+    }
+}
+
+// The residuals at @p x and their Jacobian in the unknowns @p free, by central differences with a
+// step relative to each value.
+void joint_jacobian(const joint_problem &p, const std::vector<double> &x,
+                    const std::vector<int> &free, std::vector<double> &r0, cv::Mat &jac)
+{
+    std::vector<double> rp, rm;
+    joint_residuals(p, x, r0);
+    const int m = (int)r0.size(), k = (int)free.size();
+    jac.create(m, k, CV_64F);
+    for (int c = 0; c < k; c++) {
+        int i = free[c];
+        double h = 1e-6 * std::max(1.0, std::fabs(x[i]));
+        std::vector<double> xp = x, xm = x;
+        xp[i] += h;
+        xm[i] -= h;
+        joint_residuals(p, xp, rp);
+        joint_residuals(p, xm, rm);
+        for (int row = 0; row < m; row++)
+            jac.at<double>(row, c) = (rp[row] - rm[row]) / (2.0 * h);
     }
 }
 
@@ -404,7 +432,7 @@ extern "C" int calcv_uncertainty(const calcv_corners *cam, const calcv_corners *
     for (int v = 0; v < n; v++) {
         split(cam[v], p.obj[v], p.img_cam[v]);
         if (proj != nullptr) {
-            std::vector<cv::Point3f> o;
+            std::vector<cv::Point3d> o;
             split(proj[v], o, p.img_proj[v]);
         }
         double rv[3], tv[3], rms;
@@ -423,30 +451,30 @@ extern "C" int calcv_uncertainty(const calcv_corners *cam, const calcv_corners *
             continue;
         free.push_back(i);
     }
-    std::vector<double> r0, rp, rm;
+    std::vector<double> r0;
+    cv::Mat jac, cov;
     joint_residuals(p, x, r0);
     const int m = (int)r0.size(), k = (int)free.size();
     if (m <= k)
         return -EINVAL;
-    cv::Mat jac(m, k, CV_64F);
-    for (int c = 0; c < k; c++) { // central differences, a step relative to the value
-        int i = free[c];
-        double h = 1e-6 * std::max(1.0, std::fabs(x[i]));
-        std::vector<double> xp = x, xm = x;
-        xp[i] += h;
-        xm[i] -= h;
-        joint_residuals(p, xp, rp);
-        joint_residuals(p, xm, rm);
-        for (int row = 0; row < m; row++)
-            jac.at<double>(row, c) = (rp[row] - rm[row]) / (2.0 * h);
+    // The board poses are where the camera alone puts them; the covariance is taken where
+    // camera and projector agree best, so first Gauss-Newton steps on the poses alone (the lenses
+    // and the pose between them stay what the calibration found).
+    for (int pass = 0; pass < 3; pass++) {
+        joint_jacobian(p, x, free, r0, jac);
+        if (cv::invert(jac.t() * jac, cov, cv::DECOMP_SVD) == 0.0)
+            return -EDOM;
+        if (pass == 2)
+            break;
+        cv::Mat step = -(cov * (jac.t() * cv::Mat(r0)));
+        for (int c = 0; c < k; c++)
+            if (free[c] >= 24)
+                x[free[c]] += step.at<double>(c);
     }
     double sse = 0.0;
     for (double e : r0)
         sse += e * e;
     double var = sse / (double)(m - k);
-    cv::Mat cov;
-    if (cv::invert(jac.t() * jac, cov, cv::DECOMP_SVD) == 0.0)
-        return -EDOM;
     cov *= var;
     for (int c = 0; c < k; c++) {
         int i = free[c];

@@ -10,6 +10,7 @@
 #include "decode.h"
 #include "camray.h"
 #include "lens.h"
+#include "lsq.h"
 #include "scan.h"
 #include "scan_dir.h"
 #include "scan_job.h"
@@ -566,92 +567,161 @@ static int projector_column(const struct scan_calib *c, vec3 p, double *u)
     return *u >= 0.0 && *u <= c->proj_width - 1.0 && v >= 0.0 && v <= c->proj_height - 1.0;
 }
 
-/* What the uncertainty means for a scan: the working volume's middle plane (through the table's
- * axis, facing the camera, within [fusion] radius_mm of it and from the table to top_mm) seen
- * pixel by pixel, each pixel's point given the projector column the calibration found puts on
- * it, then triangulated again (tri_range_image, the scanner's own) by each calibration drawn
- * from the uncertainty: the depth error at the volume's centre and its worst, and how much a
- * 100 mm length across the middle changes. */
-static void predict_depth_error(struct solve *s)
+/* The working volume seen on CALIB_DEPTH_PLANES planes facing the camera: through the axis, and
+ * half the volume's radius in front of it and behind it (the middle plane first). */
+#define CALIB_DEPTH_PLANES 3
+
+/* What the drawn calibrations are compared on. Per plane, a camera image of the projector
+ * column the solved calibration puts on each sampled pixel (valid marks them); the samples as a
+ * list: their plane and pixel, the point itself, where a draw puts it, and its squared errors
+ * summed over the draws; which samples are the volume's centre and 50 mm either side of it. */
+struct depth_samples {
+    float *column;
+    uint8_t *valid, *reason;
+    uint32_t *pixel; /* plane * w * h + y * w + x */
+    vec3 *truth, *drawn;
+    double *sq;
+    size_t count, centre, ends[2];
+};
+
+/* Add plane @p k of the working volume to @p d, seen through the calibration @p c. */
+static void sample_plane(const struct solve *s, const struct scan_calib *c, int k,
+                         struct depth_samples *d, double best[3])
 {
-    const struct scan_calib *c = &s->out;
     const uint32_t w = c->cam_width, h = c->cam_height;
-    if (!s->have_sigma || s->camera_only || s->draw_count == 0)
-        return;
-    float *column = calloc((size_t)w * h, sizeof(float));
-    uint8_t *reason = malloc((size_t)w * h), *valid = malloc((size_t)w * h);
-    vec3 *truth = calloc((size_t)w * h, sizeof(vec3));
-    double *sq = calloc((size_t)w * h, sizeof(double));
-    struct tri_maps *maps = malloc(sizeof(*maps));
-    if (column == NULL || reason == NULL || valid == NULL || truth == NULL || sq == NULL ||
-        maps == NULL)
-        goto out_free;
-    memset(valid, SCAN_SHADOW, (size_t)w * h);
-    vec3 a0 = v3_from(c->axis_point_mm), ad = v3_norm(v3_from(c->axis_dir));
-    vec3 n = v3_norm(v3_sub(v3(0, 0, 1), v3_scale(ad, ad.z))); /* the plane faces the camera */
+    const size_t off = (size_t)k * w * h;
+    const double radius = s->cfg->fusion.radius_mm, mid = 0.5 * s->cfg->fusion.top_mm;
+    const double depth = k == 0 ? 0.0 : (k == 1 ? -0.5 : 0.5) * radius;
+    const double half = sqrt(radius * radius - depth * depth); /* its width inside the volume */
+    vec3 ad = v3_norm(v3_from(c->axis_dir));
+    vec3 n = v3_norm(v3_sub(v3(0, 0, 1), v3_scale(ad, ad.z))); /* the planes face the camera */
+    vec3 a0 = v3_add(v3_from(c->axis_point_mm), v3_scale(n, depth));
     vec3 across = v3_norm(v3_cross(ad, n));
     struct camray rays = camray_lookup(c);
-    size_t centre = 0, ends[2] = {0, 0};
-    double best_centre = HUGE_VAL, best_end[2] = {HUGE_VAL, HUGE_VAL};
-    double mid = 0.5 * s->cfg->fusion.top_mm, radius = s->cfg->fusion.radius_mm;
+    memset(d->valid + off, SCAN_SHADOW, (size_t)w * h);
     for (uint32_t y = 0; y < h; y += CALIB_DEPTH_STEP_PX)
         for (uint32_t x = 0; x < w; x += CALIB_DEPTH_STEP_PX) {
             vec3 ray = camray_at(c, rays, x, y);
             double den = v3_dot(n, ray), u;
             if (fabs(den) < 1e-9)
                 continue;
-            vec3 p = v3_scale(ray, v3_dot(n, a0) / den), d = v3_sub(p, a0);
-            double up = v3_dot(d, ad), side = v3_dot(d, across);
-            if (up < 0.0 || up > s->cfg->fusion.top_mm || fabs(side) > radius ||
+            vec3 p = v3_scale(ray, v3_dot(n, a0) / den), e = v3_sub(p, a0);
+            double up = v3_dot(e, ad), side = v3_dot(e, across);
+            if (up < 0.0 || up > s->cfg->fusion.top_mm || fabs(side) > half ||
                 !projector_column(c, p, &u))
                 continue;
-            size_t i = (size_t)y * w + x;
-            valid[i] = SCAN_VALID;
-            column[i] = (float)u;
-            truth[i] = p;
-            double dc = hypot(up - mid, side); /* the centre, and 50 mm either side of it */
-            double de[2] = {hypot(up - mid, side + 50.0), hypot(up - mid, side - 50.0)};
-            if (dc < best_centre)
-                best_centre = dc, centre = i;
-            for (int k = 0; k < 2; k++)
-                if (de[k] < best_end[k])
-                    best_end[k] = de[k], ends[k] = i;
+            size_t i = (size_t)y * w + x, j = d->count++;
+            d->valid[off + i] = SCAN_VALID;
+            d->column[off + i] = (float)u;
+            d->pixel[j] = (uint32_t)(off + i);
+            d->truth[j] = p;
+            d->sq[j] = 0.0;
+            if (k != 0)
+                continue;
+            double dist[3] = {hypot(up - mid, side), hypot(up - mid, side + 50.0),
+                              hypot(up - mid, side - 50.0)};
+            for (int m = 0; m < 3; m++)
+                if (dist[m] < best[m]) {
+                    best[m] = dist[m];
+                    *(m == 0 ? &d->centre : &d->ends[m - 1]) = j;
+                }
         }
-    double len_sq = 0.0, len0 = v3_len(v3_sub(truth[ends[0]], truth[ends[1]]));
+}
+
+/* One drawn calibration @p ck: every sample triangulated again (the scanner's tri_range_image),
+ * the rigid motion that best moves them back removed, the errors that remain added to d->sq, the
+ * 100 mm length's change (in % of it) through @p dl_pct. Why the motion is removed: a
+ * calibration that turns or shifts the camera's frame (a camera principal point 0.4 px off
+ * turns it by 0.01 deg, 0.1 mm at the table) finds the turntable's axis in that same frame, from
+ * the same board poses, so the model comes out the same shape, only placed differently.
+ * @retval 0 @retval -EDOM a lens that folds over, or a sample it does not see: not one to
+ * judge by */
+static int draw_error(const struct scan_calib *ck, struct tri_maps *maps, struct depth_samples *d,
+                      double *dl_pct)
+{
+    const size_t plane = (size_t)ck->cam_width * ck->cam_height;
+    memcpy(d->reason, d->valid, CALIB_DEPTH_PLANES * plane);
+    for (size_t j = 0, k = 0; k < CALIB_DEPTH_PLANES; k++) {
+        struct tri_range range;
+        if (tri_range_image(ck, maps, ck->cam_width, ck->cam_height, d->column + k * plane,
+                            d->reason + k * plane, &range) != 0)
+            return -EDOM;
+        for (; j < d->count && d->pixel[j] < (k + 1) * plane; j++) {
+            size_t i = d->pixel[j] - k * plane;
+            if (d->reason[d->pixel[j]] != SCAN_VALID)
+                return -EDOM;
+            d->drawn[j] = v3(maps->xyz_mm[3 * i], maps->xyz_mm[3 * i + 1], maps->xyz_mm[3 * i + 2]);
+        }
+    }
+    /* point to point as three point-to-plane pairs (Horn's closed form would do the same) */
+    const vec3 axes[3] = {v3(1, 0, 0), v3(0, 1, 0), v3(0, 0, 1)};
+    for (int pass = 0; pass < 3; pass++) {
+        struct lsq_rigid eq;
+        struct frame_xform step;
+        lsq_rigid_clear(&eq);
+        for (size_t j = 0; j < d->count; j++)
+            for (int a = 0; a < 3; a++)
+                lsq_rigid_add(&eq, d->drawn[j], d->truth[j], axes[a]);
+        if (lsq_rigid_step(&eq, &step) != 0)
+            return -EDOM;
+        for (size_t j = 0; j < d->count; j++)
+            d->drawn[j] = frame_point(&step, d->drawn[j]);
+    }
+    for (size_t j = 0; j < d->count; j++)
+        d->sq[j] += v3_dot(v3_sub(d->drawn[j], d->truth[j]), v3_sub(d->drawn[j], d->truth[j]));
+    double len0 = v3_len(v3_sub(d->truth[d->ends[0]], d->truth[d->ends[1]]));
+    double len = v3_len(v3_sub(d->drawn[d->ends[0]], d->drawn[d->ends[1]]));
+    *dl_pct = (len - len0) * 100.0 / fmax(len0, 1e-9);
+    return 0;
+}
+
+/* What the uncertainty does to a scan: CALIB_DEPTH_DRAWS calibrations drawn from it (lenses and
+ * pose; the board poses marginalised), the working volume triangulated by each, the RMS error
+ * at the volume's centre and its worst, and a 100 mm length's. */
+static void predict_depth_error(struct solve *s)
+{
+    const struct scan_calib *c = &s->out;
+    const size_t plane = (size_t)c->cam_width * c->cam_height, most = CALIB_DEPTH_PLANES * plane;
+    if (!s->have_sigma || s->camera_only || s->draw_count == 0)
+        return;
+    struct depth_samples d = {
+        .column = calloc(most, sizeof(float)),
+        .valid = malloc(most),
+        .reason = malloc(most),
+        .pixel = malloc(most / CALIB_DEPTH_STEP_PX * sizeof(uint32_t)),
+        .truth = malloc(most / CALIB_DEPTH_STEP_PX * sizeof(vec3)),
+        .drawn = malloc(most / CALIB_DEPTH_STEP_PX * sizeof(vec3)),
+        .sq = malloc(most / CALIB_DEPTH_STEP_PX * sizeof(double)),
+    };
+    struct tri_maps *maps = malloc(sizeof(*maps));
+    double best[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL};
+    if (d.column == NULL || d.valid == NULL || d.reason == NULL || d.pixel == NULL ||
+        d.truth == NULL || d.drawn == NULL || d.sq == NULL || maps == NULL)
+        goto out_free;
+    for (int k = 0; k < CALIB_DEPTH_PLANES; k++)
+        sample_plane(s, c, k, &d, best);
+    if (best[0] == HUGE_VAL || best[1] == HUGE_VAL || best[2] == HUGE_VAL)
+        goto out_free; /* the volume's middle is not in view */
+    double len_sq = 0.0, dl;
     int used = 0;
     for (int k = 0; k < s->draw_count; k++) {
         struct scan_calib ck = *c;
-        struct tri_range range;
-        const struct calcv_draw *d = &s->draws[k];
-        lens_to_calib(&d->cam, 0, &ck);
-        lens_to_calib(&d->proj, 1, &ck);
-        memcpy(ck.proj_rot, d->rot, sizeof(ck.proj_rot));
-        memcpy(ck.proj_trans_mm, d->trans, sizeof(ck.proj_trans_mm));
-        memcpy(reason, valid, (size_t)w * h);
-        if (tri_range_image(&ck, maps, w, h, column, reason, &range) != 0 ||
-            reason[centre] != SCAN_VALID || reason[ends[0]] != SCAN_VALID ||
-            reason[ends[1]] != SCAN_VALID)
-            continue; /* a lens that folds over: not one to judge by */
-        for (size_t i = 0; i < (size_t)w * h; i++)
-            if (valid[i] == SCAN_VALID && reason[i] == SCAN_VALID) {
-                vec3 q = v3(maps->xyz_mm[3 * i], maps->xyz_mm[3 * i + 1], maps->xyz_mm[3 * i + 2]);
-                sq[i] += v3_dot(v3_sub(q, truth[i]), v3_sub(q, truth[i]));
-            }
-        vec3 e0 = v3(maps->xyz_mm[3 * ends[0]], maps->xyz_mm[3 * ends[0] + 1],
-                     maps->xyz_mm[3 * ends[0] + 2]);
-        vec3 e1 = v3(maps->xyz_mm[3 * ends[1]], maps->xyz_mm[3 * ends[1] + 1],
-                     maps->xyz_mm[3 * ends[1] + 2]);
-        double dl = (v3_len(v3_sub(e0, e1)) - len0) * 100.0 / fmax(len0, 1e-9);
+        const struct calcv_draw *draw = &s->draws[k];
+        lens_to_calib(&draw->cam, 0, &ck);
+        lens_to_calib(&draw->proj, 1, &ck);
+        memcpy(ck.proj_rot, draw->rot, sizeof(ck.proj_rot));
+        memcpy(ck.proj_trans_mm, draw->trans, sizeof(ck.proj_trans_mm));
+        if (draw_error(&ck, maps, &d, &dl) != 0)
+            continue;
         len_sq += dl * dl;
         used++;
     }
-    if (used == 0 || best_centre == HUGE_VAL)
+    if (used == 0)
         goto out_free;
     double worst = 0.0;
-    for (size_t i = 0; i < (size_t)w * h; i++)
-        if (valid[i] == SCAN_VALID)
-            worst = fmax(worst, sqrt(sq[i] / used));
-    s->depth_centre_mm = sqrt(sq[centre] / used);
+    for (size_t j = 0; j < d.count; j++)
+        worst = fmax(worst, sqrt(d.sq[j] / used));
+    s->depth_centre_mm = sqrt(d.sq[d.centre] / used);
     s->depth_worst_mm = worst;
     s->length_100_mm = sqrt(len_sq / used);
     say(s,
@@ -660,11 +730,13 @@ static void predict_depth_error(struct solve *s)
         s->depth_centre_mm, s->depth_worst_mm, s->length_100_mm, used);
 out_free:
     free(maps);
-    free(sq);
-    free(truth);
-    free(valid);
-    free(reason);
-    free(column);
+    free(d.sq);
+    free(d.drawn);
+    free(d.truth);
+    free(d.pixel);
+    free(d.reason);
+    free(d.valid);
+    free(d.column);
 }
 
 /* The projector as an inverse camera (Zhang's method on the corners' projector coordinates),
