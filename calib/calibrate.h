@@ -32,11 +32,12 @@ void calibrate_guess(const struct app_config *cfg, struct scan_calib *guess);
 int calibrate_capture(struct hal *hal, const struct app_config *cfg, const struct scan_calib *guess,
                       const char *dir);
 
-/** Compute the calibration from the captures in @p dir and write @p out_path (an existing file
- *  is kept beside it) with its report. @param cfg  the config (board, limits, light count)
- *  @retval 0 @retval -EINVAL refused (said why) @retval -errno */
+/** Compute the calibration from the captures in @p dir (and @p added, NULL for none: captures of
+ *  placements added later, e.g. those a weak calibration asked for) and write @p out_path (an
+ *  existing file is kept beside it) with its report. @param cfg  the config (board, limits,
+ *  light count) @retval 0 @retval -EINVAL refused (said why) @retval -errno */
 int calibrate_solve(const struct hal_storage *st, const struct app_config *cfg, const char *dir,
-                    const char *out_path);
+                    const char *added, const char *out_path);
 
 /** Rewrite captures made with OpenCV's GrayCodePattern (@p src: a folder a board pose, each with
  *  its PNG images in OpenCV's order: column bits and inverses, row bits and inverses, white,

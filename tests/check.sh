@@ -5,11 +5,12 @@
 # Needs $out (the test's output directory).
 pass=0
 fail=0
-check() { # name, then a command that must succeed
+check() { # name, then a command that must succeed (its seconds said: make test stays short)
     name=$1
     shift
+    start=$(date +%s)
     if "$@" >"$out.log" 2>&1; then
-        echo "[       OK ] $name"
+        echo "[       OK ] $name ($(($(date +%s) - start)) s)"
         pass=$((pass + 1))
     else
         echo "[  FAILED  ] $name"

@@ -29,12 +29,14 @@ fi
 passed=0
 failed=0
 for t in $first; do
+    start=$(date +%s)
     case $t in
     *.sh) out=$("$t" 2>&1) ;;                  # scripts run the scanner themselves
     *) out=$(${RUN_WITH:-} "$t" 2>&1) ;;
     esac
     rc=$?
     printf '%s\n' "$out"
+    echo "[   TIME   ] $t: $(($(date +%s) - start)) s" # make test stays under 10 minutes
     p=$(printf '%s\n' "$out" | sed -n 's/^\[  PASSED  \] \([0-9]*\) test.*/\1/p' | tail -n 1)
     f=$(printf '%s\n' "$out" | sed -n 's/^\[  FAILED  \] \([0-9]*\) test.*/\1/p' | tail -n 1)
     p=${p:-0}
