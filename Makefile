@@ -112,7 +112,7 @@ BOARD_SRC := $(if $(filter sim,$(HAL)),$(SIM_SRC),$(LINUX_SRC))
 # which make test installs): a scan never loads
 # OpenCV. scanner execs it for 'scanner calibrate'.
 HAVE_OPENCV := $(shell $(PKG_CONFIG) --exists opencv4 2>/dev/null && echo 1)
-CALIB_SRC := calib/calibrate.c calib/calib_solve.c calib/calib_files.c calib/calib_common.c calib/calib_import.c calib/main.c
+CALIB_SRC := calib/calibrate.c calib/calib_solve.c calib/calib_json.c calib/calib_files.c calib/calib_common.c calib/calib_import.c calib/main.c
 OPENCV_LIBS := -lopencv_aruco -lopencv_calib3d -lopencv_imgproc -lopencv_core
 CALIB_TOOL := $(if $(HAVE_OPENCV),$(BUILD)/scanner-calibrate,)
 # The web interface (scanner serve) is its own program too, scanner-web: civetweb and cJSON

@@ -13,6 +13,7 @@
 #include "scan_job.h"
 
 #include <pthread.h>
+#include <stdio.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -87,6 +88,10 @@ int job_make_view_dir(const struct job *j, uint32_t v);
 int job_open_out(struct job *j, enum scan_dir_mode mode, int *lock_fd);
 
 /* ---- job_events.c ---- */
+/** Write @p s to @p out as a JSON string: quoted, the quote and the backslash escaped, control
+ *  characters as \u00XX (the scan's events and the calibration's result). */
+void job_json_string(FILE *out, const char *s);
+
 /** One event (scan_events.h) with its numbers as JSON fields too (@p fields: '"name":value,...'
  *  or NULL). @p view < 0: not about a view. @p done: views finished so far, for the estimate. */
 void job_progress_with(struct job *j, const char *event, int view, uint32_t done,

@@ -53,7 +53,7 @@ static void job_report_cost(struct job *j, const char *what)
     job_progress_with(j, EV_COST, -1, j->views, fields, detail);
 }
 
-static void json_string(FILE *out, const char *s)
+void job_json_string(FILE *out, const char *s)
 {
     fputc('"', out);
     for (; *s != '\0'; s++) {
@@ -136,7 +136,7 @@ static void progress_line(struct job *j, const char *event, int view, uint32_t d
                "\"elapsed_s\":%.1f,\"left_s\":%.1f,%s%s\"detail\":",
                event, view, (unsigned)j->views, (unsigned)done, elapsed_s, left_s,
                fields != NULL ? fields : "", fields != NULL ? "," : "");
-        json_string(stdout, detail);
+        job_json_string(stdout, detail);
         printf("}\n");
     } else if (j->tty && view >= 0) {
         /* one status line, rewritten in place; a finished view keeps its line, without the path */

@@ -58,4 +58,23 @@ int calib_solve_n(double *a, double *b, double *x, int n);
 double calib_fit_sphere(const float *xyz, const uint8_t *reason, size_t n, int fit_radius,
                         double *radius, vec3 *centre, uint32_t *used);
 
+/** What a calibration found, for calib_json_write: every value with its uncertainty, the
+ *  quality, the prediction and the verdict. A refused one has @p file NULL and @p refusal. */
+struct calib_result {
+    const char *file, *report; /**< the files written */
+    const char *refusal;       /**< why nothing was written */
+    const struct scan_calib *calib;
+    int camera_only, have_sigma;
+    const struct calcv_sigma *sigma;
+    double axis_dir_sigma_deg, axis_across_sigma_mm, axis_along_sigma_mm; /**< 0: not known */
+    const double *light_sigma_mm;                                         /**< per light */
+    double camera_rms_px, projector_rms_px;
+    uint32_t boards;
+    double depth_centre_mm, depth_edge_mm, length_100_mm; /**< 0: not predicted */
+    const char *weak, *advice;                            /**< "" when not weak */
+};
+
+/** Write @p r to @p out as one JSON object on one line (scanner calibrate --json). */
+void calib_json_write(FILE *out, const struct calib_result *r);
+
 #endif

@@ -64,6 +64,7 @@ struct solve {
     char *report;
     size_t report_len, report_cap;
     char refusal[512]; /* the last "refused: ..." line, for the error message */
+    int json;          /* --json: stdout holds the JSON object alone */
     double cam_rms, proj_rms, stereo_rms;
     int camera_only;
     struct calcv_sigma sigma; /* one standard deviation of each value (have_sigma) */
@@ -1434,8 +1435,8 @@ static int write_outputs(struct solve *s, const struct hal_storage *st, const ch
     rc = hal_storage_write_file(st, report_path, s->report, s->report_len);
     if (rc != 0)
         fprintf(stderr, "scanner: error: cannot write %s: %s\n", report_path, strerror(-rc));
-    printf("calibration written: %s (report: %s)%s%s\n", out_path, report_path,
-           kept[0] ? "; the previous file is kept as " : "", kept);
+    fprintf(s->json ? stderr : stdout, "calibration written: %s (report: %s)%s%s\n", out_path,
+            report_path, kept[0] ? "; the previous file is kept as " : "", kept);
     return rc;
 }
 
@@ -1477,12 +1478,42 @@ static int check_added(struct solve *s, const char *added)
     return 0;
 }
 
+/* --json: the result as one JSON object on stdout (calib_json.c). */
+static void say_json(const struct solve *s, const char *out_path, int written)
+{
+    char report_path[HAL_MAX_PATH + 16];
+    calibrate_path_beside(out_path, ".report.txt", report_path, sizeof(report_path));
+    struct calib_result r = {
+        .file = written ? out_path : NULL,
+        .report = report_path,
+        .refusal = s->refusal[0] ? s->refusal : "see the messages on stderr",
+        .calib = &s->out,
+        .camera_only = s->camera_only,
+        .have_sigma = s->have_sigma,
+        .sigma = &s->sigma,
+        .axis_dir_sigma_deg = s->axis_dir_sigma_deg,
+        .axis_across_sigma_mm = s->axis_across_sigma_mm,
+        .axis_along_sigma_mm = s->axis_along_sigma_mm,
+        .light_sigma_mm = s->light_sigma_mm,
+        .camera_rms_px = s->cam_rms,
+        .projector_rms_px = s->proj_rms,
+        .boards = s->view_count,
+        .depth_centre_mm = s->depth_centre_mm,
+        .depth_edge_mm = s->depth_worst_mm,
+        .length_100_mm = s->length_100_mm,
+        .weak = s->weak,
+        .advice = s->advice,
+    };
+    calib_json_write(stdout, &r);
+}
+
 int calibrate_solve(const struct hal_storage *st, const struct app_config *cfg, const char *dir,
-                    const char *added, const char *out_path)
+                    const char *added, const char *out_path, int json)
 {
     struct solve s;
     memset(&s, 0, sizeof(s));
     s.cfg = cfg;
+    s.json = json;
     s.dir = s.dirs[s.dir_count++] = dir;
     if (added != NULL)
         s.dirs[s.dir_count++] = added;
@@ -1533,10 +1564,13 @@ int calibrate_solve(const struct hal_storage *st, const struct app_config *cfg, 
         judge_uncertainty(&s);
     if (rc == 0)
         predict_depth_error(&s);
-    fputs(s.report != NULL ? s.report : "", stdout);
+    if (!json) /* with --json the report is in its file only */
+        fputs(s.report != NULL ? s.report : "", stdout);
     if (rc == 0)
         rc = write_outputs(&s, st, out_path);
-    else if (rc == -EINVAL)
+    if (json)
+        say_json(&s, out_path, rc == 0);
+    if (rc == -EINVAL)
         fprintf(stderr, "scanner: error: calibration refused: %s; %s is unchanged\n",
                 s.refusal[0] ? s.refusal : "see above", out_path);
     free(s.report);

@@ -35,9 +35,10 @@ int calibrate_capture(struct hal *hal, const struct app_config *cfg, const struc
 /** Compute the calibration from the captures in @p dir (and @p added, NULL for none: captures of
  *  placements added later, e.g. those a weak calibration asked for) and write @p out_path (an
  *  existing file is kept beside it) with its report. @param cfg  the config (board, limits,
- *  light count) @retval 0 @retval -EINVAL refused (said why) @retval -errno */
+ *  light count) @param json  1: the result as one JSON object on stdout instead of the report
+ *  (calib_json_write) @retval 0 @retval -EINVAL refused (said why) @retval -errno */
 int calibrate_solve(const struct hal_storage *st, const struct app_config *cfg, const char *dir,
-                    const char *added, const char *out_path);
+                    const char *added, const char *out_path, int json);
 
 /** Rewrite captures made with OpenCV's GrayCodePattern (@p src: a folder a board pose, each with
  *  its PNG images in OpenCV's order: column bits and inverses, row bits and inverses, white,

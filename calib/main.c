@@ -12,13 +12,14 @@
 #include <string.h>
 
 /* scanner calibrate [verify | board | import --opencv D] --config F [--out P] [--dir D |
- * --from D [--add D2]] */
+ * --from D [--add D2] [--json]] */
 int main(int argc, char **argv)
 {
     static struct app_config cfg;
     static struct scan_calib calib;
     const char *config_path = NULL, *out = NULL, *dir = NULL, *from = NULL, *what = "";
     const char *opencv = NULL, *added = NULL;
+    int json = 0;
     int first = 2;
     if (argc > 2 && (strcmp(argv[2], "verify") == 0 || strcmp(argv[2], "board") == 0 ||
                      strcmp(argv[2], "import") == 0))
@@ -34,6 +35,8 @@ int main(int argc, char **argv)
             from = argv[++i];
         else if (strcmp(argv[i], "--add") == 0 && i + 1 < argc && what[0] == '\0')
             added = argv[++i];
+        else if (strcmp(argv[i], "--json") == 0 && what[0] == '\0')
+            json = 1;
         else if (strcmp(argv[i], "--opencv") == 0 && i + 1 < argc && what[0] == 'i')
             opencv = argv[++i];
         else {
@@ -63,13 +66,18 @@ int main(int argc, char **argv)
         }
         return calibrate_import_opencv(&st, &cfg, opencv, out) == 0 ? 0 : 1;
     }
+    if (json && from == NULL) {
+        fprintf(stderr, "scanner: calibrate: --json goes with --from DIR (the captures' prompts "
+                        "are a person's to read)\n");
+        return 2;
+    }
     if (added != NULL && from == NULL) {
         fprintf(stderr, "scanner: calibrate: --add DIR2 goes with --from DIR (the captures of "
                         "the first calibration)\n");
         return 2;
     }
     if (from != NULL)
-        return calibrate_solve(&st, &cfg, from, added, out) == 0 ? 0 : 1;
+        return calibrate_solve(&st, &cfg, from, added, out, json) == 0 ? 0 : 1;
     int rc = calib_load(&calib, cfg.calibration_file, cfg.light_count, err, sizeof(err));
     if (rc == -ENOENT && what[0] != 'v') {
         calibrate_guess(&cfg, &calib); /* a new rig: nothing calibrated yet */
@@ -94,6 +102,6 @@ int main(int argc, char **argv)
                             : calibrate_capture(rig_hal(), &cfg, &calib, dir);
     rig_down();
     if (rc == 0 && what[0] != 'v')
-        rc = calibrate_solve(&st, &cfg, dir, NULL, out);
+        rc = calibrate_solve(&st, &cfg, dir, NULL, out, 0);
     return rc == 0 ? 0 : 1;
 }

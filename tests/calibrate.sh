@@ -149,6 +149,37 @@ add_test() {
         grep -q -- '--add DIR2 goes with --from DIR' "$out/bad-add-alone.txt" && ! test -e "$out/bad-add.ini"
 }
 check placements_added_later add_test
+# --json: the result as one JSON object on stdout, the report in its file only: the tight-bounds
+# calibration's (weak, its values and sigmas), a refused one (two captures), an output name
+# with a quote, a backslash and a newline in it (escaped, still one line of JSON); --json with
+# the captures' prompts refused.
+json_test() {
+    weird="$out/we\"ird\\
+name.ini"
+    "$bin" calibrate --config "$out/tight-cfg.ini" --from "$out/cal-captures" --out "$weird" --json \
+        >"$out/json.txt" 2>"$out/json-err.txt" &&
+        ! "$bin" calibrate --config $cfg --from "$out/first" --out "$out/json-few.ini" --json \
+            >"$out/json-few.txt" 2>"$out/json-few-err.txt" && test -f "$weird" && test "$(wc -l <"$out/json.txt")" -eq 1 || return 1
+    ! "$bin" calibrate --config $cfg --out "$out/json-capture.ini" --json >"$out/json-capture.txt" 2>&1 &&
+        grep -q -- '--json goes with --from' "$out/json-capture.txt" || return 1
+    /usr/bin/python3 - "$out/json.txt" "$out/json-few.txt" "$weird" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))
+assert r["event"] == "calibration" and r["written"] and r["file"] == sys.argv[3], r.get("file")
+assert r["boards"] == 6 and 0 < r["camera_rms_px"] < 0.15
+for lens in ("camera", "projector"):
+    assert abs(r[lens]["fx_px"] - (2436 if lens == "camera" else 1871.5)) < 12
+    assert all(r[lens]["sigma"][k] > 0 for k in ("fx_px", "fy_px", "cx_px", "cy_px"))
+assert len(r["pose"]["rotation"]) == 9 and len(r["pose"]["sigma"]["translation_mm"]) == 3
+assert r["axis"]["sigma"]["dir_deg"] > 0 and len(r["lights"]) == 4
+assert 0 < r["predicted"]["depth_centre_mm"] <= r["predicted"]["depth_edge_mm"] < 1
+assert r["weak"] and "principal point" in r["weak_values"] and r["advice"].startswith("add ")
+few = json.load(open(sys.argv[2]))
+assert few["written"] is False and "too few views" in few["refused"], few
+print("json ok")
+PY
+}
+check json_result json_test
 # Three captures of one board at one angle: Zhang's method cannot tell the focal length.
 degenerate_test() {
     copy_views "$out/same" "0 0 0 0"
