@@ -9,7 +9,6 @@
 
 #include "decode.h"
 #include "camray.h"
-#include "lens.h"
 #include "lsq.h"
 #include "scan.h"
 #include "scan_dir.h"
@@ -596,14 +595,9 @@ static void judge_uncertainty(struct solve *s)
  * integers, through the projector's distortion). @retval 0 outside its image or behind it */
 static int projector_column(const struct scan_calib *c, vec3 p, double *u)
 {
-    vec3 q = v3_add(m3_mul(c->proj_rot, p), v3_from(c->proj_trans_mm));
-    double xd, yd;
-    if (q.z <= 0.0)
-        return 0;
-    lens_distort(c->proj_dist, q.x / q.z, q.y / q.z, &xd, &yd);
-    *u = c->proj_fx_px * xd + c->proj_cx_px;
-    double v = c->proj_fy_px * yd + c->proj_cy_px;
-    return *u >= 0.0 && *u <= c->proj_width - 1.0 && v >= 0.0 && v <= c->proj_height - 1.0;
+    double v;
+    return camray_project_projector(c, p, u, &v) && *u >= 0.0 && *u <= c->proj_width - 1.0 &&
+           v >= 0.0 && v <= c->proj_height - 1.0;
 }
 
 /* The working volume seen on CALIB_DEPTH_PLANES planes facing the camera: through the axis, and

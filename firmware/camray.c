@@ -71,3 +71,16 @@ void camray_project(const struct scan_calib *c, vec3 p, double *u, double *v)
     *u = c->cam_fx_px * x + c->cam_cx_px;
     *v = c->cam_fy_px * y + c->cam_cy_px;
 }
+
+int camray_project_projector(const struct scan_calib *c, vec3 p, double *u, double *v)
+{
+    vec3 q = v3_add(m3_mul(c->proj_rot, p), v3_from(c->proj_trans_mm));
+    if (q.z <= 0.0)
+        return 0;
+    double x = q.x / q.z, y = q.y / q.z;
+    if (!lens_is_pinhole(c->proj_dist))
+        lens_distort(c->proj_dist, x, y, &x, &y);
+    *u = c->proj_fx_px * x + c->proj_cx_px;
+    *v = c->proj_fy_px * y + c->proj_cy_px;
+    return 1;
+}

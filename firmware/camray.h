@@ -31,4 +31,9 @@ vec3 camray_at(const struct scan_calib *calib, struct camray rays, uint32_t x, u
  *  at integers. */
 void camray_project(const struct scan_calib *calib, vec3 p, double *u, double *v);
 
+/** Where camera-frame point @p p falls in the projector's image (its pose, pinhole, distortion:
+ *  the model tri_range_image inverts), pixel centres at integers. @retval 1 @retval 0 behind
+ *  the projector (@p u, @p v untouched) */
+int camray_project_projector(const struct scan_calib *calib, vec3 p, double *u, double *v);
+
 #endif

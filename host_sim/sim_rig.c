@@ -3,6 +3,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "sim_rig.h"
 
+#include "camray.h"
 #include "frames.h"
 #include "gray.h"
 #include "lens.h"
@@ -376,14 +377,8 @@ static int projector_light(const struct sim_rig *rig, const struct surface_point
     const struct scan_calib *c = &rig->calib;
     rad[0] = rad[1] = rad[2] = 0.0;
     *u = *v = NAN;
-    vec3 pp = v3_add(m3_mul(c->proj_rot, sp->p_cam), v3_from(c->proj_trans_mm));
-    if (pp.z <= 0.0)
+    if (!camray_project_projector(c, sp->p_cam, u, v))
         return 0;
-    double xd = pp.x / pp.z, yd = pp.y / pp.z;
-    if (!lens_is_pinhole(c->proj_dist))
-        lens_distort(c->proj_dist, pp.x / pp.z, pp.y / pp.z, &xd, &yd);
-    *u = c->proj_fx_px * xd + c->proj_cx_px;
-    *v = c->proj_fy_px * yd + c->proj_cy_px;
     vec3 to_proj = v3_sub(proj_cam, sp->p_cam);
     vec3 l = v3_norm(to_proj);
     if (*u < -0.5 || *u >= c->proj_width - 0.5 || *v < -0.5 || *v >= c->proj_height - 0.5 ||
