@@ -105,7 +105,7 @@ test-deps: deps
 test: deps test-deps
 	@$(MAKE) --no-print-directory test-run
 test-run: format-check $(BUILD)/scanner $(CALIB_TOOL) $(WEB_TOOL) $(SIM_TOOLS) $(BUILD)/seccomp-run $(TEST_BIN) $(FUZZ_REPLAY) check-firmware $(if $(filter 0,$(SAN)),check-stack,) linux-build small-build
-	@RUN_WITH="$(VALGRIND_RUN)" BUILD=$(BUILD) tests/run.sh $(TEST_BIN) tests/layers.sh tests/interop.sh tests/fuzz/replay.sh tests/resume.sh -- tests/cli.sh tests/calibrate.sh tests/web.sh tests/objects.sh
+	@RUN_WITH="$(VALGRIND_RUN)" BUILD=$(BUILD) tests/run.sh $(TEST_BIN) tests/layers.sh tests/interop.sh tests/fuzz/replay.sh tests/resume.sh tests/objects.sh tests/web.sh -- tests/cli.sh tests/calibrate.sh
 
 # make test VALGRIND=1: every cmocka test under valgrind memcheck; any invalid access,
 # uninitialised use or definite leak fails the test (exit code 99).
