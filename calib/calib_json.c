@@ -88,6 +88,8 @@ void calib_json_write(FILE *out, const struct calib_result *r)
         job_json_string(out, r->weak);
         fputs(",\"advice\":", out);
         job_json_string(out, r->advice);
+        fputs(",\"add_placements\":", out);
+        job_json_string(out, r->add_placements);
     }
     fputs("}\n", out);
 }

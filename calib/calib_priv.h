@@ -72,6 +72,7 @@ struct calib_result {
     uint32_t boards;
     double depth_centre_mm, depth_edge_mm, length_100_mm; /**< 0: not predicted */
     const char *weak, *advice;                            /**< "" when not weak */
+    const char *add_placements; /**< the advice as [calibrate] placements (weak only) */
 };
 
 /** Write @p r to @p out as one JSON object on one line (scanner calibrate --json). */

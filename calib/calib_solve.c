@@ -75,8 +75,9 @@ struct solve {
      * it) and of each light's position (the length of its error); 0: not known */
     double axis_dir_sigma_deg, axis_across_sigma_mm, axis_along_sigma_mm;
     double light_sigma_mm[HAL_MAX_LIGHTS];
-    char weak[192];   /* what is too uncertain ("" when nothing) ... */
-    char advice[192]; /* ... and what to capture next */
+    char weak[192];             /* what is too uncertain ("" when nothing) ... */
+    char advice[192];           /* ... and what to capture next */
+    const char *add_placements; /* ... as [calibrate] placements */
 };
 
 static void say(struct solve *s, const char *fmt, ...)
@@ -575,11 +576,11 @@ static void judge_uncertainty(struct solve *s)
     if (!cam && !proj)
         return;
     snprintf(s->weak, sizeof(s->weak), "%s", what);
-    snprintf(s->advice, sizeof(s->advice), "add %s",
-             proj ? "placements tilted towards and away from the projector ([calibrate] "
-                    "placements with 35 and -35) and at other offsets (0@75, 0@-75)"
-                  : "placements tilted 30 to 45 deg and offset towards the image's corners "
-                    "([calibrate] placements with 35@75 and -35@-75)");
+    s->add_placements = proj ? "35, -35, 0@75, 0@-75" : "35@75, -35@-75";
+    snprintf(s->advice, sizeof(s->advice), "add %s ([calibrate] placements = %s)",
+             proj ? "placements tilted towards and away from the projector and at other offsets"
+                  : "placements tilted 30 to 45 deg and offset towards the image's corners",
+             s->add_placements);
     say(s, "weak: %s; %s\n", s->weak, s->advice);
     say(s,
         "to add them to these captures: a config with only those placements (and sphere_turns "
@@ -1497,6 +1498,7 @@ static void say_json(const struct solve *s, const char *out_path, int written)
         .length_100_mm = s->length_100_mm,
         .weak = s->weak,
         .advice = s->advice,
+        .add_placements = s->add_placements,
     };
     calib_json_write(stdout, &r);
 }

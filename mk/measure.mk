@@ -51,6 +51,9 @@ calibrate-demo: deps $(BUILD)/scanner $(BUILD)/scanner-calibrate $(BUILD)/mesh-c
 ## measure-calib: calibrate-demo, and scans with the true, nominal and pinhole calibrations
 measure-calib: deps $(BUILD)/scanner $(BUILD)/scanner-calibrate $(BUILD)/mesh-compare $(BUILD)/measure-calib
 	scripts/measure-calib.sh $(BUILD) measure
+## measure-calib-advice: a weak 5-board calibration, its advice followed (--add), before and after
+measure-calib-advice: deps $(BUILD)/scanner $(BUILD)/scanner-calibrate $(BUILD)/mesh-compare
+	scripts/measure-calib-advice.sh $(BUILD)
 ## measure-calib-sigma: reported calibration sigma against the spread over 10 noise seeds (long)
 measure-calib-sigma: deps $(BUILD)/scanner $(BUILD)/scanner-calibrate
 	scripts/measure-calib-sigma.sh $(BUILD)

@@ -174,6 +174,7 @@ assert len(r["pose"]["rotation"]) == 9 and len(r["pose"]["sigma"]["translation_m
 assert r["axis"]["sigma"]["dir_deg"] > 0 and len(r["lights"]) == 4
 assert 0 < r["predicted"]["depth_centre_mm"] <= r["predicted"]["depth_edge_mm"] < 1
 assert r["weak"] and "principal point" in r["weak_values"] and r["advice"].startswith("add ")
+assert r["add_placements"] and r["add_placements"] in r["advice"]
 few = json.load(open(sys.argv[2]))
 assert few["written"] is False and "too few views" in few["refused"], few
 print("json ok")
