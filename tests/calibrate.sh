@@ -28,7 +28,7 @@ near() { awk -v a="$1" -v b="$2" -v t="$3" 'BEGIN { d = a - b; if (d < 0) d = -d
 # The whole procedure: every capture kept, the board found in each, a calibration written that
 # the scanner accepts, close to the true rig (fx 2436 px, baseline to the projector, light 0).
 full_test() {
-    "$bin" calibrate --config $cfg --out "$out/cal.ini" >"$out/full.txt" 2>&1 || { cat "$out/full.txt"; return 1; }
+    ASAN_OPTIONS=detect_leaks=1 "$bin" calibrate --config $cfg --out "$out/cal.ini" >"$out/full.txt" 2>&1 || { cat "$out/full.txt"; return 1; }
     cat "$out/full.txt"
     test "$(grep -c 'board found, [0-9]* corners' "$out/full.txt")" -eq 6 &&
         test -f "$out/cal-captures/view_007/view.ini" && test -f "$out/cal-captures/view_007/target.ini" &&
@@ -156,7 +156,7 @@ check placements_added_later add_test
 json_test() {
     weird="$out/we\"ird\\
 name.ini"
-    "$bin" calibrate --config "$out/tight-cfg.ini" --from "$out/cal-captures" --out "$weird" --json \
+    ASAN_OPTIONS=detect_leaks=1 "$bin" calibrate --config "$out/tight-cfg.ini" --from "$out/cal-captures" --out "$weird" --json \
         >"$out/json.txt" 2>"$out/json-err.txt" &&
         ! "$bin" calibrate --config $cfg --from "$out/first" --out "$out/json-few.ini" --json \
             >"$out/json-few.txt" 2>"$out/json-few-err.txt" && test -f "$weird" && test "$(wc -l <"$out/json.txt")" -eq 1 || return 1

@@ -121,7 +121,7 @@ check self_contained sh -c "! git grep -n '[.][.]/shared' -- ':!*.md' && rm -rf 
     rm $clone/data/bunny/bun_zipper.ply && ! $bin scan --config $clone/config/sim.ini \
     --out $clone/scan2 2> $clone/err.txt && grep 'data/bunny/bun_zipper.ply: No such file' $clone/err.txt"
 rm -rf "$out/scan" "$out/broken" "$out/broken_out"
-check scan sh -c "$bin scan --config config/sim.ini --out $out/scan | grep -q 'scan finished'"
+check scan sh -c "ASAN_OPTIONS=detect_leaks=1 $bin scan --config config/sim.ini --out $out/scan | grep -q 'scan finished'"
 # Without --out a scan never replaces another: each goes to a new folder under [output] dir,
 # named by when it began, and 'latest' links to the newest (issue 19).
 rm -rf "$out/auto"
@@ -306,7 +306,7 @@ check small_limits_refuse_bracketing sh -c "$sbin check-config --config $out/sma
 check small_limits_scan_same_model sh -c "$limit $sbin scan --config config/sim.ini \
     --out $out/scan_small >/dev/null 2>&1 && cmp $out/scan/mesh.ply $out/scan_small/mesh.ply"
 rm -rf "$out/processed"
-check process_reproduces_scan sh -c "$bin process $out/scan --out $out/processed --replace >/dev/null && \
+check process_reproduces_scan sh -c "ASAN_OPTIONS=detect_leaks=1 $bin process $out/scan --out $out/processed --replace >/dev/null && \
     cmp $out/scan/view_000/cloud.ply $out/processed/view_000/cloud.ply"
 check json_events sh -c "$bin process $out/scan --out $out/processed --replace --json | /usr/bin/python3 -c '
 import json, sys
