@@ -1152,6 +1152,25 @@ static double fit_light(const struct shade_sample *smp, size_t n, uint32_t li, v
     return sqrt(cost / n);
 }
 
+/* The samples of light @p li (every one not saturated, those in its shadow too: the model says 0
+ * there; leaving out the samples at the noise would keep only the terminator's positive noise
+ * and pull the light outwards) from each sphere capture but @p skip (@p seen: none), copied to
+ * @p use with their signal as signal[0], as fit_light takes them. Capture k's samples are
+ * starts[k] .. starts[k + 1]. @retval how many */
+static size_t light_samples(const struct shade_sample *smp, const size_t *starts, uint32_t seen,
+                            uint32_t skip, uint32_t li, struct shade_sample *use)
+{
+    size_t m = 0;
+    for (uint32_t k = 0; k < seen; k++)
+        for (size_t i = starts[k]; i < starts[k + 1] && k != skip; i++)
+            if (smp[i].signal[li] > -1.0f) {
+                use[m] = smp[i];
+                use[m].signal[0] = smp[i].signal[li];
+                m++;
+            }
+    return m;
+}
+
 /* The uncertainty of light @p li's position @p l: a jackknife over the sphere captures (each left
  * out in turn, the light fitted again from the rest; the variance (K - 1)/K times the sum of the
  * squared moves). The residuals of one capture are far from independent (its sphere's fitted
@@ -1167,14 +1186,7 @@ static double light_sigma(const struct shade_sample *smp, const size_t *starts, 
     if (seen < 3)
         return 0.0;
     for (uint32_t out = 0; out < seen; out++) {
-        size_t m = 0;
-        for (uint32_t k = 0; k < seen; k++)
-            for (size_t i = starts[k]; i < starts[k + 1] && k != out; i++)
-                if (smp[i].signal[li] > -1.0f) {
-                    use[m] = smp[i];
-                    use[m].signal[0] = smp[i].signal[li];
-                    m++;
-                }
+        size_t m = light_samples(smp, starts, seen, out, li, use);
         vec3 lk = l;
         double kk;
         if (m <= 100 || fit_light(use, m, 0, &lk, &kk) < 0.0)
@@ -1277,21 +1289,13 @@ static int solve_lights(struct solve *s)
         say(s, "refused: the sphere was seen in too few captures (%zu samples)\n", n);
         rc = -EINVAL;
     }
-    /* Per light: every sample that is not saturated, those in its shadow too (the model says 0
-     * there; leaving out the samples at the noise would keep only the terminator's positive
-     * noise and pull the light outwards). */
+    /* Per light: its samples from every capture (light_samples). */
     double intensity[HAL_MAX_LIGHTS], mean = 0.0;
     struct shade_sample *use = rc == 0 ? calloc(n, sizeof(*use)) : NULL;
     if (rc == 0 && use == NULL)
         rc = -ENOMEM;
     for (uint32_t li = 0; li < lights && rc == 0; li++) {
-        size_t m = 0;
-        for (size_t i = 0; i < n; i++)
-            if (smp[i].signal[li] > -1.0f) {
-                use[m] = smp[i];
-                use[m].signal[0] = smp[i].signal[li];
-                m++;
-            }
+        size_t m = light_samples(smp, starts, seen, seen, li, use);
         vec3 l = v3_from(s->out.light_pos_mm[li]);
         double k = 0.0, res = m > 100 ? fit_light(use, m, 0, &l, &k) : -1.0;
         if (res < 0.0) {
