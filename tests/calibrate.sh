@@ -125,7 +125,8 @@ too_few_test() {
 }
 check too_few_views_refused too_few_test
 # Placements added later (--add, what a weak calibration asks for): two captures are too few,
-# with three more from another folder they calibrate (5 boards); the folder of --from again, a
+# with three more from another folder they calibrate (5 boards); the folder of --from again
+# (also through a symlink), a
 # folder that is none, captures of another camera size, and --add without --from are refused,
 # nothing written.
 add_test() {
@@ -134,7 +135,8 @@ add_test() {
             >"$out/added.txt" 2>&1 && grep -q '^; quality: .* boards = 5$' "$out/added.ini" &&
         grep -q "^; written by scanner calibrate from $out/first and $out/more" "$out/added.ini" || return 1
     copy_views "$out/other-size" "2 3 4" && sed -i 's/^width = 1280/width = 640/' "$out/other-size/calibration.ini"
-    for bad in first nowhere other-size; do
+    rm -f "$out/first-link" && ln -s first "$out/first-link"
+    for bad in first first-link nowhere other-size; do
         ! "$bin" calibrate --config $cfg --from "$out/first" --add "$out/$bad" --out "$out/bad-add.ini" \
             >"$out/bad-add-$bad.txt" 2>&1 || return 1
         cat "$out/bad-add-$bad.txt"
@@ -144,6 +146,7 @@ add_test() {
     rc=$?
     cat "$out/bad-add-alone.txt"
     [ $rc -eq 2 ] && grep -q 'is the folder of --from itself' "$out/bad-add-first.txt" &&
+        grep -q 'is the folder of --from itself' "$out/bad-add-first-link.txt" &&
         grep -q 'not a folder of captures' "$out/bad-add-nowhere.txt" &&
         grep -q 'not the same rig' "$out/bad-add-other-size.txt" &&
         grep -q -- '--add DIR2 goes with --from DIR' "$out/bad-add-alone.txt" && ! test -e "$out/bad-add.ini"
