@@ -126,9 +126,8 @@ too_few_test() {
 check too_few_views_refused too_few_test
 # Placements added later (--add, what a weak calibration asks for): two captures are too few,
 # with three more from another folder they calibrate (5 boards); the folder of --from again
-# (also through a symlink), a
-# folder that is none, captures of another camera size, and --add without --from are refused,
-# nothing written.
+# (also through a symlink), a folder that is none, captures of another camera size, and --add
+# without --from are refused, nothing written.
 add_test() {
     copy_views "$out/first" "0 1" && copy_views "$out/more" "2 3 4" &&
         "$bin" calibrate --config $cfg --from "$out/first" --add "$out/more" --out "$out/added.ini" \
