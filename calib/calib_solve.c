@@ -662,6 +662,27 @@ static void sample_plane(const struct solve *s, const struct scan_calib *c, int 
         }
 }
 
+/* @p drawn (@p count points) moved by the rigid motion that best brings them onto @p truth:
+ * point to point as three point-to-plane pairs each (Horn's closed form would do the same).
+ * @retval 0 @retval -EDOM too few points */
+static int remove_rigid(vec3 *drawn, const vec3 *truth, size_t count)
+{
+    const vec3 axes[3] = {v3(1, 0, 0), v3(0, 1, 0), v3(0, 0, 1)};
+    for (int pass = 0; pass < 3; pass++) {
+        struct lsq_rigid eq;
+        struct frame_xform step;
+        lsq_rigid_clear(&eq);
+        for (size_t j = 0; j < count; j++)
+            for (int a = 0; a < 3; a++)
+                lsq_rigid_add(&eq, drawn[j], truth[j], axes[a]);
+        if (lsq_rigid_step(&eq, &step) != 0)
+            return -EDOM;
+        for (size_t j = 0; j < count; j++)
+            drawn[j] = frame_point(&step, drawn[j]);
+    }
+    return 0;
+}
+
 /* One drawn calibration @p ck: every sample triangulated again (the scanner's tri_range_image),
  * the rigid motion that best moves them back removed, the errors that remain added to d->sq, the
  * 100 mm length's change (in % of it) through @p dl_pct. Why the motion is removed: a
@@ -687,26 +708,102 @@ static int draw_error(const struct scan_calib *ck, struct tri_maps *maps, struct
             d->drawn[j] = v3(maps->xyz_mm[3 * i], maps->xyz_mm[3 * i + 1], maps->xyz_mm[3 * i + 2]);
         }
     }
-    /* point to point as three point-to-plane pairs (Horn's closed form would do the same) */
-    const vec3 axes[3] = {v3(1, 0, 0), v3(0, 1, 0), v3(0, 0, 1)};
-    for (int pass = 0; pass < 3; pass++) {
-        struct lsq_rigid eq;
-        struct frame_xform step;
-        lsq_rigid_clear(&eq);
-        for (size_t j = 0; j < d->count; j++)
-            for (int a = 0; a < 3; a++)
-                lsq_rigid_add(&eq, d->drawn[j], d->truth[j], axes[a]);
-        if (lsq_rigid_step(&eq, &step) != 0)
-            return -EDOM;
-        for (size_t j = 0; j < d->count; j++)
-            d->drawn[j] = frame_point(&step, d->drawn[j]);
-    }
+    if (remove_rigid(d->drawn, d->truth, d->count) != 0)
+        return -EDOM;
     for (size_t j = 0; j < d->count; j++)
         d->sq[j] += v3_dot(v3_sub(d->drawn[j], d->truth[j]), v3_sub(d->drawn[j], d->truth[j]));
     double len0 = v3_len(v3_sub(d->truth[d->ends[0]], d->truth[d->ends[1]]));
     double len = v3_len(v3_sub(d->drawn[d->ends[0]], d->drawn[d->ends[1]]));
     *dl_pct = (len - len0) * 100.0 / fmax(len0, 1e-9);
     return 0;
+}
+
+/* The axis's share of the model's error, on a cylinder of the working volume (half its radius,
+ * its height) in steps of CALIB_AXIS_STEP_DEG around and CALIB_AXIS_RINGS high. */
+#define CALIB_AXIS_STEP_DEG 10
+#define CALIB_AXIS_RINGS 9
+
+/* What an axis error does to a model: a point of the object is seen by the views that face it
+ * (within 60 degrees), each placed through the axis as the scanner places it
+ * (frame_object_from_camera_rad); with the axis off, each view lands off by a different amount,
+ * and the fused model is their mean. Unlike the lenses' errors this one is no rigid motion: a
+ * point off by da across the axis moves every view by (I - R(theta)) da, which, averaged round
+ * the object, changes its radius by up to |da|; a tilt shears it with height. Linear in the four
+ * independent errors (the point's two directions across the axis, the direction's two tilts,
+ * about the volume's middle), so each is applied at its sigma, the rigid motion removed, and the
+ * squared errors summed: @p mid_mm the RMS at mid-height, @p worst_mm the largest.
+ * @retval 0 @retval -ENOMEM */
+static int axis_model_error(const struct solve *s, double *mid_mm, double *worst_mm)
+{
+    const struct scan_calib *c = &s->out;
+    enum { AROUND = 360 / CALIB_AXIS_STEP_DEG, COUNT = AROUND * CALIB_AXIS_RINGS };
+    const double radius = 0.5 * s->cfg->fusion.radius_mm, top = s->cfg->fusion.top_mm;
+    const vec3 d = v3_norm(v3_from(c->axis_dir)), a = v3_from(c->axis_point_mm);
+    const vec3 pivot = v3_add(a, v3_scale(d, 0.5 * top));
+    vec3 e1, e2, *truth = malloc(COUNT * sizeof(vec3)), *model = malloc(COUNT * sizeof(vec3));
+    /* the errors of the axis are drawn in the camera's frame, across it (e1, e2) */
+    double *var = calloc(COUNT, sizeof(double));
+    int rc = -ENOMEM;
+    *mid_mm = *worst_mm = 0.0;
+    if (truth == NULL || model == NULL || var == NULL)
+        goto out_free;
+    e1 = v3_norm(v3_cross(d, fabs(d.x) < 0.9 ? v3(1, 0, 0) : v3(0, 1, 0)));
+    e2 = v3_cross(d, e1);
+    const double sa = s->axis_across_sigma_mm / sqrt(2.0);
+    const double st = s->axis_dir_sigma_deg * M_PI / 180.0 / sqrt(2.0);
+    for (int k = 0; k < 4; k++) {
+        struct scan_calib off = *c;
+        vec3 ad = d, ap = a;
+        if (k < 2) /* the point across the axis */
+            ap = v3_add(a, v3_scale(k == 0 ? e1 : e2, sa));
+        else { /* the direction tilted about the volume's middle */
+            ad = v3_norm(v3_add(d, v3_scale(k == 2 ? e1 : e2, st)));
+            ap = v3_sub(pivot, v3_scale(ad, 0.5 * top));
+        }
+        memcpy(off.axis_dir, (double[3]){ad.x, ad.y, ad.z}, sizeof(off.axis_dir));
+        memcpy(off.axis_point_mm, (double[3]){ap.x, ap.y, ap.z}, sizeof(off.axis_point_mm));
+        for (int ring = 0; ring < CALIB_AXIS_RINGS; ring++)
+            for (int i = 0; i < AROUND; i++) {
+                /* in the object's frame: the axis its z, the table at z = 0 */
+                double phi = i * CALIB_AXIS_STEP_DEG * M_PI / 180.0;
+                vec3 out = v3(cos(phi), sin(phi), 0.0);
+                vec3 x = v3(radius * out.x, radius * out.y, top * ring / (CALIB_AXIS_RINGS - 1.0));
+                vec3 sum = v3(0, 0, 0);
+                int views = 0;
+                for (int step = 0; step < AROUND; step++) {
+                    struct frame_xform f, g;
+                    double theta = step * CALIB_AXIS_STEP_DEG * M_PI / 180.0;
+                    frame_object_from_camera_rad(c, theta, &f);
+                    vec3 cam = v3_sub(frame_point(&f, v3(0, 0, 0)), x);
+                    if (v3_dot(cam, out) < 0.5 * v3_len(cam))
+                        continue; /* this view does not face the point */
+                    frame_object_from_camera_rad(&off, theta, &g);
+                    sum = v3_add(sum, frame_point(&g, frame_point_inv(&f, x)));
+                    views++;
+                }
+                size_t j = (size_t)ring * AROUND + (size_t)i;
+                truth[j] = x;
+                model[j] = views > 0 ? v3_scale(sum, 1.0 / views) : x;
+            }
+        if (remove_rigid(model, truth, COUNT) != 0) {
+            rc = -EDOM;
+            goto out_free;
+        }
+        for (size_t j = 0; j < COUNT; j++)
+            var[j] += v3_dot(v3_sub(model[j], truth[j]), v3_sub(model[j], truth[j]));
+    }
+    for (size_t j = 0; j < COUNT; j++) {
+        *worst_mm = fmax(*worst_mm, sqrt(var[j]));
+        if (j / AROUND == CALIB_AXIS_RINGS / 2)
+            *mid_mm += var[j] / AROUND;
+    }
+    *mid_mm = sqrt(*mid_mm);
+    rc = 0;
+out_free:
+    free(var);
+    free(model);
+    free(truth);
+    return rc;
 }
 
 /* What the uncertainty does to a scan: CALIB_DEPTH_DRAWS calibrations drawn from it (lenses and
@@ -755,13 +852,18 @@ static void predict_depth_error(struct solve *s)
     double worst = 0.0;
     for (size_t j = 0; j < d.count; j++)
         worst = fmax(worst, sqrt(d.sq[j] / used));
-    s->depth_centre_mm = sqrt(d.sq[d.centre] / used);
-    s->depth_worst_mm = worst;
+    double axis_mid = 0.0, axis_worst = 0.0;
+    if (s->axis_dir_sigma_deg > 0.0 && axis_model_error(s, &axis_mid, &axis_worst) != 0)
+        axis_mid = axis_worst = 0.0;
+    /* the lenses' and the axis's errors are independent: their variances add */
+    s->depth_centre_mm = sqrt(d.sq[d.centre] / used + axis_mid * axis_mid);
+    s->depth_worst_mm = sqrt(worst * worst + axis_worst * axis_worst);
     s->length_100_mm = sqrt(len_sq / used);
     say(s,
         "predicted depth error %.3g mm (centre) - %.3g mm (edge of the working volume); a 100 mm "
-        "length +-%.3g mm (%d calibrations drawn from the uncertainty)\n",
-        s->depth_centre_mm, s->depth_worst_mm, s->length_100_mm, used);
+        "length +-%.3g mm (%d calibrations drawn from the lenses' uncertainty, and the axis's: "
+        "%.3g - %.3g mm of it)\n",
+        s->depth_centre_mm, s->depth_worst_mm, s->length_100_mm, used, axis_mid, axis_worst);
 out_free:
     free(maps);
     free(d.sq);

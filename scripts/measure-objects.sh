@@ -18,6 +18,10 @@ objects=${OBJECTS:-"box thin_box l_bracket plate_holes hex_nut gear stepped_bloc
 views_list=${VIEWS:-"3 4 6 8 12 24"}
 methods=${METHODS:-"none multi"}
 conditions=${CONDITIONS:-"exact table1 table2 slip slip30"}
+command -v openscad >/dev/null 2>&1 || {
+    echo "measure-objects: openscad is missing (make measure-objects installs it)" >&2
+    exit 1
+} # without it every part would silently be the simulator's default object
 mkdir -p "$out/parts"
 parts=$(cd "$out/parts" && pwd) # configs name files relative to themselves: absolute paths
 

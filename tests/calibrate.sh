@@ -67,7 +67,11 @@ uncertainty_test() {
         within_sigmas projector cx_px 3 506.5 && within_sigmas projector cy_px 4 389.5 &&
         grep -q '^; predicted depth error [0-9.e-]* mm (centre) - [0-9.e-]* mm (edge); a 100 mm length' "$out/cal.ini" &&
         sed -n 's/^predicted depth error \([0-9.e-]*\) mm (centre) - \([0-9.e-]*\) mm.*/\1 \2/p' "$out/cal.report.txt" |
-        awk '{ ok = $1 > 0 && $1 <= $2 && $2 < 1 } END { exit !ok }' || return 1
+        awk '{ ok = $1 > 0 && $1 <= $2 && $2 < 1 } END { exit !ok }' &&
+        # the axis's share is in it, and no more than all of it
+        sed -n 's/^predicted depth error \([0-9.e-]*\) mm (centre) - \([0-9.e-]*\) mm.* the axis.s: \([0-9.e-]*\) - \([0-9.e-]*\) mm of it.*/\1 \2 \3 \4/p' \
+            "$out/cal.report.txt" | awk '{ ok = $3 > 0 && $3 <= $1 && $4 > 0 && $4 <= $2 } END { exit !ok }' ||
+        return 1
     sed -e 's/^\[calibrate\]/[calibrate]\nmax_sigma_centre_px = 0.01/' \
         -e "s|^calibration = ../|calibration = $PWD/|; s|^rig = ../|rig = $PWD/|" $cfg >"$out/tight-cfg.ini"
     "$bin" calibrate --config "$out/tight-cfg.ini" --from "$out/cal-captures" \
