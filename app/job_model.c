@@ -214,7 +214,8 @@ static int report_registration(struct job *j, const struct reg_report *r, double
             HAL_LOG_ERROR,
             "registration failed: view %d does not match view %d (%.0f%% of their overlap "
             "couples, at least %.0f%% needed), and no placement of it fits the other views "
-            "either: was something else on the table, or nothing in view? No model was made; "
+            "either: was something else on the table, nothing in view, or is the calibration "
+            "not this rig's (a nominal file: run 'scanner calibrate')? No model was made; "
             "the views are kept in %s. Scan again, or fuse them at the turntable's angles "
             "with 'scanner process %s --config F' where F has [registration] icp = 0",
             r->failed_view, r->failed_against, 100.0 * r->failed_share,

@@ -61,16 +61,21 @@ void lsq_rigid_clear(struct lsq_rigid *eq)
     memset(eq, 0, sizeof(*eq));
 }
 
+void lsq_rigid_add_row(struct lsq_rigid *eq, const double jac[6], double res, double weight)
+{
+    for (int r = 0; r < 6; r++) {
+        for (int c = 0; c < 6; c++)
+            eq->a[r * 6 + c] += weight * jac[r] * jac[c];
+        eq->b[r] -= weight * jac[r] * res;
+    }
+}
+
 void lsq_rigid_add(struct lsq_rigid *eq, vec3 p, vec3 q, vec3 n)
 {
     double res = v3_dot(v3_sub(p, q), n);
     vec3 pxn = v3_cross(p, n);
     const double jac[6] = {pxn.x, pxn.y, pxn.z, n.x, n.y, n.z};
-    for (int r = 0; r < 6; r++) {
-        for (int c = 0; c < 6; c++)
-            eq->a[r * 6 + c] += jac[r] * jac[c];
-        eq->b[r] -= jac[r] * res;
-    }
+    lsq_rigid_add_row(eq, jac, res, 1.0);
     eq->sq += res * res;
     eq->pairs++;
 }

@@ -40,6 +40,11 @@ int lsq_rigid_shift_axes(const struct lsq_rigid *eq, double share[3], vec3 axis[
 /** Add the pair of point @p p and the plane through @p q with unit normal @p n. */
 void lsq_rigid_add(struct lsq_rigid *eq, vec3 p, vec3 q, vec3 n);
 
+/** Add one residual @p res with its derivatives @p jac by (omega, t), weighted @p weight, to the
+ *  equations only (not to sq or pairs): a residual other than a point-to-plane distance (a
+ *  colour's, reg_place.c). */
+void lsq_rigid_add_row(struct lsq_rigid *eq, const double jac[6], double res, double weight);
+
 /** Solve (consumes @p eq) for the step that moves the points: out(p) = R p + t.
  *  @retval 0 @retval -EDOM fewer than 6 pairs or nothing determined */
 int lsq_rigid_step(struct lsq_rigid *eq, struct frame_xform *step);

@@ -81,6 +81,39 @@ int reg_begin(struct reg_ctx *r, const struct reg_params *p, const struct scan_c
     return 0;
 }
 
+/* A cell's colour: the mean of the valid pixels over the stride's square centred on it (a box
+ * filter of the stride's width: at an even stride the square's edge pixels weigh a half), not the
+ * one pixel under it. A point sample puts a paint boundary at the cell where it is seen, half a
+ * cell either side of where it is, and one boundary seen at one phase of the grid is seen there
+ * every time: the colour search placed the views after a slip 0.2 to 0.6 mm off by it (measured
+ * on the box of data/objects with exact poses: 0.5 mm at a stride of 4, 0.2 at 2, 0 at 1); the
+ * box-filtered cell holds the share of each paint, which bilinear sampling (reg_place.c) turns
+ * back into where the boundary is: 0.1 mm. */
+static void cell_colour(const struct decode_maps *m, const uint8_t *rgb, uint32_t stride,
+                        uint32_t px, uint32_t py, uint8_t out[3])
+{
+    const int half = (int)stride / 2, even = stride % 2 == 0;
+    double sum[3] = {0.0, 0.0, 0.0}, weight = 0.0;
+    for (int dy = -half; dy <= half; dy++) {
+        long y = (long)py + dy;
+        if (y < 0 || y >= (long)m->height)
+            continue;
+        for (int dx = -half; dx <= half; dx++) {
+            long x = (long)px + dx;
+            size_t i = (size_t)y * m->width + (size_t)x;
+            if (x < 0 || x >= (long)m->width || m->reason[i] != SCAN_VALID)
+                continue;
+            double w = (even && (dy == -half || dy == half) ? 0.5 : 1.0) *
+                       (even && (dx == -half || dx == half) ? 0.5 : 1.0);
+            for (int c = 0; c < 3; c++)
+                sum[c] += w * rgb[3 * i + c];
+            weight += w;
+        }
+    }
+    for (int c = 0; c < 3; c++)
+        out[c] = weight > 0.0 ? (uint8_t)lround(sum[c] / weight) : 0;
+}
+
 int reg_add_view(struct reg_ctx *r, uint32_t index, int32_t angle_mdeg, const struct decode_maps *m,
                  const struct tri_range *range, const uint8_t *rgb)
 {
@@ -95,7 +128,7 @@ int reg_add_view(struct reg_ctx *r, uint32_t index, int32_t angle_mdeg, const st
             cl->valid = m->reason[i] == SCAN_VALID;
             memcpy(cl->xyz, &range->xyz_mm[3 * i], sizeof(cl->xyz));
             memcpy(cl->normal, &range->normal[3 * i], sizeof(cl->normal));
-            memcpy(cl->rgb, &rgb[3 * i], 3);
+            cell_colour(m, rgb, r->stride, x * r->stride, y * r->stride, cl->rgb);
         }
     }
     r->reported_mdeg[index] = angle_mdeg;

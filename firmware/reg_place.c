@@ -62,7 +62,8 @@ static void prepare_landing(struct reg_ctx *r)
  * that sees it most squarely (colour: at a glancing angle a pixel spreads over the surface).
  * @retval its cell @retval NULL none */
 static const struct reg_cell *land(struct reg_ctx *r, vec3 p, vec3 n, double min_cos,
-                                   double gate_mm, int most_facing, int *landed, vec3 *q, vec3 *nq)
+                                   double gate_mm, int most_facing, int *landed, vec3 *q, vec3 *nq,
+                                   double grid_xy[2])
 {
     const struct reg_cell *best = NULL;
     double best_facing = 0.0;
@@ -91,27 +92,124 @@ static const struct reg_cell *land(struct reg_ctx *r, vec3 p, vec3 n, double min
         if (v3_len(v3_sub(p, qj)) > gate_mm || (best != NULL && facing <= best_facing))
             continue;
         best = cq, best_facing = facing, *q = qj, *nq = nqj;
+        if (grid_xy != NULL)
+            grid_xy[0] = fu / r->stride, grid_xy[1] = fv / r->stride;
         if (!most_facing)
             break;
     }
     return best;
 }
 
+/* Two hues further apart than this (the chord between their unit vectors, 0.43: 25 degrees) are
+ * a miss: the palette's colours are 45 degrees and more apart. */
+#define REG_HUE_TAU 0.43
+/* A colour whose distance from grey is under this share of its brightness is grey. */
+#define REG_HUE_MIN_SATURATION 0.15
+
+/* A colour's hue: the unit direction of its distance from grey, in the plane across the grey
+ * axis. The same under any brightness of white light and under any grey added to it (ambient
+ * light, the projector's black), so that raw colours, shaded and lit differently in each view,
+ * compare as the paint's. A colour too close to grey has none: it is grey (hue 0, 0), which
+ * matches grey only (were it left out, a patch of white paint would match anything and pull
+ * the search towards it). @retval 0 too dark to tell */
+static int hue_of(const uint8_t rgb[3], double hue[2])
+{
+    double mean = ((double)rgb[0] + rgb[1] + rgb[2]) / 3.0;
+    double x = ((double)rgb[0] - rgb[1]) / sqrt(2.0);
+    double y = ((double)rgb[0] + rgb[1] - 2.0 * rgb[2]) / sqrt(6.0);
+    double len = sqrt(x * x + y * y);
+    if (3.0 * mean < REG_COLOUR_MIN_DN)
+        return 0;
+    hue[0] = hue[1] = 0.0;
+    if (len >= REG_HUE_MIN_SATURATION * mean)
+        hue[0] = x / len, hue[1] = y / len;
+    return 1;
+}
+
+/* The hue's gradient at group-0 cell @p hit (the hue across the surface, per unit of length
+ * along it, Park, Zhou and Koltun 2017, "Colored point cloud registration revisited", eq. 7 to
+ * 10): from the cells beside it in its view that lie on the same surface (within @p reach_mm,
+ * facing within @p min_cos), by least squares in the plane of its normal @p nq.
+ * @retval 0 @p hue and @p grad (one row per hue component) set @retval -1 not measurable */
+static int hue_gradient(struct reg_ctx *r, const struct reg_cell *hit, vec3 q, vec3 nq,
+                        double min_cos, double reach_mm, double hue[2], vec3 grad[2])
+{
+    size_t k = (size_t)(hit - r->cells), count = reg_cell_count(r);
+    uint32_t j = (uint32_t)(k / count), x = (uint32_t)(k % count % r->gw),
+             y = (uint32_t)(k % count / r->gw);
+    static const int step[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
+    vec3 e1, e2;
+    double ata[3] = {0, 0, 0}, atb[2][2] = {{0, 0}, {0, 0}};
+    if (!hue_of(hit->rgb, hue))
+        return -1;
+    v3_across(nq, &e1, &e2);
+    for (int s = 0; s < 4; s++) {
+        long xs = (long)x + step[s][0], ys = (long)y + step[s][1];
+        double hs[2];
+        vec3 qs, ns;
+        if (xs < 0 || ys < 0 || xs >= (long)r->gw || ys >= (long)r->gh)
+            continue;
+        const struct reg_cell *cs = &reg_view_cells(r, j)[(size_t)ys * r->gw + (size_t)xs];
+        if (!cs->valid || !hue_of(cs->rgb, hs))
+            continue;
+        cell_in_object(cs, &r->first_pose[j], &qs, &ns);
+        vec3 d = v3_sub(qs, q);
+        if (v3_len(d) > reach_mm || v3_dot(ns, nq) < min_cos)
+            continue; /* another surface: an edge of the object, not of its paint */
+        double a = v3_dot(d, e1), b = v3_dot(d, e2);
+        ata[0] += a * a, ata[1] += a * b, ata[2] += b * b;
+        for (int c = 0; c < 2; c++)
+            atb[c][0] += a * (hs[c] - hue[c]), atb[c][1] += b * (hs[c] - hue[c]);
+    }
+    double det = ata[0] * ata[2] - ata[1] * ata[1];
+    if (!(det > 1e-6 * (ata[0] + ata[2]) * (ata[0] + ata[2])))
+        return -1; /* the neighbours on one line (or none): no gradient across it */
+    for (int c = 0; c < 2; c++) {
+        double g1 = (ata[2] * atb[c][0] - ata[1] * atb[c][1]) / det;
+        double g2 = (ata[0] * atb[c][1] - ata[1] * atb[c][0]) / det;
+        grad[c] = v3_add(v3_scale(e1, g1), v3_scale(e2, g2));
+    }
+    return 0;
+}
+
+/* A group-1 sample's hue (@p cl, at @p p) against the hue field about where it landed (@p hit,
+ * at @p q, @p nq): two rows of the step's equations, residual h_q + grad (p - q) - h_p and its
+ * derivatives p x grad, grad by the small motion (Park et al. 2017, eq. 13 and 17), weighted
+ * @p weight; a residual beyond REG_HUE_TAU is another paint altogether and adds nothing. */
+static void add_hue_rows(struct reg_ctx *r, struct lsq_rigid *eq, const struct reg_cell *cl, vec3 p,
+                         const struct reg_cell *hit, vec3 q, vec3 nq, double min_cos,
+                         double reach_mm, double weight)
+{
+    double hp[2], hq[2], res[2];
+    vec3 grad[2];
+    if (!hue_of(cl->rgb, hp) || hue_gradient(r, hit, q, nq, min_cos, reach_mm, hq, grad) != 0)
+        return;
+    for (int c = 0; c < 2; c++)
+        res[c] = hq[c] + v3_dot(grad[c], v3_sub(p, q)) - hp[c];
+    if (res[0] * res[0] + res[1] * res[1] > REG_HUE_TAU * REG_HUE_TAU)
+        return;
+    for (int c = 0; c < 2; c++) {
+        vec3 pxg = v3_cross(p, grad[c]);
+        const double jac[6] = {pxg.x, pxg.y, pxg.z, grad[c].x, grad[c].y, grad[c].z};
+        lsq_rigid_add_row(eq, jac, res[c], weight);
+    }
+}
+
 /* The group-1 samples against the group-0 views: one point-to-plane step of first_from_second
- * per call (object frame 1); with @p frozen, @p frozen_count unit directions (group 0's frame)
- * the step does not shift along (those the colour search has fixed and the shape does not hold).
+ * per call (object frame 1); with @p hue_weight > 0 their hues as well, where they land on paint
+ * that changes (add_hue_rows): the colour holds what the shape lets slide.
  * @retval pairs coupled; @p rms their residual, @p overlap the samples that landed on a group-0
  * surface facing the same way (coupled or not), @p hold how well the pairs hold a shift in every
  * direction: @p share and @p axis as lsq_rigid_shift_axes gives them (share[0] is
- * lsq_rigid_shift_hold) */
-static uint32_t refine_second_step(struct reg_ctx *r, double gate_mm, const vec3 *frozen,
-                                   int frozen_count, double *rms, uint32_t *overlap,
-                                   double share[3], vec3 axis[3])
+ * lsq_rigid_shift_hold), of the shape's pairs alone */
+static uint32_t refine_second_step(struct reg_ctx *r, double gate_mm, double hue_weight,
+                                   double *rms, uint32_t *overlap, double share[3], vec3 axis[3])
 {
     *overlap = 0;
     const double min_cos = cos(r->p.max_normal_deg * M_PI / 180.0);
-    struct lsq_rigid eq;
+    struct lsq_rigid eq, hues;
     lsq_rigid_clear(&eq);
+    lsq_rigid_clear(&hues);
     prepare_landing(r);
     for (uint32_t v = 0; v < r->views; v++) {
         struct frame_xform pose;
@@ -125,8 +223,13 @@ static uint32_t refine_second_step(struct reg_ctx *r, double gate_mm, const vec3
             if (!cl->valid)
                 continue;
             cell_in_object(cl, &pose, &p, &n);
-            if (land(r, p, n, min_cos, gate_mm, 0, &landed, &q, &nq) != NULL)
+            const struct reg_cell *hit =
+                land(r, p, n, min_cos, gate_mm, hue_weight > 0.0, &landed, &q, &nq, NULL);
+            if (hit != NULL) {
                 lsq_rigid_add(&eq, p, q, nq);
+                if (hue_weight > 0.0)
+                    add_hue_rows(r, &hues, cl, p, hit, q, nq, min_cos, 4.0 * gate_mm, hue_weight);
+            }
             *overlap += (uint32_t)landed;
         }
     }
@@ -134,11 +237,12 @@ static uint32_t refine_second_step(struct reg_ctx *r, double gate_mm, const vec3
     *rms = coupled > 0 ? sqrt(eq.sq / coupled) : 0.0;
     if (lsq_rigid_shift_axes(&eq, share, axis) != 0)
         memset(share, 0, 3 * sizeof(double)); /* no pairs: holds nothing */
+    for (int i = 0; i < 36; i++)
+        eq.a[i] += hues.a[i];
+    for (int i = 0; i < 6; i++)
+        eq.b[i] += hues.b[i];
     struct frame_xform s, moved;
     if (lsq_rigid_step(&eq, &s) == 0) {
-        for (int f = 0; f < frozen_count; f++) /* the step's shift along them taken out: the
-                                                   colour has placed them */
-            s.origin = v3_sub(s.origin, v3_scale(frozen[f], v3_dot(s.origin, frozen[f])));
         frame_compose(&s, &r->first_from_second, &moved);
         r->first_from_second = moved;
     }
@@ -173,7 +277,7 @@ void reg_align_group(struct reg_ctx *r, struct reg_report *rep)
     double rms = 0.0;
     uint32_t overlap;
     for (int it = 0; it < 15; it++)
-        rep->second_coupled = refine_second_step(r, r->p.max_pair_mm, NULL, 0, &rms, &overlap,
+        rep->second_coupled = refine_second_step(r, r->p.max_pair_mm, 0.0, &rms, &overlap,
                                                  r->placed_share, r->placed_axis);
     rep->second_rms_mm = rms;
     rep->second_turned_deg = ar.turned_deg;
@@ -206,7 +310,7 @@ int reg_place_near_table(struct reg_ctx *r, double ring_rms_mm, double reach)
     r->second_aligned = 1;
     for (int it = 0; it <= 20; it++) {
         double gate = r->p.max_pair_mm * fmax(1.0, reach / (double)(1u << (it < 8 ? it : 8)));
-        coupled = refine_second_step(r, it < 20 ? gate : r->p.max_pair_mm, NULL, 0, &rms, &overlap,
+        coupled = refine_second_step(r, it < 20 ? gate : r->p.max_pair_mm, 0.0, &rms, &overlap,
                                      r->placed_share, r->placed_axis);
     }
     r->second_aligned = placement_fits(r, coupled, overlap, rms, ring_rms_mm);
@@ -229,29 +333,34 @@ int reg_placement_holds(const struct reg_ctx *r)
  * from 4 mm steps down to 0.05 mm (reg_place_by_colour). */
 #define REG_COLOUR_SEARCH_MM 40.0
 #define REG_COLOUR_STEP_MM 0.5
-/* Two hues further apart than this (the chord between their unit vectors, 0.43: 25 degrees) are
- * a miss: the palette's colours are 45 degrees and more apart. */
-#define REG_HUE_TAU 0.43
-/* A colour whose distance from grey is under this share of its brightness is grey. */
-#define REG_HUE_MIN_SATURATION 0.15
-
-/* A colour's hue: the unit direction of its distance from grey, in the plane across the grey
- * axis. The same under any brightness of white light and under any grey added to it (ambient
- * light, the projector's black), so that raw colours, shaded and lit differently in each view,
- * compare as the paint's. A colour too close to grey has none: it is grey (hue 0, 0), which
- * matches grey only (were it left out, a patch of white paint would match anything and pull
- * the search towards it). @retval 0 too dark to tell */
-static int hue_of(const uint8_t rgb[3], double hue[2])
+/* The hue of group 0's surface at grid position @p grid_xy of the view whose cell @p hit (at
+ * @p q, facing @p nq) a sample landed on: bilinear between the four cells about it when they
+ * all lie on that surface (within @p reach_mm, facing within @p min_cos), else @p hit's own. A
+ * hue taken at the nearest cell would step by a cell (1.5 to 2 mm on the object at a stride of
+ * 4 pixels) as the search moves, hiding where the paint lines up between the steps.
+ * @retval 0 too dark to tell */
+static int hue_between(struct reg_ctx *r, const struct reg_cell *hit, vec3 q, vec3 nq,
+                       const double grid_xy[2], double min_cos, double reach_mm, double hue[2])
 {
-    double mean = ((double)rgb[0] + rgb[1] + rgb[2]) / 3.0;
-    double x = ((double)rgb[0] - rgb[1]) / sqrt(2.0);
-    double y = ((double)rgb[0] + rgb[1] - 2.0 * rgb[2]) / sqrt(6.0);
-    double len = sqrt(x * x + y * y);
-    if (3.0 * mean < REG_COLOUR_MIN_DN)
-        return 0;
-    hue[0] = hue[1] = 0.0;
-    if (len >= REG_HUE_MIN_SATURATION * mean)
-        hue[0] = x / len, hue[1] = y / len;
+    size_t count = reg_cell_count(r);
+    uint32_t j = (uint32_t)((size_t)(hit - r->cells) / count);
+    long x0 = (long)floor(grid_xy[0]), y0 = (long)floor(grid_xy[1]);
+    double fx = grid_xy[0] - (double)x0, fy = grid_xy[1] - (double)y0, sum[2] = {0.0, 0.0};
+    if (x0 < 0 || y0 < 0 || x0 + 1 >= (long)r->gw || y0 + 1 >= (long)r->gh)
+        return hue_of(hit->rgb, hue);
+    for (int c = 0; c < 4; c++) {
+        const struct reg_cell *cl =
+            &reg_view_cells(r, j)[(size_t)(y0 + c / 2) * r->gw + (size_t)(x0 + c % 2)];
+        double h[2], w = (c % 2 ? fx : 1.0 - fx) * (c / 2 ? fy : 1.0 - fy);
+        vec3 qc, nc;
+        if (!cl->valid || !hue_of(cl->rgb, h))
+            return hue_of(hit->rgb, hue);
+        cell_in_object(cl, &r->first_pose[j], &qc, &nc);
+        if (v3_len(v3_sub(qc, q)) > reach_mm || v3_dot(nc, nq) < min_cos)
+            return hue_of(hit->rgb, hue); /* an edge of the object: not one surface */
+        sum[0] += w * h[0], sum[1] += w * h[1];
+    }
+    hue[0] = sum[0], hue[1] = sum[1];
     return 1;
 }
 
@@ -279,9 +388,11 @@ static double colour_misfit(struct reg_ctx *r, vec3 shift, uint64_t *compared)
             if (!cl->valid || !hue_of(cl->rgb, hp))
                 continue;
             cell_in_object(cl, &pose, &p, &n);
-            const struct reg_cell *hit =
-                land(r, v3_add(p, shift), n, min_cos, r->p.max_pair_mm, 1, &landed, &q, &nq);
-            if (hit == NULL || !hue_of(hit->rgb, hq))
+            double grid_xy[2];
+            const struct reg_cell *hit = land(r, v3_add(p, shift), n, min_cos, r->p.max_pair_mm, 1,
+                                              &landed, &q, &nq, grid_xy);
+            if (hit == NULL ||
+                !hue_between(r, hit, q, nq, grid_xy, min_cos, 2.0 * r->p.max_pair_mm, hq))
                 continue;
             double dx = hp[0] - hq[0], dy = hp[1] - hq[1]; /* grey against a hue: a miss */
             sum += fmin(dx * dx + dy * dy, tau_sq);
@@ -306,6 +417,15 @@ static double colour_misfit(struct reg_ctx *r, vec3 shift, uint64_t *compared)
  * box, bracket, nut and stepped block of data/objects hold their second weakest 0.14 to 0.48, the
  * gear 0.016 and a plate lying flat little more: two to search); the shape must hold the third. */
 #define REG_COLOUR_MIN_NEXT 0.05
+/* From the colour search's place, the shape and the hues refine the placement together in every
+ * direction (refine_second_step), this many steps, a hue's residual weighing this many times a
+ * millimetre of the shape's: the search moves along one or two directions and never turns, and
+ * a part the shape barely holds kept the shape's small turn (the thin box 0.4 deg, 0.4 mm at its
+ * ends). Measured on the slipped parts of data/objects (8 views, 6 and 30 mm): with the weight
+ * at 1, 5 of 11 within 1.2 times the scan without a slip; at 10, 6 (the box, hex nut, gear and
+ * plate); at 100 the hues' noise turns the gear 1.5 deg. */
+#define REG_COLOUR_ITERATIONS 10
+#define REG_HUE_WEIGHT 10.0
 
 /* The placement moved by @p shift (the group-1 points, in group 0's frame). */
 static void shift_placement(struct reg_ctx *r, vec3 shift)
@@ -366,8 +486,9 @@ int reg_place_by_colour(struct reg_ctx *r, double ring_rms_mm)
     double rms = 0.0, share[3];
     uint32_t overlap = 0, coupled = 0;
     vec3 axis[3];
-    for (int it = 0; it < 5; it++) /* the shape refines the rest, the colour keeps its axes */
-        coupled = refine_second_step(r, r->p.max_pair_mm, axes, n, &rms, &overlap, share, axis);
+    for (int it = 0; it < REG_COLOUR_ITERATIONS; it++) /* shape and colour: every direction */
+        coupled =
+            refine_second_step(r, r->p.max_pair_mm, REG_HUE_WEIGHT, &rms, &overlap, share, axis);
     if (!placement_fits(r, coupled, overlap, rms, ring_rms_mm)) {
         r->first_from_second = before; /* where the paint agrees the shape does not */
         return 0;

@@ -39,8 +39,9 @@ int reg_placement_holds(const struct reg_ctx *r);
 
 /* The last placement, whose shape holds every direction but one or two (placed_axis[0], [1]),
  * moved along them to where the two groups' colours agree (their hues: raw colours compare as
- * the paint's), then refined by the shape with those directions kept, and taken when the shape
- * still fits there as a placement near the table must (@p ring_rms_mm).
+ * the paint's), then refined by the shape and the hues together (Park, Zhou and Koltun 2017),
+ * and taken when the shape still fits there as a placement near the table must
+ * (@p ring_rms_mm).
  * @retval 1 placed (placed_by_colour)
  * @retval 0 the colour does not fix it either: the placement is left as it was */
 int reg_place_by_colour(struct reg_ctx *r, double ring_rms_mm);

@@ -46,6 +46,13 @@ static inline vec3 v3_norm(vec3 a)
     double l = v3_len(a);
     return l > 0.0 ? v3_scale(a, 1.0 / l) : a;
 }
+/* Two unit vectors across unit @p d, at right angles to each other: a basis of its plane. */
+static inline void v3_across(vec3 d, vec3 *e1, vec3 *e2)
+{
+    vec3 t = fabs(d.x) < 0.9 ? (vec3){1, 0, 0} : (vec3){0, 1, 0};
+    *e1 = v3_norm(v3_cross(d, t));
+    *e2 = v3_cross(d, *e1);
+}
 static inline vec3 v3_from(const double a[3])
 {
     return v3(a[0], a[1], a[2]);
