@@ -537,11 +537,21 @@ static int config_exposures(struct app_config *cfg, const char *path, char *err,
     return 0;
 }
 
-int config_load(struct app_config *cfg, const char *path, char *err, size_t err_len)
+/* What config_load_offline gives the keys that only drive the rig, when they are left out. */
+static const struct ini_fallback offline_fallbacks[] = {
+    {"camera", "backend", "sim"},
+    {"camera", "exposure_us", "10000"},
+    {"scan", "calibration", ""},
+};
+
+/* config_load, or with @p offline config_load_offline. */
+static int load(struct app_config *cfg, const char *path, int offline, char *err, size_t err_len)
 {
     memset(cfg, 0, sizeof(*cfg));
-    int rc = ini_schema_load(config_keys, sizeof(config_keys) / sizeof(config_keys[0]), cfg, path,
-                             err, err_len);
+    int rc = ini_schema_load_with(
+        config_keys, sizeof(config_keys) / sizeof(config_keys[0]), cfg, path,
+        offline ? offline_fallbacks : NULL,
+        offline ? sizeof(offline_fallbacks) / sizeof(offline_fallbacks[0]) : 0, err, err_len);
     if (rc != 0)
         return rc;
     snprintf(cfg->path, sizeof(cfg->path), "%s", path);
@@ -613,18 +623,20 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
                  path);
         return -EINVAL;
     }
-    if (cfg->calibration_file[0] == '\0') {
+    if (cfg->calibration_file[0] == '\0' && !offline) {
         snprintf(err, err_len, "%s: [scan] calibration: empty: name the rig's calibration file",
                  path);
         return -EINVAL;
     }
-    /* The calibration file is named relative to the config file. */
+    /* The calibration file is named relative to the config file (none: offline, a guess). */
     char joined[sizeof(cfg->calibration_file)];
-    if (path_beside(path, cfg->calibration_file, joined, sizeof(joined)) != 0) {
+    if (cfg->calibration_file[0] != '\0' &&
+        path_beside(path, cfg->calibration_file, joined, sizeof(joined)) != 0) {
         snprintf(err, err_len, "%s: [scan] calibration: path too long", path);
         return -EINVAL;
     }
-    memcpy(cfg->calibration_file, joined, sizeof(joined));
+    if (cfg->calibration_file[0] != '\0')
+        memcpy(cfg->calibration_file, joined, sizeof(joined));
     rc = parse_placements(&cfg->calibrate, path, err, err_len);
     if (rc != 0)
         return rc;
@@ -665,6 +677,16 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
         return -EINVAL;
     }
     return load_sim_rig(cfg, path, err, err_len);
+}
+
+int config_load(struct app_config *cfg, const char *path, char *err, size_t err_len)
+{
+    return load(cfg, path, 0, err, err_len);
+}
+
+int config_load_offline(struct app_config *cfg, const char *path, char *err, size_t err_len)
+{
+    return load(cfg, path, 1, err, err_len);
 }
 
 void config_print_doc(FILE *out)

@@ -59,6 +59,12 @@ struct app_config {
  *  @retval 0 ok @retval -EINVAL bad content @retval -ENOENT no such file */
 int config_load(struct app_config *cfg, const char *path, char *err, size_t err_len);
 
+/** config_load for a command that works on captures already on disk (scanner calibrate --from,
+ *  calibrate import): the keys that only drive the rig may be left out ([camera] backend and
+ *  exposure_us; [scan] calibration, then empty: the calibration starts from a guess).
+ *  @retval as config_load */
+int config_load_offline(struct app_config *cfg, const char *path, char *err, size_t err_len);
+
 /** Check that the files the config names beyond its calibration can be read (the simulator's
  *  mesh_file and merl_file, where used; [sim] rig is read at load). A scan kept with its config
  *  does not need them again, so config_load leaves this to the commands that run the rig.

@@ -285,6 +285,23 @@ static int handler(void *user, const char *section, const char *name, const char
 int ini_schema_load(const struct ini_key *keys, size_t key_count, void *target, const char *path,
                     char *err, size_t err_len)
 {
+    return ini_schema_load_with(keys, key_count, target, path, NULL, 0, err, err_len);
+}
+
+/* The fallback for @p k among @p fallbacks, or its own default (NULL: required). */
+static const char *missing_value(const struct ini_key *k, const struct ini_fallback *fallbacks,
+                                 size_t fallback_count)
+{
+    for (size_t f = 0; f < fallback_count; f++)
+        if (strcmp(fallbacks[f].section, k->section) == 0 && strcmp(fallbacks[f].key, k->name) == 0)
+            return fallbacks[f].value;
+    return k->def;
+}
+
+int ini_schema_load_with(const struct ini_key *keys, size_t key_count, void *target,
+                         const char *path, const struct ini_fallback *fallbacks,
+                         size_t fallback_count, char *err, size_t err_len)
+{
     struct parse_state st = {.keys = keys,
                              .key_count = key_count,
                              .target = target,
@@ -311,11 +328,12 @@ int ini_schema_load(const struct ini_key *keys, size_t key_count, void *target, 
         if (st.seen_line[i] != 0)
             continue;
         char msg[256];
-        if (keys[i].def == NULL) {
+        const char *value = missing_value(&keys[i], fallbacks, fallback_count);
+        if (value == NULL) {
             format_where(err, err_len, path, 0, &keys[i], "required key is missing");
             return -EINVAL;
         }
-        if (set_value(&keys[i], target, keys[i].def, msg, sizeof(msg)) != 0) {
+        if (set_value(&keys[i], target, value, msg, sizeof(msg)) != 0) {
             format_where(err, err_len, "(built-in default)", 0, &keys[i], msg);
             return -EINVAL;
         }

@@ -43,6 +43,19 @@ struct ini_key {
 int ini_schema_load(const struct ini_key *keys, size_t key_count, void *target, const char *path,
                     char *err, size_t err_len);
 
+/** A value for a key the file leaves out, taken in place of the key's default or of its being
+ *  required: what a command that has no use for the key gives it (calibrating from captures on
+ *  disk needs no exposure). */
+struct ini_fallback {
+    const char *section, *key, *value;
+};
+
+/** ini_schema_load, with @p fallbacks (@p fallback_count of them) for keys the file leaves out.
+ *  @retval as ini_schema_load */
+int ini_schema_load_with(const struct ini_key *keys, size_t key_count, void *target,
+                         const char *path, const struct ini_fallback *fallbacks,
+                         size_t fallback_count, char *err, size_t err_len);
+
 /** Which keys ini_schema_write leaves out: @retval 1 leave @p key out of @p target's file. */
 typedef int (*ini_schema_skip_fn)(const struct ini_key *key, const void *target);
 

@@ -52,6 +52,7 @@ struct solve {
     const char *dirs[CALIB_MAX_DIRS];
     uint32_t dir_count;
     struct scan_calib start; /* the calibration the captures were taken with */
+    int start_guessed;       /* none was found: start is calibrate_guess's */
     struct scan_calib out;
     struct scan_params params;
     struct calcv_board board;
@@ -890,8 +891,12 @@ static int solve_projector(struct solve *s)
         }
     if (n == 0) {
         s->camera_only = 1;
-        say(s, "projector: no capture has its patterns: the camera alone is calibrated (the "
-               "projector, the axis and the lights stay as the starting file has them)\n");
+        say(s,
+            "projector: no capture has its patterns: the camera alone is calibrated (the "
+            "projector, the axis and the lights stay %s)\n",
+            s->start_guessed ? "guesses: there was no calibration file to start from; use this "
+                               "file for the camera only"
+                             : "as the starting file has them");
         for (uint32_t i = 0; i < s->view_count; i++)
             if (s->views[i].found)
                 cam[n++] = s->views[i].cam;
@@ -1626,6 +1631,7 @@ int calibrate_solve(const struct hal_storage *st, const struct app_config *cfg, 
         rc = calib_load(&s.start, cfg->calibration_file, cfg->light_count, err, sizeof(err));
         if (rc == -ENOENT)
             calibrate_guess(cfg, &s.start);
+        s.start_guessed = rc == -ENOENT;
         if (rc == -ENOENT || rc == 0)
             rc = 0;
         else

@@ -50,7 +50,9 @@ int main(int argc, char **argv)
                 what[0] == 'v' ? "" : " and --out FILE");
         return 2;
     }
-    if (config_load(&cfg, config_path, err, sizeof(err)) != 0) {
+    /* captures on disk: the keys that only drive the rig are not needed */
+    int offline = from != NULL || strcmp(what, "import") == 0;
+    if ((offline ? config_load_offline : config_load)(&cfg, config_path, err, sizeof(err)) != 0) {
         fprintf(stderr, "scanner: error: %s\n", err);
         return 2;
     }

@@ -239,6 +239,25 @@ camera_only_test() {
         grep -q "the previous file is kept as $out/$kept" "$out/white.txt"
 }
 check camera_alone_from_white_frames camera_only_test
+# The same photos with a config that says only the image size and the board (a person with a
+# camera and a printed board: no rig, no exposure, no calibration file to start from): the
+# camera calibrated, the rest said to be guesses; the keys it left out still required wherever
+# the rig is driven (check-config, the live procedure).
+photos_only_test() {
+    printf '[camera]\nwidth = 1280\nheight = 960\n\n[calibrate]\nboard = chessboard\n' >"$out/photos.ini"
+    "$bin" calibrate --config "$out/photos.ini" --from "$out/white" --out "$out/photos-cal.ini" \
+        >"$out/photos.txt" 2>&1
+    rc=$?
+    cat "$out/photos.txt"
+    [ $rc -eq 0 ] && near "$(value "$out/photos-cal.ini" camera fx_px 1)" 2436 12 &&
+        grep -q 'stay guesses: there was no calibration file to start from' "$out/photos.txt" &&
+        ! "$bin" check-config --config "$out/photos.ini" >"$out/photos-check.txt" 2>&1 &&
+        grep -q 'photos.ini: \[camera\] backend: required key is missing' "$out/photos-check.txt" &&
+        ! "$bin" calibrate --config "$out/photos.ini" --out "$out/photos-live.ini" \
+            >"$out/photos-live.txt" 2>&1 &&
+        grep -q 'required key is missing' "$out/photos-live.txt" && test ! -e "$out/photos-live.ini"
+}
+check camera_alone_from_photos_minimal_config photos_only_test
 # The board to print: PNG near 300 dpi with whole pixels per square (236 for 20 mm: 2360 x
 # 1888), SVG at true size.
 check board_to_print sh -c "$bin calibrate board --config $cfg --out $out/board &&
