@@ -302,6 +302,92 @@ def path_cases(port, key, scans, sid):
         shutil.rmtree(os.path.join(scans, f"2000-01-01_{i:06d}"))
 
 
+def manage_cases(port, key, scans):
+    """Scans to manage (issue 32): a label, checked; a delete that needs the key, refuses the
+    running scan, removes the folder and never follows a link planted in it."""
+    js = {"Content-Type": "application/json", "X-Scanner-Key": key}
+    st, _, body = request(port, "POST", "/api/scans", js, '{"profile": "fast"}')
+    gone = json.loads(body)["id"] if st == 200 else ""
+    state = wait_state(port, gone, ("finished", "failed")) if st == 200 else None
+    check(state is not None and state["state"] == "finished", "a scan to manage is made", body)
+    lbl = f"/api/scans/{gone}/label"
+    st, _, _ = request(port, "POST", lbl, {"Content-Type": "application/json"}, '{"label": "x"}')
+    check(st == 403, f"a label without the session key is refused ({st})")
+    bad = ['{"label": "two\\nlines"}', '{"label": "' + "x" * 101 + '"}', '{"label": 7}', "{}",
+           '{"label": "bell\\u0007"}']
+    sts = [request(port, "POST", lbl, js, b)[0] for b in bad]
+    check(sts == [400] * len(bad), f"labels of two lines, 101 bytes, a number, none, a control "
+          f"character are refused ({sts})")
+    st, _, _ = request(port, "POST", lbl, js, json.dumps({"label": "Vase, front – 2nd try"}))
+    got = json.loads(request(port, "GET", f"/api/scans/{gone}")[2]).get("label")
+    listed = [x.get("label") for x in json.loads(request(port, "GET", "/api/scans")[2])["scans"]
+              if x["id"] == gone]
+    check(st == 200 and got == "Vase, front – 2nd try" and listed == [got],
+          f"a label is kept and listed ({st}, {got!r})")
+    st, _, _ = request(port, "POST", "/api/scans/no-such-scan/label", js, '{"label": "a"}')
+    st2, _, _ = request(port, "POST", "/api/scans/..%2f..%2fetc/label", js, '{"label": "a"}')
+    check(st == 404 and st2 in (403, 404), f"no label for a scan that is not there ({st}, {st2})")
+    outside = os.path.join(OUT, "outside.txt")
+    with open(outside, "w") as f:
+        f.write("not the scanner's")
+    os.symlink(outside, os.path.join(scans, gone, "planted-link"))
+    os.symlink(OUT, os.path.join(scans, gone, "view_000", "planted-dir"))
+    dele = f"/api/scans/{gone}/delete"
+    st, _, _ = request(port, "POST", dele, {"Content-Type": "application/json"}, "{}")
+    st2, _, _ = request(port, "POST", dele, {**js, "Origin": "http://evil.example"}, "{}")
+    st3, _, _ = request(port, "GET", dele)
+    check(st == 403 and st2 == 403 and st3 == 404 and os.path.isdir(os.path.join(scans, gone)),
+          f"a delete without the key, from another site or by GET does nothing ({st}, {st2}, "
+          f"{st3})")
+    st, _, body = request(port, "POST", dele, js, "{}")
+    st2, _, _ = request(port, "GET", f"/api/scans/{gone}")
+    ids = [x["id"] for x in json.loads(request(port, "GET", "/api/scans")[2])["scans"]]
+    check(st == 200 and st2 == 404 and gone not in ids and not os.path.exists(
+        os.path.join(scans, gone)) and os.path.exists(outside) and os.path.isdir(OUT),
+          f"a delete removes the scan's folder, and not what links in it point to ({st})", body)
+    st, _, _ = request(port, "POST", dele, js, "{}")
+    check(st == 404, f"deleting it again: no such scan ({st})")
+    st, _, body = request(port, "POST", "/api/scans", js, '{"profile": "long"}')
+    run = json.loads(body)["id"] if st == 200 else ""
+    wait_state(port, run, ("running",))
+    st, _, body = request(port, "POST", f"/api/scans/{run}/delete", js, "{}")
+    exists = os.path.isdir(os.path.join(scans, run))
+    request(port, "POST", f"/api/scans/{run}/stop", js, "{}")
+    wait_state(port, run, ("stopped", "failed", "finished"))
+    check(st == 409 and exists, f"the running scan is not deleted ({st})", body)
+    st, _, body = request(port, "GET", "/api/status")
+    s = json.loads(body)
+    check(st == 200 and 0 < s.get("disk_free_bytes", 0) <= s.get("disk_total_bytes", 0),
+          f"the status says the disk's free space ({s.get('disk_free_bytes')})")
+
+
+def disk_cases():
+    """A scan the disk cannot hold is refused before it starts (a 4 MB file system): 507, how
+    much is free and about how much it needs."""
+    small = os.path.join(OUT, "small-disk")
+    os.makedirs(small, exist_ok=True)
+    if subprocess.run(["mount", "-t", "tmpfs", "-o", "size=4m", "tmpfs", small],
+                      capture_output=True).returncode != 0:
+        print("[  NOTE    ] a small disk needs a tmpfs mount (root): its case not run here")
+        return
+    try:
+        port = free_port()
+        srv = Server(["--config", os.path.join(OUT, "fast.ini"), "--listen",
+                      f"127.0.0.1:{port}", "--scans", small])
+        try:
+            key = json.loads(request(port, "GET", "/api/session")[2])["key"]
+            js = {"Content-Type": "application/json", "X-Scanner-Key": key}
+            st, _, body = request(port, "POST", "/api/scans", js, "{}")
+            msg = json.loads(body).get("error", "") if body else ""
+            check(st == 507 and "the disk holds" in msg and "needs about" in msg
+                  and os.listdir(small) == [],
+                  f"a scan the disk cannot hold is refused before it starts ({st}: {msg})")
+        finally:
+            check(srv.stop() == 0, "the small disk's server ends cleanly")
+    finally:
+        subprocess.run(["umount", small], capture_output=True)
+
+
 def token_cases():
     port = free_port()
     fast = os.path.join(OUT, "fast.ini")
@@ -368,6 +454,7 @@ def main():
         sid = dos_and_stop(port, key, srv)
         error = resume_cases(port, key, sid, scans)
         path_cases(port, key, scans, sid)
+        manage_cases(port, key, scans)
     finally:
         check(srv.stop() == 0, "the server ends cleanly")
     srv = Server(args)
@@ -381,6 +468,7 @@ def main():
     finally:
         check(srv.stop() == 0, "the restarted server ends cleanly")
     token_cases()
+    disk_cases()
     print(f"[  PASSED  ] {passed} test(s).")
     if failed:
         print(f"[  FAILED  ] {failed} test(s).")

@@ -16,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -49,6 +50,8 @@ static const char *reason_phrase(int status)
         return "Too Many Requests";
     case 503:
         return "Service Unavailable";
+    case 507:
+        return "Insufficient Storage";
     default:
         return "Internal Server Error";
     }
@@ -170,6 +173,9 @@ static cJSON *job_json(struct web_server *s, const char *id)
     cJSON_AddBoolToObject(o, "report", access(path, F_OK) == 0);
     snprintf(path, sizeof(path), "%s/%s/" SCAN_FILE_MESH_GLB, s->scans, id);
     cJSON_AddBoolToObject(o, "glb", access(path, F_OK) == 0);
+    char label[WEB_MAX_LABEL + 2];
+    jobs_label(s, id, label, sizeof(label));
+    cJSON_AddStringToObject(o, "label", label);
     return o;
 }
 
@@ -263,6 +269,34 @@ static const struct web_profile *resume_profile(const struct web_server *s, cons
     return found;
 }
 
+/* Whether the scans' disk holds what profile @p p's scan (or the views a resume of @p resume_id
+ * still takes) will keep, by config_view_bytes; @p why says what is short. @retval 1 it does */
+static int disk_holds(struct web_server *s, const struct web_profile *p, const char *resume_id,
+                      char *why, size_t why_len)
+{
+    struct app_config cfg;
+    struct statvfs fs;
+    char err[WEB_PATH + 128];
+    if (config_load(&cfg, p->path, err, sizeof(err)) != 0 || statvfs(s->scans, &fs) != 0)
+        return 1; /* the scanner itself says what is wrong with the profile */
+    unsigned views = cfg.views * cfg.passes, done = 0, total = 0;
+    enum web_state state;
+    char error[8];
+    if (resume_id != NULL &&
+        jobs_describe(s, resume_id, &state, &done, &total, error, sizeof(error)) == 0)
+        views = total > done ? total - done : 0;
+    double need = (double)views * (double)config_view_bytes(&cfg);
+    double free_bytes = (double)fs.f_bavail * fs.f_frsize;
+    if (need <= free_bytes)
+        return 1;
+    snprintf(why, why_len,
+             "the disk holds %.0f MB free; this scan needs about %.0f MB (%u views of about %.0f "
+             "MB, [output] keep_frames = %s): delete a scan, or keep fewer frames",
+             free_bytes / 1e6, need / 1e6, views, (double)config_view_bytes(&cfg) / 1e6,
+             cfg.keep_frames_name);
+    return 0;
+}
+
 /* POST /api/scans (a new scan) or /api/scans/ID/resume. */
 static int start_scan(struct mg_connection *conn, struct web_server *s, const char *resume_id)
 {
@@ -288,6 +322,8 @@ static int start_scan(struct mg_connection *conn, struct web_server *s, const ch
         return send_error(conn, 409, why);
     if (p == NULL)
         return send_error(conn, 400, "no such profile (GET /api/status lists them)");
+    if (!disk_holds(s, p, resume_id, why, sizeof(why)))
+        return send_error(conn, 507, why);
     char id[64], err[WEB_PATH + 128];
     int rc = jobs_start(s, p, resume_id, id, sizeof(id), err, sizeof(err));
     if (rc != 0)
@@ -536,6 +572,11 @@ static int status(struct mg_connection *conn, struct web_server *s)
     cJSON_AddStringToObject(body, "lights_and_projector",
                             busy ? "switched by the scanner as it works" : "off");
     cJSON_AddBoolToObject(body, "token_required", s->token[0] != '\0');
+    struct statvfs fs;
+    if (statvfs(s->scans, &fs) == 0) { /* what a person may use: the blocks free to them */
+        cJSON_AddNumberToObject(body, "disk_free_bytes", (double)fs.f_bavail * fs.f_frsize);
+        cJSON_AddNumberToObject(body, "disk_total_bytes", (double)fs.f_blocks * fs.f_frsize);
+    }
     return send_json(conn, 200, body);
 }
 
@@ -583,6 +624,50 @@ static int login(struct mg_connection *conn, struct web_server *s)
     return 200;
 }
 
+/* A label a person may give a scan: at most WEB_MAX_LABEL bytes, one line of text (no
+ * control characters: the page shows it as text, a file keeps it as a line). */
+static int label_ok(const char *label)
+{
+    size_t n = strlen(label);
+    for (size_t i = 0; i < n; i++)
+        if ((unsigned char)label[i] < 0x20 || label[i] == 0x7f)
+            return 0;
+    return n <= WEB_MAX_LABEL;
+}
+
+/* POST /api/scans/ID/label {"label": "..."} */
+static int set_label(struct mg_connection *conn, struct web_server *s, const char *id)
+{
+    cJSON *body = NULL;
+    int st = read_body(conn, &body);
+    const cJSON *label = cJSON_GetObjectItemCaseSensitive(body, "label");
+    int ok = st == 0 && cJSON_IsString(label) && label_ok(label->valuestring);
+    int rc = ok ? jobs_set_label(s, id, label->valuestring) : 0;
+    cJSON_Delete(body);
+    if (!ok)
+        return send_error(conn, st != 0 ? st : 400,
+                          "send {\"label\": \"...\"}: one line, at most " WEB_MAX_LABEL_TEXT
+                          " bytes");
+    if (rc == -ENOENT)
+        return send_error(conn, 404, "no such scan");
+    return rc == 0 ? send_json(conn, 200, cJSON_CreateObject())
+                   : send_error(conn, 500, "the label could not be written");
+}
+
+/* POST /api/scans/ID/delete: the scan's folder and everything in it, unless it runs. */
+static int delete_scan(struct mg_connection *conn, struct web_server *s, const char *id)
+{
+    int rc = jobs_delete(s, id);
+    if (rc == -EBUSY)
+        return send_error(conn, 409, "that scan is running: stop it first");
+    if (rc == -ENOENT)
+        return send_error(conn, 404, "no such scan");
+    return rc == 0 ? send_json(conn, 200, cJSON_CreateObject())
+                   : send_error(conn, 500,
+                                "the scan could not be removed wholly (the server's "
+                                "log says what is left)");
+}
+
 /* /api/scans/ID[/what[/rest]] */
 static int scan_route(struct mg_connection *conn, struct web_server *s, const char *method,
                       const char *path)
@@ -601,8 +686,14 @@ static int scan_route(struct mg_connection *conn, struct web_server *s, const ch
         cJSON *o = job_json(s, id);
         return o != NULL ? send_json(conn, 200, o) : send_error(conn, 404, "no such scan");
     }
-    if (strcmp(what, "stop") == 0 && is_post && !may_use_rig(s, conn))
+    int changes = strcmp(what, "stop") == 0 || strcmp(what, "delete") == 0 ||
+                  strcmp(what, "label") == 0; /* what a page of another site must not do */
+    if (changes && is_post && !may_use_rig(s, conn))
         return refuse_without_key(conn);
+    if (strcmp(what, "delete") == 0 && is_post)
+        return delete_scan(conn, s, id);
+    if (strcmp(what, "label") == 0 && is_post)
+        return set_label(conn, s, id);
     if (strcmp(what, "stop") == 0 && is_post)
         return jobs_stop(s, id) == 0 ? send_json(conn, 200, cJSON_CreateObject())
                                      : send_error(conn, 409, "that scan is not running");

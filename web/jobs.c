@@ -12,6 +12,7 @@
 #include <cJSON.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <ftw.h>
 #include <poll.h>
 #include <signal.h>
 #include <stdio.h>
@@ -202,35 +203,45 @@ static int run_to_end(const char *const *args, char *out, size_t out_len, int *s
 }
 
 /* failure.txt: the scanner's error of a scan that failed under this server, kept in its folder
- * so that the page still says why after another scan or a restart (docs/scan-format.md). */
+ * so that the page still says why after another scan or a restart; label.txt: what a person
+ * called the scan (docs/scan-format.md). */
 #define FAILURE_FILE "failure.txt"
+#define LABEL_FILE "label.txt"
 
-static void write_failure(const char *dir, const char *error)
+/* @p text as file @p name of folder @p dir, whole or not at all (a temporary file, fsync,
+ * rename). @retval 0 @retval -errno */
+static int write_note(const char *dir, const char *name, const char *text)
 {
     char path[WEB_PATH + 32], tmp[WEB_PATH + 40];
-    snprintf(path, sizeof(path), "%s/" FAILURE_FILE, dir);
+    snprintf(path, sizeof(path), "%s/%s", dir, name);
     snprintf(tmp, sizeof(tmp), "%s.tmp", path);
     int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC | O_NOFOLLOW, 0644);
-    size_t len = strlen(error);
-    int ok = fd >= 0 && write(fd, error, len) == (ssize_t)len && fsync(fd) == 0;
+    size_t len = strlen(text);
+    int ok = fd >= 0 && write(fd, text, len) == (ssize_t)len && fsync(fd) == 0;
+    int err = errno;
     if (fd >= 0)
         close(fd);
     if (!ok || rename(tmp, path) != 0) {
-        fprintf(stderr, "scanner-web: cannot keep the error in %s: %s\n", path, strerror(errno));
+        err = ok ? errno : err;
+        fprintf(stderr, "scanner-web: cannot write %s: %s\n", path, strerror(err));
         unlink(tmp);
+        return -err;
     }
+    return 0;
 }
 
-static int read_failure(const struct web_server *s, const char *id, char *error, size_t len)
+/* The first line of file @p name of scan @p id. @retval 0 @retval -errno (none) */
+static int read_note(const struct web_server *s, const char *id, const char *name, char *text,
+                     size_t len)
 {
     char path[WEB_PATH + 160];
-    snprintf(path, sizeof(path), "%s/%s/" FAILURE_FILE, s->scans, id);
+    snprintf(path, sizeof(path), "%s/%s/%s", s->scans, id, name);
     FILE *f = file_open_regular(path, "r");
     if (f == NULL)
         return -errno;
-    size_t n = fread(error, 1, len - 1, f);
-    error[n] = '\0';
-    error[strcspn(error, "\n")] = '\0';
+    size_t n = fread(text, 1, len - 1, f);
+    text[n] = '\0';
+    text[strcspn(text, "\n")] = '\0';
     fclose(f);
     return 0;
 }
@@ -281,7 +292,7 @@ static void *reader_main(void *arg)
                  WIFEXITED(status) ? "status" : "signal",
                  WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status));
     if (j->state == WEB_FAILED)
-        write_failure(dir, j->error);
+        write_note(dir, FAILURE_FILE, j->error);
     j->rig_busy = 0;
     j->seq++;
     pthread_cond_broadcast(&j->changed);
@@ -452,7 +463,60 @@ int jobs_describe(struct web_server *s, const char *id, enum web_state *state, u
     /* finished: every output written (mesh.ply alone is there before mesh.stl has failed);
      * failed: the server kept the scanner's error */
     *state = scan_dir_finished(path) ? WEB_FINISHED : WEB_STOPPED;
-    if (*state == WEB_STOPPED && read_failure(s, id, error, error_len) == 0)
+    if (*state == WEB_STOPPED && read_note(s, id, FAILURE_FILE, error, error_len) == 0)
         *state = WEB_FAILED;
     return 0;
+}
+
+int jobs_label(const struct web_server *s, const char *id, char *label, size_t len)
+{
+    int rc = read_note(s, id, LABEL_FILE, label, len);
+    if (rc != 0)
+        label[0] = '\0';
+    return rc;
+}
+
+int jobs_set_label(struct web_server *s, const char *id, const char *label)
+{
+    char dir[WEB_PATH + 64];
+    if (jobs_scan_dir(s, id, dir, sizeof(dir)) != 0)
+        return -ENOENT;
+    return write_note(dir, LABEL_FILE, label);
+}
+
+/* nftw's step: each entry removed, children first; a link is removed, never followed. */
+static int remove_entry(const char *path, const struct stat *sb, int type, struct FTW *ftw)
+{
+    (void)sb, (void)type, (void)ftw;
+    if (remove(path) != 0) {
+        fprintf(stderr, "scanner-web: cannot remove %s: %s\n", path, strerror(errno));
+        return -1;
+    }
+    return 0;
+}
+
+int jobs_delete(struct web_server *s, const char *id)
+{
+    char dir[WEB_PATH + 64], gone[WEB_PATH + 80];
+    struct web_job *j = &s->job;
+    /* Under the lock: not the scan that runs (nor one a resume is starting), and out of every
+     * list at once (a name beginning with '.' is no scan's) before the slow removal. */
+    pthread_mutex_lock(&j->lock);
+    int running = (j->state == WEB_RUNNING || j->rig_busy) && strcmp(j->id, id) == 0;
+    int rc = running ? -EBUSY : jobs_scan_dir(s, id, dir, sizeof(dir));
+    if (rc == 0) {
+        snprintf(gone, sizeof(gone), "%s/.deleting-%s", s->scans, id);
+        rc = rename(dir, gone) == 0 ? 0 : -errno;
+    }
+    if (rc == 0 && strcmp(j->id, id) == 0) { /* the last scan run: its state goes with it */
+        j->state = WEB_IDLE;
+        j->id[0] = '\0';
+        j->seq++;
+        pthread_cond_broadcast(&j->changed);
+    }
+    pthread_mutex_unlock(&j->lock);
+    if (rc != 0)
+        return rc;
+    /* FTW_PHYS: links are not followed; FTW_MOUNT: nothing mounted inside is entered */
+    return nftw(gone, remove_entry, 16, FTW_DEPTH | FTW_PHYS | FTW_MOUNT) == 0 ? 0 : -EIO;
 }

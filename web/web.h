@@ -11,6 +11,8 @@
 #define WEB_MAX_PROFILES 16u
 #define WEB_MAX_BODY 4096 /* bytes of a request body: a profile's name is all a POST carries */
 #define WEB_PATH 1024
+#define WEB_MAX_LABEL 100 /* bytes of a scan's label */
+#define WEB_MAX_LABEL_TEXT "100"
 #define WEB_MAX_STREAMS 8 /* progress streams open at once: each holds a worker thread */
 /* civetweb's workers: a connection holds one until its request is whole (10 s at most) */
 #define WEB_THREADS 256
@@ -94,6 +96,18 @@ int jobs_scan_dir(const struct web_server *s, const char *id, char *dir, size_t 
  *  @retval 0 @retval -ENOENT no such scan */
 int jobs_describe(struct web_server *s, const char *id, enum web_state *state, unsigned *views_done,
                   unsigned *views_total, char *error, size_t error_len);
+
+/** Delete scan @p id: its folder leaves the list at once, then is removed (links inside it are
+ *  removed, not followed). @retval 0 @retval -EBUSY it is the scan that runs @retval -ENOENT
+ *  no such scan @retval -errno */
+int jobs_delete(struct web_server *s, const char *id);
+
+/** What a person called scan @p id ("" when nothing). @retval 0 @retval -errno no label */
+int jobs_label(const struct web_server *s, const char *id, char *label, size_t len);
+
+/** Call scan @p id @p label (checked by the caller), kept in its folder.
+ *  @retval 0 @retval -ENOENT no such scan @retval -errno */
+int jobs_set_label(struct web_server *s, const char *id, const char *label);
 
 const char *web_state_name(enum web_state state);
 

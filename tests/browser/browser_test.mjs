@@ -186,6 +186,24 @@ async function pageTest(browser) {
   await pathTests(s.url, id);
   await foreignPageTests(browser, s.url);
 
+  // scans to manage: a label given on the page, a delete asked first (no: kept; yes: gone)
+  const row = `#past tbody tr:has(td:text-is("${stoppedId}"))`;
+  page.once('dialog', (d) => d.accept('Vase, front'));
+  await page.click(`${row} button:text-is("Label")`);
+  await page.waitForFunction((sid) => [...document.querySelectorAll('#past tbody tr')]
+    .some((tr) => tr.cells[0].textContent === sid && tr.cells[1].textContent === 'Vase, front'), stoppedId);
+  check(true, 'a label given on the page is listed beside its scan');
+  page.once('dialog', (d) => d.dismiss());
+  await page.click(`${row} button:text-is("Delete")`);
+  await page.waitForTimeout(500);
+  check(fs.existsSync(path.join(scans, stoppedId)) && (await page.$$(row)).length === 1,
+    'a delete the person says no to deletes nothing');
+  page.once('dialog', (d) => d.accept());
+  await page.click(`${row} button:text-is("Delete")`);
+  await page.waitForFunction(() => document.querySelectorAll('#past tbody tr').length === 1);
+  check(!fs.existsSync(path.join(scans, stoppedId)), 'a delete the person says yes to removes the scan from the list and the disk');
+  check(/GB free of/.test(await page.textContent('#disk')), 'the page says how much of the disk is free');
+
   // shutting the server down mid-scan stops the scan in order
   const started = JSON.parse((await raw(s.url, 'POST', '/api/scans', await keyed(s.url), '{}')).body);
   await waitFor('a view', async () => (await scanState(s.url, started.id)).views_done >= 1, 60000);

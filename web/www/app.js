@@ -243,20 +243,58 @@ async function refresh() {
   badge.textContent = st.scanning ? `scanning ${st.current}` : 'ready';
   badge.className = 'badge ' + (st.scanning ? 'busy' : 'idle');
   $('lights').textContent = st.lights_and_projector;
+  if (st.disk_free_bytes !== undefined) {
+    const gb = (n) => (n / 1e9).toFixed(1);
+    $('disk').textContent = `${gb(st.disk_free_bytes)} GB free of ${gb(st.disk_total_bytes)} GB`;
+  }
   const list = await call('GET', 'scans');
   const body = $('past').tBodies[0];
   body.textContent = '';
   for (const s of list.scans) {
     const tr = body.insertRow();
     tr.insertCell().textContent = s.id;
+    tr.insertCell().textContent = s.label || '';
     tr.insertCell().textContent = s.state;
     tr.insertCell().textContent = `${s.views_done} / ${s.views_total}`;
-    const b = document.createElement('button');
-    b.textContent = 'Open';
-    b.addEventListener('click', () => (s.state === 'running' ? follow(s.id) : open(s)));
-    tr.insertCell().append(b);
+    const cell = tr.insertCell();
+    cell.append(button('Open', () => (s.state === 'running' ? follow(s.id) : open(s))));
+    cell.append(button('Label', () => labelScan(s)));
+    const del = button('Delete', () => deleteScan(s));
+    del.disabled = s.state === 'running'; // the server refuses it too (409)
+    cell.append(del);
   }
   return st;
+}
+
+function button(text, onClick) {
+  const b = document.createElement('button');
+  b.textContent = text;
+  b.addEventListener('click', onClick);
+  return b;
+}
+
+// A label a person gives a scan (one line, at most 100 bytes: the server checks it again).
+async function labelScan(s) {
+  const label = window.prompt(`Label for scan ${s.id}`, s.label || '');
+  if (label === null) return;
+  try {
+    await call('POST', `scans/${s.id}/label`, { label });
+  } catch (err) {
+    $('error').textContent = err.message;
+  }
+  refresh();
+}
+
+// Delete a scan and all its files, once the person has said yes.
+async function deleteScan(s) {
+  const name = s.label ? `${s.id} (${s.label})` : s.id;
+  if (!window.confirm(`Delete scan ${name} and all its files? This cannot be undone.`)) return;
+  try {
+    await call('POST', `scans/${s.id}/delete`, {});
+  } catch (err) {
+    $('error').textContent = err.message;
+  }
+  refresh();
 }
 
 async function start() {
