@@ -148,7 +148,12 @@ static int report_registration(struct job *j, const struct reg_report *r, double
                  r->accepted || no_turn_seen ? "" : "turntable angles kept: ");
     }
     size_t n = strlen(detail);
-    if (no_turn_seen) /* the table's answer, whatever the solve did */
+    if (no_turn_seen && r->apart_pairs > 0) /* nothing to compare, not a shape that hides it */
+        snprintf(detail + n, sizeof(detail) - n,
+                 "views %d and %d share no surface to register (too few views for this "
+                 "object?): the table's angles kept, the axis as calibrated",
+                 r->apart_against, r->apart_view);
+    else if (no_turn_seen) /* the table's answer, whatever the solve did */
         snprintf(detail + n, sizeof(detail) - n,
                  "the object's shape does not fix the views' turns (a surface of revolution "
                  "about the axis?): the table's angles kept, the axis %s",
@@ -162,6 +167,14 @@ static int report_registration(struct job *j, const struct reg_report *r, double
                  (unsigned)r->turns_from_table);
     else if (r->solved)
         snprintf(detail + n, sizeof(detail) - n, "%s", r->refused);
+    if (r->apart_pairs > 0 && !no_turn_seen) {
+        n = strlen(detail);
+        snprintf(detail + n, sizeof(detail) - n,
+                 "; %u pair%s of neighbouring views share no surface (views %d and %d): the "
+                 "table's angle holds between them",
+                 (unsigned)r->apart_pairs, r->apart_pairs == 1 ? "" : "s", r->apart_against,
+                 r->apart_view);
+    }
     if (r->axis_from_calibration && !no_turn_seen) {
         n = strlen(detail);
         snprintf(detail + n, sizeof(detail) - n,

@@ -131,6 +131,9 @@ int reg_add_view(struct reg_ctx *r, uint32_t index, int32_t angle_mdeg, const st
             cell_colour(m, rgb, r->stride, x * r->stride, y * r->stride, cl->rgb);
         }
     }
+    r->valid_cells[index] = 0;
+    for (size_t k = 0; k < reg_cell_count(r); k++)
+        r->valid_cells[index] += out[k].valid;
     r->reported_mdeg[index] = angle_mdeg;
     r->present[index] = 1;
     return 0;
@@ -245,6 +248,27 @@ static double edge_share(const struct reg_ctx *r, const struct reg_edge_stats *s
         (st->side_overlap >= REG_SIDE_EVIDENCE && side_median(r) >= REG_SIDE_MIN))
         return (double)st->side_coupled / st->side_overlap;
     return st->overlap > 0 ? (double)st->coupled / st->overlap : 0.0;
+}
+
+/* Two neighbouring views share no surface to compare when the samples of one that land on a
+ * surface of the other facing the same way are fewer than this share of the smaller view's
+ * samples (two views half a turn apart see opposite sides: none land), while each view sees
+ * something (REG_MIN_VIEW_CELLS): the pair says nothing, the table's angle stands, no failure.
+ * A view of nothing (fewer samples) still fails, as does a pair that overlaps and does not
+ * couple (the object moved, another object). */
+#define REG_APART_SHARE 0.01
+#define REG_MIN_VIEW_CELLS 200u
+static int edge_apart(const struct reg_ctx *r, uint32_t e)
+{
+    uint32_t a = r->valid_cells[r->edge_from[e]], b = r->valid_cells[r->edge_to[e]];
+    return a >= REG_MIN_VIEW_CELLS && b >= REG_MIN_VIEW_CELLS &&
+           r->stats[e].overlap < REG_APART_SHARE * (a < b ? a : b);
+}
+
+/* Whether edge @p e's views do not match: they overlap, and too little of it couples. */
+static int edge_fails(const struct reg_ctx *r, uint32_t e)
+{
+    return edge_share(r, &r->stats[e]) < r->p.min_coupled_share && !edge_apart(r, e);
 }
 
 /* A pair's weight: Huber's. */
@@ -530,15 +554,20 @@ static void summarise(struct reg_ctx *r, struct reg_report *rep)
     uint64_t coupled = 0, loop_coupled = 0;
     double sq = 0.0, loop_sq = 0.0;
     rep->failed_view = rep->failed_against = -1;
+    rep->apart_view = rep->apart_against = -1;
+    rep->apart_pairs = 0;
     for (uint32_t e = 0; e < r->edges; e++) {
         const struct reg_edge_stats *st = &r->stats[e];
         coupled += st->coupled;
         sq += st->sq;
-        double share = edge_share(r, st);
-        if (rep->failed_view < 0 && share < r->p.min_coupled_share) {
+        if (rep->failed_view < 0 && edge_fails(r, e)) {
             rep->failed_view = (int)r->edge_to[e];
             rep->failed_against = (int)r->edge_from[e];
-            rep->failed_share = share;
+            rep->failed_share = edge_share(r, st);
+        }
+        if (edge_apart(r, e) && rep->apart_pairs++ == 0) {
+            rep->apart_view = (int)r->edge_to[e];
+            rep->apart_against = (int)r->edge_from[e];
         }
         if (r->edge_to[e] % r->per_pass == 0 && r->per_pass > 2) { /* a closing pair */
             loop_sq += st->sq;
@@ -608,9 +637,7 @@ static int cut_at_the_move(struct reg_ctx *r)
 {
     uint32_t cuts = 0, at[2] = {0, 0};
     for (uint32_t e = 0; e < r->edges; e++) {
-        const struct reg_edge_stats *st = &r->stats[e];
-        double share = edge_share(r, st);
-        if (share >= r->p.min_coupled_share)
+        if (!edge_fails(r, e))
             continue;
         if (cuts < 2)
             at[cuts] = r->edge_from[e];

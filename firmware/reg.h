@@ -58,19 +58,22 @@ struct reg_report {
     double axis_shift_mm, axis_tilt_deg; /**< the axis against the calibrated one */
     uint32_t worst_view;                 /**< the view with the largest residual */
     double worst_rms_mm;
-    int failed_view;           /**< -1, or a view that does not match the one before it (or
-                                    the first view of a second pass that matches nothing) */
-    int failed_against;        /**< the view it was compared with (-1: the first pass) */
-    double failed_share;       /**< the share of their overlap that coupled */
-    char refused[160];         /**< why a solved adjustment was not accepted ("" when it was) */
-    double second_turned_deg;  /**< two passes: how far the object was turned between them */
-    double second_share;       /**< the share of the second pass's points the search paired */
-    uint32_t second_coupled;   /**< pairs of the final refinement against the first pass */
-    double second_rms_mm;      /**< and their residual */
-    uint32_t turns_from_table; /**< views whose turn the geometry does not fix (reg_view) */
-    int axis_from_calibration; /**< 1: the pairs do not see the axis's place: calibrated kept */
-    int moved_view;            /**< -1, or the first view after the object moved on the table
-                                    (one pass): from it, moved_views views were placed freely */
+    int failed_view;               /**< -1, or a view that does not match the one before it (or
+                                        the first view of a second pass that matches nothing) */
+    int failed_against;            /**< the view it was compared with (-1: the first pass) */
+    uint32_t apart_pairs;          /**< neighbouring views that share no surface to compare (two
+                                        views half a turn apart): no failure, the table's angle */
+    int apart_view, apart_against; /**< the first such pair, or -1 */
+    double failed_share;           /**< the share of their overlap that coupled */
+    char refused[160];             /**< why a solved adjustment was not accepted ("" when it was) */
+    double second_turned_deg;      /**< two passes: how far the object was turned between them */
+    double second_share;           /**< the share of the second pass's points the search paired */
+    uint32_t second_coupled;       /**< pairs of the final refinement against the first pass */
+    double second_rms_mm;          /**< and their residual */
+    uint32_t turns_from_table;     /**< views whose turn the geometry does not fix (reg_view) */
+    int axis_from_calibration;     /**< 1: the pairs do not see the axis's place: calibrated kept */
+    int moved_view;                /**< -1, or the first view after the object moved on the table
+                                        (one pass): from it, moved_views views were placed freely */
     uint32_t moved_views;
     double moved_mm, moved_deg; /**< how far the object had moved, and turned */
     int moved_by_colour;        /**< 1: its shape left a direction free, its paint fixed it */
@@ -108,7 +111,8 @@ struct reg_ctx {
     uint32_t views, passes, per_pass, stride, gw, gh;
     int32_t reported_mdeg[REG_MAX_VIEWS];
     uint8_t present[REG_MAX_VIEWS];
-    double theta[REG_MAX_VIEWS]; /**< radians */
+    uint32_t valid_cells[REG_MAX_VIEWS]; /**< each view's valid samples */
+    double theta[REG_MAX_VIEWS];         /**< radians */
     /** How much of a turn about the axis each view's pairs see: the sums over its pairs of
      *  (n . (d x (p - a)))^2 and |d x (p - a)|^2, the motion across the surface and the whole
      *  motion of a turn (their ratio is 0 on a surface of revolution about the axis, about 0.5

@@ -44,6 +44,19 @@ sphere_test() {
         test -f "$out/sphere-3/mesh.ply"
 }
 check sphere_3_views_keeps_the_tables_turn_and_says_so sphere_test
+# Two views half a turn apart (front and back): they share no surface, which is no failure: the
+# table's angles, a model, and the scan says why (it refused the pair: 0% of nothing coupled).
+two_views_test() {
+    config mesh 2
+    sed -i "/^object = mesh/a mesh_file = $PWD/data/bunny/bun_zipper.ply" "$out/mesh-2.ini"
+    "$bin" scan --config "$out/mesh-2.ini" --out "$out/bunny-2" >"$out/bunny-2.log" 2>&1 ||
+        { tail -n 5 "$out/bunny-2.log"; return 1; }
+    grep '^registration' "$out/bunny-2.log" &&
+        grep -q "views 0 and 1 share no surface to register" "$out/bunny-2.log" &&
+        grep -q '^turn = table' "$out/bunny-2/view_001/registration.ini" &&
+        test -f "$out/bunny-2/mesh.ply"
+}
+check two_views_half_a_turn_apart_make_a_model two_views_test
 # The box knocked 6 mm along one face's normal between views 3 and 4 of 8: across the break the
 # views share two parallel faces and the top, which hold no slide along the faces; its paint
 # does. Painted in patches, the moved views are placed by shape and colour and the model is
