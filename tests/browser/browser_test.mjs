@@ -185,6 +185,7 @@ async function pageTest(browser) {
 
   await pathTests(s.url, id);
   await foreignPageTests(browser, s.url);
+  await phoneTests(browser, s.url, id);
 
   // scans to manage: a label given on the page, a delete asked first (no: kept; yes: gone)
   const row = `#past tbody tr:has(td:text-is("${stoppedId}"))`;
@@ -213,6 +214,37 @@ async function pageTest(browser) {
     'it stopped the scan, which put the rig in its safe state');
   check(fs.existsSync(path.join(scans, started.id, 'view_000', 'view.ini')), 'the views finished before are kept');
   await page.close();
+}
+
+// ---- the page on a phone: one column, nothing wider than the screen, a finger turns the model ----
+async function phoneTests(browser, url, id) {
+  const ctx = await browser.newContext({ viewport: { width: 375, height: 740 }, hasTouch: true, isMobile: true, deviceScaleFactor: 2 });
+  const phone = await ctx.newPage();
+  phone.on('pageerror', (e) => check(false, `no error in the page's JavaScript on a phone (${e.message})`));
+  await phone.goto(url);
+  await phone.waitForSelector('#main:not([hidden])');
+  const layout = await phone.evaluate(() => ({
+    wide: document.documentElement.scrollWidth, screen: window.innerWidth,
+    lefts: [...document.querySelectorAll('main > section')].map((e) => Math.round(e.getBoundingClientRect().left)),
+  }));
+  check(layout.screen === 375 && layout.wide <= 375 && new Set(layout.lefts).size === 1,
+    `on a phone the panels stand in one column, nothing wider than the screen (${layout.wide} px of ${layout.screen}; lefts ${[...new Set(layout.lefts)]})`);
+  await phone.click(`#past tbody tr:has(td:text-is("${id}")) button:text-is("Open")`);
+  await phone.waitForFunction((sid) => document.getElementById('viewer').dataset.loaded === sid, id, { timeout: 60000 });
+  await phone.locator('#viewer').scrollIntoViewIfNeeded();
+  await sleep(300);
+  const shot = () => phone.evaluate(() => document.getElementById('viewer').toDataURL());
+  const before = await shot();
+  const box = await phone.locator('#viewer').boundingBox();
+  const cdp = await ctx.newCDPSession(phone);
+  const at = (dx) => [{ x: box.x + box.width / 2 + dx, y: box.y + box.height / 2 }];
+  await cdp.send('Input.dispatchTouchEvent', { type: 'touchStart', touchPoints: at(0) });
+  for (let dx = 10; dx <= 120; dx += 10) await cdp.send('Input.dispatchTouchEvent', { type: 'touchMove', touchPoints: at(dx) });
+  await cdp.send('Input.dispatchTouchEvent', { type: 'touchEnd', touchPoints: [] });
+  await sleep(300);
+  check((await shot()) !== before, 'a finger dragged across the model turns it');
+  await phone.screenshot({ path: path.join(out, 'page-phone.png'), fullPage: true });
+  await ctx.close();
 }
 
 // ---- requests that must be refused ----
