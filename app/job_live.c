@@ -9,6 +9,7 @@
 #include "thread_posix.h"
 
 #include <errno.h>
+#include <poll.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <string.h>
@@ -256,8 +257,48 @@ static int live_view(struct job *j, uint32_t v)
     return start_processing(j, v, started, t0, &info);
 }
 
-/* The person lays the object for the second pass (the simulated person does it at once).
- * @retval 0 @retval -EINTR the person stopped (Ctrl-D) @retval -errno */
+/* The person's answer on standard input: a line, empty (Enter) or "continue" (the page's
+ * Continue, which scanner serve writes there). Polled, so that a stop (a signal) is seen while
+ * it waits; a line of anything else is said and waited past.
+ * @retval 0 @retval -EINTR stopped, or the input ended (Ctrl-D) */
+static int wait_for_answer(const struct job *j)
+{
+    char line[64];
+    size_t len = 0;
+    for (;;) {
+        if (hal_should_stop(j->hal))
+            return -EINTR;
+        struct pollfd pfd = {.fd = STDIN_FILENO, .events = POLLIN};
+        int ready = poll(&pfd, 1, 200);
+        if (ready < 0 && errno != EINTR)
+            return -EINTR;
+        if (ready <= 0)
+            continue;
+        char c;
+        ssize_t got = read(STDIN_FILENO, &c, 1);
+        if (got < 0 && (errno == EINTR || errno == EAGAIN))
+            continue;
+        if (got <= 0)
+            return -EINTR; /* the input ended: no one will answer */
+        if (c != '\n') {
+            if (len + 1 < sizeof(line))
+                line[len++] = c;
+            continue;
+        }
+        line[len] = '\0';
+        if (len == 0 || strcmp(line, "continue") == 0)
+            return 0;
+        j->hal->log(HAL_LOG_WARN,
+                    "answer '%s' not understood: Enter (or 'continue') when the "
+                    "object is laid",
+                    line);
+        len = 0;
+    }
+}
+
+/* The person lays the object for the second pass: asked, and the answer waited for, on a rig
+ * (and on the simulator with [sim] person = asked); the simulated person otherwise does it at
+ * once. @retval 0 @retval -EINTR the person stopped (Ctrl-D) @retval -errno */
 static int ask_for_second_pass(struct job *j)
 {
     char err[256];
@@ -266,16 +307,18 @@ static int ask_for_second_pass(struct job *j)
     struct board_target t = {.kind = BOARD_TARGET_OBJECT, .pass = 2};
     job_progress(j, EV_PLACE_OBJECT, -1, 0, detail);
     int rc = board_place_target((struct hal *)j->hal, &t, err, sizeof(err));
-    if (rc == 0)
+    if (rc == 0 && strcmp(j->cfg->sim.person, "asked") != 0)
         return 0;
-    if (rc != -ENOSYS) {
+    if (rc != 0 && rc != -ENOSYS) {
         j->hal->log(HAL_LOG_ERROR, "%s", err);
         return rc;
     }
-    printf("%s; press Enter when it is done (Ctrl-D stops; the views so far are kept).\n", detail);
-    fflush(stdout);
-    char line[64];
-    return fgets(line, sizeof(line), stdin) == NULL || hal_should_stop(j->hal) ? -EINTR : 0;
+    if (!j->opts->json) { /* with --json the event is the question (the page shows it) */
+        printf("%s; press Enter when it is done (Ctrl-D stops; the views so far are kept).\n",
+               detail);
+        fflush(stdout);
+    }
+    return wait_for_answer(j);
 }
 
 /* The storage thread that keeps the frames while the next are taken. */

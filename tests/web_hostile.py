@@ -350,6 +350,11 @@ def manage_cases(port, key, scans):
     st, _, body = request(port, "POST", "/api/scans", js, '{"profile": "long"}')
     run = json.loads(body)["id"] if st == 200 else ""
     wait_state(port, run, ("running",))
+    st_c, _, _ = request(port, "POST", f"/api/scans/{run}/continue", js, "{}")
+    st_o, _, _ = request(port, "POST", f"/api/scans/{run}/continue",
+                         {**js, "Origin": "http://evil.example"}, "{}")
+    check(st_c == 409 and st_o == 403, f"Continue to a scan that asks nothing is refused, and "
+          f"from another site ({st_c}, {st_o})")
     st, _, body = request(port, "POST", f"/api/scans/{run}/delete", js, "{}")
     exists = os.path.isdir(os.path.join(scans, run))
     request(port, "POST", f"/api/scans/{run}/stop", js, "{}")

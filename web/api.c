@@ -485,7 +485,7 @@ static int send_archive(struct mg_connection *conn, struct web_server *s, const 
     /* "--": a name is never an option of tar's, whatever it begins with */
     const char *args[] = {"/bin/tar", "-C", s->scans, "-cf", "-", "--", name, NULL};
     int fd;
-    pid_t pid = web_spawn(args, &fd, NULL);
+    pid_t pid = web_spawn(args, NULL, &fd, NULL);
     if (pid < 0)
         return send_error(conn, 500, "cannot run tar");
     char header[512];
@@ -687,11 +687,21 @@ static int scan_route(struct mg_connection *conn, struct web_server *s, const ch
         return o != NULL ? send_json(conn, 200, o) : send_error(conn, 404, "no such scan");
     }
     int changes = strcmp(what, "stop") == 0 || strcmp(what, "delete") == 0 ||
-                  strcmp(what, "label") == 0; /* what a page of another site must not do */
+                  strcmp(what, "label") == 0 ||
+                  strcmp(what, "continue") == 0; /* what a page of another site must not do */
     if (changes && is_post && !may_use_rig(s, conn))
         return refuse_without_key(conn);
     if (strcmp(what, "delete") == 0 && is_post)
         return delete_scan(conn, s, id);
+    if (strcmp(what, "continue") == 0 && is_post) {
+        int rc = jobs_answer(s, id);
+        return rc == 0        ? send_json(conn, 200, cJSON_CreateObject())
+               : rc == -ESRCH ? send_error(conn, 409, "that scan is not running")
+               : rc == -EBUSY ? send_error(conn, 409,
+                                           "the scan is not waiting for the object "
+                                           "to be laid (or has its answer)")
+                              : send_error(conn, 500, "the scanner has gone");
+    }
     if (strcmp(what, "label") == 0 && is_post)
         return set_label(conn, s, id);
     if (strcmp(what, "stop") == 0 && is_post)

@@ -42,15 +42,20 @@ int web_name_ok(const char *name)
 }
 
 /* The child is asked to stop with SIGTERM, the scanner's orderly shutdown. */
-pid_t web_spawn(const char *const *args, int *fd_out, int *fd_err)
+pid_t web_spawn(const char *const *args, int *fd_in, int *fd_out, int *fd_err)
 {
-    int out[2], err[2] = {-1, -1};
+    int out[2], err[2] = {-1, -1}, in[2] = {-1, -1};
     if (pipe2(out, O_CLOEXEC) != 0)
         return -errno;
-    if (fd_err != NULL && pipe2(err, O_CLOEXEC) != 0) {
+    if ((fd_err != NULL && pipe2(err, O_CLOEXEC) != 0) ||
+        (fd_in != NULL && pipe2(in, O_CLOEXEC) != 0)) {
         int e = errno;
         close(out[0]);
         close(out[1]);
+        for (int k = 0; k < 2; k++) {
+            if (err[k] >= 0)
+                close(err[k]);
+        }
         return -e;
     }
     pid_t pid = fork();
@@ -61,7 +66,7 @@ pid_t web_spawn(const char *const *args, int *fd_out, int *fd_err)
         signal(SIGPIPE, SIG_DFL);
         prctl(PR_SET_PDEATHSIG, SIGTERM);
         int null = open("/dev/null", O_RDWR);
-        dup2(null, STDIN_FILENO);
+        dup2(fd_in != NULL ? in[0] : null, STDIN_FILENO);
         dup2(out[1], STDOUT_FILENO);
         dup2(fd_err != NULL ? err[1] : null, STDERR_FILENO);
         execv(args[0], (char *const *)args);
@@ -71,12 +76,18 @@ pid_t web_spawn(const char *const *args, int *fd_out, int *fd_err)
     close(out[1]);
     if (err[1] >= 0)
         close(err[1]);
+    if (in[0] >= 0)
+        close(in[0]);
     if (pid < 0) {
         close(out[0]);
         if (err[0] >= 0)
             close(err[0]);
+        if (in[1] >= 0)
+            close(in[1]);
         return -e;
     }
+    if (fd_in != NULL)
+        *fd_in = in[1];
     *fd_out = out[0];
     if (fd_err != NULL)
         *fd_err = err[0];
@@ -99,6 +110,7 @@ static void on_event(struct web_job *j, const char *line)
     const cJSON *detail = cJSON_GetObjectItemCaseSensitive(ev, "detail");
     pthread_mutex_lock(&j->lock);
     snprintf(j->stage, sizeof(j->stage), "%s", event->valuestring);
+    j->answered = 0; /* a new event: a new question, if it is one */
     if (cJSON_IsNumber(views))
         j->views_total = (unsigned)views->valuedouble;
     /* Views taken count when one is saved (its files are there: the page asks for its
@@ -182,7 +194,7 @@ static int run_to_end(const char *const *args, char *out, size_t out_len, int *s
 {
     int fd;
     size_t used = 0;
-    pid_t pid = web_spawn(args, &fd, NULL);
+    pid_t pid = web_spawn(args, NULL, &fd, NULL);
     for (char sink[512]; pid > 0;) {
         int keep = out != NULL && used + 1 < out_len;
         ssize_t n = read(fd, keep ? out + used : sink, keep ? out_len - 1 - used : sizeof(sink));
@@ -272,6 +284,9 @@ static void *reader_main(void *arg)
     pthread_mutex_lock(&j->lock);
     pid_t pid = j->pid;
     j->pid = 0;
+    if (j->fd_in >= 0) /* nobody reads the answers any more */
+        close(j->fd_in);
+    j->fd_in = -1;
     pthread_mutex_unlock(&j->lock);
     int status = wait_for(pid);
     pthread_mutex_lock(&j->lock);
@@ -337,7 +352,8 @@ int jobs_start(struct web_server *s, const struct web_profile *p, const char *re
     const char *resume_args[] = {s->scanner, "resume", dir, "--config", p->path, "--json", NULL};
     pid_t pid = -EINVAL;
     if (rc == 0)
-        pid = web_spawn(resume_id != NULL ? resume_args : scan_args, &j->fd_out, &j->fd_err);
+        pid = web_spawn(resume_id != NULL ? resume_args : scan_args, &j->fd_in, &j->fd_out,
+                        &j->fd_err);
     if (rc != 0 || pid < 0) {
         rc = rc != 0 ? rc : (int)pid;
         snprintf(err, err_len, "cannot start the scanner in %s: %s", dir, strerror(-rc));
@@ -519,4 +535,21 @@ int jobs_delete(struct web_server *s, const char *id)
         return rc;
     /* FTW_PHYS: links are not followed; FTW_MOUNT: nothing mounted inside is entered */
     return nftw(gone, remove_entry, 16, FTW_DEPTH | FTW_PHYS | FTW_MOUNT) == 0 ? 0 : -EIO;
+}
+
+int jobs_answer(struct web_server *s, const char *id)
+{
+    struct web_job *j = &s->job;
+    static const char line[] = "continue\n";
+    pthread_mutex_lock(&j->lock);
+    int rc = j->state != WEB_RUNNING || strcmp(j->id, id) != 0                       ? -ESRCH
+             : strcmp(j->stage, EV_PLACE_OBJECT) != 0 || j->answered || j->fd_in < 0 ? -EBUSY
+                                                                                     : 0;
+    /* one short line into a pipe nobody else writes: whole, or the scanner has gone */
+    if (rc == 0 && write(j->fd_in, line, sizeof(line) - 1) != (ssize_t)(sizeof(line) - 1))
+        rc = -EPIPE;
+    if (rc == 0)
+        j->answered = 1; /* until its next event: a second click sends nothing */
+    pthread_mutex_unlock(&j->lock);
+    return rc;
 }

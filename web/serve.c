@@ -160,8 +160,9 @@ static int log_message(const struct mg_connection *conn, const char *message)
 
 int main(int argc, char **argv)
 {
-    static struct web_server s = {
-        .job = {.lock = PTHREAD_MUTEX_INITIALIZER, .changed = PTHREAD_COND_INITIALIZER}};
+    static struct web_server s = {.job = {.lock = PTHREAD_MUTEX_INITIALIZER,
+                                          .changed = PTHREAD_COND_INITIALIZER,
+                                          .fd_in = -1}};
     const char *listen = "127.0.0.1:8080", *token_file = NULL, *scans = NULL;
     int www_given = 0;
     snprintf(s.www, sizeof(s.www), "%s", WEB_WWW_DIR);

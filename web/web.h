@@ -36,6 +36,8 @@ struct web_job {
     int have_reader;
     pthread_t reader;
     int fd_out, fd_err; /* the scanner's standard output (events) and error (messages) */
+    int fd_in;          /* its standard input: the person's answer to its question, or -1 */
+    int answered;       /* the question (place_object) has its answer: none sent again */
     int done_seen;      /* it said scan_done or process_done */
     int stopping;       /* the server is shutting down: progress streams end */
     char id[64];        /* the scan folder's name */
@@ -80,10 +82,11 @@ int jobs_stop(struct web_server *s, const char *id);
 int jobs_run_tool(struct web_server *s, const char *const *args, char *out, size_t out_len,
                   int *status);
 
-/** fork and exec @p args[0] with its standard output on a pipe (@p fd_out) and its standard
- *  error on another (@p fd_err, or NULL: /dev/null); the child is asked to stop should the server
+/** fork and exec @p args[0] with its standard input from a pipe (@p fd_in, the end to write, or
+ *  NULL: /dev/null), its standard output on a pipe (@p fd_out) and its standard error on another
+ *  (@p fd_err, or NULL: /dev/null); the child is asked to stop should the server
  *  die first. @retval its pid @retval -errno */
-pid_t web_spawn(const char *const *args, int *fd_out, int *fd_err);
+pid_t web_spawn(const char *const *args, int *fd_in, int *fd_out, int *fd_err);
 
 /** Stop a running scan and wait for it (its own shutdown leaves the rig safe). */
 void jobs_shutdown(struct web_server *s);
@@ -96,6 +99,12 @@ int jobs_scan_dir(const struct web_server *s, const char *id, char *dir, size_t 
  *  @retval 0 @retval -ENOENT no such scan */
 int jobs_describe(struct web_server *s, const char *id, enum web_state *state, unsigned *views_done,
                   unsigned *views_total, char *error, size_t error_len);
+
+/** The person's answer to the running scan @p id's question (the object laid for the second
+ *  pass: stage place_object), written to its standard input, once.
+ *  @retval 0 @retval -ESRCH not the running scan @retval -EBUSY it asks nothing now (or has
+ *  its answer) @retval -EPIPE it has gone */
+int jobs_answer(struct web_server *s, const char *id);
 
 /** Delete scan @p id: its folder leaves the list at once, then is removed (links inside it are
  *  removed, not followed). @retval 0 @retval -EBUSY it is the scan that runs @retval -ENOENT

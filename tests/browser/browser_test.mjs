@@ -3,7 +3,7 @@
 // the exit status is the number of failures. Pictures of the page go to BUILD/browser/.
 //   node tests/browser/browser_test.mjs BUILD
 import { chromium } from 'playwright-core';
-import { spawn } from 'node:child_process';
+import { execFileSync, spawn } from 'node:child_process';
 import fs from 'node:fs';
 import http from 'node:http';
 import path from 'node:path';
@@ -216,6 +216,45 @@ async function pageTest(browser) {
   await page.close();
 }
 
+// ---- two passes from the page: the scanner's question shown, answered with Continue ----
+async function twoPassTest(browser) {
+  // make run-complete's bunny, the simulated person waiting to be asked as a real one would
+  const root = path.resolve('.');
+  const cfg = fs.readFileSync('config/sim-complete.ini', 'utf8')
+    .replace(/^calibration = .*$/m, `calibration = ${root}/config/sim-calib.ini`)
+    .replace(/^mesh_file = \.\.\//m, `mesh_file = ${root}/`)
+    .replace(/^\[sim\]$/m, '[sim]\nperson = asked');
+  fs.writeFileSync(path.join(out, 'two-pass.ini'), cfg);
+  const passScans = path.join(out, 'two-pass-scans');
+  const s = await serve(['--config', path.join(out, 'two-pass.ini'), '--listen', `127.0.0.1:${port + 2}`, '--scans', passScans]);
+  const page = await browser.newPage({ viewport: { width: 1400, height: 1000 } });
+  page.on('pageerror', (e) => check(false, `no error in the page's JavaScript (${e.message})`));
+  await page.goto(s.url);
+  await page.waitForSelector('#main:not([hidden])');
+  const early = await raw(s.url, 'POST', '/api/scans/nothing-runs/continue', await keyed(s.url), '{}');
+  check(early.status === 409, `Continue when no scan asks anything is refused (${early.status})`);
+  await page.click('#start');
+  await page.waitForSelector('#place:not([hidden])', { timeout: 180000 });
+  const asked = await page.textContent('#place-text');
+  const id = (await raw(s.url, 'GET', '/api/status').then((r) => JSON.parse(r.body))).current;
+  check(/lay the object on its side/.test(asked) && (await scanState(s.url, id)).views_done === 8,
+    `after the first turn the page says what to do ("${asked}"), the first pass's 8 views kept`);
+  await page.screenshot({ path: path.join(out, 'page-second-pass.png') });
+  const noKey = await raw(s.url, 'POST', `/api/scans/${id}/continue`, json, '{}');
+  check(noKey.status === 403, `Continue without the session key is refused (${noKey.status})`);
+  await page.click('#continue');
+  const twice = await raw(s.url, 'POST', `/api/scans/${id}/continue`, await keyed(s.url), '{}');
+  check(twice.status === 409, `a second Continue to one question is refused (${twice.status})`);
+  await page.waitForFunction(() => /16 of 16 views · finished/.test(document.getElementById('progress').textContent), null, { timeout: 300000 });
+  check(await page.isHidden('#place'), 'the question goes once answered');
+  const dir = path.join(passScans, id);
+  const cmp = execFileSync(path.resolve(build, 'mesh-compare'), ['--align', path.join(dir, 'mesh.ply'), path.join(dir, 'truth_mesh.ply')]).toString();
+  const within = Number((/truth -> result: mean [0-9.]+ mm, within 1 mm ([0-9.]+)%/.exec(cmp) || [])[1]);
+  check(within >= 98, `the two passes from the page make the complete model: ${within}% of the truth within 1 mm (make run-complete's target 98%)`);
+  await page.close();
+  check((await stopServer(s)) === 0, 'the two-pass server shuts down cleanly');
+}
+
 // ---- the page on a phone: one column, nothing wider than the screen, a finger turns the model ----
 async function phoneTests(browser, url, id) {
   const ctx = await browser.newContext({ viewport: { width: 375, height: 740 }, hasTouch: true, isMobile: true, deviceScaleFactor: 2 });
@@ -353,6 +392,7 @@ const browser = await chromium.launch({
 });
 try {
   await pageTest(browser);
+  await twoPassTest(browser);
   await tokenTests();
 } catch (e) {
   check(false, `the test ran to its end (${e.stack})`);

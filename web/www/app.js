@@ -58,7 +58,8 @@ function stageText(s) {
   const n = s.views_total, k = s.stage_views_done ?? s.views_done;
   switch (s.stage) {
     case 'starting': case 'scan_start': case 'homing': return 'starting: homing the turntable';
-    case 'moving': case 'capturing': case 'saving': case 'saved': case 'place_object':
+    case 'place_object': return 'waiting for the object to be laid for the second pass';
+    case 'moving': case 'capturing': case 'saving': case 'saved':
       return `taking view ${Math.min(s.views_done + 1, n)} of ${n}`;
     case 'decoded': case 'process_start': return `decoding view ${k} of ${n}`;
     case 'registration': return 'registering the views';
@@ -76,7 +77,7 @@ function showProgress(s) {
   let text = `Scan ${s.id}: ${s.views_done} of ${s.views_total} views`;
   if (running) {
     text += ` · ${stageText(s)}`;
-    if (s.left_s >= 0) text += ` · about ${Math.ceil(s.left_s)} s left`;
+    if (s.left_s >= 0 && s.stage !== 'place_object') text += ` · about ${Math.ceil(s.left_s)} s left`;
   } else {
     text += ` · ${s.state}`;
   }
@@ -86,6 +87,24 @@ function showProgress(s) {
   $('start').disabled = running;
   $('resume').hidden = s.state !== 'stopped' && s.state !== 'failed';
   $('resume').dataset.id = s.id;
+  // the scanner's question (two passes): what to do, and Continue once it is done
+  const asking = running && s.stage === 'place_object';
+  $('place').hidden = !asking;
+  if (asking) {
+    $('place-text').textContent = s.detail;
+    $('continue').dataset.id = s.id;
+    $('continue').disabled = false;
+  }
+}
+
+async function answerPlaced() {
+  $('continue').disabled = true; // one answer: the server takes no second one either
+  try {
+    await call('POST', `scans/${$('continue').dataset.id}/continue`, {});
+  } catch (err) {
+    $('error').textContent = err.message;
+    $('continue').disabled = false;
+  }
 }
 
 function addThumbs(id, upTo) {
@@ -182,6 +201,7 @@ async function startScan(resumeId) {
 
 $('start').addEventListener('click', () => startScan(null));
 $('resume').addEventListener('click', () => startScan($('resume').dataset.id));
+$('continue').addEventListener('click', answerPlaced);
 $('stop').addEventListener('click', async () => {
   try { await call('POST', `scans/${shown}/stop`, {}); } catch (err) { $('error').textContent = err.message; }
 });
