@@ -366,6 +366,57 @@ def manage_cases(port, key, scans):
           f"the status says the disk's free space ({s.get('disk_free_bytes')})")
 
 
+def profile_cases(port, key):
+    """Settings from the page: read, refused with the scanner's own message naming the key,
+    values that would write more than one line refused, kept over the old file with a backup,
+    or as a new profile (never over another)."""
+    js = {"Content-Type": "application/json", "X-Scanner-Key": key}
+    path = os.path.join(OUT, "fast.ini")
+    before = open(path).read()
+    st, _, body = request(port, "GET", "/api/profiles/fast")
+    vals = json.loads(body).get("values", {}) if st == 200 else {}
+    check(st == 200 and vals.get("scan.views") == "4" and vals.get("colour.method") == "none",
+          f"a profile's main settings are read ({st}, {vals})")
+    st, _, _ = request(port, "POST", "/api/profiles/fast", {"Content-Type": "application/json"},
+                       '{"values": {"scan.views": "6"}}')
+    check(st == 403, f"a change without the session key is refused ({st})")
+    st, _, body = request(port, "POST", "/api/profiles/fast", js, '{"values": {"scan.views": "0"}}')
+    msg = json.loads(body).get("error", "")
+    check(st == 400 and "[scan] views" in msg and open(path).read() == before,
+          f"a value out of range is refused with the scanner's words, naming the key ({msg})")
+    bad = ['{"values": {"scan.views": "6\\n[sim]\\nobject = torus"}}',
+           '{"values": {"scan.views": "6 ; x"}}', '{"values": {"sim.object": "torus"}}',
+           '{"values": {"scan.views": 6}}', '{"values": "views=6"}',
+           '{"values": {"scan.views": "' + "9" * 80 + '"}}']
+    sts = [request(port, "POST", "/api/profiles/fast", js, b)[0] for b in bad]
+    check(sts == [400] * len(bad) and open(path).read() == before,
+          f"a second line, a comment, a key the page may not change, a number, no object, a long "
+          f"value: each refused, the file as it was ({sts})")
+    st, _, _ = request(port, "POST", "/api/profiles/../../etc/passwd", js, '{"values": {}}')
+    st2, _, _ = request(port, "POST", "/api/profiles/fast", js,
+                        '{"values": {"scan.views": "6"}, "save_as": "../evil"}')
+    check(st == 404 and st2 == 400, f"no profile outside the list, no name leaving the folder "
+          f"({st}, {st2})")
+    st, _, body = request(port, "POST", "/api/profiles/fast", js,
+                          '{"values": {"scan.views": "6", "output.max_hole_mm": "10"}}')
+    baks = [f for f in os.listdir(OUT) if f.startswith("fast.ini.bak-")]
+    now = json.loads(request(port, "GET", "/api/profiles/fast")[2])["values"]
+    check(st == 200 and now["scan.views"] == "6" and now["output.max_hole_mm"] == "10"
+          and len(baks) == 1 and open(os.path.join(OUT, baks[0])).read() == before
+          and "[registration]" in open(path).read(),
+          f"a change is kept over the file, the old one beside it, the rest of it untouched "
+          f"({st}, {baks})", body)
+    st, _, _ = request(port, "POST", "/api/profiles/fast", js,
+                       '{"values": {"scan.views": "12"}, "save_as": "fast12"}')
+    profiles = json.loads(request(port, "GET", "/api/status")[2])["profiles"]
+    st2, _, _ = request(port, "POST", "/api/profiles/fast", js,
+                        '{"values": {}, "save_as": "long"}')
+    check(st == 200 and "fast12" in profiles and st2 == 409 and
+          json.loads(request(port, "GET", "/api/profiles/fast12")[2])["values"]["scan.views"]
+          == "12", f"saved as a new profile it is listed; never over another ({st}, {st2})")
+    open(path, "w").write(before)
+
+
 def disk_cases():
     """A scan the disk cannot hold is refused before it starts (a 4 MB file system): 507, how
     much is free and about how much it needs."""
@@ -460,6 +511,7 @@ def main():
         error = resume_cases(port, key, sid, scans)
         path_cases(port, key, scans, sid)
         manage_cases(port, key, scans)
+        profile_cases(port, key)
     finally:
         check(srv.stop() == 0, "the server ends cleanly")
     srv = Server(args)

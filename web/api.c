@@ -58,7 +58,7 @@ static const char *reason_phrase(int status)
 }
 
 /* Send @p body (taken) with @p status. @retval the civetweb handler's "handled" (status) */
-static int send_json(struct mg_connection *conn, int status, cJSON *body)
+int api_send_json(struct mg_connection *conn, int status, cJSON *body)
 {
     char *text = cJSON_PrintUnformatted(body);
     cJSON_Delete(body);
@@ -75,11 +75,11 @@ static int send_json(struct mg_connection *conn, int status, cJSON *body)
     return status;
 }
 
-static int send_error(struct mg_connection *conn, int status, const char *message)
+int api_send_error(struct mg_connection *conn, int status, const char *message)
 {
     cJSON *body = cJSON_CreateObject();
     cJSON_AddStringToObject(body, "error", message);
-    return send_json(conn, status, body);
+    return api_send_json(conn, status, body);
 }
 
 /* ---- who may ask ---- */
@@ -105,7 +105,7 @@ static int authorised(const struct web_server *s, const struct mg_connection *co
 }
 
 /* A request that uses the rig carries the session key (or a Bearer token). */
-static int may_use_rig(const struct web_server *s, const struct mg_connection *conn)
+int api_may_use_rig(const struct web_server *s, const struct mg_connection *conn)
 {
     return guard_has_key(s, conn) || bearer(s, conn);
 }
@@ -117,7 +117,7 @@ static int refuse_without_key(struct mg_connection *conn);
  * and at most WEB_MAX_BODY bytes, nested at most GUARD_MAX_JSON_DEPTH deep (counted before
  * parsing: cJSON recurses once a level), one JSON object and nothing after it. An empty body is
  * {}. @retval 0 or the status to answer */
-static int read_body(struct mg_connection *conn, cJSON **body)
+int api_read_body(struct mg_connection *conn, cJSON **body)
 {
     const struct mg_request_info *ri = mg_get_request_info(conn);
     const char *type = mg_get_header(conn, "Content-Type");
@@ -221,7 +221,7 @@ static int list_scans(struct mg_connection *conn, struct web_server *s)
     cJSON *body = cJSON_CreateObject();
     cJSON_AddItemToObject(body, "scans", list);
     cJSON_AddBoolToObject(body, "complete", seen <= WEB_MAX_LISTED);
-    return send_json(conn, 200, body);
+    return api_send_json(conn, 200, body);
 }
 
 static const struct web_profile *find_profile(const struct web_server *s, const cJSON *body)
@@ -300,17 +300,18 @@ static int disk_holds(struct web_server *s, const struct web_profile *p, const c
 /* POST /api/scans (a new scan) or /api/scans/ID/resume. */
 static int start_scan(struct mg_connection *conn, struct web_server *s, const char *resume_id)
 {
-    if (!may_use_rig(s, conn))
+    if (!api_may_use_rig(s, conn))
         return refuse_without_key(conn);
     cJSON *body = NULL;
-    int status = read_body(conn, &body);
+    int status = api_read_body(conn, &body);
     if (status != 0) {
         cJSON_Delete(body);
-        return send_error(conn, status,
-                          status == 415   ? "send the request as application/json"
-                          : status == 413 ? "the request is too large"
-                                          : "the body is not one JSON object (nested at most 32 "
-                                            "deep, nothing after it)");
+        return api_send_error(conn, status,
+                              status == 415 ? "send the request as application/json"
+                              : status == 413
+                                  ? "the request is too large"
+                                  : "the body is not one JSON object (nested at most 32 "
+                                    "deep, nothing after it)");
     }
     char why[WEB_PATH + 256] = "";
     int named = cJSON_GetObjectItemCaseSensitive(body, "profile") != NULL;
@@ -319,18 +320,18 @@ static int start_scan(struct mg_connection *conn, struct web_server *s, const ch
                                       : find_profile(s, body);
     cJSON_Delete(body);
     if (p == NULL && why[0] != '\0')
-        return send_error(conn, 409, why);
+        return api_send_error(conn, 409, why);
     if (p == NULL)
-        return send_error(conn, 400, "no such profile (GET /api/status lists them)");
+        return api_send_error(conn, 400, "no such profile (GET /api/status lists them)");
     if (!disk_holds(s, p, resume_id, why, sizeof(why)))
-        return send_error(conn, 507, why);
+        return api_send_error(conn, 507, why);
     char id[64], err[WEB_PATH + 128];
     int rc = jobs_start(s, p, resume_id, id, sizeof(id), err, sizeof(err));
     if (rc != 0)
-        return send_error(conn, rc == -EBUSY ? 409 : 500, err);
+        return api_send_error(conn, rc == -EBUSY ? 409 : 500, err);
     cJSON *answer = cJSON_CreateObject();
     cJSON_AddStringToObject(answer, "id", id);
-    return send_json(conn, 200, answer);
+    return api_send_json(conn, 200, answer);
 }
 
 /* stream_events once its stream is counted. */
@@ -384,7 +385,8 @@ static int stream_events(struct mg_connection *conn, struct web_server *s, const
     s->streams += !full;
     pthread_mutex_unlock(&j->lock);
     if (full)
-        return send_error(conn, 503, "too many progress streams open (close a tab of the page)");
+        return api_send_error(conn, 503,
+                              "too many progress streams open (close a tab of the page)");
     int rc = stream_events_counted(conn, s, id);
     pthread_mutex_lock(&j->lock);
     s->streams--;
@@ -401,17 +403,17 @@ static int send_scan_file(struct mg_connection *conn, struct web_server *s, cons
     for (const char *p = rel; parts < 3;) {
         size_t len = strcspn(p, "/");
         if (parts == 2 || len == 0 || len >= sizeof(part[0]))
-            return send_error(conn, 403, "not a file of the scan");
+            return api_send_error(conn, 403, "not a file of the scan");
         memcpy(part[parts], p, len);
         part[parts][len] = '\0';
         if (!web_name_ok(part[parts++]))
-            return send_error(conn, 403, "not a file of the scan");
+            return api_send_error(conn, 403, "not a file of the scan");
         if (p[len] == '\0')
             break;
         p += len + 1;
     }
     if (jobs_scan_dir(s, id, path, sizeof(path)) != 0 || realpath(path, root) == NULL)
-        return send_error(conn, 404, "no such scan");
+        return api_send_error(conn, 404, "no such scan");
     if (parts == 1)
         snprintf(path, sizeof(path), "%s/%s", root, part[0]);
     else
@@ -419,9 +421,9 @@ static int send_scan_file(struct mg_connection *conn, struct web_server *s, cons
     struct stat sb;
     /* a link planted in the folder must not lead out of it */
     if (realpath(path, real) == NULL || stat(real, &sb) != 0 || !S_ISREG(sb.st_mode))
-        return send_error(conn, 404, "no such file in the scan");
+        return api_send_error(conn, 404, "no such file in the scan");
     if (strncmp(real, root, strlen(root)) != 0 || real[strlen(root)] != '/')
-        return send_error(conn, 403, "not a file of the scan");
+        return api_send_error(conn, 403, "not a file of the scan");
     const char *name = part[parts - 1], *dot = strrchr(name, '.');
     const char *mime = dot == NULL                 ? "application/octet-stream"
                        : strcmp(dot, ".html") == 0 ? "text/html; charset=utf-8"
@@ -446,20 +448,21 @@ static int send_thumb(struct mg_connection *conn, struct web_server *s, const ch
     unsigned view;
     char kind[16];
     if (sscanf(rest, "%u/%15[a-z].png", &view, kind) != 2)
-        return send_error(conn, 404, "no such thumbnail (VIEW/raw.png, colour.png, reasons.png)");
+        return api_send_error(conn, 404,
+                              "no such thumbnail (VIEW/raw.png, colour.png, reasons.png)");
     enum report_thumb k = strcmp(kind, "raw") == 0      ? REPORT_THUMB_RAW
                           : strcmp(kind, "colour") == 0 ? REPORT_THUMB_INTRINSIC
                                                         : REPORT_THUMB_REASONS;
     if (k == REPORT_THUMB_REASONS && strcmp(kind, "reasons") != 0)
-        return send_error(conn, 404, "no such thumbnail (raw, colour or reasons)");
+        return api_send_error(conn, 404, "no such thumbnail (raw, colour or reasons)");
     char dir[WEB_PATH + 160];
     if (jobs_scan_dir(s, id, dir, sizeof(dir)) != 0)
-        return send_error(conn, 404, "no such scan");
+        return api_send_error(conn, 404, "no such scan");
     uint8_t *png = NULL;
     size_t len = 0;
     int rc = report_thumb_png(dir, view, k, &png, &len);
     if (rc != 0)
-        return send_error(conn, 404, "that view has no such picture (yet)");
+        return api_send_error(conn, 404, "that view has no such picture (yet)");
     mg_printf(conn,
               "HTTP/1.1 200 OK\r\nContent-Type: image/png\r\nContent-Length: %zu\r\n"
               "Cache-Control: no-store\r\n\r\n",
@@ -477,17 +480,17 @@ static int send_archive(struct mg_connection *conn, struct web_server *s, const 
     int running = j->state == WEB_RUNNING && strcmp(j->id, id) == 0;
     pthread_mutex_unlock(&j->lock);
     if (running)
-        return send_error(conn, 409, "the scan is still running");
+        return api_send_error(conn, 409, "the scan is still running");
     char name[160], dir[WEB_PATH + 160];
     if (jobs_scan_dir(s, id, dir, sizeof(dir)) != 0)
-        return send_error(conn, 404, "no such scan");
+        return api_send_error(conn, 404, "no such scan");
     snprintf(name, sizeof(name), "%s/", id);
     /* "--": a name is never an option of tar's, whatever it begins with */
     const char *args[] = {"/bin/tar", "-C", s->scans, "-cf", "-", "--", name, NULL};
     int fd;
     pid_t pid = web_spawn(args, NULL, &fd, NULL);
     if (pid < 0)
-        return send_error(conn, 500, "cannot run tar");
+        return api_send_error(conn, 500, "cannot run tar");
     char header[512];
     snprintf(header, sizeof(header),
              "HTTP/1.1 200 OK\r\nContent-Type: application/x-tar\r\nContent-Disposition: "
@@ -522,9 +525,9 @@ static int selftest(struct mg_connection *conn, struct web_server *s)
     pthread_mutex_unlock(&lock);
     if (rc == -EBUSY) {
         cJSON_Delete(body);
-        return send_error(conn, 409, "the rig is busy (a scan is running)");
+        return api_send_error(conn, 409, "the rig is busy (a scan is running)");
     }
-    return send_json(conn, 200, body);
+    return api_send_json(conn, 200, body);
 }
 
 /* POST /api/snapshot.png: what the camera sees lit by the projector's white. */
@@ -533,7 +536,7 @@ static int snapshot(struct mg_connection *conn, struct web_server *s)
     char path[] = "/tmp/scanner-snapshot-XXXXXX.png", out[512];
     int fd = mkstemps(path, 4);
     if (fd < 0)
-        return send_error(conn, 500, "cannot make a temporary file");
+        return api_send_error(conn, 500, "cannot make a temporary file");
     close(fd);
     const char *args[] = {s->scanner, "snapshot", "--config", s->profile[0].path,
                           "--out",    path,       NULL};
@@ -541,11 +544,11 @@ static int snapshot(struct mg_connection *conn, struct web_server *s)
     int rc = jobs_run_tool(s, args, out, sizeof(out), &status);
     if (rc == -EBUSY) {
         unlink(path);
-        return send_error(conn, 409, "the rig is busy (a scan is running)");
+        return api_send_error(conn, 409, "the rig is busy (a scan is running)");
     }
     if (rc != 0 || status != 0) {
         unlink(path);
-        return send_error(conn, 500, "the camera gave no picture (GET /api/selftest says why)");
+        return api_send_error(conn, 500, "the camera gave no picture (GET /api/selftest says why)");
     }
     mg_send_mime_file2(conn, path, "image/png", "Cache-Control: no-store\r\n");
     unlink(path);
@@ -577,7 +580,7 @@ static int status(struct mg_connection *conn, struct web_server *s)
         cJSON_AddNumberToObject(body, "disk_free_bytes", (double)fs.f_bavail * fs.f_frsize);
         cJSON_AddNumberToObject(body, "disk_total_bytes", (double)fs.f_blocks * fs.f_frsize);
     }
-    return send_json(conn, 200, body);
+    return api_send_json(conn, 200, body);
 }
 
 /* GET /api/session: the key that requests using the rig carry (X-Scanner-Key). Only a page of
@@ -588,14 +591,14 @@ static int session(struct mg_connection *conn, struct web_server *s)
     cJSON *body = cJSON_CreateObject();
     cJSON_AddStringToObject(body, "key", s->key);
     cJSON_AddStringToObject(body, "header", GUARD_KEY_HEADER);
-    return send_json(conn, 200, body);
+    return api_send_json(conn, 200, body);
 }
 
 static int refuse_without_key(struct mg_connection *conn)
 {
-    return send_error(conn, 403,
-                      "a request that uses the rig carries the session key "
-                      "(" GUARD_KEY_HEADER ": GET /api/session gives it)");
+    return api_send_error(conn, 403,
+                          "a request that uses the rig carries the session key "
+                          "(" GUARD_KEY_HEADER ": GET /api/session gives it)");
 }
 
 /* POST /api/login {"token": "..."}: the cookie the page's requests then carry. Its rate is
@@ -604,18 +607,18 @@ static int login(struct mg_connection *conn, struct web_server *s)
 {
     int st = guard_login_allowed(conn);
     if (st != 0)
-        return send_error(conn, st, "too many wrong tokens just now: wait a few seconds");
+        return api_send_error(conn, st, "too many wrong tokens just now: wait a few seconds");
     cJSON *body = NULL;
-    st = read_body(conn, &body);
+    st = api_read_body(conn, &body);
     const cJSON *token = cJSON_GetObjectItemCaseSensitive(body, "token");
     int ok = st == 0 && cJSON_IsString(token) && s->token[0] != '\0' &&
              guard_secret_equal(token->valuestring, s->token);
     cJSON_Delete(body);
     if (st != 0)
-        return send_error(conn, st, "send {\"token\": \"...\"} as application/json");
+        return api_send_error(conn, st, "send {\"token\": \"...\"} as application/json");
     if (!ok) {
         guard_login_failed(conn);
-        return send_error(conn, 401, "wrong token");
+        return api_send_error(conn, 401, "wrong token");
     }
     mg_printf(conn,
               "HTTP/1.1 200 OK\r\nContent-Type: application/json\r\nContent-Length: 2\r\n"
@@ -639,19 +642,19 @@ static int label_ok(const char *label)
 static int set_label(struct mg_connection *conn, struct web_server *s, const char *id)
 {
     cJSON *body = NULL;
-    int st = read_body(conn, &body);
+    int st = api_read_body(conn, &body);
     const cJSON *label = cJSON_GetObjectItemCaseSensitive(body, "label");
     int ok = st == 0 && cJSON_IsString(label) && label_ok(label->valuestring);
     int rc = ok ? jobs_set_label(s, id, label->valuestring) : 0;
     cJSON_Delete(body);
     if (!ok)
-        return send_error(conn, st != 0 ? st : 400,
-                          "send {\"label\": \"...\"}: one line, at most " WEB_MAX_LABEL_TEXT
-                          " bytes");
+        return api_send_error(conn, st != 0 ? st : 400,
+                              "send {\"label\": \"...\"}: one line, at most " WEB_MAX_LABEL_TEXT
+                              " bytes");
     if (rc == -ENOENT)
-        return send_error(conn, 404, "no such scan");
-    return rc == 0 ? send_json(conn, 200, cJSON_CreateObject())
-                   : send_error(conn, 500, "the label could not be written");
+        return api_send_error(conn, 404, "no such scan");
+    return rc == 0 ? api_send_json(conn, 200, cJSON_CreateObject())
+                   : api_send_error(conn, 500, "the label could not be written");
 }
 
 /* POST /api/scans/ID/delete: the scan's folder and everything in it, unless it runs. */
@@ -659,13 +662,13 @@ static int delete_scan(struct mg_connection *conn, struct web_server *s, const c
 {
     int rc = jobs_delete(s, id);
     if (rc == -EBUSY)
-        return send_error(conn, 409, "that scan is running: stop it first");
+        return api_send_error(conn, 409, "that scan is running: stop it first");
     if (rc == -ENOENT)
-        return send_error(conn, 404, "no such scan");
-    return rc == 0 ? send_json(conn, 200, cJSON_CreateObject())
-                   : send_error(conn, 500,
-                                "the scan could not be removed wholly (the server's "
-                                "log says what is left)");
+        return api_send_error(conn, 404, "no such scan");
+    return rc == 0 ? api_send_json(conn, 200, cJSON_CreateObject())
+                   : api_send_error(conn, 500,
+                                    "the scan could not be removed wholly (the server's "
+                                    "log says what is left)");
 }
 
 /* /api/scans/ID[/what[/rest]] */
@@ -675,43 +678,43 @@ static int scan_route(struct mg_connection *conn, struct web_server *s, const ch
     char id[130];
     size_t len = strcspn(path, "/");
     if (len >= sizeof(id))
-        return send_error(conn, 404, "no such scan");
+        return api_send_error(conn, 404, "no such scan");
     memcpy(id, path, len);
     id[len] = '\0';
     if (!web_name_ok(id))
-        return send_error(conn, 403, "not a scan's name");
+        return api_send_error(conn, 403, "not a scan's name");
     const char *what = path[len] == '/' ? path + len + 1 : "";
     int is_get = strcmp(method, "GET") == 0, is_post = strcmp(method, "POST") == 0;
     if (what[0] == '\0' && is_get) {
         cJSON *o = job_json(s, id);
-        return o != NULL ? send_json(conn, 200, o) : send_error(conn, 404, "no such scan");
+        return o != NULL ? api_send_json(conn, 200, o) : api_send_error(conn, 404, "no such scan");
     }
     int changes = strcmp(what, "stop") == 0 || strcmp(what, "delete") == 0 ||
                   strcmp(what, "label") == 0 ||
                   strcmp(what, "continue") == 0; /* what a page of another site must not do */
-    if (changes && is_post && !may_use_rig(s, conn))
+    if (changes && is_post && !api_may_use_rig(s, conn))
         return refuse_without_key(conn);
     if (strcmp(what, "delete") == 0 && is_post)
         return delete_scan(conn, s, id);
     if (strcmp(what, "continue") == 0 && is_post) {
         int rc = jobs_answer(s, id);
-        return rc == 0        ? send_json(conn, 200, cJSON_CreateObject())
-               : rc == -ESRCH ? send_error(conn, 409, "that scan is not running")
-               : rc == -EBUSY ? send_error(conn, 409,
-                                           "the scan is not waiting for the object "
-                                           "to be laid (or has its answer)")
-                              : send_error(conn, 500, "the scanner has gone");
+        return rc == 0        ? api_send_json(conn, 200, cJSON_CreateObject())
+               : rc == -ESRCH ? api_send_error(conn, 409, "that scan is not running")
+               : rc == -EBUSY ? api_send_error(conn, 409,
+                                               "the scan is not waiting for the object "
+                                               "to be laid (or has its answer)")
+                              : api_send_error(conn, 500, "the scanner has gone");
     }
     if (strcmp(what, "label") == 0 && is_post)
         return set_label(conn, s, id);
     if (strcmp(what, "stop") == 0 && is_post)
-        return jobs_stop(s, id) == 0 ? send_json(conn, 200, cJSON_CreateObject())
-                                     : send_error(conn, 409, "that scan is not running");
+        return jobs_stop(s, id) == 0 ? api_send_json(conn, 200, cJSON_CreateObject())
+                                     : api_send_error(conn, 409, "that scan is not running");
     if (strcmp(what, "resume") == 0 && is_post) {
         cJSON *o = job_json(s, id);
         int ok = o != NULL;
         cJSON_Delete(o);
-        return ok ? start_scan(conn, s, id) : send_error(conn, 404, "no such scan");
+        return ok ? start_scan(conn, s, id) : api_send_error(conn, 404, "no such scan");
     }
     if (strcmp(what, "events") == 0 && is_get)
         return stream_events(conn, s, id);
@@ -721,7 +724,7 @@ static int scan_route(struct mg_connection *conn, struct web_server *s, const ch
         return send_thumb(conn, s, id, what + 7);
     if (strcmp(what, "archive.tar") == 0 && is_get)
         return send_archive(conn, s, id);
-    return send_error(conn, is_get || is_post ? 404 : 405, "no such request");
+    return api_send_error(conn, is_get || is_post ? 404 : 405, "no such request");
 }
 
 int api_handle(struct mg_connection *conn, void *cbdata)
@@ -735,21 +738,21 @@ int api_handle(struct mg_connection *conn, void *cbdata)
     int is_get = strcmp(method, "GET") == 0, is_post = strcmp(method, "POST") == 0;
     int refused = guard_request(s, conn, &why);
     if (refused != 0)
-        return send_error(conn, refused, why);
+        return api_send_error(conn, refused, why);
     if (!is_get && !is_post) /* OPTIONS too: no CORS pre-flight is ever answered yes */
-        return send_error(conn, 405, "GET or POST only");
+        return api_send_error(conn, 405, "GET or POST only");
     if (strcmp(path, "/api/login") == 0 && is_post)
         return login(conn, s);
     if (!authorised(s, conn))
-        return send_error(conn, 401, "this scanner wants its token (POST /api/login)");
+        return api_send_error(conn, 401, "this scanner wants its token (POST /api/login)");
     if (strcmp(path, "/api/status") == 0 && is_get)
         return status(conn, s);
     if (strcmp(path, "/api/session") == 0 && is_get)
         return session(conn, s);
     int device = strcmp(path, "/api/selftest") == 0 || strcmp(path, "/api/snapshot.png") == 0;
     if (device && !is_post)
-        return send_error(conn, 405, "POST: it uses the rig");
-    if (device && !may_use_rig(s, conn))
+        return api_send_error(conn, 405, "POST: it uses the rig");
+    if (device && !api_may_use_rig(s, conn))
         return refuse_without_key(conn);
     if (strcmp(path, "/api/selftest") == 0)
         return selftest(conn, s);
@@ -761,5 +764,7 @@ int api_handle(struct mg_connection *conn, void *cbdata)
         return start_scan(conn, s, NULL);
     if (strncmp(path, "/api/scans/", 11) == 0)
         return scan_route(conn, s, method, path + 11);
-    return send_error(conn, 404, "no such request (docs/api.md)");
+    if (strncmp(path, "/api/profiles/", 14) == 0)
+        return profiles_handle(conn, s, method, path + 14);
+    return api_send_error(conn, 404, "no such request (docs/api.md)");
 }

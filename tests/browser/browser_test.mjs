@@ -251,6 +251,26 @@ async function twoPassTest(browser) {
   const cmp = execFileSync(path.resolve(build, 'mesh-compare'), ['--align', path.join(dir, 'mesh.ply'), path.join(dir, 'truth_mesh.ply')]).toString();
   const within = Number((/truth -> result: mean [0-9.]+ mm, within 1 mm ([0-9.]+)%/.exec(cmp) || [])[1]);
   check(within >= 98, `the two passes from the page make the complete model: ${within}% of the truth within 1 mm (make run-complete's target 98%)`);
+
+  // settings on the page (this profile is the test's own copy): refused beside the field, kept
+  await page.fill('#settings [name="scan.views"]', 'abc');
+  await page.click('#settings-save');
+  await page.waitForSelector('#settings .field-error');
+  const said = await page.textContent('#settings .field-error');
+  const beside = await page.evaluate(() => document.querySelector('#settings .field-error').previousElementSibling.name);
+  check(beside === 'scan.views' && /\[scan\] views/.test(said), `a wrong value is refused, the scanner's words beside its field ("${said}")`);
+  await page.locator('#settings-panel').screenshot({ path: path.join(out, 'page-settings.png') });
+  await page.fill('#settings [name="scan.views"]', '6');
+  await page.selectOption('#settings [name="colour.method"]', 'multi');
+  await page.click('#settings-save');
+  await page.waitForFunction(() => /saved/.test(document.getElementById('settings-msg').textContent));
+  const saved = fs.readFileSync(path.join(out, 'two-pass.ini'), 'utf8');
+  check(/^views = 6$/m.test(saved) && /^method = multi$/m.test(saved) &&
+    fs.readdirSync(out).some((f) => f.startsWith('two-pass.ini.bak-')), 'a right value is saved in the profile, the old file kept beside it');
+  await page.fill('#settings-as', 'six-views');
+  await page.click('#settings-save-as');
+  await page.waitForFunction(() => [...document.getElementById('profile').options].some((o) => o.value === 'six-views'));
+  check(fs.existsSync(path.join(out, 'six-views.ini')), 'saved as a new profile, it can be picked to scan with');
   await page.close();
   check((await stopServer(s)) === 0, 'the two-pass server shuts down cleanly');
 }

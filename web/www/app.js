@@ -317,14 +317,66 @@ async function deleteScan(s) {
   refresh();
 }
 
+// ---- settings: a profile's main keys, checked by the scanner's own key table ----
+async function loadSettings() {
+  const name = $('settings-profile').value;
+  const p = await call('GET', `profiles/${encodeURIComponent(name)}`);
+  for (const [k, v] of Object.entries(p.values)) {
+    const field = $('settings').elements[k];
+    if (field) field.value = v;
+  }
+  clearFieldErrors();
+}
+
+function clearFieldErrors() {
+  for (const e of document.querySelectorAll('#settings .field-error')) e.remove();
+  $('settings-msg').textContent = '';
+}
+
+async function saveSettings(asNew) {
+  clearFieldErrors();
+  const values = {};
+  for (const f of $('settings').elements) if (f.name) values[f.name] = f.value;
+  const body = { values };
+  if (asNew) body.save_as = $('settings-as').value;
+  try {
+    await call('POST', `profiles/${encodeURIComponent($('settings-profile').value)}`, body);
+    $('settings-msg').textContent = asNew ? `saved as profile ${body.save_as}`
+      : 'saved (the old file is kept beside it)';
+    if (asNew) await listProfiles(body.save_as);
+  } catch (err) {
+    // the scanner's message names "[section] key": shown beside that field
+    const m = /\[(\w+)\] (\w+)/.exec(err.message);
+    const field = m && $('settings').elements[`${m[1]}.${m[2]}`];
+    if (!field) { $('settings-msg').textContent = err.message; return; }
+    const note = document.createElement('span');
+    note.className = 'field-error';
+    note.textContent = err.message;
+    field.after(note);
+  }
+}
+
+async function listProfiles(pick) {
+  const st = await call('GET', 'status');
+  for (const sel of [$('profile'), $('settings-profile')]) {
+    const was = sel.value;
+    sel.textContent = '';
+    for (const p of st.profiles) sel.add(new Option(p, p));
+    sel.value = pick || was || st.profiles[0];
+  }
+  await loadSettings();
+}
+
+$('settings-profile').addEventListener('change', loadSettings);
+$('settings-save').addEventListener('click', () => saveSettings(false));
+$('settings-save-as').addEventListener('click', () => saveSettings(true));
+
 async function start() {
   $('main').hidden = false;
   if (!viewer) viewer = new Viewer($('viewer'));
   $('legend').innerHTML = reasons.map(([n, c]) => `<i style="background:${c}"></i>${n}`).join('');
   const st = await refresh();
-  const sel = $('profile');
-  sel.textContent = '';
-  for (const p of st.profiles) sel.add(new Option(p, p));
+  await listProfiles();
   if (st.scanning) follow(st.current);
 }
 
