@@ -222,14 +222,16 @@ static int set_profile(struct mg_connection *conn, struct web_server *s,
     char *slash = strrchr(dir, '/');
     if (slash != NULL)
         *slash = '\0';
-    if ((size_t)snprintf(tmp, sizeof(tmp), "%s/.%s.ini.%ld.tmp", dir, p->name, (long)getpid()) >=
-            sizeof(tmp) ||
+    /* one name a request: two changes at once never write each other's file */
+    static unsigned long serial;
+    unsigned long mine = __atomic_add_fetch(&serial, 1, __ATOMIC_RELAXED);
+    if ((size_t)snprintf(tmp, sizeof(tmp), "%s/.%s.ini.%ld-%lu.tmp", dir, p->name, (long)getpid(),
+                         mine) >= sizeof(tmp) ||
         (as != NULL && (size_t)snprintf(target, sizeof(target), "%s/%s.ini", dir,
                                         as->valuestring) >= sizeof(s->profile[0].path))) {
         st = api_send_error(conn, 500, "the profile's folder has too long a name");
         goto out_free;
     }
-    unlink(tmp);
     int rc = write_new(tmp, text);
     struct app_config cfg;
     if (rc == 0 && config_load(&cfg, tmp, err, sizeof(err)) != 0) {
