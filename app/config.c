@@ -633,14 +633,14 @@ static int load(struct app_config *cfg, const char *path, int offline, char *err
         return -EINVAL;
     }
     /* The calibration file is named relative to the config file (none: offline, a guess). */
-    char joined[sizeof(cfg->calibration_file)];
-    if (cfg->calibration_file[0] != '\0' &&
-        path_beside(path, cfg->calibration_file, joined, sizeof(joined)) != 0) {
-        snprintf(err, err_len, "%s: [scan] calibration: path too long", path);
-        return -EINVAL;
-    }
-    if (cfg->calibration_file[0] != '\0')
+    if (cfg->calibration_file[0] != '\0') {
+        char joined[sizeof(cfg->calibration_file)];
+        if (path_beside(path, cfg->calibration_file, joined, sizeof(joined)) != 0) {
+            snprintf(err, err_len, "%s: [scan] calibration: path too long", path);
+            return -EINVAL;
+        }
         memcpy(cfg->calibration_file, joined, sizeof(joined));
+    }
     rc = parse_placements(&cfg->calibrate, path, err, err_len);
     if (rc != 0)
         return rc;

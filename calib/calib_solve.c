@@ -748,8 +748,7 @@ static int axis_model_error(const struct solve *s, double *mid_mm, double *worst
     *mid_mm = *worst_mm = 0.0;
     if (truth == NULL || model == NULL || var == NULL)
         goto out_free;
-    e1 = v3_norm(v3_cross(d, fabs(d.x) < 0.9 ? v3(1, 0, 0) : v3(0, 1, 0)));
-    e2 = v3_cross(d, e1);
+    v3_across(d, &e1, &e2);
     const double sa = s->axis_across_sigma_mm / sqrt(2.0);
     const double st = s->axis_dir_sigma_deg * M_PI / 180.0 / sqrt(2.0);
     for (int k = 0; k < 4; k++) {

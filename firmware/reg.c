@@ -121,19 +121,18 @@ int reg_add_view(struct reg_ctx *r, uint32_t index, int32_t angle_mdeg, const st
         (m->height + r->stride - 1) / r->stride != r->gh)
         return -EINVAL;
     struct reg_cell *out = reg_view_cells(r, index);
+    r->valid_cells[index] = 0;
     for (uint32_t y = 0; y < r->gh; y++) {
         for (uint32_t x = 0; x < r->gw; x++) {
             size_t i = (size_t)y * r->stride * m->width + (size_t)x * r->stride;
             struct reg_cell *cl = &out[(size_t)y * r->gw + x];
             cl->valid = m->reason[i] == SCAN_VALID;
+            r->valid_cells[index] += cl->valid;
             memcpy(cl->xyz, &range->xyz_mm[3 * i], sizeof(cl->xyz));
             memcpy(cl->normal, &range->normal[3 * i], sizeof(cl->normal));
             cell_colour(m, rgb, r->stride, x * r->stride, y * r->stride, cl->rgb);
         }
     }
-    r->valid_cells[index] = 0;
-    for (size_t k = 0; k < reg_cell_count(r); k++)
-        r->valid_cells[index] += out[k].valid;
     r->reported_mdeg[index] = angle_mdeg;
     r->present[index] = 1;
     return 0;
@@ -165,14 +164,6 @@ static void axis_rotation(vec3 d, double angle, double rot[9])
     struct frame_xform f;
     frame_from_small_motion(x, &f);
     memcpy(rot, f.rot, sizeof(f.rot));
-}
-
-/* Two unit vectors across d. */
-static void across(vec3 d, vec3 *e1, vec3 *e2)
-{
-    vec3 t = fabs(d.x) < 0.9 ? v3(1, 0, 0) : v3(0, 1, 0);
-    *e1 = v3_norm(v3_cross(d, t));
-    *e2 = v3_cross(d, *e1);
 }
 
 /* Unknowns: the angle of each view but the first of its pass (the gauge of that pass's frame),
@@ -286,7 +277,7 @@ static void pair_views(struct reg_ctx *r, uint32_t src, uint32_t dst, double gat
     double rot[9];
     axis_rotation(r->d, r->theta[dst] - r->theta[src], rot);
     vec3 e1, e2;
-    across(r->d, &e1, &e2);
+    v3_across(r->d, &e1, &e2);
     vec3 r_e1 = m3_mul(rot, e1), r_e2 = m3_mul(rot, e2);
     const int axis = (int)(r->views - r->passes);
     int idx[6] = {angle_param(r, src), angle_param(r, dst), axis, axis + 1, axis + 2, axis + 3};
@@ -430,7 +421,7 @@ static void add_prior(struct reg_ctx *r)
         r->normal_b[i] += w_angle * (r->theta[v] - reported_rad(r, v));
     }
     vec3 e1, e2, a0, d0;
-    across(r->d, &e1, &e2);
+    v3_across(r->d, &e1, &e2);
     calibrated_axis(r, &a0, &d0);
     vec3 da = v3_sub(r->a, a0), dd = v3_sub(r->d, d0);
     /* the unknowns' own measures of how far the axis is: shifts along e1, e2 and the tilts
@@ -469,7 +460,7 @@ static double gauss_newton_step(struct reg_ctx *r)
         largest = fmax(largest, fabs(r->step_x[angle_param(r, v)]));
     }
     vec3 e1, e2;
-    across(r->d, &e1, &e2);
+    v3_across(r->d, &e1, &e2);
     const double *ax = &r->step_x[r->views - r->passes];
     r->a = v3_add(r->a, v3_add(v3_scale(e1, ax[0]), v3_scale(e2, ax[1])));
     r->d = v3_norm(v3_add(r->d, v3_cross(v3_add(v3_scale(e1, ax[2]), v3_scale(e2, ax[3])), r->d)));

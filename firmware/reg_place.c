@@ -106,6 +106,17 @@ static const struct reg_cell *land(struct reg_ctx *r, vec3 p, vec3 n, double min
 /* A colour whose distance from grey is under this share of its brightness is grey. */
 #define REG_HUE_MIN_SATURATION 0.15
 
+/* Where cell @p cl lies: its view @p j and its place @p x, @p y in that view's grid (NULL: not
+ * wanted). */
+static void cell_place(const struct reg_ctx *r, const struct reg_cell *cl, uint32_t *j, uint32_t *x,
+                       uint32_t *y)
+{
+    size_t k = (size_t)(cl - r->cells), count = reg_cell_count(r);
+    *j = (uint32_t)(k / count);
+    if (x != NULL)
+        *x = (uint32_t)(k % count % r->gw), *y = (uint32_t)(k % count / r->gw);
+}
+
 /* A colour's hue: the unit direction of its distance from grey, in the plane across the grey
  * axis. The same under any brightness of white light and under any grey added to it (ambient
  * light, the projector's black), so that raw colours, shaded and lit differently in each view,
@@ -134,9 +145,8 @@ static int hue_of(const uint8_t rgb[3], double hue[2])
 static int hue_gradient(struct reg_ctx *r, const struct reg_cell *hit, vec3 q, vec3 nq,
                         double min_cos, double reach_mm, double hue[2], vec3 grad[2])
 {
-    size_t k = (size_t)(hit - r->cells), count = reg_cell_count(r);
-    uint32_t j = (uint32_t)(k / count), x = (uint32_t)(k % count % r->gw),
-             y = (uint32_t)(k % count / r->gw);
+    uint32_t j, x, y;
+    cell_place(r, hit, &j, &x, &y);
     static const int step[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
     vec3 e1, e2;
     double ata[3] = {0, 0, 0}, atb[2][2] = {{0, 0}, {0, 0}};
@@ -342,8 +352,8 @@ int reg_placement_holds(const struct reg_ctx *r)
 static int hue_between(struct reg_ctx *r, const struct reg_cell *hit, vec3 q, vec3 nq,
                        const double grid_xy[2], double min_cos, double reach_mm, double hue[2])
 {
-    size_t count = reg_cell_count(r);
-    uint32_t j = (uint32_t)((size_t)(hit - r->cells) / count);
+    uint32_t j;
+    cell_place(r, hit, &j, NULL, NULL);
     long x0 = (long)floor(grid_xy[0]), y0 = (long)floor(grid_xy[1]);
     double fx = grid_xy[0] - (double)x0, fy = grid_xy[1] - (double)y0, sum[2] = {0.0, 0.0};
     if (x0 < 0 || y0 < 0 || x0 + 1 >= (long)r->gw || y0 + 1 >= (long)r->gh)
