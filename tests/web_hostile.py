@@ -414,7 +414,26 @@ def profile_cases(port, key):
     check(st == 200 and "fast12" in profiles and st2 == 409 and
           json.loads(request(port, "GET", "/api/profiles/fast12")[2])["values"]["scan.views"]
           == "12", f"saved as a new profile it is listed; never over another ({st}, {st2})")
+    st, _, _ = request(port, "POST", "/api/profiles/fast", {**js, "Origin": "http://evil.example"},
+                       '{"values": {"scan.views": "7"}}')
+    st2, _, _ = request(port, "POST", "/api/profiles/fast", js,
+                        '{"values": ' + "[" * 1000 + "]" * 1000 + "}")
+    check(st == 403 and st2 == 400, f"a change from another site, or 1000 deep, is refused "
+          f"({st}, {st2})")
     open(path, "w").write(before)
+    os.rename(path, path + ".aside")
+    os.mkfifo(path)
+    try:
+        t0 = time.time()
+        st, _, _ = request(port, "GET", "/api/profiles/fast", timeout=10)
+        st2, _, _ = request(port, "POST", "/api/profiles/fast", js,
+                            '{"values": {"scan.views": "7"}}', timeout=10)
+        check(st == 500 and st2 == 500 and time.time() - t0 < 5,
+              f"a pipe put in the profile's place is refused at once, read or changed "
+              f"({st}, {st2})")
+    finally:
+        os.unlink(path)
+        os.rename(path + ".aside", path)
 
 
 def disk_cases():

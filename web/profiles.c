@@ -5,6 +5,7 @@
 #include "api.h"
 
 #include "config.h"
+#include "file_posix.h"
 
 #include <cJSON.h>
 #include <civetweb.h>
@@ -133,10 +134,11 @@ static int value_ok(const char *v)
     return 1;
 }
 
-/* @p path's text into @p text (cap bytes). @retval 0 @retval -errno */
+/* @p path's text into @p text (cap bytes): a regular file only (a pipe put in its place would
+ * hold the request's thread). @retval 0 @retval -errno */
 static int read_text(const char *path, char *text, size_t cap)
 {
-    FILE *f = fopen(path, "r");
+    FILE *f = file_open_regular(path, "r");
     if (f == NULL)
         return -errno;
     size_t n = fread(text, 1, cap - 1, f);
