@@ -294,9 +294,10 @@ static const struct ini_key config_keys[] = {
      "object_pose (degrees about x, then y, then z, then stood on the table)",
      NULL, NULL},
     ENUM("sim", "person", sim.person, "auto|asked", "auto",
-         "[scan] passes = 2: auto, the simulated person lays the object for the second pass at "
-         "once; asked, the scanner asks as on a real rig and waits for the answer (Enter, or "
-         "the page's Continue)"),
+         "how the simulated person meets the scanner's questions (the second pass of [scan] "
+         "passes = 2, each step of scanner calibrate): auto, does what is asked at once; asked, "
+         "does it, and the scanner waits for the answer as on a real rig (Enter, or the "
+         "page's Continue)"),
     {"sim", "object_pose", INI_VEC, C(sim.object_pose_deg), 3, -360, 360, 0, "0, 0, 0", NULL,
      "the object turned by these angles (degrees, about x, then y, then z) before it is stood on "
      "the table at its lowest point: 90, 0, 0 lays an upright object on its side (a second pass)",

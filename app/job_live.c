@@ -3,13 +3,13 @@
 #define _POSIX_C_SOURCE 200809L
 #include "job.h"
 
+#include "answer.h"
 #include "board.h"
 #include "clock_posix.h"
 #include "frame_writer.h"
 #include "thread_posix.h"
 
 #include <errno.h>
-#include <poll.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <string.h>
@@ -257,45 +257,6 @@ static int live_view(struct job *j, uint32_t v)
     return start_processing(j, v, started, t0, &info);
 }
 
-/* The person's answer on standard input: a line, empty (Enter) or "continue" (the page's
- * Continue, which scanner serve writes there). Polled, so that a stop (a signal) is seen while
- * it waits; a line of anything else is said and waited past.
- * @retval 0 @retval -EINTR stopped, or the input ended (Ctrl-D) */
-static int wait_for_answer(const struct job *j)
-{
-    char line[64];
-    size_t len = 0;
-    for (;;) {
-        if (hal_should_stop(j->hal))
-            return -EINTR;
-        struct pollfd pfd = {.fd = STDIN_FILENO, .events = POLLIN};
-        int ready = poll(&pfd, 1, 200);
-        if (ready < 0 && errno != EINTR)
-            return -EINTR;
-        if (ready <= 0)
-            continue;
-        char c;
-        ssize_t got = read(STDIN_FILENO, &c, 1);
-        if (got < 0 && (errno == EINTR || errno == EAGAIN))
-            continue;
-        if (got <= 0)
-            return -EINTR; /* the input ended: no one will answer */
-        if (c != '\n') {
-            if (len + 1 < sizeof(line))
-                line[len++] = c;
-            continue;
-        }
-        line[len] = '\0';
-        if (len == 0 || strcmp(line, "continue") == 0)
-            return 0;
-        j->hal->log(HAL_LOG_WARN,
-                    "answer '%s' not understood: Enter (or 'continue') when the "
-                    "object is laid",
-                    line);
-        len = 0;
-    }
-}
-
 /* The person lays the object for the second pass: asked, and the answer waited for, on a rig
  * (and on the simulator with [sim] person = asked); the simulated person otherwise does it at
  * once. @retval 0 @retval -EINTR the person stopped (Ctrl-D) @retval -errno */
@@ -318,7 +279,10 @@ static int ask_for_second_pass(struct job *j)
                detail);
         fflush(stdout);
     }
-    return wait_for_answer(j);
+    static const char *const answers[] = {"continue"};
+    unsigned which;
+    return answer_wait(j->hal, answers, 1, "Enter (or 'continue') when the object is laid", NULL,
+                       NULL, &which);
 }
 
 /* The storage thread that keeps the frames while the next are taken. */

@@ -131,6 +131,35 @@ extern "C" int calcv_board_image(const calcv_board *b, double px_per_mm, uint8_t
     return 0;
 }
 
+extern "C" int calcv_preview(const calcv_board *b, const uint8_t *rgb, int width, int height,
+                             const calcv_corners *corners, uint8_t **out, int *out_width,
+                             int *out_height)
+{
+    const double scale = width > 640 ? 640.0 / width : 1.0;
+    const int w = (int)(width * scale + 0.5), h = (int)(height * scale + 0.5);
+    uint8_t *pixels = (uint8_t *)malloc((size_t)w * h * 3);
+    if (pixels == NULL)
+        return -ENOMEM;
+    cv::Mat src(height, width, CV_8UC3, const_cast<uint8_t *>(rgb)), dst(h, w, CV_8UC3, pixels);
+    cv::resize(src, dst, dst.size(), 0, 0, cv::INTER_AREA);
+    if (corners != NULL && corners->count > 0) { // OpenCV's colours are BGR
+        cv::cvtColor(dst, dst, cv::COLOR_RGB2BGR);
+        const int nx = b->squares_x - 1, ny = b->squares_y - 1;
+        const bool whole = b->kind == CALCV_CHESSBOARD && corners->count == nx * ny;
+        std::vector<cv::Point2f> pts;
+        for (int i = 0; i < corners->count; i++) // centres at integers in both pictures
+            pts.emplace_back((float)((corners->image[i][0] + 0.5) * scale - 0.5),
+                             (float)((corners->image[i][1] + 0.5) * scale - 0.5));
+        cv::drawChessboardCorners(dst, whole ? cv::Size(nx, ny) : cv::Size(corners->count, 1), pts,
+                                  whole);
+        cv::cvtColor(dst, dst, cv::COLOR_BGR2RGB);
+    }
+    *out = pixels;
+    *out_width = w;
+    *out_height = h;
+    return 0;
+}
+
 extern "C" int calcv_find_corners(const calcv_board *b, const uint8_t *grey, int width, int height,
                                   int min_corners, calcv_corners *out, char *why, size_t why_len)
 {

@@ -58,6 +58,13 @@ int calcv_board_image(const struct calcv_board *b, double px_per_mm, uint8_t **g
 int calcv_find_corners(const struct calcv_board *b, const uint8_t *grey, int width, int height,
                        int min_corners, struct calcv_corners *out, char *why, size_t why_len);
 
+/** A picture for the page: @p rgb (@p width x @p height) shrunk to at most 640 pixels across,
+ *  with @p corners drawn (cv::drawChessboardCorners; connected when the whole board was found).
+ *  @param corners  NULL or none: the picture alone @param out  out: RGB the caller frees
+ *  @retval 0 @retval -ENOMEM */
+int calcv_preview(const struct calcv_board *b, const uint8_t *rgb, int width, int height,
+                  const struct calcv_corners *corners, uint8_t **out, int *out_width,
+                  int *out_height);
 /** Zhang's calibration over @p n views (calibrateCamera), k3 fixed at 0 when @p fix_k3.
  *  @param lens  out @param rvec, tvec  out: 3 per view, board sheet -> camera
  *  @param view_rms  out: reprojection RMS per view, px @param rms  out: over all corners

@@ -3,6 +3,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "calibrate.h"
 
+#include "answer.h"
 #include "board.h"
 #include "calib_cv.h"
 #include "calib_priv.h"
@@ -12,12 +13,14 @@
 #include "scan.h"
 #include "scan_dir.h"
 #include "scan_job.h"
+#include "job.h"
 
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 /* ---- the person's steps ---- */
 
@@ -27,12 +30,16 @@ struct capture {
     const struct scan_calib *guess;
     const char *dir;
     uint32_t view;
+    uint32_t kept; /* views on disk (a step taken again starts below it) */
     struct scan_params params;
     struct calcv_board board;
     uint8_t *sheet; /* the board as printed, for the simulated person */
     int sheet_w, sheet_h;
     int person;      /* 1: a person places the targets (a rig), and may take a view again */
     int board_found; /* the last board capture showed the board */
+    int json;        /* --json: events on stdout (docs/api.md), answers on stdin: the page */
+    int live;        /* a live picture while the person places the board (json only) */
+    double live_next_s;
 };
 
 static int save_frame(void *priv, uint32_t pattern, const uint8_t *pixels, uint32_t width,
@@ -48,48 +55,158 @@ static int save_frame(void *priv, uint32_t pattern, const uint8_t *pixels, uint3
     return rc;
 }
 
-/* Ask the person to put the target there; the simulator's person does it at once. */
-static int place(struct capture *c, const struct board_target *t, const char *what)
+/* Answers a person gives: the first is Enter's. */
+static const char *const answers_place[] = {"continue", "back"};
+static const char *const answers_retry[] = {"again", "skip", "s", "S"};
+
+static double now_s(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* The picture the page shows: @p rgb with @p corners (NULL: none) drawn, as DIR/live.png,
+ * replaced whole (a temporary file renamed). */
+static void write_picture(struct capture *c, const uint8_t *rgb, uint32_t width, uint32_t height,
+                          const struct calcv_corners *corners)
+{
+    uint8_t *pic = NULL;
+    int w, h;
+    char path[HAL_MAX_PATH + 16], tmp[HAL_MAX_PATH + 24];
+    snprintf(path, sizeof(path), "%s/live.png", c->dir);
+    snprintf(tmp, sizeof(tmp), "%s/live.tmp.png", c->dir);
+    if (calcv_preview(&c->board, rgb, (int)width, (int)height, corners, &pic, &w, &h) != 0)
+        return;
+    if (image_write_png(&c->hal->storage, tmp, pic, (uint32_t)w, (uint32_t)h, 3) == 0)
+        rename(tmp, path);
+    free(pic);
+}
+
+/* The outline of @p k's corners, in parts of the image's width and height: the four corners
+ * farthest along the diagonals (a whole board's own corners), for the page's coverage picture. */
+static void say_outline(const struct calcv_corners *k, uint32_t width, uint32_t height)
+{
+    static const double dir[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+    printf(",\"outline\":[");
+    for (int d = 0; d < 4; d++) {
+        int best = 0;
+        for (int i = 1; i < k->count; i++)
+            if (dir[d][0] * k->image[i][0] + dir[d][1] * k->image[i][1] >
+                dir[d][0] * k->image[best][0] + dir[d][1] * k->image[best][1])
+                best = i;
+        printf("%s%.4f,%.4f", d ? "," : "", k->image[best][0] / width, k->image[best][1] / height);
+    }
+    putchar(']');
+}
+
+/* While the person places the board (json only): a picture about once a second, its corners
+ * drawn as found, and whether the board is seen (or why not). */
+static void live_picture(void *ctx)
+{
+    struct capture *c = ctx;
+    if (!c->live || now_s() < c->live_next_s)
+        return;
+    const uint8_t *rgb;
+    int rc = scan_snapshot(scan_job_views(), c->hal, &c->params, c->guess, &rgb);
+    if (rc != 0) { /* said by the layer that met it; the steps go on without pictures */
+        c->live = 0;
+        return;
+    }
+    static struct calcv_corners corners;
+    static uint8_t grey[HAL_MAX_PIXELS];
+    char why[256] = "";
+    uint32_t w = c->guess->cam_width, h = c->guess->cam_height;
+    decode_rgb_to_grey(rgb, grey, (size_t)w * h, 256);
+    int found =
+        calcv_find_corners(&c->board, grey, (int)w, (int)h, (int)c->cfg->calibrate.min_corners,
+                           &corners, why, sizeof(why)) == 0;
+    write_picture(c, rgb, w, h, &corners);
+    printf("{\"event\":\"calib_live\",\"found\":%s,\"corners\":%d,\"why\":",
+           found ? "true" : "false", corners.count);
+    job_json_string(stdout, why);
+    if (corners.count > 0)
+        say_outline(&corners, w, h);
+    printf("}\n");
+    fflush(stdout);
+    c->live_next_s = now_s() + 1.0;
+}
+
+/* Ask the person to put the target there (step @p step of @p steps; @p kind "board", "sphere"
+ * or "compute"); the simulator's person does it at once, or (sim person = asked) does it and
+ * waits to be told to go on, as a person would. @param may_go_back  the person may take the step
+ * before again @retval 0 go on @retval 1 back to the step before @retval -EINTR stop */
+static int place(struct capture *c, const struct board_target *t, const char *what, uint32_t step,
+                 uint32_t steps, const char *kind, int may_go_back)
 {
     char err[256];
-    printf("\n>>> %s\n", what);
-    fflush(stdout);
-    int rc = board_place_target(c->hal, t, err, sizeof(err));
-    if (rc == 0) {
-        printf("    (the simulated person has done it)\n");
-        return 0;
+    int rc = t != NULL ? board_place_target(c->hal, t, err, sizeof(err)) : -ENOSYS;
+    int asked = rc == -ENOSYS || strcmp(c->cfg->sim.person, "asked") == 0;
+    if (c->json) {
+        printf("{\"event\":\"calib_place\",\"step\":%u,\"steps\":%u,\"kind\":\"%s\",\"detail\":",
+               (unsigned)step, (unsigned)steps, kind);
+        job_json_string(stdout, what);
+        printf(",\"answers\":[%s]}\n", !asked        ? ""
+                                       : may_go_back ? "\"continue\",\"back\""
+                                                     : "\"continue\"");
+    } else {
+        printf("\n>>> %s\n", what);
     }
-    if (rc != -ENOSYS) {
+    fflush(stdout);
+    if (rc != 0 && rc != -ENOSYS) {
         c->hal->log(HAL_LOG_ERROR, "%s", err);
         return rc;
     }
+    if (rc == 0 && !asked) {
+        if (!c->json)
+            printf("    (the simulated person has done it)\n");
+        return 0;
+    }
     c->person = 1;
-    printf("    Press Enter when it is done (Ctrl-D stops; the captures so far are kept).\n");
-    fflush(stdout);
-    char line[64];
-    if (fgets(line, sizeof(line), stdin) == NULL || c->hal->stop_requested())
-        return -EINTR;
-    return 0;
+    if (!c->json) {
+        printf("    Press Enter when it is done%s (Ctrl-D stops; the captures so far are kept).\n",
+               may_go_back ? ", or type back and Enter to take the step before again" : "");
+        fflush(stdout);
+    }
+    c->live = c->json && t != NULL && t->kind == BOARD_TARGET_BOARD;
+    c->live_next_s = 0.0;
+    unsigned which;
+    rc = answer_wait(c->hal, answers_place, may_go_back ? 2 : 1,
+                     may_go_back ? "Enter (or 'continue') when it is done, 'back' for the step "
+                                   "before"
+                                 : "Enter (or 'continue') when it is done",
+                     live_picture, c, &which);
+    c->live = 0;
+    return rc != 0 ? rc : (int)which;
 }
 
 /* After a capture whose board was not found, a person may put it right and take it again.
  * @retval 1 again @retval 0 go on @retval -EINTR stop */
-static int ask_again(struct capture *c)
+static int ask_again(struct capture *c, const char *why)
 {
     if (!c->person || c->board_found)
         return 0;
-    printf("    Put it right and press Enter to take this view again, or type s and Enter to "
-           "go on without it.\n");
+    if (c->json) {
+        printf("{\"event\":\"calib_retry\",\"view\":%u,\"detail\":", (unsigned)c->view);
+        job_json_string(stdout, why);
+        printf(",\"answers\":[\"again\",\"skip\"]}\n");
+    } else {
+        printf("    Put it right and press Enter to take this view again, or type s and Enter to "
+               "go on without it.\n");
+    }
     fflush(stdout);
-    char line[64];
-    if (fgets(line, sizeof(line), stdin) == NULL || c->hal->stop_requested())
-        return -EINTR;
-    return line[0] == 's' || line[0] == 'S' ? 0 : 1;
+    unsigned which;
+    int rc = answer_wait(c->hal, answers_retry, 4,
+                         "Enter (or 'again') to take it again, 's' "
+                         "(or 'skip') to go on without it",
+                         NULL, NULL, &which);
+    return rc != 0 ? rc : which == 0;
 }
 
 /* One capture: the table to @p angle_mdeg, the frames, target.ini and view.ini; then the board
- * looked for at once, so that the person hears now if it was not seen. */
-static int capture_one(struct capture *c, const struct calib_target_info *ti)
+ * looked for at once, so that the person hears now if it was not seen (@p why: why not). */
+static int capture_one(struct capture *c, const struct calib_target_info *ti, char *why,
+                       size_t why_len)
 {
     struct hal *hal = c->hal;
     int rc = hal_table_move_to(&hal->turntable, ti->angle_mdeg);
@@ -121,111 +238,158 @@ static int capture_one(struct capture *c, const struct calib_target_info *ti)
                  strerror(-rc));
         return rc;
     }
+    static struct calcv_corners corners;
+    corners.count = 0;
+    why[0] = '\0';
     if (ti->kind == CALIB_TARGET_BOARD) {
-        static struct calcv_corners corners;
         static uint8_t grey[HAL_MAX_PIXELS];
-        char why[256];
         decode_rgb_to_grey(view.white_rgb, grey, (size_t)view.width * view.height, 256);
         c->board_found =
             calcv_find_corners(&c->board, grey, (int)view.width, (int)view.height,
-                               (int)c->cfg->calibrate.min_corners, &corners, why, sizeof(why)) == 0;
-        if (c->board_found)
-            printf("    view_%03u at %7.2f deg: board found, %d corners\n", (unsigned)c->view,
-                   st.position_mdeg / 1000.0, corners.count);
-        else
-            printf("    view_%03u at %7.2f deg: board NOT found: %s\n", (unsigned)c->view,
-                   st.position_mdeg / 1000.0, why);
-    } else {
+                               (int)c->cfg->calibrate.min_corners, &corners, why, why_len) == 0;
+    }
+    if (c->json) {
+        write_picture(c, view.white_rgb, view.width, view.height, &corners);
+        printf("{\"event\":\"calib_capture\",\"view\":%u,\"placement\":%u,\"kind\":\"%s\","
+               "\"angle_deg\":%.3f,\"tilt_deg\":%.1f,\"found\":%s,\"corners\":%d,\"points\":%u,"
+               "\"why\":",
+               (unsigned)c->view, (unsigned)ti->placement,
+               ti->kind == CALIB_TARGET_BOARD ? "board" : "sphere", st.position_mdeg / 1000.0,
+               ti->tilt_deg, ti->kind == CALIB_TARGET_BOARD && c->board_found ? "true" : "false",
+               corners.count, (unsigned)info.valid_points);
+        job_json_string(stdout, why);
+        if (corners.count > 0)
+            say_outline(&corners, view.width, view.height);
+        printf("}\n");
+    } else if (ti->kind != CALIB_TARGET_BOARD) {
         printf("    view_%03u at %7.2f deg: sphere, %u points\n", (unsigned)c->view,
                st.position_mdeg / 1000.0, (unsigned)info.valid_points);
+    } else if (c->board_found) {
+        printf("    view_%03u at %7.2f deg: board found, %d corners\n", (unsigned)c->view,
+               st.position_mdeg / 1000.0, corners.count);
+    } else {
+        printf("    view_%03u at %7.2f deg: board NOT found: %s\n", (unsigned)c->view,
+               st.position_mdeg / 1000.0, why);
     }
     fflush(stdout);
     return 0;
 }
 
-static int board_steps(struct capture *c)
+/* Step @p p's instruction (a board placement, or the sphere after the last) and target. */
+static void step_target(const struct capture *c, uint32_t p, char *what, size_t len,
+                        struct board_target *t)
 {
     const struct calib_settings *s = &c->cfg->calibrate;
+    if (p >= s->placement_count) {
+        snprintf(what, len,
+                 "Take the board off. Put the matte white sphere (%.0f mm) on "
+                 "the table, %.0f mm from its centre towards the camera.",
+                 s->sphere_diameter_mm, s->sphere_offset_mm);
+        *t = (struct board_target){.kind = BOARD_TARGET_SPHERE,
+                                   .diameter_mm = s->sphere_diameter_mm,
+                                   .position_mm = {s->sphere_offset_mm, 0.0}};
+        return;
+    }
+    double tilt = s->tilt_deg[p], off = s->offset_mm[p];
+    char where[96];
+    if (off == 0.0)
+        snprintf(where, sizeof(where), "its centre on the table's centre");
+    else
+        snprintf(where, sizeof(where), "its centre %.0f mm to the %s of the table's centre",
+                 fabs(off), off > 0.0 ? "right (as the camera sees it)" : "left");
+    if (tilt >= 80.0)
+        snprintf(what, len,
+                 "Placement %u of %u: lay the board flat on the table, "
+                 "%s, its top edge away from the camera.",
+                 (unsigned)p + 1, (unsigned)s->placement_count, where);
+    else
+        snprintf(what, len,
+                 "Placement %u of %u: stand the board on the table "
+                 "facing the camera, %s, %s %.0f degrees.",
+                 (unsigned)p + 1, (unsigned)s->placement_count, where,
+                 tilt >= 0.0 ? "leaning back by" : "leaning forward by", fabs(tilt));
+    *t = (struct board_target){.kind = BOARD_TARGET_BOARD,
+                               .sheet = c->sheet,
+                               .sheet_width = (uint32_t)c->sheet_w,
+                               .sheet_height = (uint32_t)c->sheet_h,
+                               .sheet_px_per_mm = CALIB_SHEET_PX_PER_MM,
+                               .thickness_mm = s->board_thickness_mm,
+                               .tilt_deg = tilt,
+                               .position_mm = {0.0, off}};
+}
+
+/* The captures of step @p p: a board placement at each table angle (a view whose board was not
+ * seen may be taken again), or the sphere all round. */
+static int step_captures(struct capture *c, uint32_t p)
+{
+    const struct calib_settings *s = &c->cfg->calibrate;
+    int sphere = p >= s->placement_count, rc = 0;
+    uint32_t turns = sphere ? s->sphere_turns : s->turns;
+    for (uint32_t k = 0; k < turns && rc == 0; k++) {
+        struct calib_target_info ti = {.kind = sphere ? CALIB_TARGET_SPHERE : CALIB_TARGET_BOARD,
+                                       .placement = p};
+        if (sphere) {
+            ti.angle_mdeg = (int32_t)lround(360000.0 * k / turns);
+        } else {
+            ti.tilt_deg = s->tilt_deg[p];
+            ti.angle_mdeg =
+                (int32_t)lround(((double)k - 0.5 * (turns - 1.0)) * s->turn_step_deg * 1000.0);
+        }
+        int again = 1;
+        char why[256];
+        while (rc == 0 && again == 1) { /* the same view again, at the same index */
+            rc = capture_one(c, &ti, why, sizeof(why));
+            again = rc == 0 && !sphere ? ask_again(c, why) : 0;
+            rc = again < 0 ? again : rc;
+        }
+        c->view += rc == 0;
+        c->kept = c->view > c->kept ? c->view : c->kept;
+    }
+    return rc;
+}
+
+/* Every step: the board's placements, then the sphere (when there are lights to place), and, for
+ * a person, a last word before the computation. A person may go back a step (its captures are
+ * taken again, over the old ones). */
+static int run_steps(struct capture *c)
+{
+    const struct calib_settings *s = &c->cfg->calibrate;
+    uint32_t steps = s->placement_count + (s->sphere_turns > 0 && c->cfg->light_count > 0);
+    uint32_t first_view[CALIB_MAX_PLACEMENTS + 1];
+    uint32_t p = 0;
     int rc = 0;
-    for (uint32_t p = 0; p < s->placement_count && rc == 0; p++) {
-        double tilt = s->tilt_deg[p], off = s->offset_mm[p];
-        char what[320], where[96];
-        if (off == 0.0)
-            snprintf(where, sizeof(where), "its centre on the table's centre");
-        else
-            snprintf(where, sizeof(where), "its centre %.0f mm to the %s of the table's centre",
-                     fabs(off), off > 0.0 ? "right (as the camera sees it)" : "left");
-        if (tilt >= 80.0)
-            snprintf(what, sizeof(what),
-                     "Placement %u of %u: lay the board flat on the table, "
-                     "%s, its top edge away from the camera.",
-                     (unsigned)p + 1, (unsigned)s->placement_count, where);
-        else
-            snprintf(what, sizeof(what),
-                     "Placement %u of %u: stand the board on the table "
-                     "facing the camera, %s, %s %.0f degrees.",
-                     (unsigned)p + 1, (unsigned)s->placement_count, where,
-                     tilt >= 0.0 ? "leaning back by" : "leaning forward by", fabs(tilt));
-        struct board_target t = {.kind = BOARD_TARGET_BOARD,
-                                 .sheet = c->sheet,
-                                 .sheet_width = (uint32_t)c->sheet_w,
-                                 .sheet_height = (uint32_t)c->sheet_h,
-                                 .sheet_px_per_mm = CALIB_SHEET_PX_PER_MM,
-                                 .thickness_mm = s->board_thickness_mm,
-                                 .tilt_deg = tilt,
-                                 .position_mm = {0.0, off}};
-        /* the table turns to the first angle before the person places the board */
-        rc = hal_table_move_to(&c->hal->turntable, 0);
-        if (rc == 0)
-            rc = place(c, &t, what);
-        for (uint32_t k = 0; k < s->turns && rc == 0; k++) {
-            struct calib_target_info ti = {
-                .kind = CALIB_TARGET_BOARD,
-                .placement = p,
-                .tilt_deg = tilt,
-                .angle_mdeg = (int32_t)lround(((double)k - 0.5 * (s->turns - 1.0)) *
-                                              s->turn_step_deg * 1000.0)};
-            int again = 1;
-            while (rc == 0 && again == 1) /* the same view again, at the same index */
-                if ((rc = capture_one(c, &ti)) == 0 && (again = ask_again(c)) < 0)
-                    rc = again;
-            c->view += rc == 0;
+    while (rc == 0 && p <= steps) {
+        if (p == steps && !c->person)
+            break;
+        char what[320];
+        struct board_target t;
+        if (p == steps) {
+            rc = place(c, NULL, "Every capture is taken: go on to compute the calibration.", p,
+                       steps, "compute", 1);
+        } else {
+            first_view[p] = c->view;
+            step_target(c, p, what, sizeof(what), &t);
+            rc = hal_table_move_to(&c->hal->turntable, 0); /* before the target is placed */
+            if (rc == 0)
+                rc = place(c, &t, what, p, steps, p < s->placement_count ? "board" : "sphere",
+                           p > 0);
+        }
+        if (rc == 1) { /* back: the step before, from its first view */
+            c->view = first_view[--p];
+            rc = 0;
+        } else if (rc == 0 && p < steps) {
+            rc = step_captures(c, p++);
+        } else if (rc == 0) {
+            break;
         }
     }
     return rc;
 }
 
-static int sphere_steps(struct capture *c)
-{
-    const struct calib_settings *s = &c->cfg->calibrate;
-    if (s->sphere_turns == 0 || c->cfg->light_count == 0)
-        return 0;
-    char what[256];
-    snprintf(what, sizeof(what),
-             "Take the board off. Put the matte white sphere (%.0f mm) on "
-             "the table, %.0f mm from its centre towards the camera.",
-             s->sphere_diameter_mm, s->sphere_offset_mm);
-    struct board_target t = {.kind = BOARD_TARGET_SPHERE,
-                             .diameter_mm = s->sphere_diameter_mm,
-                             .position_mm = {s->sphere_offset_mm, 0.0}};
-    int rc = hal_table_move_to(&c->hal->turntable, 0);
-    if (rc == 0)
-        rc = place(c, &t, what);
-    for (uint32_t k = 0; k < s->sphere_turns && rc == 0; k++) {
-        struct calib_target_info ti = {.kind = CALIB_TARGET_SPHERE,
-                                       .placement = s->placement_count,
-                                       .angle_mdeg =
-                                           (int32_t)lround(360000.0 * k / s->sphere_turns)};
-        rc = capture_one(c, &ti);
-        c->view += rc == 0;
-    }
-    return rc;
-}
-
 int calibrate_capture(struct hal *hal, const struct app_config *cfg, const struct scan_calib *guess,
-                      const char *dir)
+                      const char *dir, int json)
 {
-    struct capture c = {.hal = hal, .cfg = cfg, .guess = guess, .dir = dir};
+    struct capture c = {.hal = hal, .cfg = cfg, .guess = guess, .dir = dir, .json = json};
     calib_capture_params(cfg, &c.params);
     char err[HAL_MAX_PATH + 256];
     int lock_fd = -1;
@@ -247,12 +411,22 @@ int calibrate_capture(struct hal *hal, const struct app_config *cfg, const struc
     if ((rc = calib_write_file(&hal->storage, dir, SCAN_FILE_CONFIG, cfg->path)) != 0 ||
         (rc = calib_write_guess(&hal->storage, dir, guess)) != 0)
         goto out_dir;
-    printf("Calibration: %u board placements x %u table angles, then %u sphere angles. Every "
-           "capture is kept in %s.\n",
-           (unsigned)cfg->calibrate.placement_count, (unsigned)cfg->calibrate.turns,
-           cfg->light_count > 0 ? (unsigned)cfg->calibrate.sphere_turns : 0u, dir);
-    if ((rc = hal_table_home(&hal->turntable)) == 0 && (rc = board_steps(&c)) == 0)
-        rc = sphere_steps(&c);
+    const unsigned spheres = cfg->light_count > 0 ? (unsigned)cfg->calibrate.sphere_turns : 0u;
+    if (json) {
+        printf("{\"event\":\"calib_start\",\"placements\":%u,\"turns\":%u,"
+               "\"sphere_turns\":%u,\"dir\":",
+               (unsigned)cfg->calibrate.placement_count, (unsigned)cfg->calibrate.turns, spheres);
+        job_json_string(stdout, dir);
+        printf("}\n");
+    } else {
+        printf("Calibration: %u board placements x %u table angles, then %u sphere angles. "
+               "Every capture is kept in %s.\n",
+               (unsigned)cfg->calibrate.placement_count, (unsigned)cfg->calibrate.turns, spheres,
+               dir);
+    }
+    fflush(stdout);
+    if ((rc = hal_table_home(&hal->turntable)) == 0)
+        rc = run_steps(&c);
     if (rc == 0)
         rc = hal_table_move_to(&hal->turntable, 0);
     if (rc != 0)
@@ -260,7 +434,7 @@ int calibrate_capture(struct hal *hal, const struct app_config *cfg, const struc
                  "calibration captures stopped (%s); the %u finished ones are "
                  "kept in %s: 'scanner calibrate --config %s --from %s --out FILE' computes from "
                  "them",
-                 rc == -EINTR ? "stopped by request" : strerror(-rc), (unsigned)c.view, dir,
+                 rc == -EINTR ? "stopped by request" : strerror(-rc), (unsigned)c.kept, dir,
                  cfg->path, dir);
 out_dir:
     scan_dir_close(lock_fd);
@@ -316,10 +490,11 @@ int calibrate_print_board(const struct hal_storage *st, const struct app_config 
 
 /* ---- verification: a sphere of known diameter ---- */
 
-int calibrate_verify(struct hal *hal, const struct app_config *cfg, const struct scan_calib *calib)
+int calibrate_verify(struct hal *hal, const struct app_config *cfg, const struct scan_calib *calib,
+                     int json)
 {
     const struct calib_settings *s = &cfg->calibrate;
-    struct capture c = {.hal = hal, .cfg = cfg, .guess = calib};
+    struct capture c = {.hal = hal, .cfg = cfg, .guess = calib, .json = json};
     struct board_target t = {.kind = BOARD_TARGET_SPHERE,
                              .diameter_mm = s->sphere_diameter_mm,
                              .position_mm = {s->sphere_offset_mm, 0.0}};
@@ -332,7 +507,7 @@ int calibrate_verify(struct hal *hal, const struct app_config *cfg, const struct
     params.colour.method = COLOUR_NONE;
     int rc = hal_table_home(&hal->turntable);
     if (rc == 0)
-        rc = place(&c, &t, what);
+        rc = place(&c, &t, what, 0, 1, "sphere", 0);
     struct scan_view view;
     struct scan_view_info info;
     if (rc == 0)
@@ -353,11 +528,21 @@ int calibrate_verify(struct hal *hal, const struct app_config *cfg, const struct
     }
     double cam_rms, proj_rms;
     calib_read_quality(cfg->calibration_file, &cam_rms, &proj_rms);
+    const double found_mm = 2.0 * radius, error_mm = found_mm - s->sphere_diameter_mm;
+    if (json) {
+        printf("{\"event\":\"calib_verify\",\"points\":%u,\"diameter_mm\":%.4f,"
+               "\"true_mm\":%.4f,\"error_mm\":%.4f,\"fit_rms_mm\":%.4f",
+               (unsigned)used, found_mm, s->sphere_diameter_mm, error_mm, rms);
+        if (cam_rms >= 0.0)
+            printf(",\"camera_rms_px\":%.4f,\"projector_rms_px\":%.4f", cam_rms, proj_rms);
+        printf("}\n");
+        fflush(stdout);
+        return 0;
+    }
     printf("sphere: %u points, centre (%.2f, %.2f, %.2f) mm\n", (unsigned)used, centre.x, centre.y,
            centre.z);
-    printf("diameter: %.3f mm measured, %.3f mm true: error %+.3f mm (%+.3f%%)\n", 2.0 * radius,
-           s->sphere_diameter_mm, 2.0 * radius - s->sphere_diameter_mm,
-           100.0 * (2.0 * radius - s->sphere_diameter_mm) / s->sphere_diameter_mm);
+    printf("diameter: %.3f mm measured, %.3f mm true: error %+.3f mm (%+.3f%%)\n", found_mm,
+           s->sphere_diameter_mm, error_mm, 100.0 * error_mm / s->sphere_diameter_mm);
     printf("sphere fit RMS: %.4f mm\n", rms);
     if (cam_rms >= 0.0)
         printf("reprojection RMS (from the calibration): camera %.4f px, projector %.4f px\n",

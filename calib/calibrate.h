@@ -28,9 +28,11 @@ void calibrate_guess(const struct app_config *cfg, struct scan_calib *guess);
 
 /** Capture every step into @p dir (new, or an unfinished calibration directory: the steps
  *  already there are kept), telling the person what to do; the simulator places the targets.
- *  @retval 0 @retval -EINTR stopped (captures kept) @retval -errno (said) */
+ *  @param json  1: the steps, captures and live pictures as events on stdout (docs/api.md), the
+ *  answers on stdin (scanner serve) @retval 0 @retval -EINTR stopped (captures kept)
+ *  @retval -errno (said) */
 int calibrate_capture(struct hal *hal, const struct app_config *cfg, const struct scan_calib *guess,
-                      const char *dir);
+                      const char *dir, int json);
 
 /** Compute the calibration from the captures in @p dir (and @p added, NULL for none: captures of
  *  placements added later, e.g. those a weak calibration asked for) and write @p out_path (an
@@ -49,8 +51,10 @@ int calibrate_import_opencv(const struct hal_storage *st, const struct app_confi
                             const char *src, const char *dst);
 
 /** Scan the sphere of [calibrate] sphere_diameter_mm once and print the diameter error and the
- *  sphere fit's RMS, with the calibration's reprojection RMS. @retval 0 @retval -errno */
-int calibrate_verify(struct hal *hal, const struct app_config *cfg, const struct scan_calib *calib);
+ *  sphere fit's RMS, with the calibration's reprojection RMS. @param json  1: as one event
+ *  (calib_verify) on stdout @retval 0 @retval -errno */
+int calibrate_verify(struct hal *hal, const struct app_config *cfg, const struct scan_calib *calib,
+                     int json);
 
 /** Write the board to print: PNG at 300 dpi and SVG at true size (@p base.png, @p base.svg).
  *  @retval 0 @retval -errno */

@@ -35,7 +35,7 @@ int main(int argc, char **argv)
             from = argv[++i];
         else if (strcmp(argv[i], "--add") == 0 && i + 1 < argc && what[0] == '\0')
             added = argv[++i];
-        else if (strcmp(argv[i], "--json") == 0 && what[0] == '\0')
+        else if (strcmp(argv[i], "--json") == 0 && what[0] != 'b' && what[0] != 'i')
             json = 1;
         else if (strcmp(argv[i], "--opencv") == 0 && i + 1 < argc && what[0] == 'i')
             opencv = argv[++i];
@@ -68,11 +68,6 @@ int main(int argc, char **argv)
         }
         return calibrate_import_opencv(&st, &cfg, opencv, out) == 0 ? 0 : 1;
     }
-    if (json && from == NULL) {
-        fprintf(stderr, "scanner: calibrate: --json goes with --from DIR (the captures' prompts "
-                        "are a person's to read)\n");
-        return 2;
-    }
     if (added != NULL && from == NULL) {
         fprintf(stderr, "scanner: calibrate: --add DIR2 goes with --from DIR (the captures of "
                         "the first calibration)\n");
@@ -100,10 +95,10 @@ int main(int argc, char **argv)
     }
     rc = rig_up(&cfg, &calib);
     if (rc == 0)
-        rc = what[0] == 'v' ? calibrate_verify(rig_hal(), &cfg, &calib)
-                            : calibrate_capture(rig_hal(), &cfg, &calib, dir);
+        rc = what[0] == 'v' ? calibrate_verify(rig_hal(), &cfg, &calib, json)
+                            : calibrate_capture(rig_hal(), &cfg, &calib, dir, json);
     rig_down();
     if (rc == 0 && what[0] != 'v')
-        rc = calibrate_solve(&st, &cfg, dir, NULL, out, 0);
+        rc = calibrate_solve(&st, &cfg, dir, NULL, out, json);
     return rc == 0 ? 0 : 1;
 }
