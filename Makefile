@@ -121,7 +121,7 @@ CALIB_TOOL := $(if $(HAVE_OPENCV),$(BUILD)/scanner-calibrate,)
 # (Debian's libcivetweb-dev and libcjson-dev, which make installs); a scan never loads them.
 # Not cross-built: the board runs the native build's (docs/web.md).
 HAVE_CIVETWEB := $(if $(CROSS_COMPILE),,$(shell test -f /usr/include/civetweb.h && $(PKG_CONFIG) --exists libcjson 2>/dev/null && echo 1))
-WEB_SRC := web/serve.c web/api.c web/jobs.c web/guard.c web/profiles.c
+WEB_SRC := web/serve.c web/api.c web/jobs.c web/guard.c web/profiles.c web/calibration.c
 WEB_TOOL := $(if $(HAVE_CIVETWEB),$(BUILD)/scanner-web,)
 BOARD_LIBS = $(if $(filter linux,$(HAL)),$(shell $(PKG_CONFIG) --libs libgpiod libdrm 2>/dev/null) $(LIBCAMERA_LIBS),)
 

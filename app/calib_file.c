@@ -236,3 +236,11 @@ void calib_print_doc(FILE *out)
 {
     ini_schema_print_doc(calib_keys, sizeof(calib_keys) / sizeof(calib_keys[0]), out);
 }
+
+void calib_path_beside(const char *cal_path, const char *suffix, char *buf, size_t len)
+{
+    size_t l = strlen(cal_path);
+    if (l > 4 && strcmp(cal_path + l - 4, ".ini") == 0)
+        l -= 4;
+    snprintf(buf, len, "%.*s%s", (int)l, cal_path, suffix);
+}

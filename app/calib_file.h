@@ -28,6 +28,10 @@ void calib_read_quality(const char *path, double *camera_rms_px, double *project
  *  @retval 1 flagged @retval 0 not (or no such file) */
 int calib_read_weak(const char *path, char *why, size_t why_len);
 
+/** A file named after the calibration file @p cal_path, its ".ini" replaced by @p suffix
+ *  ("CAL.ini" and "-captures": "CAL-captures"; ".report.txt": its report). */
+void calib_path_beside(const char *cal_path, const char *suffix, char *buf, size_t len);
+
 /** Markdown documentation of the calibration file's keys. */
 void calib_print_doc(FILE *out);
 

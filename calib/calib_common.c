@@ -151,11 +151,3 @@ double calib_fit_sphere(const float *xyz, const uint8_t *reason, size_t n, int f
     *radius = r;
     return rms;
 }
-
-void calibrate_path_beside(const char *cal_path, const char *suffix, char *buf, size_t len)
-{
-    size_t l = strlen(cal_path);
-    if (l > 4 && strcmp(cal_path + l - 4, ".ini") == 0)
-        l -= 4;
-    snprintf(buf, len, "%.*s%s", (int)l, cal_path, suffix);
-}

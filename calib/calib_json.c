@@ -82,6 +82,15 @@ void calib_json_write(FILE *out, const struct calib_result *r)
                 ",\"predicted\":{\"depth_centre_mm\":%.4g,\"depth_edge_mm\":%.4g,"
                 "\"length_100_mm\":%.4g}",
                 r->depth_centre_mm, r->depth_edge_mm, r->length_100_mm);
+    fputs(",\"views\":[", out);
+    for (uint32_t i = 0; i < r->residual_views; i++) {
+        fprintf(out, "%s{\"view\":%u,\"camera_rms_px\":%.4g", i ? "," : "",
+                (unsigned)r->residual_view[i], r->residual_camera_px[i]);
+        if (r->residual_projector_px[i] >= 0.0)
+            fprintf(out, ",\"projector_rms_px\":%.4g", r->residual_projector_px[i]);
+        fputc('}', out);
+    }
+    fputc(']', out);
     fprintf(out, ",\"weak\":%s", r->weak[0] ? "true" : "false");
     if (r->weak[0]) {
         fputs(",\"weak_values\":", out);

@@ -73,6 +73,10 @@ struct calib_result {
     double depth_centre_mm, depth_edge_mm, length_100_mm; /**< 0: not predicted */
     const char *weak, *advice;                            /**< "" when not weak */
     const char *add_placements; /**< the advice as [calibrate] placements (weak only) */
+    uint32_t residual_views;    /**< boards found, each with its reprojection RMS: */
+    uint32_t residual_view[CALIB_MAX_VIEWS];       /**< its view number in the captures */
+    double residual_camera_px[CALIB_MAX_VIEWS];    /**< the camera's */
+    double residual_projector_px[CALIB_MAX_VIEWS]; /**< the projector's; -1: not known */
 };
 
 /** Write @p r to @p out as one JSON object on one line (scanner calibrate --json). */

@@ -43,6 +43,7 @@ struct board_view {
     struct calcv_corners camp; /* the corners the projector's coordinates are known at */
     struct calcv_corners proj; /* those corners in projector pixels */
     double rvec[3], tvec[3], rms;
+    double joint_cam_rms, joint_proj_rms; /* px, through the joint lenses; -1: not known */
     int found, has_proj;
 };
 
@@ -333,6 +334,7 @@ static int load_folder(struct solve *s, uint32_t f)
         ti.placement += f * CALIB_PLACEMENTS_APART;
         struct board_view *bv = &s->views[s->view_count];
         memset(bv, 0, sizeof(*bv));
+        bv->joint_cam_rms = bv->joint_proj_rms = -1.0;
         bv->dir = dir;
         bv->view = v;
         bv->ti = ti;
@@ -937,6 +939,8 @@ static int solve_projector(struct solve *s)
         calcv_pose_through(rvec, tvec, s->out.proj_rot, s->out.proj_trans_mm, rvp, tp);
         double e = calcv_reprojection_rms(&bv->proj, &pl, rvp, tp);
         say(s, "view_%03u: camera %.3f px, projector %.3f px\n", (unsigned)bv->view, rms, e);
+        bv->joint_cam_rms = rms;
+        bv->joint_proj_rms = e;
         sum += e * e * bv->proj.count;
         count += bv->proj.count;
     }
@@ -1512,7 +1516,7 @@ static int write_outputs(struct solve *s, const struct hal_storage *st, const ch
     /* Written beside it first, and what calib_load accepts is the test of what was written:
      * only a file that loads replaces the one in use (which is then kept beside it). */
     char fresh[HAL_MAX_PATH + 16];
-    calibrate_path_beside(out_path, ".new.ini", fresh, sizeof(fresh));
+    calib_path_beside(out_path, ".new.ini", fresh, sizeof(fresh));
     int rc = calib_save(st, fresh, &s->out, comment);
     if (rc != 0) {
         fprintf(stderr, "scanner: error: cannot write %s: %s\n", fresh, strerror(-rc));
@@ -1536,7 +1540,7 @@ static int write_outputs(struct solve *s, const struct hal_storage *st, const ch
     }
     if (rc != 0)
         return rc;
-    calibrate_path_beside(out_path, ".report.txt", report_path, sizeof(report_path));
+    calib_path_beside(out_path, ".report.txt", report_path, sizeof(report_path));
     rc = hal_storage_write_file(st, report_path, s->report, s->report_len);
     if (rc != 0)
         fprintf(stderr, "scanner: error: cannot write %s: %s\n", report_path, strerror(-rc));
@@ -1587,8 +1591,9 @@ static int check_added(struct solve *s, const char *added)
 static void say_json(const struct solve *s, const char *out_path, int written)
 {
     char report_path[HAL_MAX_PATH + 16];
-    calibrate_path_beside(out_path, ".report.txt", report_path, sizeof(report_path));
-    struct calib_result r = {
+    calib_path_beside(out_path, ".report.txt", report_path, sizeof(report_path));
+    static struct calib_result r;
+    r = (struct calib_result){
         .file = written ? out_path : NULL,
         .report = report_path,
         .refusal = s->refusal[0] ? s->refusal : "see the messages on stderr",
@@ -1610,6 +1615,15 @@ static void say_json(const struct solve *s, const char *out_path, int written)
         .advice = s->advice,
         .add_placements = s->add_placements,
     };
+    for (uint32_t i = 0; i < s->view_count && r.residual_views < CALIB_MAX_VIEWS; i++) {
+        const struct board_view *bv = &s->views[i];
+        if (!bv->found)
+            continue;
+        r.residual_view[r.residual_views] = bv->view;
+        r.residual_camera_px[r.residual_views] =
+            bv->has_proj && bv->joint_cam_rms >= 0.0 ? bv->joint_cam_rms : bv->rms;
+        r.residual_projector_px[r.residual_views++] = bv->has_proj ? bv->joint_proj_rms : -1.0;
+    }
     calib_json_write(stdout, &r);
 }
 

@@ -18,10 +18,6 @@
  *  columns; every light's frame): the projector must store this sequence. */
 void calib_capture_params(const struct app_config *cfg, struct scan_params *p);
 
-/** A file named after the calibration file @p cal_path, its ".ini" replaced by @p suffix
- *  ("CAL.ini" and "-captures": "CAL-captures"). */
-void calibrate_path_beside(const char *cal_path, const char *suffix, char *buf, size_t len);
-
 /** A first guess of the rig for the captures when no calibration file exists: the camera's
  *  size from [camera], the projector's from [calibrate], nominal optics and pose. */
 void calibrate_guess(const struct app_config *cfg, struct scan_calib *guess);

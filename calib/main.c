@@ -90,7 +90,7 @@ int main(int argc, char **argv)
         calib_capture_params(&cfg, &cfg.scan);
     char dir_buf[HAL_MAX_PATH];
     if (dir == NULL && out != NULL) {
-        calibrate_path_beside(out, "-captures", dir_buf, sizeof(dir_buf));
+        calib_path_beside(out, "-captures", dir_buf, sizeof(dir_buf));
         dir = dir_buf;
     }
     rc = rig_up(&cfg, &calib);

@@ -110,7 +110,14 @@ int api_may_use_rig(const struct web_server *s, const struct mg_connection *conn
     return guard_has_key(s, conn) || bearer(s, conn);
 }
 
-static int refuse_without_key(struct mg_connection *conn);
+int api_send_body_error(struct mg_connection *conn, int status)
+{
+    return api_send_error(conn, status,
+                          status == 415   ? "send the request as application/json"
+                          : status == 413 ? "the request is too large"
+                                          : "the body is not one JSON object (nested at most 32 "
+                                            "deep, nothing after it)");
+}
 
 /* A POST's JSON body: application/json (which a page of another site cannot send here without
  * the browser asking first, so that no other site can start the rig from a visitor's browser)
@@ -159,7 +166,7 @@ static cJSON *job_json(struct web_server *s, const char *id)
     cJSON_AddStringToObject(o, "error", error);
     struct web_job *j = &s->job;
     pthread_mutex_lock(&j->lock);
-    if (strcmp(j->id, id) == 0 && j->state != WEB_IDLE) { /* the live details */
+    if (strcmp(j->id, id) == 0 && j->state != WEB_IDLE && j->kind == WEB_SCAN) { /* live */
         cJSON_AddStringToObject(o, "stage", j->stage);
         cJSON_AddNumberToObject(o, "stage_views_done", j->step_done);
         cJSON_AddStringToObject(o, "detail", j->detail);
@@ -224,7 +231,7 @@ static int list_scans(struct mg_connection *conn, struct web_server *s)
     return api_send_json(conn, 200, body);
 }
 
-static const struct web_profile *find_profile(const struct web_server *s, const cJSON *body)
+const struct web_profile *api_find_profile(const struct web_server *s, const cJSON *body)
 {
     const cJSON *name = cJSON_GetObjectItemCaseSensitive(body, "profile");
     if (name == NULL)
@@ -301,23 +308,18 @@ static int disk_holds(struct web_server *s, const struct web_profile *p, const c
 static int start_scan(struct mg_connection *conn, struct web_server *s, const char *resume_id)
 {
     if (!api_may_use_rig(s, conn))
-        return refuse_without_key(conn);
+        return api_refuse_without_key(conn);
     cJSON *body = NULL;
     int status = api_read_body(conn, &body);
     if (status != 0) {
         cJSON_Delete(body);
-        return api_send_error(conn, status,
-                              status == 415 ? "send the request as application/json"
-                              : status == 413
-                                  ? "the request is too large"
-                                  : "the body is not one JSON object (nested at most 32 "
-                                    "deep, nothing after it)");
+        return api_send_body_error(conn, status);
     }
     char why[WEB_PATH + 256] = "";
     int named = cJSON_GetObjectItemCaseSensitive(body, "profile") != NULL;
     const struct web_profile *p = resume_id != NULL && !named
                                       ? resume_profile(s, resume_id, why, sizeof(why))
-                                      : find_profile(s, body);
+                                      : api_find_profile(s, body);
     cJSON_Delete(body);
     if (p == NULL && why[0] != '\0')
         return api_send_error(conn, 409, why);
@@ -564,11 +566,13 @@ static int status(struct mg_connection *conn, struct web_server *s)
         cJSON_AddItemToArray(profiles, cJSON_CreateString(s->profile[i].name));
     cJSON_AddItemToObject(body, "profiles", profiles);
     pthread_mutex_lock(&j->lock);
-    int running = j->state == WEB_RUNNING, busy = j->rig_busy;
+    int running = j->state == WEB_RUNNING && j->kind == WEB_SCAN, busy = j->rig_busy;
+    int calibrating = j->state == WEB_RUNNING && j->kind != WEB_SCAN;
     char id[64];
     snprintf(id, sizeof(id), "%s", j->id);
     pthread_mutex_unlock(&j->lock);
     cJSON_AddBoolToObject(body, "scanning", running);
+    cJSON_AddBoolToObject(body, "calibrating", calibrating);
     cJSON_AddStringToObject(body, "current", running ? id : "");
     /* every scanner command leaves lights and projector off when it ends: while none runs,
      * they are off */
@@ -594,7 +598,7 @@ static int session(struct mg_connection *conn, struct web_server *s)
     return api_send_json(conn, 200, body);
 }
 
-static int refuse_without_key(struct mg_connection *conn)
+int api_refuse_without_key(struct mg_connection *conn)
 {
     return api_send_error(conn, 403,
                           "a request that uses the rig carries the session key "
@@ -693,11 +697,11 @@ static int scan_route(struct mg_connection *conn, struct web_server *s, const ch
                   strcmp(what, "label") == 0 ||
                   strcmp(what, "continue") == 0; /* what a page of another site must not do */
     if (changes && is_post && !api_may_use_rig(s, conn))
-        return refuse_without_key(conn);
+        return api_refuse_without_key(conn);
     if (strcmp(what, "delete") == 0 && is_post)
         return delete_scan(conn, s, id);
     if (strcmp(what, "continue") == 0 && is_post) {
-        int rc = jobs_answer(s, id);
+        int rc = jobs_answer(s, WEB_SCAN, id, "continue");
         return rc == 0        ? api_send_json(conn, 200, cJSON_CreateObject())
                : rc == -ESRCH ? api_send_error(conn, 409, "that scan is not running")
                : rc == -EBUSY ? api_send_error(conn, 409,
@@ -708,8 +712,9 @@ static int scan_route(struct mg_connection *conn, struct web_server *s, const ch
     if (strcmp(what, "label") == 0 && is_post)
         return set_label(conn, s, id);
     if (strcmp(what, "stop") == 0 && is_post)
-        return jobs_stop(s, id) == 0 ? api_send_json(conn, 200, cJSON_CreateObject())
-                                     : api_send_error(conn, 409, "that scan is not running");
+        return jobs_stop(s, WEB_SCAN, id) == 0
+                   ? api_send_json(conn, 200, cJSON_CreateObject())
+                   : api_send_error(conn, 409, "that scan is not running");
     if (strcmp(what, "resume") == 0 && is_post) {
         cJSON *o = job_json(s, id);
         int ok = o != NULL;
@@ -753,7 +758,7 @@ int api_handle(struct mg_connection *conn, void *cbdata)
     if (device && !is_post)
         return api_send_error(conn, 405, "POST: it uses the rig");
     if (device && !api_may_use_rig(s, conn))
-        return refuse_without_key(conn);
+        return api_refuse_without_key(conn);
     if (strcmp(path, "/api/selftest") == 0)
         return selftest(conn, s);
     if (strcmp(path, "/api/snapshot.png") == 0)
@@ -766,5 +771,7 @@ int api_handle(struct mg_connection *conn, void *cbdata)
         return scan_route(conn, s, method, path + 11);
     if (strncmp(path, "/api/profiles/", 14) == 0)
         return profiles_handle(conn, s, method, path + 14);
+    if (strcmp(path, "/api/calibration") == 0 || strncmp(path, "/api/calibration/", 17) == 0)
+        return calibration_handle(conn, s, method, path + 16);
     return api_send_error(conn, 404, "no such request (docs/api.md)");
 }

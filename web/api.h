@@ -27,6 +27,20 @@ int api_may_use_rig(const struct web_server *s, const struct mg_connection *conn
  *  @retval 0 @retval 400, 413 or 415 (@p body NULL or to be freed) */
 int api_read_body(struct mg_connection *conn, cJSON **body);
 
+/** Send 403: a request that uses the rig without the session key. @retval 403 */
+int api_refuse_without_key(struct mg_connection *conn);
+
+/** Send what is wrong with a body api_read_body refused with @p status. @retval status */
+int api_send_body_error(struct mg_connection *conn, int status);
+
+/** The profile a body names ("profile"; none: the first served). @retval NULL no such one */
+const struct web_profile *api_find_profile(const struct web_server *s, const cJSON *body);
+
+/** /api/calibration and below (calibration.c): the calibration wizard's requests; @p rest is
+ *  "" or "/answer" and the like. @retval the HTTP status sent */
+int calibration_handle(struct mg_connection *conn, struct web_server *s, const char *method,
+                       const char *rest);
+
 /** /api/profiles/NAME: GET its main settings, POST them changed (profiles.c).
  *  @retval the HTTP status sent */
 int profiles_handle(struct mg_connection *conn, struct web_server *s, const char *method,

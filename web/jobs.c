@@ -94,6 +94,42 @@ pid_t web_spawn(const char *const *args, int *fd_in, int *fd_out, int *fd_err)
     return pid;
 }
 
+/* The question @p ev asks (its "answers"; a second pass's place_object takes "continue"), kept
+ * as the only answers the page may send. @retval 1 it is a question */
+static int take_question(struct web_job *j, const cJSON *ev, const char *name)
+{
+    const cJSON *answers = cJSON_GetObjectItemCaseSensitive(ev, "answers"), *a;
+    j->answers = 0;
+    if (strcmp(name, EV_PLACE_OBJECT) == 0)
+        snprintf(j->answer[j->answers++], WEB_MAX_ANSWER, "continue");
+    if (!cJSON_IsArray(answers))
+        return j->answers > 0;
+    cJSON_ArrayForEach(a, answers)
+    {
+        if (j->answers < WEB_MAX_ANSWERS && cJSON_IsString(a) &&
+            strlen(a->valuestring) < WEB_MAX_ANSWER)
+            snprintf(j->answer[j->answers++], WEB_MAX_ANSWER, "%s", a->valuestring);
+    }
+    return j->answers > 0;
+}
+
+/* A calibration's event kept for the page: the live picture's, the result, or in the log. */
+static void keep_calibration_event(struct web_job *j, const char *name, const char *line)
+{
+    size_t len = strlen(line);
+    if (strcmp(name, "calib_live") == 0)
+        snprintf(j->calib_live, sizeof(j->calib_live), "%s",
+                 len < sizeof(j->calib_live) ? line : "");
+    else if (strcmp(name, "calibration") == 0 || strcmp(name, "calib_verify") == 0)
+        snprintf(j->calib_result, sizeof(j->calib_result), "%s", line);
+    else if (j->calib_log_len + len + 2 <= sizeof(j->calib_log)) { /* beyond: left out */
+        memcpy(j->calib_log + j->calib_log_len, line, len);
+        j->calib_log_len += len;
+        j->calib_log[j->calib_log_len++] = '\n';
+        j->calib_log[j->calib_log_len] = '\0';
+    }
+}
+
 /* One event line of `scanner --json` (docs/api.md lists them) into the job's state. */
 static void on_event(struct web_job *j, const char *line)
 {
@@ -108,14 +144,25 @@ static void on_event(struct web_job *j, const char *line)
     const cJSON *elapsed = cJSON_GetObjectItemCaseSensitive(ev, "elapsed_s");
     const cJSON *left = cJSON_GetObjectItemCaseSensitive(ev, "left_s");
     const cJSON *detail = cJSON_GetObjectItemCaseSensitive(ev, "detail");
+    const cJSON *written = cJSON_GetObjectItemCaseSensitive(ev, "written");
+    const char *e = event->valuestring;
     pthread_mutex_lock(&j->lock);
-    snprintf(j->stage, sizeof(j->stage), "%s", event->valuestring);
+    if (j->kind != WEB_SCAN)
+        keep_calibration_event(j, e, line);
+    if (strcmp(e, "calib_live") == 0) { /* a picture while the question waits: no new stage */
+        j->seq++;
+        pthread_cond_broadcast(&j->changed);
+        pthread_mutex_unlock(&j->lock);
+        cJSON_Delete(ev);
+        return;
+    }
+    snprintf(j->stage, sizeof(j->stage), "%s", e);
+    take_question(j, ev, e);
     j->answered = 0; /* a new event: a new question, if it is one */
     if (cJSON_IsNumber(views))
         j->views_total = (unsigned)views->valuedouble;
     /* Views taken count when one is saved (its files are there: the page asks for its
      * thumbnails), decoded again, or fused; the fusion counts from 0 again: they only grow. */
-    const char *e = event->valuestring;
     if (cJSON_IsNumber(done) &&
         (strcmp(e, EV_SAVED) == 0 || strcmp(e, EV_DECODED) == 0 || strcmp(e, EV_FUSED) == 0)) {
         j->step_done = (unsigned)done->valuedouble;
@@ -128,8 +175,8 @@ static void on_event(struct web_job *j, const char *line)
         j->left_s = left->valuedouble;
     if (cJSON_IsString(detail))
         snprintf(j->detail, sizeof(j->detail), "%s", detail->valuestring);
-    if (strcmp(event->valuestring, EV_SCAN_DONE) == 0 ||
-        strcmp(event->valuestring, EV_PROCESS_DONE) == 0)
+    if (strcmp(e, EV_SCAN_DONE) == 0 || strcmp(e, EV_PROCESS_DONE) == 0 ||
+        (strcmp(e, "calibration") == 0 && cJSON_IsTrue(written)) || strcmp(e, "calib_verify") == 0)
         j->done_seen = 1;
     j->seq++;
     pthread_cond_broadcast(&j->changed);
@@ -150,7 +197,7 @@ static void on_message(struct web_job *j, const char *line)
 }
 
 struct line_buf {
-    char text[8192];
+    char text[WEB_CALIB_RESULT]; /* the longest line: a calibration's result */
     size_t len;
 };
 
@@ -295,7 +342,7 @@ static void *reader_main(void *arg)
     snprintf(dir, sizeof(dir), "%s", j->dir);
     pthread_mutex_unlock(&j->lock);
     /* a scan that ended early still gets its report, of what it has */
-    if (!finished) {
+    if (!finished && j->kind == WEB_SCAN) {
         const char *args[] = {s->scanner, "report", dir, NULL};
         int ignored;
         run_to_end(args, NULL, 0, &ignored);
@@ -309,10 +356,80 @@ static void *reader_main(void *arg)
     if (j->state == WEB_FAILED)
         write_note(dir, FAILURE_FILE, j->error);
     j->rig_busy = 0;
+    j->answers = 0;
     j->seq++;
     pthread_cond_broadcast(&j->changed);
     pthread_mutex_unlock(&j->lock);
     return NULL;
+}
+
+/* The rig for a job: refused while another holds it; the last job's reader joined. */
+static int claim_rig(struct web_job *j)
+{
+    pthread_mutex_lock(&j->lock);
+    int busy = j->rig_busy;
+    j->rig_busy = 1;
+    pthread_mutex_unlock(&j->lock);
+    if (busy)
+        return -EBUSY;
+    if (j->have_reader) { /* the last job's reader has ended: it freed the rig */
+        pthread_join(j->reader, NULL);
+        j->have_reader = 0;
+    }
+    return 0;
+}
+
+static void release_rig(struct web_job *j)
+{
+    pthread_mutex_lock(&j->lock);
+    j->rig_busy = 0;
+    pthread_mutex_unlock(&j->lock);
+}
+
+/* Run @p args as the rig's job (claimed) of @p kind, @p id in folder @p dir, and the thread
+ * that reads its events. @retval 0 @retval -errno (@p err says what; the rig released) */
+static int run_job(struct web_server *s, enum web_kind kind, const char *const *args,
+                   const char *id, const char *dir, const char *profile, char *err, size_t err_len)
+{
+    struct web_job *j = &s->job;
+    pid_t pid = web_spawn(args, &j->fd_in, &j->fd_out, &j->fd_err);
+    if (pid < 0) {
+        snprintf(err, err_len, "cannot start the scanner in %s: %s", dir, strerror((int)-pid));
+        release_rig(j);
+        return (int)pid;
+    }
+    pthread_mutex_lock(&j->lock);
+    j->pid = pid;
+    j->kind = kind;
+    j->state = WEB_RUNNING;
+    j->stop_requested = j->done_seen = 0;
+    j->views_done = j->views_total = j->step_done = 0;
+    j->answers = 0;
+    j->elapsed_s = 0;
+    j->left_s = -1;
+    j->error[0] = j->detail[0] = '\0';
+    j->calib_log[0] = j->calib_live[0] = j->calib_result[0] = j->calib_choice[0] = '\0';
+    j->calib_log_len = 0;
+    snprintf(j->stage, sizeof(j->stage), "starting");
+    snprintf(j->id, sizeof(j->id), "%s", id);
+    snprintf(j->dir, sizeof(j->dir), "%s", dir);
+    snprintf(j->profile, sizeof(j->profile), "%s", profile);
+    j->seq++;
+    pthread_cond_broadcast(&j->changed);
+    pthread_mutex_unlock(&j->lock);
+    if (pthread_create(&j->reader, NULL, reader_main, s) == 0) {
+        j->have_reader = 1;
+        return 0;
+    }
+    /* nobody would read its events: ask it to stop (it ends on its own shutdown path) */
+    kill(pid, SIGTERM);
+    wait_for(pid);
+    pthread_mutex_lock(&j->lock);
+    j->state = WEB_FAILED;
+    j->rig_busy = 0;
+    pthread_mutex_unlock(&j->lock);
+    snprintf(err, err_len, "cannot start a thread for the job");
+    return -EAGAIN;
 }
 
 int jobs_start(struct web_server *s, const struct web_profile *p, const char *resume_id, char *id,
@@ -320,17 +437,9 @@ int jobs_start(struct web_server *s, const struct web_profile *p, const char *re
 {
     struct web_job *j = &s->job;
     char dir[WEB_PATH];
-    pthread_mutex_lock(&j->lock);
-    int busy = j->rig_busy;
-    j->rig_busy = 1;
-    pthread_mutex_unlock(&j->lock);
-    if (busy) {
-        snprintf(err, err_len, "the rig is busy (one scan at a time)");
+    if (claim_rig(j) != 0) {
+        snprintf(err, err_len, "the rig is busy (one scan, calibration or picture at a time)");
         return -EBUSY;
-    }
-    if (j->have_reader) { /* the last scan's reader has ended: it freed the rig */
-        pthread_join(j->reader, NULL);
-        j->have_reader = 0;
     }
     int rc = 0;
     dir[0] = '\0';
@@ -347,57 +456,60 @@ int jobs_start(struct web_server *s, const struct web_profile *p, const char *re
         if (rc == 0)
             snprintf(id, id_len, "%s", name);
     }
+    if (rc != 0) {
+        snprintf(err, err_len, "cannot start the scanner in %s: %s", dir, strerror(-rc));
+        release_rig(j);
+        return rc;
+    }
     const char *scan_args[] = {s->scanner, "scan", "--config", p->path,
                                "--out",    dir,    "--json",   NULL};
     const char *resume_args[] = {s->scanner, "resume", dir, "--config", p->path, "--json", NULL};
-    pid_t pid = -EINVAL;
-    if (rc == 0)
-        pid = web_spawn(resume_id != NULL ? resume_args : scan_args, &j->fd_in, &j->fd_out,
-                        &j->fd_err);
-    if (rc != 0 || pid < 0) {
-        rc = rc != 0 ? rc : (int)pid;
-        snprintf(err, err_len, "cannot start the scanner in %s: %s", dir, strerror(-rc));
-        pthread_mutex_lock(&j->lock);
-        j->rig_busy = 0;
-        pthread_mutex_unlock(&j->lock);
-        return rc;
-    }
-    pthread_mutex_lock(&j->lock);
-    j->pid = pid;
-    j->state = WEB_RUNNING;
-    j->stop_requested = j->done_seen = 0;
-    j->views_done = j->views_total = j->step_done = 0;
-    j->elapsed_s = 0;
-    j->left_s = -1;
-    j->error[0] = j->detail[0] = '\0';
-    snprintf(j->stage, sizeof(j->stage), "starting");
-    snprintf(j->id, sizeof(j->id), "%s", id);
-    snprintf(j->dir, sizeof(j->dir), "%s", dir);
-    snprintf(j->profile, sizeof(j->profile), "%s", p->name);
-    j->seq++;
-    pthread_cond_broadcast(&j->changed);
-    pthread_mutex_unlock(&j->lock);
-    if (pthread_create(&j->reader, NULL, reader_main, s) == 0) {
-        j->have_reader = 1;
-        return 0;
-    }
-    /* nobody would read its events: ask it to stop (it ends on its own shutdown path) */
-    kill(pid, SIGTERM);
-    wait_for(pid);
-    pthread_mutex_lock(&j->lock);
-    j->state = WEB_FAILED;
-    j->rig_busy = 0;
-    pthread_mutex_unlock(&j->lock);
-    snprintf(err, err_len, "cannot start a thread for the scan");
-    return -EAGAIN;
+    return run_job(s, WEB_SCAN, resume_id != NULL ? resume_args : scan_args, id, dir, p->name, err,
+                   err_len);
 }
 
-int jobs_stop(struct web_server *s, const char *id)
+int jobs_start_calibration(struct web_server *s, const struct web_profile *p, int verify,
+                           const char *calib_file, char *id, size_t id_len, char *err,
+                           size_t err_len)
+{
+    struct web_job *j = &s->job;
+    char dir[WEB_PATH], out[WEB_PATH + 32], captures[WEB_PATH + 32];
+    if (claim_rig(j) != 0) {
+        snprintf(err, err_len, "the rig is busy (one scan, calibration or picture at a time)");
+        return -EBUSY;
+    }
+    const char *name = "verify";
+    int rc = verify ? 0 : scan_dir_make_new(s->calibrations, dir, sizeof(dir), &name);
+    if (rc != 0) {
+        snprintf(err, err_len, "cannot make a folder in %s: %s", s->calibrations, strerror(-rc));
+        release_rig(j);
+        return rc;
+    }
+    if (verify)
+        dir[0] = '\0';
+    snprintf(id, id_len, "%s", name);
+    snprintf(out, sizeof(out), "%s/calibration.ini", dir);
+    snprintf(captures, sizeof(captures), "%s/captures", dir);
+    const char *calibrate_args[] = {s->scanner, "calibrate", "--config", p->path,  "--out",
+                                    out,        "--dir",     captures,   "--json", NULL};
+    const char *verify_args[] = {s->scanner, "calibrate", "verify", "--config",
+                                 p->path,    "--json",    NULL};
+    rc = run_job(s, verify ? WEB_VERIFY : WEB_CALIBRATION, verify ? verify_args : calibrate_args,
+                 id, dir, p->name, err, err_len);
+    if (rc == 0) {
+        pthread_mutex_lock(&j->lock);
+        snprintf(j->calib_file, sizeof(j->calib_file), "%s", calib_file);
+        pthread_mutex_unlock(&j->lock);
+    }
+    return rc;
+}
+
+int jobs_stop(struct web_server *s, enum web_kind kind, const char *id)
 {
     struct web_job *j = &s->job;
     int rc = -ESRCH;
     pthread_mutex_lock(&j->lock);
-    if (j->state == WEB_RUNNING && strcmp(j->id, id) == 0 && j->pid > 0) {
+    if (j->state == WEB_RUNNING && j->kind == kind && strcmp(j->id, id) == 0 && j->pid > 0) {
         j->stop_requested = 1;
         kill(j->pid, SIGTERM);
         rc = 0;
@@ -456,7 +568,7 @@ int jobs_describe(struct web_server *s, const char *id, enum web_state *state, u
     struct web_job *j = &s->job;
     error[0] = '\0';
     pthread_mutex_lock(&j->lock);
-    if (j->state != WEB_IDLE && strcmp(j->id, id) == 0) {
+    if (j->state != WEB_IDLE && j->kind == WEB_SCAN && strcmp(j->id, id) == 0) {
         *state = j->state;
         *views_done = j->views_done;
         *views_total = j->views_total;
@@ -518,13 +630,14 @@ int jobs_delete(struct web_server *s, const char *id)
     /* Under the lock: not the scan that runs (nor one a resume is starting), and out of every
      * list at once (a name beginning with '.' is no scan's) before the slow removal. */
     pthread_mutex_lock(&j->lock);
-    int running = (j->state == WEB_RUNNING || j->rig_busy) && strcmp(j->id, id) == 0;
+    int running =
+        (j->state == WEB_RUNNING || j->rig_busy) && j->kind == WEB_SCAN && strcmp(j->id, id) == 0;
     int rc = running ? -EBUSY : jobs_scan_dir(s, id, dir, sizeof(dir));
     if (rc == 0) {
         snprintf(gone, sizeof(gone), "%s/.deleting-%s", s->scans, id);
         rc = rename(dir, gone) == 0 ? 0 : -errno;
     }
-    if (rc == 0 && strcmp(j->id, id) == 0) { /* the last scan run: its state goes with it */
+    if (rc == 0 && j->kind == WEB_SCAN && strcmp(j->id, id) == 0) { /* its state goes too */
         j->state = WEB_IDLE;
         j->id[0] = '\0';
         j->seq++;
@@ -537,19 +650,23 @@ int jobs_delete(struct web_server *s, const char *id)
     return nftw(gone, remove_entry, 16, FTW_DEPTH | FTW_PHYS | FTW_MOUNT) == 0 ? 0 : -EIO;
 }
 
-int jobs_answer(struct web_server *s, const char *id)
+int jobs_answer(struct web_server *s, enum web_kind kind, const char *id, const char *answer)
 {
     struct web_job *j = &s->job;
-    static const char line[] = "continue\n";
+    char line[WEB_MAX_ANSWER + 1];
     pthread_mutex_lock(&j->lock);
-    int rc = j->state != WEB_RUNNING || strcmp(j->id, id) != 0                       ? -ESRCH
-             : strcmp(j->stage, EV_PLACE_OBJECT) != 0 || j->answered || j->fd_in < 0 ? -EBUSY
-                                                                                     : 0;
+    int rc = j->state != WEB_RUNNING || j->kind != kind || strcmp(j->id, id) != 0 ? -ESRCH
+             : j->answers == 0 || j->answered || j->fd_in < 0                     ? -EBUSY
+                                                                                  : -EINVAL;
+    for (unsigned k = 0; rc == -EINVAL && k < j->answers; k++)
+        if (strcmp(answer, j->answer[k]) == 0)
+            rc = 0;
     /* one short line into a pipe nobody else writes: whole, or the scanner has gone */
-    if (rc == 0 && write(j->fd_in, line, sizeof(line) - 1) != (ssize_t)(sizeof(line) - 1))
+    int len = snprintf(line, sizeof(line), "%s\n", answer);
+    if (rc == 0 && write(j->fd_in, line, (size_t)len) != len)
         rc = -EPIPE;
     if (rc == 0)
-        j->answered = 1; /* until its next event: a second click sends nothing */
+        j->answered = 1; /* until its next question: a second click sends nothing */
     pthread_mutex_unlock(&j->lock);
     return rc;
 }

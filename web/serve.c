@@ -24,7 +24,8 @@
 
 static const char usage_text[] =
     "usage: scanner serve --config FILE [--config FILE2 ...] [--listen ADDR:PORT]\n"
-    "                     [--token-file FILE] [--scans DIR] [--www DIR]\n"
+    "                     [--token-file FILE] [--scans DIR] [--calibrations DIR]\n"
+    "                     [--www DIR]\n"
     "  --config      a config the page can scan with (a profile: its file name without .ini);\n"
     "                the first is the default and the rig's selftest and snapshot use it\n"
     "  --listen      where to listen (default 127.0.0.1:8080; a comma-separated list\n"
@@ -34,6 +35,8 @@ static const char usage_text[] =
     "                there is no default)\n"
     "  --scans       where scan folders are made and listed (default: the first config's\n"
     "                [output] dir)\n"
+    "  --calibrations  where calibrations started from the page keep their captures and\n"
+    "                result (default: calibrations beside the scans' folder)\n"
     "  --www         the page's files (default " WEB_WWW_DIR ")\n";
 
 /* The secret: the file's first line, without its line end, whole (a longer one is refused, not
@@ -105,7 +108,7 @@ static int make_dirs(const char *path)
 
 /* Every config must load (file, line and key said now, not at the first scan). The first's
  * [output] dir holds the scans unless --scans says otherwise. */
-static int check_configs(struct web_server *s, const char *scans)
+static int check_configs(struct web_server *s, const char *scans, const char *calibrations)
 {
     struct app_config cfg;
     char err[1024], first_output[WEB_PATH] = "";
@@ -125,6 +128,16 @@ static int check_configs(struct web_server *s, const char *scans)
     }
     if (realpath(scans, s->scans) == NULL) {
         fprintf(stderr, "scanner serve: %s: %s\n", scans, strerror(errno));
+        return -1;
+    }
+    /* beside the scans, never among them: a calibration's captures are no scan */
+    char beside[WEB_PATH + 16];
+    if (calibrations == NULL) {
+        snprintf(beside, sizeof(beside), "%s/../calibrations", s->scans);
+        calibrations = beside;
+    }
+    if (make_dirs(calibrations) != 0 || realpath(calibrations, s->calibrations) == NULL) {
+        fprintf(stderr, "scanner serve: cannot make %s: %s\n", calibrations, strerror(errno));
         return -1;
     }
     return 0;
@@ -164,6 +177,7 @@ int main(int argc, char **argv)
                                           .changed = PTHREAD_COND_INITIALIZER,
                                           .fd_in = -1}};
     const char *listen = "127.0.0.1:8080", *token_file = NULL, *scans = NULL;
+    const char *calibrations = NULL;
     int www_given = 0;
     snprintf(s.www, sizeof(s.www), "%s", WEB_WWW_DIR);
     int first = argc > 1 && strcmp(argv[1], "serve") == 0 ? 2 : 1;
@@ -181,6 +195,8 @@ int main(int argc, char **argv)
             token_file = value;
         } else if (value != NULL && strcmp(argv[i], "--scans") == 0) {
             scans = value;
+        } else if (value != NULL && strcmp(argv[i], "--calibrations") == 0) {
+            calibrations = value;
         } else if (value != NULL && strcmp(argv[i], "--www") == 0) {
             snprintf(s.www, sizeof(s.www), "%s", value);
             www_given = 1;
@@ -212,7 +228,7 @@ int main(int argc, char **argv)
                 strerror(errno));
         return 1;
     }
-    if (check_configs(&s, scans) != 0 || find_scanner(&s, www_given) != 0)
+    if (check_configs(&s, scans, calibrations) != 0 || find_scanner(&s, www_given) != 0)
         return 2;
     char index[WEB_PATH + 16];
     snprintf(index, sizeof(index), "%s/index.html", s.www);

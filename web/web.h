@@ -24,12 +24,21 @@ struct web_profile {
 
 enum web_state { WEB_IDLE, WEB_RUNNING, WEB_FINISHED, WEB_FAILED, WEB_STOPPED };
 
+/* What the rig's job is: a scan (or resume), a calibration, or a verification of one. */
+enum web_kind { WEB_SCAN, WEB_CALIBRATION, WEB_VERIFY };
+
+#define WEB_MAX_ANSWERS 4      /* answers a question takes */
+#define WEB_MAX_ANSWER 16      /* bytes of one, with its NUL */
+#define WEB_CALIB_LOG 65536    /* bytes of a calibration's events kept for the page */
+#define WEB_CALIB_RESULT 16384 /* bytes of its result (the calibration event) */
+
 /* The scan (or resume) the rig runs now, or ran last: a child process, `scanner scan --json`,
  * whose event lines a thread of ours reads. Every field under @c lock. */
 struct web_job {
     pthread_mutex_t lock;
     pthread_cond_t changed; /* broadcast at every event (the progress streams wait on it) */
     enum web_state state;
+    enum web_kind kind;
     int rig_busy; /* a scan, a snapshot or a selftest holds the rig */
     pid_t pid;    /* the scanner while it runs */
     int stop_requested;
@@ -37,7 +46,9 @@ struct web_job {
     pthread_t reader;
     int fd_out, fd_err; /* the scanner's standard output (events) and error (messages) */
     int fd_in;          /* its standard input: the person's answer to its question, or -1 */
-    int answered;       /* the question (place_object) has its answer: none sent again */
+    int answered;       /* the question has its answer: none sent again */
+    unsigned answers;   /* the question's answers (none: it asks nothing now) */
+    char answer[WEB_MAX_ANSWERS][WEB_MAX_ANSWER];
     int done_seen;      /* it said scan_done or process_done */
     int stopping;       /* the server is shutting down: progress streams end */
     char id[64];        /* the scan folder's name */
@@ -50,12 +61,21 @@ struct web_job {
     double elapsed_s, left_s;
     char error[512];   /* the scanner's own error line, when it failed */
     unsigned long seq; /* events so far */
+    /* a calibration: its events (one JSON object a line, the live pictures' left out), the
+     * last live picture's event, its result, and what the person chose to do with it */
+    char calib_log[WEB_CALIB_LOG];
+    size_t calib_log_len;
+    char calib_live[1024];
+    char calib_result[WEB_CALIB_RESULT];
+    char calib_file[WEB_PATH]; /* the profile's calibration file, which a result may replace */
+    char calib_choice[16];     /* "", "used" or "kept" */
 };
 
 struct web_server {
-    char scanner[WEB_PATH]; /* the scanner program the scans run in */
-    char www[WEB_PATH];     /* the page */
-    char scans[WEB_PATH];   /* where scan folders are made and listed */
+    char scanner[WEB_PATH];      /* the scanner program the scans run in */
+    char www[WEB_PATH];          /* the page */
+    char scans[WEB_PATH];        /* where scan folders are made and listed */
+    char calibrations[WEB_PATH]; /* where calibrations from the page keep their captures */
     struct web_profile profile[WEB_MAX_PROFILES];
     unsigned profiles;
     char token[256];  /* "" on loopback: nothing to present */
@@ -72,9 +92,18 @@ struct web_server {
 int jobs_start(struct web_server *s, const struct web_profile *p, const char *resume_id, char *id,
                size_t id_len, char *err, size_t err_len);
 
-/** Ask the running scan @p id to stop (it stops between frames, rig safe, finished views kept).
- *  @retval 0 @retval -ESRCH not the running scan */
-int jobs_stop(struct web_server *s, const char *id);
+/** Start `scanner calibrate --json` with @p p, its captures and result in a new folder under
+ *  the calibrations' folder, or (@p verify) `scanner calibrate verify --json`.
+ *  @param calib_file  the profile's calibration file (which the result may replace)
+ *  @param id  out: the job's id (the folder's name, or "verify")
+ *  @retval 0 @retval -EBUSY the rig is in use @retval -errno (@p err says what) */
+int jobs_start_calibration(struct web_server *s, const struct web_profile *p, int verify,
+                           const char *calib_file, char *id, size_t id_len, char *err,
+                           size_t err_len);
+
+/** Ask the running job @p id of @p kind to stop (it stops between frames, rig safe, finished
+ *  views kept). @retval 0 @retval -ESRCH not the running job */
+int jobs_stop(struct web_server *s, enum web_kind kind, const char *id);
 
 /** Run `scanner ARGS...` to its end on the rig (a selftest, a snapshot) unless a scan holds it;
  *  its standard output into @p out (at most @p out_len - 1 bytes, NUL-terminated).
@@ -100,11 +129,12 @@ int jobs_scan_dir(const struct web_server *s, const char *id, char *dir, size_t 
 int jobs_describe(struct web_server *s, const char *id, enum web_state *state, unsigned *views_done,
                   unsigned *views_total, char *error, size_t error_len);
 
-/** The person's answer to the running scan @p id's question (the object laid for the second
- *  pass: stage place_object), written to its standard input, once.
- *  @retval 0 @retval -ESRCH not the running scan @retval -EBUSY it asks nothing now (or has
- *  its answer) @retval -EPIPE it has gone */
-int jobs_answer(struct web_server *s, const char *id);
+/** The person's @p answer to the question of the running job @p id of @p kind (the object laid
+ *  for a second pass, a calibration's step), written to its standard input, once; only an
+ *  answer the question named. @retval 0 @retval -ESRCH not the running job @retval -EBUSY it
+ *  asks nothing now (or has its answer) @retval -EINVAL not an answer it takes
+ *  @retval -EPIPE it has gone */
+int jobs_answer(struct web_server *s, enum web_kind kind, const char *id, const char *answer);
 
 /** Delete scan @p id: its folder leaves the list at once, then is removed (links inside it are
  *  removed, not followed). @retval 0 @retval -EBUSY it is the scan that runs @retval -ENOENT
