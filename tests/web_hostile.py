@@ -101,6 +101,9 @@ def write_configs():
     for name, views in [("fast", 4), ("long", 100)]:
         with open(os.path.join(OUT, f"{name}.ini"), "w") as f:
             f.write(base.format(views=views, out=OUT))
+    # asked: a calibration at the simulated rig whose person waits to be told to go on
+    with open(os.path.join(OUT, "asked.ini"), "w") as f:
+        f.write(base.format(views=4, out=OUT).replace("[sim]\n", "[sim]\nperson = asked\n"))
 
 
 def wait_state(port, sid, states, timeout=120, key=None):
@@ -436,6 +439,88 @@ def profile_cases(port, key):
         os.rename(path + ".aside", path)
 
 
+def wait_calibration(port, test, timeout=60):
+    until = time.time() + timeout
+    while time.time() < until:
+        c = json.loads(request(port, "GET", "/api/calibration")[2])
+        if test(c):
+            return c
+        time.sleep(0.2)
+    return None
+
+
+def calibration_cases(port, key, scans):
+    """The calibration wizard's requests (issue 32): one job on the rig at a time, the answer
+    channel taking only what the question names, once, from this page with its key; bounded
+    bodies; Use only for a finished calibration; a stop keeps the captures."""
+    js = {"Content-Type": "application/json", "X-Scanner-Key": key}
+    st, _, body = request(port, "GET", "/api/calibration")
+    c = json.loads(body)
+    check(st == 200 and c["state"] == "idle" and c["in_use"]["file"].endswith("calib.ini"),
+          f"before any calibration: idle, and the file in use named ({st})", body)
+    st, _, _ = request(port, "POST", "/api/calibration", {"Content-Type": "application/json"},
+                       '{"profile": "asked"}')
+    st2, _, _ = request(port, "POST", "/api/calibration", {**js, "Origin": "http://evil.example"},
+                        '{"profile": "asked"}')
+    st3, _, _ = request(port, "GET", "/api/calibration/answer")
+    st4, _, _ = request(port, "POST", "/api/calibration/nothing", js, "{}")
+    st5, _, _ = request(port, "POST", "/api/calibration", js, '{"profile": "../../etc/passwd"}')
+    check((st, st2, st3, st4, st5) == (403, 403, 405, 404, 400),
+          f"a calibration without the key or from another site is not started; GET on a POST, "
+          f"no such request, no such profile ({st}, {st2}, {st3}, {st4}, {st5})")
+    before = sorted(os.listdir(scans))
+    st, _, body = request(port, "POST", "/api/calibration", js, '{"profile": "asked"}')
+    cid = json.loads(body).get("id", "") if st == 200 else ""
+    c = wait_calibration(port, lambda c: c.get("question") is not None)
+    check(st == 200 and c is not None and c["question"]["answers"] == ["continue"]
+          and c["events"][0]["event"] == "calib_start" and sorted(os.listdir(scans)) == before
+          and os.path.isdir(os.path.join(OUT, "calibrations", cid)),
+          f"a calibration starts and asks its first step; its folder is not among the scans ({st})",
+          body)
+    busy = [request(port, "POST", p, js, b)[0] for p, b in [
+        ("/api/calibration", '{"profile": "asked"}'), ("/api/calibration/verify", "{}"),
+        ("/api/scans", "{}"), ("/api/snapshot.png", None), ("/api/calibration/use", "{}"),
+        (f"/api/scans/{cid}/continue", "{}"), (f"/api/scans/{cid}/stop", "{}")]]
+    check(busy == [409] * 7, f"while it runs: no second calibration, check, scan or picture; "
+          f"no Use; the scan requests do not reach it ({busy})")
+    bad = ['{"answer": 5}', '{"answer": "' + "c" * 100 + '"}', "{}", '{"answer": "back"}',
+           '{"answer": "continue\\nback"}', '{"answer": ""}', "[" * 1000 + "]" * 1000, "not json",
+           '{"answer": "continue"} junk']
+    sts = [request(port, "POST", "/api/calibration/answer", js, b)[0] for b in bad]
+    big = request(port, "POST", "/api/calibration/answer", js, " " * 5000)[0]
+    plain = request(port, "POST", "/api/calibration/answer", {"X-Scanner-Key": key},
+                    '{"answer": "continue"}')[0]
+    foreign = request(port, "POST", "/api/calibration/answer",
+                      {**js, "Sec-Fetch-Site": "cross-site"}, '{"answer": "continue"}')[0]
+    c = json.loads(request(port, "GET", "/api/calibration")[2])
+    check(sts == [400] * len(bad) and big == 413 and plain == 415 and foreign == 403
+          and c["question"] is not None and c["stage"] == "calib_place",
+          f"answers it does not take (a number, 100 bytes, none, 'back' at the first step, two "
+          f"lines, empty, 1000 deep, not JSON, junk after), 5000 bytes, not JSON's type, another "
+          f"site: refused, the question still waiting ({sts}, {big}, {plain}, {foreign})")
+    wait_calibration(port, lambda c: c.get("pictures", 0) > 0)
+    st, h, png = request(port, "GET", "/api/calibration/live.png")
+    check(st == 200 and png[:8] == b"\x89PNG\r\n\x1a\n" and h.get("cache-control") == "no-store",
+          f"the live picture is served ({st}, {len(png)} bytes)")
+    st, _, _ = request(port, "POST", "/api/calibration/answer", js, '{"answer": "continue"}')
+    st2, _, _ = request(port, "POST", "/api/calibration/answer", js, '{"answer": "continue"}')
+    check(st == 200 and st2 == 409, f"the answer is taken once; a second is refused ({st}, {st2})")
+    c = wait_calibration(port, lambda c: any(e["event"] == "calib_capture" for e in c["events"]))
+    st, _, _ = request(port, "POST", "/api/calibration/stop", js, "{}")
+    c2 = wait_calibration(port, lambda c: c["state"] != "running")
+    captures = os.path.join(OUT, "calibrations", cid, "captures")
+    check(c is not None and st == 200 and c2 is not None and c2["state"] == "stopped"
+          and os.path.isfile(os.path.join(captures, "view_000", "view.ini"))
+          and not json.loads(request(port, "GET", "/api/status")[2])["calibrating"],
+          f"a stop ends it with its captures kept and the rig free ({st}, {c2 and c2['state']})")
+    st, _, _ = request(port, "POST", "/api/calibration/use", js, "{}")
+    st2, _, _ = request(port, "GET", "/api/calibration?profile=" + "x" * 5000)
+    st3, _, _ = request(port, "POST", "/api/calibration/answer", js, '{"answer": "continue"}')
+    check(st == 409 and st2 in (200, 414, 431) and st3 == 409,
+          f"a stopped calibration cannot be used or answered; a long query is harmless ({st}, "
+          f"{st2}, {st3})")
+
+
 def disk_cases():
     """A scan the disk cannot hold is refused before it starts (a 4 MB file system): 507, how
     much is free and about how much it needs."""
@@ -521,7 +606,8 @@ def main():
     scans = os.path.join(OUT, "scans")
     port = free_port()
     args = ["--config", os.path.join(OUT, "fast.ini"), "--config", os.path.join(OUT, "long.ini"),
-            "--listen", f"127.0.0.1:{port}", "--scans", scans]
+            "--config", os.path.join(OUT, "asked.ini"), "--listen", f"127.0.0.1:{port}",
+            "--scans", scans]
     srv = Server(args)
     sid = error = None
     try:
@@ -531,6 +617,7 @@ def main():
         path_cases(port, key, scans, sid)
         manage_cases(port, key, scans)
         profile_cases(port, key)
+        calibration_cases(port, key, scans)
     finally:
         check(srv.stop() == 0, "the server ends cleanly")
     srv = Server(args)

@@ -112,7 +112,7 @@ struct snapshot {
     enum web_kind kind;
     enum web_state state;
     int asking;
-    unsigned answers;
+    unsigned answers, pictures;
     char answer[WEB_MAX_ANSWERS][WEB_MAX_ANSWER];
     char id[64], profile[64], stage[32], detail[512], error[512], choice[16];
     char dir[WEB_PATH], file[WEB_PATH];
@@ -130,6 +130,7 @@ static int take_snapshot(struct web_server *s, struct snapshot *out)
         out->state = j->state;
         out->asking = j->state == WEB_RUNNING && j->answers > 0 && !j->answered;
         out->answers = j->answers;
+        out->pictures = j->calib_pictures;
         memcpy(out->answer, j->answer, sizeof(out->answer));
         snprintf(out->id, sizeof(out->id), "%s", j->id);
         snprintf(out->profile, sizeof(out->profile), "%s", j->profile);
@@ -170,6 +171,7 @@ static int get_state(struct mg_connection *conn, struct web_server *s)
         cJSON_AddStringToObject(o, "stage", sn->stage);
         cJSON_AddStringToObject(o, "error", sn->error);
         cJSON_AddStringToObject(o, "choice", sn->choice);
+        cJSON_AddNumberToObject(o, "pictures", sn->pictures);
         cJSON *q = cJSON_CreateObject(), *answers = cJSON_CreateArray();
         for (unsigned k = 0; sn->asking && k < sn->answers; k++)
             cJSON_AddItemToArray(answers, cJSON_CreateString(sn->answer[k]));

@@ -117,6 +117,8 @@ static int take_question(struct web_job *j, const cJSON *ev, const char *name)
 static void keep_calibration_event(struct web_job *j, const char *name, const char *line)
 {
     size_t len = strlen(line);
+    if (strcmp(name, "calib_live") == 0 || strcmp(name, "calib_capture") == 0)
+        j->calib_pictures++;
     if (strcmp(name, "calib_live") == 0)
         snprintf(j->calib_live, sizeof(j->calib_live), "%s",
                  len < sizeof(j->calib_live) ? line : "");
@@ -410,6 +412,7 @@ static int run_job(struct web_server *s, enum web_kind kind, const char *const *
     j->error[0] = j->detail[0] = '\0';
     j->calib_log[0] = j->calib_live[0] = j->calib_result[0] = j->calib_choice[0] = '\0';
     j->calib_log_len = 0;
+    j->calib_pictures = 0;
     snprintf(j->stage, sizeof(j->stage), "starting");
     snprintf(j->id, sizeof(j->id), "%s", id);
     snprintf(j->dir, sizeof(j->dir), "%s", dir);

@@ -66,6 +66,7 @@ struct web_job {
     char calib_log[WEB_CALIB_LOG];
     size_t calib_log_len;
     char calib_live[1024];
+    unsigned calib_pictures; /* pictures taken (live.png written) so far */
     char calib_result[WEB_CALIB_RESULT];
     char calib_file[WEB_PATH]; /* the profile's calibration file, which a result may replace */
     char calib_choice[16];     /* "", "used" or "kept" */

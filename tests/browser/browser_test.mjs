@@ -275,6 +275,82 @@ async function twoPassTest(browser) {
   check((await stopServer(s)) === 0, 'the two-pass server shuts down cleanly');
 }
 
+// ---- the calibration wizard: scanner calibrate driven from the page, its result put in use ----
+async function calibrationTest(browser) {
+  // tests/calibrate.ini's short procedure on the simulated demo rig, the simulated person waiting
+  // to be told to go on; the profile's calibration file starts as the nominal one
+  const root = path.resolve('.');
+  const calFile = path.join(out, 'wizard-cal.ini');
+  fs.copyFileSync('config/sim-calib.ini', calFile);
+  const cfg = fs.readFileSync('tests/calibrate.ini', 'utf8')
+    .replace(/^calibration = .*$/m, `calibration = ${calFile}`)
+    .replace(/^rig = \.\.\//m, `rig = ${root}/`)
+    .replace(/^\[sim\]$/m, '[sim]\nperson = asked');
+  fs.writeFileSync(path.join(out, 'wizard.ini'), cfg);
+  const s = await serve(['--config', path.join(out, 'wizard.ini'), '--listen', `127.0.0.1:${port + 3}`,
+    '--scans', path.join(out, 'wizard-scans')]);
+  const page = await browser.newPage({ viewport: { width: 1400, height: 1100 } });
+  page.on('pageerror', (e) => check(false, `no error in the page's JavaScript (${e.message})`));
+  await page.goto(s.url);
+  await page.waitForSelector('#main:not([hidden])');
+  await page.waitForFunction(() => /In use: .*wizard-cal\.ini/.test(document.getElementById('calib-in-use').textContent));
+  check(true, 'the calibration panel names the file in use');
+  const early = await raw(s.url, 'POST', '/api/calibration/use', await keyed(s.url), '{}');
+  check(early.status === 409, `Use with no calibration finished is refused (${early.status})`);
+  await page.click('#calib-start');
+  await page.waitForSelector('#calib-ask:not([hidden])', { timeout: 60000 });
+  await page.waitForFunction(() => { const i = document.getElementById('calib-live'); return !i.hidden && i.naturalWidth === 640; },
+    null, { timeout: 30000 });
+  await page.waitForFunction(() => /sees the board: 48 corners/.test(document.getElementById('calib-seen').textContent), null, { timeout: 30000 });
+  check(/Step 1 of 4: .*Placement 1 of 3/.test(await page.textContent('#calib-ask')),
+    'the first step says where to put the board; the live picture shows it with its 48 corners found');
+  await page.locator('#calib-panel').screenshot({ path: path.join(out, 'page-calibration.png') });
+  // hostile answers: another site, no key, an answer the question does not take, a scan meanwhile
+  const foreign = await raw(s.url, 'POST', '/api/calibration/answer',
+    { ...(await keyed(s.url)), Origin: 'http://evil.example' }, '{"answer":"continue"}');
+  check(foreign.status === 403, `an answer from another site is refused (${foreign.status})`);
+  const noKey = await raw(s.url, 'POST', '/api/calibration/answer', json, '{"answer":"continue"}');
+  check(noKey.status === 403, `an answer without the session key is refused (${noKey.status})`);
+  const wrong = await raw(s.url, 'POST', '/api/calibration/answer', await keyed(s.url), '{"answer":"back"}');
+  check(wrong.status === 400, `an answer the question does not take ("back" at the first step) is refused (${wrong.status})`);
+  const scan = await raw(s.url, 'POST', '/api/scans', await keyed(s.url), '{}');
+  check(scan.status === 409, `a scan while the rig calibrates is refused (${scan.status})`);
+  const clickAnswer = async (label) => {
+    await page.waitForSelector(`#calib-answers button:text-is("${label}"):not([disabled])`, { timeout: 120000 });
+    await page.click(`#calib-answers button:text-is("${label}")`);
+  };
+  await clickAnswer('Continue');
+  await page.waitForFunction(() => /Step 2 of 4/.test(document.getElementById('calib-step').textContent), null, { timeout: 120000 });
+  await clickAnswer('Take the step before again'); // placement 1 again, over its own views
+  await page.waitForFunction(() => /Step 1 of 4/.test(document.getElementById('calib-step').textContent), null, { timeout: 120000 });
+  for (let k = 0; k < 5; k++) await clickAnswer('Continue'); // steps 1-4, then compute
+  await page.waitForSelector('#calib-choose:not([hidden])', { timeout: 180000 });
+  const rows = await page.locator('#calib-captures tbody tr').count();
+  check(rows === 8, `the captures listed once each, the step taken again included (${rows} of 8)`);
+  const r = JSON.parse((await raw(s.url, 'GET', '/api/calibration')).body).result;
+  check(r.written && Math.abs(r.camera.fx_px - 2436) < 12 && Math.abs(r.pose.translation_mm[0] + 250.59) < 2 &&
+    r.views.length === 6, `the result is the demo rig's (camera fx ${r.camera.fx_px.toFixed(1)} px, baseline x ${r.pose.translation_mm[0].toFixed(2)} mm, 6 boards)`);
+  await page.locator('#calib-panel').screenshot({ path: path.join(out, 'page-calibration-result.png') });
+  await page.click('#calib-use');
+  await page.waitForFunction(() => /In use now/.test(document.getElementById('calib-choice').textContent));
+  const kept = fs.readdirSync(out).filter((f) => /^wizard-cal\.ini\.\d{8}T\d{6}Z$/.test(f));
+  const check_config = execFileSync(scanner, ['check-config', '--config', path.join(out, 'wizard.ini')]).toString();
+  check(kept.length === 1 && /ok/.test(check_config) && /camera_rms_px/.test(fs.readFileSync(calFile, 'utf8')),
+    `Use puts it in the profile's file, which check-config accepts; the old file kept beside it (${kept})`);
+  const again = await raw(s.url, 'POST', '/api/calibration/use', await keyed(s.url), '{}');
+  check(again.status === 409, `a second Use is refused (${again.status})`);
+  // a scan with it from the page: the sphere where the truth is (the nominal file: 6.7 mm off)
+  await page.click('#start');
+  await page.waitForFunction(() => /1 of 1 views · finished/.test(document.getElementById('progress').textContent), null, { timeout: 120000 });
+  const id = fs.readdirSync(path.join(out, 'wizard-scans')).find((f) => /^\d{4}-/.test(f));
+  const dir = path.join(out, 'wizard-scans', id);
+  const cmp = execFileSync(path.resolve(build, 'mesh-compare'), [path.join(dir, 'mesh.ply'), path.join(dir, 'truth_mesh.ply')]).toString();
+  const mean = Number((/result -> truth: mean ([0-9.]+) mm/.exec(cmp) || [])[1]);
+  check(mean < 0.1, `a scan with the page's calibration is as good as with the CLI's: ${mean} mm from the truth (the CLI's 0.046 mm)`);
+  await page.close();
+  check((await stopServer(s)) === 0, 'the calibration server shuts down cleanly');
+}
+
 // ---- the page on a phone: one column, nothing wider than the screen, a finger turns the model ----
 async function phoneTests(browser, url, id) {
   const ctx = await browser.newContext({ viewport: { width: 375, height: 740 }, hasTouch: true, isMobile: true, deviceScaleFactor: 2 });
@@ -413,6 +489,7 @@ const browser = await chromium.launch({
 try {
   await pageTest(browser);
   await twoPassTest(browser);
+  await calibrationTest(browser);
   await tokenTests();
 } catch (e) {
   check(false, `the test ran to its end (${e.stack})`);

@@ -1,6 +1,7 @@
 // The scanner's page: rig status, start/stop/resume, live progress (Server-Sent Events), each
 // view's thumbnails as it is taken, the model in a 3D viewer, downloads, the past scans.
 import { Viewer } from './viewer.js';
+import { setupCalibration } from './calibration.js';
 
 const $ = (id) => document.getElementById(id);
 const api = (path) => 'api/' + path;
@@ -12,6 +13,7 @@ let shown = null;       // the scan whose views and model the page shows
 let thumbsShown = 0;
 let events = null;      // the EventSource following a running scan
 
+let calibration = null; // the calibration panel (calibration.js)
 let session = null; // {key, header}: what a request that uses the rig carries (docs/api.md)
 
 // The session key, fetched once: only a page of this server can read it.
@@ -260,8 +262,8 @@ $('live').addEventListener('change', async () => {
 async function refresh() {
   const st = await call('GET', 'status');
   const badge = $('rig-state');
-  badge.textContent = st.scanning ? `scanning ${st.current}` : 'ready';
-  badge.className = 'badge ' + (st.scanning ? 'busy' : 'idle');
+  badge.textContent = st.scanning ? `scanning ${st.current}` : st.calibrating ? 'calibrating' : 'ready';
+  badge.className = 'badge ' + (st.scanning || st.calibrating ? 'busy' : 'idle');
   $('lights').textContent = st.lights_and_projector;
   if (st.disk_free_bytes !== undefined) {
     const gb = (n) => (n / 1e9).toFixed(1);
@@ -358,7 +360,7 @@ async function saveSettings(asNew) {
 
 async function listProfiles(pick) {
   const st = await call('GET', 'status');
-  for (const sel of [$('profile'), $('settings-profile')]) {
+  for (const sel of [$('profile'), $('settings-profile'), $('calib-profile')]) {
     const was = sel.value;
     sel.textContent = '';
     for (const p of st.profiles) sel.add(new Option(p, p));
@@ -375,9 +377,11 @@ async function start() {
   $('main').hidden = false;
   if (!viewer) viewer = new Viewer($('viewer'));
   $('legend').innerHTML = reasons.map(([n, c]) => `<i style="background:${c}"></i>${n}`).join('');
+  if (!calibration) calibration = setupCalibration(call);
   const st = await refresh();
   await listProfiles();
   if (st.scanning) follow(st.current);
+  calibration.poll();
 }
 
 start().catch((err) => {
