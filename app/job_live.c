@@ -7,6 +7,7 @@
 #include "board.h"
 #include "clock_posix.h"
 #include "frame_writer.h"
+#include "image_io.h"
 #include "thread_posix.h"
 
 #include <errno.h>
@@ -257,6 +258,37 @@ static int live_view(struct job *j, uint32_t v)
     return start_processing(j, v, started, t0, &info);
 }
 
+/* While the person lays the object for a second pass (the page asks: --json), what the camera
+ * sees about once a second as DIR/live.png (a temporary file renamed), which the page shows
+ * beside its question; removed once answered. */
+struct live_picture {
+    struct job *j;
+    double next_ms; /* the wall clock's: a simulated rig's clock stands still while it waits */
+    int off;        /* the camera gave no picture: said once, no more tried */
+};
+
+static void live_picture_take(void *ctx)
+{
+    struct live_picture *l = ctx;
+    const struct hal *hal = l->j->hal;
+    double now_ms = job_wall_ms();
+    if (l->off || now_ms < l->next_ms)
+        return;
+    const uint8_t *rgb;
+    const struct scan_params *p = &l->j->cfg->scan;
+    char path[HAL_MAX_PATH + 16], tmp[HAL_MAX_PATH + 24];
+    snprintf(path, sizeof(path), "%s/" SCAN_FILE_LIVE, l->j->out_dir);
+    snprintf(tmp, sizeof(tmp), "%s.tmp", path);
+    if (scan_snapshot(l->j->scan, hal, p, l->j->calib, &rgb) != 0 ||
+        image_write_png(&hal->storage, tmp, rgb, p->width, p->height, 3) != 0 ||
+        rename(tmp, path) != 0) {
+        hal->log(HAL_LOG_WARN, "no live picture while the scan waits (the scan goes on)");
+        l->off = 1;
+        return;
+    }
+    l->next_ms = now_ms + 1000.0;
+}
+
 /* The person lays the object for the second pass: asked, and the answer waited for, on a rig
  * (and on the simulator with [sim] person = asked); the simulated person otherwise does it at
  * once. @retval 0 @retval -EINTR the person stopped (Ctrl-D) @retval -errno */
@@ -280,9 +312,14 @@ static int ask_for_second_pass(struct job *j)
         fflush(stdout);
     }
     static const char *const answers[] = {"continue"};
+    struct live_picture live = {.j = j};
     unsigned which;
-    return answer_wait(j->hal, answers, 1, "Enter (or 'continue') when the object is laid", NULL,
-                       NULL, &which);
+    rc = answer_wait(j->hal, answers, 1, "Enter (or 'continue') when the object is laid",
+                     j->opts->json ? live_picture_take : NULL, &live, &which);
+    char path[HAL_MAX_PATH + 16];
+    snprintf(path, sizeof(path), "%s/" SCAN_FILE_LIVE, j->out_dir);
+    unlink(path);
+    return rc;
 }
 
 /* The storage thread that keeps the frames while the next are taken. */

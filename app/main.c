@@ -38,14 +38,17 @@ static int cmd_scan(const char *config_path, const struct scan_job_opts *opts)
     return rc == 0 ? 0 : 1;
 }
 
-/* One picture of the object lit by the projector's white, as a PNG (the web page's live view). */
-static int cmd_snapshot(const char *config_path, const char *out)
+/* One picture of the object lit by the projector's white, as a PNG (the web page's live view);
+ * at @p exposure_us instead of the config's unless 0 (the page's settings, to judge one). */
+static int cmd_snapshot(const char *config_path, const char *out, uint32_t exposure_us)
 {
     struct app_config cfg;
     struct scan_calib calib;
     const uint8_t *rgb = NULL;
     if (rig_load_all(config_path, &cfg, &calib) != 0)
         return 2;
+    if (exposure_us != 0) /* the camera opens at it (rig_up) */
+        cfg.camera.exposure_us = cfg.scan.colour.exposure_us = exposure_us;
     int rc = rig_up(&cfg, &calib);
     if (rc == 0)
         rc = scan_snapshot(scan_job_views(), rig_hal(), &cfg.scan, &calib, &rgb);
@@ -239,7 +242,9 @@ static const struct command {
      "scanner serve --config FILE [--listen ADDR:PORT] [--token-file F]  the web interface\n"
      "    (default http://127.0.0.1:8080; scanner serve --help says more)\n",
      NEEDS_CONFIG},
-    {"snapshot", "scanner snapshot --config FILE --out FILE.png  one picture, projector white\n",
+    {"snapshot",
+     "scanner snapshot --config FILE --out FILE.png [--exposure-us N]  one picture, projector "
+     "white\n",
      NEEDS_CONFIG},
     {"config-doc", "scanner config-doc                    print the config reference (Markdown)\n",
      NEEDS_NOTHING},
@@ -326,7 +331,8 @@ int main(int argc, char **argv)
 {
     const char *config_path = NULL, *scan_dir = NULL;
     struct scan_job_opts opts = {0, NULL, NULL, 0, 0};
-    double white_albedo = 0.95; /* a typical white reference target */
+    double white_albedo = 0.95;        /* a typical white reference target */
+    uint32_t snapshot_exposure_us = 0; /* snapshot --exposure-us: 0 the config's */
     const struct command *cmd = NULL;
     int status = check_command_line(argc, argv, &cmd);
     if (status >= 0)
@@ -361,9 +367,21 @@ int main(int argc, char **argv)
             opts.replace = 1;
         else if (strcmp(argv[i], "--albedo") == 0 && i + 1 < argc)
             white_albedo = atof(argv[++i]);
-        else {
+        else if (strcmp(argv[i], "--exposure-us") == 0 && i + 1 < argc &&
+                 strcmp(argv[1], "snapshot") == 0) {
+            char *end;
+            unsigned long v = strtoul(argv[++i], &end, 10);
+            if (end == argv[i] || *end != '\0' || argv[i][0] == '-' || v < 10 || v > 10000000) {
+                fprintf(stderr,
+                        "scanner snapshot: --exposure-us '%s': a whole number of "
+                        "microseconds from 10 to 10000000 ([camera] exposure_us's range)\n",
+                        argv[i]);
+                return 2;
+            }
+            snapshot_exposure_us = (uint32_t)v;
+        } else {
             int valued = strcmp(argv[i], "--config") == 0 || strcmp(argv[i], "--out") == 0 ||
-                         strcmp(argv[i], "--albedo") == 0;
+                         strcmp(argv[i], "--albedo") == 0 || strcmp(argv[i], "--exposure-us") == 0;
             fprintf(stderr, "scanner %s: %s '%s'\n", cmd->name,
                     valued ? "a value is missing after" : "unknown argument", argv[i]);
             usage_of(stderr, cmd);
@@ -431,7 +449,7 @@ int main(int argc, char **argv)
         return cmd_scan(config_path, &opts);
     if (strcmp(argv[1], "snapshot") == 0)
         return opts.out_dir == NULL ? missing(cmd, "--out FILE.png")
-                                    : cmd_snapshot(config_path, opts.out_dir);
+                                    : cmd_snapshot(config_path, opts.out_dir, snapshot_exposure_us);
     if (strcmp(argv[1], "calibrate-white") == 0)
         return cmd_calibrate_white(config_path, white_albedo);
     return cmd_selftest(config_path);

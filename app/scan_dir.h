@@ -27,6 +27,7 @@
 #define SCAN_FILE_REFLECTANCE "reflectance.ini" /* [colour] method = fit's materials */
 #define SCAN_FILE_SUMMARY "summary.ini"         /* last: the scan is complete */
 #define SCAN_FILE_REPORT "report.html"
+#define SCAN_FILE_LIVE "live.png" /* the camera's picture while a scan asks (a second pass) */
 /* In each view's folder (view_NNN), beside its frames: */
 #define SCAN_FILE_VIEW "view.ini" /* last of a view's capture: the view is complete */
 #define SCAN_FILE_RANGE "range.bin"

@@ -468,6 +468,14 @@ def calibration_cases(port, key, scans):
     check((st, st2, st3, st4, st5) == (403, 403, 405, 404, 400),
           f"a calibration without the key or from another site is not started; GET on a POST, "
           f"no such request, no such profile ({st}, {st2}, {st3}, {st4}, {st5})")
+    bad = ['{"exposure_us": 5}', '{"exposure_us": 1e12}', '{"exposure_us": "100"}',
+           '{"exposure_us": 1000.5}', '{"exposure_us": -1}', '{"profile": "../fast"}', "[]"]
+    sts = [request(port, "POST", "/api/snapshot.png", js, b)[0] for b in bad]
+    st, h, png = request(port, "POST", "/api/snapshot.png", js,
+                         '{"profile": "fast", "exposure_us": 2000}')
+    check(sts == [400] * len(bad) and st == 200 and png[:4] == b"\x89PNG",
+          f"a picture at an exposure: out of range, not a whole number, no such profile refused; "
+          f"a right one taken ({sts}, {st})")
     before = sorted(os.listdir(scans))
     st, _, body = request(port, "POST", "/api/calibration", js, '{"profile": "asked"}')
     cid = json.loads(body).get("id", "") if st == 200 else ""

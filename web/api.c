@@ -532,21 +532,66 @@ static int selftest(struct mg_connection *conn, struct web_server *s)
     return api_send_json(conn, 200, body);
 }
 
+/* The profile and exposure a picture is taken with: none given (no body), the first profile at
+ * its own exposure; {"profile": NAME, "exposure_us": N} to judge an exposure before it is saved.
+ * @retval 0 @retval the status sent */
+static int snapshot_settings(struct mg_connection *conn, const struct web_server *s,
+                             const struct web_profile **p, char *exposure, size_t len)
+{
+    *p = &s->profile[0];
+    exposure[0] = '\0';
+    if (mg_get_header(conn, "Content-Type") == NULL &&
+        mg_get_request_info(conn)->content_length <= 0)
+        return 0;
+    cJSON *body = NULL;
+    int status = api_read_body(conn, &body);
+    if (status != 0) {
+        cJSON_Delete(body);
+        return api_send_body_error(conn, status);
+    }
+    const cJSON *e = cJSON_GetObjectItemCaseSensitive(body, "exposure_us");
+    *p = api_find_profile(s, body);
+    int ok = e == NULL || (cJSON_IsNumber(e) && e->valuedouble >= 10 && e->valuedouble <= 1e7 &&
+                           e->valuedouble == (double)(long)e->valuedouble);
+    if (ok && e != NULL)
+        snprintf(exposure, len, "%ld", (long)e->valuedouble);
+    cJSON_Delete(body);
+    if (*p == NULL)
+        return api_send_error(conn, 400, "no such profile (GET /api/status lists them)");
+    if (!ok)
+        return api_send_error(conn, 400,
+                              "exposure_us: a whole number of microseconds from 10 "
+                              "to 10000000");
+    return 0;
+}
+
 /* POST /api/snapshot.png: what the camera sees lit by the projector's white. */
 static int snapshot(struct mg_connection *conn, struct web_server *s)
 {
+    const struct web_profile *p;
+    char exposure[16];
+    int st = snapshot_settings(conn, s, &p, exposure, sizeof(exposure));
+    if (st != 0)
+        return st;
     char path[] = "/tmp/scanner-snapshot-XXXXXX.png", out[512];
     int fd = mkstemps(path, 4);
     if (fd < 0)
         return api_send_error(conn, 500, "cannot make a temporary file");
     close(fd);
-    const char *args[] = {s->scanner, "snapshot", "--config", s->profile[0].path,
-                          "--out",    path,       NULL};
+    const char *args[] = {s->scanner,
+                          "snapshot",
+                          "--config",
+                          p->path,
+                          "--out",
+                          path,
+                          exposure[0] ? "--exposure-us" : NULL,
+                          exposure,
+                          NULL};
     int status = -1;
     int rc = jobs_run_tool(s, args, out, sizeof(out), &status);
     if (rc == -EBUSY) {
         unlink(path);
-        return api_send_error(conn, 409, "the rig is busy (a scan is running)");
+        return api_send_error(conn, 409, "the rig is busy (a scan or a calibration is running)");
     }
     if (rc != 0 || status != 0) {
         unlink(path);

@@ -342,7 +342,7 @@ static int choose(struct mg_connection *conn, struct web_server *s, int use)
     char dir[WEB_PATH], file[WEB_PATH], profile[64];
     pthread_mutex_lock(&j->lock);
     int ready = j->state == WEB_FINISHED && j->kind == WEB_CALIBRATION && j->done_seen &&
-                j->calib_choice[0] == '\0' && !j->rig_busy;
+                j->calib_choice[0] == '\0';
     if (ready) /* taken now: a second click finds it chosen */
         snprintf(j->calib_choice, sizeof(j->calib_choice), "%s", use ? "using" : "kept");
     snprintf(dir, sizeof(dir), "%s", j->dir);

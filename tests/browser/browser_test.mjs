@@ -239,6 +239,9 @@ async function twoPassTest(browser) {
   const id = (await raw(s.url, 'GET', '/api/status').then((r) => JSON.parse(r.body))).current;
   check(/lay the object on its side/.test(asked) && (await scanState(s.url, id)).views_done === 8,
     `after the first turn the page says what to do ("${asked}"), the first pass's 8 views kept`);
+  await page.waitForFunction(() => { const i = document.getElementById('place-live'); return !i.hidden && i.naturalWidth === 1280; },
+    null, { timeout: 30000 });
+  check(true, 'while it waits, the page shows what the camera sees (the laid object)');
   await page.screenshot({ path: path.join(out, 'page-second-pass.png') });
   const noKey = await raw(s.url, 'POST', `/api/scans/${id}/continue`, json, '{}');
   check(noKey.status === 403, `Continue without the session key is refused (${noKey.status})`);
@@ -247,6 +250,7 @@ async function twoPassTest(browser) {
   check(twice.status === 409, `a second Continue to one question is refused (${twice.status})`);
   await page.waitForFunction(() => /16 of 16 views · finished/.test(document.getElementById('progress').textContent), null, { timeout: 300000 });
   check(await page.isHidden('#place'), 'the question goes once answered');
+  check(!fs.existsSync(path.join(passScans, id, 'live.png')), 'and its live picture leaves the scan folder');
   const dir = path.join(passScans, id);
   const cmp = execFileSync(path.resolve(build, 'mesh-compare'), ['--align', path.join(dir, 'mesh.ply'), path.join(dir, 'truth_mesh.ply')]).toString();
   const within = Number((/truth -> result: mean [0-9.]+ mm, within 1 mm ([0-9.]+)%/.exec(cmp) || [])[1]);
@@ -259,6 +263,17 @@ async function twoPassTest(browser) {
   const said = await page.textContent('#settings .field-error');
   const beside = await page.evaluate(() => document.querySelector('#settings .field-error').previousElementSibling.name);
   check(beside === 'scan.views' && /\[scan\] views/.test(said), `a wrong value is refused, the scanner's words beside its field ("${said}")`);
+  // a picture at an exposure typed in (not saved): brighter at a longer one
+  const levels = [];
+  for (const e of ['2000', '40000']) {
+    await page.fill('#settings [name="camera.exposure_us"]', e);
+    await page.click('#settings-picture-btn');
+    await page.waitForFunction((x) => new RegExp(`^at ${x} µs`).test(document.getElementById('settings-picture-note').textContent), e, { timeout: 30000 });
+    levels.push(Number(await page.getAttribute('#settings-picture-note', 'data-mean')));
+  }
+  check(levels[1] > levels[0] + 5, `a picture at the exposure typed in: brighter at 40000 µs than at 2000 (${levels.join(' < ')})`);
+  const badExposure = await raw(s.url, 'POST', '/api/snapshot.png', await keyed(s.url), '{"exposure_us": 5}');
+  check(badExposure.status === 400, `an exposure out of range is refused (${badExposure.status})`);
   await page.locator('#settings-panel').screenshot({ path: path.join(out, 'page-settings.png') });
   await page.fill('#settings [name="scan.views"]', '6');
   await page.selectOption('#settings [name="colour.method"]', 'multi');

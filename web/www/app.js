@@ -96,7 +96,22 @@ function showProgress(s) {
     $('place-text').textContent = s.detail;
     $('continue').dataset.id = s.id;
     $('continue').disabled = false;
+    if (!placeLive) placeLive = setInterval(() => showPlaceLive(s.id), 1000);
+  } else if (placeLive) {
+    clearInterval(placeLive);
+    placeLive = null;
+    $('place-live').hidden = true;
   }
+}
+
+// While the scan waits for the object to be laid, what the camera sees (the scanner writes it
+// into the scan's folder about once a second, and removes it once answered).
+let placeLive = null;
+function showPlaceLive(id) {
+  const img = $('place-live');
+  img.onload = () => { img.hidden = false; };
+  img.onerror = () => { img.hidden = true; };
+  img.src = api(`scans/${id}/files/live.png?t=${Date.now()}`);
 }
 
 async function answerPlaced() {
@@ -369,6 +384,47 @@ async function listProfiles(pick) {
   await loadSettings();
 }
 
+// A picture at the exposure in the field (not saved yet), and how much of it is saturated or
+// dark: the numbers a person judges an exposure by.
+async function pictureAtExposure() {
+  const note = $('settings-picture-note');
+  const exposure = Number($('settings').elements['camera.exposure_us'].value);
+  note.textContent = 'taking a picture…';
+  await inflight;
+  const res = await fetch(api('snapshot.png'), {
+    method: 'POST',
+    headers: { ...(await sessionHeaders()), 'Content-Type': 'application/json' },
+    body: JSON.stringify({ profile: $('settings-profile').value, exposure_us: exposure }),
+  });
+  if (!res.ok) {
+    note.textContent = (await res.json().catch(() => ({}))).error || res.statusText;
+    return;
+  }
+  const img = $('settings-picture');
+  if (img.src) URL.revokeObjectURL(img.src);
+  img.src = URL.createObjectURL(await res.blob());
+  await img.decode();
+  img.hidden = false;
+  const c = document.createElement('canvas');
+  c.width = img.naturalWidth;
+  c.height = img.naturalHeight;
+  const g = c.getContext('2d');
+  g.drawImage(img, 0, 0);
+  const px = g.getImageData(0, 0, c.width, c.height).data;
+  let sum = 0, saturated = 0, dark = 0;
+  for (let i = 0; i < px.length; i += 4) {
+    const hi = Math.max(px[i], px[i + 1], px[i + 2]);
+    sum += (px[i] + px[i + 1] + px[i + 2]) / 3;
+    saturated += hi >= 250;
+    dark += hi < 10;
+  }
+  const n = px.length / 4;
+  note.dataset.mean = (sum / n).toFixed(1);
+  note.textContent = `at ${exposure} µs: mean level ${(sum / n).toFixed(0)} of 255, ` +
+    `${(100 * saturated / n).toFixed(1)}% saturated, ${(100 * dark / n).toFixed(1)}% dark`;
+}
+
+$('settings-picture-btn').addEventListener('click', pictureAtExposure);
 $('settings-profile').addEventListener('change', loadSettings);
 $('settings-save').addEventListener('click', () => saveSettings(false));
 $('settings-save-as').addEventListener('click', () => saveSettings(true));
