@@ -97,6 +97,8 @@ async function pageTest(browser) {
   page.on('pageerror', (e) => check(false, `no error in the page's JavaScript (${e.message})`));
   await page.goto(s.url);
   await page.waitForSelector('#main:not([hidden])');
+  // the badge says "connecting" until the page's first status answer
+  await page.waitForFunction(() => !/connecting/.test(document.getElementById('rig-state').textContent));
   check((await page.textContent('#rig-state')) === 'ready', 'the page says the rig is ready');
   check((await page.textContent('#lights')) === 'off', 'lights and projector are off while idle');
 
