@@ -128,6 +128,10 @@ static const struct ini_key config_keys[] = {
          "themselves; the projector's stored sequence changes: scanner patterns)"),
     U32("scan", "decode_rows", scan.decode_rows, 0, 1, "0",
         "1: code projector rows too (twice the patterns; rows must agree with neighbours)"),
+    U32("scan", "inverse_bits", scan.inverse_bits, 0, 16, "0",
+        "the finest bits of each coordinate projected with their inverse; a coarser bit is read "
+        "against the mean of white and black, a frame fewer each (0: every bit has its "
+        "inverse; the projector's stored sequence changes: scanner patterns)"),
     U32("scan", "refine", scan.refine, 0, 1, "1",
         "1: interpolate the projector column across each stripe (sub-stripe refinement)"),
     U32("scan", "normal_radius_px", scan.normal_radius_px, 1, 32, "4",
@@ -753,6 +757,7 @@ PLAN_GET(gain, c->camera.gain_milli)
 PLAN_GET(hdr_count, c->scan.exposure_count)
 PLAN_GET(code, c->scan.code)
 PLAN_GET(rows, c->scan.decode_rows)
+PLAN_GET(inverse_bits, c->scan.inverse_bits)
 PLAN_GET(lights, c->light_count)
 /* 0: the camera's exposure (docs/config.md): compared as the exposure the frames get */
 PLAN_GET(all_lights, c->scan.colour.all_lights_exposure_us ? c->scan.colour.all_lights_exposure_us
@@ -790,6 +795,7 @@ int config_plan_differs(const struct app_config *taken, const struct app_config 
         {"scan", "exposures_us", plan_hdr, SCAN_MAX_EXPOSURES, NULL},
         {"scan", "code", plan_code, 1, plan_code_text},
         {"scan", "decode_rows", plan_rows, 1, NULL},
+        {"scan", "inverse_bits", plan_inverse_bits, 1, NULL},
         {"lights", "count", plan_lights, 1, NULL},
         {"colour", "all_lights_exposure_us", plan_all_lights, 1, NULL},
         {"colour", "light_exposure_us", plan_light_exp, 1, NULL},

@@ -21,10 +21,13 @@ static void describe(const struct gray_layout *l, uint32_t index, char *out, siz
         snprintf(out, len, "black");
         return;
     }
-    uint32_t k = (index - GRAY_PATTERN_FIRST_BIT) / 2u; /* most significant first */
-    uint32_t inverse = (index - GRAY_PATTERN_FIRST_BIT) % 2u;
-    int row = k >= l->col_bits;
-    uint32_t bits = row ? l->row_bits : l->col_bits, bit = row ? k - l->col_bits : k;
+    int row, inverse;
+    uint32_t bit; /* most significant first */
+    if (gray_layout_pattern(l, index, &row, &bit, &inverse) != 0) {
+        snprintf(out, len, "none");
+        return;
+    }
+    uint32_t bits = row ? l->row_bits : l->col_bits;
     uint32_t position = bits - 1u - bit; /* of the bit in the word, 0 the finest */
     int rides = (gray_code_xor_mask(l->code, bits) >> position) & 1u;
     char rides_on[24] = ""; /* XOR-04: the base it rides on */

@@ -98,7 +98,9 @@ static void colour_frame_name(const struct colour_layout *lay, uint32_t k, char 
 static void pattern_name(uint32_t pattern, const struct gray_layout *l, int hdr, char *buf,
                          size_t len)
 {
-    uint32_t k = (pattern - GRAY_PATTERN_FIRST_BIT) / 2u;
+    int is_row = 0, inverse = 0;
+    uint32_t k = 0;
+    gray_layout_pattern(l, pattern, &is_row, &k, &inverse);
     const char *grey =
         hdr ? (l->code == GRAY_CODE_XOR04 ? "XOR-04, grey, HDR merged" : "grey, HDR merged")
             : (l->code == GRAY_CODE_XOR04 ? "XOR-04, grey" : "grey");
@@ -107,10 +109,8 @@ static void pattern_name(uint32_t pattern, const struct gray_layout *l, int hdr,
     else if (pattern == GRAY_PATTERN_BLACK)
         snprintf(buf, len, "black, %s", grey);
     else
-        snprintf(buf, len, "%s bit %u of %u%s, %s", k < l->col_bits ? "column" : "row",
-                 (unsigned)(k < l->col_bits ? k : k - l->col_bits),
-                 (unsigned)(k < l->col_bits ? l->col_bits : l->row_bits),
-                 (pattern - GRAY_PATTERN_FIRST_BIT) % 2u ? " inverse" : "", grey);
+        snprintf(buf, len, "%s bit %u of %u%s, %s", is_row ? "row" : "column", (unsigned)k,
+                 (unsigned)(is_row ? l->row_bits : l->col_bits), inverse ? " inverse" : "", grey);
 }
 
 void scan_dir_describe_frames(const struct scan_params *p, const struct scan_calib *c,

@@ -17,8 +17,10 @@ static int render(void *ctx, uint32_t pattern, uint8_t *xrgb, uint32_t width, ui
                   uint32_t pitch)
 {
     const struct board_display *d = ctx;
-    int is_row = pattern >= GRAY_PATTERN_FIRST_BIT &&
-                 (pattern - GRAY_PATTERN_FIRST_BIT) / 2u >= d->layout.col_bits;
+    int is_row = 0, inverse;
+    uint32_t k;
+    if (gray_layout_pattern(&d->layout, pattern, &is_row, &k, &inverse) != 0)
+        is_row = 0; /* white or black: the same on every row */
     for (uint32_t y = 0; y < height; y++) {
         uint32_t *row = (uint32_t *)(void *)(xrgb + (size_t)y * pitch);
         if (y > 0 && !is_row) { /* column patterns: every row as the first */

@@ -48,6 +48,17 @@ uint32_t decode_bit_threshold(const struct scan_params *p, uint32_t contrast_dn)
     return t > 254.0 ? 254u : (uint32_t)t;
 }
 
+uint32_t decode_mean_threshold(const struct scan_params *p, uint32_t contrast_dn)
+{
+    /* A quarter of the pair's threshold, measured (make measure-inverse, docs/performance.md):
+     * the same noise model's threshold (sigma^2 = 1.5 read^2 + 0.75 contrast / gain for half
+     * the contrast) lost up to 3 points of valid pixels, half the pair's up to 0.6, at grazing
+     * incidence, where the read against the mean has sqrt(3) less signal to noise and the
+     * unclear bits pile up; a bit decided by its sign near its own stripe edge is at worst one
+     * column off (Gray code), and a wrong one far from it is left to the neighbourhood checks. */
+    return (decode_bit_threshold(p, contrast_dn) + 3u) / 4u;
+}
+
 int decode_begin(struct decode_ctx *d, const struct scan_params *params,
                  const struct gray_layout *layout, uint32_t proj_width, uint32_t proj_height)
 {
@@ -60,8 +71,10 @@ int decode_begin(struct decode_ctx *d, const struct scan_params *params,
     d->proj_width = proj_width;
     d->proj_height = proj_height;
     d->next_pattern = 0;
-    for (uint32_t c = 0; c < 256; c++)
+    for (uint32_t c = 0; c < 256; c++) {
         d->bit_threshold[c] = (uint8_t)decode_bit_threshold(params, c);
+        d->mean_threshold[c] = (uint8_t)decode_mean_threshold(params, c);
+    }
     d->xor_col = gray_code_xor_mask(layout->code, layout->col_bits);
     d->xor_row = gray_code_xor_mask(layout->code, layout->row_bits);
     return 0;
@@ -89,8 +102,8 @@ int decode_frame(struct decode_ctx *d, uint32_t pattern, const uint8_t *grey)
  * compared with the pixel's own threshold, and a pair is saturated when both frames reached
  * DECODE_SATURATED (one saturated frame still says which is brighter). decode_reference is the
  * same, plainly. */
-static void accumulate(struct decode_ctx *d, uint32_t first, uint32_t bits, size_t start,
-                       size_t len, const uint8_t *threshold, uint16_t *code, uint16_t *unclear,
+static void accumulate(struct decode_ctx *d, int is_row, uint32_t bits, size_t start, size_t len,
+                       const uint8_t *threshold, uint16_t *code, uint16_t *unclear,
                        uint8_t *both_saturated)
 {
     const uint16_t xor_mask = (uint16_t)gray_code_xor_mask(d->layout.code, bits);
@@ -101,8 +114,14 @@ static void accumulate(struct decode_ctx *d, uint32_t first, uint32_t bits, size
     memset(unclear_hi, 0, len);
     memset(unclear_lo, 0, len);
     for (uint32_t k = 0; k < bits; k++) {
-        const uint8_t *restrict pos = d->frame_store[first + 2u * k] + start;
-        const uint8_t *restrict neg = d->frame_store[first + 2u * k + 1u] + start;
+        uint32_t stripes;
+        int32_t inverse;
+        gray_layout_bit(&d->layout, is_row, k, &stripes, &inverse);
+        /* a bit without its inverse is read against the mean of white and black */
+        const uint8_t *restrict pos = d->frame_store[stripes] + start;
+        const uint8_t *restrict neg =
+            inverse >= 0 ? d->frame_store[inverse] + start : d->block.mean;
+        const uint8_t *restrict thr = inverse >= 0 ? threshold : d->block.mean_threshold;
         uint8_t *restrict plane = k < 8 ? plane_hi : plane_lo;
         uint8_t *restrict unc = k < 8 ? unclear_hi : unclear_lo;
         uint8_t *restrict sat = both_saturated;
@@ -110,7 +129,7 @@ static void accumulate(struct decode_ctx *d, uint32_t first, uint32_t bits, size
             uint8_t a = pos[i], b = neg[i];
             uint8_t up = (uint8_t)(a > b ? a - b : 0), down = (uint8_t)(b > a ? b - a : 0);
             plane[i] = (uint8_t)((plane[i] << 1) | (up != 0));
-            unc[i] = (uint8_t)((unc[i] << 1) | ((up | down) <= threshold[i]));
+            unc[i] = (uint8_t)((unc[i] << 1) | ((up | down) <= thr[i]));
             sat[i] = (uint8_t)(sat[i] | ((a & b) == DECODE_SATURATED));
         }
     }
@@ -173,15 +192,17 @@ static void decode_block(struct decode_ctx *d, size_t start, size_t len, uint8_t
     const uint8_t *white = d->frame_store[GRAY_PATTERN_WHITE] + start;
     const uint8_t *black = d->frame_store[GRAY_PATTERN_BLACK] + start;
     const struct gray_layout *l = &d->layout;
+    uint8_t *mean = d->block.mean, *mean_threshold = d->block.mean_threshold;
     for (size_t i = 0; i < len; i++) {
-        threshold[i] = d->bit_threshold[white[i] > black[i] ? white[i] - black[i] : 0];
+        uint8_t contrast = (uint8_t)(white[i] > black[i] ? white[i] - black[i] : 0);
+        threshold[i] = d->bit_threshold[contrast];
+        mean_threshold[i] = d->mean_threshold[contrast];
+        mean[i] = (uint8_t)(((unsigned)white[i] + black[i] + 1u) >> 1);
         sat[i] = 0;
     }
-    accumulate(d, GRAY_PATTERN_FIRST_BIT, l->col_bits, start, len, threshold, code_col,
-               d->unclear_col + start, sat);
+    accumulate(d, 0, l->col_bits, start, len, threshold, code_col, d->unclear_col + start, sat);
     if (l->row_bits > 0)
-        accumulate(d, GRAY_PATTERN_FIRST_BIT + 2u * l->col_bits, l->row_bits, start, len, threshold,
-                   code_row, d->unclear_row + start, sat);
+        accumulate(d, 1, l->row_bits, start, len, threshold, code_row, d->unclear_row + start, sat);
     else
         memset(d->unclear_row + start, 0, len * sizeof(uint16_t));
     /* Locals: the stores to reason[] (bytes) may alias anything, and would make the compiler
@@ -415,19 +436,25 @@ int decode_finish(struct decode_ctx *d, uint8_t *reason, struct decode_maps *map
 
 /* ---- the plain reference: one pixel at a time, every frame ---- */
 
-static uint16_t reference_bits(const uint8_t *const *frames, uint32_t code, uint32_t first,
-                               uint32_t bits, size_t i, int t, unsigned *unclear,
+/* @p t: the threshold of a bit with its inverse, @p tm of one against the mean */
+static uint16_t reference_bits(const uint8_t *const *frames, const struct gray_layout *l,
+                               int is_row, size_t i, int t, int tm, unsigned *unclear,
                                int *both_saturated)
 {
-    uint32_t word = 0;
+    uint32_t word = 0, bits = is_row ? l->row_bits : l->col_bits;
+    int mean = (frames[GRAY_PATTERN_WHITE][i] + frames[GRAY_PATTERN_BLACK][i] + 1) / 2;
     *unclear = 0;
     for (uint32_t k = 0; k < bits; k++) {
-        int a = frames[first + 2u * k][i], b = frames[first + 2u * k + 1u][i];
+        uint32_t stripes;
+        int32_t inverse;
+        gray_layout_bit(l, is_row, k, &stripes, &inverse);
+        int a = frames[stripes][i], b = inverse >= 0 ? frames[inverse][i] : mean;
+        int limit = inverse >= 0 ? t : tm;
         word = (word << 1) | (a > b ? 1u : 0u);
-        *unclear = (*unclear << 1) | (a - b <= t && b - a <= t);
+        *unclear = (*unclear << 1) | (a - b <= limit && b - a <= limit);
         *both_saturated |= a == DECODE_SATURATED && b == DECODE_SATURATED;
     }
-    return (uint16_t)gray_code_value(code, bits, word);
+    return (uint16_t)gray_code_value(l->code, bits, word);
 }
 
 void decode_reference(const struct scan_params *p, const struct gray_layout *l, uint32_t proj_width,
@@ -437,14 +464,14 @@ void decode_reference(const struct scan_params *p, const struct gray_layout *l, 
     for (size_t i = 0; i < n; i++) {
         unsigned unclear_c = 0, unclear_r = 0;
         int white = frames[GRAY_PATTERN_WHITE][i], black = frames[GRAY_PATTERN_BLACK][i];
-        int t = (int)decode_bit_threshold(p, (uint32_t)(white > black ? white - black : 0));
+        uint32_t contrast = (uint32_t)(white > black ? white - black : 0);
+        int t = (int)decode_bit_threshold(p, contrast),
+            tm = (int)decode_mean_threshold(p, contrast);
         int sat = 0;
-        column[i] = reference_bits(frames, l->code, GRAY_PATTERN_FIRST_BIT, l->col_bits, i, t,
-                                   &unclear_c, &sat);
+        column[i] = reference_bits(frames, l, 0, i, t, tm, &unclear_c, &sat);
         uint16_t r = 0;
         if (l->row_bits > 0)
-            r = reference_bits(frames, l->code, GRAY_PATTERN_FIRST_BIT + 2u * l->col_bits,
-                               l->row_bits, i, t, &unclear_r, &sat);
+            r = reference_bits(frames, l, 1, i, t, tm, &unclear_r, &sat);
         if (row != NULL)
             row[i] = r;
         int out = column[i] >= proj_width || (l->row_bits > 0 && r >= proj_height);

@@ -49,6 +49,7 @@ struct decode_ctx {
     struct {                         /* one block's accumulators */
         uint16_t code_col[DECODE_BLOCK], code_row[DECODE_BLOCK];
         uint8_t threshold[DECODE_BLOCK], sat[DECODE_BLOCK];
+        uint8_t mean[DECODE_BLOCK], mean_threshold[DECODE_BLOCK]; /* bits without inverse */
         uint8_t plane_hi[DECODE_BLOCK], plane_lo[DECODE_BLOCK];
         uint8_t unclear_hi[DECODE_BLOCK], unclear_lo[DECODE_BLOCK];
     } block;
@@ -56,8 +57,9 @@ struct decode_ctx {
     struct gray_layout layout;
     uint32_t proj_width, proj_height;
     uint32_t next_pattern;
-    uint8_t bit_threshold[256]; /* |I - I_inverse| at or below this is unclear, per contrast */
-    uint32_t xor_col, xor_row;  /* gray_code_xor_mask of the columns and rows */
+    uint8_t bit_threshold[256];  /* |I - I_inverse| at or below this is unclear, per contrast */
+    uint8_t mean_threshold[256]; /* |I - (white + black) / 2| likewise, a bit without inverse */
+    uint32_t xor_col, xor_row;   /* gray_code_xor_mask of the columns and rows */
 };
 
 /** Short name of a reason code, for logs and reports. */
@@ -75,6 +77,11 @@ void decode_rgb_to_grey(const uint8_t *rgb, uint8_t *grey, size_t n, uint32_t sa
  *  camera's noise model, bit_noise_sigmas standard deviations of the difference of two frames
  *  at this white-minus-black contrast, and never below min_bit_diff_dn. */
 uint32_t decode_bit_threshold(const struct scan_params *params, uint32_t contrast_dn);
+
+/** The threshold of a bit projected without its inverse (gray_layout's inverse_bits), read
+ *  against the mean of white and black: |I - mean| at or below it leaves the bit unclear. A
+ *  quarter of decode_bit_threshold, rounded up (measured: decode.c says why). */
+uint32_t decode_mean_threshold(const struct scan_params *params, uint32_t contrast_dn);
 
 /** Start a view of a @p proj_width x @p proj_height projector coded as @p layout in @p d.
  *  @retval 0 ok @retval -EINVAL size or pattern count above the compiled limits */

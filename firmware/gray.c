@@ -11,7 +11,7 @@ uint32_t gray_bits_for_width(uint32_t proj_width)
 
 uint32_t gray_pattern_count(uint32_t bits)
 {
-    struct gray_layout l = {bits, 0, GRAY_CODE_GRAY};
+    struct gray_layout l = {bits, 0, GRAY_CODE_GRAY, 0};
     return gray_layout_count(&l);
 }
 
@@ -20,6 +20,7 @@ void gray_layout_for(uint32_t proj_width, uint32_t proj_height, int rows, struct
     l->col_bits = gray_bits_for_width(proj_width);
     l->row_bits = rows ? gray_bits_for_width(proj_height) : 0;
     l->code = GRAY_CODE_GRAY;
+    l->inverse_bits = 0;
 }
 
 /* XOR-04's base is Gray bit 1 (stripes 4 projector pixels wide); the bits above it ride on it. */
@@ -45,9 +46,51 @@ uint32_t gray_code_value(uint32_t code, uint32_t bits, uint32_t word)
     return gray_decode(g);
 }
 
+/* Bits of a coordinate of @p bits that have an inverse pattern: the finest. */
+static uint32_t inverses(const struct gray_layout *l, uint32_t bits)
+{
+    return l->inverse_bits == 0 || l->inverse_bits > bits ? bits : l->inverse_bits;
+}
+
+/* Patterns of a coordinate of @p bits. */
+static uint32_t axis_patterns(const struct gray_layout *l, uint32_t bits)
+{
+    return bits + inverses(l, bits);
+}
+
 uint32_t gray_layout_count(const struct gray_layout *l)
 {
-    return GRAY_PATTERN_FIRST_BIT + 2u * (l->col_bits + l->row_bits);
+    return GRAY_PATTERN_FIRST_BIT + axis_patterns(l, l->col_bits) + axis_patterns(l, l->row_bits);
+}
+
+void gray_layout_bit(const struct gray_layout *l, int is_row, uint32_t k, uint32_t *pattern,
+                     int32_t *inverse)
+{
+    uint32_t bits = is_row ? l->row_bits : l->col_bits;
+    uint32_t base = GRAY_PATTERN_FIRST_BIT + (is_row ? axis_patterns(l, l->col_bits) : 0u);
+    uint32_t plain = bits - inverses(l, bits); /* the coarsest, alone */
+    if (k < plain) {
+        *pattern = base + k;
+        *inverse = -1;
+    } else {
+        *pattern = base + plain + 2u * (k - plain);
+        *inverse = (int32_t)*pattern + 1;
+    }
+}
+
+int gray_layout_pattern(const struct gray_layout *l, uint32_t index, int *is_row, uint32_t *k,
+                        int *inverse)
+{
+    if (index < GRAY_PATTERN_FIRST_BIT || index >= gray_layout_count(l))
+        return -1;
+    uint32_t i = index - GRAY_PATTERN_FIRST_BIT, cols = axis_patterns(l, l->col_bits);
+    *is_row = i >= cols;
+    i -= *is_row ? cols : 0u;
+    uint32_t bits = *is_row ? l->row_bits : l->col_bits;
+    uint32_t plain = bits - inverses(l, bits);
+    *k = i < plain ? i : plain + (i - plain) / 2u;
+    *inverse = i >= plain && (i - plain) % 2u == 1u;
+    return 0;
 }
 
 uint32_t gray_encode(uint32_t binary)
@@ -69,19 +112,17 @@ int gray_layout_lit(const struct gray_layout *l, uint32_t index, uint32_t column
         return 1;
     if (index == GRAY_PATTERN_BLACK)
         return 0;
-    uint32_t k = (index - GRAY_PATTERN_FIRST_BIT) / 2u; /* bit, most significant first */
-    int inverse = (int)((index - GRAY_PATTERN_FIRST_BIT) % 2u);
-    int lit =
-        k < l->col_bits
-            ? (int)((gray_code_word(l->code, l->col_bits, column) >> (l->col_bits - 1u - k)) & 1u)
-            : (int)((gray_code_word(l->code, l->row_bits, row) >>
-                     (l->row_bits - 1u - (k - l->col_bits))) &
-                    1u);
+    int is_row, inverse;
+    uint32_t k; /* bit, most significant first */
+    if (gray_layout_pattern(l, index, &is_row, &k, &inverse) != 0)
+        return 0;
+    uint32_t bits = is_row ? l->row_bits : l->col_bits;
+    int lit = (int)((gray_code_word(l->code, bits, is_row ? row : column) >> (bits - 1u - k)) & 1u);
     return inverse ? !lit : lit;
 }
 
 int gray_pattern_lit(uint32_t bits, uint32_t index, uint32_t column)
 {
-    struct gray_layout l = {bits, 0, GRAY_CODE_GRAY};
+    struct gray_layout l = {bits, 0, GRAY_CODE_GRAY, 0};
     return gray_layout_lit(&l, index, column, 0);
 }

@@ -147,6 +147,7 @@ void scan_layout(const struct scan_params *p, const struct scan_calib *c, struct
 {
     gray_layout_for(c->proj_width, c->proj_height, (int)p->decode_rows, l);
     l->code = p->code;
+    l->inverse_bits = p->inverse_bits;
 }
 
 int scan_begin_view(struct scan_ctx *s, const struct scan_params *p, const struct scan_calib *c)

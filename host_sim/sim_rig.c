@@ -620,8 +620,10 @@ static void ensure_light(struct sim_rig *rig, uint32_t li)
 static double pattern_light(const struct sim_rig *rig, uint32_t pattern, double u, double v)
 {
     const struct gray_layout *l = &rig->layout;
-    int is_row =
-        pattern >= GRAY_PATTERN_FIRST_BIT && (pattern - GRAY_PATTERN_FIRST_BIT) / 2u >= l->col_bits;
+    int is_row = 0, inverse;
+    uint32_t k;
+    if (gray_layout_pattern(l, pattern, &is_row, &k, &inverse) != 0)
+        is_row = 0; /* white or black */
     double x = is_row ? v : u, b = rig->cfg.projector_blur_px, lo = x - 0.5 * b, hi = x + 0.5 * b;
     int limit = (int)(is_row ? rig->calib.proj_height : rig->calib.proj_width);
     double c0 = floor(lo + 0.5), c1 = floor(hi + 0.5), lit;

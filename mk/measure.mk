@@ -7,6 +7,9 @@ $(BUILD)/measure_view: $(BUILD)/tools/measure_view.o $(BUILD)/tests/test_util.o 
 ## measure: one view against the simulator's truth: decoding, depth, normals, time
 measure: deps $(BUILD)/measure_view
 	$(BUILD)/measure_view config/sim.ini config/sim-limit.ini config/sim-glossy.ini config/sim-concave.ini
+## measure-inverse: make measure with inverses for the finest 4, 3, 2 bits only, side by side (6 min)
+measure-inverse: deps $(BUILD)/measure_view
+	/usr/bin/python3 scripts/measure-inverse.py $(BUILD)
 
 # Intrinsic colour (issue 4): Jost et al.'s comparison reproduced on the simulator, written to
 # docs/colour-eval/ (table as Markdown and CSV, close-up PNGs of a view boundary). About 20 minutes.

@@ -105,6 +105,13 @@ for change in "views = 12|\\[scan\\] views = 8, not 12" "passes = 1|\\[scan\\] p
     [ ! -e "$out/other/view_010/view.ini" ] && [ ! -e "$out/other/view_016" ] ||
         fail "resume with $key touched the scan"
 done
+# the frames a view has ([scan] inverse_bits: fewer inverse patterns) are how it was taken too
+sed "s|^\[scan\]|[scan]\ninverse_bits = 3|" "$out/two.ini" > "$out/other.ini"
+"$bin" resume "$out/other" --config "$out/other.ini" >"$out/other.log" 2>&1
+rc=$?
+[ $rc -eq 2 ] && grep -q '\[scan\] inverse_bits = 0, not 3' "$out/other.log" &&
+    [ ! -e "$out/other/view_010/view.ini" ] ||
+    fail "resume with inverse_bits = 3: rc $rc, $(tail -n 2 "$out/other.log")"
 sed "s|^exposure_us = .*|exposure_us = 12000|" "$out/two.ini" > "$out/other.ini"
 "$bin" process "$ref" --config "$out/other.ini" --out "$out/other-processed" >"$out/other.log" 2>&1
 rc=$?

@@ -47,10 +47,23 @@ static struct scan_params params(void)
  * projector light), 5 dark paint, 6 saturated wherever the projector lights it, 7 normal but
  * for pixel 30, saturated in every frame. */
 static uint32_t render_code = GRAY_CODE_GRAY; /* how the projector codes its columns */
+static uint32_t render_inverse = 0;           /* its finest bits with an inverse (0: all) */
+
+static struct gray_layout layout_of(uint32_t bits)
+{
+    struct gray_layout l = {bits, 0, render_code, render_inverse};
+    return l;
+}
+
+static uint32_t pattern_count(uint32_t bits)
+{
+    struct gray_layout l = layout_of(bits);
+    return gray_layout_count(&l);
+}
 
 static void render(uint32_t pattern, uint32_t bits)
 {
-    struct gray_layout l = {bits, 0, render_code};
+    struct gray_layout l = layout_of(bits);
     for (uint32_t y = 0; y < H; y++) {
         for (uint32_t x = 0; x < W; x++) {
             int lit = gray_layout_lit(&l, pattern, x, 0);
@@ -70,7 +83,7 @@ static struct decode_maps maps_out;
 
 static int begin(struct scan_params *p, uint32_t bits)
 {
-    struct gray_layout l = {bits, 0, render_code};
+    struct gray_layout l = layout_of(bits);
     return decode_begin(&dec, p, &l, PROJ_W, 1);
 }
 
@@ -78,7 +91,7 @@ static void decode_all(uint32_t bits)
 {
     struct scan_params p = params();
     assert_int_equal(begin(&p, bits), 0);
-    for (uint32_t i = 0; i < gray_pattern_count(bits); i++) {
+    for (uint32_t i = 0; i < pattern_count(bits); i++) {
         render(i, bits);
         assert_int_equal(feed(i), 0);
     }
@@ -141,22 +154,24 @@ static void test_size_above_limit_rejected(void **state)
     assert_int_equal(begin(&p, 6), -EINVAL);
     p = params();
     assert_int_equal(begin(&p, 17), -EINVAL);
-    struct gray_layout too_many = {16, 16,
-                                   GRAY_CODE_GRAY}; /* more patterns than the frame store holds */
+    struct gray_layout too_many = {16, 16, GRAY_CODE_GRAY, 0}; /* more than the store holds */
     assert_int_equal(decode_begin(&dec, &p, &too_many, PROJ_W, 1), -EINVAL);
 }
 
 /* Every pattern of the synthetic scene, with pixel 10 of row 0 ambiguous in bit 0 and pixel 20
- * ambiguous in bits 0 and 1. */
+ * ambiguous in bits 0 and 1: the mean of white and black (201, 53) in those bits' frames. */
 static void feed_ambiguous_scene(uint32_t bits)
 {
-    for (uint32_t i = 0; i < gray_pattern_count(bits); i++) {
+    struct gray_layout l = layout_of(bits);
+    for (uint32_t i = 0; i < pattern_count(bits); i++) {
         render(i, bits);
-        uint32_t k = i >= 2 ? (i - 2) / 2 : 99;
+        int is_row, inverse;
+        uint32_t k = 99;
+        gray_layout_pattern(&l, i, &is_row, &k, &inverse);
         if (k == 0)
-            memset(&frame[3 * 10], 120, 3);
+            memset(&frame[3 * 10], 127, 3);
         if (k <= 1)
-            memset(&frame[3 * 20], 120, 3);
+            memset(&frame[3 * 20], 127, 3);
         assert_int_equal(feed(i), 0);
     }
 }
@@ -229,12 +244,12 @@ static void test_blocked_matches_reference(void **state)
     (void)state;
     uint32_t bits = gray_bits_for_width(PROJ_W);
     struct scan_params p = params();
-    struct gray_layout l = {bits, 0, render_code};
+    struct gray_layout l = layout_of(bits);
     assert_int_equal(decode_begin(&dec, &p, &l, PROJ_W, 1), 0);
     feed_ambiguous_scene(bits);
     assert_int_equal(decode_pixels(&dec, reason_out, &maps_out), 0);
     const uint8_t *frames[DECODE_MAX_PATTERNS];
-    for (uint32_t i = 0; i < gray_pattern_count(bits); i++)
+    for (uint32_t i = 0; i < pattern_count(bits); i++)
         frames[i] = decode_frame_slot(&dec, i);
     uint16_t col[W * H];
     uint8_t reason[W * H];
@@ -261,6 +276,37 @@ static void test_xor04_columns_and_reference(void **state)
     render_code = GRAY_CODE_GRAY;
 }
 
+/* Inverses for the finest 3 bits only ([scan] inverse_bits): the coarser bits read against the
+ * mean of white and black, three frames fewer, the same columns and reasons, blocked and plain
+ * alike; Gray and XOR-04. */
+static void test_fewer_inverses(void **state)
+{
+    uint32_t bits = gray_bits_for_width(PROJ_W);
+    render_inverse = 3;
+    assert_int_equal(pattern_count(bits), 2 + bits + 3);
+    for (render_code = GRAY_CODE_GRAY; render_code <= GRAY_CODE_XOR04; render_code++) {
+        test_columns_and_reasons(state);
+        test_ambiguous_bits(state);
+        test_blocked_matches_reference(state);
+    }
+    render_code = GRAY_CODE_GRAY;
+    render_inverse = 0;
+}
+
+/* A bit read against the mean: a quarter of the pair's threshold, rounded up. */
+static void test_mean_threshold(void **state)
+{
+    (void)state;
+    struct scan_params p = params();
+    assert_int_equal(decode_mean_threshold(&p, 100), 1); /* the pair's floor 4 */
+    p.read_noise_dn = 1.5;
+    p.electrons_per_dn = 20.0;
+    p.bit_noise_sigmas = 2.0;
+    assert_int_equal(decode_mean_threshold(&p, 100), 2); /* the pair's 7 */
+    p.min_bit_diff_dn = 12;
+    assert_int_equal(decode_mean_threshold(&p, 100), 3); /* the pair's 12 */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -273,6 +319,8 @@ int main(void)
         cmocka_unit_test(test_lone_wrong_code_inconsistent),
         cmocka_unit_test(test_blocked_matches_reference),
         cmocka_unit_test(test_xor04_columns_and_reference),
+        cmocka_unit_test(test_fewer_inverses),
+        cmocka_unit_test(test_mean_threshold),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

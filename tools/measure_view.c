@@ -3,6 +3,7 @@
 #include "test_util.h"
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
@@ -13,9 +14,15 @@ static double now_ms(void)
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
 }
 
+/* --inverse-bits N: every view with inverses for the finest N bits only ([scan] inverse_bits);
+ * -1: as each config says. */
+static long inverse_bits = -1;
+
 /* One view of the rig @p t (loaded, set as the table wants), measured and timed; 0 ok. */
 static int measure_rig(struct test_rig *t, struct view_quality *q, double *ms)
 {
+    if (inverse_bits >= 0)
+        t->cfg.scan.inverse_bits = (uint32_t)inverse_bits;
     if (test_rig_start(t) != 0)
         return 1;
     struct scan_view view;
@@ -179,9 +186,20 @@ static int table_concave(const char *config)
     return 0;
 }
 
-/* measure_view [CONFIG [LIMIT_CONFIG [HARD_CONFIG [CONCAVE_CONFIG]]]]; "-" leaves a table out. */
+/* measure_view [--inverse-bits N] [CONFIG [LIMIT_CONFIG [HARD_CONFIG [CONCAVE_CONFIG]]]]; "-"
+ * leaves a table out. */
 int main(int argc, char **argv)
 {
+    if (argc > 2 && strcmp(argv[1], "--inverse-bits") == 0) {
+        inverse_bits = strtol(argv[2], NULL, 10);
+        if (inverse_bits < 0 || inverse_bits > 16) {
+            fprintf(stderr, "measure_view: --inverse-bits 0..16 (0: every bit)\n");
+            return 2;
+        }
+        printf("Every view with [scan] inverse_bits = %ld\n", inverse_bits);
+        argc -= 2;
+        argv += 2;
+    }
     const char *config = argc > 1 ? argv[1] : "config/sim.ini";
     if (strcmp(config, "-") != 0 && table_objects(config) != 0)
         return 1;
