@@ -110,6 +110,16 @@ int api_may_use_rig(const struct web_server *s, const struct mg_connection *conn
     return guard_has_key(s, conn) || bearer(s, conn);
 }
 
+int api_send_png(struct mg_connection *conn, const void *png, size_t len)
+{
+    mg_printf(conn,
+              "HTTP/1.1 200 OK\r\nContent-Type: image/png\r\nContent-Length: %zu\r\n"
+              "Cache-Control: no-store\r\n\r\n",
+              len);
+    mg_write(conn, png, len);
+    return 200;
+}
+
 int api_send_body_error(struct mg_connection *conn, int status)
 {
     return api_send_error(conn, status,
@@ -465,11 +475,7 @@ static int send_thumb(struct mg_connection *conn, struct web_server *s, const ch
     int rc = report_thumb_png(dir, view, k, &png, &len);
     if (rc != 0)
         return api_send_error(conn, 404, "that view has no such picture (yet)");
-    mg_printf(conn,
-              "HTTP/1.1 200 OK\r\nContent-Type: image/png\r\nContent-Length: %zu\r\n"
-              "Cache-Control: no-store\r\n\r\n",
-              len);
-    mg_write(conn, png, len);
+    api_send_png(conn, png, len);
     free(png);
     return 200;
 }

@@ -30,6 +30,9 @@ int api_read_body(struct mg_connection *conn, cJSON **body);
 /** Send 403: a request that uses the rig without the session key. @retval 403 */
 int api_refuse_without_key(struct mg_connection *conn);
 
+/** Send @p len bytes of PNG, not to be cached. @retval 200 */
+int api_send_png(struct mg_connection *conn, const void *png, size_t len);
+
 /** Send what is wrong with a body api_read_body refused with @p status. @retval status */
 int api_send_body_error(struct mg_connection *conn, int status);
 

@@ -393,11 +393,7 @@ static int send_live(struct mg_connection *conn, struct web_server *s)
         free(png);
         return api_send_error(conn, 404, "no picture yet");
     }
-    mg_printf(conn,
-              "HTTP/1.1 200 OK\r\nContent-Type: image/png\r\nContent-Length: %zu\r\n"
-              "Cache-Control: no-store\r\n\r\n",
-              n);
-    mg_write(conn, png, n);
+    api_send_png(conn, png, n);
     free(png);
     return 200;
 }
