@@ -54,7 +54,13 @@ void outbuf_printf(struct outbuf *o, const char *fmt, ...)
 void outbuf_u32le(struct outbuf *o, uint32_t u)
 {
     uint8_t b[4] = {(uint8_t)u, (uint8_t)(u >> 8), (uint8_t)(u >> 16), (uint8_t)(u >> 24)};
-    outbuf_put(o, b, 4);
+    if (o->used + 4u > sizeof(chunk)) { /* the chunk's end: outbuf_put flushes it */
+        outbuf_put(o, b, 4);
+        return;
+    }
+    /* a mesh's every coordinate comes this way (16 million for make run's): straight in */
+    memcpy(chunk + o->used, b, 4);
+    o->used += 4;
 }
 
 void outbuf_f32le(struct outbuf *o, float f)
