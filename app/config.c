@@ -132,6 +132,9 @@ static const struct ini_key config_keys[] = {
         "the finest bits of each coordinate projected with their inverse; a coarser bit is read "
         "against the mean of white and black, a frame fewer each (0: every bit has its "
         "inverse; the projector's stored sequence changes: scanner patterns)"),
+    U32("scan", "threads", scan.threads, 0, HAL_MAX_THREADS, "0",
+        "the cores a view's decoding is split across (0: all there are); the result is the same "
+        "to the byte however many"),
     U32("scan", "refine", scan.refine, 0, 1, "1",
         "1: interpolate the projector column across each stripe (sub-stripe refinement)"),
     U32("scan", "normal_radius_px", scan.normal_radius_px, 1, 32, "4",

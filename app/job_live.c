@@ -138,7 +138,8 @@ static int save_view(struct pending *p)
     const struct hal *hal = j->hal;
     struct scan_view view;
     char detail[HAL_MAX_PATH + 160], fields[96];
-    int rc = scan_finish_view(j->scan, j->calib, p->info.angle_mdeg, &view, &p->info);
+    int rc =
+        scan_finish_view(j->scan, &j->hal->thread, j->calib, p->info.angle_mdeg, &view, &p->info);
     int rc_frames = flush_frames(j); /* nothing writes into the view's directory after this */
     if (rc == 0)
         rc = rc_frames;

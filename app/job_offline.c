@@ -209,7 +209,7 @@ static int load_view(struct job *j, const char *scan_dir, uint32_t v, struct sca
         return rc;
     }
     memset(info, 0, sizeof(*info));
-    return scan_finish_view(j->scan, j->calib, meta.angle_mdeg, view, info);
+    return scan_finish_view(j->scan, &j->hal->thread, j->calib, meta.angle_mdeg, view, info);
 }
 
 /* Stopped by request between views of the offline work: nothing is lost. */

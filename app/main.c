@@ -11,6 +11,7 @@
 #include "patterns.h"
 #include "report.h"
 #include "storage_posix.h"
+#include "thread_posix.h"
 
 #include <errno.h>
 #include <signal.h>
@@ -146,6 +147,7 @@ static int cmd_process(const char *scan_dir, const struct scan_job_opts *opts)
     rig_install_signals();
     storage_posix_init(&hal.storage);
     clock_posix_init(&hal.clock);
+    thread_posix_init(&hal.thread, 0); /* [scan] threads limits it */
     return scan_job_process(&hal, scan_dir, opts) == 0 ? 0 : 1;
 }
 

@@ -50,7 +50,7 @@ __attribute__((noinline)) void process_view_once(struct test_rig *t, const uint8
                              .height = t->cfg.scan.height,
                              .rgb = rgb,
                              .confidence = confidence};
-    decode_finish(&sc->decode, reason, &view.maps);
+    decode_finish(&sc->decode, NULL, reason, &view.maps); /* one thread: the stage's own cost */
     s[2] = now_ms();
     refine_columns(&view.maps, (int)t->cfg.scan.refine, sc->column);
     view.column = sc->column;

@@ -8,6 +8,7 @@
 #include "clock_posix.h"
 #include "gpio_gpiod.h"
 #include "storage_posix.h"
+#include "thread_posix.h"
 #include "turntable_modbus.h"
 #ifdef HAVE_LIBCAMERA
 #include "camera_libcamera.h"
@@ -77,6 +78,7 @@ int board_init(struct hal *hal, const struct board_config *cfg, const struct sca
 {
     clock_posix_init(&hal->clock);
     storage_posix_init(&hal->storage);
+    thread_posix_init(&hal->thread, 0); /* [scan] threads limits it */
     /* Camera first: a camera that fails leaves no GPIO line requested. */
     int rc = camera_init(hal, cfg, err, err_len);
     if (rc != 0)

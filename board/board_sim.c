@@ -10,6 +10,7 @@
 #include "pty_link.h"
 #include "sim_config.h"
 #include "storage_posix.h"
+#include "thread_posix.h"
 #include "tt_server.h"
 #include "turntable_modbus.h"
 
@@ -123,6 +124,7 @@ int board_init(struct hal *hal, const struct board_config *cfg, const struct sca
     sim.camera.frame_rate_hz = cfg->sim->frame_rate_hz;
     sim.camera.readout_us = cfg->sim->readout_us;
     storage_posix_init(&hal->storage);
+    thread_posix_init(&hal->thread, 0); /* [scan] threads limits it */
     sim.ready = 1;
     rc = start_turntable(hal, cfg, err, err_len);
     if (rc != 0)

@@ -225,7 +225,7 @@ static int load_board_view(struct solve *s, struct board_view *bv)
         return rc == -ENOENT ? 0 : rc;
     }
     struct decode_maps maps;
-    if ((rc = decode_finish(&scan_job_views()->decode, reason, &maps)) != 0)
+    if ((rc = decode_finish(&scan_job_views()->decode, NULL, reason, &maps)) != 0)
         return rc;
     if (maps.row == NULL) {
         say(s, "view_%03u: no projector rows were captured: camera only\n", (unsigned)bv->view);
@@ -1335,7 +1335,7 @@ static int solve_lights(struct solve *s)
         struct scan_view view;
         struct scan_view_info info;
         if ((rc = feed_patterns(s, dir, v, &s->out)) != 0 ||
-            (rc = scan_finish_view(scan_job_views(), &s->out, 0, &view, &info)) != 0)
+            (rc = scan_finish_view(scan_job_views(), NULL, &s->out, 0, &view, &info)) != 0)
             break;
         vec3 centre;
         uint32_t used;

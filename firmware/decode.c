@@ -102,13 +102,13 @@ int decode_frame(struct decode_ctx *d, uint32_t pattern, const uint8_t *grey)
  * compared with the pixel's own threshold, and a pair is saturated when both frames reached
  * DECODE_SATURATED (one saturated frame still says which is brighter). decode_reference is the
  * same, plainly. */
-static void accumulate(struct decode_ctx *d, int is_row, uint32_t bits, size_t start, size_t len,
-                       const uint8_t *threshold, uint16_t *code, uint16_t *unclear,
-                       uint8_t *both_saturated)
+static void accumulate(const struct decode_ctx *d, struct decode_block *blk, int is_row,
+                       uint32_t bits, size_t start, size_t len, const uint8_t *threshold,
+                       uint16_t *code, uint16_t *unclear, uint8_t *both_saturated)
 {
     const uint16_t xor_mask = (uint16_t)gray_code_xor_mask(d->layout.code, bits);
-    uint8_t *plane_hi = d->block.plane_hi, *plane_lo = d->block.plane_lo;
-    uint8_t *unclear_hi = d->block.unclear_hi, *unclear_lo = d->block.unclear_lo;
+    uint8_t *plane_hi = blk->plane_hi, *plane_lo = blk->plane_lo;
+    uint8_t *unclear_hi = blk->unclear_hi, *unclear_lo = blk->unclear_lo;
     memset(plane_hi, 0, len);
     memset(plane_lo, 0, len);
     memset(unclear_hi, 0, len);
@@ -119,9 +119,8 @@ static void accumulate(struct decode_ctx *d, int is_row, uint32_t bits, size_t s
         gray_layout_bit(&d->layout, is_row, k, &stripes, &inverse);
         /* a bit without its inverse is read against the mean of white and black */
         const uint8_t *restrict pos = d->frame_store[stripes] + start;
-        const uint8_t *restrict neg =
-            inverse >= 0 ? d->frame_store[inverse] + start : d->block.mean;
-        const uint8_t *restrict thr = inverse >= 0 ? threshold : d->block.mean_threshold;
+        const uint8_t *restrict neg = inverse >= 0 ? d->frame_store[inverse] + start : blk->mean;
+        const uint8_t *restrict thr = inverse >= 0 ? threshold : blk->mean_threshold;
         uint8_t *restrict plane = k < 8 ? plane_hi : plane_lo;
         uint8_t *restrict unc = k < 8 ? unclear_hi : unclear_lo;
         uint8_t *restrict sat = both_saturated;
@@ -185,14 +184,15 @@ static uint8_t classify(const struct scan_params *p, int white, int black, int b
     return out_of_range ? SCAN_INCONSISTENT : SCAN_VALID;
 }
 
-static void decode_block(struct decode_ctx *d, size_t start, size_t len, uint8_t *reason)
+static void decode_block(struct decode_ctx *d, struct decode_block *blk, size_t start, size_t len,
+                         uint8_t *reason)
 {
-    uint16_t *code_col = d->block.code_col, *code_row = d->block.code_row;
-    uint8_t *threshold = d->block.threshold, *sat = d->block.sat;
+    uint16_t *code_col = blk->code_col, *code_row = blk->code_row;
+    uint8_t *threshold = blk->threshold, *sat = blk->sat;
     const uint8_t *white = d->frame_store[GRAY_PATTERN_WHITE] + start;
     const uint8_t *black = d->frame_store[GRAY_PATTERN_BLACK] + start;
     const struct gray_layout *l = &d->layout;
-    uint8_t *mean = d->block.mean, *mean_threshold = d->block.mean_threshold;
+    uint8_t *mean = blk->mean, *mean_threshold = blk->mean_threshold;
     for (size_t i = 0; i < len; i++) {
         uint8_t contrast = (uint8_t)(white[i] > black[i] ? white[i] - black[i] : 0);
         threshold[i] = d->bit_threshold[contrast];
@@ -200,9 +200,11 @@ static void decode_block(struct decode_ctx *d, size_t start, size_t len, uint8_t
         mean[i] = (uint8_t)(((unsigned)white[i] + black[i] + 1u) >> 1);
         sat[i] = 0;
     }
-    accumulate(d, 0, l->col_bits, start, len, threshold, code_col, d->unclear_col + start, sat);
+    accumulate(d, blk, 0, l->col_bits, start, len, threshold, code_col, d->unclear_col + start,
+               sat);
     if (l->row_bits > 0)
-        accumulate(d, 1, l->row_bits, start, len, threshold, code_row, d->unclear_row + start, sat);
+        accumulate(d, blk, 1, l->row_bits, start, len, threshold, code_row, d->unclear_row + start,
+                   sat);
     else
         memset(d->unclear_row + start, 0, len * sizeof(uint16_t));
     /* Locals: the stores to reason[] (bytes) may alias anything, and would make the compiler
@@ -220,13 +222,34 @@ static void decode_block(struct decode_ctx *d, size_t start, size_t len, uint8_t
     }
 }
 
-int decode_pixels(struct decode_ctx *d, uint8_t *reason, struct decode_maps *maps)
+/* Part @p k of @p parts of the pixels, whole blocks, with the accumulators of its own. */
+struct pixel_parts {
+    struct decode_ctx *d;
+    uint8_t *reason;
+    size_t pixels;
+    unsigned parts;
+};
+
+static void decode_part(void *arg, unsigned k)
+{
+    const struct pixel_parts *p = arg;
+    size_t blocks = (p->pixels + DECODE_BLOCK - 1u) / DECODE_BLOCK;
+    for (size_t b = blocks * k / p->parts; b < blocks * (k + 1u) / p->parts; b++) {
+        size_t start = b * DECODE_BLOCK, left = p->pixels - start;
+        decode_block(p->d, &p->d->block[k], start, left < DECODE_BLOCK ? left : DECODE_BLOCK,
+                     p->reason);
+    }
+}
+
+int decode_pixels(struct decode_ctx *d, const struct hal_thread *threads, uint8_t *reason,
+                  struct decode_maps *maps)
 {
     if (d->next_pattern != gray_layout_count(&d->layout))
         return -EINVAL;
-    size_t n = (size_t)d->params.width * d->params.height;
-    for (size_t start = 0; start < n; start += DECODE_BLOCK)
-        decode_block(d, start, n - start < DECODE_BLOCK ? n - start : DECODE_BLOCK, reason);
+    /* every pixel on its own: the same maps however the pixels are split */
+    struct pixel_parts p = {d, reason, (size_t)d->params.width * d->params.height,
+                            hal_thread_count(threads)};
+    hal_thread_run(threads, p.parts, decode_part, &p);
     maps->column = d->column_map;
     maps->row = d->layout.row_bits > 0 ? d->row_map : NULL;
     maps->reason = reason;
@@ -329,12 +352,24 @@ static int nearest_reading(uint32_t code, uint32_t bits, uint16_t plain, uint16_
  * Verdicts go to d->scratch and corrections wait in the unclear maps (not needed after this) until
  * the pass ends, so that what this pass changes is not the reference of others. */
 #define RESOLVE_CORRECTED SCAN_REASON_COUNT /* in d->scratch: valid, its reading replaced */
-static void resolve_unclear(struct decode_ctx *d, uint8_t *reason)
+
+/* Rows of a neighbourhood stage split into parts (every pixel's verdict is its own: the same
+ * maps however many). */
+struct row_parts {
+    struct decode_ctx *d;
+    uint8_t *reason;
+    unsigned parts;
+};
+
+static void resolve_rows(void *arg, unsigned k)
 {
+    const struct row_parts *p = arg;
+    struct decode_ctx *d = p->d;
+    const uint8_t *reason = p->reason;
     const uint32_t w = d->params.width, h = d->params.height;
     const uint32_t max_unclear = d->params.max_unclear_bits;
     const int rows = d->layout.row_bits > 0;
-    for (uint32_t y = 0; y < h; y++) {
+    for (uint32_t y = h * k / p->parts; y < h * (k + 1u) / p->parts; y++) {
         for (uint32_t x = 0; x < w; x++) {
             size_t i = (size_t)y * w + x;
             uint8_t r = reason[i];
@@ -365,7 +400,18 @@ static void resolve_unclear(struct decode_ctx *d, uint8_t *reason)
             }
         }
     }
-    size_t n = (size_t)w * h;
+}
+
+/* A pixel with unclear bits takes, of its possible readings, the one its decoded neighbourhood
+ * predicts: one with more than max_ambiguous_bits (or decoding outside the projector) becomes
+ * valid so; a valid one whose unclear bit read the wrong way (noise, not an edge) is corrected.
+ * Verdicts go to d->scratch and corrections wait in the unclear maps (not needed after this) until
+ * the pass ends, so that what this pass changes is not the reference of others. */
+static void resolve_unclear(struct decode_ctx *d, const struct hal_thread *threads, uint8_t *reason)
+{
+    struct row_parts p = {d, reason, hal_thread_count(threads)};
+    hal_thread_run(threads, p.parts, resolve_rows, &p);
+    size_t n = (size_t)d->params.width * d->params.height;
     for (size_t i = 0; i < n; i++) {
         if (d->scratch[i] == RESOLVE_CORRECTED) {
             d->column_map[i] = d->unclear_col[i];
@@ -385,14 +431,13 @@ static int codes_agree(const struct decode_ctx *d, const uint8_t *reason, size_t
             within(d->row_map[a], d->row_map[b], d->params.max_column_jump));
 }
 
-/* A wrong bit makes a lone jump: a pixel is inconsistent when more of its valid neighbours
- * disagree with it than agree, or when fewer than min_consistent_neighbours agree and none of
- * its 5 x 5 neighbourhood backs it. A pixel with only a few valid neighbours, all agreeing (on
- * a thin part, beside a shadow), is kept: alone is not wrong. Columns and, when coded, rows. */
-static void check_neighbours(struct decode_ctx *d, uint8_t *reason)
+static void check_rows(void *arg, unsigned k)
 {
+    const struct row_parts *p = arg;
+    struct decode_ctx *d = p->d;
+    const uint8_t *reason = p->reason;
     const uint32_t w = d->params.width, h = d->params.height;
-    for (uint32_t y = 0; y < h; y++) {
+    for (uint32_t y = h * k / p->parts; y < h * (k + 1u) / p->parts; y++) {
         for (uint32_t x = 0; x < w; x++) {
             size_t i = (size_t)y * w + x;
             d->scratch[i] = reason[i];
@@ -421,15 +466,27 @@ static void check_neighbours(struct decode_ctx *d, uint8_t *reason)
                 d->scratch[i] = SCAN_INCONSISTENT;
         }
     }
-    memcpy(reason, d->scratch, (size_t)w * h);
 }
 
-int decode_finish(struct decode_ctx *d, uint8_t *reason, struct decode_maps *maps)
+/* A wrong bit makes a lone jump: a pixel is inconsistent when more of its valid neighbours
+ * disagree with it than agree, or when fewer than min_consistent_neighbours agree and none of
+ * its 5 x 5 neighbourhood backs it. A pixel with only a few valid neighbours, all agreeing (on
+ * a thin part, beside a shadow), is kept: alone is not wrong. Columns and, when coded, rows. */
+static void check_neighbours(struct decode_ctx *d, const struct hal_thread *threads,
+                             uint8_t *reason)
 {
-    int rc = decode_pixels(d, reason, maps);
+    struct row_parts p = {d, reason, hal_thread_count(threads)};
+    hal_thread_run(threads, p.parts, check_rows, &p);
+    memcpy(reason, d->scratch, (size_t)d->params.width * d->params.height);
+}
+
+int decode_finish(struct decode_ctx *d, const struct hal_thread *threads, uint8_t *reason,
+                  struct decode_maps *maps)
+{
+    int rc = decode_pixels(d, threads, reason, maps);
     if (rc == 0) {
-        resolve_unclear(d, reason);
-        check_neighbours(d, reason);
+        resolve_unclear(d, threads, reason);
+        check_neighbours(d, threads, reason);
     }
     return rc;
 }

@@ -6,6 +6,7 @@
 #define DECODE_H
 
 #include "gray.h"
+#include "hal_thread.h"
 #include "scan_types.h"
 
 #include <stddef.h>
@@ -46,13 +47,13 @@ struct decode_ctx {
     uint16_t unclear_col[HAL_MAX_PIXELS]; /* bit k: Gray bit k of the column was unclear */
     uint16_t unclear_row[HAL_MAX_PIXELS];
     uint8_t scratch[HAL_MAX_PIXELS]; /* the neighbourhood stages' verdicts, applied after */
-    struct {                         /* one block's accumulators */
+    struct decode_block {            /* one block's accumulators, one set a thread */
         uint16_t code_col[DECODE_BLOCK], code_row[DECODE_BLOCK];
         uint8_t threshold[DECODE_BLOCK], sat[DECODE_BLOCK];
         uint8_t mean[DECODE_BLOCK], mean_threshold[DECODE_BLOCK]; /* bits without inverse */
         uint8_t plane_hi[DECODE_BLOCK], plane_lo[DECODE_BLOCK];
         uint8_t unclear_hi[DECODE_BLOCK], unclear_lo[DECODE_BLOCK];
-    } block;
+    } block[HAL_MAX_THREADS];
     struct scan_params params;
     struct gray_layout layout;
     uint32_t proj_width, proj_height;
@@ -95,12 +96,16 @@ uint8_t *decode_frame_slot(struct decode_ctx *d, uint32_t pattern);
 int decode_frame(struct decode_ctx *d, uint32_t pattern, const uint8_t *grey);
 /** Decode every pixel from the kept frames (decode_pixels); then pixels with several unclear
  *  bits take the reading their neighbourhood agrees with; then the neighbour check.
+ *  @param threads  the cores to split the pixels across (NULL: this thread alone); the result
+ *  is the same to the byte however many
  *  @param reason  out: enum scan_reason per pixel (width * height, the caller's buffer)
  *  @param maps    out: the decoder's column and row maps, and @p reason
  *  @retval 0 ok @retval -EINVAL frames missing */
-int decode_finish(struct decode_ctx *d, uint8_t *reason, struct decode_maps *maps);
+int decode_finish(struct decode_ctx *d, const struct hal_thread *threads, uint8_t *reason,
+                  struct decode_maps *maps);
 /** The per-pixel stage of decode_finish alone (for tests and benchmarks); same parameters. */
-int decode_pixels(struct decode_ctx *d, uint8_t *reason, struct decode_maps *maps);
+int decode_pixels(struct decode_ctx *d, const struct hal_thread *threads, uint8_t *reason,
+                  struct decode_maps *maps);
 
 /** The plain per-pixel reference the blocked decoder must match (tests compare them): decode
  *  @p n pixels of @p frames (one pointer per pattern of @p layout) into @p column, @p row

@@ -234,9 +234,16 @@ int scan_feed_light_frame(struct scan_ctx *s, uint32_t k, const uint8_t *rgb)
     return 0;
 }
 
-int scan_finish_view(struct scan_ctx *s, const struct scan_calib *c, int32_t angle_mdeg,
-                     struct scan_view *view, struct scan_view_info *info)
+int scan_finish_view(struct scan_ctx *s, const struct hal_thread *threads,
+                     const struct scan_calib *c, int32_t angle_mdeg, struct scan_view *view,
+                     struct scan_view_info *info)
 {
+    /* the platform's cores, as many as [scan] threads allows (0: all of them) */
+    struct hal_thread cores = {0};
+    if (threads != NULL)
+        cores = *threads;
+    if (s->params.threads > 0 && s->params.threads < cores.threads)
+        cores.threads = s->params.threads;
     memset(view, 0, sizeof(*view));
     view->width = s->params.width;
     view->height = s->params.height;
@@ -246,7 +253,7 @@ int scan_finish_view(struct scan_ctx *s, const struct scan_calib *c, int32_t ang
         view->lights[k] = s->light_present[k] ? s->light_rgb[k] : NULL;
     view->rgb = s->view_rgb;
     view->confidence = s->view_confidence;
-    int rc = decode_finish(&s->decode, s->view_reason, &view->maps);
+    int rc = decode_finish(&s->decode, &cores, s->view_reason, &view->maps);
     if (rc == 0)
         rc = refine_columns(&view->maps, (int)s->params.refine, s->column);
     view->column = s->column;
@@ -484,7 +491,7 @@ int scan_take_view(struct scan_ctx *s, const struct hal *hal, const struct scan_
                    struct scan_view_info *info)
 {
     int rc = scan_capture_view(s, hal, p, c, angle_mdeg, sink, info);
-    return rc != 0 ? rc : scan_finish_view(s, c, angle_mdeg, view, info);
+    return rc != 0 ? rc : scan_finish_view(s, &hal->thread, c, angle_mdeg, view, info);
 }
 
 int scan_keep_for_registration(struct reg_ctx *reg, uint32_t index, const struct scan_view *view)

@@ -73,6 +73,7 @@ struct scan_params {
     uint32_t refine;            /**< 1: sub-stripe refinement of the columns (refine.h) */
     uint32_t decode_rows;       /**< 1: projector rows are coded too (more patterns) */
     uint32_t inverse_bits;      /**< the finest bits projected with their inverse (0: every bit) */
+    uint32_t threads;           /**< cores a view's per-pixel stages split across (0: all) */
     uint32_t code;              /**< enum gray_code: Gray, or XOR-04 (robust to interreflection) */
     uint32_t normal_radius_px;  /**< normals span up to this many pixels each side */
     uint32_t pattern_settle_us; /**< wait after the projector changes pattern */

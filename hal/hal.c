@@ -161,3 +161,21 @@ int hal_should_stop(const struct hal *hal)
 {
     return hal->stop_requested != NULL && hal->stop_requested();
 }
+
+unsigned hal_thread_count(const struct hal_thread *t)
+{
+    if (t == NULL || t->ops == NULL || t->threads <= 1)
+        return 1;
+    return t->threads < HAL_MAX_THREADS ? t->threads : HAL_MAX_THREADS;
+}
+
+void hal_thread_run(const struct hal_thread *t, unsigned count, hal_thread_fn fn, void *arg)
+{
+    unsigned threads = hal_thread_count(t);
+    if (threads > 1 && count > 1) {
+        t->ops->run(t->priv, threads, count, fn, arg);
+        return;
+    }
+    for (unsigned k = 0; k < count; k++)
+        fn(arg, k);
+}

@@ -95,7 +95,7 @@ static void decode_all(uint32_t bits)
         render(i, bits);
         assert_int_equal(feed(i), 0);
     }
-    assert_int_equal(decode_finish(&dec, reason_out, &maps_out), 0);
+    assert_int_equal(decode_finish(&dec, NULL, reason_out, &maps_out), 0);
 }
 
 static void test_columns_and_reasons(void **state)
@@ -143,7 +143,8 @@ static void test_frames_out_of_order_rejected(void **state)
     render(0, 6);
     assert_int_equal(feed(1), -EINVAL);
     assert_int_equal(feed(0), 0);
-    assert_int_equal(decode_finish(&dec, reason_out, &maps_out), -EINVAL); /* frames missing */
+    assert_int_equal(decode_finish(&dec, NULL, reason_out, &maps_out),
+                     -EINVAL); /* frames missing */
 }
 
 static void test_size_above_limit_rejected(void **state)
@@ -186,7 +187,7 @@ static void test_ambiguous_bits(void **state)
     struct scan_params p = params();
     assert_int_equal(begin(&p, bits), 0);
     feed_ambiguous_scene(bits);
-    assert_int_equal(decode_finish(&dec, reason_out, &maps_out), 0);
+    assert_int_equal(decode_finish(&dec, NULL, reason_out, &maps_out), 0);
     const struct decode_maps *m = &maps_out;
     assert_int_equal(m->reason[10], SCAN_VALID);
     assert_int_equal(m->reason[20], SCAN_VALID);
@@ -194,7 +195,7 @@ static void test_ambiguous_bits(void **state)
     p.max_unclear_bits = 1;
     assert_int_equal(begin(&p, bits), 0);
     feed_ambiguous_scene(bits);
-    assert_int_equal(decode_finish(&dec, reason_out, &maps_out), 0);
+    assert_int_equal(decode_finish(&dec, NULL, reason_out, &maps_out), 0);
     assert_int_equal(m->reason[10], SCAN_VALID);
     assert_int_equal(m->reason[20], SCAN_LOW_CONTRAST);
 }
@@ -231,7 +232,7 @@ static void test_lone_wrong_code_inconsistent(void **state)
         }
         assert_int_equal(feed(i), 0);
     }
-    assert_int_equal(decode_finish(&dec, reason_out, &maps_out), 0);
+    assert_int_equal(decode_finish(&dec, NULL, reason_out, &maps_out), 0);
     const struct decode_maps *m = &maps_out;
     assert_int_equal(m->reason[2 * W + 10], SCAN_INCONSISTENT);
     assert_int_equal(m->reason[2 * W + 11], SCAN_VALID);
@@ -247,7 +248,7 @@ static void test_blocked_matches_reference(void **state)
     struct gray_layout l = layout_of(bits);
     assert_int_equal(decode_begin(&dec, &p, &l, PROJ_W, 1), 0);
     feed_ambiguous_scene(bits);
-    assert_int_equal(decode_pixels(&dec, reason_out, &maps_out), 0);
+    assert_int_equal(decode_pixels(&dec, NULL, reason_out, &maps_out), 0);
     const uint8_t *frames[DECODE_MAX_PATTERNS];
     for (uint32_t i = 0; i < pattern_count(bits); i++)
         frames[i] = decode_frame_slot(&dec, i);

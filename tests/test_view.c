@@ -12,6 +12,7 @@
 
 #include "gray.h"
 #include "test_util.h"
+#include "thread_posix.h"
 
 /* One view of the rig @p t (loaded, its settings as the test wants them), measured. */
 static void take_and_measure(struct test_rig *t, struct view_quality *q,
@@ -187,7 +188,7 @@ static void blocked_matches_reference(uint32_t inverse_bits, uint32_t patterns)
     static uint8_t pixel_reason[HAL_MAX_PIXELS];
     struct decode_maps pixel_maps;
     /* again, without the neighbour check */
-    assert_int_equal(decode_pixels(&t.scan->decode, pixel_reason, &pixel_maps), 0);
+    assert_int_equal(decode_pixels(&t.scan->decode, NULL, pixel_reason, &pixel_maps), 0);
     const struct decode_maps *m = &pixel_maps;
     size_t n = (size_t)m->width * m->height;
     static uint16_t col[HAL_MAX_PIXELS], row[HAL_MAX_PIXELS];
@@ -216,6 +217,43 @@ static void test_blocked_decoder_matches_reference(void **state)
 {
     (void)state;
     blocked_matches_reference(0, 42);
+}
+
+/* The decode split across threads (hal_thread, POSIX threads; 1 to 8, more than this machine's
+ * cores too) gives the maps of one thread to the byte: columns, rows, reasons. */
+static void test_threads_decode_the_same(void **state)
+{
+    (void)state;
+    static struct test_rig t;
+    assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
+    snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "mesh");
+    t.cfg.scan.decode_rows = 1;
+    assert_int_equal(test_rig_start(&t), 0);
+    struct scan_view view;
+    struct scan_view_info info;
+    assert_int_equal(scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info),
+                     0);
+    static uint8_t reason1[HAL_MAX_PIXELS], reason[HAL_MAX_PIXELS];
+    static uint16_t col1[HAL_MAX_PIXELS], row1[HAL_MAX_PIXELS];
+    struct decode_maps m;
+    assert_int_equal(decode_finish(&t.scan->decode, NULL, reason1, &m), 0);
+    size_t n = (size_t)m.width * m.height, valid = 0;
+    memcpy(col1, m.column, n * sizeof(uint16_t));
+    memcpy(row1, m.row, n * sizeof(uint16_t));
+    for (size_t i = 0; i < n; i++)
+        valid += reason1[i] == SCAN_VALID;
+    for (unsigned threads = 2; threads <= HAL_MAX_THREADS; threads *= 2) {
+        struct hal_thread cores;
+        thread_posix_init(&cores, threads);
+        assert_int_equal(cores.threads, threads);
+        assert_int_equal(decode_finish(&t.scan->decode, &cores, reason, &m), 0);
+        assert_memory_equal(reason, reason1, n);
+        assert_memory_equal(m.column, col1, n * sizeof(uint16_t));
+        assert_memory_equal(m.row, row1, n * sizeof(uint16_t));
+    }
+    test_rig_stop(&t);
+    print_message("%zu valid pixels, the same maps on 1, 2, 4 and 8 threads\n", valid);
+    assert_true(valid > 100000);
 }
 
 /* Inverses for the finest 3 bits only ([scan] inverse_bits = 3: 28 patterns with rows, 15
@@ -289,6 +327,7 @@ int main(void)
         cmocka_unit_test(test_dark_paint_with_hdr_and_highlights),
         cmocka_unit_test(test_interreflection_gray_against_xor04),
         cmocka_unit_test(test_blocked_decoder_matches_reference),
+        cmocka_unit_test(test_threads_decode_the_same),
         cmocka_unit_test(test_fewer_inverses),
         cmocka_unit_test(test_two_scan_contexts_are_independent),
     };

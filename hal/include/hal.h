@@ -7,6 +7,7 @@
 #include "hal_gpio.h"
 #include "hal_limits.h"
 #include "hal_storage.h"
+#include "hal_thread.h"
 #include "hal_turntable.h"
 
 enum hal_log_level { HAL_LOG_ERROR = 0, HAL_LOG_WARN, HAL_LOG_INFO, HAL_LOG_DEBUG };
@@ -18,6 +19,7 @@ struct hal {
     struct hal_turntable turntable;
     struct hal_clock clock;
     struct hal_storage storage;
+    struct hal_thread thread; /**< the cores beside the rig's thread (optional: one thread) */
     /** printf-style logger (required). */
     void (*log)(enum hal_log_level level, const char *fmt, ...)
         __attribute__((format(printf, 2, 3)));

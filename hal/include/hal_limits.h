@@ -89,6 +89,9 @@
 #define ALIGN_MAX_POINTS 150000u
 #define ALIGN_MAX_CELLS (1u << 21)
 #endif
+/* Threads a per-pixel stage may use (hal_thread.h): [scan] threads is checked against it. */
+#define HAL_MAX_THREADS 8u
+
 /* Largest stack frame a firmware/ function may have (gcc -fstack-usage, checked by make test:
  * scripts/check-stack.sh); big state lives in static buffers, never on the stack. */
 #define HAL_STACK_FRAME_MAX 2048u

@@ -11,4 +11,11 @@
  *  @retval 0 @retval -errno (the caller's signal mask is as it was) */
 int thread_posix_start(pthread_t *thread, size_t stack_bytes, void *(*fn)(void *), void *arg);
 
+struct hal_thread;
+
+/** The firmware's parallel loop (hal_thread.h) on POSIX threads: @p threads of them (0: the
+ *  cores online), the caller's and workers started here, at set-up, and kept (a scan starts
+ *  none: that would allocate). Loops from several threads take turns. */
+void thread_posix_init(struct hal_thread *t, unsigned threads);
+
 #endif

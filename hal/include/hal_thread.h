@@ -1,0 +1,30 @@
+/* The board's cores for the firmware's per-pixel stages: a parallel loop the platform runs on
+ * its threads (POSIX: hal/posix/thread_posix.c), or one item after another where it has none. */
+#ifndef HAL_THREAD_H
+#define HAL_THREAD_H
+
+/** One item of a parallel loop: @p k of the loop's count. Items write disjoint memory. */
+typedef void (*hal_thread_fn)(void *arg, unsigned k);
+
+struct hal_thread_ops {
+    /** Run @p fn(@p arg, k) for every k below @p count on up to @p threads threads (the
+     *  calling one among them: all of them on it when no other can be started) and return
+     *  once every item has run. */
+    void (*run)(void *priv, unsigned threads, unsigned count, hal_thread_fn fn, void *arg);
+};
+
+/** The cores the firmware may use. @c ops NULL (or @c threads 1): one thread. */
+struct hal_thread {
+    const struct hal_thread_ops *ops;
+    void *priv;
+    unsigned threads; /**< at most HAL_MAX_THREADS */
+};
+
+/** Items a per-pixel stage splits into: one a thread (1 when @p t is NULL or has no ops). */
+unsigned hal_thread_count(const struct hal_thread *t);
+
+/** Run @p fn for k = 0 .. @p count - 1 on @p t's threads, or one after another here (@p t
+ *  NULL, no ops, one thread); every item has run when it returns. */
+void hal_thread_run(const struct hal_thread *t, unsigned count, hal_thread_fn fn, void *arg);
+
+#endif
