@@ -29,8 +29,9 @@ static int save_results(struct job *j, uint32_t v, const struct scan_view *view,
         rc = scan_dir_path(path, sizeof(path), j->out_dir, (int)v, SCAN_FILE_CLOUD);
     if (rc == 0)
         rc = scan_save_cloud(j->hal, view, &pose, path); /* says what failed itself */
+    struct hal_thread cores = scan_cores(&j->hal->thread, &j->cfg->scan);
     if (rc == 0)
-        rc = scan_fuse_view(j->vol, j->calib, view, &pose);
+        rc = scan_fuse_view(j->vol, &cores, j->calib, view, &pose);
     return rc;
 }
 

@@ -108,7 +108,7 @@ int main(int argc, char **argv)
                 return 1;
             }
             double t0 = cpu_ms();
-            scan_fuse_view(&vol, &calib, &view, &pose);
+            scan_fuse_view(&vol, NULL, &calib, &view, &pose);
             integrate += cpu_ms() - t0;
             if (run == 0) {
                 const double *r = pose.rot;

@@ -65,7 +65,7 @@ __attribute__((noinline)) void process_view_once(struct test_rig *t, const uint8
     s[6] = now_ms();
     struct frame_xform pose;
     frame_object_from_camera(&t->calib, view.angle_mdeg, &pose);
-    scan_fuse_view(&volume, &t->calib, &view, &pose);
+    scan_fuse_view(&volume, NULL, &t->calib, &view, &pose);
     s[7] = now_ms();
     scan_save_cloud_at_turntable_pose(t, &view, "build/bench_view.ply");
     s[8] = now_ms();

@@ -274,26 +274,29 @@ static void integrate_run(struct fusion_volume *vol, const struct scan_calib *c,
     }
 }
 
-int fusion_integrate(struct fusion_volume *vol, const struct scan_calib *c,
-                     const struct frame_xform *obj_from_cam, const struct decode_maps *m,
-                     const struct tri_range *r, const uint8_t *rgb, const float *confidence)
+/* The marked runs of slices z0 .. z1 of the grid, row by row in memory order. */
+struct slices {
+    struct fusion_volume *vol;
+    const struct scan_calib *c;
+    const struct frame_xform *obj_from_cam;
+    const struct decode_maps *m;
+    const struct tri_range *r;
+    const uint8_t *rgb;
+    const float *confidence;
+    vec3 step_x;
+    uint32_t nb[3];
+    int pinhole;
+    unsigned parts;
+};
+
+static void integrate_slices(void *arg, unsigned k)
 {
-    if (!pixel_weights(vol, c, m, r))
-        return 0;
-    const uint32_t *dims = vol->dims;
-    const uint32_t nb[3] = {(dims[0] + BLOCK - 1) / BLOCK, (dims[1] + BLOCK - 1) / BLOCK,
-                            (dims[2] + BLOCK - 1) / BLOCK};
-    const int pinhole = lens_is_pinhole(c->cam_dist); /* the voxel loop's common case, inline */
-    const vec3 step_x = m3_tmul(obj_from_cam->rot, v3(vol->p.voxel_mm, 0, 0));
-    if (!mark_blocks(vol, obj_from_cam, m, r, nb))
-        return 0;
-    /* a point's band reaches truncation / voxel voxels (and one for rounding) from its block */
-    double band = vol->p.truncation_mm / vol->p.voxel_mm + 1.0;
-    grow_blocks(vol, nb, (uint32_t)ceil(band / BLOCK));
-    /* Row by row in the grid's memory order; along a row, each run of marked blocks at once. */
-    for (uint32_t z = 0; z < dims[2]; z++)
+    const struct slices *s = arg;
+    const uint32_t *dims = s->vol->dims, *nb = s->nb;
+    for (uint32_t z = dims[2] * k / s->parts; z < dims[2] * (k + 1u) / s->parts; z++)
         for (uint32_t y = 0; y < dims[1]; y++) {
-            const uint8_t *marks = &vol->block_mark[bidx(nb, 0, y / BLOCK, z / BLOCK)];
+            const uint8_t *marks = &s->vol->block_mark[bidx(nb, 0, y / BLOCK, z / BLOCK)];
+            /* along a row, each run of marked blocks at once */
             for (uint32_t bx = 0; bx < nb[0];) {
                 if (!marks[bx]) {
                     bx++;
@@ -303,10 +306,40 @@ int fusion_integrate(struct fusion_volume *vol, const struct scan_calib *c,
                 while (bx < nb[0] && marks[bx])
                     bx++;
                 uint32_t x1 = bx * BLOCK < dims[0] ? bx * BLOCK : dims[0];
-                integrate_run(vol, c, obj_from_cam, m, r, rgb, confidence, step_x, first * BLOCK,
-                              x1, y, z, pinhole);
+                integrate_run(s->vol, s->c, s->obj_from_cam, s->m, s->r, s->rgb, s->confidence,
+                              s->step_x, first * BLOCK, x1, y, z, s->pinhole);
             }
         }
+}
+
+int fusion_integrate(struct fusion_volume *vol, const struct hal_thread *threads,
+                     const struct scan_calib *c, const struct frame_xform *obj_from_cam,
+                     const struct decode_maps *m, const struct tri_range *r, const uint8_t *rgb,
+                     const float *confidence)
+{
+    if (!pixel_weights(vol, c, m, r))
+        return 0;
+    const uint32_t *dims = vol->dims;
+    struct slices s = {.vol = vol,
+                       .c = c,
+                       .obj_from_cam = obj_from_cam,
+                       .m = m,
+                       .r = r,
+                       .rgb = rgb,
+                       .confidence = confidence,
+                       /* the voxel loop's common case, inline */
+                       .pinhole = lens_is_pinhole(c->cam_dist),
+                       .step_x = m3_tmul(obj_from_cam->rot, v3(vol->p.voxel_mm, 0, 0)),
+                       .nb = {(dims[0] + BLOCK - 1) / BLOCK, (dims[1] + BLOCK - 1) / BLOCK,
+                              (dims[2] + BLOCK - 1) / BLOCK},
+                       .parts = hal_thread_count(threads)};
+    if (!mark_blocks(vol, obj_from_cam, m, r, s.nb))
+        return 0;
+    /* a point's band reaches truncation / voxel voxels (and one for rounding) from its block */
+    double band = vol->p.truncation_mm / vol->p.voxel_mm + 1.0;
+    grow_blocks(vol, s.nb, (uint32_t)ceil(band / BLOCK));
+    /* each voxel is its own: slices split across the cores fuse as one thread does */
+    hal_thread_run(threads, s.parts, integrate_slices, &s);
     return 0;
 }
 

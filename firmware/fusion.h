@@ -36,10 +36,13 @@ int fusion_begin(struct fusion_volume *vol, const struct fusion_params *p);
  *  Weight of a pixel: cos(view angle) x (600 mm / depth)^2 x edge fade; its colour weighs that
  *  times the colour's @p confidence per pixel when given (NULL: 1), so an unreliable colour
  *  estimate (a highlight, a grazing light) still gives its geometry.
+ *  @param threads  the cores the voxels are split across, by slices (NULL: this thread): each
+ *  voxel is its own, the volume the same to the byte however many
  *  @retval 0 */
-int fusion_integrate(struct fusion_volume *vol, const struct scan_calib *calib,
-                     const struct frame_xform *obj_from_cam, const struct decode_maps *maps,
-                     const struct tri_range *range, const uint8_t *rgb, const float *confidence);
+int fusion_integrate(struct fusion_volume *vol, const struct hal_thread *threads,
+                     const struct scan_calib *calib, const struct frame_xform *obj_from_cam,
+                     const struct decode_maps *maps, const struct tri_range *range,
+                     const uint8_t *rgb, const float *confidence);
 
 /** Set every voxel from a signed distance function of the object-frame position (mm), weight 1
  *  and grey colour (NAN: never observed): synthetic objects and tests of the extraction.

@@ -238,12 +238,7 @@ int scan_finish_view(struct scan_ctx *s, const struct hal_thread *threads,
                      const struct scan_calib *c, int32_t angle_mdeg, struct scan_view *view,
                      struct scan_view_info *info)
 {
-    /* the platform's cores, as many as [scan] threads allows (0: all of them) */
-    struct hal_thread cores = {0};
-    if (threads != NULL)
-        cores = *threads;
-    if (s->params.threads > 0 && s->params.threads < cores.threads)
-        cores.threads = s->params.threads;
+    struct hal_thread cores = scan_cores(threads, &s->params);
     memset(view, 0, sizeof(*view));
     view->width = s->params.width;
     view->height = s->params.height;
@@ -499,10 +494,21 @@ int scan_keep_for_registration(struct reg_ctx *reg, uint32_t index, const struct
     return reg_add_view(reg, index, view->angle_mdeg, &view->maps, &view->range, view->rgb);
 }
 
-int scan_fuse_view(struct fusion_volume *vol, const struct scan_calib *calib,
-                   const struct scan_view *view, const struct frame_xform *obj_from_cam)
+struct hal_thread scan_cores(const struct hal_thread *threads, const struct scan_params *p)
 {
-    return fusion_integrate(vol, calib, obj_from_cam, &view->maps, &view->range, view->rgb,
+    struct hal_thread cores = {0};
+    if (threads != NULL)
+        cores = *threads;
+    if (p->threads > 0 && p->threads < cores.threads)
+        cores.threads = p->threads;
+    return cores;
+}
+
+int scan_fuse_view(struct fusion_volume *vol, const struct hal_thread *cores,
+                   const struct scan_calib *calib, const struct scan_view *view,
+                   const struct frame_xform *obj_from_cam)
+{
+    return fusion_integrate(vol, cores, calib, obj_from_cam, &view->maps, &view->range, view->rgb,
                             view->confidence);
 }
 

@@ -161,9 +161,15 @@ int scan_finish_view(struct scan_ctx *s, const struct hal_thread *threads,
  *  first). */
 int scan_keep_for_registration(struct reg_ctx *reg, uint32_t index, const struct scan_view *view);
 
-/** Fuse @p view into the volume @p vol (fusion_begin first) seen through @p obj_from_cam. */
-int scan_fuse_view(struct fusion_volume *vol, const struct scan_calib *calib,
-                   const struct scan_view *view, const struct frame_xform *obj_from_cam);
+/** Fuse @p view into the volume @p vol (fusion_begin first) seen through @p obj_from_cam, its
+ *  voxels split across @p cores (scan_cores; NULL: this thread). */
+int scan_fuse_view(struct fusion_volume *vol, const struct hal_thread *cores,
+                   const struct scan_calib *calib, const struct scan_view *view,
+                   const struct frame_xform *obj_from_cam);
+
+/** The cores a view's stages may split across: the platform's @p threads (NULL: one), as many
+ *  as [scan] threads in @p p allows (0: all of them). */
+struct hal_thread scan_cores(const struct hal_thread *threads, const struct scan_params *p);
 
 /** Write @p view's point cloud as binary PLY, through @p obj_from_cam into the object frame.
  *  @retval 0 ok @retval -errno from storage */

@@ -8,6 +8,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "gray.h"
@@ -220,7 +221,8 @@ static void test_blocked_decoder_matches_reference(void **state)
 }
 
 /* The decode split across threads (hal_thread, POSIX threads; 1 to 8, more than this machine's
- * cores too) gives the maps of one thread to the byte: columns, rows, reasons. */
+ * cores too) gives the maps of one thread to the byte: columns, rows, reasons; the fusion of the
+ * view likewise, voxel for voxel. */
 static void test_threads_decode_the_same(void **state)
 {
     (void)state;
@@ -251,9 +253,31 @@ static void test_threads_decode_the_same(void **state)
         assert_memory_equal(m.column, col1, n * sizeof(uint16_t));
         assert_memory_equal(m.row, row1, n * sizeof(uint16_t));
     }
+    /* and the view fused: every voxel the same on 1 and 4 threads */
+    static struct fusion_volume vol;
+    struct frame_xform pose;
+    frame_object_from_camera(&t.calib, view.angle_mdeg, &pose);
+    assert_int_equal(scan_finish_view(t.scan, NULL, &t.calib, view.angle_mdeg, &view, &info), 0);
+    assert_int_equal(fusion_begin(&vol, &t.cfg.fusion), 0);
+    assert_int_equal(scan_fuse_view(&vol, NULL, &t.calib, &view, &pose), 0);
+    size_t voxels = (size_t)vol.dims[0] * vol.dims[1] * vol.dims[2], observed = 0;
+    struct voxel *one = malloc(voxels * sizeof(*one));
+    assert_non_null(one);
+    memcpy(one, vol.grid, voxels * sizeof(*one));
+    for (size_t i = 0; i < voxels; i++)
+        observed += one[i].weight > 0;
+    struct hal_thread cores;
+    thread_posix_init(&cores, 4);
+    assert_int_equal(fusion_begin(&vol, &t.cfg.fusion), 0);
+    assert_int_equal(scan_fuse_view(&vol, &cores, &t.calib, &view, &pose), 0);
+    assert_memory_equal(vol.grid, one, voxels * sizeof(*one));
+    free(one);
     test_rig_stop(&t);
-    print_message("%zu valid pixels, the same maps on 1, 2, 4 and 8 threads\n", valid);
+    print_message("%zu valid pixels, the same maps on 1, 2, 4 and 8 threads; %zu voxels observed, "
+                  "the same on 1 and 4\n",
+                  valid, observed);
     assert_true(valid > 100000);
+    assert_true(observed > 100000);
 }
 
 /* Inverses for the finest 3 bits only ([scan] inverse_bits = 3: 28 patterns with rows, 15
