@@ -263,7 +263,8 @@ static int recolour_from_frames(struct job *j, const char *scan_dir, uint32_t v,
         return rc;
     }
     scan_attach_colour(j->scan, view);
-    return scan_recolour(&p->colour, j->calib, view, j->pool);
+    struct hal_thread cores = scan_cores(&j->hal->thread, p);
+    return scan_recolour(&p->colour, &cores, j->calib, view, j->pool);
 }
 
 /* View @p v as the model is made of it (load_range), coloured again from its frames while the

@@ -38,7 +38,7 @@ int white_cal_from_view(const struct app_config *cfg, const struct scan_calib *c
         /* with this scale the stored byte is half the compensated value in grey levels: colour
          * frames at a shorter exposure are scaled up to the camera's, beyond 255 */
         p.white_scale[0] = p.white_scale[1] = p.white_scale[2] = HALF / 255.0;
-        int rc = scan_recolour(&p, calib, view, NULL); /* none .. multi */
+        int rc = scan_recolour(&p, NULL, calib, view, NULL); /* none .. multi */
         if (rc != 0)
             return rc;
         for (int ch = 0; ch < 3; ch++) {

@@ -384,18 +384,32 @@ static void fit_pixel(const struct frame_ctx *f, const struct scan_calib *c, str
 }
 
 /* One pass over the pixels with the Ca of @p f: albedo and confidence of every valid pixel. */
-static void compute_pass(const struct frame_ctx *f, const struct scan_calib *c,
-                         const struct decode_maps *m, const struct tri_range *r,
-                         const uint8_t *white, uint8_t *albedo, float *confidence,
-                         struct reflect_pool *pool, int last)
+/* One pass over the pixels of a view, or part of them (pixels i0 .. i1 - 1). */
+struct pass {
+    const struct frame_ctx *f;
+    const struct scan_calib *c;
+    const struct decode_maps *m;
+    const struct tri_range *r;
+    const uint8_t *white;
+    uint8_t *albedo;
+    float *confidence;
+    struct fit_state fs;
+    vec3 proj;
+    size_t pixels;
+    unsigned parts;
+};
+
+static void pass_pixels(struct pass *ps, size_t i0, size_t i1)
 {
+    const struct frame_ctx *f = ps->f;
     const struct colour_params *prm = f->prm;
-    size_t n = (size_t)m->width * m->height;
-    vec3 proj = v3_scale(m3_tmul(c->proj_rot, v3_from(c->proj_trans_mm)), -1.0);
-    struct fit_state fs = {pool, pool != NULL ? reflect_model(pool) : NULL,
-                           pool != NULL && last && reflect_collecting(pool),
-                           pool != NULL ? reflect_stride(pool, r->valid_count) : UINT32_MAX, 0};
-    for (size_t i = 0; i < n; i++) {
+    const struct scan_calib *c = ps->c;
+    const struct decode_maps *m = ps->m;
+    const struct tri_range *r = ps->r;
+    const uint8_t *white = ps->white;
+    uint8_t *albedo = ps->albedo;
+    float *confidence = ps->confidence;
+    for (size_t i = i0; i < i1; i++) {
         if (prm->method == COLOUR_NONE || m->reason[i] != SCAN_VALID) {
             memcpy(&albedo[3 * i], &white[3 * i], 3); /* the raw colour */
             /* trusted where valid, but not where the white frame clipped (a highlight now has
@@ -411,14 +425,14 @@ static void compute_pass(const struct frame_ctx *f, const struct scan_calib *c,
         vec3 p = v3(r->xyz_mm[3 * i], r->xyz_mm[3 * i + 1], r->xyz_mm[3 * i + 2]);
         vec3 nn = v3(r->normal[3 * i], r->normal[3 * i + 1], r->normal[3 * i + 2]);
         if (prm->method == COLOUR_FIT) {
-            fit_pixel(f, c, &fs, m, r, i, p, nn, &albedo[3 * i], &confidence[i]);
+            fit_pixel(f, c, &ps->fs, m, r, i, p, nn, &albedo[3 * i], &confidence[i]);
             continue;
         }
-        double num[3], trust, den = pixel_estimate(f, c, proj, white, i, p, nn, 0, num, &trust);
+        double num[3], trust, den = pixel_estimate(f, c, ps->proj, white, i, p, nn, 0, num, &trust);
         float conf = (float)(trust > 1.0 ? 1.0 : trust);
         if (den <= 1e-6) { /* no reliable estimate: a best effort that weighs nothing in the
                               fusion unless no view has better (raw colour is not an albedo) */
-            den = pixel_estimate(f, c, proj, white, i, p, nn, 1, num, &trust);
+            den = pixel_estimate(f, c, ps->proj, white, i, p, nn, 1, num, &trust);
             conf = 0.0f;
         }
         if (den <= 1e-6) { /* no estimate at all: no colour, rather than the raw one (which
@@ -432,6 +446,38 @@ static void compute_pass(const struct frame_ctx *f, const struct scan_calib *c,
             albedo[3 * i + (size_t)k] = albedo_byte(num[k] / den * prm->white_scale[k]);
         confidence[i] = conf;
     }
+}
+
+/* Part @p k of the pass's pixels (each pixel reads and writes only its own). */
+static void pass_part(void *arg, unsigned k)
+{
+    struct pass *ps = arg;
+    pass_pixels(ps, ps->pixels * k / ps->parts, ps->pixels * (k + 1u) / ps->parts);
+}
+
+static void compute_pass(const struct frame_ctx *f, const struct hal_thread *threads,
+                         const struct scan_calib *c, const struct decode_maps *m,
+                         const struct tri_range *r, const uint8_t *white, uint8_t *albedo,
+                         float *confidence, struct reflect_pool *pool, int last)
+{
+    struct pass ps = {.f = f,
+                      .c = c,
+                      .m = m,
+                      .r = r,
+                      .white = white,
+                      .albedo = albedo,
+                      .confidence = confidence,
+                      .fs = {pool, pool != NULL ? reflect_model(pool) : NULL,
+                             pool != NULL && last && reflect_collecting(pool),
+                             pool != NULL ? reflect_stride(pool, r->valid_count) : UINT32_MAX, 0},
+                      .proj = v3_scale(m3_tmul(c->proj_rot, v3_from(c->proj_trans_mm)), -1.0),
+                      .pixels = (size_t)m->width * m->height,
+                      .parts = hal_thread_count(threads)};
+    if (f->prm->method == COLOUR_FIT) { /* its samples are kept in pixel order: one thread */
+        pass_pixels(&ps, 0, ps.pixels);
+        return;
+    }
+    hal_thread_run(threads, ps.parts, pass_part, &ps);
 }
 
 /* ca = albedo: each dark frame's value at a confident pixel, per channel, as offset + slope x
@@ -459,10 +505,10 @@ static void fit_ambient(struct frame_ctx *f, const struct decode_maps *m, const 
     }
 }
 
-int colour_compute(const struct colour_params *prm, const struct scan_calib *c,
-                   const struct decode_maps *m, const struct tri_range *r, const uint8_t *white,
-                   const uint8_t *const *lights, uint8_t *albedo, float *confidence,
-                   struct reflect_pool *pool)
+int colour_compute(const struct colour_params *prm, const struct hal_thread *threads,
+                   const struct scan_calib *c, const struct decode_maps *m,
+                   const struct tri_range *r, const uint8_t *white, const uint8_t *const *lights,
+                   uint8_t *albedo, float *confidence, struct reflect_pool *pool)
 {
     static struct frame_ctx f; /* static: the firmware keeps large state off the stack */
     static struct colour_layout lay;
@@ -481,12 +527,12 @@ int colour_compute(const struct colour_params *prm, const struct scan_calib *c,
             channel_offset(m, lights[k], f.ca_channel[k]);
     }
     int two = prm->method != COLOUR_NONE && prm->ca == COLOUR_CA_ALBEDO;
-    compute_pass(&f, c, m, r, white, albedo, confidence, pool, !two);
+    compute_pass(&f, threads, c, m, r, white, albedo, confidence, pool, !two);
     if (!two)
         return 0;
     for (uint32_t k = 0; k < lay.count; k++)
         if (lights[k] != NULL && lay.dark_of[k] == k)
             fit_ambient(&f, m, albedo, confidence, k);
-    compute_pass(&f, c, m, r, white, albedo, confidence, pool, 1);
+    compute_pass(&f, threads, c, m, r, white, albedo, confidence, pool, 1);
     return 0;
 }

@@ -50,10 +50,13 @@ void colour_layout(const struct colour_params *p, uint32_t light_count, struct c
  *  no view has better); one with none gets colour 0 and COLOUR_NO_ESTIMATE.
  *  @param pool  method fit: the reflectance (its model, once fitted, is taken off each light;
  *  while it collects, the last pass adds samples to it); NULL: none (fit gives multi's estimate)
+ *  @param threads  the cores the pixels are split across (NULL: this thread; fit, which keeps
+ *  samples in order, takes one): every pixel its own, the same colours however many
  *  @retval 0 @retval -EINVAL a needed frame missing */
-int colour_compute(const struct colour_params *p, const struct scan_calib *calib,
-                   const struct decode_maps *maps, const struct tri_range *range,
-                   const uint8_t *white, const uint8_t *const *lights, uint8_t *albedo_rgb,
-                   float *confidence, struct reflect_pool *pool);
+int colour_compute(const struct colour_params *p, const struct hal_thread *threads,
+                   const struct scan_calib *calib, const struct decode_maps *maps,
+                   const struct tri_range *range, const uint8_t *white,
+                   const uint8_t *const *lights, uint8_t *albedo_rgb, float *confidence,
+                   struct reflect_pool *pool);
 
 #endif

@@ -259,7 +259,7 @@ int scan_finish_view(struct scan_ctx *s, const struct hal_thread *threads,
         rc = tri_normals(&s->tri, &view->range, s->view_reason, s->params.normal_radius_px,
                          s->params.max_depth_jump_mm);
     if (rc == 0)
-        rc = scan_recolour(&s->params.colour, c, view, NULL); /* fit: multi's, until the
+        rc = scan_recolour(&s->params.colour, &cores, c, view, NULL); /* fit: multi's, until the
                                                                    job's model colours it */
     if (rc != 0)
         return rc;
@@ -532,12 +532,12 @@ void scan_attach_colour(struct scan_ctx *s, struct scan_view *view)
         view->lights[k] = s->light_present[k] ? s->light_rgb[k] : NULL;
 }
 
-int scan_recolour(const struct colour_params *colour, const struct scan_calib *c,
-                  struct scan_view *view, struct reflect_pool *pool)
+int scan_recolour(const struct colour_params *colour, const struct hal_thread *cores,
+                  const struct scan_calib *c, struct scan_view *view, struct reflect_pool *pool)
 {
     view->colour_method = colour->method;
-    return colour_compute(colour, c, &view->maps, &view->range, view->white_rgb, view->lights,
-                          view->rgb, view->confidence, pool);
+    return colour_compute(colour, cores, c, &view->maps, &view->range, view->white_rgb,
+                          view->lights, view->rgb, view->confidence, pool);
 }
 
 void scan_close(const struct hal *hal)

@@ -179,8 +179,9 @@ int scan_save_cloud(const struct hal *hal, const struct scan_view *view,
 /** Recompute @p view's colour and confidence with other colour parameters (same frames, same
  *  geometry): the white calibration compares the methods on one view; method fit colours with
  *  @p pool (colour_compute; NULL: none). @retval 0 or -EINVAL */
-int scan_recolour(const struct colour_params *colour, const struct scan_calib *calib,
-                  struct scan_view *view, struct reflect_pool *pool);
+int scan_recolour(const struct colour_params *colour, const struct hal_thread *cores,
+                  const struct scan_calib *calib, struct scan_view *view,
+                  struct reflect_pool *pool);
 
 /** Point @p view (restored from its range image) at the colour frames fed since
  *  scan_begin_view (scan_feed_light_frame, and the white colour read into scan_frame_buffer),

@@ -108,9 +108,9 @@ static void compute(void)
     render();
     struct decode_maps m = {NULL, NULL, s.reason, WIDTH, 1};
     struct tri_range r = {s.xyz, s.normal, WIDTH, 1, WIDTH};
-    assert_int_equal(
-        colour_compute(&s.prm, &s.calib, &m, &r, s.white, s.frame_ptr, s.out, s.confidence, NULL),
-        0);
+    assert_int_equal(colour_compute(&s.prm, NULL, &s.calib, &m, &r, s.white, s.frame_ptr, s.out,
+                                    s.confidence, NULL),
+                     0);
 }
 
 /* The albedo colour_compute gave paint @p i's pixel in the middle of the row (grey paint: the

@@ -221,8 +221,8 @@ static void test_blocked_decoder_matches_reference(void **state)
 }
 
 /* The decode split across threads (hal_thread, POSIX threads; 1 to 8, more than this machine's
- * cores too) gives the maps of one thread to the byte: columns, rows, reasons; the fusion of the
- * view likewise, voxel for voxel. */
+ * cores too) gives the maps of one thread to the byte: columns, rows, reasons; the view's colour
+ * and its fusion likewise, pixel for pixel and voxel for voxel. */
 static void test_threads_decode_the_same(void **state)
 {
     (void)state;
@@ -253,6 +253,18 @@ static void test_threads_decode_the_same(void **state)
         assert_memory_equal(m.column, col1, n * sizeof(uint16_t));
         assert_memory_equal(m.row, row1, n * sizeof(uint16_t));
     }
+    /* its colour (config/sim.ini's method, multi, both passes): the same on 1 and 4 threads */
+    struct hal_thread four;
+    thread_posix_init(&four, 4);
+    assert_int_equal(scan_recolour(&t.cfg.scan.colour, NULL, &t.calib, &view, NULL), 0);
+    static uint8_t rgb1[3 * HAL_MAX_PIXELS];
+    static float conf1[HAL_MAX_PIXELS];
+    memcpy(rgb1, view.rgb, 3 * n);
+    memcpy(conf1, view.confidence, n * sizeof(float));
+    assert_int_equal(scan_recolour(&t.cfg.scan.colour, &four, &t.calib, &view, NULL), 0);
+    assert_memory_equal(view.rgb, rgb1, 3 * n);
+    assert_memory_equal(view.confidence, conf1, n * sizeof(float));
+    assert_int_equal(t.cfg.scan.colour.method, COLOUR_MULTI);
     /* and the view fused: every voxel the same on 1 and 4 threads */
     static struct fusion_volume vol;
     struct frame_xform pose;
@@ -266,10 +278,8 @@ static void test_threads_decode_the_same(void **state)
     memcpy(one, vol.grid, voxels * sizeof(*one));
     for (size_t i = 0; i < voxels; i++)
         observed += one[i].weight > 0;
-    struct hal_thread cores;
-    thread_posix_init(&cores, 4);
     assert_int_equal(fusion_begin(&vol, &t.cfg.fusion), 0);
-    assert_int_equal(scan_fuse_view(&vol, &cores, &t.calib, &view, &pose), 0);
+    assert_int_equal(scan_fuse_view(&vol, &four, &t.calib, &view, &pose), 0);
     assert_memory_equal(vol.grid, one, voxels * sizeof(*one));
     free(one);
     test_rig_stop(&t);
