@@ -472,7 +472,7 @@ static void compute_pass(const struct frame_ctx *f, const struct hal_thread *thr
                              pool != NULL ? reflect_stride(pool, r->valid_count) : UINT32_MAX, 0},
                       .proj = v3_scale(m3_tmul(c->proj_rot, v3_from(c->proj_trans_mm)), -1.0),
                       .pixels = (size_t)m->width * m->height,
-                      .parts = hal_thread_count(threads)};
+                      .parts = hal_thread_parts(threads, 64)};
     if (f->prm->method == COLOUR_FIT) { /* its samples are kept in pixel order: one thread */
         pass_pixels(&ps, 0, ps.pixels);
         return;

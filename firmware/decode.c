@@ -248,7 +248,7 @@ int decode_pixels(struct decode_ctx *d, const struct hal_thread *threads, uint8_
         return -EINVAL;
     /* every pixel on its own: the same maps however the pixels are split */
     struct pixel_parts p = {d, reason, (size_t)d->params.width * d->params.height,
-                            hal_thread_count(threads)};
+                            hal_thread_parts(threads, HAL_MAX_THREADS)}; /* a block set each */
     hal_thread_run(threads, p.parts, decode_part, &p);
     maps->column = d->column_map;
     maps->row = d->layout.row_bits > 0 ? d->row_map : NULL;
@@ -409,7 +409,7 @@ static void resolve_rows(void *arg, unsigned k)
  * the pass ends, so that what this pass changes is not the reference of others. */
 static void resolve_unclear(struct decode_ctx *d, const struct hal_thread *threads, uint8_t *reason)
 {
-    struct row_parts p = {d, reason, hal_thread_count(threads)};
+    struct row_parts p = {d, reason, hal_thread_parts(threads, 64)};
     hal_thread_run(threads, p.parts, resolve_rows, &p);
     size_t n = (size_t)d->params.width * d->params.height;
     for (size_t i = 0; i < n; i++) {
@@ -475,7 +475,7 @@ static void check_rows(void *arg, unsigned k)
 static void check_neighbours(struct decode_ctx *d, const struct hal_thread *threads,
                              uint8_t *reason)
 {
-    struct row_parts p = {d, reason, hal_thread_count(threads)};
+    struct row_parts p = {d, reason, hal_thread_parts(threads, 64)};
     hal_thread_run(threads, p.parts, check_rows, &p);
     memcpy(reason, d->scratch, (size_t)d->params.width * d->params.height);
 }

@@ -332,7 +332,7 @@ int fusion_integrate(struct fusion_volume *vol, const struct hal_thread *threads
                        .step_x = m3_tmul(obj_from_cam->rot, v3(vol->p.voxel_mm, 0, 0)),
                        .nb = {(dims[0] + BLOCK - 1) / BLOCK, (dims[1] + BLOCK - 1) / BLOCK,
                               (dims[2] + BLOCK - 1) / BLOCK},
-                       .parts = hal_thread_count(threads)};
+                       .parts = hal_thread_parts(threads, 64)};
     if (!mark_blocks(vol, obj_from_cam, m, r, s.nb))
         return 0;
     /* a point's band reaches truncation / voxel voxels (and one for rounding) from its block */

@@ -169,6 +169,14 @@ unsigned hal_thread_count(const struct hal_thread *t)
     return t->threads < HAL_MAX_THREADS ? t->threads : HAL_MAX_THREADS;
 }
 
+unsigned hal_thread_parts(const struct hal_thread *t, unsigned most)
+{
+    unsigned threads = hal_thread_count(t);
+    if (threads <= 1)
+        return 1;
+    return 4u * threads < most ? 4u * threads : most;
+}
+
 void hal_thread_run(const struct hal_thread *t, unsigned count, hal_thread_fn fn, void *arg)
 {
     unsigned threads = hal_thread_count(t);

@@ -23,6 +23,10 @@ struct hal_thread {
 /** Items a per-pixel stage splits into: one a thread (1 when @p t is NULL or has no ops). */
 unsigned hal_thread_count(const struct hal_thread *t);
 
+/** Parts a stage splits into so that its threads stay busy when parts cost unequally (the
+ *  image's edges, the object's middle): four a thread, at most @p most; 1 on one thread. */
+unsigned hal_thread_parts(const struct hal_thread *t, unsigned most);
+
 /** Run @p fn for k = 0 .. @p count - 1 on @p t's threads, or one after another here (@p t
  *  NULL, no ops, one thread); every item has run when it returns. */
 void hal_thread_run(const struct hal_thread *t, unsigned count, hal_thread_fn fn, void *arg);
