@@ -49,6 +49,7 @@ static struct {
     pthread_mutex_t lock;
     pthread_cond_t wake, done;
     unsigned workers;         /* started */
+    unsigned ready;           /* of them, waiting for loops: their start is over */
     unsigned long generation; /* loops so far */
     struct loop *loop;
     unsigned wanted, joined, finished;
@@ -61,6 +62,8 @@ static void *pool_worker(void *unused)
     (void)unused;
     unsigned long seen = 0;
     pthread_mutex_lock(&pool.lock);
+    pool.ready++;
+    pthread_cond_broadcast(&pool.done);
     for (;;) {
         while (pool.generation == seen)
             pthread_cond_wait(&pool.wake, &pool.lock);
@@ -119,6 +122,10 @@ void thread_posix_init(struct hal_thread *t, unsigned threads)
         pthread_detach(worker);
         pool.workers++;
     }
+    /* Until each is waiting: what a thread's start costs (the C library's and a sanitizer's
+     * own allocations) is paid here, at set-up, not in the middle of a scan. */
+    while (pool.ready < pool.workers)
+        pthread_cond_wait(&pool.done, &pool.lock);
     pthread_mutex_unlock(&pool.lock);
     t->ops = &loop_ops;
     t->priv = NULL;
