@@ -266,6 +266,7 @@ struct live_picture {
     struct job *j;
     double next_ms; /* the wall clock's: a simulated rig's clock stands still while it waits */
     int off;        /* the camera gave no picture: said once, no more tried */
+    char path[HAL_MAX_PATH + 16]; /* DIR/live.png */
 };
 
 static void live_picture_take(void *ctx)
@@ -277,12 +278,9 @@ static void live_picture_take(void *ctx)
         return;
     const uint8_t *rgb;
     const struct scan_params *p = &l->j->cfg->scan;
-    char path[HAL_MAX_PATH + 16], tmp[HAL_MAX_PATH + 24];
-    snprintf(path, sizeof(path), "%s/" SCAN_FILE_LIVE, l->j->out_dir);
-    snprintf(tmp, sizeof(tmp), "%s.tmp", path);
+    /* image_write_png replaces the file whole: the page never reads half a picture */
     if (scan_snapshot(l->j->scan, hal, p, l->j->calib, &rgb) != 0 ||
-        image_write_png(&hal->storage, tmp, rgb, p->width, p->height, 3) != 0 ||
-        rename(tmp, path) != 0) {
+        image_write_png(&hal->storage, l->path, rgb, p->width, p->height, 3) != 0) {
         hal->log(HAL_LOG_WARN, "no live picture while the scan waits (the scan goes on)");
         l->off = 1;
         return;
@@ -314,12 +312,11 @@ static int ask_for_second_pass(struct job *j)
     }
     static const char *const answers[] = {"continue"};
     struct live_picture live = {.j = j};
+    snprintf(live.path, sizeof(live.path), "%s/" SCAN_FILE_LIVE, j->out_dir);
     unsigned which;
     rc = answer_wait(j->hal, answers, 1, "Enter (or 'continue') when the object is laid",
                      j->opts->json ? live_picture_take : NULL, &live, &which);
-    char path[HAL_MAX_PATH + 16];
-    snprintf(path, sizeof(path), "%s/" SCAN_FILE_LIVE, j->out_dir);
-    unlink(path);
+    unlink(live.path);
     return rc;
 }
 

@@ -20,7 +20,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 /* ---- the person's steps ---- */
 
@@ -35,11 +34,11 @@ struct capture {
     struct calcv_board board;
     uint8_t *sheet; /* the board as printed, for the simulated person */
     int sheet_w, sheet_h;
-    int person;      /* 1: a person places the targets (a rig), and may take a view again */
-    int board_found; /* the last board capture showed the board */
-    int json;        /* --json: events on stdout (docs/api.md), answers on stdin: the page */
-    int live;        /* a live picture while the person places the board (json only) */
-    double live_next_s;
+    int person;          /* 1: a person places the targets (a rig), and may take a view again */
+    int board_found;     /* the last board capture showed the board */
+    int json;            /* --json: events on stdout (docs/api.md), answers on stdin: the page */
+    int live;            /* a live picture while the person places the board (json only) */
+    double live_next_ms; /* job_wall_ms when the next live picture is due */
 };
 
 static int save_frame(void *priv, uint32_t pattern, const uint8_t *pixels, uint32_t width,
@@ -59,27 +58,29 @@ static int save_frame(void *priv, uint32_t pattern, const uint8_t *pixels, uint3
 static const char *const answers_place[] = {"continue", "back"};
 static const char *const answers_retry[] = {"again", "skip", "s", "S"};
 
-static double now_s(void)
+/* The board in the picture @p rgb (the camera's size): its corners, or why not (@p why).
+ * @retval 1 found */
+static int find_board(const struct capture *c, const uint8_t *rgb, uint32_t width, uint32_t height,
+                      struct calcv_corners *corners, char *why, size_t why_len)
 {
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+    static uint8_t grey[HAL_MAX_PIXELS];
+    decode_rgb_to_grey(rgb, grey, (size_t)width * height, 256);
+    return calcv_find_corners(&c->board, grey, (int)width, (int)height,
+                              (int)c->cfg->calibrate.min_corners, corners, why, why_len) == 0;
 }
 
 /* The picture the page shows: @p rgb with @p corners (NULL: none) drawn, as DIR/live.png,
- * replaced whole (a temporary file renamed). */
+ * replaced whole (image_write_png writes atomically). */
 static void write_picture(struct capture *c, const uint8_t *rgb, uint32_t width, uint32_t height,
                           const struct calcv_corners *corners)
 {
     uint8_t *pic = NULL;
     int w, h;
-    char path[HAL_MAX_PATH + 16], tmp[HAL_MAX_PATH + 24];
+    char path[HAL_MAX_PATH + 16];
     snprintf(path, sizeof(path), "%s/live.png", c->dir);
-    snprintf(tmp, sizeof(tmp), "%s/live.tmp.png", c->dir);
     if (calcv_preview(&c->board, rgb, (int)width, (int)height, corners, &pic, &w, &h) != 0)
         return;
-    if (image_write_png(&c->hal->storage, tmp, pic, (uint32_t)w, (uint32_t)h, 3) == 0)
-        rename(tmp, path);
+    image_write_png(&c->hal->storage, path, pic, (uint32_t)w, (uint32_t)h, 3);
     free(pic);
 }
 
@@ -105,7 +106,7 @@ static void say_outline(const struct calcv_corners *k, uint32_t width, uint32_t 
 static void live_picture(void *ctx)
 {
     struct capture *c = ctx;
-    if (!c->live || now_s() < c->live_next_s)
+    if (!c->live || job_wall_ms() < c->live_next_ms)
         return;
     const uint8_t *rgb;
     int rc = scan_snapshot(scan_job_views(), c->hal, &c->params, c->guess, &rgb);
@@ -114,13 +115,9 @@ static void live_picture(void *ctx)
         return;
     }
     static struct calcv_corners corners;
-    static uint8_t grey[HAL_MAX_PIXELS];
     char why[256] = "";
     uint32_t w = c->guess->cam_width, h = c->guess->cam_height;
-    decode_rgb_to_grey(rgb, grey, (size_t)w * h, 256);
-    int found =
-        calcv_find_corners(&c->board, grey, (int)w, (int)h, (int)c->cfg->calibrate.min_corners,
-                           &corners, why, sizeof(why)) == 0;
+    int found = find_board(c, rgb, w, h, &corners, why, sizeof(why));
     write_picture(c, rgb, w, h, &corners);
     printf("{\"event\":\"calib_live\",\"found\":%s,\"corners\":%d,\"why\":",
            found ? "true" : "false", corners.count);
@@ -129,7 +126,7 @@ static void live_picture(void *ctx)
         say_outline(&corners, w, h);
     printf("}\n");
     fflush(stdout);
-    c->live_next_s = now_s() + 1.0;
+    c->live_next_ms = job_wall_ms() + 1000.0;
 }
 
 /* Ask the person to put the target there (step @p step of @p steps; @p kind "board", "sphere"
@@ -169,7 +166,7 @@ static int place(struct capture *c, const struct board_target *t, const char *wh
         fflush(stdout);
     }
     c->live = c->json && t != NULL && t->kind == BOARD_TARGET_BOARD;
-    c->live_next_s = 0.0;
+    c->live_next_ms = 0.0;
     unsigned which;
     rc = answer_wait(c->hal, answers_place, may_go_back ? 2 : 1,
                      may_go_back ? "Enter (or 'continue') when it is done, 'back' for the step "
@@ -241,13 +238,9 @@ static int capture_one(struct capture *c, const struct calib_target_info *ti, ch
     static struct calcv_corners corners;
     corners.count = 0;
     why[0] = '\0';
-    if (ti->kind == CALIB_TARGET_BOARD) {
-        static uint8_t grey[HAL_MAX_PIXELS];
-        decode_rgb_to_grey(view.white_rgb, grey, (size_t)view.width * view.height, 256);
+    if (ti->kind == CALIB_TARGET_BOARD)
         c->board_found =
-            calcv_find_corners(&c->board, grey, (int)view.width, (int)view.height,
-                               (int)c->cfg->calibrate.min_corners, &corners, why, why_len) == 0;
-    }
+            find_board(c, view.white_rgb, view.width, view.height, &corners, why, why_len);
     if (c->json) {
         write_picture(c, view.white_rgb, view.width, view.height, &corners);
         printf("{\"event\":\"calib_capture\",\"view\":%u,\"placement\":%u,\"kind\":\"%s\","

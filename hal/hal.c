@@ -162,7 +162,8 @@ int hal_should_stop(const struct hal *hal)
     return hal->stop_requested != NULL && hal->stop_requested();
 }
 
-unsigned hal_thread_count(const struct hal_thread *t)
+/* Threads @p t may use: one when it is NULL or has no ops. */
+static unsigned hal_thread_count(const struct hal_thread *t)
 {
     if (t == NULL || t->ops == NULL || t->threads <= 1)
         return 1;

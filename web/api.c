@@ -241,15 +241,20 @@ static int list_scans(struct mg_connection *conn, struct web_server *s)
     return api_send_json(conn, 200, body);
 }
 
+const struct web_profile *api_profile_named(const struct web_server *s, const char *name)
+{
+    for (unsigned i = 0; i < s->profiles; i++)
+        if (strcmp(s->profile[i].name, name) == 0)
+            return &s->profile[i];
+    return NULL;
+}
+
 const struct web_profile *api_find_profile(const struct web_server *s, const cJSON *body)
 {
     const cJSON *name = cJSON_GetObjectItemCaseSensitive(body, "profile");
     if (name == NULL)
         return &s->profile[0]; /* {}: the served config */
-    for (unsigned i = 0; cJSON_IsString(name) && i < s->profiles; i++)
-        if (strcmp(s->profile[i].name, name->valuestring) == 0)
-            return &s->profile[i];
-    return NULL;
+    return cJSON_IsString(name) ? api_profile_named(s, name->valuestring) : NULL;
 }
 
 /* The profile to resume scan @p id with: the first that takes views as the scan did (its own

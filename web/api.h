@@ -36,6 +36,9 @@ int api_send_png(struct mg_connection *conn, const void *png, size_t len);
 /** Send what is wrong with a body api_read_body refused with @p status. @retval status */
 int api_send_body_error(struct mg_connection *conn, int status);
 
+/** The profile called @p name. @retval NULL no such one */
+const struct web_profile *api_profile_named(const struct web_server *s, const char *name);
+
 /** The profile a body names ("profile"; none: the first served). @retval NULL no such one */
 const struct web_profile *api_find_profile(const struct web_server *s, const cJSON *body);
 

@@ -8,11 +8,11 @@
 #include "calib_file.h"
 #include "config.h"
 #include "file_posix.h"
+#include "storage_posix.h"
 
 #include <cJSON.h>
 #include <civetweb.h>
 #include <errno.h>
-#include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -80,11 +80,8 @@ static cJSON *file_summary(const char *path, uint32_t light_count)
 static const struct web_profile *profile_config(const struct web_server *s, const char *name,
                                                 struct app_config *cfg, char *err, size_t err_len)
 {
-    const struct web_profile *p = &s->profile[0];
-    for (unsigned i = 0; name != NULL && name[0] != '\0' && i < s->profiles; i++)
-        if (strcmp(s->profile[i].name, name) == 0)
-            p = &s->profile[i];
-    if (name != NULL && name[0] != '\0' && strcmp(p->name, name) != 0) {
+    const struct web_profile *p = name[0] != '\0' ? api_profile_named(s, name) : &s->profile[0];
+    if (p == NULL) {
         snprintf(err, err_len, "no such profile");
         return NULL;
     }
@@ -115,7 +112,6 @@ struct snapshot {
     unsigned answers, pictures;
     char answer[WEB_MAX_ANSWERS][WEB_MAX_ANSWER];
     char id[64], profile[64], stage[32], detail[512], error[512], choice[16];
-    char dir[WEB_PATH], file[WEB_PATH];
     char live[1024], result[WEB_CALIB_RESULT], log[WEB_CALIB_LOG];
 };
 
@@ -138,8 +134,6 @@ static int take_snapshot(struct web_server *s, struct snapshot *out)
         snprintf(out->detail, sizeof(out->detail), "%s", j->detail);
         snprintf(out->error, sizeof(out->error), "%s", j->error);
         snprintf(out->choice, sizeof(out->choice), "%s", j->calib_choice);
-        snprintf(out->dir, sizeof(out->dir), "%s", j->dir);
-        snprintf(out->file, sizeof(out->file), "%s", j->calib_file);
         memcpy(out->live, j->calib_live, sizeof(out->live));
         memcpy(out->result, j->calib_result, sizeof(out->result));
         memcpy(out->log, j->calib_log, j->calib_log_len + 1);
@@ -263,12 +257,10 @@ static int answer(struct mg_connection *conn, struct web_server *s)
                            : api_send_error(conn, 500, "the scanner has gone");
 }
 
-/* @p src copied whole to @p dst (a temporary file beside it, fsync, rename), bounded.
- * @retval 0 @retval -errno */
+/* @p src copied whole to @p dst, bounded, durably and atomically (the storage layer's temporary
+ * file, fsync, rename). @retval 0 @retval -errno */
 static int copy_file(const char *src, const char *dst)
 {
-    char tmp[WEB_PATH + 32];
-    snprintf(tmp, sizeof(tmp), "%s.page.tmp", dst);
     FILE *in = file_open_regular(src, "rb");
     char *text = malloc(CAL_MAX_FILE);
     size_t n = in != NULL && text != NULL ? fread(text, 1, CAL_MAX_FILE, in) : 0;
@@ -278,17 +270,10 @@ static int copy_file(const char *src, const char *dst)
                                                : 0;
     if (in != NULL)
         fclose(in);
-    int fd = rc == 0 ? open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC | O_NOFOLLOW, 0644) : -1;
-    if (rc == 0 && fd < 0)
-        rc = -errno;
-    if (rc == 0 && (write(fd, text, n) != (ssize_t)n || fsync(fd) != 0))
-        rc = -errno;
-    if (fd >= 0)
-        close(fd);
-    if (rc == 0 && rename(tmp, dst) != 0)
-        rc = -errno;
-    if (rc != 0 && fd >= 0)
-        unlink(tmp);
+    struct hal_storage st;
+    storage_posix_init(&st);
+    if (rc == 0)
+        rc = hal_storage_write_file(&st, dst, text, n);
     free(text);
     return rc;
 }
@@ -356,7 +341,7 @@ static int choose(struct mg_connection *conn, struct web_server *s, int use)
         return api_send_json(conn, 200, o);
     struct app_config cfg;
     char fresh[WEB_PATH + 32], kept[WEB_PATH + 40], err[WEB_PATH + 256];
-    snprintf(fresh, sizeof(fresh), "%s/calibration.ini", dir);
+    snprintf(fresh, sizeof(fresh), "%s/" WEB_CALIB_FILE, dir);
     int rc = profile_config(s, profile, &cfg, err, sizeof(err)) != NULL ? 0 : -EINVAL;
     if (rc == 0)
         rc = install(fresh, file, cfg.light_count, kept, sizeof(kept), err, sizeof(err));
@@ -382,7 +367,7 @@ static int send_live(struct mg_connection *conn, struct web_server *s)
     char path[WEB_PATH + 32];
     pthread_mutex_lock(&j->lock);
     int have = j->state != WEB_IDLE && j->kind == WEB_CALIBRATION;
-    snprintf(path, sizeof(path), "%s/captures/live.png", j->dir);
+    snprintf(path, sizeof(path), "%s/" WEB_CALIB_CAPTURES "/live.png", j->dir);
     pthread_mutex_unlock(&j->lock);
     FILE *f = have ? file_open_regular(path, "rb") : NULL;
     char *png = f != NULL ? malloc(CAL_MAX_FILE) : NULL;

@@ -95,22 +95,21 @@ pid_t web_spawn(const char *const *args, int *fd_in, int *fd_out, int *fd_err)
 }
 
 /* The question @p ev asks (its "answers"; a second pass's place_object takes "continue"), kept
- * as the only answers the page may send. @retval 1 it is a question */
-static int take_question(struct web_job *j, const cJSON *ev, const char *name)
+ * as the only answers the page may send (none: it asks nothing). */
+static void take_question(struct web_job *j, const cJSON *ev, const char *name)
 {
     const cJSON *answers = cJSON_GetObjectItemCaseSensitive(ev, "answers"), *a;
     j->answers = 0;
     if (strcmp(name, EV_PLACE_OBJECT) == 0)
         snprintf(j->answer[j->answers++], WEB_MAX_ANSWER, "continue");
     if (!cJSON_IsArray(answers))
-        return j->answers > 0;
+        return;
     cJSON_ArrayForEach(a, answers)
     {
         if (j->answers < WEB_MAX_ANSWERS && cJSON_IsString(a) &&
             strlen(a->valuestring) < WEB_MAX_ANSWER)
             snprintf(j->answer[j->answers++], WEB_MAX_ANSWER, "%s", a->valuestring);
     }
-    return j->answers > 0;
 }
 
 /* A calibration's event kept for the page: the live picture's, the result, or in the log. */
@@ -491,8 +490,8 @@ int jobs_start_calibration(struct web_server *s, const struct web_profile *p, in
     if (verify)
         dir[0] = '\0';
     snprintf(id, id_len, "%s", name);
-    snprintf(out, sizeof(out), "%s/calibration.ini", dir);
-    snprintf(captures, sizeof(captures), "%s/captures", dir);
+    snprintf(out, sizeof(out), "%s/" WEB_CALIB_FILE, dir);
+    snprintf(captures, sizeof(captures), "%s/" WEB_CALIB_CAPTURES, dir);
     const char *calibrate_args[] = {s->scanner, "calibrate", "--config", p->path,  "--out",
                                     out,        "--dir",     captures,   "--json", NULL};
     const char *verify_args[] = {s->scanner, "calibrate", "verify", "--config",

@@ -29,14 +29,6 @@ static const struct {
 #define PROFILE_MAX_FILE 65536 /* bytes of a config file the page edits */
 #define PROFILE_MAX_VALUE 64
 
-static const struct web_profile *find(const struct web_server *s, const char *name)
-{
-    for (unsigned i = 0; i < s->profiles; i++)
-        if (strcmp(s->profile[i].name, name) == 0)
-            return &s->profile[i];
-    return NULL;
-}
-
 /* GET: {"name", "values": {"scan.views": "8", ...}} as the scanner reads them. */
 static int get_profile(struct mg_connection *conn, const struct web_profile *p)
 {
@@ -251,7 +243,8 @@ static int set_profile(struct mg_connection *conn, struct web_server *s,
     }
     if (as != NULL) { /* a new profile: never over another file */
         pthread_mutex_lock(&s->job.lock);
-        int full = s->profiles == WEB_MAX_PROFILES, taken = find(s, as->valuestring) != NULL;
+        int full = s->profiles == WEB_MAX_PROFILES,
+            taken = api_profile_named(s, as->valuestring) != NULL;
         rc = full || taken ? -EEXIST : link(tmp, target) == 0 ? 0 : -errno;
         if (rc == 0) { /* filled first, then counted: a reader sees it whole or not at all */
             struct web_profile *np = &s->profile[s->profiles];
@@ -291,7 +284,7 @@ out_free:
 int profiles_handle(struct mg_connection *conn, struct web_server *s, const char *method,
                     const char *name)
 {
-    const struct web_profile *p = find(s, name);
+    const struct web_profile *p = api_profile_named(s, name);
     int is_get = strcmp(method, "GET") == 0;
     if (p == NULL)
         return api_send_error(conn, 404, "no such profile (GET /api/status lists them)");

@@ -27,9 +27,12 @@ enum web_state { WEB_IDLE, WEB_RUNNING, WEB_FINISHED, WEB_FAILED, WEB_STOPPED };
 /* What the rig's job is: a scan (or resume), a calibration, or a verification of one. */
 enum web_kind { WEB_SCAN, WEB_CALIBRATION, WEB_VERIFY };
 
-#define WEB_MAX_ANSWERS 4      /* answers a question takes */
-#define WEB_MAX_ANSWER 16      /* bytes of one, with its NUL */
-#define WEB_CALIB_LOG 65536    /* bytes of a calibration's events kept for the page */
+#define WEB_MAX_ANSWERS 4   /* answers a question takes */
+#define WEB_MAX_ANSWER 16   /* bytes of one, with its NUL */
+#define WEB_CALIB_LOG 65536 /* bytes of a calibration's events kept for the page */
+/* A calibration's folder from the page: its result, and its captures (live.png among them) */
+#define WEB_CALIB_FILE "calibration.ini"
+#define WEB_CALIB_CAPTURES "captures"
 #define WEB_CALIB_RESULT 16384 /* bytes of its result (the calibration event) */
 
 /* The scan (or resume) the rig runs now, or ran last: a child process, `scanner scan --json`,

@@ -20,9 +20,6 @@ struct hal_thread {
     unsigned threads; /**< at most HAL_MAX_THREADS */
 };
 
-/** Items a per-pixel stage splits into: one a thread (1 when @p t is NULL or has no ops). */
-unsigned hal_thread_count(const struct hal_thread *t);
-
 /** Parts a stage splits into so that its threads stay busy when parts cost unequally (the
  *  image's edges, the object's middle): four a thread, at most @p most; 1 on one thread. */
 unsigned hal_thread_parts(const struct hal_thread *t, unsigned most);
