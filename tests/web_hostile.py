@@ -521,6 +521,22 @@ def calibration_cases(port, key, scans):
           and os.path.isfile(os.path.join(captures, "view_000", "view.ini"))
           and not json.loads(request(port, "GET", "/api/status")[2])["calibrating"],
           f"a stop ends it with its captures kept and the rig free ({st}, {c2 and c2['state']})")
+    # a pipe or a link where the live picture belongs: answered at once, nothing served through it
+    live = os.path.join(captures, "live.png")
+    codes = []
+    for plant in ("fifo", "link"):
+        if os.path.lexists(live):
+            os.unlink(live)
+        if plant == "fifo":
+            os.mkfifo(live)
+        else:
+            os.symlink("/etc/passwd", live)
+        t0 = time.time()
+        st, _, body = request(port, "GET", "/api/calibration/live.png", timeout=10)
+        codes.append((st, time.time() - t0 < 5, b"root:" not in body))
+    os.unlink(live)
+    check(codes == [(404, True, True)] * 2,
+          f"a pipe or a link to /etc/passwd as the live picture: 404 at once ({codes})")
     st, _, _ = request(port, "POST", "/api/calibration/use", js, "{}")
     st2, _, _ = request(port, "GET", "/api/calibration?profile=" + "x" * 5000)
     st3, _, _ = request(port, "POST", "/api/calibration/answer", js, '{"answer": "continue"}')
