@@ -160,6 +160,12 @@ static const struct ini_key config_keys[] = {
          "which camera frames a scan keeps: all (scanner process can decode and colour again), "
          "colour (the colour frames, not the stripe patterns), or none; each view's range image "
          "(range.bin) is kept in every case, so process can still register and fuse again"),
+    U32("output", "texture", texture, 0, 1, "1",
+        "1: the model's colour also as a texture at the camera's resolution (texture.png, with "
+        "mesh.obj's mesh.mtl and inside mesh.glb); vertex colours are kept either way"),
+    F64("output", "texel_mm", texel_mm, 0, 10, "0",
+        "a texel's edge on the object; 0: a camera pixel's at the turntable's axis (larger when "
+        "the surface does not fit the compiled texture size, said)"),
     F64("output", "min_fragment_share", min_fragment_share, 0, 1, "0.01",
         "floating pieces of the mesh with fewer triangles than this share of the largest piece "
         "are left out of every output (0: keep every piece)"),

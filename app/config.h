@@ -47,6 +47,8 @@ struct app_config {
     double min_fragment_share; /**< [output]: smaller floating pieces are left out of the mesh */
     double max_hole_mm;        /**< [output]: holes up to this wide are filled */
     uint32_t watertight;       /**< [output]: 1: the model is closed */
+    uint32_t texture;          /**< [output]: 1: a texture atlas beside the vertex colours */
+    double texel_mm;           /**< [output]: its texel (0: a camera pixel at the axis) */
     struct hal_gpio_config gpio;
     struct tt_client_config turntable;
     struct fusion_params fusion;

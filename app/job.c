@@ -3,6 +3,8 @@
 #define _POSIX_C_SOURCE 200809L
 #include "job.h"
 
+#include "atlas.h"
+
 #include "board.h"
 #include "clock_posix.h"
 #include "reflect.h"
@@ -39,6 +41,8 @@ static struct reflect_pool reflectance;
 static struct scan_ctx views;
 /* The volume the views are fused in and the mesh made from, likewise. */
 static struct fusion_volume volume;
+/* The model's texture atlas and its work space, likewise. */
+static struct atlas texture;
 
 struct scan_ctx *scan_job_views(void)
 {
@@ -62,6 +66,7 @@ void job_init(struct job *j, const struct hal *hal, const struct app_config *cfg
                       .reg = &registration,
                       .pool = &reflectance,
                       .vol = &volume,
+                      .atlas = &texture,
                       .tty = isatty(STDOUT_FILENO) && !opts->json};
     if (hal_clock_now_us(&hal->clock, &j->start_rig_us) != 0)
         j->start_rig_us = 0;

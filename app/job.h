@@ -50,6 +50,7 @@ struct job {
     struct reg_ctx *reg;         /* the registration of the job's views (job.c keeps the one) */
     struct reflect_pool *pool;   /* [colour] method = fit: the reflectance (job.c keeps it) */
     struct fusion_volume *vol;   /* the model's volume (job.c keeps it) */
+    struct atlas *atlas;         /* its texture ([output] texture; job.c keeps it) */
     struct pending pending_view; /* where the view processed while the table turns is kept */
     struct pending *pending;     /* that view while it is processed, or NULL */
     struct eta {                 /* views finished of the current run, and when */
@@ -114,6 +115,17 @@ int job_home_and_take_views(struct job *j, uint32_t first);
 int job_begin_model(struct job *j);
 /** Once every view is in: registration, reflectance, fusion, the mesh. */
 int job_make_model(struct job *j, const char *scan_dir);
+/** View @p v as the model is made of it: its range image read back from @p scan_dir, recoloured
+ *  from its frames for the reflectance. @retval 0 @retval -errno (said) */
+int job_view_for_model(struct job *j, const char *scan_dir, uint32_t v, struct scan_view *view,
+                       struct scan_view_info *info);
+
+/* ---- job_texture.c ---- */
+/** The texture atlas of the prepared mesh ([output] texture): charts, every view's colour,
+ *  texture.png and mesh.mtl beside the mesh; @p said tells what was made, for the mesh's line.
+ *  A texture that cannot be made is said (a warning) and left out: the vertex colours stand.
+ *  @retval 0 made @retval -errno not made */
+int job_make_texture(struct job *j, const char *scan_dir, char *said, size_t said_len);
 
 /* ---- job_offline.c ---- */
 /** Frame @p f of view @p v read from @p scan_dir into the firmware's buffer for it. */

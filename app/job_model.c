@@ -3,6 +3,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "job.h"
 
+#include "atlas.h"
 #include "clock_posix.h"
 #include "fusion.h"
 #include "gray.h"
@@ -36,8 +37,8 @@ static int save_results(struct job *j, uint32_t v, const struct scan_view *view,
 }
 
 /* The fused model: mesh.ply, mesh.obj, mesh.stl and mesh.glb in the scan directory, without
- * floating fragments. */
-static int write_model(struct job *j)
+ * floating fragments, and its texture. */
+static int write_model(struct job *j, const char *scan_dir)
 {
     static const char *const names[] = {SCAN_FILE_MESH_PLY, SCAN_FILE_MESH_OBJ, SCAN_FILE_MESH_STL,
                                         SCAN_FILE_MESH_GLB};
@@ -60,6 +61,9 @@ static int write_model(struct job *j)
             j->hal->log(HAL_LOG_WARN, "holes left on the mesh unclosed: %s", strerror(-rc));
         rc = fusion_mesh_counts(j->vol, &ms);
     }
+    char texture[256] = "";
+    int textured = fits && rc == 0 && j->cfg->texture &&
+                   job_make_texture(j, scan_dir, texture, sizeof(texture)) == 0;
     if (rc == -E2BIG)
         j->hal->log(HAL_LOG_WARN,
                     "the mesh has %u vertices, more than MESH_MAX_VERTICES (%u): it is written "
@@ -74,7 +78,10 @@ static int write_model(struct job *j)
         if (!fits && (writers[k] == fusion_write_stl || writers[k] == NULL))
             continue;
         rc = scan_dir_path(path, sizeof(path), j->out_dir, -1, names[k]);
-        if (rc == 0)
+        if (rc == 0 && textured && writers[k] == fusion_write_obj)
+            rc = fusion_write_obj_textured(j->vol, j->atlas, SCAN_FILE_MESH_MTL, &j->hal->storage,
+                                           path);
+        else if (rc == 0)
             rc = writers[k] != NULL ? writers[k](j->vol, &j->hal->storage, path)
                                     : fusion_write_glb(j->vol, &j->hal->storage, path,
                                                        reflect_model(j->pool)); /* or matte */
@@ -99,10 +106,10 @@ static int write_model(struct job *j)
                  (unsigned)holes.filled);
     snprintf(detail, sizeof(detail),
              "%u vertices, %u triangles (%u floating fragments of %u pieces left out; %u voxels "
-             "filled holes%s%s%s) -> %s/mesh.ply, mesh.obj%s",
+             "filled holes%s%s%s) -> %s/mesh.ply, mesh.obj%s%s",
              (unsigned)ms.kept_vertices, (unsigned)ms.kept_triangles, (unsigned)ms.removed_pieces,
              (unsigned)ms.pieces, (unsigned)filled, mesh_holes, closed, uncoloured, j->out_dir,
-             fits ? ", mesh.stl and mesh.glb" : "");
+             fits ? ", mesh.stl and mesh.glb" : "", texture);
     char fields[192];
     snprintf(fields, sizeof(fields),
              "\"vertices\":%u,\"triangles\":%u,\"pieces_left_out\":%u,\"colour_filled\":%u,"
@@ -270,8 +277,8 @@ static int recolour_from_frames(struct job *j, const char *scan_dir, uint32_t v,
 /* View @p v as the model is made of it (load_range), coloured again from its frames while the
  * reflectance pool collects or once its model is fitted (fit); stopped by request between
  * views. */
-static int view_for_model(struct job *j, const char *scan_dir, uint32_t v, struct scan_view *view,
-                          struct scan_view_info *info)
+int job_view_for_model(struct job *j, const char *scan_dir, uint32_t v, struct scan_view *view,
+                       struct scan_view_info *info)
 {
     int rc = job_stopped_offline(j, scan_dir, v);
     if (rc == 0)
@@ -295,7 +302,7 @@ static int fit_reflectance(struct job *j, const char *scan_dir)
     for (uint32_t v = 0; v < j->views && rc == 0; v++) {
         struct scan_view view;
         struct scan_view_info info;
-        rc = view_for_model(j, scan_dir, v, &view, &info);
+        rc = job_view_for_model(j, scan_dir, v, &view, &info);
     }
     struct reflect_model m;
     if (rc == 0 && (rc = reflect_fit(j->pool, j->cfg->scan.colour.clusters, &m)) == -ENODATA) {
@@ -345,7 +352,7 @@ int job_make_model(struct job *j, const char *scan_dir)
     for (uint32_t v = 0; v < j->views && rc == 0; v++) {
         struct scan_view view;
         struct scan_view_info info;
-        rc = view_for_model(j, scan_dir, v, &view, &info);
+        rc = job_view_for_model(j, scan_dir, v, &view, &info);
         if (rc == 0)
             rc = job_make_view_dir(j, v);
         struct reg_view rv;
@@ -362,5 +369,5 @@ int job_make_model(struct job *j, const char *scan_dir)
             job_progress_with(j, EV_FUSED, (int)v, v + 1, fields, detail);
         }
     }
-    return rc == 0 ? write_model(j) : rc;
+    return rc == 0 ? write_model(j, scan_dir) : rc;
 }

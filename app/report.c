@@ -677,9 +677,9 @@ int report_write(const struct hal_storage *st, const char *dir, char *err, size_
     text_html(&t, dir_name(dir));
     text_printf(&t, "</h1>\n<p class=state>%u of %u views taken. Files: ", (unsigned)done,
                 (unsigned)views);
-    static const char *const files[] = {SCAN_FILE_MESH_PLY, SCAN_FILE_MESH_OBJ,
-                                        SCAN_FILE_MESH_STL, SCAN_FILE_MESH_GLB,
-                                        SCAN_FILE_CONFIG,   SCAN_FILE_CALIBRATION};
+    static const char *const files[] = {
+        SCAN_FILE_MESH_PLY, SCAN_FILE_MESH_OBJ, SCAN_FILE_MESH_MTL, SCAN_FILE_TEXTURE,
+        SCAN_FILE_MESH_STL, SCAN_FILE_MESH_GLB, SCAN_FILE_CONFIG,   SCAN_FILE_CALIBRATION};
     struct stat sb;
     for (size_t f = 0; f < sizeof(files) / sizeof(files[0]); f++)
         if (scan_dir_path(path, sizeof(path), dir, -1, files[f]) == 0 && stat(path, &sb) == 0)

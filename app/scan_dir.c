@@ -526,8 +526,8 @@ int scan_dir_keep_settings(const struct hal_storage *st, const char *config_path
 static int scan_file(const char *name)
 {
     static const char *const names[] = {
-        SCAN_FILE_CONFIG,      SCAN_FILE_CALIBRATION, SCAN_FILE_MESH_PLY,
-        SCAN_FILE_MESH_OBJ,    SCAN_FILE_MESH_STL,    SCAN_FILE_MESH_GLB,
+        SCAN_FILE_CONFIG,      SCAN_FILE_CALIBRATION, SCAN_FILE_MESH_PLY, SCAN_FILE_MESH_OBJ,
+        SCAN_FILE_MESH_STL,    SCAN_FILE_MESH_GLB,    SCAN_FILE_MESH_MTL, SCAN_FILE_TEXTURE,
         SCAN_FILE_REFLECTANCE, SCAN_FILE_SUMMARY,     SCAN_FILE_REPORT};
     for (size_t k = 0; k < sizeof(names) / sizeof(names[0]); k++)
         if (strcmp(name, names[k]) == 0)

@@ -24,6 +24,8 @@
 #define SCAN_FILE_MESH_OBJ "mesh.obj"
 #define SCAN_FILE_MESH_STL "mesh.stl"
 #define SCAN_FILE_MESH_GLB "mesh.glb"
+#define SCAN_FILE_MESH_MTL "mesh.mtl"           /* mesh.obj's material: its texture */
+#define SCAN_FILE_TEXTURE "texture.png"         /* the model's texture atlas (sRGB) */
 #define SCAN_FILE_REFLECTANCE "reflectance.ini" /* [colour] method = fit's materials */
 #define SCAN_FILE_SUMMARY "summary.ini"         /* last: the scan is complete */
 #define SCAN_FILE_REPORT "report.html"

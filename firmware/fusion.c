@@ -132,6 +132,12 @@ static int pixel_weights(struct fusion_volume *vol, const struct scan_calib *c,
     return 1;
 }
 
+const float *fusion_view_weights(struct fusion_volume *vol, const struct scan_calib *calib,
+                                 const struct decode_maps *maps, const struct tri_range *range)
+{
+    return pixel_weights(vol, calib, maps, range) ? vol->weight_map : NULL;
+}
+
 /* Blend colour @p rgb with weight @p cw into the voxel; a voxel no confident view has coloured
  * yet takes any estimate (weight 0: a best effort), so that every surface gets some colour.
  * colour_weight: 0 never coloured, COLOUR_BEST_EFFORT only best efforts, else the summed weight

@@ -44,6 +44,12 @@ int fusion_integrate(struct fusion_volume *vol, const struct hal_thread *threads
                      const struct decode_maps *maps, const struct tri_range *range,
                      const uint8_t *rgb, const float *confidence);
 
+/** The weight fusion_integrate gives each pixel of a view (above; 0: not fused), in @p vol's
+ *  work space, which the mesh's hole filling shares: once the mesh is made (the texture atlas).
+ *  @retval the weights, width x height @retval NULL no pixel is valid */
+const float *fusion_view_weights(struct fusion_volume *vol, const struct scan_calib *calib,
+                                 const struct decode_maps *maps, const struct tri_range *range);
+
 /** Set every voxel from a signed distance function of the object-frame position (mm), weight 1
  *  and grey colour (NAN: never observed): synthetic objects and tests of the extraction.
  *  @retval 0 */
@@ -133,6 +139,14 @@ int fusion_mesh_counts(struct fusion_volume *vol, struct mesh_summary *summary);
 int fusion_write_ply(struct fusion_volume *vol, const struct hal_storage *st, const char *path);
 int fusion_write_obj(struct fusion_volume *vol, const struct hal_storage *st, const char *path);
 int fusion_write_stl(struct fusion_volume *vol, const struct hal_storage *st, const char *path);
+
+struct atlas;
+/** fusion_write_obj with texture coordinates from @p atlas (atlas.h) and the material of
+ *  @p mtl_name (a file beside it, which names the texture): "mtllib", "usemtl scan", a "vt" for
+ *  each corner of each triangle (NULL atlas or mtl_name: fusion_write_obj's file).
+ *  @retval as fusion_write_obj */
+int fusion_write_obj_textured(struct fusion_volume *vol, const struct atlas *atlas,
+                              const char *mtl_name, const struct hal_storage *st, const char *path);
 
 /** Write the prepared mesh as glTF 2.0 binary (firmware/mesh_glb.c): metres, +Y up, linear vertex
  *  colours, atomically; one material, or one per cluster of @p model (the reflectance fitted, or

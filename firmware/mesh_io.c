@@ -6,6 +6,7 @@
  * renumbering the vertices it keeps. A mesh too large for the tables (more than
  * MESH_MAX_VERTICES or MESH_MAX_TRIANGLES) keeps every piece and gets no STL; PLY and OBJ then
  * stream from marching cubes again, which is deterministic. */
+#include "atlas.h"
 #include "fusion.h"
 #include "outbuf.h"
 #include "ply.h"
@@ -262,6 +263,51 @@ static int obj_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
 
 int fusion_write_obj(struct fusion_volume *vol, const struct hal_storage *st, const char *path)
 {
+    return fusion_write_obj_textured(vol, NULL, NULL, st, path);
+}
+
+/* One "vt" line (OBJ's v runs up from the image's bottom). */
+static void obj_vt(struct outbuf *o, const float uv[2])
+{
+    outbuf_printf(o, "vt %.6f %.6f\n", uv[0], 1.0 - uv[1]);
+}
+
+/* The kept triangles with their texture coordinates: a "vt" for each kept vertex (numbered as the
+ * vertex, in its own chart), then the faces, each corner whose triangle lies in another chart
+ * (a chart's border) with a "vt" of its own just before its face. */
+static void obj_textured_faces(struct fusion_volume *vol, const struct atlas *atlas,
+                               struct outbuf *o)
+{
+    float uv[2];
+    for (uint32_t v = 0; v < vol->mp.s.vertices && o->rc == 0; v++) {
+        if (vol->mesh_index[v] == MESH_DROPPED)
+            continue;
+        if (atlas_vertex_uv(atlas, vol, v, uv) != 0)
+            uv[0] = uv[1] = 0.0f;
+        obj_vt(o, uv);
+    }
+    uint32_t vt = vol->mp.s.kept_vertices;
+    for (uint32_t t = 0; t < vol->mp.s.triangles && o->rc == 0; t++) {
+        const uint32_t *tri = &vol->mesh_tri[3 * (size_t)t];
+        uint32_t at[3];
+        if (vol->mesh_index[tri[0]] == MESH_DROPPED)
+            continue;
+        for (int k = 0; k < 3; k++) {
+            at[k] = vol->mesh_index[tri[k]] + 1;
+            if (atlas_corner_is_vertex(atlas, vol, t, k) || atlas_uv(atlas, vol, t, k, uv) != 0)
+                continue;
+            obj_vt(o, uv);
+            at[k] = ++vt;
+        }
+        uint32_t a = vol->mesh_index[tri[0]] + 1, b = vol->mesh_index[tri[1]] + 1,
+                 c = vol->mesh_index[tri[2]] + 1;
+        outbuf_printf(o, "f %u/%u/%u %u/%u/%u %u/%u/%u\n", a, at[0], a, b, at[1], b, c, at[2], c);
+    }
+}
+
+int fusion_write_obj_textured(struct fusion_volume *vol, const struct atlas *atlas,
+                              const char *mtl_name, const struct hal_storage *st, const char *path)
+{
     struct outbuf o;
     if (!vol->mp.prepared)
         return -EINVAL;
@@ -270,8 +316,13 @@ int fusion_write_obj(struct fusion_volume *vol, const struct hal_storage *st, co
     outbuf_printf(&o, "# turntable colour scanner: fused mesh; units: millimetres; Y up (the "
                       "object frame's x, z, -y: its z, up the turntable's axis, is Y here); vertex "
                       "colours sRGB-encoded\n");
-    struct mesh_sink sink = {obj_vertex, obj_triangle, &o};
+    int textured = atlas != NULL && mtl_name != NULL && vol->mp.fits;
+    if (textured)
+        outbuf_printf(&o, "mtllib %s\nusemtl scan\n", mtl_name);
+    struct mesh_sink sink = {obj_vertex, textured ? NULL : obj_triangle, &o};
     fusion_extract_prepared(vol, &sink);
+    if (textured)
+        obj_textured_faces(vol, atlas, &o);
     return outbuf_close(&o);
 }
 

@@ -1,6 +1,8 @@
 /* sRGB encoding of linear bytes: one table, as the writers call it per vertex. */
 #include "srgb.h"
 
+#include <math.h>
+
 /* srgb_encode(i) for i = 0..255: the formula in srgb.h, rounded (tests/test_ply.c checks every
  * entry against it). A table rather than pow() per channel: a fused mesh has ~10^6 channels. */
 static const uint8_t encode_table[256] = {
@@ -23,4 +25,21 @@ static const uint8_t encode_table[256] = {
 uint8_t srgb_encode(uint8_t linear)
 {
     return encode_table[linear];
+}
+
+#define FINE_STEPS 4096
+uint8_t srgb_encode_unit(double linear)
+{
+    static uint8_t fine[FINE_STEPS]; /* the formula at i / (FINE_STEPS - 1), made on first use */
+    static int made;
+    if (!made) {
+        for (int i = 0; i < FINE_STEPS; i++) {
+            double x = (double)i / (FINE_STEPS - 1);
+            double e = x < 0.0031308 ? 12.92 * x : 1.055 * pow(x, 1.0 / 2.4) - 0.055;
+            fine[i] = (uint8_t)lround(255.0 * e);
+        }
+        made = 1;
+    }
+    double x = linear < 0.0 ? 0.0 : linear > 1.0 ? 1.0 : linear;
+    return fine[lround(x * (FINE_STEPS - 1))];
 }

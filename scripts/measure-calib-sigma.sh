@@ -7,7 +7,8 @@
 # RMS error against the true rig ([sim] rig), which also holds what every seed shares (the
 # rendering's own bias), over the same reported sigma.
 # Usage: scripts/measure-calib-sigma.sh BUILD; CONFIG=F for another procedure (e.g. fewer
-# placements), SEEDS=N.
+# placements), SEEDS=N, KEEP=1 to keep each seed's captures (half a gigabyte each) so that the
+# uncertainty can be computed again from them (scanner calibrate --from).
 set -eu
 build=$1
 seeds=${SEEDS:-10}
@@ -40,7 +41,7 @@ for s in $(seq 1 "$seeds"); do
     "$build/scanner" calibrate --config "$out/seed-$s.ini" --out "$out/seed-$s.cal.ini" \
         >"$out/seed-$s.log" 2>&1 || { echo "seed $s: calibration failed (see $out/seed-$s.log)"; continue; }
     c="$out/seed-$s.cal.ini"
-    rm -rf "$out/seed-$s.cal-captures" # half a gigabyte a calibration
+    [ "${KEEP:-0}" = 1 ] || rm -rf "$out/seed-$s.cal-captures" # half a gigabyte a calibration
     # value and reported sigma, one row per seed: camera fx cx cy, projector fx cx cy, t1 t2 t3
     echo "$(value "$c" camera fx_px 1) $(sigma "$c" 'camera fx' fx 1) $(value "$c" camera cx_px 1)" \
         "$(sigma "$c" 'camera fx' cx 1) $(value "$c" camera cy_px 1) $(sigma "$c" 'camera fx' cy 1)" \

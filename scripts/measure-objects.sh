@@ -9,7 +9,8 @@
 # model against the truth once aligned (mean, mm), the truth within 1 mm of the model (above the
 # table), holes and pieces of the model, and the registration's CPU.
 # Usage: scripts/measure-objects.sh BUILD; OBJECTS="box gear", VIEWS="4 8", METHODS="none" and
-# CONDITIONS="exact" (exact table1 table2 slip slip30) choose a subset.
+# CONDITIONS="exact" (exact table1 table2 slip slip30) choose a subset; KEEP=1 keeps the frames
+# (scanner process DIR computes a scan again from them).
 set -eu
 build=$1
 out=$build/measure-objects
@@ -48,7 +49,8 @@ config() {
     sim_lines "$1" | sed -i "/^\[sim\]/r /dev/stdin" "$out/$5.ini"
     printf "$4" | sed -i "/^\[sim\]/r /dev/stdin" "$out/$5.ini"
     [ "$3" = none ] || printf '\n[colour]\nmethod = %s\nwhite_scale = 0.008333, 0.008333, 0.008333\n' "$3" >>"$out/$5.ini"
-    printf '\n[output]\nkeep_frames = none\n' >>"$out/$5.ini" # 250 scans' frames would be 60 GB
+    # 250 scans' frames would be 60 GB; KEEP=1 keeps them, to compute scans again
+    [ "${KEEP:-0}" = 1 ] || printf '\n[output]\nkeep_frames = none\n' >>"$out/$5.ini"
 }
 row() { # object, views, method, table, name: scan it and print its row
     rm -rf "${out:?}/$5"

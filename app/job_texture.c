@@ -1,0 +1,74 @@
+/* A scan job's texture (job.h): the atlas of the prepared mesh, each view's colour projected onto
+ * it at the view's registered pose, written as texture.png with mesh.obj's material. */
+#define _POSIX_C_SOURCE 200809L
+#include "job.h"
+
+#include "atlas.h"
+#include "clock_posix.h"
+#include "image_io.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <string.h>
+
+/* A camera pixel's edge on the object at the turntable's axis: the texture's default texel. */
+static double pixel_at_axis_mm(const struct scan_calib *c)
+{
+    vec3 a = v3_from(c->axis_point_mm);
+    return v3_len(a) / c->cam_fx_px;
+}
+
+/* View @p v's colour onto the atlas at its registered pose, its range image read back as the
+ * fusion read it. */
+static int texture_view(struct job *j, const char *scan_dir, uint32_t v)
+{
+    struct scan_view view;
+    struct scan_view_info info;
+    struct frame_xform pose;
+    struct reg_view rv;
+    int rc = job_view_for_model(j, scan_dir, v, &view, &info);
+    if (rc == 0)
+        rc = reg_view_pose(j->reg, v, &pose, &rv);
+    if (rc == 0)
+        rc = atlas_add_view(j->atlas, j->vol, j->calib, &pose, &view.maps, &view.range, view.rgb,
+                            view.confidence);
+    return rc;
+}
+
+int job_make_texture(struct job *j, const char *scan_dir, char *said, size_t said_len)
+{
+    double t0 = clock_posix_thread_cpu_s();
+    double texel = j->cfg->texel_mm > 0.0 ? j->cfg->texel_mm : pixel_at_axis_mm(j->calib);
+    struct atlas_report ar;
+    char path[SCAN_DIR_PATH_MAX];
+    uint32_t uncoloured = 0;
+    int rc = atlas_build(j->atlas, j->vol, texel, &ar);
+    for (uint32_t v = 0; v < j->views && rc == 0; v++)
+        rc = texture_view(j, scan_dir, v);
+    if (rc == 0)
+        rc = atlas_finish(j->atlas, j->vol, &uncoloured);
+    if (rc == 0)
+        rc = scan_dir_path(path, sizeof(path), j->out_dir, -1, SCAN_FILE_TEXTURE);
+    if (rc == 0)
+        rc = image_write_png(&j->hal->storage, path, j->atlas->texture, ar.width, ar.height, 3);
+    static const char mtl[] =
+        "# turntable colour scanner: the texture of mesh.obj\n"
+        "newmtl scan\nKa 0 0 0\nKd 1 1 1\nKs 0 0 0\nmap_Kd " SCAN_FILE_TEXTURE "\n";
+    if (rc == 0)
+        rc = scan_dir_path(path, sizeof(path), j->out_dir, -1, SCAN_FILE_MESH_MTL);
+    if (rc == 0)
+        rc = hal_storage_write_file(&j->hal->storage, path, mtl, sizeof(mtl) - 1);
+    if (rc != 0) {
+        j->hal->log(HAL_LOG_WARN, "no texture: %s%s; the model keeps its vertex colours",
+                    strerror(-rc),
+                    rc == -ENOSPC ? " (more charts than the compiled ATLAS_MAX_CHARTS)" : "");
+        return rc;
+    }
+    snprintf(said, said_len,
+             "; texture %u x %u, %.3f mm a texel%s, %u charts, %.0f%% of it used, %u texels no "
+             "view saw (%.2f s CPU)",
+             (unsigned)ar.width, (unsigned)ar.height, ar.texel_mm,
+             ar.texel_mm > texel * 1.01 ? " (the finest that fits)" : "", (unsigned)ar.charts,
+             100.0 * ar.used_share, (unsigned)uncoloured, clock_posix_thread_cpu_s() - t0);
+    return 0;
+}

@@ -1,0 +1,488 @@
+/* The texture atlas (atlas.h): charts of the prepared mesh by the axis direction its normals lie
+ * nearest (a "box projection": each chart is a height field over its axis plane, so the
+ * orthographic projection along the axis unfolds it without stretching more than 1/cos 55
+ * degrees), packed into shelves; then each texel's surface point projected into every view. */
+#include "atlas.h"
+#include "camray.h"
+#include "frames.h"
+#include "srgb.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define NONE 0xFFFFFFFFu
+/* A texel's point and what a view measured along its ray agree within this many voxels: else the
+ * view sees another surface in front of it (or none there). */
+#define ATLAS_DEPTH_VOXELS 2.0
+/* The packing's target: the texture's area over the charts' (the shelves' waste). */
+#define ATLAS_SLACK 1.15
+
+static const uint32_t *tri_at(const struct fusion_volume *vol, uint32_t t)
+{
+    return &vol->mesh_tri[3 * (size_t)t];
+}
+
+static vec3 vertex_pos(const struct fusion_volume *vol, uint32_t v)
+{
+    const float *p = &vol->mesh_pos[3 * (size_t)v];
+    return v3(p[0], p[1], p[2]);
+}
+
+/* A triangle's normal: the mean of its vertices' (the volume's gradient, smoother than the face's
+ * own, so neighbouring triangles agree and the charts are few and large). */
+static vec3 tri_normal(const struct fusion_volume *vol, uint32_t t)
+{
+    vec3 n = v3(0, 0, 0);
+    for (int k = 0; k < 3; k++) {
+        const float *m = &vol->mesh_nrm[3 * (size_t)tri_at(vol, t)[k]];
+        n = v3_add(n, v3(m[0], m[1], m[2]));
+    }
+    return n;
+}
+
+/* The axis direction nearest @p n: 2 x axis + (1 when negative). */
+static uint8_t nearest_axis(vec3 n)
+{
+    const double c[3] = {n.x, n.y, n.z};
+    int best = 0;
+    for (int k = 1; k < 3; k++)
+        if (fabs(c[k]) > fabs(c[best]))
+            best = k;
+    return (uint8_t)(2 * best + (c[best] < 0.0));
+}
+
+/* @p p projected along axis direction @p axis: its two other coordinates (mm). */
+static void project(uint8_t axis, vec3 p, double *u, double *v)
+{
+    const double c[3] = {p.x, p.y, p.z};
+    int d = axis / 2;
+    *u = c[(d + 1) % 3];
+    *v = c[(d + 2) % 3];
+}
+
+/* Where @p p lies in the texture (texels, centres at +0.5) through chart @p ch. */
+static void texel_xy(const struct atlas *a, const struct atlas_chart *ch, vec3 p, double *x,
+                     double *y)
+{
+    double u, v;
+    project(ch->axis, p, &u, &v);
+    *x = ch->x0 + ATLAS_GUTTER + (u - ch->min_u) / a->texel_mm;
+    *y = ch->y0 + ATLAS_GUTTER + (v - ch->min_v) / a->texel_mm;
+}
+
+/* ---- charts: union-find over triangles through the vertices they share ---- */
+
+static uint32_t find_root(struct atlas *a, uint32_t t)
+{
+    while (a->tri_chart[t] != t) {
+        a->tri_chart[t] = a->tri_chart[a->tri_chart[t]]; /* path halving */
+        t = a->tri_chart[t];
+    }
+    return t;
+}
+
+static void unite(struct atlas *a, uint32_t x, uint32_t y)
+{
+    x = find_root(a, x);
+    y = find_root(a, y);
+    if (x != y) /* the larger under the smaller: a root is its piece's first triangle */
+        a->tri_chart[x > y ? x : y] = x < y ? x : y;
+}
+
+/* Every kept triangle's axis direction and chart number; each chart's projected extent (min in
+ * min_u/min_v, the extent's far corner in w/h as mm, made texels by size_charts).
+ * @retval 0 @retval -ENOSPC more charts than ATLAS_MAX_CHARTS */
+static int make_charts(struct atlas *a, const struct fusion_volume *vol, double far_uv[][2])
+{
+    const uint32_t nt = vol->mp.s.triangles, nv = vol->mp.s.vertices;
+    for (uint32_t t = 0; t < nt; t++) {
+        a->tri_chart[t] = t;
+        a->tri_axis[t] = vol->mesh_index[tri_at(vol, t)[0]] == MESH_DROPPED
+                             ? 0xFF
+                             : nearest_axis(tri_normal(vol, t));
+    }
+    for (uint8_t axis = 0; axis < 6; axis++) { /* joined only with triangles of its own axis */
+        memset(a->vertex_tri, 0xFF, nv * sizeof(a->vertex_tri[0]));
+        for (uint32_t t = 0; t < nt; t++) {
+            if (a->tri_axis[t] != axis)
+                continue;
+            for (int k = 0; k < 3; k++) {
+                uint32_t v = tri_at(vol, t)[k];
+                if (a->vertex_tri[v] == NONE)
+                    a->vertex_tri[v] = t;
+                else
+                    unite(a, t, a->vertex_tri[v]);
+            }
+        }
+    }
+    /* Each triangle straight to its root (a root is its piece's smallest triangle, and
+     * parents are smaller than their children), then in increasing order each root given its
+     * chart's number before the other triangles of its piece read it. */
+    for (uint32_t t = 0; t < nt; t++)
+        a->tri_chart[t] = find_root(a, t);
+    a->chart_count = 0;
+    for (uint32_t t = 0; t < nt; t++) {
+        if (a->tri_axis[t] == 0xFF) {
+            a->tri_chart[t] = NONE;
+            continue;
+        }
+        if (a->tri_chart[t] == t) {
+            if (a->chart_count >= ATLAS_MAX_CHARTS)
+                return -ENOSPC;
+            struct atlas_chart *ch = &a->chart[a->chart_count];
+            memset(ch, 0, sizeof(*ch));
+            ch->axis = a->tri_axis[t];
+            ch->min_u = ch->min_v = INFINITY;
+            far_uv[a->chart_count][0] = far_uv[a->chart_count][1] = -INFINITY;
+            a->tri_chart[t] = a->chart_count++;
+        } else {
+            a->tri_chart[t] = a->tri_chart[a->tri_chart[t]]; /* its root's, numbered already */
+        }
+        uint32_t c = a->tri_chart[t];
+        struct atlas_chart *ch = &a->chart[c];
+        ch->triangles++;
+        for (int k = 0; k < 3; k++) {
+            double u, v;
+            project(ch->axis, vertex_pos(vol, tri_at(vol, t)[k]), &u, &v);
+            ch->min_u = (float)fmin(ch->min_u, u);
+            ch->min_v = (float)fmin(ch->min_v, v);
+            far_uv[c][0] = fmax(far_uv[c][0], u);
+            far_uv[c][1] = fmax(far_uv[c][1], v);
+        }
+    }
+    return 0;
+}
+
+/* Each chart's size in texels at texel_mm: its extent, one texel for the reach, the gutters.
+ * @retval the charts' texels in all */
+static uint64_t size_charts(struct atlas *a, const double far_uv[][2])
+{
+    uint64_t area = 0;
+    for (uint32_t c = 0; c < a->chart_count; c++) {
+        struct atlas_chart *ch = &a->chart[c];
+        ch->w = (uint32_t)ceil((far_uv[c][0] - ch->min_u) / a->texel_mm) + 1 + 2 * ATLAS_GUTTER;
+        ch->h = (uint32_t)ceil((far_uv[c][1] - ch->min_v) / a->texel_mm) + 1 + 2 * ATLAS_GUTTER;
+        area += (uint64_t)ch->w * ch->h;
+    }
+    return area;
+}
+
+static int taller_first(const void *x, const void *y)
+{
+    uint64_t a = *(const uint64_t *)x, b = *(const uint64_t *)y;
+    return a < b ? -1 : a > b;
+}
+
+/* Shelf packing (tallest first, left to right, a new shelf when the row is full) into a texture
+ * @p width wide. @retval its height, or 0 when a chart is wider than the texture */
+static uint32_t pack(struct atlas *a, uint64_t *keys, uint32_t width)
+{
+    uint32_t x = 0, y = 0, shelf = 0;
+    for (uint32_t i = 0; i < a->chart_count; i++) {
+        struct atlas_chart *ch = &a->chart[keys[i] & 0xFFFFFFFFu];
+        if (ch->w > width)
+            return 0;
+        if (x + ch->w > width)
+            y += shelf, x = 0, shelf = 0;
+        ch->x0 = x, ch->y0 = y;
+        x += ch->w;
+        shelf = ch->h > shelf ? ch->h : shelf;
+    }
+    return y + shelf;
+}
+
+int atlas_build(struct atlas *a, const struct fusion_volume *vol, double texel_mm,
+                struct atlas_report *rep)
+{
+    /* far corners and sort keys: the accumulators' space, free until the views come */
+    double(*far_uv)[2] = (double(*)[2])(void *)a->accum;
+    uint64_t *keys = (uint64_t *)(void *)(a->accum + 4 * (size_t)ATLAS_MAX_CHARTS);
+    _Static_assert(sizeof(double) * 2 * ATLAS_MAX_CHARTS <= sizeof(float) * 4 * ATLAS_MAX_CHARTS,
+                   "far corners fit the accumulators' first charts' worth");
+    _Static_assert(16ull * ATLAS_MAX_CHARTS + 8ull * ATLAS_MAX_CHARTS <= 16ull * ATLAS_MAX_TEXELS,
+                   "the sort keys fit after them");
+    memset(rep, 0, sizeof(*rep));
+    a->width = a->height = a->chart_count = 0;
+    if (!vol->mp.prepared || !(texel_mm > 0.0))
+        return -EINVAL;
+    if (!vol->mp.fits)
+        return -E2BIG;
+    int rc = make_charts(a, vol, far_uv);
+    if (rc != 0)
+        return rc;
+    /* each vertex's chart: its first triangle's (a vertex on a chart's border has another
+     * place in the texture for its other charts' triangles) */
+    memset(a->vertex_tri, 0xFF, vol->mp.s.vertices * sizeof(a->vertex_tri[0]));
+    for (uint32_t t = 0; t < vol->mp.s.triangles; t++)
+        for (int k = 0; k < 3 && a->tri_chart[t] != NONE; k++)
+            if (a->vertex_tri[tri_at(vol, t)[k]] == NONE)
+                a->vertex_tri[tri_at(vol, t)[k]] = a->tri_chart[t];
+    for (a->texel_mm = texel_mm;; a->texel_mm *= 1.25) {
+        uint64_t area = size_charts(a, far_uv);
+        uint32_t widest = 0;
+        for (uint32_t c = 0; c < a->chart_count; c++) {
+            widest = a->chart[c].w > widest ? a->chart[c].w : widest;
+            keys[c] = (uint64_t)(0xFFFFFFFFu - a->chart[c].h) << 32 | c;
+        }
+        uint32_t width = (uint32_t)ceil(sqrt((double)area * ATLAS_SLACK));
+        width = ((width > widest ? width : widest) + 3u) & ~3u; /* rows of whole words */
+        if (width <= ATLAS_MAX_SIDE && area <= ATLAS_MAX_TEXELS) {
+            qsort(keys, a->chart_count, sizeof(keys[0]), taller_first);
+            uint32_t height = (pack(a, keys, width) + 3u) & ~3u;
+            if (height > 0 && height <= ATLAS_MAX_SIDE &&
+                (uint64_t)width * height <= ATLAS_MAX_TEXELS) {
+                a->width = width, a->height = height;
+                rep->used_share = (double)area / ((double)width * height);
+                break;
+            }
+        }
+    }
+    memset(a->accum, 0, (size_t)a->width * a->height * 4 * sizeof(a->accum[0]));
+    rep->width = a->width, rep->height = a->height;
+    rep->texel_mm = a->texel_mm;
+    rep->charts = a->chart_count;
+    return 0;
+}
+
+/* ---- texels: each triangle rasterised in its chart ---- */
+
+/* Called for each texel of a triangle with its barycentric weights (raster). */
+typedef void (*texel_fn)(void *ctx, size_t texel, const double bary[3], uint32_t t);
+
+/* Call @p fn for each texel of triangle @p t whose centre lies inside it (on an edge: for both
+ * triangles; the colour is a mean, so a texel met twice is no harm). The texels a chart's edge
+ * cuts whose centres lie outside take their neighbours' colour with the gutter (atlas_finish). */
+static void raster(const struct atlas *a, const struct fusion_volume *vol, uint32_t t, texel_fn fn,
+                   void *ctx)
+{
+    const struct atlas_chart *ch = &a->chart[a->tri_chart[t]];
+    double x[3], y[3];
+    for (int k = 0; k < 3; k++)
+        texel_xy(a, ch, vertex_pos(vol, tri_at(vol, t)[k]), &x[k], &y[k]);
+    double area2 = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
+    if (fabs(area2) < 1e-12)
+        return; /* on edge in the projection: no texel of its own */
+    long xa = (long)ceil(fmin(x[0], fmin(x[1], x[2])) - 0.5);
+    long xb = (long)floor(fmax(x[0], fmax(x[1], x[2])) - 0.5);
+    long ya = (long)ceil(fmin(y[0], fmin(y[1], y[2])) - 0.5);
+    long yb = (long)floor(fmax(y[0], fmax(y[1], y[2])) - 0.5);
+    const double inv = 1.0 / area2;
+    for (long ty = ya; ty <= yb; ty++)
+        for (long tx = xa; tx <= xb; tx++) {
+            double cx = tx + 0.5, cy = ty + 0.5, l[3];
+            l[0] = ((x[1] - cx) * (y[2] - cy) - (x[2] - cx) * (y[1] - cy)) * inv;
+            l[1] = ((x[2] - cx) * (y[0] - cy) - (x[0] - cx) * (y[2] - cy)) * inv;
+            l[2] = 1.0 - l[0] - l[1];
+            if (l[0] >= 0.0 && l[1] >= 0.0 && l[2] >= 0.0)
+                fn(ctx, (size_t)ty * a->width + (size_t)tx, l, t);
+        }
+}
+
+struct view_ctx {
+    struct atlas *a;
+    const struct decode_maps *m;
+    const struct tri_range *r;
+    const uint8_t *rgb;
+    const float *confidence, *weight;
+    double depth_tol_mm;
+    /* the triangle being rasterised: where its corners are seen (pixels) and their depth, and
+     * the depth's scale to a distance along the ray */
+    double u[3], v[3], z[3], ray;
+};
+
+/* One texel of the triangle seen by the view (atlas_add_view): where it is seen and its depth
+ * interpolated from the corners' (a triangle spans a pixel or two: the lens's bending and the
+ * perspective's across it are thousandths of a pixel). */
+static void view_texel(void *ctx, size_t texel, const double l[3], uint32_t t)
+{
+    (void)t;
+    const struct view_ctx *s = ctx;
+    double fu = l[0] * s->u[0] + l[1] * s->u[1] + l[2] * s->u[2];
+    double fv = l[0] * s->v[0] + l[1] * s->v[1] + l[2] * s->v[2];
+    double z = l[0] * s->z[0] + l[1] * s->z[1] + l[2] * s->z[2];
+    if (!(fu >= 0.0 && fv >= 0.0))
+        return;
+    long x0 = (long)fu, y0 = (long)fv;
+    if (x0 + 1 >= (long)s->m->width || y0 + 1 >= (long)s->m->height)
+        return;
+    double fx = fu - x0, fy = fv - y0;
+    double sum[3] = {0.0, 0.0, 0.0}, wsum = 0.0;
+    for (int q = 0; q < 4; q++) {
+        size_t i = (size_t)(y0 + q / 2) * s->m->width + (size_t)(x0 + q % 2);
+        double w = s->weight[i];
+        if (w <= 0.0 || fabs(s->r->xyz_mm[3 * i + 2] - z) * s->ray > s->depth_tol_mm)
+            continue;
+        w *= w * (q % 2 ? fx : 1.0 - fx) * (q / 2 ? fy : 1.0 - fy);
+        w *= s->confidence != NULL ? fmax(s->confidence[i], 0.0) : 1.0; /* 0: no estimate */
+        for (int k = 0; k < 3; k++)
+            sum[k] += w * s->rgb[3 * i + k];
+        wsum += w;
+    }
+    float *acc = &s->a->accum[4 * texel];
+    for (int k = 0; k < 3; k++)
+        acc[k] += (float)sum[k];
+    acc[3] += (float)wsum;
+}
+
+int atlas_add_view(struct atlas *a, struct fusion_volume *vol, const struct scan_calib *calib,
+                   const struct frame_xform *obj_from_cam, const struct decode_maps *maps,
+                   const struct tri_range *range, const uint8_t *rgb, const float *confidence)
+{
+    if (a->width == 0)
+        return -EINVAL;
+    const float *weight = fusion_view_weights(vol, calib, maps, range);
+    if (weight == NULL)
+        return 0; /* a view of nothing */
+    struct view_ctx s = {.a = a,
+                         .m = maps,
+                         .r = range,
+                         .rgb = rgb,
+                         .confidence = confidence,
+                         .weight = weight,
+                         .depth_tol_mm = ATLAS_DEPTH_VOXELS * vol->p.voxel_mm};
+    for (uint32_t t = 0; t < vol->mp.s.triangles; t++) {
+        if (a->tri_chart[t] == NONE)
+            continue;
+        vec3 p[3];
+        for (int k = 0; k < 3; k++)
+            p[k] = frame_point_inv(obj_from_cam, vertex_pos(vol, tri_at(vol, t)[k]));
+        /* facing the camera: the normal against the ray to its first corner */
+        if (v3_dot(frame_dir_inv(obj_from_cam, tri_normal(vol, t)), p[0]) >= 0.0 || p[0].z <= 1.0 ||
+            p[1].z <= 1.0 || p[2].z <= 1.0)
+            continue;
+        for (int k = 0; k < 3; k++) {
+            camray_project(calib, p[k], &s.u[k], &s.v[k]);
+            s.z[k] = p[k].z;
+        }
+        s.ray = v3_len(p[0]) / p[0].z;
+        raster(a, vol, t, view_texel, &s);
+    }
+    return 0;
+}
+
+/* ---- the texture ---- */
+
+/* A texel's state in accum[4 i + 3] once finish has taken the views' colours: */
+#define SEEN (-1.0f)        /* coloured: the linear colour in accum[4 i .. 4 i + 2] */
+#define FROM_MESH (-2.0f)   /* no view: the mesh's vertex colours */
+#define FILLED_BASE (-3.0f) /* a gutter texel filled in pass k: FILLED_BASE - k */
+
+struct finish_ctx {
+    struct atlas *a;
+    const struct fusion_volume *vol;
+    uint32_t uncoloured;
+};
+
+/* A texel no view coloured takes the vertex colours there (atlas_finish). */
+static void mesh_texel(void *ctx, size_t texel, const double bary[3], uint32_t t)
+{
+    struct finish_ctx *s = ctx;
+    float *acc = &s->a->accum[4 * texel];
+    if (acc[3] != 0.0f)
+        return;
+    for (int k = 0; k < 3; k++) {
+        double c = 0.0;
+        for (int j = 0; j < 3; j++)
+            c += bary[j] * s->vol->mesh_rgb[3 * (size_t)tri_at(s->vol, t)[j] + (size_t)k];
+        acc[k] = (float)c;
+    }
+    acc[3] = FROM_MESH;
+    s->uncoloured++;
+}
+
+/* Gutter texels beside coloured ones take their mean, @p passes rings out. */
+static void fill_gutters(struct atlas *a, int passes)
+{
+    const long w = a->width, h = a->height;
+    for (int pass = 0; pass < passes; pass++) {
+        const float mark = FILLED_BASE - (float)pass;
+        for (long y = 0; y < h; y++)
+            for (long x = 0; x < w; x++) {
+                float *acc = &a->accum[4 * (size_t)(y * w + x)];
+                if (acc[3] != 0.0f)
+                    continue;
+                double sum[3] = {0.0, 0.0, 0.0};
+                int n = 0;
+                static const int step[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
+                for (int s = 0; s < 4; s++) {
+                    long xs = x + step[s][0], ys = y + step[s][1];
+                    if (xs < 0 || ys < 0 || xs >= w || ys >= h)
+                        continue;
+                    const float *nb = &a->accum[4 * (size_t)(ys * w + xs)];
+                    if (nb[3] == 0.0f || nb[3] == mark) /* not this pass's own */
+                        continue;
+                    for (int k = 0; k < 3; k++)
+                        sum[k] += nb[k];
+                    n++;
+                }
+                if (n == 0)
+                    continue;
+                for (int k = 0; k < 3; k++)
+                    acc[k] = (float)(sum[k] / n);
+                acc[3] = mark;
+            }
+    }
+}
+
+int atlas_finish(struct atlas *a, const struct fusion_volume *vol, uint32_t *uncoloured)
+{
+    if (a->width == 0)
+        return -EINVAL;
+    const size_t n = (size_t)a->width * a->height;
+    for (size_t i = 0; i < n; i++) {
+        float *acc = &a->accum[4 * i];
+        if (acc[3] > 0.0f) {
+            for (int k = 0; k < 3; k++)
+                acc[k] /= acc[3];
+            acc[3] = SEEN;
+        }
+    }
+    struct finish_ctx s = {a, vol, 0};
+    for (uint32_t t = 0; t < vol->mp.s.triangles; t++)
+        if (a->tri_chart[t] != NONE)
+            raster(a, vol, t, mesh_texel, &s);
+    fill_gutters(a, (int)ATLAS_GUTTER + 1);
+    for (size_t i = 0; i < n; i++) {
+        const float *acc = &a->accum[4 * i];
+        for (int k = 0; k < 3; k++)
+            a->texture[3 * i + (size_t)k] =
+                acc[3] != 0.0f ? srgb_encode_unit(acc[k] / 255.0) : 128; /* mid grey */
+    }
+    *uncoloured = s.uncoloured;
+    return 0;
+}
+
+/* Where vertex @p v lies through chart @p c, as glTF takes it. */
+static void uv_in(const struct atlas *a, const struct fusion_volume *vol, uint32_t c, uint32_t v,
+                  float uv[2])
+{
+    double x, y;
+    texel_xy(a, &a->chart[c], vertex_pos(vol, v), &x, &y);
+    uv[0] = (float)(x / a->width);
+    uv[1] = (float)(y / a->height);
+}
+
+int atlas_uv(const struct atlas *a, const struct fusion_volume *vol, uint32_t t, int k, float uv[2])
+{
+    if (a->width == 0 || t >= vol->mp.s.triangles || a->tri_chart[t] == NONE || k < 0 || k > 2)
+        return -EINVAL;
+    uv_in(a, vol, a->tri_chart[t], tri_at(vol, t)[k], uv);
+    return 0;
+}
+
+int atlas_vertex_uv(const struct atlas *a, const struct fusion_volume *vol, uint32_t v, float uv[2])
+{
+    if (a->width == 0 || v >= vol->mp.s.vertices || a->vertex_tri[v] == NONE)
+        return -EINVAL;
+    uv_in(a, vol, a->vertex_tri[v], v, uv);
+    return 0;
+}
+
+int atlas_corner_is_vertex(const struct atlas *a, const struct fusion_volume *vol, uint32_t t,
+                           int k)
+{
+    return a->width > 0 && t < vol->mp.s.triangles && k >= 0 && k < 3 && a->tri_chart[t] != NONE &&
+           a->tri_chart[t] == a->vertex_tri[tri_at(vol, t)[k]];
+}

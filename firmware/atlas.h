@@ -1,0 +1,84 @@
+/* A texture atlas for the fused mesh: charts on the prepared mesh packed into one image, each
+ * texel coloured from the views that see its point best, so the model keeps the colour detail the
+ * camera resolved (vertex colours hold one colour a voxel). */
+#ifndef ATLAS_H
+#define ATLAS_H
+
+#include "fusion.h"
+
+#include <stdint.h>
+
+#define ATLAS_GUTTER 2u /* texels around each chart: bilinear and mipmapped reads stay inside */
+
+/** A chart: triangles joined through shared vertices whose normals lie nearest one axis
+ *  direction, projected along it (orthographic), in the atlas at (x0, y0), w x h texels. */
+struct atlas_chart {
+    uint8_t axis;       /* 0..5: +x, -x, +y, -y, +z, -z (object frame) */
+    float min_u, min_v; /* the projection's corner, mm */
+    uint32_t x0, y0, w, h;
+    uint32_t triangles;
+};
+
+/** What atlas_build made. */
+struct atlas_report {
+    uint32_t width, height; /**< the texture, texels */
+    double texel_mm;        /**< a texel's edge on the object */
+    uint32_t charts;        /**< charts packed */
+    double used_share;      /**< share of the texture inside charts */
+};
+
+/** The atlas, its work space and its texture: tens of MB at the compiled limits, kept static by
+ *  its owner (the job) and passed by pointer; its fields are atlas.c's. */
+struct atlas {
+    uint32_t width, height, chart_count;
+    double texel_mm;
+    struct atlas_chart chart[ATLAS_MAX_CHARTS];
+    uint32_t order[ATLAS_MAX_CHARTS];              /* charts by height, for packing */
+    uint32_t tri_chart[MESH_MAX_TRIANGLES];        /* each prepared triangle's chart (or none) */
+    uint8_t tri_axis[MESH_MAX_TRIANGLES];          /* its axis direction */
+    uint32_t vertex_tri[MESH_MAX_VERTICES];        /* a triangle at each vertex, then its chart */
+    _Alignas(8) float accum[ATLAS_MAX_TEXELS * 4]; /* weighted linear colour and the weight */
+    uint8_t texture[ATLAS_MAX_TEXELS * 3];         /* sRGB-encoded RGB, rows top down */
+};
+
+/** Charts on @p vol's prepared mesh (fusion_mesh_prepare, holes closed), packed at @p texel_mm
+ *  or, when that does not fit ATLAS_MAX_SIDE x ATLAS_MAX_SIDE, the smallest texel (a quarter
+ *  larger a step) that does; the colour accumulators emptied.
+ *  @param rep  out @retval 0 @retval -EINVAL not prepared or texel_mm <= 0 @retval -E2BIG the mesh
+ *  did not fit the tables (no atlas) @retval -ENOSPC more charts than ATLAS_MAX_CHARTS */
+int atlas_build(struct atlas *a, const struct fusion_volume *vol, double texel_mm,
+                struct atlas_report *rep);
+
+/** Add one view's colour: each texel of a triangle facing the camera, projected into the view
+ *  through @p obj_from_cam, takes the colour about where it lands (bilinear over valid pixels)
+ *  when the view measured the surface there (the view's own depth within two voxels: else the
+ *  texel is hidden or off the view's surface), weighed as fusion weighs the pixel (fusion.h),
+ *  squared so the most head-on view dominates, times the colour's @p confidence (NULL: 1).
+ *  Uses @p vol's pixel weights (fusion_view_weights): after the mesh is prepared.
+ *  @retval 0 @retval -EINVAL no atlas built */
+int atlas_add_view(struct atlas *a, struct fusion_volume *vol, const struct scan_calib *calib,
+                   const struct frame_xform *obj_from_cam, const struct decode_maps *maps,
+                   const struct tri_range *range, const uint8_t *rgb, const float *confidence);
+
+/** The texture: each texel's weighted colour, sRGB-encoded; texels no view coloured take the
+ *  mesh's vertex colours there (barycentric); the gutters take their chart's edge.
+ *  @param uncoloured  out: texels inside charts that no view coloured @retval 0 @retval -EINVAL */
+int atlas_finish(struct atlas *a, const struct fusion_volume *vol, uint32_t *uncoloured);
+
+/** Texture coordinates of corner @p k (0..2) of prepared triangle @p t, as glTF takes them:
+ *  0..1, origin at the image's top left. @retval 0 @retval -EINVAL not in a chart */
+int atlas_uv(const struct atlas *a, const struct fusion_volume *vol, uint32_t t, int k,
+             float uv[2]);
+
+/** Texture coordinates of prepared vertex @p v in its own chart (that of its first triangle), as
+ *  atlas_uv gives them. @retval 0 @retval -EINVAL in no chart */
+int atlas_vertex_uv(const struct atlas *a, const struct fusion_volume *vol, uint32_t v,
+                    float uv[2]);
+
+/** @retval 1 corner @p k of triangle @p t lies in its vertex's own chart: atlas_vertex_uv's
+ *  coordinates serve it (a writer shares them) @retval 0 the vertex is on a chart's border and
+ *  the triangle in another chart: atlas_uv's own */
+int atlas_corner_is_vertex(const struct atlas *a, const struct fusion_volume *vol, uint32_t t,
+                           int k);
+
+#endif
