@@ -122,10 +122,12 @@ int job_view_for_model(struct job *j, const char *scan_dir, uint32_t v, struct s
 
 /* ---- job_texture.c ---- */
 /** The texture atlas of the prepared mesh ([output] texture): charts, every view's colour,
- *  texture.png and mesh.mtl beside the mesh; @p said tells what was made, for the mesh's line.
- *  A texture that cannot be made is said (a warning) and left out: the vertex colours stand.
- *  @retval 0 made @retval -errno not made */
-int job_make_texture(struct job *j, const char *scan_dir, char *said, size_t said_len);
+ *  texture.png and mesh.mtl beside the mesh; @p said tells what was made, for the mesh's line;
+ *  @p png, @p png_len: the texture's PNG for mesh.glb, the caller's to free. A texture that
+ *  cannot be made is said (a warning) and left out: the vertex colours stand.
+ *  @retval 0 made @retval -errno not made (*png NULL) */
+int job_make_texture(struct job *j, const char *scan_dir, char *said, size_t said_len,
+                     uint8_t **png, size_t *png_len);
 
 /* ---- job_offline.c ---- */
 /** Frame @p f of view @p v read from @p scan_dir into the firmware's buffer for it. */

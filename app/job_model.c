@@ -11,6 +11,7 @@
 
 #include <errno.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* Results of processed view @p v once the scan is registered: its registration.ini, its point
@@ -61,9 +62,6 @@ static int write_model(struct job *j, const char *scan_dir)
             j->hal->log(HAL_LOG_WARN, "holes left on the mesh unclosed: %s", strerror(-rc));
         rc = fusion_mesh_counts(j->vol, &ms);
     }
-    char texture[256] = "";
-    int textured = fits && rc == 0 && j->cfg->texture &&
-                   job_make_texture(j, scan_dir, texture, sizeof(texture)) == 0;
     if (rc == -E2BIG)
         j->hal->log(HAL_LOG_WARN,
                     "the mesh has %u vertices, more than MESH_MAX_VERTICES (%u): it is written "
@@ -73,6 +71,11 @@ static int write_model(struct job *j, const char *scan_dir)
                     (unsigned)ms.vertices, MESH_MAX_VERTICES);
     else if (rc != 0)
         return rc;
+    char texture[256] = "";
+    uint8_t *png = NULL; /* the texture, once encoded: texture.png and inside mesh.glb */
+    size_t png_len = 0;
+    int textured = fits && rc == 0 && j->cfg->texture &&
+                   job_make_texture(j, scan_dir, texture, sizeof(texture), &png, &png_len) == 0;
     rc = 0;
     for (size_t k = 0; k < sizeof(names) / sizeof(names[0]) && rc == 0; k++) {
         if (!fits && (writers[k] == fusion_write_stl || writers[k] == NULL))
@@ -82,12 +85,15 @@ static int write_model(struct job *j, const char *scan_dir)
             rc = fusion_write_obj_textured(j->vol, j->atlas, SCAN_FILE_MESH_MTL, &j->hal->storage,
                                            path);
         else if (rc == 0)
-            rc = writers[k] != NULL ? writers[k](j->vol, &j->hal->storage, path)
-                                    : fusion_write_glb(j->vol, &j->hal->storage, path,
-                                                       reflect_model(j->pool)); /* or matte */
+            rc = writers[k] != NULL
+                     ? writers[k](j->vol, &j->hal->storage, path)
+                     : fusion_write_glb_textured(j->vol, &j->hal->storage, path,
+                                                 reflect_model(j->pool), /* or matte */
+                                                 textured ? j->atlas : NULL, png, png_len);
         if (rc != 0)
             j->hal->log(HAL_LOG_ERROR, "cannot write %s: %s", path, strerror(-rc));
     }
+    free(png);
     if (rc != 0)
         return rc;
     char closed[96] = "";

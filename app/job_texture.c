@@ -9,6 +9,7 @@
 
 #include <errno.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* A camera pixel's edge on the object at the turntable's axis: the texture's default texel. */
@@ -35,8 +36,11 @@ static int texture_view(struct job *j, const char *scan_dir, uint32_t v)
     return rc;
 }
 
-int job_make_texture(struct job *j, const char *scan_dir, char *said, size_t said_len)
+int job_make_texture(struct job *j, const char *scan_dir, char *said, size_t said_len,
+                     uint8_t **png, size_t *png_len)
 {
+    *png = NULL;
+    *png_len = 0;
     double t0 = clock_posix_thread_cpu_s();
     double texel = j->cfg->texel_mm > 0.0 ? j->cfg->texel_mm : pixel_at_axis_mm(j->calib);
     struct atlas_report ar;
@@ -49,8 +53,10 @@ int job_make_texture(struct job *j, const char *scan_dir, char *said, size_t sai
         rc = atlas_finish(j->atlas, j->vol, &uncoloured);
     if (rc == 0)
         rc = scan_dir_path(path, sizeof(path), j->out_dir, -1, SCAN_FILE_TEXTURE);
+    if (rc == 0) /* once, for texture.png and mesh.glb */
+        rc = image_encode_png(j->atlas->texture, ar.width, ar.height, 3, png, png_len);
     if (rc == 0)
-        rc = image_write_png(&j->hal->storage, path, j->atlas->texture, ar.width, ar.height, 3);
+        rc = hal_storage_write_file(&j->hal->storage, path, *png, *png_len);
     static const char mtl[] =
         "# turntable colour scanner: the texture of mesh.obj\n"
         "newmtl scan\nKa 0 0 0\nKd 1 1 1\nKs 0 0 0\nmap_Kd " SCAN_FILE_TEXTURE "\n";
@@ -59,6 +65,9 @@ int job_make_texture(struct job *j, const char *scan_dir, char *said, size_t sai
     if (rc == 0)
         rc = hal_storage_write_file(&j->hal->storage, path, mtl, sizeof(mtl) - 1);
     if (rc != 0) {
+        free(*png);
+        *png = NULL;
+        *png_len = 0;
         j->hal->log(HAL_LOG_WARN, "no texture: %s%s; the model keeps its vertex colours",
                     strerror(-rc),
                     rc == -ENOSPC ? " (more charts than the compiled ATLAS_MAX_CHARTS)" : "");

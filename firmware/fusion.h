@@ -156,6 +156,14 @@ int fusion_write_obj_textured(struct fusion_volume *vol, const struct atlas *atl
 int fusion_write_glb(struct fusion_volume *vol, const struct hal_storage *st, const char *path,
                      const struct reflect_model *model);
 
+/** fusion_write_glb with the texture of @p atlas: TEXCOORD_0 instead of COLOR_0, @p png (the
+ *  atlas's texture as PNG, @p png_len bytes) in the BIN chunk as every material's
+ *  baseColorTexture; a vertex on a chart's border repeated for each other chart about it
+ *  (NULL atlas or png: fusion_write_glb's file). @retval as fusion_write_glb */
+int fusion_write_glb_textured(struct fusion_volume *vol, const struct hal_storage *st,
+                              const char *path, const struct reflect_model *model,
+                              const struct atlas *atlas, const uint8_t *png, size_t png_len);
+
 /* ---- the volume: the grid and its work space, a model's worth ---- */
 
 /* 8 bytes: distance in units of truncation / 32767, weight in thousandths, colour, and the

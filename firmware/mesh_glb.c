@@ -13,7 +13,15 @@
  * COLOR_0 is linear, so the fused albedo goes in as it is; the material multiplies it by its
  * base colour factor 1. One material, matte; with [colour] method = fit one per material
  * cluster (json_material), each with the triangles whose first vertex's colour is nearest to
- * the cluster's (a primitive each, sharing the vertices). */
+ * the cluster's (a primitive each, sharing the vertices).
+ *
+ * With a texture atlas (fusion_write_glb_textured) COLOR_0 gives way to TEXCOORD_0 (glTF
+ * multiplies the two: the texture alone is the colour) and the texture's PNG follows the indices
+ * in the BIN chunk, the base colour texture of every material (sRGB, as glTF's base colour is).
+ * A vertex on a chart's border has one place in the texture for each chart about it: after the
+ * kept vertices come the "border corners", one vertex each (position and normal repeated), in
+ * the order of their triangles (atlas_corner_is_vertex). */
+#include "atlas.h"
 #include "fusion.h"
 #include "outbuf.h"
 #include "reflect.h"
@@ -84,12 +92,20 @@ static int colour_vertex(void *priv, const struct mesh_vertex *v)
     return o->rc;
 }
 
-/* The mesh's materials: one per cluster of [colour] method = fit (reflect.h), else one matte. */
+/* The mesh's materials: one per cluster of [colour] method = fit (reflect.h), else one matte;
+ * with a texture, its PNG's length (0: none, vertex colours). */
 struct glb_parts {
     uint32_t count;                           /* materials, one primitive each */
     uint32_t triangles[REFLECT_MAX_CLUSTERS]; /* of each */
     const struct reflect_model *model;        /* NULL: matte */
+    uint64_t png_len;
 };
+
+/* A material's base colour texture, when there is one. */
+static const char *texture_ref(const struct glb_parts *parts)
+{
+    return parts->png_len > 0 ? ",\"baseColorTexture\":{\"index\":0}" : "";
+}
 
 static void json_put(struct fusion_volume *vol, const char *fmt, ...)
 {
@@ -110,17 +126,18 @@ static void json_put(struct fusion_volume *vol, const char *fmt, ...)
  * rho cos(theta_i), is pi f cos(theta_i) of a microfacet BRDF f = D G F / (4 cos_i cos_o) with
  * the normalised GGX D (peak 1 / (pi a^2)) and G = 1: F0 = 4 a^2 K. glTF's GGX takes
  * alpha = roughness^2. Dielectric (metallic 0): a metal's tinted F0 is the specular colour. */
-static void json_material(struct fusion_volume *vol, const struct reflect_cluster *c, uint32_t k)
+static void json_material(struct fusion_volume *vol, const struct reflect_cluster *c, uint32_t k,
+                          const char *texture)
 {
     double a = c->roughness, f0[3];
     for (int ch = 0; ch < 3; ch++)
         f0[ch] = 4.0 * a * a * c->specular[ch];
     json_put(vol,
              "%s{\"name\":\"cluster %u\",\"pbrMetallicRoughness\":{\"baseColorFactor\":"
-             "[1,1,1,1],\"metallicFactor\":0,\"roughnessFactor\":%.4f},\"extensions\":"
+             "[1,1,1,1],\"metallicFactor\":0,\"roughnessFactor\":%.4f%s},\"extensions\":"
              "{\"KHR_materials_specular\":{\"specularFactor\":1,\"specularColorFactor\":"
              "[%.5f,%.5f,%.5f]}}}",
-             k ? "," : "", (unsigned)k, fmin(1.0, sqrt(a)), f0[0] / 0.04, f0[1] / 0.04,
+             k ? "," : "", (unsigned)k, fmin(1.0, sqrt(a)), texture, f0[0] / 0.04, f0[1] / 0.04,
              f0[2] / 0.04);
 }
 
@@ -131,7 +148,9 @@ static int glb_json_text(struct fusion_volume *vol, uint32_t vertices,
                          const struct glb_parts *parts, const struct glb_bounds *b,
                          uint64_t bin_len)
 {
-    uint64_t v = vertices, pos_len = 12 * v, col_len = 4 * v, at = 2 * pos_len + col_len;
+    const int textured = parts->png_len > 0;
+    uint64_t v = vertices, pos_len = 12 * v, col_len = (textured ? 8 : 4) * v;
+    uint64_t at = 2 * pos_len + col_len;
     vol->glb_json_len = 0;
     json_put(vol, "{\"asset\":{\"version\":\"2.0\",\"generator\":\"turntable colour scanner\"},");
     if (parts->model != NULL)
@@ -143,17 +162,20 @@ static int glb_json_text(struct fusion_volume *vol, uint32_t vertices,
     for (uint32_t k = 0, n = 0; k < parts->count; k++)
         if (parts->triangles[k] > 0) {
             json_put(vol,
-                     "%s{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"COLOR_0\":2},"
+                     "%s{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,\"%s\":2},"
                      "\"indices\":%u,\"material\":%u,\"mode\":4}",
-                     n ? "," : "", (unsigned)(3 + n), (unsigned)k);
+                     n ? "," : "", textured ? "TEXCOORD_0" : "COLOR_0", (unsigned)(3 + n),
+                     (unsigned)k);
             n++;
         }
     json_put(vol, "]}],\"materials\":[");
     if (parts->model == NULL)
-        json_put(vol, "{\"name\":\"matte\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,1,1,1],"
-                      "\"metallicFactor\":0,\"roughnessFactor\":1}}");
+        json_put(vol,
+                 "{\"name\":\"matte\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,1,1,1],"
+                 "\"metallicFactor\":0,\"roughnessFactor\":1%s}}",
+                 texture_ref(parts));
     for (uint32_t k = 0; parts->model != NULL && k < parts->count; k++)
-        json_material(vol, &parts->model->cluster[k], k);
+        json_material(vol, &parts->model->cluster[k], k, texture_ref(parts));
     json_put(vol,
              "],\"buffers\":[{\"byteLength\":%llu}],\"bufferViews\":["
              "{\"buffer\":0,\"byteOffset\":0,\"byteLength\":%llu,\"target\":%d},"
@@ -162,23 +184,29 @@ static int glb_json_text(struct fusion_volume *vol, uint32_t vertices,
              (unsigned long long)bin_len, (unsigned long long)pos_len, GL_ARRAY_BUFFER,
              (unsigned long long)pos_len, (unsigned long long)pos_len, GL_ARRAY_BUFFER,
              (unsigned long long)(2 * pos_len), (unsigned long long)col_len, GL_ARRAY_BUFFER);
+    uint32_t views = 3;
     for (uint32_t k = 0; k < parts->count; k++) {
         uint64_t len = 12 * (uint64_t)parts->triangles[k];
         if (len > 0)
             json_put(vol, ",{\"buffer\":0,\"byteOffset\":%llu,\"byteLength\":%llu,\"target\":%d}",
                      (unsigned long long)at, (unsigned long long)len, GL_ELEMENT_ARRAY_BUFFER);
+        views += len > 0;
         at += len;
     }
+    if (textured) /* the image's view: no target (not a vertex attribute nor indices) */
+        json_put(vol, ",{\"buffer\":0,\"byteOffset\":%llu,\"byteLength\":%llu}",
+                 (unsigned long long)at, (unsigned long long)parts->png_len);
     json_put(vol,
              "],\"accessors\":["
              "{\"bufferView\":0,\"componentType\":%d,\"count\":%u,\"type\":\"VEC3\","
              "\"min\":[%.9g,%.9g,%.9g],\"max\":[%.9g,%.9g,%.9g]},"
              "{\"bufferView\":1,\"componentType\":%d,\"count\":%u,\"type\":\"VEC3\"},"
-             "{\"bufferView\":2,\"componentType\":%d,\"normalized\":true,\"count\":%u,"
-             "\"type\":\"VEC4\"}",
+             "{\"bufferView\":2,\"componentType\":%d%s,\"count\":%u,"
+             "\"type\":\"%s\"}",
              GL_FLOAT, (unsigned)vertices, (double)b->lo[0], (double)b->lo[1], (double)b->lo[2],
              (double)b->hi[0], (double)b->hi[1], (double)b->hi[2], GL_FLOAT, (unsigned)vertices,
-             GL_UNSIGNED_BYTE, (unsigned)vertices);
+             textured ? GL_FLOAT : GL_UNSIGNED_BYTE, textured ? "" : ",\"normalized\":true",
+             (unsigned)vertices, textured ? "VEC2" : "VEC4");
     for (uint32_t k = 0, n = 0; k < parts->count; k++)
         if (parts->triangles[k] > 0)
             json_put(vol,
@@ -186,7 +214,14 @@ static int glb_json_text(struct fusion_volume *vol, uint32_t vertices,
                      "\"SCALAR\"}",
                      (unsigned)(3 + n++), GL_UNSIGNED_INT,
                      (unsigned long long)(3 * (uint64_t)parts->triangles[k]));
-    json_put(vol, "]}");
+    json_put(vol, "]");
+    if (textured) /* linear magnification, trilinear minification, edges clamped */
+        json_put(vol,
+                 ",\"images\":[{\"bufferView\":%u,\"mimeType\":\"image/png\"}],"
+                 "\"samplers\":[{\"magFilter\":9729,\"minFilter\":9987,\"wrapS\":33071,"
+                 "\"wrapT\":33071}],\"textures\":[{\"sampler\":0,\"source\":0}]",
+                 (unsigned)views);
+    json_put(vol, "}");
     if (vol->glb_json_len < 0 || (size_t)vol->glb_json_len + 4 > sizeof(vol->glb_json))
         return -EOVERFLOW;
     while (vol->glb_json_len % 4 != 0)
@@ -246,8 +281,94 @@ static int index_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
     return ip->o->rc;
 }
 
+/* ---- a texture's border corners (atlas.h) ---- */
+
+/* Whether corner @p k of kept triangle @p t is a border corner: a vertex of its own. */
+static int border_corner(const struct fusion_volume *vol, const struct atlas *atlas, uint32_t t,
+                         int k)
+{
+    return atlas != NULL && !atlas_corner_is_vertex(atlas, vol, t, k);
+}
+
+static int kept_triangle(const struct fusion_volume *vol, uint32_t t)
+{
+    return vol->mesh_index[vol->mesh_tri[3 * (size_t)t]] != MESH_DROPPED;
+}
+
+static uint32_t count_border_corners(const struct fusion_volume *vol, const struct atlas *atlas)
+{
+    uint32_t n = 0;
+    for (uint32_t t = 0; t < vol->mp.s.triangles; t++)
+        for (int k = 0; k < 3 && kept_triangle(vol, t); k++)
+            n += (uint32_t)border_corner(vol, atlas, t, k);
+    return n;
+}
+
+/* The border corners' positions or normals (@p sink's vertex callback), in their order. */
+static void border_vertices(struct fusion_volume *vol, const struct atlas *atlas,
+                            const struct mesh_sink *sink)
+{
+    struct mesh_vertex mv;
+    memset(&mv, 0, sizeof(mv));
+    for (uint32_t t = 0; t < vol->mp.s.triangles; t++)
+        for (int k = 0; k < 3 && kept_triangle(vol, t); k++) {
+            if (!border_corner(vol, atlas, t, k))
+                continue;
+            uint32_t v = vol->mesh_tri[3 * (size_t)t + (size_t)k];
+            memcpy(mv.pos, &vol->mesh_pos[3 * (size_t)v], sizeof(mv.pos));
+            memcpy(mv.normal, &vol->mesh_nrm[3 * (size_t)v], sizeof(mv.normal));
+            sink->vertex(sink->priv, &mv);
+        }
+}
+
+/* TEXCOORD_0 of the kept vertices, then of the border corners. */
+static void texcoords(struct fusion_volume *vol, const struct atlas *atlas, struct outbuf *o)
+{
+    float uv[2];
+    for (uint32_t v = 0; v < vol->mp.s.vertices; v++) {
+        if (vol->mesh_index[v] == MESH_DROPPED)
+            continue;
+        if (atlas_vertex_uv(atlas, vol, v, uv) != 0)
+            uv[0] = uv[1] = 0.0f;
+        outbuf_f32le(o, uv[0]);
+        outbuf_f32le(o, uv[1]);
+    }
+    for (uint32_t t = 0; t < vol->mp.s.triangles; t++)
+        for (int k = 0; k < 3 && kept_triangle(vol, t); k++)
+            if (border_corner(vol, atlas, t, k) && atlas_uv(atlas, vol, t, k, uv) == 0) {
+                outbuf_f32le(o, uv[0]);
+                outbuf_f32le(o, uv[1]);
+            }
+}
+
+/* The indices of part @p part with the border corners numbered after the kept vertices. */
+static void textured_indices(struct fusion_volume *vol, const struct atlas *atlas, struct outbuf *o,
+                             uint8_t part)
+{
+    uint32_t next = vol->mp.s.kept_vertices;
+    for (uint32_t t = 0; t < vol->mp.s.triangles; t++) {
+        const uint32_t *tri = &vol->mesh_tri[3 * (size_t)t];
+        uint32_t at[3];
+        if (!kept_triangle(vol, t))
+            continue;
+        for (int k = 0; k < 3; k++)
+            at[k] = border_corner(vol, atlas, t, k) ? next++ : vol->mesh_index[tri[k]];
+        if (vol->vertex_part[vol->mesh_index[tri[0]]] != part)
+            continue;
+        for (int k = 0; k < 3; k++)
+            outbuf_u32le(o, at[k]);
+    }
+}
+
 int fusion_write_glb(struct fusion_volume *vol, const struct hal_storage *st, const char *path,
                      const struct reflect_model *model)
+{
+    return fusion_write_glb_textured(vol, st, path, model, NULL, NULL, 0);
+}
+
+int fusion_write_glb_textured(struct fusion_volume *vol, const struct hal_storage *st,
+                              const char *path, const struct reflect_model *model,
+                              const struct atlas *atlas, const uint8_t *png, size_t png_len)
 {
     struct mesh_summary ms;
     struct outbuf o;
@@ -256,19 +377,24 @@ int fusion_write_glb(struct fusion_volume *vol, const struct hal_storage *st, co
         return rc;
     if (ms.kept_vertices == 0)
         return -ENODATA; /* an accessor must count at least one element */
+    if (atlas == NULL || png == NULL || png_len == 0)
+        atlas = NULL, png_len = 0;
     struct glb_scan gs = {vol->vertex_part,
                           {{INFINITY, INFINITY, INFINITY}, {-INFINITY, -INFINITY, -INFINITY}},
-                          {1, {0}, model},
+                          {1, {0}, model, png_len},
                           0};
     if (gs.parts.model != NULL)
         gs.parts.count = gs.parts.model->count;
     struct mesh_sink scan_pass = {scan_vertex, scan_triangle, &gs};
     fusion_extract_prepared(vol, &scan_pass);
     const struct glb_parts parts = gs.parts;
-    uint64_t bin_len = 28 * (uint64_t)ms.kept_vertices;
+    const uint64_t vertices = ms.kept_vertices + (uint64_t)count_border_corners(vol, atlas);
+    uint64_t bin_len = (atlas != NULL ? 32 : 28) * vertices + ((png_len + 3) & ~(uint64_t)3);
     for (uint32_t k = 0; k < parts.count; k++)
         bin_len += 12 * (uint64_t)parts.triangles[k];
-    int json = glb_json_text(vol, ms.kept_vertices, &parts, &gs.bounds, bin_len);
+    if (vertices > UINT32_MAX)
+        return -EFBIG;
+    int json = glb_json_text(vol, (uint32_t)vertices, &parts, &gs.bounds, bin_len);
     if (json < 0)
         return json;
     uint64_t total = 12 + 8 + (uint64_t)json + 8 + bin_len; /* bin_len is 4-aligned */
@@ -284,15 +410,29 @@ int fusion_write_glb(struct fusion_volume *vol, const struct hal_storage *st, co
     outbuf_put(&o, vol->glb_json, (size_t)json);
     outbuf_u32le(&o, (uint32_t)bin_len);
     outbuf_u32le(&o, GLB_CHUNK_BIN);
-    struct mesh_sink passes[3] = {
-        {position_vertex, NULL, &o}, {normal_vertex, NULL, &o}, {colour_vertex, NULL, &o}};
-    for (int k = 0; k < 3 && o.rc == 0; k++)
+    struct mesh_sink passes[2] = {{position_vertex, NULL, &o}, {normal_vertex, NULL, &o}};
+    for (int k = 0; k < 2 && o.rc == 0; k++) {
         fusion_extract_prepared(vol, &passes[k]);
+        if (atlas != NULL)
+            border_vertices(vol, atlas, &passes[k]);
+    }
+    struct mesh_sink colours = {colour_vertex, NULL, &o};
+    if (atlas != NULL)
+        texcoords(vol, atlas, &o);
+    else
+        fusion_extract_prepared(vol, &colours);
     for (uint32_t k = 0; k < parts.count && o.rc == 0; k++) {
         struct index_pass ip = {vol->vertex_part, &o, (uint8_t)k};
         struct mesh_sink pass = {NULL, index_triangle, &ip};
-        if (parts.triangles[k] > 0)
+        if (parts.triangles[k] > 0 && atlas != NULL)
+            textured_indices(vol, atlas, &o, (uint8_t)k);
+        else if (parts.triangles[k] > 0)
             fusion_extract_prepared(vol, &pass);
+    }
+    if (png_len > 0) {
+        static const uint8_t zero[3] = {0, 0, 0};
+        outbuf_put(&o, png, png_len);
+        outbuf_put(&o, zero, (4 - png_len % 4) % 4);
     }
     return outbuf_close(&o);
 }

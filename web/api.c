@@ -190,6 +190,8 @@ static cJSON *job_json(struct web_server *s, const char *id)
     cJSON_AddBoolToObject(o, "report", access(path, F_OK) == 0);
     snprintf(path, sizeof(path), "%s/%s/" SCAN_FILE_MESH_GLB, s->scans, id);
     cJSON_AddBoolToObject(o, "glb", access(path, F_OK) == 0);
+    snprintf(path, sizeof(path), "%s/%s/" SCAN_FILE_TEXTURE, s->scans, id);
+    cJSON_AddBoolToObject(o, "texture", access(path, F_OK) == 0);
     char label[WEB_MAX_LABEL + 2];
     jobs_label(s, id, label, sizeof(label));
     cJSON_AddStringToObject(o, "label", label);

@@ -157,8 +157,9 @@ function showDownloads(s) {
     box.append(a);
   };
   if (s.state === 'finished')
-    for (const f of ['mesh.ply', 'mesh.obj', 'mesh.stl', 'mesh.glb'])
-      if (f !== 'mesh.glb' || s.glb) link(`${base}${f}?download=1`, f, true);
+    for (const f of ['mesh.ply', 'mesh.obj', 'mesh.mtl', 'texture.png', 'mesh.stl', 'mesh.glb'])
+      if ((f !== 'mesh.glb' || s.glb) && ((f !== 'mesh.mtl' && f !== 'texture.png') || s.texture))
+        link(`${base}${f}?download=1`, f, true);
   link(api(`scans/${s.id}/archive.tar`), 'whole scan (.tar)', true);
   if (s.report) link(`${base}report.html`, 'report', false);
 }

@@ -1,4 +1,4 @@
-// The 3D viewer: a scan's mesh.glb (metres, +Y up, linear vertex colours, as glTF has it) or,
+// The 3D viewer: a scan's mesh.glb (metres, +Y up, its texture or linear vertex colours) or,
 // where no glb was written, its mesh.ply (millimetres, Z up, sRGB colours), with orbit controls.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
@@ -98,6 +98,8 @@ export class Viewer {
     this.model.traverse((o) => {
       if (o.isMesh) {
         o.material.vertexColors = on && !!o.geometry.getAttribute('color');
+        if (o.userData.map === undefined) o.userData.map = o.material.map; // the texture, kept
+        o.material.map = on ? o.userData.map : null;
         o.material.needsUpdate = true;
       }
     });
