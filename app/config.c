@@ -327,8 +327,12 @@ static const struct ini_key config_keys[] = {
     STR("sim", "merl_name", sim.merl_name, "", "material name in the MERL/ABC table"),
     F64("sim", "phong_ks", sim.phong_ks, 0, 100, "0.5", "Phong specular strength ks"),
     F64("sim", "phong_ke", sim.phong_ke, 1, 10000, "40", "Phong shininess ke"),
-    ENUM("sim", "albedo_pattern", sim.albedo_pattern, "patches|uniform", "patches",
-         "painted patches and stripes (with a very dark one), or one colour"),
+    ENUM("sim", "albedo_pattern", sim.albedo_pattern, "patches|uniform|image", "patches",
+         "painted patches and stripes (with a very dark one), one colour, or albedo_image "
+         "wrapped round the object (its columns once round the axis, its rows top to bottom)"),
+    STR("sim", "albedo_image", sim.albedo_image, "",
+        "albedo_pattern = image: a PNG photograph (sRGB; white is albedo 0.9), relative to this "
+        "file"),
     {"sim", "albedo", INI_VEC, C(sim.albedo), 3, 0, 1, 0, "0.8, 0.8, 0.8", NULL,
      "albedo for albedo_pattern = uniform", NULL, NULL},
     U32("sim", "seed", sim.seed, 0, 4294967295.0, "1", "noise seed (runs are repeatable)"),
@@ -491,6 +495,7 @@ int config_check_files(const struct app_config *cfg, char *err, size_t err_len)
     } files[] = {
         {"mesh_file", cfg->sim.mesh_file, strcmp(cfg->sim.object, "mesh") == 0},
         {"merl_file", cfg->sim.merl_file, strcmp(cfg->sim.material, "merl") == 0},
+        {"albedo_image", cfg->sim.albedo_image, strcmp(cfg->sim.albedo_pattern, "image") == 0},
     };
     if (strcmp(cfg->camera_backend, "sim") != 0)
         return 0;

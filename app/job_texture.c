@@ -46,7 +46,9 @@ int job_make_texture(struct job *j, const char *scan_dir, char *said, size_t sai
     struct atlas_report ar;
     char path[SCAN_DIR_PATH_MAX];
     uint32_t uncoloured = 0;
-    int rc = atlas_build(j->atlas, j->vol, texel, &ar);
+    size_t work_bytes;
+    void *work = fusion_spend_grid(j->vol, &work_bytes); /* the grid: the mesh is made */
+    int rc = atlas_build(j->atlas, j->vol, texel, work, work_bytes, &ar);
     for (uint32_t v = 0; v < j->views && rc == 0; v++)
         rc = texture_view(j, scan_dir, v);
     if (rc == 0)

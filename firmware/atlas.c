@@ -8,6 +8,7 @@
 #include "srgb.h"
 
 #include <errno.h>
+#include <stdint.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -193,23 +194,50 @@ static uint32_t pack(struct atlas *a, uint64_t *keys, uint32_t width)
     return y + shelf;
 }
 
-int atlas_build(struct atlas *a, const struct fusion_volume *vol, double texel_mm,
-                struct atlas_report *rep)
+static void assign_texels(struct atlas *a, const struct fusion_volume *vol);
+
+_Static_assert((uint64_t)FUSION_MAX_VOXELS * sizeof(struct voxel) >=
+                   ATLAS_WORK_BYTES(ATLAS_MAX_TEXELS, MESH_MAX_TRIANGLES, MESH_MAX_VERTICES),
+               "the spent fusion grid holds the largest texture's work space");
+
+/* The atlas's parts in @p work: 8-byte aligned first (the accumulators, which hold the packing's
+ * doubles until the views come), the bytes last. @retval 0 @retval -ENOSPC too small */
+static int carve(struct atlas *a, const struct fusion_volume *vol, void *work, size_t bytes)
 {
-    /* far corners and sort keys: the accumulators' space, free until the views come */
-    double(*far_uv)[2] = (double(*)[2])(void *)a->accum;
-    uint64_t *keys = (uint64_t *)(void *)(a->accum + 4 * (size_t)ATLAS_MAX_CHARTS);
-    _Static_assert(sizeof(double) * 2 * ATLAS_MAX_CHARTS <= sizeof(float) * 4 * ATLAS_MAX_CHARTS,
-                   "far corners fit the accumulators' first charts' worth");
-    _Static_assert(16ull * ATLAS_MAX_CHARTS + 8ull * ATLAS_MAX_CHARTS <= 16ull * ATLAS_MAX_TEXELS,
-                   "the sort keys fit after them");
+    const uint64_t nt = vol->mp.s.triangles, nv = vol->mp.s.vertices;
+    uint64_t fixed = ATLAS_WORK_BYTES(0, nt, nv);
+    if (bytes < fixed)
+        return -ENOSPC;
+    uint64_t texels = (bytes - fixed) / ATLAS_TEXEL_BYTES;
+    a->max_texels = (size_t)(texels < ATLAS_MAX_TEXELS ? texels : ATLAS_MAX_TEXELS);
+    /* far corners and sort keys of the charts (atlas_build) in the accumulators */
+    if (24u * (uint64_t)ATLAS_MAX_CHARTS > 16u * (uint64_t)a->max_texels)
+        return -ENOSPC;
+    a->accum = work;
+    a->owner = (uint32_t *)(void *)(a->accum + 4 * a->max_texels);
+    a->tri_chart = a->owner + a->max_texels;
+    a->vertex_tri = a->tri_chart + nt;
+    a->chart = (struct atlas_chart *)(void *)(a->vertex_tri + nv);
+    a->texture = (uint8_t *)(a->chart + ATLAS_MAX_CHARTS);
+    a->tri_axis = a->texture + 3 * a->max_texels;
+    return 0;
+}
+
+int atlas_build(struct atlas *a, const struct fusion_volume *vol, double texel_mm, void *work,
+                size_t work_bytes, struct atlas_report *rep)
+{
     memset(rep, 0, sizeof(*rep));
     a->width = a->height = a->chart_count = 0;
-    if (!vol->mp.prepared || !(texel_mm > 0.0))
+    if (!vol->mp.prepared || !(texel_mm > 0.0) || work == NULL || ((uintptr_t)work & 7u) != 0)
         return -EINVAL;
     if (!vol->mp.fits)
         return -E2BIG;
-    int rc = make_charts(a, vol, far_uv);
+    int rc = carve(a, vol, work, work_bytes);
+    if (rc != 0)
+        return rc;
+    double(*far_uv)[2] = (double(*)[2])(void *)a->accum;
+    uint64_t *keys = (uint64_t *)(void *)(far_uv + ATLAS_MAX_CHARTS);
+    rc = make_charts(a, vol, far_uv);
     if (rc != 0)
         return rc;
     /* each vertex's chart: its first triangle's (a vertex on a chart's border has another
@@ -228,11 +256,11 @@ int atlas_build(struct atlas *a, const struct fusion_volume *vol, double texel_m
         }
         uint32_t width = (uint32_t)ceil(sqrt((double)area * ATLAS_SLACK));
         width = ((width > widest ? width : widest) + 3u) & ~3u; /* rows of whole words */
-        if (width <= ATLAS_MAX_SIDE && area <= ATLAS_MAX_TEXELS) {
+        if (width <= ATLAS_MAX_SIDE && area <= a->max_texels) {
             qsort(keys, a->chart_count, sizeof(keys[0]), taller_first);
             uint32_t height = (pack(a, keys, width) + 3u) & ~3u;
             if (height > 0 && height <= ATLAS_MAX_SIDE &&
-                (uint64_t)width * height <= ATLAS_MAX_TEXELS) {
+                (uint64_t)width * height <= a->max_texels) {
                 a->width = width, a->height = height;
                 rep->used_share = (double)area / ((double)width * height);
                 break;
@@ -240,6 +268,7 @@ int atlas_build(struct atlas *a, const struct fusion_volume *vol, double texel_m
         }
     }
     memset(a->accum, 0, (size_t)a->width * a->height * 4 * sizeof(a->accum[0]));
+    assign_texels(a, vol);
     rep->width = a->width, rep->height = a->height;
     rep->texel_mm = a->texel_mm;
     rep->charts = a->chart_count;
@@ -248,36 +277,97 @@ int atlas_build(struct atlas *a, const struct fusion_volume *vol, double texel_m
 
 /* ---- texels: each triangle rasterised in its chart ---- */
 
-/* Called for each texel of a triangle with its barycentric weights (raster). */
+/* Called for each texel a triangle owns with its barycentric weights (raster). */
 typedef void (*texel_fn)(void *ctx, size_t texel, const double bary[3], uint32_t t);
 
-/* Call @p fn for each texel of triangle @p t whose centre lies inside it (on an edge: for both
- * triangles; the colour is a mean, so a texel met twice is no harm). The texels a chart's edge
- * cuts whose centres lie outside take their neighbours' colour with the gutter (atlas_finish). */
-static void raster(const struct atlas *a, const struct fusion_volume *vol, uint32_t t, texel_fn fn,
-                   void *ctx)
+/* A texel is owned by the triangle its centre lies in or, outside every triangle of its chart,
+ * by one whose edges it lies within this many texels of: a bilinear read at a point of the
+ * surface reads texels up to sqrt(2) texels from it, and near a chart's border those must hold
+ * the surface's colour (extrapolated on the triangle's plane), not the gutter's. */
+#define ATLAS_REACH 1.5
+
+/* Triangle @p t's corners in the texture and twice its signed area there.
+ * @retval 0 @retval -1 on edge in the projection: no texel of its own */
+static int tri_texels(const struct atlas *a, const struct fusion_volume *vol, uint32_t t,
+                      double x[3], double y[3], double *area2)
 {
     const struct atlas_chart *ch = &a->chart[a->tri_chart[t]];
-    double x[3], y[3];
     for (int k = 0; k < 3; k++)
         texel_xy(a, ch, vertex_pos(vol, tri_at(vol, t)[k]), &x[k], &y[k]);
-    double area2 = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
-    if (fabs(area2) < 1e-12)
-        return; /* on edge in the projection: no texel of its own */
-    long xa = (long)ceil(fmin(x[0], fmin(x[1], x[2])) - 0.5);
-    long xb = (long)floor(fmax(x[0], fmax(x[1], x[2])) - 0.5);
-    long ya = (long)ceil(fmin(y[0], fmin(y[1], y[2])) - 0.5);
-    long yb = (long)floor(fmax(y[0], fmax(y[1], y[2])) - 0.5);
+    *area2 = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
+    return fabs(*area2) < 1e-12 ? -1 : 0;
+}
+
+/* The texels about triangle @p t (its bounding box and ATLAS_REACH about it): @p fn is called with
+ * each one's barycentric weights (outside the triangle, some negative) when @p claim is NULL
+ * and the texel is the triangle's (atlas->owner); else @p claim decides, given the weights. */
+static void raster(struct atlas *a, const struct fusion_volume *vol, uint32_t t, texel_fn fn,
+                   void *ctx,
+                   int (*claim)(struct atlas *a, size_t texel, const double l[3],
+                                const double height[3], uint32_t t))
+{
+    double x[3], y[3], area2, height[3];
+    if (tri_texels(a, vol, t, x, y, &area2) != 0)
+        return;
+    for (int k = 0; k < 3; k++) { /* over the edge opposite corner k, in texels */
+        double ex = x[(k + 2) % 3] - x[(k + 1) % 3], ey = y[(k + 2) % 3] - y[(k + 1) % 3];
+        height[k] = fabs(area2) / sqrt(ex * ex + ey * ey);
+    }
+    const struct atlas_chart *ch = &a->chart[a->tri_chart[t]];
+    long xa = (long)floor(fmin(x[0], fmin(x[1], x[2])) - ATLAS_REACH);
+    long xb = (long)ceil(fmax(x[0], fmax(x[1], x[2])) + ATLAS_REACH);
+    long ya = (long)floor(fmin(y[0], fmin(y[1], y[2])) - ATLAS_REACH);
+    long yb = (long)ceil(fmax(y[0], fmax(y[1], y[2])) + ATLAS_REACH);
+    xa = xa < (long)ch->x0 ? (long)ch->x0 : xa;
+    ya = ya < (long)ch->y0 ? (long)ch->y0 : ya;
+    xb = xb > (long)(ch->x0 + ch->w) ? (long)(ch->x0 + ch->w) : xb;
+    yb = yb > (long)(ch->y0 + ch->h) ? (long)(ch->y0 + ch->h) : yb;
     const double inv = 1.0 / area2;
-    for (long ty = ya; ty <= yb; ty++)
-        for (long tx = xa; tx <= xb; tx++) {
+    for (long ty = ya; ty < yb; ty++)
+        for (long tx = xa; tx < xb; tx++) {
+            size_t texel = (size_t)ty * a->width + (size_t)tx;
+            if (claim == NULL && a->owner[texel] != t)
+                continue;
             double cx = tx + 0.5, cy = ty + 0.5, l[3];
             l[0] = ((x[1] - cx) * (y[2] - cy) - (x[2] - cx) * (y[1] - cy)) * inv;
             l[1] = ((x[2] - cx) * (y[0] - cy) - (x[0] - cx) * (y[2] - cy)) * inv;
             l[2] = 1.0 - l[0] - l[1];
-            if (l[0] >= 0.0 && l[1] >= 0.0 && l[2] >= 0.0)
-                fn(ctx, (size_t)ty * a->width + (size_t)tx, l, t);
+            if (claim != NULL)
+                claim(a, texel, l, height, t);
+            else
+                fn(ctx, texel, l, t);
         }
+}
+
+/* The texels a triangle's centre lies in; then (near) the ones about it nobody owns. */
+static int claim_inside(struct atlas *a, size_t texel, const double l[3], const double height[3],
+                        uint32_t t)
+{
+    (void)height;
+    if (l[0] >= 0.0 && l[1] >= 0.0 && l[2] >= 0.0)
+        a->owner[texel] = t;
+    return 0;
+}
+
+static int claim_near(struct atlas *a, size_t texel, const double l[3], const double height[3],
+                      uint32_t t)
+{
+    if (a->owner[texel] == NONE && l[0] * height[0] >= -ATLAS_REACH &&
+        l[1] * height[1] >= -ATLAS_REACH && l[2] * height[2] >= -ATLAS_REACH)
+        a->owner[texel] = t;
+    return 0;
+}
+
+/* Each texel's triangle (owner), for the views' colour and the vertex colours' (raster). */
+static void assign_texels(struct atlas *a, const struct fusion_volume *vol)
+{
+    memset(a->owner, 0xFF, (size_t)a->width * a->height * sizeof(a->owner[0]));
+    for (uint32_t t = 0; t < vol->mp.s.triangles; t++)
+        if (a->tri_chart[t] != NONE)
+            raster(a, vol, t, NULL, NULL, claim_inside);
+    for (uint32_t t = 0; t < vol->mp.s.triangles; t++)
+        if (a->tri_chart[t] != NONE)
+            raster(a, vol, t, NULL, NULL, claim_near);
 }
 
 struct view_ctx {
@@ -357,7 +447,7 @@ int atlas_add_view(struct atlas *a, struct fusion_volume *vol, const struct scan
             s.z[k] = p[k].z;
         }
         s.ray = v3_len(p[0]) / p[0].z;
-        raster(a, vol, t, view_texel, &s);
+        raster(a, vol, t, view_texel, &s, NULL);
     }
     return 0;
 }
@@ -442,7 +532,7 @@ int atlas_finish(struct atlas *a, const struct fusion_volume *vol, uint32_t *unc
     struct finish_ctx s = {a, vol, 0};
     for (uint32_t t = 0; t < vol->mp.s.triangles; t++)
         if (a->tri_chart[t] != NONE)
-            raster(a, vol, t, mesh_texel, &s);
+            raster(a, vol, t, mesh_texel, &s, NULL);
     fill_gutters(a, (int)ATLAS_GUTTER + 1);
     for (size_t i = 0; i < n; i++) {
         const float *acc = &a->accum[4 * i];

@@ -27,27 +27,40 @@ struct atlas_report {
     double used_share;      /**< share of the texture inside charts */
 };
 
-/** The atlas, its work space and its texture: tens of MB at the compiled limits, kept static by
- *  its owner (the job) and passed by pointer; its fields are atlas.c's. */
+/** What atlas_build needs of its work space: a texel's weighted colour and weight (4 floats),
+ *  its triangle (uint32) and its sRGB colour (3 bytes); a triangle's chart (uint32) and axis
+ *  (a byte); a vertex's chart (uint32); a chart. */
+#define ATLAS_TEXEL_BYTES (4u * sizeof(float) + sizeof(uint32_t) + 3u)
+#define ATLAS_WORK_BYTES(texels, triangles, vertices)                                              \
+    ((uint64_t)(texels)*ATLAS_TEXEL_BYTES + 5ull * (triangles) + 4ull * (vertices) +               \
+     (uint64_t)ATLAS_MAX_CHARTS * sizeof(struct atlas_chart))
+
+/** The atlas: its size and texel, and where its parts lie in the work space atlas_build is given
+ *  (the fusion grid's, spent once the mesh is made: fusion_spend_grid), so that it costs no memory
+ *  of its own; the fields are atlas.c's. */
 struct atlas {
     uint32_t width, height, chart_count;
     double texel_mm;
-    struct atlas_chart chart[ATLAS_MAX_CHARTS];
-    uint32_t order[ATLAS_MAX_CHARTS];              /* charts by height, for packing */
-    uint32_t tri_chart[MESH_MAX_TRIANGLES];        /* each prepared triangle's chart (or none) */
-    uint8_t tri_axis[MESH_MAX_TRIANGLES];          /* its axis direction */
-    uint32_t vertex_tri[MESH_MAX_VERTICES];        /* a triangle at each vertex, then its chart */
-    _Alignas(8) float accum[ATLAS_MAX_TEXELS * 4]; /* weighted linear colour and the weight */
-    uint8_t texture[ATLAS_MAX_TEXELS * 3];         /* sRGB-encoded RGB, rows top down */
+    size_t max_texels;
+    float *accum;              /* weighted linear colour and the weight, 4 a texel */
+    uint32_t *owner;           /* each texel's triangle (atlas.c's raster) */
+    uint32_t *tri_chart;       /* each prepared triangle's chart (or none) */
+    uint32_t *vertex_tri;      /* a triangle at each vertex, then its chart */
+    struct atlas_chart *chart; /* the charts */
+    uint8_t *texture;          /* sRGB-encoded RGB, rows top down */
+    uint8_t *tri_axis;         /* each triangle's axis direction */
 };
 
 /** Charts on @p vol's prepared mesh (fusion_mesh_prepare, holes closed), packed at @p texel_mm
- *  or, when that does not fit ATLAS_MAX_SIDE x ATLAS_MAX_SIDE, the smallest texel (a quarter
- *  larger a step) that does; the colour accumulators emptied.
- *  @param rep  out @retval 0 @retval -EINVAL not prepared or texel_mm <= 0 @retval -E2BIG the mesh
- *  did not fit the tables (no atlas) @retval -ENOSPC more charts than ATLAS_MAX_CHARTS */
-int atlas_build(struct atlas *a, const struct fusion_volume *vol, double texel_mm,
-                struct atlas_report *rep);
+ *  or, when that does not fit ATLAS_MAX_SIDE a side, ATLAS_MAX_TEXELS or the work space, the
+ *  smallest texel (a quarter larger a step) that does; the colour accumulators emptied.
+ *  @param work  the texels' space (8-byte aligned), ATLAS_TEXEL_BYTES a texel, the atlas's until
+ *  it is built again @param rep  out
+ *  @retval 0 @retval -EINVAL not prepared, texel_mm <= 0 or no work space @retval -E2BIG the mesh
+ *  did not fit the tables (no atlas) @retval -ENOSPC more charts than ATLAS_MAX_CHARTS or the
+ *  work space holds */
+int atlas_build(struct atlas *a, const struct fusion_volume *vol, double texel_mm, void *work,
+                size_t work_bytes, struct atlas_report *rep);
 
 /** Add one view's colour: each texel of a triangle facing the camera, projected into the view
  *  through @p obj_from_cam, takes the colour about where it lands (bilinear over valid pixels)

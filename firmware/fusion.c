@@ -38,8 +38,19 @@ int fusion_begin(struct fusion_volume *vol, const struct fusion_params *p)
     vol->origin = v3(-p->radius_mm, -p->radius_mm, p->bottom_mm);
     memset(vol->grid, 0, (size_t)vol->dims[0] * vol->dims[1] * vol->dims[2] * sizeof(vol->grid[0]));
     vol->mp.prepared = 0; /* an earlier model's mesh tables are no longer this one's */
+    vol->grid_spent = 0;
     mc_table_build();
     return 0;
+}
+
+void *fusion_spend_grid(struct fusion_volume *vol, size_t *bytes)
+{
+    *bytes = 0;
+    if (!vol->mp.prepared || !vol->mp.fits)
+        return NULL;
+    vol->grid_spent = 1;
+    *bytes = sizeof(vol->grid);
+    return vol->grid;
 }
 
 /* The rectangle of pixels a view's work covers: its valid pixels and a ring of one pixel
@@ -351,6 +362,7 @@ int fusion_integrate(struct fusion_volume *vol, const struct hal_thread *threads
 
 int fusion_fill(struct fusion_volume *vol, double (*sdf_mm)(vec3 p, void *ctx), void *ctx)
 {
+    vol->grid_spent = 0;
     for (uint32_t z = 0; z < vol->dims[2]; z++)
         for (uint32_t y = 0; y < vol->dims[1]; y++)
             for (uint32_t x = 0; x < vol->dims[0]; x++) {
@@ -475,6 +487,8 @@ static int extract_cell(struct fusion_volume *vol, struct extract_state *st, uin
 
 int fusion_extract(struct fusion_volume *vol, const struct mesh_sink *sink)
 {
+    if (vol->grid_spent)
+        return -EINVAL; /* the grid holds something else now (fusion_spend_grid) */
     struct extract_state st = {sink, 0};
     size_t plane = (size_t)vol->dims[0] * vol->dims[1];
     memset(vol->edge_vertex_x[0], 0xFF, plane * sizeof(uint32_t));

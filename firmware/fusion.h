@@ -50,6 +50,13 @@ int fusion_integrate(struct fusion_volume *vol, const struct hal_thread *threads
 const float *fusion_view_weights(struct fusion_volume *vol, const struct scan_calib *calib,
                                  const struct decode_maps *maps, const struct tri_range *range);
 
+/** The grid's memory for another use once the mesh is made (fusion_mesh_prepare, and the whole
+ *  mesh fit the tables: the writers read the tables, never the grid again): the texture atlas's
+ *  work space. Until fusion_begin, fusion_extract refuses (-EINVAL).
+ *  @param bytes  out: its size @retval the grid's memory (8-byte aligned) @retval NULL the mesh
+ *  is not made, or did not fit the tables */
+void *fusion_spend_grid(struct fusion_volume *vol, size_t *bytes);
+
 /** Set every voxel from a signed distance function of the object-frame position (mm), weight 1
  *  and grey colour (NAN: never observed): synthetic objects and tests of the extraction.
  *  @retval 0 */
@@ -189,7 +196,8 @@ struct voxel {
  *  it by pointer, so there is no allocation; two volumes are two independent models. Its fields
  *  are the fusion's own (fusion.c, fusion_close.c, mesh_io.c, mesh_glb.c). */
 struct fusion_volume {
-    struct voxel grid[FUSION_MAX_VOXELS];
+    _Alignas(8) struct voxel grid[FUSION_MAX_VOXELS];
+    int grid_spent; /* 1: fusion_spend_grid lent it out */
     struct fusion_params p;
     uint32_t dims[3];
     vec3 origin; /* where voxel (0, 0, 0) is (object frame, mm) */

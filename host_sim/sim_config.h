@@ -25,7 +25,8 @@ struct sim_config {
     char merl_file[HAL_MAX_PATH];
     char merl_name[64];
     double phong_ks, phong_ke;
-    char albedo_pattern[16]; /**< patches | uniform */
+    char albedo_pattern[16];         /**< patches | uniform | image */
+    char albedo_image[HAL_MAX_PATH]; /**< image: the PNG wrapped round the object */
     double albedo[3];
     uint32_t seed;
     uint32_t table_angle_error_mdeg;

@@ -45,6 +45,11 @@ int sim_albedo_at(const struct sim_config *cfg, double height_mm, vec3 p, double
     double az = atan2(p.y, p.x);
     if (az < 0.0)
         az += 2.0 * M_PI;
+    if (strcmp(cfg->albedo_pattern, "image") == 0) {
+        double v = 1.0 - p.z / height_mm;
+        sim_albedo_image_at(az / (2.0 * M_PI), v < 0.0 ? 0.0 : v > 1.0 ? 1.0 : v, albedo);
+        return 0;
+    }
     int sector = (int)(az / (M_PI / 4.0)) % 8;
     double h = p.z / height_mm;
     int band = h < 0.0 ? 0 : (h >= 1.0 ? 4 : (int)(h * 5.0));
@@ -171,6 +176,8 @@ int sim_rig_init(struct sim_rig *rig, const struct sim_config *cfg, const struct
     int rc = build_object(rig, dir, err, len);
     if (rc == 0)
         rc = build_material(rig, dir, err, len);
+    if (rc == 0)
+        rc = sim_albedo_image_load(cfg, dir, err, len);
     if (rc == 0)
         rc = sim_bvh_build(&rig->bvh, &rig->mesh);
     if (rc != 0)

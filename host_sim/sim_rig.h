@@ -101,4 +101,13 @@ double sim_rig_placed_height(const struct sim_config *cfg);
 /** Albedo of the painted pattern at an object-frame point. @retval 1 on the very dark paint */
 int sim_albedo_at(const struct sim_config *cfg, double height_mm, vec3 p_obj, double albedo[3]);
 
+/** [sim] albedo_pattern = image: load albedo_image (relative to @p dir) for sim_albedo_at, once
+ *  per path (sim_albedo_image.c); nothing to do for another pattern.
+ *  @retval 0 @retval -EINVAL not given, not a PNG or too large (@p err says which) */
+int sim_albedo_image_load(const struct sim_config *cfg, const char *dir, char *err, size_t len);
+
+/** The loaded image's albedo at (@p u round the object, @p v down it), both 0..1, bilinear
+ *  (mid grey when none is loaded). */
+void sim_albedo_image_at(double u, double v, double albedo[3]);
+
 #endif

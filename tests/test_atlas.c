@@ -62,12 +62,20 @@ static void prepare_sphere(void)
     assert_true(ms.kept_triangles > 1000);
 }
 
+/* The atlas in the spent grid's memory, as the job makes it. */
+static int build(double texel_mm, struct atlas_report *rep)
+{
+    size_t bytes;
+    void *work = fusion_spend_grid(&vol, &bytes);
+    return atlas_build(&atlas, &vol, texel_mm, work, bytes, rep);
+}
+
 static void test_charts_cover_the_mesh_without_overlap(void **state)
 {
     (void)state;
     struct atlas_report rep;
     prepare_sphere();
-    assert_int_equal(atlas_build(&atlas, &vol, 0.25, &rep), 0);
+    assert_int_equal(build(0.25, &rep), 0);
     assert_true(rep.charts >= 6); /* a sphere faces every axis direction */
     assert_true(rep.width > 0 && rep.width <= ATLAS_MAX_SIDE && rep.height <= ATLAS_MAX_SIDE);
     assert_true(rep.used_share > 0.3 && rep.used_share <= 1.0);
@@ -129,7 +137,7 @@ static void test_a_view_colours_what_it_saw(void **state)
     struct atlas_report rep;
     uint32_t uncoloured;
     prepare_sphere();
-    assert_int_equal(atlas_build(&atlas, &vol, 0.25, &rep), 0);
+    assert_int_equal(build(0.25, &rep), 0);
     struct scan_calib c = {.cam_fx_px = 800,
                            .cam_fy_px = 800,
                            .cam_cx_px = 319.5,
@@ -188,12 +196,19 @@ static void test_unprepared_or_no_texel_refused(void **state)
     (void)state;
     struct atlas_report rep;
     uint32_t n;
+    static uint64_t work[1u << 16]; /* 512 KB */
     memset(&vol.mp, 0, sizeof(vol.mp));
-    assert_int_equal(atlas_build(&atlas, &vol, 0.25, &rep), -EINVAL);
+    size_t bytes;
+    assert_null(fusion_spend_grid(&vol, &bytes)); /* no mesh made: the grid is the model's */
+    assert_int_equal(atlas_build(&atlas, &vol, 0.25, work, sizeof(work), &rep), -EINVAL);
     assert_int_equal(atlas_finish(&atlas, &vol, &n), -EINVAL);
     prepare_sphere();
-    assert_int_equal(atlas_build(&atlas, &vol, 0.0, &rep), -EINVAL);
-    assert_int_equal(atlas_build(&atlas, &vol, NAN, &rep), -EINVAL);
+    assert_int_equal(atlas_build(&atlas, &vol, 0.0, work, sizeof(work), &rep), -EINVAL);
+    assert_int_equal(atlas_build(&atlas, &vol, NAN, work, sizeof(work), &rep), -EINVAL);
+    assert_int_equal(atlas_build(&atlas, &vol, 0.25, NULL, sizeof(work), &rep), -EINVAL);
+    assert_int_equal(atlas_build(&atlas, &vol, 0.25, (char *)work + 4, 1000, &rep), -EINVAL);
+    /* a work space too small for the charts' own bookkeeping */
+    assert_int_equal(atlas_build(&atlas, &vol, 0.25, work, sizeof(work), &rep), -ENOSPC);
 }
 
 static void test_too_fine_a_texel_grows_until_it_fits(void **state)
@@ -202,9 +217,12 @@ static void test_too_fine_a_texel_grows_until_it_fits(void **state)
     struct atlas_report rep;
     prepare_sphere();
     /* 5000 mm^2 of sphere at 0.001 mm would be 5e9 texels */
-    assert_int_equal(atlas_build(&atlas, &vol, 0.001, &rep), 0);
+    assert_int_equal(build(0.001, &rep), 0);
     assert_true(rep.texel_mm > 0.001);
     assert_true((uint64_t)rep.width * rep.height <= ATLAS_MAX_TEXELS);
+    /* the grid is lent out: marching cubes refuses to read it */
+    struct mesh_sink none = {NULL, NULL, NULL};
+    assert_int_equal(fusion_extract(&vol, &none), -EINVAL);
     assert_true(rep.width <= ATLAS_MAX_SIDE && rep.height <= ATLAS_MAX_SIDE);
     /* and not far from the finest that fits: one step finer would not */
     assert_true(4.0 * M_PI * RADIUS * RADIUS / (rep.texel_mm * rep.texel_mm / 1.5625) >

@@ -63,10 +63,10 @@
 #define MESH_MAX_VERTICES (2u << 20)
 #endif
 #define MESH_MAX_TRIANGLES (2u * MESH_MAX_VERTICES)
-/* The texture atlas (atlas.h): its longer side and its texels, 19 bytes each while it is made
- * (linear colour and weight as floats, then sRGB bytes), and its charts, 28 bytes each. 4 M
- * texels hold 0.36 m^2 of surface at 0.3 mm (a camera pixel at 600 mm), less the packing's waste.
- */
+/* The texture atlas (atlas.h): its longer side and its texels, and its charts. It costs no memory
+ * of its own: it is made in the fusion grid's, spent once the mesh is (atlas.c asserts it fits).
+ * 4 M texels hold 0.36 m^2 of surface at 0.3 mm (a camera pixel at 600 mm), less the packing's
+ * waste. */
 #ifdef HAL_LIMITS_SMALL
 #define ATLAS_MAX_SIDE 2048u
 #define ATLAS_MAX_TEXELS (2u << 20)
@@ -74,7 +74,7 @@
 #define ATLAS_MAX_SIDE 4096u
 #define ATLAS_MAX_TEXELS (4u << 20)
 #endif
-#define ATLAS_MAX_CHARTS (1u << 17)
+#define ATLAS_MAX_CHARTS (1u << 16)
 /* [colour] method = fit (reflect.h): the light x view samples its lobes are fitted from, ~180
  * bytes each. */
 #ifdef HAL_LIMITS_SMALL

@@ -1,0 +1,239 @@
+/* build/texture-eval: how close a scan's texture (texture.png through mesh.obj's vt) and its
+ * vertex colours are to the simulated object's true albedo, over the whole surface, paint edges
+ * included (issue 34).
+ *
+ *   texture-eval SCAN_DIR RESULT_DIR [SCENE_CONFIG]
+ *
+ * SCAN_DIR is a simulated scan (its config and truth mesh); RESULT_DIR holds mesh.obj, mesh.mtl and
+ * texture.png (`scanner process SCAN_DIR --out RESULT_DIR`, or SCAN_DIR itself); SCENE_CONFIG
+ * is the config the scan was taken with, for [sim] albedo_image's path (the scan keeps a copy of
+ * it whose relative paths no longer lead anywhere), default SCAN_DIR/config.ini. Each triangle is
+ * sampled at its centroid and three points towards its corners; a sample farther than 1 mm from
+ * the true surface is not compared. Prints one line: samples, then CIEDE2000 mean and 95th
+ * percentile of the texture and of the vertex colours (interpolated across the triangle as a
+ * viewer shows them), then the same over the dark paint (true L* < 30), then the seams: at each
+ * vertex that has more than one place in the texture (a chart's border), the texture's colour
+ * at each place against its first. */
+#define _POSIX_C_SOURCE 200809L
+#include "colour_metrics.h"
+#include "config.h"
+#include "image_io.h"
+#include "sim_bvh.h"
+#include "sim_mesh.h"
+#include "sim_rig.h"
+
+#include <libgen.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define MATCH_MM 1.0
+#define MAX_SIDE 4096u
+
+struct obj_mesh {
+    float *v;   /* x y z (object frame, mm) and r g b (sRGB 0..1) */
+    float *vt;  /* u v (OBJ: v up from the bottom) */
+    int64_t *f; /* per corner: vertex, texture coordinate */
+    size_t nv, nvt, nf, cap_v, cap_vt, cap_f;
+};
+
+static void *grow(void *p, size_t *cap, size_t need, size_t size)
+{
+    if (need <= *cap)
+        return p;
+    *cap = need * 2;
+    return realloc(p, *cap * size);
+}
+
+/* mesh.obj as the scanner writes it: "v x y z r g b" (Y up: the object frame's x, z, -y),
+ * "vt u v", "f v/vt/vn ..." (triangles). @retval 0 @retval -1 (said) */
+static int obj_load(const char *path, struct obj_mesh *m)
+{
+    FILE *fp = fopen(path, "r");
+    char line[512];
+    memset(m, 0, sizeof(*m));
+    if (fp == NULL) {
+        perror(path);
+        return -1;
+    }
+    while (fgets(line, sizeof(line), fp) != NULL) {
+        float a[6];
+        long long c[6];
+        if (sscanf(line, "v %f %f %f %f %f %f", &a[0], &a[1], &a[2], &a[3], &a[4], &a[5]) == 6) {
+            m->v = grow(m->v, &m->cap_v, m->nv + 1, 6 * sizeof(float));
+            float *o = &m->v[6 * m->nv++];
+            o[0] = a[0], o[1] = -a[2], o[2] = a[1]; /* back to the object frame */
+            o[3] = a[3], o[4] = a[4], o[5] = a[5];
+        } else if (sscanf(line, "vt %f %f", &a[0], &a[1]) == 2) {
+            m->vt = grow(m->vt, &m->cap_vt, m->nvt + 1, 2 * sizeof(float));
+            m->vt[2 * m->nvt] = a[0], m->vt[2 * m->nvt + 1] = a[1];
+            m->nvt++;
+        } else if (sscanf(line, "f %lld/%lld/%*d %lld/%lld/%*d %lld/%lld/%*d", &c[0], &c[1], &c[2],
+                          &c[3], &c[4], &c[5]) == 6) {
+            m->f = grow(m->f, &m->cap_f, m->nf + 1, 6 * sizeof(int64_t));
+            for (int k = 0; k < 6; k++)
+                m->f[6 * m->nf + (size_t)k] = c[k] - 1;
+            m->nf++;
+        }
+    }
+    fclose(fp);
+    for (size_t i = 0; i < 6 * m->nf; i++)
+        if (m->f[i] < 0 || (size_t)m->f[i] >= (i % 2 == 0 ? m->nv : m->nvt)) {
+            fprintf(stderr, "texture-eval: %s: a face names a vertex or vt it does not have\n",
+                    path);
+            return -1;
+        }
+    if (m->nf == 0 || m->v == NULL || m->vt == NULL) {
+        fprintf(stderr, "texture-eval: %s: no textured faces\n", path);
+        return -1;
+    }
+    return 0;
+}
+
+static double srgb_decode(double e)
+{
+    return e <= 0.04045 ? e / 12.92 : pow((e + 0.055) / 1.055, 2.4);
+}
+
+/* The texture's linear colour at (u, v) (OBJ's), bilinear, texel centres at +0.5. */
+static void texture_at(const uint8_t *tex, uint32_t w, uint32_t h, double u, double v,
+                       double out[3])
+{
+    double x = u * w - 0.5, y = (1.0 - v) * h - 0.5;
+    long x0 = (long)floor(x), y0 = (long)floor(y);
+    double fx = x - x0, fy = y - y0;
+    out[0] = out[1] = out[2] = 0.0;
+    for (int q = 0; q < 4; q++) {
+        long xs = x0 + q % 2, ys = y0 + q / 2;
+        xs = xs < 0 ? 0 : xs >= (long)w ? (long)w - 1 : xs;
+        ys = ys < 0 ? 0 : ys >= (long)h ? (long)h - 1 : ys;
+        double wt = (q % 2 ? fx : 1.0 - fx) * (q / 2 ? fy : 1.0 - fy);
+        for (int k = 0; k < 3; k++)
+            out[k] += wt * srgb_decode(tex[3 * ((size_t)ys * w + (size_t)xs) + (size_t)k] / 255.0);
+    }
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double p95(double *v, size_t n)
+{
+    qsort(v, n, sizeof(double), cmp_double);
+    return n > 0 ? v[(size_t)(0.95 * (double)(n - 1))] : 0.0;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 3 || argc > 4) {
+        fprintf(stderr, "usage: texture-eval SCAN_DIR RESULT_DIR [SCENE_CONFIG]\n");
+        return 2;
+    }
+    static struct app_config cfg;
+    char path[HAL_MAX_PATH * 2 + 64], err[512], dir[HAL_MAX_PATH * 2 + 64];
+    snprintf(path, sizeof(path), "%s/config.ini", argv[1]);
+    snprintf(dir, sizeof(dir), "%s", argc == 4 ? argv[3] : path);
+    if (config_load(&cfg, argc == 4 ? argv[3] : path, err, sizeof(err)) != 0 ||
+        sim_albedo_image_load(&cfg.sim, dirname(dir), err, sizeof(err)) != 0) {
+        fprintf(stderr, "texture-eval: %s\n", err);
+        return 1;
+    }
+    struct sim_mesh truth;
+    struct sim_bvh bvh;
+    struct obj_mesh m;
+    snprintf(path, sizeof(path), "%s/truth_mesh.ply", argv[1]);
+    if (sim_mesh_load_ply(&truth, path, err, sizeof(err)) != 0 || sim_bvh_build(&bvh, &truth)) {
+        fprintf(stderr, "texture-eval: %s: %s\n", path, err);
+        return 1;
+    }
+    snprintf(path, sizeof(path), "%s/mesh.obj", argv[2]);
+    if (obj_load(path, &m) != 0)
+        return 1;
+    uint8_t *tex = malloc((size_t)MAX_SIDE * MAX_SIDE * 3);
+    uint32_t w = 0, h = 0;
+    snprintf(path, sizeof(path), "%s/texture.png", argv[2]);
+    if (tex == NULL ||
+        image_read_png(path, tex, (size_t)MAX_SIDE * MAX_SIDE * 3, &w, &h, 3, err, sizeof(err))) {
+        fprintf(stderr, "texture-eval: %s: %s\n", path, err);
+        return 1;
+    }
+    const double height = sim_rig_placed_height(&cfg.sim);
+    static const double bary[4][3] = {{1.0 / 3, 1.0 / 3, 1.0 / 3},
+                                      {4.0 / 6, 1.0 / 6, 1.0 / 6},
+                                      {1.0 / 6, 4.0 / 6, 1.0 / 6},
+                                      {1.0 / 6, 1.0 / 6, 4.0 / 6}};
+    double *de_tex = malloc(4 * m.nf * sizeof(double)), *de_vtx = malloc(4 * m.nf * sizeof(double));
+    size_t n = 0, dark = 0;
+    double sum_tex = 0, sum_vtx = 0, dark_tex = 0, dark_vtx = 0;
+    for (size_t f = 0; f < m.nf && de_tex != NULL && de_vtx != NULL; f++) {
+        const int64_t *c = &m.f[6 * f];
+        for (int s = 0; s < 4; s++) {
+            double p[3] = {0, 0, 0}, vc[3] = {0, 0, 0}, uv[2] = {0, 0};
+            for (int k = 0; k < 3; k++) {
+                const float *v = &m.v[6 * (size_t)c[2 * k]], *t = &m.vt[2 * (size_t)c[2 * k + 1]];
+                for (int d = 0; d < 3; d++) {
+                    p[d] += bary[s][k] * v[d];
+                    vc[d] += bary[s][k] * srgb_decode(v[3 + d]);
+                }
+                uv[0] += bary[s][k] * t[0], uv[1] += bary[s][k] * t[1];
+            }
+            vec3 q;
+            if (sim_bvh_closest(&bvh, v3(p[0], p[1], p[2]), MATCH_MM, &q) >= MATCH_MM)
+                continue;
+            double albedo[3], tc[3], lab_true[3], lab_tex[3], lab_vtx[3];
+            sim_albedo_at(&cfg.sim, height, q, albedo);
+            texture_at(tex, w, h, uv[0], uv[1], tc);
+            colour_linear_rgb_to_lab(albedo, lab_true);
+            colour_linear_rgb_to_lab(tc, lab_tex);
+            colour_linear_rgb_to_lab(vc, lab_vtx);
+            de_tex[n] = colour_ciede2000(lab_true, lab_tex);
+            de_vtx[n] = colour_ciede2000(lab_true, lab_vtx);
+            sum_tex += de_tex[n], sum_vtx += de_vtx[n];
+            if (lab_true[0] < 30.0)
+                dark++, dark_tex += de_tex[n], dark_vtx += de_vtx[n];
+            n++;
+        }
+    }
+    if (n == 0) {
+        fprintf(stderr, "texture-eval: %s: no sample lies on the true surface\n", argv[2]);
+        return 1;
+    }
+    /* seams: each vertex's first place in the texture against its others */
+    int64_t *first_vt = malloc(m.nv * sizeof(int64_t));
+    double *first_lab = malloc(m.nv * 3 * sizeof(double)), seam_sum = 0.0, seam_max = 0.0;
+    size_t seams = 0;
+    for (size_t i = 0; first_vt != NULL && i < m.nv; i++)
+        first_vt[i] = -1;
+    for (size_t i = 0; first_vt != NULL && first_lab != NULL && i < 3 * m.nf; i++) {
+        int64_t v = m.f[2 * i], t = m.f[2 * i + 1];
+        double tc[3], lab[3];
+        texture_at(tex, w, h, m.vt[2 * t], m.vt[2 * t + 1], tc);
+        colour_linear_rgb_to_lab(tc, lab);
+        if (first_vt[v] < 0) {
+            first_vt[v] = t;
+            memcpy(&first_lab[3 * v], lab, sizeof(lab));
+        } else if (first_vt[v] != t) {
+            double d = colour_ciede2000(&first_lab[3 * v], lab);
+            seam_sum += d, seam_max = fmax(seam_max, d), seams++;
+        }
+    }
+    free(first_vt);
+    free(first_lab);
+    double tex_mean = sum_tex / n, vtx_mean = sum_vtx / n;
+    printf("texture-eval: %zu samples on %zu triangles, texture %u x %u: texture dE00 mean %.3f "
+           "p95 %.3f; vertex colours mean %.3f p95 %.3f; dark paint (L* < 30, %zu samples) "
+           "texture %.3f, vertex colours %.3f; seams: %zu places, dE00 mean %.3f max %.3f\n",
+           n, m.nf, (unsigned)w, (unsigned)h, tex_mean, p95(de_tex, n), vtx_mean, p95(de_vtx, n),
+           dark, dark ? dark_tex / dark : 0.0, dark ? dark_vtx / dark : 0.0, seams,
+           seams ? seam_sum / seams : 0.0, seam_max);
+    free(de_tex);
+    free(de_vtx);
+    free(tex);
+    free(m.v), free(m.vt), free(m.f);
+    sim_bvh_free(&bvh);
+    sim_mesh_free(&truth);
+    return 0;
+}
