@@ -285,6 +285,8 @@ typedef void (*texel_fn)(void *ctx, size_t texel, const double bary[3], uint32_t
  * surface reads texels up to sqrt(2) texels from it, and near a chart's border those must hold
  * the surface's colour (extrapolated on the triangle's plane), not the gutter's. */
 #define ATLAS_REACH 1.5
+/* tri_axis's flag of a triangle that owns texels outside its bounding box */
+#define REACHES 0x80u
 
 /* Triangle @p t's corners in the texture and twice its signed area there.
  * @retval 0 @retval -1 on edge in the projection: no texel of its own */
@@ -296,6 +298,16 @@ static int tri_texels(const struct atlas *a, const struct fusion_volume *vol, ui
         texel_xy(a, ch, vertex_pos(vol, tri_at(vol, t)[k]), &x[k], &y[k]);
     *area2 = (x[1] - x[0]) * (y[2] - y[0]) - (x[2] - x[0]) * (y[1] - y[0]);
     return fabs(*area2) < 1e-12 ? -1 : 0;
+}
+
+/* The barycentric weights @p l of point (@p cx, @p cy) in the triangle of corners @p x, @p y
+ * (@p inv: one over twice its signed area): negative outside. */
+static void barycentric(const double x[3], const double y[3], double inv, double cx, double cy,
+                        double l[3])
+{
+    l[0] = ((x[1] - cx) * (y[2] - cy) - (x[2] - cx) * (y[1] - cy)) * inv;
+    l[1] = ((x[2] - cx) * (y[0] - cy) - (x[0] - cx) * (y[2] - cy)) * inv;
+    l[2] = 1.0 - l[0] - l[1];
 }
 
 /* The texels about triangle @p t (its bounding box and ATLAS_REACH about it): @p fn is called with
@@ -314,10 +326,13 @@ static void raster(struct atlas *a, const struct fusion_volume *vol, uint32_t t,
         height[k] = fabs(area2) / sqrt(ex * ex + ey * ey);
     }
     const struct atlas_chart *ch = &a->chart[a->tri_chart[t]];
-    long xa = (long)floor(fmin(x[0], fmin(x[1], x[2])) - ATLAS_REACH);
-    long xb = (long)ceil(fmax(x[0], fmax(x[1], x[2])) + ATLAS_REACH);
-    long ya = (long)floor(fmin(y[0], fmin(y[1], y[2])) - ATLAS_REACH);
-    long yb = (long)ceil(fmax(y[0], fmax(y[1], y[2])) + ATLAS_REACH);
+    /* the texels about it: a triangle that owns none outside its bounding box (all but those on
+     * a chart's border, marked by claim_near) needs only that box's */
+    const double reach = claim != NULL || (a->tri_axis[t] & REACHES) ? ATLAS_REACH : 0.0;
+    long xa = (long)floor(fmin(x[0], fmin(x[1], x[2])) - reach);
+    long xb = (long)ceil(fmax(x[0], fmax(x[1], x[2])) + reach);
+    long ya = (long)floor(fmin(y[0], fmin(y[1], y[2])) - reach);
+    long yb = (long)ceil(fmax(y[0], fmax(y[1], y[2])) + reach);
     xa = xa < (long)ch->x0 ? (long)ch->x0 : xa;
     ya = ya < (long)ch->y0 ? (long)ch->y0 : ya;
     xb = xb > (long)(ch->x0 + ch->w) ? (long)(ch->x0 + ch->w) : xb;
@@ -328,10 +343,8 @@ static void raster(struct atlas *a, const struct fusion_volume *vol, uint32_t t,
             size_t texel = (size_t)ty * a->width + (size_t)tx;
             if (claim == NULL && a->owner[texel] != t)
                 continue;
-            double cx = tx + 0.5, cy = ty + 0.5, l[3];
-            l[0] = ((x[1] - cx) * (y[2] - cy) - (x[2] - cx) * (y[1] - cy)) * inv;
-            l[1] = ((x[2] - cx) * (y[0] - cy) - (x[0] - cx) * (y[2] - cy)) * inv;
-            l[2] = 1.0 - l[0] - l[1];
+            double l[3];
+            barycentric(x, y, inv, tx + 0.5, ty + 0.5, l);
             if (claim != NULL)
                 claim(a, texel, l, height, t);
             else
@@ -353,8 +366,10 @@ static int claim_near(struct atlas *a, size_t texel, const double l[3], const do
                       uint32_t t)
 {
     if (a->owner[texel] == NONE && l[0] * height[0] >= -ATLAS_REACH &&
-        l[1] * height[1] >= -ATLAS_REACH && l[2] * height[2] >= -ATLAS_REACH)
+        l[1] * height[1] >= -ATLAS_REACH && l[2] * height[2] >= -ATLAS_REACH) {
         a->owner[texel] = t;
+        a->tri_axis[t] |= REACHES;
+    }
     return 0;
 }
 
@@ -529,10 +544,18 @@ int atlas_finish(struct atlas *a, const struct fusion_volume *vol, uint32_t *unc
             acc[3] = SEEN;
         }
     }
+    /* owned texels no view coloured: the vertex colours, through their triangle's weights there
+     * (a few per cent of them: texel by texel rather than every triangle rasterised again) */
     struct finish_ctx s = {a, vol, 0};
-    for (uint32_t t = 0; t < vol->mp.s.triangles; t++)
-        if (a->tri_chart[t] != NONE)
-            raster(a, vol, t, mesh_texel, &s, NULL);
+    for (size_t i = 0; i < n; i++) {
+        double x[3], y[3], area2, l[3];
+        uint32_t t = a->owner[i];
+        if (a->accum[4 * i + 3] != 0.0f || t == NONE || tri_texels(a, vol, t, x, y, &area2) != 0)
+            continue;
+        barycentric(x, y, 1.0 / area2, (double)(i % a->width) + 0.5, (double)(i / a->width) + 0.5,
+                    l);
+        mesh_texel(&s, i, l, t);
+    }
     fill_gutters(a, (int)ATLAS_GUTTER + 1);
     for (size_t i = 0; i < n; i++) {
         const float *acc = &a->accum[4 * i];
