@@ -218,7 +218,8 @@ static int carve(struct atlas *a, const struct fusion_volume *vol, void *work, s
     a->tri_chart = a->owner + a->max_texels;
     a->vertex_tri = a->tri_chart + nt;
     a->chart = (struct atlas_chart *)(void *)(a->vertex_tri + nv);
-    a->texture = (uint8_t *)(a->chart + ATLAS_MAX_CHARTS);
+    a->vertex_cam = (float *)(void *)(a->chart + ATLAS_MAX_CHARTS);
+    a->texture = (uint8_t *)(a->vertex_cam + 5 * nv);
     a->tri_axis = a->texture + 3 * a->max_texels;
     return 0;
 }
@@ -447,21 +448,29 @@ int atlas_add_view(struct atlas *a, struct fusion_volume *vol, const struct scan
                          .confidence = confidence,
                          .weight = weight,
                          .depth_tol_mm = ATLAS_DEPTH_VOXELS * vol->p.voxel_mm};
+    /* every vertex in the camera's frame and where it is seen, once (a vertex has six triangles) */
+    for (uint32_t v = 0; v < vol->mp.s.vertices; v++) {
+        float *c = &a->vertex_cam[5 * (size_t)v];
+        vec3 p = frame_point_inv(obj_from_cam, vertex_pos(vol, v));
+        double u = 0.0, w = 0.0;
+        if (p.z > 1.0)
+            camray_project(calib, p, &u, &w);
+        c[0] = (float)p.x, c[1] = (float)p.y, c[2] = (float)p.z, c[3] = (float)u, c[4] = (float)w;
+    }
     for (uint32_t t = 0; t < vol->mp.s.triangles; t++) {
         if (a->tri_chart[t] == NONE)
             continue;
-        vec3 p[3];
+        const float *c[3];
         for (int k = 0; k < 3; k++)
-            p[k] = frame_point_inv(obj_from_cam, vertex_pos(vol, tri_at(vol, t)[k]));
+            c[k] = &a->vertex_cam[5 * (size_t)tri_at(vol, t)[k]];
+        vec3 p0 = v3(c[0][0], c[0][1], c[0][2]);
         /* facing the camera: the normal against the ray to its first corner */
-        if (v3_dot(frame_dir_inv(obj_from_cam, tri_normal(vol, t)), p[0]) >= 0.0 || p[0].z <= 1.0 ||
-            p[1].z <= 1.0 || p[2].z <= 1.0)
+        if (v3_dot(frame_dir_inv(obj_from_cam, tri_normal(vol, t)), p0) >= 0.0 || c[0][2] <= 1.0 ||
+            c[1][2] <= 1.0 || c[2][2] <= 1.0)
             continue;
-        for (int k = 0; k < 3; k++) {
-            camray_project(calib, p[k], &s.u[k], &s.v[k]);
-            s.z[k] = p[k].z;
-        }
-        s.ray = v3_len(p[0]) / p[0].z;
+        for (int k = 0; k < 3; k++)
+            s.u[k] = c[k][3], s.v[k] = c[k][4], s.z[k] = c[k][2];
+        s.ray = v3_len(p0) / p0.z;
         raster(a, vol, t, view_texel, &s, NULL);
     }
     return 0;

@@ -14,6 +14,10 @@ measure-inverse: deps $(BUILD)/measure_view
 # Intrinsic colour (issue 4): Jost et al.'s comparison reproduced on the simulator, written to
 # docs/colour-eval/ (table as Markdown and CSV, close-up PNGs of a view boundary). About 20 minutes.
 EVAL_DIR ?= docs/colour-eval
+## eval-texture: the texture atlas against the vertex colours and the truth, docs/colour-eval/texture-eval.md (about 5 min)
+eval-texture: deps $(BUILD)/scanner $(BUILD)/texture-eval
+	tools/texture_eval.sh $(BUILD) $(EVAL_DIR)
+
 ## eval: intrinsic colour compared on the simulator into docs/colour-eval/ (about 25 min)
 eval: deps $(BUILD)/scanner $(BUILD)/colour-eval $(BUILD)/relight-eval
 	tools/colour_eval.sh $(BUILD) $(EVAL_DIR)

@@ -13,7 +13,8 @@
  * percentile of the texture and of the vertex colours (interpolated across the triangle as a
  * viewer shows them), then the same over the dark paint (true L* < 30), then the seams: at each
  * vertex that has more than one place in the texture (a chart's border), the texture's colour
- * at each place against its first. */
+ * at each place against its first; then the same numbers as one CSV line ("csv,samples,
+ * texture mean,p95,vertex mean,p95,dark samples,dark texture,dark vertex,seams,mean,max"). */
 #define _POSIX_C_SOURCE 200809L
 #include "colour_metrics.h"
 #include "config.h"
@@ -229,6 +230,10 @@ int main(int argc, char **argv)
            n, m.nf, (unsigned)w, (unsigned)h, tex_mean, p95(de_tex, n), vtx_mean, p95(de_vtx, n),
            dark, dark ? dark_tex / dark : 0.0, dark ? dark_vtx / dark : 0.0, seams,
            seams ? seam_sum / seams : 0.0, seam_max);
+    double tex_p95 = p95(de_tex, n), vtx_p95 = p95(de_vtx, n);
+    printf("csv,%zu,%.3f,%.3f,%.3f,%.3f,%zu,%.3f,%.3f,%zu,%.3f,%.3f\n", n, tex_mean, tex_p95,
+           vtx_mean, vtx_p95, dark, dark ? dark_tex / dark : 0.0, dark ? dark_vtx / dark : 0.0,
+           seams, seams ? seam_sum / seams : 0.0, seam_max);
     free(de_tex);
     free(de_vtx);
     free(tex);
