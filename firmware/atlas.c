@@ -319,10 +319,10 @@ static void raster(struct atlas *a, const struct fusion_volume *vol, uint32_t t,
                    int (*claim)(struct atlas *a, size_t texel, const double l[3],
                                 const double height[3], uint32_t t))
 {
-    double x[3], y[3], area2, height[3];
+    double x[3], y[3], area2, height[3] = {0.0, 0.0, 0.0};
     if (tri_texels(a, vol, t, x, y, &area2) != 0)
         return;
-    for (int k = 0; k < 3; k++) { /* over the edge opposite corner k, in texels */
+    for (int k = 0; k < 3 && claim != NULL; k++) { /* over the edge opposite corner k, texels */
         double ex = x[(k + 2) % 3] - x[(k + 1) % 3], ey = y[(k + 2) % 3] - y[(k + 1) % 3];
         height[k] = fabs(area2) / sqrt(ex * ex + ey * ey);
     }
