@@ -311,6 +311,9 @@ static void barycentric(const double x[3], const double y[3], double inv, double
     l[2] = 1.0 - l[0] - l[1];
 }
 
+static int claim_near(struct atlas *a, size_t texel, const double l[3], const double height[3],
+                      uint32_t t);
+
 /* The texels about triangle @p t (its bounding box and ATLAS_REACH about it): @p fn is called with
  * each one's barycentric weights (outside the triangle, some negative) when @p claim is NULL
  * and the texel is the triangle's (atlas->owner); else @p claim decides, given the weights. */
@@ -322,14 +325,15 @@ static void raster(struct atlas *a, const struct fusion_volume *vol, uint32_t t,
     double x[3], y[3], area2, height[3] = {0.0, 0.0, 0.0};
     if (tri_texels(a, vol, t, x, y, &area2) != 0)
         return;
-    for (int k = 0; k < 3 && claim != NULL; k++) { /* over the edge opposite corner k, texels */
+    for (int k = 0; k < 3 && claim == claim_near; k++) { /* over the edge opposite corner k */
         double ex = x[(k + 2) % 3] - x[(k + 1) % 3], ey = y[(k + 2) % 3] - y[(k + 1) % 3];
         height[k] = fabs(area2) / sqrt(ex * ex + ey * ey);
     }
     const struct atlas_chart *ch = &a->chart[a->tri_chart[t]];
     /* the texels about it: a triangle that owns none outside its bounding box (all but those on
      * a chart's border, marked by claim_near) needs only that box's */
-    const double reach = claim != NULL || (a->tri_axis[t] & REACHES) ? ATLAS_REACH : 0.0;
+    const double reach =
+        claim == claim_near || (claim == NULL && (a->tri_axis[t] & REACHES)) ? ATLAS_REACH : 0.0;
     long xa = (long)floor(fmin(x[0], fmin(x[1], x[2])) - reach);
     long xb = (long)ceil(fmax(x[0], fmax(x[1], x[2])) + reach);
     long ya = (long)floor(fmin(y[0], fmin(y[1], y[2])) - reach);
@@ -565,7 +569,7 @@ int atlas_finish(struct atlas *a, const struct fusion_volume *vol, uint32_t *unc
                     l);
         mesh_texel(&s, i, l, t);
     }
-    fill_gutters(a, (int)ATLAS_GUTTER + 1);
+    fill_gutters(a, (int)ATLAS_GUTTER);
     for (size_t i = 0; i < n; i++) {
         const float *acc = &a->accum[4 * i];
         for (int k = 0; k < 3; k++)
