@@ -6,6 +6,7 @@
 #include "camray.h"
 #include "frames.h"
 #include "srgb.h"
+#include "unionfind.h"
 
 #include <errno.h>
 #include <stdint.h>
@@ -75,23 +76,6 @@ static void texel_xy(const struct atlas *a, const struct atlas_chart *ch, vec3 p
 
 /* ---- charts: union-find over triangles through the vertices they share ---- */
 
-static uint32_t find_root(struct atlas *a, uint32_t t)
-{
-    while (a->tri_chart[t] != t) {
-        a->tri_chart[t] = a->tri_chart[a->tri_chart[t]]; /* path halving */
-        t = a->tri_chart[t];
-    }
-    return t;
-}
-
-static void unite(struct atlas *a, uint32_t x, uint32_t y)
-{
-    x = find_root(a, x);
-    y = find_root(a, y);
-    if (x != y) /* the larger under the smaller: a root is its piece's first triangle */
-        a->tri_chart[x > y ? x : y] = x < y ? x : y;
-}
-
 /* Every kept triangle's axis direction and chart number; each chart's projected extent (min in
  * min_u/min_v, the extent's far corner in w/h as mm, made texels by size_charts).
  * @retval 0 @retval -ENOSPC more charts than ATLAS_MAX_CHARTS */
@@ -114,7 +98,7 @@ static int make_charts(struct atlas *a, const struct fusion_volume *vol, double 
                 if (a->vertex_tri[v] == NONE)
                     a->vertex_tri[v] = t;
                 else
-                    unite(a, t, a->vertex_tri[v]);
+                    uf_join(a->tri_chart, t, a->vertex_tri[v]);
             }
         }
     }
@@ -122,7 +106,7 @@ static int make_charts(struct atlas *a, const struct fusion_volume *vol, double 
      * parents are smaller than their children), then in increasing order each root given its
      * chart's number before the other triangles of its piece read it. */
     for (uint32_t t = 0; t < nt; t++)
-        a->tri_chart[t] = find_root(a, t);
+        a->tri_chart[t] = uf_root(a->tri_chart, t);
     a->chart_count = 0;
     for (uint32_t t = 0; t < nt; t++) {
         if (a->tri_axis[t] == 0xFF) {

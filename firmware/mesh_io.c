@@ -11,6 +11,7 @@
 #include "outbuf.h"
 #include "ply.h"
 #include "srgb.h"
+#include "unionfind.h"
 
 #include <errno.h>
 #include <string.h>
@@ -18,23 +19,6 @@
 /* The tables (struct fusion_volume): vol->mesh_index is each vertex's union-find parent, and after
  * prepare its new number or MESH_DROPPED; vol->mesh_coloured 0 where no view coloured the surface
  * (colour_fill gives it one). */
-
-static uint32_t find_root(struct fusion_volume *vol, uint32_t v)
-{
-    while (vol->mesh_index[v] != v) {
-        vol->mesh_index[v] = vol->mesh_index[vol->mesh_index[v]]; /* path halving */
-        v = vol->mesh_index[v];
-    }
-    return v;
-}
-
-static void join(struct fusion_volume *vol, uint32_t a, uint32_t b)
-{
-    a = find_root(vol, a);
-    b = find_root(vol, b);
-    if (a != b) /* the larger number under the smaller: deterministic */
-        vol->mesh_index[a > b ? a : b] = a < b ? a : b;
-}
 
 static int keep_vertex(void *priv, const struct mesh_vertex *mv)
 {
@@ -59,8 +43,8 @@ static int keep_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
         tri[0] = a;
         tri[1] = b;
         tri[2] = c;
-        join(vol, a, b);
-        join(vol, b, c);
+        uf_join(vol->mesh_index, a, b);
+        uf_join(vol->mesh_index, b, c);
     }
     return 0;
 }
@@ -71,9 +55,9 @@ static void drop_fragments(struct fusion_volume *vol, double min_fragment_share)
     uint32_t n = vol->mp.s.vertices, largest = 0, next = 0;
     memset(vol->mesh_tris, 0, n * sizeof(uint32_t));
     for (uint32_t t = 0; t < vol->mp.s.triangles; t++)
-        vol->mesh_tris[find_root(vol, vol->mesh_tri[3 * (size_t)t])]++;
+        vol->mesh_tris[uf_root(vol->mesh_index, vol->mesh_tri[3 * (size_t)t])]++;
     for (uint32_t v = 0; v < n; v++)
-        vol->mesh_index[v] = find_root(vol, v); /* every vertex straight to its root */
+        vol->mesh_index[v] = uf_root(vol->mesh_index, v); /* every vertex straight to its root */
     for (uint32_t v = 0; v < n; v++)
         if (vol->mesh_index[v] == v && vol->mesh_tris[v] > largest)
             largest = vol->mesh_tris[v];
