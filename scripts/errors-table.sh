@@ -91,6 +91,16 @@ ply_row short "PLY truncated" "header only" \
     'ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n'
 ply_row huge "PLY claiming more than it holds" "element vertex 50000000, no data" \
     'ply\nformat binary_little_endian 1.0\nelement vertex 50000000\nproperty float x\nend_header\n'
+img_row() { # name, what, input shown, albedo_image line, command: the photographic paint
+    cfg "$1" "[sim]
+albedo_pattern = image
+$4"
+    row "$2" "$3" "$sim" $5 --config "$w/$1.ini" --out "$w/scan-$1"
+}
+img_row noimage "albedo_image missing" "albedo_image = no-such.png" "albedo_image = no-such.png" scan
+printf 'not a png' > "$w/text.png"
+img_row textimage "albedo_image not a PNG" "albedo_image = text.png (text)" "albedo_image = text.png" scan
+img_row unnamedimage "albedo_image not given" "albedo_pattern = image alone" "" scan
 mkdir -p "$w/not-a-scan"
 row "not a scan directory" "process an empty directory" "$sim" process "$w/not-a-scan"
 row "config not a regular file" "--config /dev/zero" "$sim" check-config --config /dev/zero
