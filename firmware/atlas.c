@@ -203,7 +203,8 @@ static int carve(struct atlas *a, const struct fusion_volume *vol, void *work, s
     a->vertex_tri = a->tri_chart + nt;
     a->chart = (struct atlas_chart *)(void *)(a->vertex_tri + nv);
     a->vertex_cam = (float *)(void *)(a->chart + ATLAS_MAX_CHARTS);
-    a->texture = (uint8_t *)(a->vertex_cam + 5 * nv);
+    a->pixel = a->vertex_cam + 5 * nv;
+    a->texture = (uint8_t *)(a->pixel + 2 * (size_t)HAL_MAX_PIXELS);
     a->tri_axis = a->texture + 3 * a->max_texels;
     return 0;
 }
@@ -377,9 +378,7 @@ static void assign_texels(struct atlas *a, const struct fusion_volume *vol)
 struct view_ctx {
     struct atlas *a;
     const struct decode_maps *m;
-    const struct tri_range *r;
     const uint8_t *rgb;
-    const float *confidence, *weight;
     double depth_tol_mm;
     /* the triangle being rasterised: where its corners are seen (pixels) and their depth, and
      * the depth's scale to a distance along the ray */
@@ -405,11 +404,10 @@ static void view_texel(void *ctx, size_t texel, const double l[3], uint32_t t)
     double sum[3] = {0.0, 0.0, 0.0}, wsum = 0.0;
     for (int q = 0; q < 4; q++) {
         size_t i = (size_t)(y0 + q / 2) * s->m->width + (size_t)(x0 + q % 2);
-        double w = s->weight[i];
-        if (w <= 0.0 || fabs(s->r->xyz_mm[3 * i + 2] - z) * s->ray > s->depth_tol_mm)
+        const float *px = &s->a->pixel[2 * i];
+        if (px[0] <= 0.0f || fabs(px[1] - z) * s->ray > s->depth_tol_mm)
             continue;
-        w *= w * (q % 2 ? fx : 1.0 - fx) * (q / 2 ? fy : 1.0 - fy);
-        w *= s->confidence != NULL ? fmax(s->confidence[i], 0.0) : 1.0; /* 0: no estimate */
+        double w = px[0] * (q % 2 ? fx : 1.0 - fx) * (q / 2 ? fy : 1.0 - fy);
         for (int k = 0; k < 3; k++)
             sum[k] += w * s->rgb[3 * i + k];
         wsum += w;
@@ -429,13 +427,19 @@ int atlas_add_view(struct atlas *a, struct fusion_volume *vol, const struct scan
     const float *weight = fusion_view_weights(vol, calib, maps, range);
     if (weight == NULL)
         return 0; /* a view of nothing */
-    struct view_ctx s = {.a = a,
-                         .m = maps,
-                         .r = range,
-                         .rgb = rgb,
-                         .confidence = confidence,
-                         .weight = weight,
-                         .depth_tol_mm = ATLAS_DEPTH_VOXELS * vol->p.voxel_mm};
+    /* each pixel's weight (fusion's, squared, so the most head-on view dominates, times the
+     * colour's confidence; a negative confidence is no estimate) and depth, side by side: the
+     * texels read four pixels each, wherever they land */
+    const size_t pixels = (size_t)maps->width * maps->height;
+    if (pixels > HAL_MAX_PIXELS)
+        return -EINVAL;
+    for (size_t i = 0; i < pixels; i++) {
+        double c = confidence != NULL ? confidence[i] : 1.0, w = weight[i];
+        a->pixel[2 * i] = w > 0.0 && c > 0.0 ? (float)(w * w * c) : 0.0f;
+        a->pixel[2 * i + 1] = w > 0.0 ? range->xyz_mm[3 * i + 2] : 0.0f;
+    }
+    struct view_ctx s = {
+        .a = a, .m = maps, .rgb = rgb, .depth_tol_mm = ATLAS_DEPTH_VOXELS * vol->p.voxel_mm};
     /* every vertex in the camera's frame and where it is seen, once (a vertex has six triangles) */
     for (uint32_t v = 0; v < vol->mp.s.vertices; v++) {
         float *c = &a->vertex_cam[5 * (size_t)v];

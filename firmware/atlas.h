@@ -29,11 +29,12 @@ struct atlas_report {
 
 /** What atlas_build needs of its work space: a texel's weighted colour and weight (4 floats),
  *  its triangle (uint32) and its sRGB colour (3 bytes); a triangle's chart (uint32) and axis
- *  (a byte); a vertex's chart (uint32) and its place in a view (5 floats); a chart. */
+ *  (a byte); a vertex's chart (uint32) and its place in a view (5 floats); a chart; a camera
+ *  pixel's weight and depth (2 floats). */
 #define ATLAS_TEXEL_BYTES (4u * sizeof(float) + sizeof(uint32_t) + 3u)
 #define ATLAS_WORK_BYTES(texels, triangles, vertices)                                              \
     ((uint64_t)(texels)*ATLAS_TEXEL_BYTES + 5ull * (triangles) + 24ull * (vertices) +              \
-     (uint64_t)ATLAS_MAX_CHARTS * sizeof(struct atlas_chart))
+     (uint64_t)ATLAS_MAX_CHARTS * sizeof(struct atlas_chart) + 8ull * HAL_MAX_PIXELS)
 
 /** The atlas: its size and texel, and where its parts lie in the work space atlas_build is given
  *  (the fusion grid's, spent once the mesh is made: fusion_spend_grid), so that it costs no memory
@@ -48,6 +49,7 @@ struct atlas {
     uint32_t *vertex_tri;      /* a triangle at each vertex, then its chart */
     struct atlas_chart *chart; /* the charts */
     float *vertex_cam;         /* each vertex in the view's camera frame, and its pixel (5) */
+    float *pixel;              /* each pixel of the view: its weight and depth (2) */
     uint8_t *texture;          /* sRGB-encoded RGB, rows top down */
     uint8_t *tri_axis;         /* each triangle's axis direction */
 };
