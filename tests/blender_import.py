@@ -1,9 +1,11 @@
 """Blender 3.4 (Debian's, in background mode) imports a scan's mesh.ply, mesh.obj, mesh.stl and mesh.glb
 with its own importers and their default settings, in a scene whose unit is the millimetre
 (how a user working with scans sets it): each must come in upright (the turntable's axis along
-Blender's Z) at the object's true size, and the three must agree.
+Blender's Z) at the object's true size, and the three must agree; with a texture, mesh.obj's and
+mesh.glb's materials take their base colour from it.
 
     blender -b --python-exit-code 1 -P tests/blender_import.py -- SCAN_DIR HEIGHT_MM"""
+import os
 import sys
 
 import bpy
@@ -13,6 +15,16 @@ import numpy
 # importer fails with "module 'numpy' has no attribute 'bool'". The alias it meant is bool.
 if not hasattr(numpy, "bool"):
     numpy.bool = bool
+
+
+def texture_size(obj):
+    """The size of the image the object's first material takes its base colour from (None)."""
+    for node in obj.data.materials[0].node_tree.nodes:
+        if node.type == "BSDF_PRINCIPLED":
+            for link in node.inputs["Base Color"].links:
+                if link.from_node.type == "TEX_IMAGE" and link.from_node.image is not None:
+                    return tuple(link.from_node.image.size)
+    return None
 
 
 def main():
@@ -28,12 +40,23 @@ def main():
         "mesh.glb": lambda p: bpy.ops.import_scene.gltf(filepath=p),  # metres, +Y up
     }
     sizes = {}
+    textured = None  # the texture's size when the scan has one (texture.png beside mesh.obj)
+    if os.path.exists(f"{scan}/texture.png"):
+        img = bpy.data.images.load(f"{scan}/texture.png")
+        textured = tuple(img.size)
+        bpy.data.images.remove(img)
     for name, load in importers.items():
         before = set(bpy.data.objects)
         load(f"{scan}/{name}")
         (obj,) = set(bpy.data.objects) - before
-        if name == "mesh.glb":  # glTF's colours and materials (one per cluster with fit) too
-            assert len(obj.data.color_attributes) == 1 and len(obj.data.materials) >= 1, name
+        if name == "mesh.glb":  # glTF's materials (one per cluster with fit) too
+            assert len(obj.data.materials) >= 1, name
+        if name in ("mesh.obj", "mesh.glb") and textured:  # the texture, found and read
+            size = texture_size(obj)
+            assert size == textured, (name, "texture", size, textured)
+            print(f"blender: {name}: its material's base colour is the {size[0]} x {size[1]} texture")
+        elif name == "mesh.glb":  # else its vertex colours
+            assert len(obj.data.color_attributes) == 1, name
         pts = [obj.matrix_world @ v.co for v in obj.data.vertices]
         lo = [min(p[k] for p in pts) for k in range(3)]
         hi = [max(p[k] for p in pts) for k in range(3)]
