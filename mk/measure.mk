@@ -18,6 +18,11 @@ EVAL_DIR ?= docs/colour-eval
 eval-texture: deps $(BUILD)/scanner $(BUILD)/texture-eval
 	tools/texture_eval.sh $(BUILD) $(EVAL_DIR)
 
+## eval-cycles: the colour eval through Blender's Cycles, docs/colour-eval/cycles-eval.md (about 15 min; not in CI)
+eval-cycles: deps $(BUILD)/scanner $(BUILD)/texture-eval $(BUILD)/mesh-compare
+	@command -v blender >/dev/null || scripts/install-deps.sh blender
+	tools/cycles_eval.sh $(BUILD) $(EVAL_DIR)
+
 ## eval: intrinsic colour compared on the simulator into docs/colour-eval/ (about 25 min)
 eval: deps $(BUILD)/scanner $(BUILD)/colour-eval $(BUILD)/relight-eval
 	tools/colour_eval.sh $(BUILD) $(EVAL_DIR)

@@ -2,7 +2,7 @@
  * vertex colours are to the simulated object's true albedo, over the whole surface, paint edges
  * included (issue 34).
  *
- *   texture-eval SCAN_DIR RESULT_DIR [SCENE_CONFIG]
+ *   texture-eval SCAN_DIR RESULT_DIR [SCENE_CONFIG] [--balanced]
  *
  * SCAN_DIR is a simulated scan (its config and truth mesh); RESULT_DIR holds mesh.obj, mesh.mtl and
  * texture.png (`scanner process SCAN_DIR --out RESULT_DIR`, or SCAN_DIR itself); SCENE_CONFIG
@@ -14,7 +14,10 @@
  * viewer shows them), then the same over the dark paint (true L* < 30), then the seams: at each
  * vertex that has more than one place in the texture (a chart's border), the texture's colour
  * at each place against its first; then the same numbers as one CSV line ("csv,samples,
- * texture mean,p95,vertex mean,p95,dark samples,dark texture,dark vertex,seams,mean,max"). */
+ * texture mean,p95,vertex mean,p95,dark samples,dark texture,dark vertex,seams,mean,max"), and
+ * per channel the gain that brings the texture (and the vertex colours) to the truth in least
+ * squares; --balanced applies them first (what a white reference of the renderer that made the
+ * frames would set: make eval-cycles, whose frames are not the simulator's). */
 #define _POSIX_C_SOURCE 200809L
 #include "colour_metrics.h"
 #include "config.h"
@@ -129,8 +132,10 @@ static double p95(double *v, size_t n)
 
 int main(int argc, char **argv)
 {
+    int balanced = argc > 3 && strcmp(argv[argc - 1], "--balanced") == 0;
+    argc -= balanced;
     if (argc < 3 || argc > 4) {
-        fprintf(stderr, "usage: texture-eval SCAN_DIR RESULT_DIR [SCENE_CONFIG]\n");
+        fprintf(stderr, "usage: texture-eval SCAN_DIR RESULT_DIR [SCENE_CONFIG] [--balanced]\n");
         return 2;
     }
     static struct app_config cfg;
@@ -166,38 +171,60 @@ int main(int argc, char **argv)
                                       {4.0 / 6, 1.0 / 6, 1.0 / 6},
                                       {1.0 / 6, 4.0 / 6, 1.0 / 6},
                                       {1.0 / 6, 1.0 / 6, 4.0 / 6}};
-    double *de_tex = malloc(4 * m.nf * sizeof(double)), *de_vtx = malloc(4 * m.nf * sizeof(double));
-    size_t n = 0, dark = 0;
-    double sum_tex = 0, sum_vtx = 0, dark_tex = 0, dark_vtx = 0;
-    for (size_t f = 0; f < m.nf && de_tex != NULL && de_vtx != NULL; f++) {
+    /* every sample's true, texture and vertex colour (linear) first: the gains need them all */
+    double *smp = malloc(4 * m.nf * 9 * sizeof(double));
+    size_t n = 0;
+    for (size_t f = 0; f < m.nf && smp != NULL; f++) {
         const int64_t *c = &m.f[6 * f];
         for (int s = 0; s < 4; s++) {
-            double p[3] = {0, 0, 0}, vc[3] = {0, 0, 0}, uv[2] = {0, 0};
+            double p[3] = {0, 0, 0}, uv[2] = {0, 0}, *o = &smp[9 * n];
+            o[6] = o[7] = o[8] = 0.0;
             for (int k = 0; k < 3; k++) {
                 const float *v = &m.v[6 * (size_t)c[2 * k]], *t = &m.vt[2 * (size_t)c[2 * k + 1]];
                 for (int d = 0; d < 3; d++) {
                     p[d] += bary[s][k] * v[d];
-                    vc[d] += bary[s][k] * srgb_decode(v[3 + d]);
+                    o[6 + d] += bary[s][k] * srgb_decode(v[3 + d]);
                 }
                 uv[0] += bary[s][k] * t[0], uv[1] += bary[s][k] * t[1];
             }
             vec3 q;
             if (sim_bvh_closest(&bvh, v3(p[0], p[1], p[2]), MATCH_MM, &q) >= MATCH_MM)
                 continue;
-            double albedo[3], tc[3], lab_true[3], lab_tex[3], lab_vtx[3];
-            sim_albedo_at(&cfg.sim, height, q, albedo);
-            texture_at(tex, w, h, uv[0], uv[1], tc);
-            colour_linear_rgb_to_lab(albedo, lab_true);
-            colour_linear_rgb_to_lab(tc, lab_tex);
-            colour_linear_rgb_to_lab(vc, lab_vtx);
-            de_tex[n] = colour_ciede2000(lab_true, lab_tex);
-            de_vtx[n] = colour_ciede2000(lab_true, lab_vtx);
-            sum_tex += de_tex[n], sum_vtx += de_vtx[n];
-            if (lab_true[0] < 30.0)
-                dark++, dark_tex += de_tex[n], dark_vtx += de_vtx[n];
+            sim_albedo_at(&cfg.sim, height, q, o);
+            texture_at(tex, w, h, uv[0], uv[1], &o[3]);
             n++;
         }
     }
+    /* per channel, the gain that brings each to the truth in least squares: what a white
+     * reference of the same renderer would have set (applied with --balanced) */
+    double gain[2][3];
+    for (int which = 0; which < 2; which++)
+        for (int k = 0; k < 3; k++) {
+            double num = 0.0, den = 0.0;
+            for (size_t i = 0; i < n; i++)
+                num += smp[9 * i + k] * smp[9 * i + 3 + 3 * which + k],
+                    den += smp[9 * i + 3 + 3 * which + k] * smp[9 * i + 3 + 3 * which + k];
+            gain[which][k] = den > 0.0 ? num / den : 1.0;
+        }
+    double *de_tex = malloc((n + 1) * sizeof(double)), *de_vtx = malloc((n + 1) * sizeof(double));
+    size_t dark = 0;
+    double sum_tex = 0, sum_vtx = 0, dark_tex = 0, dark_vtx = 0;
+    for (size_t i = 0; i < n && de_tex != NULL && de_vtx != NULL; i++) {
+        double lab_true[3], lab_tex[3], lab_vtx[3], tc[3], vc[3];
+        for (int k = 0; k < 3; k++) {
+            tc[k] = smp[9 * i + 3 + k] * (balanced ? gain[0][k] : 1.0);
+            vc[k] = smp[9 * i + 6 + k] * (balanced ? gain[1][k] : 1.0);
+        }
+        colour_linear_rgb_to_lab(&smp[9 * i], lab_true);
+        colour_linear_rgb_to_lab(tc, lab_tex);
+        colour_linear_rgb_to_lab(vc, lab_vtx);
+        de_tex[i] = colour_ciede2000(lab_true, lab_tex);
+        de_vtx[i] = colour_ciede2000(lab_true, lab_vtx);
+        sum_tex += de_tex[i], sum_vtx += de_vtx[i];
+        if (lab_true[0] < 30.0)
+            dark++, dark_tex += de_tex[i], dark_vtx += de_vtx[i];
+    }
+    free(smp);
     if (n == 0) {
         fprintf(stderr, "texture-eval: %s: no sample lies on the true surface\n", argv[2]);
         return 1;
@@ -230,6 +257,10 @@ int main(int argc, char **argv)
            n, m.nf, (unsigned)w, (unsigned)h, tex_mean, p95(de_tex, n), vtx_mean, p95(de_vtx, n),
            dark, dark ? dark_tex / dark : 0.0, dark ? dark_vtx / dark : 0.0, seams,
            seams ? seam_sum / seams : 0.0, seam_max);
+    printf("texture-eval: the truth over the texture, per channel %.3f %.3f %.3f; over the vertex "
+           "colours %.3f %.3f %.3f%s\n",
+           gain[0][0], gain[0][1], gain[0][2], gain[1][0], gain[1][1], gain[1][2],
+           balanced ? " (applied: --balanced)" : "");
     double tex_p95 = p95(de_tex, n), vtx_p95 = p95(de_vtx, n);
     printf("csv,%zu,%.3f,%.3f,%.3f,%.3f,%zu,%.3f,%.3f,%zu,%.3f,%.3f\n", n, tex_mean, tex_p95,
            vtx_mean, vtx_p95, dark, dark ? dark_tex / dark : 0.0, dark ? dark_vtx / dark : 0.0,

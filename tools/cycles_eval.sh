@@ -1,0 +1,51 @@
+#!/bin/sh
+# make eval-cycles (issue 34): the colour eval through a second, independent renderer. The
+# simulator scans tests/eval/cycles.ini (4 views, the bunny in a photograph) for the scan's layout,
+# exact poses and truth; Blender's Cycles renders every frame of it again (tools/cycles_scan.py:
+# the projector a textured spot light through its calibrated lens, point lights, a Principled
+# BSDF painted with the photograph, the simulator's camera noise); both sets of frames are then
+# processed alike ([colour] method multi, the simulator's white reference) and measured by
+# build/texture-eval against the true paint: as they are, and balanced per channel on the truth
+# (what a white reference rendered by the same renderer would set). Writes
+# REPORT_DIR/cycles-eval.md. Not in CI: about 15 minutes on 2 cores, most of it Cycles.
+# Usage: tools/cycles_eval.sh BUILD_DIR REPORT_DIR (SAMPLES=4 COLOUR_SAMPLES=32: Cycles samples
+# a pixel of the stripe patterns and of the colour frames)
+set -eu
+build=$1
+report=$2
+work=$build/eval-cycles
+rm -rf "$work"
+mkdir -p "$work" "$report"
+echo "eval-cycles: the simulator's scan" >&2
+"$build/scanner" scan --config tests/eval/cycles.ini --out "$work/simulator" > "$work/simulator.log" 2>&1
+"$build/scanner" patterns --config tests/eval/cycles.ini --out "$work/patterns" > /dev/null
+cp -r "$work/simulator" "$work/cycles"
+echo "eval-cycles: Cycles renders every frame again" >&2
+start=$(date +%s)
+blender -b --python-exit-code 1 -P tools/cycles_scan.py -- "$work/cycles" "$work/patterns" \
+    "$(pwd)/data/textures/coffee.png" "${SAMPLES:-4}" "${COLOUR_SAMPLES:-32}" > "$work/blender.log" 2>&1 ||
+    { tail -n 20 "$work/blender.log" >&2; exit 1; }
+took=$(($(date +%s) - start))
+out=$report/cycles-eval.md
+{
+    echo "| renderer | model -> truth mean mm | texture dE00 mean | p95 | vertex colours mean | p95 | dark paint: texture | vertex | seams mean | balanced: texture mean | vertex mean | truth / texture (r g b) |"
+    echo "|---|---|---|---|---|---|---|---|---|---|---|---|"
+} > "$out"
+for r in simulator cycles; do
+    sed -e 's/^icp = 0/icp = 1/' -e "s|^calibration = .*|calibration = calibration.ini|" \
+        "$work/$r/config.ini" > "$work/$r-multi.ini"
+    "$build/scanner" process "$work/$r" --config "$work/$r-multi.ini" --out "$work/$r-multi" \
+        > "$work/$r-multi.log" 2>&1
+    "$build/texture-eval" "$work/$r" "$work/$r-multi" tests/eval/cycles.ini > "$work/$r.eval"
+    "$build/texture-eval" "$work/$r" "$work/$r-multi" tests/eval/cycles.ini --balanced > "$work/$r.balanced"
+    head -n 1 "$work/$r.eval" >&2
+    mean=$("$build/mesh-compare" --align "$work/$r-multi/mesh.ply" "$work/$r/truth_mesh.ply" |
+        sed -n 's/^result -> truth: mean \([0-9.]*\) mm.*/\1/p')
+    gains=$(sed -n 's/.*per channel \([0-9.]* [0-9.]* [0-9.]*\); over.*/\1/p' "$work/$r.eval")
+    balanced=$(awk -F, '$1 == "csv" { print $3 " | " $5 }' "$work/$r.balanced")
+    awk -F, -v r="$r" -v mean="$mean" -v b="$balanced" -v g="$gains" '$1 == "csv" {
+        printf "| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n", r, mean, $3, $4, $5, $6,
+            $8, $9, $11, b, g }' "$work/$r.eval" >> "$out"
+done
+echo "Cycles rendered $(grep -c '^cycles:' "$work/blender.log") frames in $took s (SAMPLES=${SAMPLES:-4}, COLOUR_SAMPLES=${COLOUR_SAMPLES:-32})." >> "$out"
+cat "$out"
