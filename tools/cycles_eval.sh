@@ -9,7 +9,9 @@
 # (what a white reference rendered by the same renderer would set). Writes
 # REPORT_DIR/cycles-eval.md. Not in CI: about 15 minutes on 2 cores, most of it Cycles.
 # Usage: tools/cycles_eval.sh BUILD_DIR REPORT_DIR (SAMPLES=4 COLOUR_SAMPLES=32: Cycles samples
-# a pixel of the stripe patterns and of the colour frames)
+# a pixel of the stripe patterns and of the colour frames; LAMBERT=1 adds a row rendered by Cycles
+# with the simulator's own model, a Lambertian surface lit directly: what is left of the
+# difference is then the renderer's)
 set -eu
 build=$1
 report=$2
@@ -26,12 +28,20 @@ blender -b --python-exit-code 1 -P tools/cycles_scan.py -- "$work/cycles" "$work
     "$(pwd)/data/textures/coffee.png" "${SAMPLES:-4}" "${COLOUR_SAMPLES:-32}" > "$work/blender.log" 2>&1 ||
     { tail -n 20 "$work/blender.log" >&2; exit 1; }
 took=$(($(date +%s) - start))
+renderers="simulator cycles"
+if [ "${LAMBERT:-0}" = 1 ]; then
+    cp -r "$work/simulator" "$work/cycles-lambert"
+    blender -b --python-exit-code 1 -P tools/cycles_scan.py -- "$work/cycles-lambert" "$work/patterns" \
+        "$(pwd)/data/textures/coffee.png" "${SAMPLES:-4}" "${COLOUR_SAMPLES:-32}" lambert \
+        > "$work/blender-lambert.log" 2>&1 || { tail -n 20 "$work/blender-lambert.log" >&2; exit 1; }
+    renderers="$renderers cycles-lambert"
+fi
 out=$report/cycles-eval.md
 {
     echo "| renderer | model -> truth mean mm | texture dE00 mean | p95 | vertex colours mean | p95 | dark paint: texture | vertex | seams mean | balanced: texture mean | vertex mean | truth / texture (r g b) |"
     echo "|---|---|---|---|---|---|---|---|---|---|---|---|"
 } > "$out"
-for r in simulator cycles; do
+for r in $renderers; do
     sed -e 's/^icp = 0/icp = 1/' -e "s|^calibration = .*|calibration = calibration.ini|" \
         "$work/$r/config.ini" > "$work/$r-multi.ini"
     "$build/scanner" process "$work/$r" --config "$work/$r-multi.ini" --out "$work/$r-multi" \

@@ -8,13 +8,15 @@ simulator's camera model says. The frames are written over the scan's own (PGM/P
 `scanner process` decodes and colours what Cycles saw.
 
     blender -b --python-exit-code 1 -P tools/cycles_scan.py -- SCAN_DIR PATTERN_DIR IMAGE SAMPLES \
-        COLOUR_SAMPLES
+        COLOUR_SAMPLES [lambert]
 
 SCAN_DIR: a simulated scan taken with [output] frame_format = pnm and [registration] icp = 0 (its
 registration.ini poses are then the table's, exact); PATTERN_DIR: `scanner patterns` of its
 config; IMAGE: the [sim] albedo_image; SAMPLES: Cycles samples a pixel of a stripe pattern (the
 decoder compares a pattern with its inverse: little noise matters), COLOUR_SAMPLES of the RGB
-frames the colour is made of."""
+frames the colour is made of; lambert: a Lambertian surface lit directly only (the simulator's
+own model, rendered by Cycles: what is left of the difference is the renderer's, not the
+light's)."""
 import configparser
 import math
 import os
@@ -133,7 +135,7 @@ def setup_lights(lights_sec, count):
     return out
 
 
-def setup_object(scan, image, height_mm):
+def setup_object(scan, image, height_mm, lambert):
     bpy.ops.import_mesh.ply(filepath=f"{scan}/truth_mesh.ply")
     obj = bpy.context.selected_objects[0]
     mat = bpy.data.materials.new("photograph")
@@ -142,6 +144,13 @@ def setup_object(scan, image, height_mm):
     bsdf = nodes["Principled BSDF"]
     bsdf.inputs["Specular"].default_value = 0.0
     bsdf.inputs["Roughness"].default_value = 1.0
+    colour_input = "Base Color"
+    if lambert:  # Oren-Nayar at roughness 0 is Lambert's law
+        nodes.remove(bsdf)
+        bsdf = nodes.new("ShaderNodeBsdfDiffuse")
+        bsdf.inputs["Roughness"].default_value = 0.0
+        links.new(bsdf.outputs[0], nodes["Material Output"].inputs["Surface"])
+        colour_input = "Color"
     coord = nodes.new("ShaderNodeTexCoord")
     sep = nodes.new("ShaderNodeSeparateXYZ")
     links.new(coord.outputs["Object"], sep.inputs[0])
@@ -171,7 +180,7 @@ def setup_object(scan, image, height_mm):
     scale.blend_type, scale.inputs[0].default_value = "MULTIPLY", 1.0
     scale.inputs[2].default_value = (ALBEDO_MAX,) * 3 + (1.0,)
     links.new(tex.outputs["Color"], scale.inputs[1])
-    links.new(scale.outputs[0], bsdf.inputs["Base Color"])
+    links.new(scale.outputs[0], bsdf.inputs[colour_input])
     obj.data.materials.clear()
     obj.data.materials.append(mat)
     return obj
@@ -213,12 +222,13 @@ def main():
     args = sys.argv[sys.argv.index("--") + 1:]
     scan, patterns, image = args[0], args[1], args[2]
     samples, colour_samples = int(args[3]), int(args[4])
+    lambert = len(args) > 5 and args[5] == "lambert"
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     scene.render.engine = "CYCLES"
     scene.cycles.device, scene.cycles.samples = "CPU", samples
     scene.cycles.use_denoising = False
-    scene.cycles.max_bounces = 4
+    scene.cycles.max_bounces = 0 if lambert else 4  # 0: direct light only
     scene.render.image_settings.file_format = "OPEN_EXR"
     scene.render.image_settings.color_depth = "32"
     scene.view_settings.view_transform = "Standard"
@@ -230,7 +240,7 @@ def main():
     projector, pattern_tex = setup_projector(calib["projector"])
     count = int(cfg["lights"]["count"])
     lights = setup_lights(calib["lights"], count)
-    obj = setup_object(scan, image, float(cfg["sim"].get("object_height_mm", "150")))
+    obj = setup_object(scan, image, float(cfg["sim"].get("object_height_mm", "150")), lambert)
     pattern_images = {}
     rng = np.random.default_rng(7)
     views = sorted(d for d in os.listdir(scan) if re.fullmatch(r"view_\d{3}", d))
