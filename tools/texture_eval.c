@@ -118,6 +118,49 @@ static void texture_at(const uint8_t *tex, uint32_t w, uint32_t h, double u, dou
     }
 }
 
+/* The stage before fusion: each view's own colour (RESULT_DIR/view_NNN/cloud.ply, at its
+ * registered pose; every 8th point with a colour estimate) against the truth. Prints a line
+ * "views,points,mean,p95". */
+static double p95(double *v, size_t n);
+static void views_stage(const char *result, const struct app_config *cfg, double height,
+                        const struct sim_bvh *bvh)
+{
+    size_t n = 0, cap = 0;
+    double *de = NULL, sum = 0.0;
+    for (unsigned v = 0;; v++) {
+        char path[HAL_MAX_PATH * 2 + 64], err[512];
+        struct sim_mesh c;
+        snprintf(path, sizeof(path), "%s/view_%03u/cloud.ply", result, v);
+        if (sim_mesh_load_ply_points(&c, path, err, sizeof(err)) != 0)
+            break;
+        for (uint32_t i = 0; c.rgb != NULL && c.quality != NULL && i < c.vert_count; i += 8) {
+            const float *p = &c.pos[3 * i];
+            vec3 q;
+            if (!(c.quality[i] > 0.0f) ||
+                sim_bvh_closest(bvh, v3(p[0], p[1], p[2]), MATCH_MM, &q) >= MATCH_MM)
+                continue;
+            double albedo[3], got[3], lab_true[3], lab_got[3];
+            sim_albedo_at(&cfg->sim, height, q, albedo);
+            for (int k = 0; k < 3; k++)
+                got[k] = c.rgb[3 * i + (size_t)k] / 255.0;
+            colour_linear_rgb_to_lab(albedo, lab_true);
+            colour_linear_rgb_to_lab(got, lab_got);
+            if (n == cap)
+                de = realloc(de, (cap = cap ? 2 * cap : 65536) * sizeof(double));
+            if (de == NULL)
+                break;
+            de[n] = colour_ciede2000(lab_true, lab_got);
+            sum += de[n++];
+        }
+        sim_mesh_free(&c);
+    }
+    if (n > 0)
+        printf("texture-eval: each view's own colour before fusion (%zu points): dE00 mean %.3f "
+               "p95 %.3f\nviews,%zu,%.3f,%.3f\n",
+               n, sum / n, p95(de, n), n, sum / n, p95(de, n));
+    free(de);
+}
+
 static int cmp_double(const void *a, const void *b)
 {
     double x = *(const double *)a, y = *(const double *)b;
@@ -265,6 +308,7 @@ int main(int argc, char **argv)
     printf("csv,%zu,%.3f,%.3f,%.3f,%.3f,%zu,%.3f,%.3f,%zu,%.3f,%.3f\n", n, tex_mean, tex_p95,
            vtx_mean, vtx_p95, dark, dark ? dark_tex / dark : 0.0, dark ? dark_vtx / dark : 0.0,
            seams, seams ? seam_sum / seams : 0.0, seam_max);
+    views_stage(argv[2], &cfg, height, &bvh);
     free(de_tex);
     free(de_vtx);
     free(tex);

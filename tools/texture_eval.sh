@@ -17,8 +17,8 @@ mkdir -p "$work" "$report"
 scale=$(awk '$1 == ";" && $2 == "multi" { getline; sub(/^white_scale = /, ""); print }' "$work/white.txt")
 out=$report/texture-eval.md
 {
-    echo "| scene | texture | texel mm | texture dE00 mean | p95 | vertex colours mean | p95 | dark paint: texture | vertex colours | seams mean | seams max | texture CPU s |"
-    echo "|---|---|---|---|---|---|---|---|---|---|---|---|"
+    echo "| scene | texture | texel mm | each view before fusion: mean | p95 | texture dE00 mean | p95 | vertex colours mean | p95 | dark paint: texture | vertex colours | seams mean | seams max | texture CPU s |"
+    echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 } > "$out"
 for scene in $scenes; do
     scan=$work/$scene
@@ -33,8 +33,9 @@ for scene in $scenes; do
     size=$(sed -n 's/.*; texture \([0-9]* x [0-9]*\), .*/\1/p' "$scan-multi.log")
     texel=$(sed -n 's/.*; texture [0-9]* x [0-9]*, \([0-9.]*\) mm a texel.*/\1/p' "$scan-multi.log")
     cpu=$(sed -n 's/.*; texture .* view saw (\([0-9.]*\) s CPU).*/\1/p' "$scan-multi.log")
-    awk -F, -v s="$scene" -v size="$size" -v texel="$texel" -v cpu="$cpu" '$1 == "csv" {
-        printf "| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n", s, size, texel,
-            $3, $4, $5, $6, $8, $9, $11, $12, cpu }' "$scan-multi.eval" >> "$out"
+    awk -F, -v s="$scene" -v size="$size" -v texel="$texel" -v cpu="$cpu" '$1 == "views" {
+        views = $3 " | " $4 } $1 == "csv" { row = $3 " | " $4 " | " $5 " | " $6 " | " $8 " | " $9 " | " $11 " | " $12 }
+        END { printf "| %s | %s | %s | %s | %s | %s |\n", s, size, texel, views, row, cpu }' \
+        "$scan-multi.eval" >> "$out"
 done
 cat "$out"
