@@ -1,7 +1,8 @@
 /* The texture atlas (atlas.h): charts of the prepared mesh by the axis direction its normals lie
- * nearest (a "box projection": each chart is a height field over its axis plane, so the
- * orthographic projection along the axis unfolds it without stretching more than 1/cos 55
- * degrees), packed into shelves; then each texel's surface point projected into every view. */
+ * nearest (a "box projection": every normal of a chart within 55 degrees of its axis, so the
+ * orthographic projection along the axis unfolds it stretched by at most 1/cos 55 degrees; a
+ * chart that folds back over itself, rare on a scan, shares the texels where it overlaps), packed
+ * into shelves; then each texel's surface point projected into every view. */
 #include "atlas.h"
 #include "camray.h"
 #include "frames.h"
