@@ -2,6 +2,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "board.h"
 
+#include "board_albedo.h"
 #include "gray.h"
 #include "scan.h"
 #include "clock_posix.h"
@@ -115,7 +116,10 @@ int board_init(struct hal *hal, const struct board_config *cfg, const struct sca
                  (unsigned)calib->proj_width, (unsigned)calib->proj_height);
         return -EINVAL;
     }
-    int rc = sim_rig_init(&sim.rig, cfg->sim, truth, &layout, dirname(dir_buf), err, err_len);
+    const char *dir = dirname(dir_buf);
+    int rc = board_albedo_image_load(cfg->sim, dir, err, err_len);
+    if (rc == 0)
+        rc = sim_rig_init(&sim.rig, cfg->sim, truth, &layout, dir, err, err_len);
     if (rc != 0)
         return rc;
     gpio_sim_init(&sim.gpio, gray_layout_count(&layout), &hal->gpio);

@@ -1,16 +1,15 @@
-/* The simulator's photographic paint ([sim] albedo_pattern = image): a PNG wrapped round the
+/* The simulator's photographic paint ([sim] albedo_pattern = image): a picture wrapped round the
  * object about the turntable's axis, its columns the azimuth (once round), its rows the height
- * (top row at the top), each pixel's sRGB decoded to a linear albedo. Loaded once per path. */
+ * (top row at the top), each pixel's sRGB decoded to a linear albedo. The board reads the file
+ * (board_albedo.c, through the project's PNG reader) and hands its pixels here. */
 #include "sim_rig.h"
 
 #include <errno.h>
 #include <math.h>
-#include <png.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#define SIM_IMAGE_MAX_SIDE 8192u
 #define SIM_IMAGE_ALBEDO_MAX 0.9 /* white in the photo: a white paint, not a perfect reflector */
 
 static struct {
@@ -24,53 +23,25 @@ static double srgb_decode(double e)
     return e <= 0.04045 ? e / 12.92 : pow((e + 0.055) / 1.055, 2.4);
 }
 
-int sim_albedo_image_load(const struct sim_config *cfg, const char *dir, char *err, size_t len)
+int sim_albedo_image_set(const char *path, const uint8_t *rgb, uint32_t width, uint32_t height)
 {
-    if (strcmp(cfg->albedo_pattern, "image") != 0)
-        return 0;
-    char path[sizeof(image.path)];
-    const char *name = cfg->albedo_image;
-    int n = name[0] == '/' ? snprintf(path, sizeof(path), "%s", name)
-                           : snprintf(path, sizeof(path), "%s/%s", dir, name);
-    if (name[0] == '\0' || n < 0 || (size_t)n >= sizeof(path)) {
-        snprintf(err, len, "[sim] albedo_image: %s", name[0] ? "path too long" : "not given");
-        return -EINVAL;
-    }
-    if (image.linear != NULL && strcmp(image.path, path) == 0)
-        return 0;
-    png_image png;
-    memset(&png, 0, sizeof(png));
-    png.version = PNG_IMAGE_VERSION;
-    uint8_t *rgb = NULL;
-    int ok = png_image_begin_read_from_file(&png, path);
-    if (ok && (png.width > SIM_IMAGE_MAX_SIDE || png.height > SIM_IMAGE_MAX_SIDE)) {
-        png_image_free(&png);
-        snprintf(err, len, "[sim] albedo_image: %s: larger than %u pixels a side", path,
-                 SIM_IMAGE_MAX_SIDE);
-        return -EINVAL;
-    }
-    if (ok) {
-        png.format = PNG_FORMAT_RGB;
-        rgb = malloc(PNG_IMAGE_SIZE(png));
-        ok = rgb != NULL && png_image_finish_read(&png, NULL, rgb, 0, NULL);
-    }
-    float *linear = ok ? malloc((size_t)png.width * png.height * 3 * sizeof(float)) : NULL;
-    if (linear == NULL) {
-        snprintf(err, len, "[sim] albedo_image: %s: %s", path,
-                 png.message[0] ? png.message : "out of memory");
-        png_image_free(&png);
-        free(rgb);
-        return -EINVAL;
-    }
-    for (size_t i = 0; i < (size_t)png.width * png.height * 3; i++)
+    float *linear =
+        width > 0 && height > 0 ? malloc((size_t)width * height * 3 * sizeof(float)) : NULL;
+    if (linear == NULL)
+        return -ENOMEM;
+    for (size_t i = 0; i < (size_t)width * height * 3; i++)
         linear[i] = (float)(SIM_IMAGE_ALBEDO_MAX * srgb_decode(rgb[i] / 255.0));
-    free(rgb);
     free(image.linear);
     image.linear = linear;
-    image.width = png.width;
-    image.height = png.height;
+    image.width = width;
+    image.height = height;
     snprintf(image.path, sizeof(image.path), "%s", path);
     return 0;
+}
+
+int sim_albedo_image_is(const char *path)
+{
+    return image.linear != NULL && strcmp(image.path, path) == 0;
 }
 
 void sim_albedo_image_at(double u, double v, double albedo[3])

@@ -177,8 +177,6 @@ int sim_rig_init(struct sim_rig *rig, const struct sim_config *cfg, const struct
     if (rc == 0)
         rc = build_material(rig, dir, err, len);
     if (rc == 0)
-        rc = sim_albedo_image_load(cfg, dir, err, len);
-    if (rc == 0)
         rc = sim_bvh_build(&rig->bvh, &rig->mesh);
     if (rc != 0)
         goto out_free;

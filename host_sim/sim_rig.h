@@ -101,10 +101,13 @@ double sim_rig_placed_height(const struct sim_config *cfg);
 /** Albedo of the painted pattern at an object-frame point. @retval 1 on the very dark paint */
 int sim_albedo_at(const struct sim_config *cfg, double height_mm, vec3 p_obj, double albedo[3]);
 
-/** [sim] albedo_pattern = image: load albedo_image (relative to @p dir) for sim_albedo_at, once
- *  per path (sim_albedo_image.c); nothing to do for another pattern.
- *  @retval 0 @retval -EINVAL not given, not a PNG or too large (@p err says which) */
-int sim_albedo_image_load(const struct sim_config *cfg, const char *dir, char *err, size_t len);
+/** [sim] albedo_pattern = image: the picture sim_albedo_at wraps round the object, 8-bit sRGB,
+ *  @p width x @p height (sim_albedo_image.c keeps a linear copy), read from @p path (by the
+ *  board: board_albedo.c). @retval 0 @retval -ENOMEM */
+int sim_albedo_image_set(const char *path, const uint8_t *rgb, uint32_t width, uint32_t height);
+
+/** @retval 1 the picture in use was read from @p path */
+int sim_albedo_image_is(const char *path);
 
 /** The loaded image's albedo at (@p u round the object, @p v down it), both 0..1, bilinear
  *  (mid grey when none is loaded). */

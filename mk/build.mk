@@ -68,7 +68,7 @@ $(BUILD)/drm-show: $(call obj,tools/drm_show.c board/board_display.c hal/linux/p
 $(BUILD)/mesh-compare: $(call obj,tools/mesh_compare.c tests/mesh_compare_lib.c host_sim/sim_bvh.c host_sim/sim_mesh.c host_sim/sim_ply_read.c $(CONFIG_SRC) $(SCAN_DIR_SRC) hal/posix/image_io.c) $(BUILD)/libfirmware.a
 	$(LINK) $(LDLIBS_COMMON)
 
-EVAL_SIM_SRC := tests/colour_metrics.c host_sim/sim_bvh.c host_sim/sim_mesh.c host_sim/sim_ply_read.c host_sim/sim_rig.c host_sim/sim_albedo_image.c host_sim/sim_jpeg.c host_sim/sim_target.c host_sim/sim_material.c $(CONFIG_SRC) $(SCAN_DIR_SRC) hal/posix/image_io.c hal/posix/storage_posix.c
+EVAL_SIM_SRC := tests/colour_metrics.c host_sim/sim_bvh.c host_sim/sim_mesh.c host_sim/sim_ply_read.c host_sim/sim_rig.c host_sim/sim_albedo_image.c board/board_albedo.c host_sim/sim_jpeg.c host_sim/sim_target.c host_sim/sim_material.c $(CONFIG_SRC) $(SCAN_DIR_SRC) hal/posix/image_io.c hal/posix/storage_posix.c
 $(BUILD)/colour-eval: $(call obj,tools/colour_eval.c $(EVAL_SIM_SRC)) $(BUILD)/libfirmware.a
 	$(LINK) $(LDLIBS_COMMON)
 $(BUILD)/relight-eval: $(call obj,tools/relight_eval.c $(EVAL_SIM_SRC)) $(BUILD)/libfirmware.a

@@ -101,6 +101,8 @@ img_row noimage "albedo_image missing" "albedo_image = no-such.png" "albedo_imag
 printf 'not a png' > "$w/text.png"
 img_row textimage "albedo_image not a PNG" "albedo_image = text.png (text)" "albedo_image = text.png" scan
 img_row unnamedimage "albedo_image not given" "albedo_pattern = image alone" "" scan
+mkfifo "$w/fifo.png"
+img_row fifoimage "albedo_image a FIFO" "albedo_image = fifo.png (a named pipe)" "albedo_image = fifo.png" scan
 mkdir -p "$w/not-a-scan"
 row "not a scan directory" "process an empty directory" "$sim" process "$w/not-a-scan"
 row "config not a regular file" "--config /dev/zero" "$sim" check-config --config /dev/zero

@@ -19,6 +19,7 @@
  * squares; --balanced applies them first (what a white reference of the renderer that made the
  * frames would set: make eval-cycles, whose frames are not the simulator's). */
 #define _POSIX_C_SOURCE 200809L
+#include "board_albedo.h"
 #include "colour_metrics.h"
 #include "config.h"
 #include "image_io.h"
@@ -186,7 +187,7 @@ int main(int argc, char **argv)
     snprintf(path, sizeof(path), "%s/config.ini", argv[1]);
     snprintf(dir, sizeof(dir), "%s", argc == 4 ? argv[3] : path);
     if (config_load(&cfg, argc == 4 ? argv[3] : path, err, sizeof(err)) != 0 ||
-        sim_albedo_image_load(&cfg.sim, dirname(dir), err, sizeof(err)) != 0) {
+        board_albedo_image_load(&cfg.sim, dirname(dir), err, sizeof(err)) != 0) {
         fprintf(stderr, "texture-eval: %s\n", err);
         return 1;
     }
