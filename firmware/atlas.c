@@ -264,9 +264,6 @@ int atlas_build(struct atlas *a, const struct fusion_volume *vol, double texel_m
 
 /* ---- texels: each triangle rasterised in its chart ---- */
 
-/* Called for each texel a triangle owns with its barycentric weights (raster). */
-typedef void (*texel_fn)(void *ctx, size_t texel, const double bary[3], uint32_t t);
-
 /* A texel is owned by the triangle its centre lies in or, outside every triangle of its chart,
  * by one whose edges it lies within this many texels of: a bilinear read at a point of the
  * surface reads texels up to sqrt(2) texels from it, and near a chart's border those must hold
@@ -297,29 +294,29 @@ static void barycentric(const double x[3], const double y[3], double inv, double
     l[2] = 1.0 - l[0] - l[1];
 }
 
-static int claim_near(struct atlas *a, size_t texel, const double l[3], const double height[3],
-                      uint32_t t);
+struct view_ctx;
+static void view_texel(struct view_ctx *s, size_t texel, const double l[3]);
 
-/* The texels about triangle @p t (its bounding box and ATLAS_REACH about it): @p fn is called with
- * each one's barycentric weights (outside the triangle, some negative) when @p claim is NULL
- * and the texel is the triangle's (atlas->owner); else @p claim decides, given the weights. */
-static void raster(struct atlas *a, const struct fusion_volume *vol, uint32_t t, texel_fn fn,
-                   void *ctx,
-                   int (*claim)(struct atlas *a, size_t texel, const double l[3],
-                                const double height[3], uint32_t t))
+/* What raster does with the texels about a triangle: claim those its centre lies in, claim
+ * those nobody owns within ATLAS_REACH of it (assign_texels), or colour those it owns from a
+ * view (atlas_add_view). */
+enum raster_mode { CLAIM_INSIDE, CLAIM_NEAR, COLOUR };
+
+/* The texels about triangle @p t: its bounding box, and ATLAS_REACH about it when it claims the
+ * near ones or owns some outside its box (all but those on a chart's border own none). */
+static void raster(struct atlas *a, const struct fusion_volume *vol, uint32_t t,
+                   enum raster_mode mode, struct view_ctx *view)
 {
     double x[3], y[3], area2, height[3] = {0.0, 0.0, 0.0};
     if (tri_texels(a, vol, t, x, y, &area2) != 0)
         return;
-    for (int k = 0; k < 3 && claim == claim_near; k++) { /* over the edge opposite corner k */
+    for (int k = 0; k < 3 && mode == CLAIM_NEAR; k++) { /* over the edge opposite corner k */
         double ex = x[(k + 2) % 3] - x[(k + 1) % 3], ey = y[(k + 2) % 3] - y[(k + 1) % 3];
         height[k] = fabs(area2) / sqrt(ex * ex + ey * ey);
     }
     const struct atlas_chart *ch = &a->chart[a->tri_chart[t]];
-    /* the texels about it: a triangle that owns none outside its bounding box (all but those on
-     * a chart's border, marked by claim_near) needs only that box's */
     const double reach =
-        claim == claim_near || (claim == NULL && (a->tri_axis[t] & REACHES)) ? ATLAS_REACH : 0.0;
+        mode == CLAIM_NEAR || (mode == COLOUR && (a->tri_axis[t] & REACHES)) ? ATLAS_REACH : 0.0;
     long xa = (long)floor(fmin(x[0], fmin(x[1], x[2])) - reach);
     long xb = (long)ceil(fmax(x[0], fmax(x[1], x[2])) + reach);
     long ya = (long)floor(fmin(y[0], fmin(y[1], y[2])) - reach);
@@ -332,48 +329,34 @@ static void raster(struct atlas *a, const struct fusion_volume *vol, uint32_t t,
     for (long ty = ya; ty < yb; ty++)
         for (long tx = xa; tx < xb; tx++) {
             size_t texel = (size_t)ty * a->width + (size_t)tx;
-            if (claim == NULL && a->owner[texel] != t)
+            if (mode == COLOUR && a->owner[texel] != t)
                 continue;
             double l[3];
             barycentric(x, y, inv, tx + 0.5, ty + 0.5, l);
-            if (claim != NULL)
-                claim(a, texel, l, height, t);
-            else
-                fn(ctx, texel, l, t);
+            if (mode == COLOUR) {
+                view_texel(view, texel, l);
+            } else if (mode == CLAIM_INSIDE) {
+                if (l[0] >= 0.0 && l[1] >= 0.0 && l[2] >= 0.0)
+                    a->owner[texel] = t;
+            } else if (a->owner[texel] == NONE && l[0] * height[0] >= -ATLAS_REACH &&
+                       l[1] * height[1] >= -ATLAS_REACH && l[2] * height[2] >= -ATLAS_REACH) {
+                a->owner[texel] = t;
+                a->tri_axis[t] |= REACHES;
+            }
         }
 }
 
-/* The texels a triangle's centre lies in; then (near) the ones about it nobody owns. */
-static int claim_inside(struct atlas *a, size_t texel, const double l[3], const double height[3],
-                        uint32_t t)
-{
-    (void)height;
-    if (l[0] >= 0.0 && l[1] >= 0.0 && l[2] >= 0.0)
-        a->owner[texel] = t;
-    return 0;
-}
-
-static int claim_near(struct atlas *a, size_t texel, const double l[3], const double height[3],
-                      uint32_t t)
-{
-    if (a->owner[texel] == NONE && l[0] * height[0] >= -ATLAS_REACH &&
-        l[1] * height[1] >= -ATLAS_REACH && l[2] * height[2] >= -ATLAS_REACH) {
-        a->owner[texel] = t;
-        a->tri_axis[t] |= REACHES;
-    }
-    return 0;
-}
-
-/* Each texel's triangle (owner), for the views' colour and the vertex colours' (raster). */
+/* Each texel's triangle (owner), for the views' colour and the vertex colours': the texels each
+ * triangle's centre lies in, then the ones near a triangle that nobody owns. */
 static void assign_texels(struct atlas *a, const struct fusion_volume *vol)
 {
     memset(a->owner, 0xFF, (size_t)a->width * a->height * sizeof(a->owner[0]));
     for (uint32_t t = 0; t < vol->mp.s.triangles; t++)
         if (a->tri_chart[t] != NONE)
-            raster(a, vol, t, NULL, NULL, claim_inside);
+            raster(a, vol, t, CLAIM_INSIDE, NULL);
     for (uint32_t t = 0; t < vol->mp.s.triangles; t++)
         if (a->tri_chart[t] != NONE)
-            raster(a, vol, t, NULL, NULL, claim_near);
+            raster(a, vol, t, CLAIM_NEAR, NULL);
 }
 
 struct view_ctx {
@@ -389,10 +372,8 @@ struct view_ctx {
 /* One texel of the triangle seen by the view (atlas_add_view): where it is seen and its depth
  * interpolated from the corners' (a triangle spans a pixel or two: the lens's bending and the
  * perspective's across it are thousandths of a pixel). */
-static void view_texel(void *ctx, size_t texel, const double l[3], uint32_t t)
+static void view_texel(struct view_ctx *s, size_t texel, const double l[3])
 {
-    (void)t;
-    const struct view_ctx *s = ctx;
     double fu = l[0] * s->u[0] + l[1] * s->u[1] + l[2] * s->u[2];
     double fv = l[0] * s->v[0] + l[1] * s->v[1] + l[2] * s->v[2];
     double z = l[0] * s->z[0] + l[1] * s->z[1] + l[2] * s->z[2];
@@ -464,7 +445,7 @@ int atlas_add_view(struct atlas *a, struct fusion_volume *vol, const struct scan
         for (int k = 0; k < 3; k++)
             s.u[k] = c[k][3], s.v[k] = c[k][4], s.z[k] = c[k][2];
         s.ray = v3_len(p0) / p0.z;
-        raster(a, vol, t, view_texel, &s, NULL);
+        raster(a, vol, t, COLOUR, &s);
     }
     return 0;
 }
@@ -476,27 +457,18 @@ int atlas_add_view(struct atlas *a, struct fusion_volume *vol, const struct scan
 #define FROM_MESH (-2.0f)   /* no view: the mesh's vertex colours */
 #define FILLED_BASE (-3.0f) /* a gutter texel filled in pass k: FILLED_BASE - k */
 
-struct finish_ctx {
-    struct atlas *a;
-    const struct fusion_volume *vol;
-    uint32_t uncoloured;
-};
-
 /* A texel no view coloured takes the vertex colours there (atlas_finish). */
-static void mesh_texel(void *ctx, size_t texel, const double bary[3], uint32_t t)
+static void mesh_texel(struct atlas *a, const struct fusion_volume *vol, size_t texel,
+                       const double bary[3], uint32_t t)
 {
-    struct finish_ctx *s = ctx;
-    float *acc = &s->a->accum[4 * texel];
-    if (acc[3] != 0.0f)
-        return;
+    float *acc = &a->accum[4 * texel];
     for (int k = 0; k < 3; k++) {
         double c = 0.0;
         for (int j = 0; j < 3; j++)
-            c += bary[j] * s->vol->mesh_rgb[3 * (size_t)tri_at(s->vol, t)[j] + (size_t)k];
+            c += bary[j] * vol->mesh_rgb[3 * (size_t)tri_at(vol, t)[j] + (size_t)k];
         acc[k] = (float)c;
     }
     acc[3] = FROM_MESH;
-    s->uncoloured++;
 }
 
 /* Gutter texels beside coloured ones take their mean, @p passes rings out. */
@@ -548,7 +520,7 @@ int atlas_finish(struct atlas *a, const struct fusion_volume *vol, uint32_t *unc
     }
     /* owned texels no view coloured: the vertex colours, through their triangle's weights there
      * (a few per cent of them: texel by texel rather than every triangle rasterised again) */
-    struct finish_ctx s = {a, vol, 0};
+    uint32_t unseen = 0;
     for (size_t i = 0; i < n; i++) {
         double x[3], y[3], area2, l[3];
         uint32_t t = a->owner[i];
@@ -556,7 +528,8 @@ int atlas_finish(struct atlas *a, const struct fusion_volume *vol, uint32_t *unc
             continue;
         barycentric(x, y, 1.0 / area2, (double)(i % a->width) + 0.5, (double)(i / a->width) + 0.5,
                     l);
-        mesh_texel(&s, i, l, t);
+        mesh_texel(a, vol, i, l, t);
+        unseen++;
     }
     fill_gutters(a, (int)ATLAS_GUTTER);
     for (size_t i = 0; i < n; i++) {
@@ -565,7 +538,7 @@ int atlas_finish(struct atlas *a, const struct fusion_volume *vol, uint32_t *unc
             a->texture[3 * i + (size_t)k] =
                 acc[3] != 0.0f ? srgb_encode_unit(acc[k] / 255.0) : 128; /* mid grey */
     }
-    *uncoloured = s.uncoloured;
+    *uncoloured = unseen;
     return 0;
 }
 
