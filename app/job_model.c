@@ -76,6 +76,13 @@ static int write_model(struct job *j, const char *scan_dir)
     size_t png_len = 0;
     int textured = fits && rc == 0 && j->cfg->texture &&
                    job_make_texture(j, scan_dir, texture, sizeof(texture), &png, &png_len) == 0;
+    for (int k = 0; k < 2 && !textured; k++) { /* an earlier model's texture is not this one's */
+        static const char *const texture_files[] = {SCAN_FILE_TEXTURE, SCAN_FILE_MESH_MTL};
+        int gone = scan_dir_remove(j->out_dir, -1, texture_files[k]);
+        if (gone != 0)
+            j->hal->log(HAL_LOG_WARN, "cannot remove %s/%s: %s", j->out_dir, texture_files[k],
+                        strerror(-gone));
+    }
     rc = 0;
     for (size_t k = 0; k < sizeof(names) / sizeof(names[0]) && rc == 0; k++) {
         if (!fits && (writers[k] == fusion_write_stl || writers[k] == NULL))

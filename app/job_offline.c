@@ -228,7 +228,7 @@ int scan_job_process(const struct hal *hal, const char *scan_dir, const struct s
 {
     struct app_config cfg;
     struct scan_calib calib;
-    char path[HAL_MAX_PATH + 32], err[512];
+    char err[512];
     int rc = scan_job_load_settings(scan_dir, opts->config_path, 0, &cfg, &calib, err, sizeof(err));
     if (rc != 0) {
         hal->log(HAL_LOG_ERROR, "%s", err);
@@ -246,8 +246,7 @@ int scan_job_process(const struct hal *hal, const char *scan_dir, const struct s
     if (rc != 0)
         return rc;
     /* summary.ini says every output is written (docs/scan-format.md): they are made again */
-    if (scan_dir_path(path, sizeof(path), j.out_dir, -1, SCAN_FILE_SUMMARY) == 0)
-        unlink(path);
+    scan_dir_remove(j.out_dir, -1, SCAN_FILE_SUMMARY);
     if (elsewhere && (rc = scan_dir_keep_settings(&hal->storage, cfg.path, cfg.calibration_file,
                                                   j.out_dir)) != 0) /* how they were made */
         hal->log(HAL_LOG_ERROR, "cannot keep the settings in %s: %s", j.out_dir, strerror(-rc));

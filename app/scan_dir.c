@@ -665,15 +665,20 @@ void scan_dir_close(int lock_fd)
         close(lock_fd); /* and with it the lock */
 }
 
+int scan_dir_remove(const char *dir, int view, const char *name)
+{
+    char path[SCAN_DIR_PATH_MAX];
+    int rc = scan_dir_path(path, sizeof(path), dir, view, name);
+    if (rc == 0 && unlink(path) != 0 && errno != ENOENT)
+        rc = -errno;
+    return rc;
+}
+
 int scan_dir_begin_view(const struct hal_storage *st, const char *dir, uint32_t view)
 {
     char path[SCAN_DIR_PATH_MAX];
     int rc = scan_dir_path(path, sizeof(path), dir, (int)view, NULL);
     if (rc == 0)
         rc = hal_storage_mkdir_p(st, path);
-    if (rc == 0)
-        rc = scan_dir_path(path, sizeof(path), dir, (int)view, SCAN_FILE_VIEW);
-    if (rc == 0 && unlink(path) != 0 && errno != ENOENT)
-        rc = -errno;
-    return rc;
+    return rc == 0 ? scan_dir_remove(dir, (int)view, SCAN_FILE_VIEW) : rc;
 }

@@ -188,6 +188,10 @@ void scan_dir_close(int lock_fd);
  *  -errno */
 int scan_dir_begin_view(const struct hal_storage *st, const char *dir, uint32_t view);
 
+/** Remove file @p name of @p dir (of view @p view, or -1: the scan's own) when it is there.
+ *  @retval 0 removed, or there was none @retval -errno */
+int scan_dir_remove(const char *dir, int view, const char *name);
+
 /** Remove what interrupted writes (a kill, a power cut) left in the scan directory @p dir and
  *  in the directories of its views 0 .. @p views - 1. @retval 0 @retval -errno */
 int scan_dir_sweep(const struct hal_storage *st, const char *dir, uint32_t views);
