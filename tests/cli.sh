@@ -332,11 +332,13 @@ fused = [e[\"left_s\"] for e in lines if e[\"event\"] == \"fused\"]
 assert fused[0] == -1 and min(fused[1:]) >= 0 and fused[-1] == 0, fused'"
 # Processed again in place with [output] texture = 0 (issue 34): the earlier model's texture.png
 # and mesh.mtl go with it, not left beside a mesh.obj that no longer names them
-sed 's/^\[output\]/[output]\ntexture = 0/' "$out/processed/config.ini" > "$out/notexture.ini"
-check texture_off_removes_the_old_texture sh -c "test -f $out/processed/texture.png &&
-    $bin process $out/processed --config $out/notexture.ini > $out/notexture.log 2>&1 &&
-    ! test -e $out/processed/texture.png && ! test -e $out/processed/mesh.mtl &&
-    ! grep -q mtllib $out/processed/mesh.obj"
+rm -rf "$out/inplace" && cp -r "$out/scan" "$out/inplace"
+sed 's/^\[output\]/[output]\ntexture = 0/' "$out/inplace/config.ini" > "$out/notexture.ini"
+check texture_off_removes_the_old_texture sh -c "test -f $out/inplace/texture.png &&
+    $bin process $out/inplace --config $out/notexture.ini > $out/notexture.log 2>&1 &&
+    ! test -e $out/inplace/texture.png && ! test -e $out/inplace/mesh.mtl &&
+    ! grep -q mtllib $out/inplace/mesh.obj"
+rm -rf "$out/inplace"
 cp -r "$out/scan" "$out/broken" 2>/dev/null; rm -f "$out/broken/view_000/frame_07.pgm.zst"
 check process_names_missing_frame sh -c "$bin process $out/broken --out $out/broken_out 2>&1 | \
     grep -q 'view_000/frame_07: no such frame'; test \$? -eq 0"
