@@ -179,24 +179,9 @@ if [ -x "$build/scanner-web" ]; then
 | bad request | what was sent | answer |
 |---|---|---|
 EOF
-    # A port free a moment ago may be taken by the time the server binds it (CI met one such:
-    # the server exited "in use" and every row read "no answer"): a server that exits is
-    # started again on another port; one that listens within 30 s is asked.
     mkdir -p "$w/web-scans"
-    listens() { /usr/bin/python3 -c "import socket; socket.create_connection(('127.0.0.1', $1), 1)" 2>/dev/null; }
-    for try in 1 2 3 4 5; do
-        port=$(/usr/bin/python3 -c 'import socket; s=socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
-        "$sim" serve --config "$w/one.ini" --listen "127.0.0.1:$port" --scans "$w/web-scans" >"$w/web.log" 2>&1 &
-        web=$!
-        i=0
-        while kill -0 "$web" 2>/dev/null && ! listens "$port" && [ $i -lt 300 ]; do
-            sleep 0.1
-            i=$((i + 1))
-        done
-        kill -0 "$web" 2>/dev/null && break
-        wait "$web" 2>/dev/null
-    done
-    listens "$port" || { echo "scanner serve did not listen:" >&2; cat "$w/web.log" >&2; }
+    . scripts/serve-loopback.sh
+    serve_loopback "$w/web.log" "$sim" serve --config "$w/one.ini" --scans "$w/web-scans"
     /usr/bin/python3 scripts/errors-web.py "$port" "$w/web-scans"
     kill -TERM "$web"
     wait "$web" 2>/dev/null

@@ -214,9 +214,9 @@ serve_test() {
     sed -e "s|^dir = .*|dir = $out/serve-scans/a/b|" -e "s|^calibration = .*|calibration = $PWD/config/sim-calib.ini|" \
         -e "s|^mesh_file = ../|mesh_file = $PWD/|" config/sim.ini > "$out/serve.ini"
     rm -rf "$out/serve-scans"
-    port=$((30000 + $$ % 20000))
-    "$bin" serve --config "$out/serve.ini" --listen "127.0.0.1:$port" > "$out/serve.txt" 2>&1 &
-    pid=$!
+    . scripts/serve-loopback.sh
+    serve_loopback "$out/serve.txt" "$bin" serve --config "$out/serve.ini"
+    pid=$web
     /usr/bin/python3 - "$port" <<'PY'
 import json, sys, time, urllib.request
 for _ in range(100):
