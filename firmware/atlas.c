@@ -185,29 +185,40 @@ _Static_assert((uint64_t)FUSION_MAX_VOXELS * sizeof(struct voxel) >=
                    ATLAS_WORK_BYTES(ATLAS_MAX_TEXELS, MESH_MAX_TRIANGLES, MESH_MAX_VERTICES),
                "the spent fusion grid holds the largest texture's work space");
 
-/* The atlas's parts in @p work: 8-byte aligned first (the accumulators, which hold the packing's
- * doubles until the views come), the bytes last. @retval 0 @retval -ENOSPC too small */
+/* The atlas's parts in @p work, the mesh's tables first and the texels' after them, so that a
+ * texture touches only the memory its own size needs (the grid's pages the fusion did not use
+ * are mapped only when touched): the charts, each vertex's place in a view, each triangle's and
+ * each vertex's chart and each triangle's axis; then, 8-byte aligned, the texels (placed by
+ * place_texels once their number is known; until then the packing's far corners and sort keys).
+ * @retval 0 @retval -ENOSPC too small */
 static int carve(struct atlas *a, const struct fusion_volume *vol, void *work, size_t bytes)
 {
     const uint64_t nt = vol->mp.s.triangles, nv = vol->mp.s.vertices;
-    uint64_t fixed = ATLAS_WORK_BYTES(0, nt, nv);
+    const uint64_t fixed = ATLAS_WORK_BYTES(0, nt, nv);
     if (bytes < fixed)
         return -ENOSPC;
     uint64_t texels = (bytes - fixed) / ATLAS_TEXEL_BYTES;
     a->max_texels = (size_t)(texels < ATLAS_MAX_TEXELS ? texels : ATLAS_MAX_TEXELS);
-    /* far corners and sort keys of the charts (atlas_build) in the accumulators */
     if (24u * (uint64_t)ATLAS_MAX_CHARTS > 16u * (uint64_t)a->max_texels)
         return -ENOSPC;
-    a->accum = work;
-    a->owner = (uint32_t *)(void *)(a->accum + 4 * a->max_texels);
-    a->tri_chart = a->owner + a->max_texels;
-    a->vertex_tri = a->tri_chart + nt;
-    a->chart = (struct atlas_chart *)(void *)(a->vertex_tri + nv);
+    a->chart = work;
     a->vertex_cam = (float *)(void *)(a->chart + ATLAS_MAX_CHARTS);
-    a->pixel = a->vertex_cam + 5 * nv;
-    a->texture = (uint8_t *)(a->pixel + 2 * (size_t)HAL_MAX_PIXELS);
-    a->tri_axis = a->texture + 3 * a->max_texels;
+    a->tri_chart = (uint32_t *)(void *)(a->vertex_cam + 5 * nv);
+    a->vertex_tri = a->tri_chart + nt;
+    a->tri_axis = (uint8_t *)(void *)(a->vertex_tri + nv);
+    uintptr_t texel_start = ((uintptr_t)(a->tri_axis + nt) + 7u) & ~(uintptr_t)7u;
+    a->accum = (float *)texel_start;
     return 0;
+}
+
+/* The texels' parts for @p texels texels, from the accumulators on (carve), the camera pixels'
+ * weights and depths after them. */
+static void place_texels(struct atlas *a, size_t texels)
+{
+    a->bary = a->accum + 4 * texels;
+    a->owner = (uint32_t *)(void *)(a->bary + 2 * texels);
+    a->texture = (uint8_t *)(void *)(a->owner + texels);
+    a->pixel = (float *)(((uintptr_t)(a->texture + 3 * texels) + 3u) & ~(uintptr_t)3u);
 }
 
 int atlas_build(struct atlas *a, const struct fusion_volume *vol, double texel_mm, void *work,
@@ -254,6 +265,7 @@ int atlas_build(struct atlas *a, const struct fusion_volume *vol, double texel_m
             }
         }
     }
+    place_texels(a, (size_t)a->width * a->height);
     memset(a->accum, 0, (size_t)a->width * a->height * 4 * sizeof(a->accum[0]));
     assign_texels(a, vol);
     rep->width = a->width, rep->height = a->height;
@@ -269,8 +281,8 @@ int atlas_build(struct atlas *a, const struct fusion_volume *vol, double texel_m
  * surface reads texels up to sqrt(2) texels from it, and near a chart's border those must hold
  * the surface's colour (extrapolated on the triangle's plane), not the gutter's. */
 #define ATLAS_REACH 1.5
-/* tri_axis's flag of a triangle that owns texels outside its bounding box */
-#define REACHES 0x80u
+/* tri_axis's flag of a triangle that faces the view being added (atlas_add_view) */
+#define FACING 0x80u
 
 /* Triangle @p t's corners in the texture and twice its signed area there.
  * @retval 0 @retval -1 on edge in the projection: no texel of its own */
@@ -294,18 +306,22 @@ static void barycentric(const double x[3], const double y[3], double inv, double
     l[2] = 1.0 - l[0] - l[1];
 }
 
-struct view_ctx;
-static void view_texel(struct view_ctx *s, size_t texel, const double l[3]);
+/* What raster does with the texels about a triangle: claim those its centre lies in, or claim
+ * those nobody owns within ATLAS_REACH of it (assign_texels). */
+enum raster_mode { CLAIM_INSIDE, CLAIM_NEAR };
 
-/* What raster does with the texels about a triangle: claim those its centre lies in, claim
- * those nobody owns within ATLAS_REACH of it (assign_texels), or colour those it owns from a
- * view (atlas_add_view). */
-enum raster_mode { CLAIM_INSIDE, CLAIM_NEAR, COLOUR };
+/* Texel @p texel is triangle @p t's, at barycentric weights @p l there. */
+static void claim(struct atlas *a, size_t texel, uint32_t t, const double l[3])
+{
+    a->owner[texel] = t;
+    a->bary[2 * texel] = (float)l[0];
+    a->bary[2 * texel + 1] = (float)l[1];
+}
 
 /* The texels about triangle @p t: its bounding box, and ATLAS_REACH about it when it claims the
- * near ones or owns some outside its box (all but those on a chart's border own none). */
+ * near ones. */
 static void raster(struct atlas *a, const struct fusion_volume *vol, uint32_t t,
-                   enum raster_mode mode, struct view_ctx *view)
+                   enum raster_mode mode)
 {
     double x[3], y[3], area2, height[3] = {0.0, 0.0, 0.0};
     if (tri_texels(a, vol, t, x, y, &area2) != 0)
@@ -315,8 +331,7 @@ static void raster(struct atlas *a, const struct fusion_volume *vol, uint32_t t,
         height[k] = fabs(area2) / sqrt(ex * ex + ey * ey);
     }
     const struct atlas_chart *ch = &a->chart[a->tri_chart[t]];
-    const double reach =
-        mode == CLAIM_NEAR || (mode == COLOUR && (a->tri_axis[t] & REACHES)) ? ATLAS_REACH : 0.0;
+    const double reach = mode == CLAIM_NEAR ? ATLAS_REACH : 0.0;
     long xa = (long)floor(fmin(x[0], fmin(x[1], x[2])) - reach);
     long xb = (long)ceil(fmax(x[0], fmax(x[1], x[2])) + reach);
     long ya = (long)floor(fmin(y[0], fmin(y[1], y[2])) - reach);
@@ -329,19 +344,14 @@ static void raster(struct atlas *a, const struct fusion_volume *vol, uint32_t t,
     for (long ty = ya; ty < yb; ty++)
         for (long tx = xa; tx < xb; tx++) {
             size_t texel = (size_t)ty * a->width + (size_t)tx;
-            if (mode == COLOUR && a->owner[texel] != t)
-                continue;
             double l[3];
             barycentric(x, y, inv, tx + 0.5, ty + 0.5, l);
-            if (mode == COLOUR) {
-                view_texel(view, texel, l);
-            } else if (mode == CLAIM_INSIDE) {
+            if (mode == CLAIM_INSIDE) {
                 if (l[0] >= 0.0 && l[1] >= 0.0 && l[2] >= 0.0)
-                    a->owner[texel] = t;
+                    claim(a, texel, t, l);
             } else if (a->owner[texel] == NONE && l[0] * height[0] >= -ATLAS_REACH &&
                        l[1] * height[1] >= -ATLAS_REACH && l[2] * height[2] >= -ATLAS_REACH) {
-                a->owner[texel] = t;
-                a->tri_axis[t] |= REACHES;
+                claim(a, texel, t, l);
             }
         }
 }
@@ -353,10 +363,10 @@ static void assign_texels(struct atlas *a, const struct fusion_volume *vol)
     memset(a->owner, 0xFF, (size_t)a->width * a->height * sizeof(a->owner[0]));
     for (uint32_t t = 0; t < vol->mp.s.triangles; t++)
         if (a->tri_chart[t] != NONE)
-            raster(a, vol, t, CLAIM_INSIDE, NULL);
+            raster(a, vol, t, CLAIM_INSIDE);
     for (uint32_t t = 0; t < vol->mp.s.triangles; t++)
         if (a->tri_chart[t] != NONE)
-            raster(a, vol, t, CLAIM_NEAR, NULL);
+            raster(a, vol, t, CLAIM_NEAR);
 }
 
 struct view_ctx {
@@ -364,10 +374,24 @@ struct view_ctx {
     const struct decode_maps *m;
     const uint8_t *rgb;
     double depth_tol_mm;
-    /* the triangle being rasterised: where its corners are seen (pixels) and their depth, and
-     * the depth's scale to a distance along the ray */
+    /* the triangle of the texels being coloured: where its corners are seen (pixels) and their
+     * depth, and the depth's scale to a distance along the ray */
+    uint32_t t;
     double u[3], v[3], z[3], ray;
 };
+
+/* Triangle @p t's corners as the view sees them, in @p s. */
+static void view_triangle(struct view_ctx *s, const struct fusion_volume *vol, uint32_t t)
+{
+    const float *c[3];
+    for (int k = 0; k < 3; k++) {
+        c[k] = &s->a->vertex_cam[5 * (size_t)tri_at(vol, t)[k]];
+        s->u[k] = c[k][3], s->v[k] = c[k][4], s->z[k] = c[k][2];
+    }
+    vec3 p0 = v3(c[0][0], c[0][1], c[0][2]);
+    s->ray = v3_len(p0) / p0.z;
+    s->t = t;
+}
 
 /* One texel of the triangle seen by the view (atlas_add_view): where it is seen and its depth
  * interpolated from the corners' (a triangle spans a pixel or two: the lens's bending and the
@@ -382,14 +406,17 @@ static void view_texel(struct view_ctx *s, size_t texel, const double l[3])
     long x0 = (long)fu, y0 = (long)fv;
     if (x0 + 1 >= (long)s->m->width || y0 + 1 >= (long)s->m->height)
         return;
-    double fx = fu - x0, fy = fv - y0;
+    const double fx = fu - x0, fy = fv - y0;
+    const double wx[2] = {1.0 - fx, fx}, wy[2] = {1.0 - fy, fy};
+    const size_t first = (size_t)y0 * s->m->width + (size_t)x0;
+    const double z_tol = s->depth_tol_mm / s->ray;
     double sum[3] = {0.0, 0.0, 0.0}, wsum = 0.0;
     for (int q = 0; q < 4; q++) {
-        size_t i = (size_t)(y0 + q / 2) * s->m->width + (size_t)(x0 + q % 2);
+        size_t i = first + (q / 2 ? s->m->width : 0u) + (size_t)(q % 2);
         const float *px = &s->a->pixel[2 * i];
-        if (px[0] <= 0.0f || fabs(px[1] - z) * s->ray > s->depth_tol_mm)
+        if (px[0] <= 0.0f || fabs(px[1] - z) > z_tol)
             continue;
-        double w = px[0] * (q % 2 ? fx : 1.0 - fx) * (q / 2 ? fy : 1.0 - fy);
+        double w = px[0] * wx[q % 2] * wy[q / 2];
         for (int k = 0; k < 3; k++)
             sum[k] += w * s->rgb[3 * i + k];
         wsum += w;
@@ -431,7 +458,10 @@ int atlas_add_view(struct atlas *a, struct fusion_volume *vol, const struct scan
             camray_project(calib, p, &u, &w);
         c[0] = (float)p.x, c[1] = (float)p.y, c[2] = (float)p.z, c[3] = (float)u, c[4] = (float)w;
     }
+    for (uint32_t c = 0; c < a->chart_count; c++)
+        a->chart[c].facing = 0;
     for (uint32_t t = 0; t < vol->mp.s.triangles; t++) {
+        a->tri_axis[t] &= (uint8_t)~FACING;
         if (a->tri_chart[t] == NONE)
             continue;
         const float *c[3];
@@ -439,13 +469,30 @@ int atlas_add_view(struct atlas *a, struct fusion_volume *vol, const struct scan
             c[k] = &a->vertex_cam[5 * (size_t)tri_at(vol, t)[k]];
         vec3 p0 = v3(c[0][0], c[0][1], c[0][2]);
         /* facing the camera: the normal against the ray to its first corner */
-        if (v3_dot(frame_dir_inv(obj_from_cam, tri_normal(vol, t)), p0) >= 0.0 || c[0][2] <= 1.0 ||
-            c[1][2] <= 1.0 || c[2][2] <= 1.0)
-            continue;
-        for (int k = 0; k < 3; k++)
-            s.u[k] = c[k][3], s.v[k] = c[k][4], s.z[k] = c[k][2];
-        s.ray = v3_len(p0) / p0.z;
-        raster(a, vol, t, COLOUR, &s);
+        if (v3_dot(frame_dir_inv(obj_from_cam, tri_normal(vol, t)), p0) < 0.0 && c[0][2] > 1.0 &&
+            c[1][2] > 1.0 && c[2][2] > 1.0) {
+            a->tri_axis[t] |= FACING;
+            a->chart[a->tri_chart[t]].facing = 1;
+        }
+    }
+    /* the texels of each chart that faces the view (half of them face away), each at its place
+     * in its triangle (a triangle's texels lie together along a row: its corners are looked up
+     * again only when the triangle changes) */
+    s.t = NONE;
+    for (uint32_t c = 0; c < a->chart_count; c++) {
+        const struct atlas_chart *ch = &a->chart[c];
+        for (uint32_t y = ch->y0; y < ch->y0 + ch->h && ch->facing; y++)
+            for (size_t i = (size_t)y * a->width + ch->x0;
+                 i < (size_t)y * a->width + ch->x0 + ch->w; i++) {
+                uint32_t t = a->owner[i];
+                if (t == NONE || !(a->tri_axis[t] & FACING))
+                    continue;
+                if (t != s.t)
+                    view_triangle(&s, vol, t);
+                const double l[3] = {a->bary[2 * i], a->bary[2 * i + 1],
+                                     1.0 - a->bary[2 * i] - a->bary[2 * i + 1]};
+                view_texel(&s, i, l);
+            }
     }
     return 0;
 }
@@ -522,12 +569,11 @@ int atlas_finish(struct atlas *a, const struct fusion_volume *vol, uint32_t *unc
      * (a few per cent of them: texel by texel rather than every triangle rasterised again) */
     uint32_t unseen = 0;
     for (size_t i = 0; i < n; i++) {
-        double x[3], y[3], area2, l[3];
         uint32_t t = a->owner[i];
-        if (a->accum[4 * i + 3] != 0.0f || t == NONE || tri_texels(a, vol, t, x, y, &area2) != 0)
+        if (a->accum[4 * i + 3] != 0.0f || t == NONE)
             continue;
-        barycentric(x, y, 1.0 / area2, (double)(i % a->width) + 0.5, (double)(i / a->width) + 0.5,
-                    l);
+        const double l[3] = {a->bary[2 * i], a->bary[2 * i + 1],
+                             1.0 - a->bary[2 * i] - a->bary[2 * i + 1]};
         mesh_texel(a, vol, i, l, t);
         unseen++;
     }

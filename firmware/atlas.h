@@ -14,6 +14,7 @@
  *  direction, projected along it (orthographic), in the atlas at (x0, y0), w x h texels. */
 struct atlas_chart {
     uint8_t axis;       /* 0..5: +x, -x, +y, -y, +z, -z (object frame) */
+    uint8_t facing;     /* a triangle of it faces the view being added (atlas_add_view) */
     float min_u, min_v; /* the projection's corner, mm */
     uint32_t x0, y0, w, h;
     uint32_t triangles;
@@ -28,13 +29,14 @@ struct atlas_report {
 };
 
 /** What atlas_build needs of its work space: a texel's weighted colour and weight (4 floats),
- *  its triangle (uint32) and its sRGB colour (3 bytes); a triangle's chart (uint32) and axis
- *  (a byte); a vertex's chart (uint32) and its place in a view (5 floats); a chart; a camera
- *  pixel's weight and depth (2 floats). */
-#define ATLAS_TEXEL_BYTES (4u * sizeof(float) + sizeof(uint32_t) + 3u)
+ *  its place in its triangle (2 doubles), its triangle (uint32) and its sRGB colour (3 bytes); a
+ * triangle's chart (uint32) and axis (a byte); a vertex's chart (uint32) and its place in a view (5
+ * floats); a chart; a camera pixel's weight and depth (2 floats). */
+#define ATLAS_TEXEL_BYTES (4u * sizeof(float) + 2u * sizeof(float) + sizeof(uint32_t) + 3u)
 #define ATLAS_WORK_BYTES(texels, triangles, vertices)                                              \
     ((uint64_t)(texels)*ATLAS_TEXEL_BYTES + 5ull * (triangles) + 24ull * (vertices) +              \
-     (uint64_t)ATLAS_MAX_CHARTS * sizeof(struct atlas_chart) + 8ull * HAL_MAX_PIXELS)
+     (uint64_t)ATLAS_MAX_CHARTS * sizeof(struct atlas_chart) + 8ull * HAL_MAX_PIXELS +             \
+     16u /* alignment */)
 
 /** The atlas: its size and texel, and where its parts lie in the work space atlas_build is given
  *  (the fusion grid's, spent once the mesh is made: fusion_spend_grid), so that it costs no memory
@@ -44,6 +46,7 @@ struct atlas {
     double texel_mm;
     size_t max_texels;
     float *accum;              /* weighted linear colour and the weight, 4 a texel */
+    float *bary;               /* each owned texel's first two barycentric weights in it (2) */
     uint32_t *owner;           /* each texel's triangle (atlas.c's raster) */
     uint32_t *tri_chart;       /* each prepared triangle's chart (or none) */
     uint32_t *vertex_tri;      /* a triangle at each vertex, then its chart */
@@ -51,7 +54,7 @@ struct atlas {
     float *vertex_cam;         /* each vertex in the view's camera frame, and its pixel (5) */
     float *pixel;              /* each pixel of the view: its weight and depth (2) */
     uint8_t *texture;          /* sRGB-encoded RGB, rows top down */
-    uint8_t *tri_axis;         /* each triangle's axis direction */
+    uint8_t *tri_axis;         /* each triangle's axis direction; FACING (atlas.c) */
 };
 
 /** Charts on @p vol's prepared mesh (fusion_mesh_prepare, holes closed), packed at @p texel_mm

@@ -223,6 +223,34 @@ int fusion_write_ply(struct fusion_volume *vol, const struct hal_storage *st, co
     return outbuf_close(&o);
 }
 
+/* One OBJ line: @p tag and @p n numbers with @p decimals digits after the point ("%.4f"). */
+static void obj_numbers(struct outbuf *o, const char *tag, const double *x, int n,
+                        unsigned decimals)
+{
+    outbuf_put(o, tag, strlen(tag));
+    for (int k = 0; k < n; k++) {
+        outbuf_put(o, " ", 1);
+        outbuf_fixed(o, x[k], decimals);
+    }
+    outbuf_put(o, "\n", 1);
+}
+
+/* One face: each corner's vertex, texture coordinate (0: none, "v//vn") and normal. */
+static void obj_face(struct outbuf *o, const uint32_t corner[3][3])
+{
+    outbuf_put(o, "f", 1);
+    for (int k = 0; k < 3; k++) {
+        outbuf_put(o, " ", 1);
+        outbuf_u32(o, corner[k][0]);
+        outbuf_put(o, "/", 1);
+        if (corner[k][1] > 0)
+            outbuf_u32(o, corner[k][1]);
+        outbuf_put(o, "/", 1);
+        outbuf_u32(o, corner[k][2]);
+    }
+    outbuf_put(o, "\n", 1);
+}
+
 static int obj_vertex(void *priv, const struct mesh_vertex *v)
 {
     struct outbuf *o = priv;
@@ -232,16 +260,23 @@ static int obj_vertex(void *priv, const struct mesh_vertex *v)
      * sRGB-encoded, see srgb.h). Y up, as OBJ readers assume (Blender's importer turns Y up
      * into its Z up): the object frame's (x, y, z) with z up is written (x, z, -y), a
      * right-handed turn about x. */
-    outbuf_printf(o, "v %.4f %.4f %.4f %.4f %.4f %.4f\nvn %.5f %.5f %.5f\n", p[0], p[2], -p[1],
-                  srgb_encode(rgb[0]) / 255.0, srgb_encode(rgb[1]) / 255.0,
-                  srgb_encode(rgb[2]) / 255.0, n[0], n[2], -n[1]);
+    const double vertex[6] = {p[0],
+                              p[2],
+                              -p[1],
+                              srgb_encode(rgb[0]) / 255.0,
+                              srgb_encode(rgb[1]) / 255.0,
+                              srgb_encode(rgb[2]) / 255.0};
+    const double normal[3] = {n[0], n[2], -n[1]};
+    obj_numbers(o, "v", vertex, 6, 4);
+    obj_numbers(o, "vn", normal, 3, 5);
     return o->rc;
 }
 
 static int obj_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
 {
     struct outbuf *o = priv;
-    outbuf_printf(o, "f %u//%u %u//%u %u//%u\n", a + 1, a + 1, b + 1, b + 1, c + 1, c + 1);
+    const uint32_t corner[3][3] = {{a + 1, 0, a + 1}, {b + 1, 0, b + 1}, {c + 1, 0, c + 1}};
+    obj_face(o, corner);
     return o->rc;
 }
 
@@ -253,7 +288,8 @@ int fusion_write_obj(struct fusion_volume *vol, const struct hal_storage *st, co
 /* One "vt" line (OBJ's v runs up from the image's bottom). */
 static void obj_vt(struct outbuf *o, const float uv[2])
 {
-    outbuf_printf(o, "vt %.6f %.6f\n", uv[0], 1.0 - uv[1]);
+    const double x[2] = {uv[0], 1.0 - uv[1]};
+    obj_numbers(o, "vt", x, 2, 6);
 }
 
 /* The kept triangles with their texture coordinates: a "vt" for each kept vertex (numbered as the
@@ -283,9 +319,10 @@ static void obj_textured_faces(struct fusion_volume *vol, const struct atlas *at
             obj_vt(o, uv);
             at[k] = ++vt;
         }
-        uint32_t a = vol->mesh_index[tri[0]] + 1, b = vol->mesh_index[tri[1]] + 1,
-                 c = vol->mesh_index[tri[2]] + 1;
-        outbuf_printf(o, "f %u/%u/%u %u/%u/%u %u/%u/%u\n", a, at[0], a, b, at[1], b, c, at[2], c);
+        uint32_t corner[3][3];
+        for (int k = 0; k < 3; k++)
+            corner[k][0] = corner[k][2] = vol->mesh_index[tri[k]] + 1, corner[k][1] = at[k];
+        obj_face(o, corner);
     }
 }
 

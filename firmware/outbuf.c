@@ -2,6 +2,7 @@
 #include "outbuf.h"
 
 #include <errno.h>
+#include <math.h>
 
 #include <stdarg.h>
 #include <stdio.h>
@@ -49,6 +50,54 @@ void outbuf_printf(struct outbuf *o, const char *fmt, ...)
         o->rc = -EOVERFLOW; /* a cut line would make a damaged file: a writer's bug, said */
     else if (n > 0)
         outbuf_put(o, line, (size_t)n);
+}
+
+/* The decimal digits of @p u at the end of @p end's buffer. @retval their first */
+static char *digits(char *end, uint64_t u)
+{
+    do {
+        *--end = (char)('0' + u % 10u);
+        u /= 10u;
+    } while (u > 0);
+    return end;
+}
+
+void outbuf_u32(struct outbuf *o, uint32_t v)
+{
+    char buf[16], *end = buf + sizeof(buf);
+    char *p = digits(end, v);
+    outbuf_put(o, p, (size_t)(end - p));
+}
+
+void outbuf_fixed(struct outbuf *o, double v, unsigned decimals)
+{
+    static const double scale[10] = {1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9};
+    const double product = decimals <= 9u ? fabs(v) * scale[decimals] : NAN;
+    if (!(product < 4503599627370496.0)) { /* 2^52: beyond exact integers (or NaN): printf's */
+        outbuf_printf(o, "%.*f", (int)(decimals > 9u ? 9u : decimals), v);
+        return;
+    }
+    /* printf rounds the exact value, half to even. The product is rounded once already; only
+     * when it landed on a half can that rounding have moved it across one, and then the exact
+     * product's remainder (fma) says to which side it lies. */
+    double whole = nearbyint(product);
+    if (product - floor(product) == 0.5) {
+        double rest = fma(fabs(v), scale[decimals], -product);
+        whole = rest > 0.0 ? ceil(product) : rest < 0.0 ? floor(product) : whole;
+    }
+    const uint64_t u = (uint64_t)whole;
+    const uint64_t unit = (uint64_t)scale[decimals];
+    char buf[40], *end = buf + sizeof(buf), *p = end;
+    if (decimals > 0) {
+        uint64_t frac = u % unit;
+        for (unsigned k = 0; k < decimals; k++, frac /= 10u)
+            *--p = (char)('0' + frac % 10u);
+        *--p = '.';
+    }
+    p = digits(p, u / unit);
+    if (signbit(v))
+        *--p = '-'; /* as printf: "-0.0000" for a negative value that rounds to 0 */
+    outbuf_put(o, p, (size_t)(end - p));
 }
 
 void outbuf_u32le(struct outbuf *o, uint32_t u)

@@ -19,6 +19,12 @@ int outbuf_open(struct outbuf *o, const struct hal_storage *st, const char *path
 void outbuf_put(struct outbuf *o, const void *data, size_t len);
 /** Append printf-formatted text. */
 void outbuf_printf(struct outbuf *o, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/** Append @p v with @p decimals digits after the point, as printf's "%.*f" writes it (the same
+ *  text: tests/test_ply.c) but without parsing a format (a mesh's text has millions of
+ *  numbers); more than 9 decimals are 9. */
+void outbuf_fixed(struct outbuf *o, double v, unsigned decimals);
+/** Append @p v in decimal. */
+void outbuf_u32(struct outbuf *o, uint32_t v);
 /** Append a float, little-endian. */
 void outbuf_f32le(struct outbuf *o, float f);
 /** Append a uint32, little-endian. */

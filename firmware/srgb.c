@@ -41,5 +41,5 @@ uint8_t srgb_encode_unit(double linear)
         made = 1;
     }
     double x = linear < 0.0 ? 0.0 : linear > 1.0 ? 1.0 : linear;
-    return fine[lround(x * (FINE_STEPS - 1))];
+    return fine[(int)(x * (FINE_STEPS - 1) + 0.5)]; /* rounded (lround's call cost a third) */
 }

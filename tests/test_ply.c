@@ -10,6 +10,8 @@
 #include <string.h>
 
 #include "frames.h"
+#include "outbuf.h"
+#include "storage_posix.h"
 #include "srgb.h"
 #include "test_util.h"
 
@@ -92,10 +94,65 @@ static void test_srgb_table(void **state)
     assert_int_equal(srgb_encode(46), 118); /* 18% grey reads as the middle of the scale */
 }
 
+/* outbuf_fixed and outbuf_u32 (the OBJ writer's numbers) write what printf's "%.*f" and "%u"
+ * write: values of a mesh (mm, unit normals, colours, texture coordinates), their negatives,
+ * negative zero, exact halves at the last digit (rounded to even, as printf), and values beyond
+ * the integers' reach, which go through printf itself. */
+static void test_outbuf_numbers(void **state)
+{
+    (void)state;
+    struct hal_storage st;
+    storage_posix_init(&st);
+    const char *path = "build/test_outbuf.txt";
+    static const double edge[] = {0.0,       -0.0,     -0.00001,  0.00005,       0.00015,
+                                  1.0 / 32,  3.0 / 32, 1.0 / 128, -1.0 / 128,    0.5,
+                                  999.99995, 1e9 - 1,  1e9,       -3e12,         123456.78901234,
+                                  2.5 / 1e4, 1.0,      -1.0,      4095.0 / 4096, 1e-300};
+    static const unsigned decimals[] = {0, 1, 4, 5, 6, 9, 12};
+    char expect[64 * 1024], line[64];
+    size_t len = 0;
+    struct outbuf o;
+    assert_int_equal(outbuf_open(&o, &st, path), 0);
+    uint64_t seed = 12345;
+    for (int i = 0; i < 600; i++) {
+        double v;
+        if (i < (int)(sizeof(edge) / sizeof(edge[0]))) {
+            v = edge[i];
+        } else { /* a mesh's spread of magnitudes */
+            seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+            v = ((double)(seed >> 11) / 9007199254740992.0 - 0.5) * pow(10.0, (double)(i % 7) - 2);
+        }
+        for (size_t d = 0; d < sizeof(decimals) / sizeof(decimals[0]); d++) {
+            int n =
+                snprintf(line, sizeof(line), "%.*f ", (int)(decimals[d] > 9 ? 9 : decimals[d]), v);
+            assert_true(n > 0 && len + (size_t)n < sizeof(expect));
+            memcpy(expect + len, line, (size_t)n);
+            len += (size_t)n;
+            outbuf_fixed(&o, v, decimals[d]);
+            outbuf_put(&o, " ", 1);
+        }
+        uint32_t u = i < 3 ? (uint32_t[]){0u, 9u, 4294967295u}[i] : (uint32_t)(seed >> 40);
+        int n = snprintf(line, sizeof(line), "%u\n", u);
+        memcpy(expect + len, line, (size_t)n);
+        len += (size_t)n;
+        outbuf_u32(&o, u);
+        outbuf_put(&o, "\n", 1);
+    }
+    assert_int_equal(outbuf_close(&o), 0);
+    static char got[64 * 1024];
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    size_t read = fread(got, 1, sizeof(got), f);
+    fclose(f);
+    assert_int_equal(read, len);
+    assert_memory_equal(got, expect, len);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_srgb_table),
+        cmocka_unit_test(test_outbuf_numbers),
         cmocka_unit_test(test_ply_roundtrip),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
