@@ -90,8 +90,9 @@ struct reg_cell {
     float normal[3];
     uint8_t rgb[3];
     uint8_t valid;
+    int16_t hue[2]; /* the mean of its pixels' hues x 32767 (reg_priv.h); REG_NO_HUE: too dark */
 };
-_Static_assert(sizeof(struct reg_cell) == 28, "cell layout");
+_Static_assert(sizeof(struct reg_cell) == 32, "cell layout");
 
 /** What the pairs of one edge (both directions) gave in the last pass. */
 struct reg_edge_stats {

@@ -103,8 +103,11 @@ static const struct reg_cell *land(struct reg_ctx *r, vec3 p, vec3 n, double min
 /* Two hues further apart than this (the chord between their unit vectors, 0.43: 25 degrees) are
  * a miss: the palette's colours are 45 degrees and more apart. */
 #define REG_HUE_TAU 0.43
-/* A colour whose distance from grey is under this share of its brightness is grey. */
-#define REG_HUE_MIN_SATURATION 0.15
+/* The colour search (and the hues in the refinement after it) moves along the one or two directions
+ * the shape holds less than this (the box, bracket, nut and stepped block of data/objects hold
+ * their second weakest 0.14 to 0.48, the gear 0.016 and a plate lying flat little more: two to
+ * search); the shape must hold the third. */
+#define REG_COLOUR_MIN_NEXT 0.05
 
 /* Where cell @p cl lies: its view @p j and its place @p x, @p y in that view's grid (NULL: not
  * wanted). */
@@ -117,23 +120,12 @@ static void cell_place(const struct reg_ctx *r, const struct reg_cell *cl, uint3
         *x = (uint32_t)(k % count % r->gw), *y = (uint32_t)(k % count / r->gw);
 }
 
-/* A colour's hue: the unit direction of its distance from grey, in the plane across the grey
- * axis. The same under any brightness of white light and under any grey added to it (ambient
- * light, the projector's black), so that raw colours, shaded and lit differently in each view,
- * compare as the paint's. A colour too close to grey has none: it is grey (hue 0, 0), which
- * matches grey only (were it left out, a patch of white paint would match anything and pull
- * the search towards it). @retval 0 too dark to tell */
-static int hue_of(const uint8_t rgb[3], double hue[2])
+/* Cell @p cl's hue (reg_priv.h: the mean of its pixels'). @retval 0 too dark to tell */
+static int hue_of(const struct reg_cell *cl, double hue[2])
 {
-    double mean = ((double)rgb[0] + rgb[1] + rgb[2]) / 3.0;
-    double x = ((double)rgb[0] - rgb[1]) / sqrt(2.0);
-    double y = ((double)rgb[0] + rgb[1] - 2.0 * rgb[2]) / sqrt(6.0);
-    double len = sqrt(x * x + y * y);
-    if (3.0 * mean < REG_COLOUR_MIN_DN)
+    if (cl->hue[0] == REG_NO_HUE)
         return 0;
-    hue[0] = hue[1] = 0.0;
-    if (len >= REG_HUE_MIN_SATURATION * mean)
-        hue[0] = x / len, hue[1] = y / len;
+    hue[0] = cl->hue[0] / 32767.0, hue[1] = cl->hue[1] / 32767.0;
     return 1;
 }
 
@@ -150,7 +142,7 @@ static int hue_gradient(struct reg_ctx *r, const struct reg_cell *hit, vec3 q, v
     static const int step[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
     vec3 e1, e2;
     double ata[3] = {0, 0, 0}, atb[2][2] = {{0, 0}, {0, 0}};
-    if (!hue_of(hit->rgb, hue))
+    if (!hue_of(hit, hue))
         return -1;
     v3_across(nq, &e1, &e2);
     for (int s = 0; s < 4; s++) {
@@ -160,7 +152,7 @@ static int hue_gradient(struct reg_ctx *r, const struct reg_cell *hit, vec3 q, v
         if (xs < 0 || ys < 0 || xs >= (long)r->gw || ys >= (long)r->gh)
             continue;
         const struct reg_cell *cs = &reg_view_cells(r, j)[(size_t)ys * r->gw + (size_t)xs];
-        if (!cs->valid || !hue_of(cs->rgb, hs))
+        if (!cs->valid || !hue_of(cs, hs))
             continue;
         cell_in_object(cs, &r->first_pose[j], &qs, &ns);
         vec3 d = v3_sub(qs, q);
@@ -192,7 +184,7 @@ static void add_hue_rows(struct reg_ctx *r, struct lsq_rigid *eq, const struct r
 {
     double hp[2], hq[2], res[2];
     vec3 grad[2];
-    if (!hue_of(cl->rgb, hp) || hue_gradient(r, hit, q, nq, min_cos, reach_mm, hq, grad) != 0)
+    if (!hue_of(cl, hp) || hue_gradient(r, hit, q, nq, min_cos, reach_mm, hq, grad) != 0)
         return;
     for (int c = 0; c < 2; c++)
         res[c] = hq[c] + v3_dot(grad[c], v3_sub(p, q)) - hp[c];
@@ -247,10 +239,28 @@ static uint32_t refine_second_step(struct reg_ctx *r, double gate_mm, double hue
     *rms = coupled > 0 ? sqrt(eq.sq / coupled) : 0.0;
     if (lsq_rigid_shift_axes(&eq, share, axis) != 0)
         memset(share, 0, 3 * sizeof(double)); /* no pairs: holds nothing */
-    for (int i = 0; i < 36; i++)
-        eq.a[i] += hues.a[i];
-    for (int i = 0; i < 6; i++)
-        eq.b[i] += hues.b[i];
+    /* The hues only along the shift axes the shape does not hold (where the colour search
+     * looked, reg_place_by_colour): elsewhere the shape's thousands of pairs fix the motion and
+     * the paint's few boundaries add nothing but their noise. Measured on the box of
+     * data/objects slipped 30 mm, against the simulator's true poses: the hues on every motion
+     * turned the views after the slip 0.25 to 0.3 degrees and tilted them 0.17; on the shifts
+     * the shape lets slide only, 0.06 to 0.15 and 0.01 (REG_COLOUR_ITERATIONS). */
+    for (int k = 0; k < 3 && hue_weight > 0.0; k++) {
+        if (share[k] >= REG_COLOUR_MIN_NEXT)
+            continue;
+        const double u[3] = {axis[k].x, axis[k].y, axis[k].z};
+        double a_u = 0.0, b_u = 0.0;
+        for (int i = 0; i < 3; i++) {
+            b_u += u[i] * hues.b[3 + i];
+            for (int j = 0; j < 3; j++)
+                a_u += u[i] * hues.a[(3 + i) * 6 + 3 + j] * u[j];
+        }
+        for (int i = 0; i < 3; i++) { /* A += a_u u u^T, b += b_u u on the shifts */
+            eq.b[3 + i] += b_u * u[i];
+            for (int j = 0; j < 3; j++)
+                eq.a[(3 + i) * 6 + 3 + j] += a_u * u[i] * u[j];
+        }
+    }
     struct frame_xform s, moved;
     if (lsq_rigid_step(&eq, &s) == 0) {
         frame_compose(&s, &r->first_from_second, &moved);
@@ -357,17 +367,17 @@ static int hue_between(struct reg_ctx *r, const struct reg_cell *hit, vec3 q, ve
     long x0 = (long)floor(grid_xy[0]), y0 = (long)floor(grid_xy[1]);
     double fx = grid_xy[0] - (double)x0, fy = grid_xy[1] - (double)y0, sum[2] = {0.0, 0.0};
     if (x0 < 0 || y0 < 0 || x0 + 1 >= (long)r->gw || y0 + 1 >= (long)r->gh)
-        return hue_of(hit->rgb, hue);
+        return hue_of(hit, hue);
     for (int c = 0; c < 4; c++) {
         const struct reg_cell *cl =
             &reg_view_cells(r, j)[(size_t)(y0 + c / 2) * r->gw + (size_t)(x0 + c % 2)];
         double h[2], w = (c % 2 ? fx : 1.0 - fx) * (c / 2 ? fy : 1.0 - fy);
         vec3 qc, nc;
-        if (!cl->valid || !hue_of(cl->rgb, h))
-            return hue_of(hit->rgb, hue);
+        if (!cl->valid || !hue_of(cl, h))
+            return hue_of(hit, hue);
         cell_in_object(cl, &r->first_pose[j], &qc, &nc);
         if (v3_len(v3_sub(qc, q)) > reach_mm || v3_dot(nc, nq) < min_cos)
-            return hue_of(hit->rgb, hue); /* an edge of the object: not one surface */
+            return hue_of(hit, hue); /* an edge of the object: not one surface */
         sum[0] += w * h[0], sum[1] += w * h[1];
     }
     hue[0] = sum[0], hue[1] = sum[1];
@@ -395,7 +405,7 @@ static double colour_misfit(struct reg_ctx *r, vec3 shift, uint64_t *compared)
             double hp[2], hq[2];
             vec3 p, n, q, nq;
             int landed;
-            if (!cl->valid || !hue_of(cl->rgb, hp))
+            if (!cl->valid || !hue_of(cl, hp))
                 continue;
             cell_in_object(cl, &pose, &p, &n);
             double grid_xy[2];
@@ -423,17 +433,15 @@ static double colour_misfit(struct reg_ctx *r, vec3 shift, uint64_t *compared)
  * lined up at 0.20. */
 #define REG_COLOUR_MAX_MISFIT 0.14
 #define REG_COLOUR_MIN_COMPARED 200
-/* The colour search moves along the one or two directions the shape holds less than this (the
- * box, bracket, nut and stepped block of data/objects hold their second weakest 0.14 to 0.48, the
- * gear 0.016 and a plate lying flat little more: two to search); the shape must hold the third. */
-#define REG_COLOUR_MIN_NEXT 0.05
-/* From the colour search's place, the shape and the hues refine the placement together in every
- * direction (refine_second_step), this many steps, a hue's residual weighing this many times a
- * millimetre of the shape's: the search moves along one or two directions and never turns, and
- * a part the shape barely holds kept the shape's small turn (the thin box 0.4 deg, 0.4 mm at its
- * ends). Measured on the slipped parts of data/objects (8 views, 6 and 30 mm): with the weight
- * at 1, 5 of 11 within 1.2 times the scan without a slip; at 10, 6 (the box, hex nut, gear and
- * plate); at 100 the hues' noise turns the gear 1.5 deg. */
+/* From the colour search's place, the shape and the hues refine the placement together
+ * (refine_second_step), this many steps, a hue's residual weighing this many times a millimetre
+ * of the shape's, the hues along the shifts the shape does not hold only. Measured on the box,
+ * thin box, stepped block, L-bracket and plate of data/objects slipped 6 and 30 mm in 8 views
+ * (2026-12-05, each cell's hue the mean of its pixels'): the hues on every motion gave 1.01 to
+ * 1.54 times the scan without a slip (the box slipped 30 mm turned 0.3 deg and tilted 0.17 by
+ * them); on those shifts only, 1.03 to 1.28. Before, with the hue of each cell's mean colour:
+ * at the weight 1, 5 of 11 parts within 1.2 times; at 10, 6; at 100 the hues' noise turned the
+ * gear 1.5 deg. */
 #define REG_COLOUR_ITERATIONS 10
 #define REG_HUE_WEIGHT 10.0
 

@@ -5,11 +5,38 @@
 
 #include "reg.h"
 
+#include <math.h>
 #include <stddef.h>
+#include <stdint.h>
 
 /* Raw colours darker than this (sum of the channels) have no chromaticity or hue to compare
  * (reg.c's colour gate, reg_place.c's colour search). */
 #define REG_COLOUR_MIN_DN 30.0
+
+/* A colour whose distance from grey is under this share of its brightness is grey. */
+#define REG_HUE_MIN_SATURATION 0.15
+/* A cell's hue[0] when its pixels are too dark to have one. */
+#define REG_NO_HUE INT16_MIN
+
+/* A colour's hue: the unit direction of its distance from grey, in the plane across the grey
+ * axis. The same under any brightness of white light and under any grey added to it (ambient
+ * light, the projector's black), so that raw colours, shaded and lit differently in each view,
+ * compare as the paint's. A colour too close to grey has none: it is grey (hue 0, 0), which
+ * matches grey only (were it left out, a patch of white paint would match anything and pull
+ * the search towards it). @retval 0 too dark to tell */
+static inline int reg_hue_of(const double rgb[3], double hue[2])
+{
+    double mean = (rgb[0] + rgb[1] + rgb[2]) / 3.0;
+    double x = (rgb[0] - rgb[1]) / sqrt(2.0);
+    double y = (rgb[0] + rgb[1] - 2.0 * rgb[2]) / sqrt(6.0);
+    double len = sqrt(x * x + y * y);
+    hue[0] = hue[1] = 0.0;
+    if (3.0 * mean < REG_COLOUR_MIN_DN)
+        return 0;
+    if (len >= REG_HUE_MIN_SATURATION * mean)
+        hue[0] = x / len, hue[1] = y / len;
+    return 1;
+}
 
 /* The kept samples of one view: gw x gh cells. */
 static inline size_t reg_cell_count(const struct reg_ctx *r)

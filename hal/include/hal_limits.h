@@ -84,7 +84,7 @@
 #endif
 #define REFLECT_MAX_CLUSTERS 8u /* material clusters, each with its specular lobe */
 /* Joint registration (reg.h): the views of one scan (as many as [scan] views allows), and the
- * samples kept of all of them together, 28 bytes each; a scan of many views keeps every n-th
+ * samples kept of all of them together, 32 bytes each; a scan of many views keeps every n-th
  * pixel with a larger n. */
 #define REG_MAX_VIEWS 360u
 #ifdef HAL_LIMITS_SMALL /* 8 views of 1280 x 960 at every 4th pixel, as the default build */
