@@ -338,6 +338,12 @@ static const struct ini_key config_keys[] = {
     U32("sim", "seed", sim.seed, 0, 4294967295.0, "1", "noise seed (runs are repeatable)"),
     U32("sim", "table_angle_error_mdeg", sim.table_angle_error_mdeg, 0, 10000, "0",
         "the table ends each move up to this far from the angle it reports (open-loop stepper)"),
+    F64("sim", "placement_jitter_mm", sim.placement_jitter_mm, 0, 50, "0",
+        "scanner calibrate: the simulated person stands each board up to this far (mm, along and "
+        "across the table) from where the step asks, by the seed (a person repeating the "
+        "procedure never places a board the same way twice); 0: exactly there"),
+    F64("sim", "placement_jitter_deg", sim.placement_jitter_deg, 0, 20, "0",
+        "... and leaning up to this much more or less than asked (degrees)"),
     F64("sim", "black_offset_dn", sim.black_offset_dn, 0, 255, "51",
         "camera black offset (Jost et al. Table 1: 51)"),
     F64("sim", "ambient_dn", sim.ambient_dn, 0, 255, "3", "indirect light on a white surface"),

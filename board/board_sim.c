@@ -10,6 +10,7 @@
 #include "sim_devices.h"
 #include "pty_link.h"
 #include "sim_config.h"
+#include "sim_random.h"
 #include "storage_posix.h"
 #include "thread_posix.h"
 #include "tt_server.h"
@@ -136,6 +137,22 @@ int board_init(struct hal *hal, const struct board_config *cfg, const struct sca
     return rc;
 }
 
+/* A board stood where the step asks, give or take [sim] placement_jitter_mm and _deg: the same
+ * for every capture of one placement (drawn from the seed and the placement asked for), another
+ * for the next placement and for another seed. */
+static void jitter_placement(struct sim_target *st)
+{
+    const struct sim_config *c = &sim.rig.cfg;
+    if (!(c->placement_jitter_mm > 0.0 || c->placement_jitter_deg > 0.0))
+        return;
+    uint64_t state = 0x91ac3ull ^ ((uint64_t)c->seed << 20);
+    state ^= (uint64_t)llround(st->tilt_deg * 1000.0) * 0x9E3779B97F4A7C15ull;
+    state ^= (uint64_t)llround(st->position_mm[1] * 1000.0) * 0xC2B2AE3D27D4EB4Full;
+    for (int k = 0; k < 2; k++)
+        st->position_mm[k] += (2.0 * sim_random_unit(&state) - 1.0) * c->placement_jitter_mm;
+    st->tilt_deg += (2.0 * sim_random_unit(&state) - 1.0) * c->placement_jitter_deg;
+}
+
 int board_place_target(struct hal *hal, const struct board_target *t, char *err, size_t len)
 {
     (void)hal;
@@ -152,6 +169,8 @@ int board_place_target(struct hal *hal, const struct board_target *t, char *err,
         .diameter_mm = t->diameter_mm,
         .position_mm = {t->position_mm[0], t->position_mm[1]},
     };
+    if (t->kind == BOARD_TARGET_BOARD) /* the person stands it about where asked */
+        jitter_placement(&st);
     if (t->kind == BOARD_TARGET_OBJECT) { /* the person lays the object as the pass asks */
         static double first_pose[3];
         static int kept;

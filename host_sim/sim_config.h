@@ -30,6 +30,8 @@ struct sim_config {
     double albedo[3];
     uint32_t seed;
     uint32_t table_angle_error_mdeg;
+    double placement_jitter_mm;  /**< a calibration board stood this far (up to) from where asked */
+    double placement_jitter_deg; /**< ... and leaning up to this much more or less */
     double black_offset_dn, ambient_dn, read_noise_dn, electrons_per_dn;
     double projector_intensity_dn, projector_black_level, projector_blur_px;
     double camera_blur_px;   /**< sigma of the camera lens's Gaussian point spread */

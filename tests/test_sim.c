@@ -225,6 +225,46 @@ static void test_merl_material(void **state)
     assert_true(off[0] == 0.0 && off[1] == 0.0 && off[2] == 0.0);
 }
 
+/* [sim] placement_jitter_mm and _deg: a board stands about where the step asks (the same for
+ * every capture of one placement, within the bounds, another for another seed); 0: exactly. */
+static void test_board_placement_jitter(void **state)
+{
+    (void)state;
+    static struct test_rig t;
+    assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
+    snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "box");
+    t.cfg.sim.segments = 16;
+    assert_int_equal(test_rig_start(&t), 0);
+    struct sim_rig *rig = sim_ctl_rig();
+    static const uint8_t sheet[16 * 16] = {0};
+    const struct board_target asked = {.kind = BOARD_TARGET_BOARD,
+                                       .sheet = sheet,
+                                       .sheet_width = 16,
+                                       .sheet_height = 16,
+                                       .sheet_px_per_mm = 0.1,
+                                       .thickness_mm = 3.0,
+                                       .tilt_deg = 25.0,
+                                       .position_mm = {0.0, 40.0}};
+    char err[256];
+    double placed[3][3]; /* exact; jittered; jittered again */
+    for (int k = 0; k < 3; k++) {
+        rig->cfg.placement_jitter_mm = k == 0 ? 0.0 : 5.0;
+        rig->cfg.placement_jitter_deg = k == 0 ? 0.0 : 3.0;
+        assert_int_equal(board_place_target(&t.hal, &asked, err, sizeof(err)), 0);
+        placed[k][0] = rig->target.position_mm[0], placed[k][1] = rig->target.position_mm[1];
+        placed[k][2] = rig->target.tilt_deg;
+    }
+    assert_true(placed[0][0] == 0.0 && placed[0][1] == 40.0 && placed[0][2] == 25.0);
+    assert_true(fabs(placed[1][0]) <= 5.0 && fabs(placed[1][1] - 40.0) <= 5.0 &&
+                fabs(placed[1][2] - 25.0) <= 3.0);
+    assert_true(placed[1][0] != 0.0 && placed[1][2] != 25.0);
+    assert_memory_equal(placed[1], placed[2], sizeof(placed[1])); /* one placement, one stance */
+    rig->cfg.seed++;
+    assert_int_equal(board_place_target(&t.hal, &asked, err, sizeof(err)), 0);
+    assert_true(rig->target.position_mm[0] != placed[1][0] && rig->target.tilt_deg != placed[1][2]);
+    test_rig_stop(&t);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -234,6 +274,7 @@ int main(void)
         cmocka_unit_test(test_deterministic_noise_and_black_level),
         cmocka_unit_test(test_merl_material),
         cmocka_unit_test(test_object_pose),
+        cmocka_unit_test(test_board_placement_jitter),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
