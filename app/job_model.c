@@ -203,13 +203,15 @@ static int report_registration(struct job *j, const struct reg_report *r, double
     }
     if (r->moved_view >= 0) {
         n = strlen(detail);
-        snprintf(detail + n, sizeof(detail) - n,
-                 "; the object moved on the table at view %d: %u view%s placed by the object's "
-                 "%s, as it had moved %.1f mm and turned %.1f deg",
-                 r->moved_view, (unsigned)r->moved_views, r->moved_views == 1 ? "" : "s",
-                 r->moved_by_colour ? "shape and colour (its shape alone lets them slide one way)"
-                                    : "shape alone",
-                 r->moved_mm, r->moved_deg);
+        snprintf(
+            detail + n, sizeof(detail) - n,
+            "; the object moved on the table at view %d: %u view%s placed by the object's "
+            "%s, as it had moved %.1f mm and turned %.1f deg",
+            r->moved_view, (unsigned)r->moved_views, r->moved_views == 1 ? "" : "s",
+            r->moved_by_colour == 2 ? "shape and colour (its shape alone lets them slide two ways)"
+            : r->moved_by_colour == 1 ? "shape and colour (its shape alone lets them slide one way)"
+                                      : "shape alone",
+            r->moved_mm, r->moved_deg);
     }
     if (j->cfg->passes == 2 && r->failed_view < 0) {
         n = strlen(detail);

@@ -76,9 +76,10 @@ struct reg_report {
                                         (one pass): from it, moved_views views were placed freely */
     uint32_t moved_views;
     double moved_mm, moved_deg; /**< how far the object had moved, and turned */
-    int moved_by_colour;        /**< 1: its shape left a direction free, its paint fixed it */
-    int moved_unfixed;          /**< 1: failed_view's views fit the others only up to a slide
-                                     neither shape nor colour fixes */
+    int moved_by_colour; /**< the directions its shape left free, which its paint fixed (1 or 2;
+                              0: its shape alone placed it) */
+    int moved_unfixed;   /**< 1: failed_view's views fit the others only up to a slide
+                              neither shape nor colour fixes */
 };
 
 #define REG_PARAMS (REG_MAX_VIEWS + 4u) /* every angle, two shifts, two tilts */
@@ -135,7 +136,7 @@ struct reg_ctx {
     double placed_share[3];           /**< how well the last placement's pairs held a shift, weakest
                                            first (lsq_rigid_shift_axes) ... */
     vec3 placed_axis[3];              /**< ... along these directions (group 0's object frame) */
-    int placed_by_colour; /**< the shape left one direction free: the colours placed it */
+    int placed_by_colour; /**< the directions the shape left free, the colours placed (0: none) */
     struct frame_xform first_from_second;
     struct frame_xform first_pose[REG_MAX_VIEWS], first_cam[REG_MAX_VIEWS]; /* refinement's */
     struct align_ctx align; /**< the second pass found in the first */

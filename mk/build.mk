@@ -36,7 +36,12 @@ $(BUILD)/libfirmware.a: $(FW_OBJ)
 $(BUILD)/scanner: $(MAIN_OBJ) $(HOST_OBJ) $(BUILD)/libfirmware.a
 	$(LINK) $(LDLIBS_COMMON) $(BOARD_LIBS)
 
-$(BUILD)/calib/calib_cv.o: calib/calib_cv.cpp calib/calib_cv.h | deps
+# OpenCV is installed when the calibration is built on a machine without it (make
+# measure-calib-sigma, make calibrate-demo on a fresh machine): before the recipe, whose
+# pkg-config --cflags is expanded when it starts.
+opencv-deps: deps
+	@$(PKG_CONFIG) --exists opencv4 || scripts/install-deps.sh bench
+$(BUILD)/calib/calib_cv.o: calib/calib_cv.cpp calib/calib_cv.h | deps opencv-deps
 	@mkdir -p $(dir $@)
 	$(CXX) -std=c++17 -Wall -Wextra -Werror $(OPT) -g -MMD -MP -Icalib $(shell $(PKG_CONFIG) --cflags opencv4 2>/dev/null) -c $< -o $@
 $(BUILD)/scanner-calibrate: $(call obj,$(CALIB_SRC)) $(BUILD)/calib/calib_cv.o $(HOST_OBJ) $(BUILD)/libfirmware.a

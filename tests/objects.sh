@@ -97,6 +97,25 @@ slip_far_test() {
         awk -v m="$m" 'BEGIN { exit !(m != "" && m < 0.08) }'
 }
 check box_pushed_30mm_is_placed_by_its_paint_within_a_tenth slip_far_test
+# The plate with holes of data/objects (100 x 70 x 10 mm, lying flat) pushed 30 mm: its shape
+# holds neither shift along the table (its top and its holes' few walls), its paint holds both.
+# The paint lined up at 0.17 of a full miss before the refinement turned it the last tenth of a
+# degree, which a bound on that alone (0.14) took for a wrong place and refused the scan; now
+# the placed views' colours, refined, are held to the agreement of the views of one arc (0.073
+# both). The model 0.049 mm from the truth, the same plate unmoved 0.047.
+slip_plate_test() {
+    slip_config patches 30
+    sed -e "s|^object = .*|object = mesh\nmesh_file = $PWD/data/objects/plate_holes.ply|" \
+        -e 's/^object_height_mm = .*/object_height_mm = 10/' "$out/slip-patches.ini" >"$out/slip-plate.ini"
+    "$bin" scan --config "$out/slip-plate.ini" --out "$out/slip-plate" >"$out/slip-plate.log" 2>&1 ||
+        { tail -n 5 "$out/slip-plate.log"; return 1; }
+    m=$(aligned_mean slip-plate)
+    moved=$(sed -n "s/.*placed by the object's shape and colour.*as it had moved \([0-9.]*\) mm.*/\1/p" "$out/slip-plate.log")
+    echo "plate with holes, 8 views, 30 mm slip at view 4: moved $moved mm said, model -> truth mean $m mm"
+    grep -q "its shape alone lets them slide two ways" "$out/slip-plate.log" &&
+        awk -v m="$m" -v d="$moved" 'BEGIN { exit !(m != "" && m < 0.06 && d != "" && d > 29 && d < 31) }'
+}
+check plate_pushed_30mm_is_placed_by_its_paint slip_plate_test
 slip_plain_test() {
     slip_config uniform
     if "$bin" scan --config "$out/slip-uniform.ini" --out "$out/slip-uniform" >"$out/slip-uniform.log" 2>&1; then
