@@ -85,12 +85,15 @@ check box_slipped_along_its_faces_is_placed_by_its_paint slip_painted_test
 # towards the brighter paint by how obliquely a view saw it, and placed them 0.43 mm off: the
 # model 0.122 mm from the truth against 0.050 unmoved), and the hues move only the slide the
 # shape leaves (on every motion they turned the views 0.3 degrees). Now 0.064 mm.
-slip_far_test() {
+part_pushed() { # name, part of data/objects, its height (mm): painted, 8 views, pushed 30 mm
     slip_config patches 30
-    sed -e "s|^object = .*|object = mesh\nmesh_file = $PWD/data/objects/box.ply|" \
-        -e 's/^object_height_mm = .*/object_height_mm = 80/' "$out/slip-patches.ini" >"$out/slip-far.ini"
-    "$bin" scan --config "$out/slip-far.ini" --out "$out/slip-far" >"$out/slip-far.log" 2>&1 ||
-        { tail -n 5 "$out/slip-far.log"; return 1; }
+    sed -e "s|^object = .*|object = mesh\nmesh_file = $PWD/data/objects/$2.ply|" \
+        -e "s/^object_height_mm = .*/object_height_mm = $3/" "$out/slip-patches.ini" >"$out/$1.ini"
+    "$bin" scan --config "$out/$1.ini" --out "$out/$1" >"$out/$1.log" 2>&1 ||
+        { tail -n 5 "$out/$1.log"; return 1; }
+}
+slip_far_test() {
+    part_pushed slip-far box 80 || return 1
     m=$(aligned_mean slip-far)
     echo "box, 8 views, 30 mm slip at view 4, painted: model -> truth mean $m mm"
     grep -q "placed by the object's shape and colour" "$out/slip-far.log" &&
@@ -104,11 +107,7 @@ check box_pushed_30mm_is_placed_by_its_paint_within_a_tenth slip_far_test
 # the placed views' colours, refined, are held to the agreement of the views of one arc (0.073
 # both). The model 0.049 mm from the truth, the same plate unmoved 0.047.
 slip_plate_test() {
-    slip_config patches 30
-    sed -e "s|^object = .*|object = mesh\nmesh_file = $PWD/data/objects/plate_holes.ply|" \
-        -e 's/^object_height_mm = .*/object_height_mm = 10/' "$out/slip-patches.ini" >"$out/slip-plate.ini"
-    "$bin" scan --config "$out/slip-plate.ini" --out "$out/slip-plate" >"$out/slip-plate.log" 2>&1 ||
-        { tail -n 5 "$out/slip-plate.log"; return 1; }
+    part_pushed slip-plate plate_holes 10 || return 1
     m=$(aligned_mean slip-plate)
     moved=$(sed -n "s/.*placed by the object's shape and colour.*as it had moved \([0-9.]*\) mm.*/\1/p" "$out/slip-plate.log")
     echo "plate with holes, 8 views, 30 mm slip at view 4: moved $moved mm said, model -> truth mean $m mm"
