@@ -359,9 +359,9 @@ static const struct ini_key config_keys[] = {
     F64("sim", "camera_blur_px", sim.camera_blur_px, 0, 8, "0",
         "camera lens blur, the sigma of a Gaussian point spread in camera pixels"),
     F64("sim", "frame_rate_hz", sim.frame_rate_hz, 0, 1000, "30",
-        "the camera streams frames at this rate, as a real sensor does: a capture waits for the "
-        "next frame to begin and for it to end (and readout_us), so the simulated scan takes "
-        "the real rig's time; 0: a frame takes only its exposure"),
+        "the camera streams frames at this rate, as a real sensor does: a capture lets the frame "
+        "in flight go by ([camera] drop_frames) and waits for the next to end (and readout_us), "
+        "so the simulated scan takes the real rig's time; 0: a frame takes only its exposure"),
     U32("sim", "readout_us", sim.readout_us, 0, 1000000, "0",
         "from the end of a frame to its arrival (ISP, USB transfer)"),
     U32("sim", "jpeg_quality", sim.jpeg_quality, 0, 100, "0",

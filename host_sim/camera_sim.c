@@ -62,10 +62,13 @@ static double thread_cpu_s(void)
 
 /* When the frame delivered for a capture asked for at @p now_us began, and when it arrives. A
  * streaming sensor starts a frame every period (1 / frame_rate_hz, longer when the exposure
- * is); a capture waits for the next start, then lets [camera] drop_frames frames go by as the
- * V4L2 backend does (frames exposed during a pattern change), then takes the next whole frame,
- * which arrives after its period and the readout. Without a frame rate, a frame takes its
- * exposure from the request on. */
+ * is). As the V4L2 backend does, the capture gives back the frames already filled and lets
+ * [camera] drop_frames go by, the first of them the frame being exposed when it was asked for
+ * (it began before: during the light or pattern change the capture follows; one that begins
+ * just then is not), then takes the next, which arrives after its period and the readout. So
+ * with drop_frames = 1 a capture waits for the frame in flight and one period more; with 0 it
+ * is handed the frame in flight, stamped with its start, which the scan discards as stale.
+ * Without a frame rate, a frame takes its exposure from the request on. */
 static void frame_times(const struct camera_sim *cam, uint64_t now_us, uint64_t *start_us,
                         uint64_t *arrive_us)
 {
@@ -75,9 +78,12 @@ static void frame_times(const struct camera_sim *cam, uint64_t now_us, uint64_t 
         return;
     }
     double period = fmax(1e6 / cam->frame_rate_hz, (double)cam->cfg.exposure_us);
-    double first = ceil((double)now_us / period) * period;
-    *start_us = (uint64_t)(first + cam->cfg.drop_frames * period);
-    *arrive_us = (uint64_t)(first + (cam->cfg.drop_frames + 1u) * period) + cam->readout_us;
+    double next = ceil((double)now_us / period) * period; /* the first start at or after now */
+    /* within a microsecond of now it begins now: the times are whole microseconds, so a
+     * capture asked for as the frame before arrived (a retry) sees it so */
+    double in_flight = next >= (double)now_us + 1.0 ? next - period : next;
+    *start_us = (uint64_t)(in_flight + cam->cfg.drop_frames * period);
+    *arrive_us = (uint64_t)(in_flight + (cam->cfg.drop_frames + 1u) * period) + cam->readout_us;
 }
 
 static int camera_sim_capture(void *priv, struct hal_image *img)
@@ -101,16 +107,29 @@ static int camera_sim_capture(void *priv, struct hal_image *img)
     gpio_sim_sources(cam->gpio, cam->light_count, &src);
     src.exposure_us = cam->cfg.exposure_us;
     src.gain_milli = cam->cfg.gain_milli;
-    uint64_t start_us, arrive_us;
-    frame_times(cam, clock_sim_now(cam->clock), &start_us, &arrive_us);
-    if (!(faulty && stale(cam, &src, &start_us))) {
+    uint64_t start_us, arrive_us, asked_us = clock_sim_now(cam->clock);
+    frame_times(cam, asked_us, &start_us, &arrive_us);
+    int in_flight = start_us < asked_us; /* exposed during the change: the old light on it */
+    if (in_flight) {
+        if (cam->has_shown) { /* its start stays its own: the scan tells it by that */
+            src = cam->shown;
+            cam->rig->table_angle_mdeg = cam->shown_angle_mdeg;
+        }
+    } else if (!(faulty && stale(cam, &src, &start_us))) {
         cam->shown = src;
         cam->shown_start_us = start_us;
         cam->shown_angle_mdeg = cam->rig->table_angle_mdeg;
         cam->has_shown = 1;
     }
     double t0 = thread_cpu_s();
-    sim_rig_render(cam->rig, &src, noise_id(cam, &src), img->rgb);
+    /* a frame in flight is not one of those in a row that showed the same (the scan discards
+     * it): the noise of those after it is what it would have been without it */
+    uint64_t last_key = cam->last_key, id;
+    uint32_t repeat = cam->repeat;
+    id = noise_id(cam, &src);
+    if (in_flight)
+        cam->last_key = last_key, cam->repeat = repeat;
+    sim_rig_render(cam->rig, &src, id, img->rgb);
     cam->render_cpu_s += thread_cpu_s() - t0;
     uint64_t now_us = clock_sim_now(cam->clock);
     if (arrive_us > now_us)

@@ -6,6 +6,7 @@
 #include <cmocka.h>
 
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -129,6 +130,56 @@ static void test_stale_frames_are_discarded(void **state)
     sim_ctl_inject_camera_fault(SIM_FAULT_NONE, 0, 0);
 }
 
+/* The simulated camera's timing is the V4L2 backend's: a capture asked for during a frame lets
+ * that frame go by (it was being exposed when the pattern changed) as the one of drop_frames = 1
+ * and takes the next, which begins at the next frame start; with drop_frames = 0 it is handed
+ * the frame in flight, stamped with its start, which the scan tells from a fresh one and takes
+ * again: every capture one stale frame, at the same rig time, and the view the clean one. */
+static void test_camera_drops_the_frame_in_flight(void **state)
+{
+    (void)state;
+    const double period = 1e6 / t.cfg.sim.frame_rate_hz;
+    uint64_t now, asked;
+    assert_true(t.cfg.sim.frame_rate_hz > 0.0 && t.cfg.camera.drop_frames == 1);
+    assert_int_equal(hal_clock_now_us(&t.hal.clock, &now), 0);
+    /* 10 ms into a frame */
+    double next = ceil((double)now / period) * period;
+    assert_int_equal(hal_clock_sleep_us(&t.hal.clock, (uint64_t)(next + 10000.0) - now), 0);
+    assert_int_equal(hal_clock_now_us(&t.hal.clock, &asked), 0);
+    struct hal_image img = {.rgb = t.scan->frame_rgb, .capacity = sizeof(t.scan->frame_rgb)};
+    assert_int_equal(hal_cam_capture(&t.hal.camera, &img), 0);
+    assert_int_equal(hal_clock_now_us(&t.hal.clock, &now), 0);
+    double frame_start = (double)asked - 10000.0 + period; /* the next start after asking */
+    assert_true(fabs((double)img.start_us - frame_start) <= 1.0);
+    assert_true(fabs((double)now - (frame_start + period + t.cfg.sim.readout_us)) <= 1.0);
+
+    scan_clean_view();
+    assert_int_equal(hal_clock_now_us(&t.hal.clock, &asked), 0);
+    struct scan_view_info info;
+    assert_int_equal(scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info),
+                     0);
+    uint64_t one_drop_us;
+    assert_int_equal(hal_clock_now_us(&t.hal.clock, &now), 0);
+    one_drop_us = now - asked;
+    assert_int_equal(info.capture_retries, 0);
+    struct hal_camera_config none = t.cfg.camera;
+    none.drop_frames = 0;
+    assert_int_equal(hal_cam_close(&t.hal.camera), 0);
+    assert_int_equal(hal_cam_open(&t.hal.camera, &none), 0);
+    asked = now;
+    assert_int_equal(scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info),
+                     0);
+    assert_int_equal(hal_clock_now_us(&t.hal.clock, &now), 0);
+    print_message("a view on the rig's clock: %.3f s dropping one frame, %.3f s handed the frames "
+                  "in flight (%u of them discarded)\n",
+                  one_drop_us / 1e6, (now - asked) / 1e6, (unsigned)info.capture_retries);
+    assert_int_equal(info.capture_retries, info.frames_captured);
+    assert_true(fabs((double)(now - asked) - (double)one_drop_us) <= 2.0 * period);
+    assert_view_is_clean(&info);
+    assert_int_equal(hal_cam_close(&t.hal.camera), 0);
+    assert_int_equal(hal_cam_open(&t.hal.camera, &t.cfg.camera), 0);
+}
+
 /* A camera that only ever gives old frames: bounded retries, a message that says what to
  * change, the rig dark, and nothing decoded from the old pattern. */
 static void test_persistent_stale_frames_stop_the_view(void **state)
@@ -207,6 +258,7 @@ int main(void)
         cmocka_unit_test(test_unplugged_camera_not_retried),
         cmocka_unit_test(test_stale_frames_are_discarded),
         cmocka_unit_test(test_persistent_stale_frames_stop_the_view),
+        cmocka_unit_test(test_camera_drops_the_frame_in_flight),
         cmocka_unit_test(test_stop_request_leaves_rig_dark),
         cmocka_unit_test(test_safe_state_turns_everything_off),
         cmocka_unit_test(test_projector_sequence),
