@@ -245,6 +245,14 @@ static int report_registration(struct job *j, const struct reg_report *r, double
                     "far it moved. No model was made; the views are kept in %s. Scan again "
                     "without touching the object, or with paint or a marker on its faces",
                     r->failed_view, scan_dir);
+    else if (r->failed_colour > 0.0)
+        j->hal->log(HAL_LOG_ERROR,
+                    "registration failed: view %d fits view %d in shape but not in colour (their "
+                    "paint misses by %.0f%% of a full miss, the other pairs' far less): the "
+                    "object slid along its faces on the table, and no placement of the views "
+                    "from it fits the others. No model was made; the views are kept in %s. "
+                    "Scan again without touching the object",
+                    r->failed_view, r->failed_against, 100.0 * r->failed_colour, scan_dir);
     else
         j->hal->log(
             HAL_LOG_ERROR,

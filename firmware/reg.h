@@ -65,6 +65,8 @@ struct reg_report {
                                         views half a turn apart): no failure, the table's angle */
     int apart_view, apart_against; /**< the first such pair, or -1 */
     double failed_share;           /**< the share of their overlap that coupled */
+    double failed_colour;          /**< > 0: they couple, but their paint misses by this share of
+                                        a full miss (the object slid along its faces) */
     char refused[160];             /**< why a solved adjustment was not accepted ("" when it was) */
     double second_turned_deg;      /**< two passes: how far the object was turned between them */
     double second_share;           /**< the share of the second pass's points the search paired */
@@ -132,11 +134,13 @@ struct reg_ctx {
      *  freely, as a second pass is). */
     uint8_t group[REG_MAX_VIEWS];
     uint8_t cut_after[REG_MAX_VIEWS]; /**< the pair (v, v + 1) does not match: not an edge */
-    int second_aligned;               /**< the group-1 views go through first_from_second */
-    double placed_share[3];           /**< how well the last placement's pairs held a shift, weakest
-                                           first (lsq_rigid_shift_axes) ... */
-    vec3 placed_axis[3];              /**< ... along these directions (group 0's object frame) */
-    int placed_by_colour; /**< the directions the shape left free, the colours placed (0: none) */
+    uint8_t colour_break_after[REG_MAX_VIEWS]; /**< the pair (v, v + 1) matches in shape, not
+                                                    in colour (reg.c, find_colour_breaks) */
+    int second_aligned;     /**< the group-1 views go through first_from_second */
+    double placed_share[3]; /**< how well the last placement's pairs held a shift, weakest
+                                 first (lsq_rigid_shift_axes) ... */
+    vec3 placed_axis[3];    /**< ... along these directions (group 0's object frame) */
+    int placed_by_colour;   /**< the directions the shape left free, the colours placed (0: none) */
     struct frame_xform first_from_second;
     struct frame_xform first_pose[REG_MAX_VIEWS], first_cam[REG_MAX_VIEWS]; /* refinement's */
     struct align_ctx align; /**< the second pass found in the first */

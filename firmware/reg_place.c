@@ -428,6 +428,39 @@ static double colour_misfit(struct reg_ctx *r, vec3 shift, uint64_t *compared)
     return *compared > 0 ? sum / (double)*compared : REG_HUE_TAU * REG_HUE_TAU;
 }
 
+double reg_pair_colour_misfit(struct reg_ctx *r, uint32_t v, uint32_t w, uint64_t *compared)
+{
+    const double min_cos = cos(r->p.max_normal_deg * M_PI / 180.0);
+    double sum = 0.0;
+    *compared = 0;
+    prepare_landing(r);
+    for (size_t k = 0; k < reg_cell_count(r); k++) {
+        const struct reg_cell *cl = &reg_view_cells(r, v)[k];
+        double hp[2], hq[2], fu, fv;
+        vec3 p, n, q, nq;
+        if (!cl->valid || !hue_of(cl, hp))
+            continue;
+        cell_in_object(cl, &r->first_pose[v], &p, &n);
+        vec3 c = frame_point(&r->first_cam[w], p);
+        if (c.z <= 1.0 || v3_dot(frame_dir(&r->first_cam[w], n), c) >= 0.0)
+            continue; /* behind the camera, or facing away from it */
+        camray_project(&r->calib, c, &fu, &fv);
+        long u = lround(fu / r->stride), y = lround(fv / r->stride);
+        if (u < 0 || y < 0 || u >= (long)r->gw || y >= (long)r->gh)
+            continue;
+        const struct reg_cell *cq = &reg_view_cells(r, w)[(size_t)y * r->gw + (size_t)u];
+        if (!cq->valid || !hue_of(cq, hq))
+            continue;
+        cell_in_object(cq, &r->first_pose[w], &q, &nq);
+        if (v3_dot(n, nq) < min_cos || v3_len(v3_sub(p, q)) > r->p.max_pair_mm)
+            continue;
+        double dx = hp[0] - hq[0], dy = hp[1] - hq[1];
+        sum += fmin(dx * dx + dy * dy, REG_HUE_TAU * REG_HUE_TAU);
+        (*compared)++;
+    }
+    return *compared > 0 ? sum / (double)*compared / (REG_HUE_TAU * REG_HUE_TAU) : 1.0;
+}
+
 /* The same among group 0's own views, which the ring registered together: how well an object's
  * paint lines up where its views are known to agree (its mixed pixels at the paint's boundaries,
  * its noise). @retval the misfit (REG_HUE_TAU^2 when nothing was compared) */
