@@ -483,12 +483,17 @@ static double arc_colour_misfit(struct reg_ctx *r)
  * others' at most this many times as well as the others agree among themselves
  * (arc_colour_misfit: where views are known to line up, the pairs that disagree are those on
  * the paint's boundaries, mixed pixels, and the noise), as placement_fits asks of the shape's
- * residual. Measured on the parts of data/objects slipped 6 and 30 mm in 8 views (2026-12-05):
- * 0.91 to 1.45 times (the arcs' own 0.043 to 0.088 of a full miss). A bound on the search's
- * misfit alone (0.14 of a full miss) refused the plate slipped 30 mm, lined up at 0.17 before the
- * refinement turned it the last tenth of a degree, 0.073 after, its arcs' 0.073; a cup slipped
- * 30 mm, its shape fitting a wrong place, had lined up at 0.20. */
+ * residual, or at most REG_COLOUR_MAX_MISFIT of a full miss. Measured on the parts of data/objects
+ * slipped 6 and 30 mm in 8 views (2026-12-05): 0.91 to 1.45 times (the arcs' own 0.043 to 0.088 of
+ * a full miss). A bound on the search's misfit alone (0.14 of a full miss) refused the plate
+ * slipped 30 mm, lined up at 0.17 before the refinement turned it the last tenth of a degree, 0.073
+ * after, its arcs' 0.073; a cup slipped 30 mm, its shape fitting a wrong place, had lined up at
+ * 0.20. */
 #define REG_COLOUR_MAX_ARC_RATIO 2.0
+/* The paint's boundaries alone: 0.07 to 0.10 of a full miss measured on the parts slipped in 8
+ * views; the box of data/objects pushed 30 mm in 6 views, its arcs of three views agreeing
+ * better (0.047), placed right at 0.134 (2.85 times; the model 0.087 mm from the truth). */
+#define REG_COLOUR_MAX_MISFIT 0.14
 #define REG_COLOUR_MIN_COMPARED 200
 /* From the colour search's place, the shape and the hues refine the placement together
  * (refine_second_step), this many steps, a hue's residual weighing this many times a millimetre
@@ -567,7 +572,8 @@ int reg_place_by_colour(struct reg_ctx *r, double ring_rms_mm)
     double misfit = colour_misfit(r, v3(0.0, 0.0, 0.0), &compared);
     if (!placement_fits(r, coupled, overlap, rms, ring_rms_mm) ||
         compared < REG_COLOUR_MIN_COMPARED ||
-        misfit > REG_COLOUR_MAX_ARC_RATIO * arc_colour_misfit(r)) {
+        (misfit > REG_COLOUR_MAX_ARC_RATIO * arc_colour_misfit(r) &&
+         misfit > REG_COLOUR_MAX_MISFIT * REG_HUE_TAU * REG_HUE_TAU)) {
         r->first_from_second = before; /* where the paint agrees the shape does not, or the
                                           paint agrees worse than the views of an arc */
         return 0;
