@@ -19,10 +19,7 @@ static void test_ply_roundtrip(void **state)
 {
     (void)state;
     static struct test_rig t;
-    assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
-    snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "box");
-    t.cfg.sim.segments = 16;
-    assert_int_equal(test_rig_start(&t), 0);
+    assert_int_equal(test_rig_start_box(&t), 0);
     struct scan_view view;
     struct scan_view_info info;
     const int32_t angle_mdeg = 30000;

@@ -17,12 +17,7 @@ static struct test_rig t;
 static int setup(void **state)
 {
     (void)state;
-    if (test_rig_load(&t, "config/sim.ini") != 0)
-        return -1;
-    /* A small object keeps these tests quick; the geometry does not matter here. */
-    snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "box");
-    t.cfg.sim.segments = 16;
-    return test_rig_start(&t);
+    return test_rig_start_box(&t);
 }
 
 static int teardown(void **state)

@@ -117,10 +117,7 @@ static void test_deterministic_noise_and_black_level(void **state)
 {
     (void)state;
     static struct test_rig t;
-    assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
-    snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "box");
-    t.cfg.sim.segments = 16;
-    assert_int_equal(test_rig_start(&t), 0);
+    assert_int_equal(test_rig_start_box(&t), 0);
     struct sim_rig *rig = sim_ctl_rig();
     size_t n = (size_t)rig->width * rig->height * 3;
     static uint8_t a[HAL_MAX_PIXELS * 3], b[HAL_MAX_PIXELS * 3];
@@ -231,10 +228,7 @@ static void test_board_placement_jitter(void **state)
 {
     (void)state;
     static struct test_rig t;
-    assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
-    snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "box");
-    t.cfg.sim.segments = 16;
-    assert_int_equal(test_rig_start(&t), 0);
+    assert_int_equal(test_rig_start_box(&t), 0);
     struct sim_rig *rig = sim_ctl_rig();
     static const uint8_t sheet[16 * 16] = {0};
     const struct board_target asked = {.kind = BOARD_TARGET_BOARD,

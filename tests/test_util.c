@@ -125,6 +125,16 @@ int test_rig_start(struct test_rig *t)
     return rc;
 }
 
+int test_rig_start_box(struct test_rig *t)
+{
+    int rc = test_rig_load(t, "config/sim.ini");
+    if (rc != 0)
+        return rc;
+    snprintf(t->cfg.sim.object, sizeof(t->cfg.sim.object), "box");
+    t->cfg.sim.segments = 16;
+    return test_rig_start(t);
+}
+
 void test_rig_stop(struct test_rig *t)
 {
     scan_close(&t->hal);

@@ -41,6 +41,9 @@ void test_rig_log(enum hal_log_level level, const char *fmt, ...);
 int test_rig_load(struct test_rig *t, const char *config_path);
 /** board_init + scan_open with the quiet test logger. @retval 0 or the error */
 int test_rig_start(struct test_rig *t);
+/** config/sim.ini's rig with a coarse box for its object (quick to render; the geometry does
+ *  not matter to the test), loaded and started. @retval 0 or the error */
+int test_rig_start_box(struct test_rig *t);
 /** scan_close + board_shutdown. */
 void test_rig_stop(struct test_rig *t);
 
