@@ -5,11 +5,11 @@
 # simulator's sphere, cylinder and torus, and two scanned meshes, the Stanford bunny and
 # armadillo. For each object: every view count with [colour] method none and multi and the table
 # exact; at 8 views the table 1 and 2 degrees off; at 8 views a 6 mm and a 30 mm slip after 170
-# degrees. Columns: finished (and how the views after a slip were placed) or the error, the
+# degrees, and at 6 views the 30 mm one (push6: the pairs across it see the faces it slid along). Columns: finished (and how the views after a slip were placed) or the error, the
 # model against the truth once aligned (mean, mm), the truth within 1 mm of the model (above the
 # table), holes and pieces of the model, and the registration's CPU.
 # Usage: scripts/measure-objects.sh BUILD; OBJECTS="box gear", VIEWS="4 8", METHODS="none" and
-# CONDITIONS="exact" (exact table1 table2 slip slip30) choose a subset; KEEP=1 keeps the frames
+# CONDITIONS="exact" (exact table1 table2 slip slip30 push6) choose a subset; KEEP=1 keeps the frames
 # (scanner process DIR computes a scan again from them).
 set -eu
 build=$1
@@ -18,7 +18,7 @@ top=$(pwd)
 objects=${OBJECTS:-"box thin_box l_bracket plate_holes hex_nut gear stepped_block cup cone sphere cylinder torus bunny armadillo"}
 views_list=${VIEWS:-"3 4 6 8 12 24"}
 methods=${METHODS:-"none multi"}
-conditions=${CONDITIONS:-"exact table1 table2 slip slip30"}
+conditions=${CONDITIONS:-"exact table1 table2 slip slip30 push6"}
 command -v openscad >/dev/null 2>&1 || {
     echo "measure-objects: openscad is missing (make measure-objects installs it)" >&2
     exit 1
@@ -94,6 +94,8 @@ for obj in $objects; do
             row "$obj" 8 none "6 mm slip" "$obj-slip" ;;
         slip30) config "$obj" 8 none "slip_mm = 30, 0, 0\nslip_at_deg = 170\n" "$obj-slip30"
             row "$obj" 8 none "30 mm slip" "$obj-slip30" ;;
+        push6) config "$obj" 6 none "slip_mm = 30, 0, 0\nslip_at_deg = 170\n" "$obj-push6"
+            row "$obj" 6 none "30 mm slip" "$obj-push6" ;;
         esac
     done
 done
