@@ -135,7 +135,8 @@ struct reg_ctx {
     uint8_t group[REG_MAX_VIEWS];
     uint8_t cut_after[REG_MAX_VIEWS]; /**< the pair (v, v + 1) does not match: not an edge */
     uint8_t colour_break_after[REG_MAX_VIEWS]; /**< the pair (v, v + 1) matches in shape, not
-                                                    in colour (reg.c, find_colour_breaks) */
+                                                    in colour, or shares no surface (reg.c,
+                                                  find_quiet_breaks) */
     int second_aligned;     /**< the group-1 views go through first_from_second */
     double placed_share[3]; /**< how well the last placement's pairs held a shift, weakest
                                  first (lsq_rigid_shift_axes) ... */
