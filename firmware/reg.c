@@ -663,20 +663,29 @@ static void solve_joint(struct reg_ctx *r, struct reg_report *rep)
  * of the corpus of 4 views or more has even one such pair. The first taken as the failed pair in
  * @p rep. @retval the breaks (0 or 2) */
 #define REG_APART_RING_MIN 5u
+
+/* Edge @p e a break its shape let through, the @p found-th: cut after it, and the first said in
+ * @p rep as the failed pair (their paint missing by @p misfit; 0: not the paint). */
+static void note_break(struct reg_ctx *r, struct reg_report *rep, uint32_t e, int found,
+                       double misfit)
+{
+    r->colour_break_after[r->edge_from[e]] = 1;
+    if (found > 0)
+        return;
+    rep->failed_view = (int)r->edge_to[e];
+    rep->failed_against = (int)r->edge_from[e];
+    rep->failed_share = edge_share(r, &r->stats[e]);
+    rep->failed_colour = misfit;
+}
+
 static int apart_breaks(struct reg_ctx *r, struct reg_report *rep)
 {
     int aparts = 0, found = 0;
     for (uint32_t e = 0; e < r->edges; e++)
         aparts += edge_apart(r, e);
     for (uint32_t e = 0; e < r->edges && aparts == 2 && r->edges >= REG_APART_RING_MIN; e++) {
-        if (!edge_apart(r, e))
-            continue;
-        r->colour_break_after[r->edge_from[e]] = 1;
-        if (found++ == 0) {
-            rep->failed_view = (int)r->edge_to[e];
-            rep->failed_against = (int)r->edge_from[e];
-            rep->failed_share = edge_share(r, &r->stats[e]);
-        }
+        if (edge_apart(r, e))
+            note_break(r, rep, e, found++, 0.0);
     }
     return found;
 }
@@ -705,15 +714,8 @@ static int colour_breaks(struct reg_ctx *r, struct reg_report *rep)
     qsort(sorted, r->edges, sizeof(sorted[0]), by_value);
     double median = sorted[r->edges / 2];
     for (uint32_t e = 0; e < r->edges; e++) {
-        if (misfit[e] <= REG_BREAK_MISFIT || misfit[e] <= REG_BREAK_RATIO * median)
-            continue;
-        r->colour_break_after[r->edge_from[e]] = 1;
-        if (found++ == 0) {
-            rep->failed_view = (int)r->edge_to[e];
-            rep->failed_against = (int)r->edge_from[e];
-            rep->failed_share = edge_share(r, &r->stats[e]);
-            rep->failed_colour = misfit[e];
-        }
+        if (misfit[e] > REG_BREAK_MISFIT && misfit[e] > REG_BREAK_RATIO * median)
+            note_break(r, rep, e, found++, misfit[e]);
     }
     return found;
 }
