@@ -280,7 +280,7 @@ static int edge_apart(const struct reg_ctx *r, uint32_t e)
 static int edge_fails(const struct reg_ctx *r, uint32_t e)
 {
     return (edge_share(r, &r->stats[e]) < r->p.min_coupled_share && !edge_apart(r, e)) ||
-           r->colour_break_after[r->edge_from[e]];
+           r->quiet_break_after[r->edge_from[e]];
 }
 
 /* A pair's weight: Huber's. */
@@ -655,21 +655,12 @@ static void solve_joint(struct reg_ctx *r, struct reg_report *rep)
 #define REG_BREAK_SAMPLES 50u
 #define REG_BREAK_RATIO 3.0
 
-/* Two neighbouring views that share no surface say nothing of each other (two views half a turn
- * apart: edge_apart). In a ring of REG_APART_RING_MIN views and more, every pair no more than
- * 72 degrees apart, two such pairs and every other coupling is the mark of a push between them:
- * the stepped block of data/objects pushed 30 mm in 6 views, the views across the push landing
- * beside each other's surfaces, finished 3.0 mm from the truth without a word; no unslipped scan
- * of the corpus of 4 views or more has even one such pair. The first taken as the failed pair in
- * @p rep. @retval the breaks (0 or 2) */
-#define REG_APART_RING_MIN 5u
-
 /* Edge @p e a break its shape let through, the @p found-th: cut after it, and the first said in
  * @p rep as the failed pair (their paint missing by @p misfit; 0: not the paint). */
 static void note_break(struct reg_ctx *r, struct reg_report *rep, uint32_t e, int found,
                        double misfit)
 {
-    r->colour_break_after[r->edge_from[e]] = 1;
+    r->quiet_break_after[r->edge_from[e]] = 1;
     if (found > 0)
         return;
     rep->failed_view = (int)r->edge_to[e];
@@ -678,15 +669,24 @@ static void note_break(struct reg_ctx *r, struct reg_report *rep, uint32_t e, in
     rep->failed_colour = misfit;
 }
 
+/* Two neighbouring views that share no surface say nothing of each other (two views half a turn
+ * apart: edge_apart). In a ring of REG_APART_RING_MIN views and more, every pair no more than
+ * 72 degrees apart, two such pairs and every other coupling is the mark of a push between them:
+ * the stepped block of data/objects pushed 30 mm in 6 views, the views across the push landing
+ * beside each other's surfaces, finished 3.0 mm from the truth without a word; no unslipped scan
+ * of the corpus of 4 views or more has even one such pair. The first taken as the failed pair in
+ * @p rep. @retval the breaks (0 or 2) */
+#define REG_APART_RING_MIN 5u
 static int apart_breaks(struct reg_ctx *r, struct reg_report *rep)
 {
     int aparts = 0, found = 0;
     for (uint32_t e = 0; e < r->edges; e++)
         aparts += edge_apart(r, e);
-    for (uint32_t e = 0; e < r->edges && aparts == 2 && r->edges >= REG_APART_RING_MIN; e++) {
+    if (aparts != 2 || r->edges < REG_APART_RING_MIN)
+        return 0;
+    for (uint32_t e = 0; e < r->edges; e++)
         if (edge_apart(r, e))
             note_break(r, rep, e, found++, 0.0);
-    }
     return found;
 }
 
@@ -696,7 +696,7 @@ static int by_value(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* The pairs of a ring that match in shape and break on colour (colour_break_after), the first
+/* The pairs of a ring that match in shape and break on colour (quiet_break_after), the first
  * as the failed pair in @p rep. @retval the breaks */
 static int colour_breaks(struct reg_ctx *r, struct reg_report *rep)
 {
@@ -704,6 +704,7 @@ static int colour_breaks(struct reg_ctx *r, struct reg_report *rep)
     int found = 0;
     if (!r->p.use_colour)
         return 0;
+    reg_prepare_landing(r);
     for (uint32_t e = 0; e < r->edges; e++) {
         uint64_t n_ab, n_ba;
         double ab = reg_pair_colour_misfit(r, r->edge_from[e], r->edge_to[e], &n_ab);
@@ -800,7 +801,7 @@ int reg_solve(struct reg_ctx *r, struct reg_report *rep)
     for (uint32_t v = 0; v < r->views; v++)
         rep->views += r->present[v];
     memset(r->cut_after, 0, sizeof(r->cut_after));
-    memset(r->colour_break_after, 0, sizeof(r->colour_break_after));
+    memset(r->quiet_break_after, 0, sizeof(r->quiet_break_after));
     r->second_aligned = 0;
     r->placed_by_colour = 0;
     solve_joint(r, rep);

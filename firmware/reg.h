@@ -134,10 +134,10 @@ struct reg_ctx {
      *  freely, as a second pass is). */
     uint8_t group[REG_MAX_VIEWS];
     uint8_t cut_after[REG_MAX_VIEWS]; /**< the pair (v, v + 1) does not match: not an edge */
-    uint8_t colour_break_after[REG_MAX_VIEWS]; /**< the pair (v, v + 1) matches in shape, not
+    uint8_t quiet_break_after[REG_MAX_VIEWS]; /**< the pair (v, v + 1) matches in shape, not
                                                     in colour, or shares no surface (reg.c,
                                                   find_quiet_breaks) */
-    int second_aligned;     /**< the group-1 views go through first_from_second */
+    int second_aligned;                       /**< the group-1 views go through first_from_second */
     double placed_share[3]; /**< how well the last placement's pairs held a shift, weakest
                                  first (lsq_rigid_shift_axes) ... */
     vec3 placed_axis[3];    /**< ... along these directions (group 0's object frame) */

@@ -48,12 +48,42 @@ static void feed_alignment(struct reg_ctx *r)
 
 /* Group 0's poses, and their inverses, for landing samples on its views (r->first_pose and
  * r->first_cam, too big for a stack). */
-static void prepare_landing(struct reg_ctx *r)
+void reg_prepare_landing(struct reg_ctx *r)
 {
     struct reg_view rv;
     for (uint32_t j = 0; j < r->views; j++)
         if (!r->group[j] && reg_view_pose(r, j, &r->first_pose[j], &rv) == 0)
             frame_invert(&r->first_pose[j], &r->first_cam[j]);
+}
+
+/* Where a sample (@p p, @p n in group 0's object frame) lands in group-0 view @p j, projectively:
+ * @p landed when on a surface facing its way, and that surface's cell when within @p gate_mm
+ * of it (@p q, @p nq; @p facing how squarely the view sees it, @p grid_xy where in its grid).
+ * @retval the cell @retval NULL none within the gate */
+static const struct reg_cell *land_in(struct reg_ctx *r, uint32_t j, vec3 p, vec3 n, double min_cos,
+                                      double gate_mm, int *landed, double *facing, vec3 *q,
+                                      vec3 *nq, double grid_xy[2])
+{
+    *landed = 0;
+    vec3 c = frame_point(&r->first_cam[j], p);
+    *facing = -v3_dot(frame_dir(&r->first_cam[j], n), c);
+    if (c.z <= 1.0 || *facing <= 0.0)
+        return NULL; /* behind the camera, or facing away from it */
+    double fu, fv;
+    camray_project(&r->calib, c, &fu, &fv);
+    long u = lround(fu / r->stride), w = lround(fv / r->stride);
+    if (u < 0 || w < 0 || u >= (long)r->gw || w >= (long)r->gh)
+        return NULL;
+    const struct reg_cell *cq = &reg_view_cells(r, j)[(size_t)w * r->gw + (size_t)u];
+    if (!cq->valid)
+        return NULL;
+    cell_in_object(cq, &r->first_pose[j], q, nq);
+    if (v3_dot(n, *nq) < min_cos)
+        return NULL;
+    *landed = 1;
+    *facing /= v3_len(c);
+    grid_xy[0] = fu / r->stride, grid_xy[1] = fv / r->stride;
+    return v3_len(v3_sub(p, *q)) <= gate_mm ? cq : NULL;
 }
 
 /* Where a group-1 sample (@p p, @p n in group 0's object frame) lands on group 0, projectively,
@@ -72,29 +102,17 @@ static const struct reg_cell *land(struct reg_ctx *r, vec3 p, vec3 n, double min
     for (uint32_t j = 0; j < r->views; j++) {
         if (!r->present[j] || r->group[j] || j == skip)
             continue;
-        vec3 c = frame_point(&r->first_cam[j], p);
-        double facing = -v3_dot(frame_dir(&r->first_cam[j], n), c);
-        if (c.z <= 1.0 || facing <= 0.0)
-            continue; /* behind the camera, or facing away from it */
-        double fu, fv;
-        camray_project(&r->calib, c, &fu, &fv);
-        long u = lround(fu / r->stride), w = lround(fv / r->stride);
-        if (u < 0 || w < 0 || u >= (long)r->gw || w >= (long)r->gh)
-            continue;
-        const struct reg_cell *cq = &reg_view_cells(r, j)[(size_t)w * r->gw + (size_t)u];
+        int on;
+        double facing, g[2];
         vec3 qj, nqj;
-        if (!cq->valid)
-            continue;
-        cell_in_object(cq, &r->first_pose[j], &qj, &nqj);
-        if (v3_dot(n, nqj) < min_cos)
-            continue;
-        *landed = 1;
-        facing /= v3_len(c);
-        if (v3_len(v3_sub(p, qj)) > gate_mm || (best != NULL && facing <= best_facing))
+        const struct reg_cell *cq =
+            land_in(r, j, p, n, min_cos, gate_mm, &on, &facing, &qj, &nqj, g);
+        *landed |= on;
+        if (cq == NULL || (best != NULL && facing <= best_facing))
             continue;
         best = cq, best_facing = facing, *q = qj, *nq = nqj;
         if (grid_xy != NULL)
-            grid_xy[0] = fu / r->stride, grid_xy[1] = fv / r->stride;
+            grid_xy[0] = g[0], grid_xy[1] = g[1];
         if (!most_facing)
             break;
     }
@@ -128,6 +146,13 @@ static int hue_of(const struct reg_cell *cl, double hue[2])
         return 0;
     hue[0] = cl->hue[0] / 32767.0, hue[1] = cl->hue[1] / 32767.0;
     return 1;
+}
+
+/* Two hues' squared distance, truncated at REG_HUE_TAU: grey against a hue is a miss. */
+static double hue_miss(const double a[2], const double b[2])
+{
+    double dx = a[0] - b[0], dy = a[1] - b[1];
+    return fmin(dx * dx + dy * dy, REG_HUE_TAU * REG_HUE_TAU);
 }
 
 /* The hue's gradient at group-0 cell @p hit (the hue across the surface, per unit of length
@@ -213,7 +238,7 @@ static uint32_t refine_second_step(struct reg_ctx *r, double gate_mm, double hue
     struct lsq_rigid eq, hues;
     lsq_rigid_clear(&eq);
     lsq_rigid_clear(&hues);
-    prepare_landing(r);
+    reg_prepare_landing(r);
     for (uint32_t v = 0; v < r->views; v++) {
         struct frame_xform pose;
         struct reg_view rv;
@@ -409,8 +434,7 @@ static void view_misfit(struct reg_ctx *r, uint32_t v, vec3 shift, double *sum, 
         if (hit == NULL ||
             !hue_between(r, hit, q, nq, grid_xy, min_cos, 2.0 * r->p.max_pair_mm, hq))
             continue;
-        double dx = hp[0] - hq[0], dy = hp[1] - hq[1]; /* grey against a hue: a miss */
-        *sum += fmin(dx * dx + dy * dy, REG_HUE_TAU * REG_HUE_TAU);
+        *sum += hue_miss(hp, hq);
         (*compared)++;
     }
 }
@@ -433,29 +457,19 @@ double reg_pair_colour_misfit(struct reg_ctx *r, uint32_t v, uint32_t w, uint64_
     const double min_cos = cos(r->p.max_normal_deg * M_PI / 180.0);
     double sum = 0.0;
     *compared = 0;
-    prepare_landing(r);
     for (size_t k = 0; k < reg_cell_count(r); k++) {
         const struct reg_cell *cl = &reg_view_cells(r, v)[k];
-        double hp[2], hq[2], fu, fv;
+        double hp[2], hq[2], facing, grid_xy[2];
         vec3 p, n, q, nq;
+        int landed;
         if (!cl->valid || !hue_of(cl, hp))
             continue;
         cell_in_object(cl, &r->first_pose[v], &p, &n);
-        vec3 c = frame_point(&r->first_cam[w], p);
-        if (c.z <= 1.0 || v3_dot(frame_dir(&r->first_cam[w], n), c) >= 0.0)
-            continue; /* behind the camera, or facing away from it */
-        camray_project(&r->calib, c, &fu, &fv);
-        long u = lround(fu / r->stride), y = lround(fv / r->stride);
-        if (u < 0 || y < 0 || u >= (long)r->gw || y >= (long)r->gh)
+        const struct reg_cell *cq =
+            land_in(r, w, p, n, min_cos, r->p.max_pair_mm, &landed, &facing, &q, &nq, grid_xy);
+        if (cq == NULL || !hue_of(cq, hq))
             continue;
-        const struct reg_cell *cq = &reg_view_cells(r, w)[(size_t)y * r->gw + (size_t)u];
-        if (!cq->valid || !hue_of(cq, hq))
-            continue;
-        cell_in_object(cq, &r->first_pose[w], &q, &nq);
-        if (v3_dot(n, nq) < min_cos || v3_len(v3_sub(p, q)) > r->p.max_pair_mm)
-            continue;
-        double dx = hp[0] - hq[0], dy = hp[1] - hq[1];
-        sum += fmin(dx * dx + dy * dy, REG_HUE_TAU * REG_HUE_TAU);
+        sum += hue_miss(hp, hq);
         (*compared)++;
     }
     return *compared > 0 ? sum / (double)*compared / (REG_HUE_TAU * REG_HUE_TAU) : 1.0;
@@ -549,7 +563,7 @@ int reg_place_by_colour(struct reg_ctx *r, double ring_rms_mm)
         {{REG_COLOUR_STEP_MM, REG_COLOUR_SEARCH_MM / REG_COLOUR_STEP_MM},
          {REG_COLOUR_STEP_MM / 10.0, 10}},
         {{4.0, REG_COLOUR_SEARCH_MM / 4.0}, {1.0, 4}, {0.25, 4}, {0.05, 5}}};
-    prepare_landing(r);
+    reg_prepare_landing(r);
     double at[2] = {0.0, 0.0}, best_misfit = HUGE_VAL, mean = 0.0;
     uint64_t best_compared = 0;
     for (int l = 0; l < 4 && levels[n - 1][l][0] > 0.0; l++) {

@@ -73,8 +73,12 @@ int reg_placement_holds(const struct reg_ctx *r);
  * @retval 0 the colour does not fix it either: the placement is left as it was */
 int reg_place_by_colour(struct reg_ctx *r, double ring_rms_mm);
 
+/* Group 0's poses and their inverses, where its views are landed on (first_pose, first_cam). */
+void reg_prepare_landing(struct reg_ctx *r);
+
 /* How badly view @p w's hues agree with view @p v's where @p v's samples land on @p w's surface
- * at the views' poses, over @p compared samples, as a share of a full miss. @retval 0 .. 1 */
+ * at the views' poses (both of group 0, after reg_prepare_landing), over @p compared samples,
+ * as a share of a full miss. @retval 0 .. 1 */
 double reg_pair_colour_misfit(struct reg_ctx *r, uint32_t v, uint32_t w, uint64_t *compared);
 
 #endif

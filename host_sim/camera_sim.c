@@ -24,8 +24,10 @@ static int camera_sim_open(void *priv, const struct hal_camera_config *cfg)
 
 /* The noise of a frame depends on what it shows (table angle, projector pattern, lights,
  * exposure) and on how many frames in a row showed the same, not on how many came before: a
- * scan resumed after an interruption sees the frames an uninterrupted one would. */
-static uint64_t noise_id(struct camera_sim *cam, const struct sim_sources *src)
+ * scan resumed after an interruption sees the frames an uninterrupted one would. A frame not
+ * @p counted (one in flight, which the scan discards) is not one of that row: the noise of
+ * those after it is what it would have been without it. */
+static uint64_t noise_id(struct camera_sim *cam, const struct sim_sources *src, int counted)
 {
     const uint64_t part[] = {(uint64_t)src->projector_on,
                              src->pattern_index,
@@ -36,9 +38,10 @@ static uint64_t noise_id(struct camera_sim *cam, const struct sim_sources *src)
     uint64_t key = 1469598103934665603ull; /* FNV-1a over the parts */
     for (size_t k = 0; k < sizeof(part) / sizeof(part[0]); k++)
         key = (key ^ part[k]) * 1099511628211ull;
-    cam->repeat = key == cam->last_key ? cam->repeat + 1 : 0;
-    cam->last_key = key;
-    return key + cam->repeat;
+    uint32_t repeat = key == cam->last_key ? cam->repeat + 1 : 0;
+    if (counted)
+        cam->repeat = repeat, cam->last_key = key;
+    return key + repeat;
 }
 
 /* A stale frame: one the camera exposed before the last light or pattern change (it had it
@@ -122,14 +125,7 @@ static int camera_sim_capture(void *priv, struct hal_image *img)
         cam->has_shown = 1;
     }
     double t0 = thread_cpu_s();
-    /* a frame in flight is not one of those in a row that showed the same (the scan discards
-     * it): the noise of those after it is what it would have been without it */
-    uint64_t last_key = cam->last_key, id;
-    uint32_t repeat = cam->repeat;
-    id = noise_id(cam, &src);
-    if (in_flight)
-        cam->last_key = last_key, cam->repeat = repeat;
-    sim_rig_render(cam->rig, &src, id, img->rgb);
+    sim_rig_render(cam->rig, &src, noise_id(cam, &src, !in_flight), img->rgb);
     cam->render_cpu_s += thread_cpu_s() - t0;
     uint64_t now_us = clock_sim_now(cam->clock);
     if (arrive_us > now_us)
