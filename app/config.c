@@ -267,7 +267,9 @@ static const struct ini_key config_keys[] = {
     F64("registration", "max_normal_deg", registration.max_normal_deg, 0, 180, "20",
         "normals differing more do not couple"),
     U32("registration", "use_colour", registration.use_colour, 0, 1, "1",
-        "1: colours must agree too (multi-feature matching)"),
+        "1: colours must agree too (multi-feature matching), and a pair whose shapes agree but "
+        "whose paint does not marks where the object slid along its faces (0: such a slide "
+        "goes unseen)"),
     F64("registration", "max_colour_dn", registration.max_colour_dn, 0, 255, "40",
         "largest per-channel colour difference of a coupled pair"),
     F64("registration", "max_correction_deg", registration.max_correction_deg, 0, 45, "3",
