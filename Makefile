@@ -97,7 +97,7 @@ LDLIBS_COMMON = $(PKG_LIBS) -lm
 FW_SRC := $(wildcard firmware/*.c) hal/hal.c
 POSIX_SRC := $(wildcard hal/posix/*.c) $(wildcard hal/modbus/*.c)
 # A config and a calibration read and checked: every program that loads one links these.
-CONFIG_SRC := app/config.c app/calib_file.c app/ini_schema.c hal/posix/file_posix.c
+CONFIG_SRC := app/config.c app/disk_room.c app/calib_file.c app/ini_schema.c hal/posix/file_posix.c
 SCAN_DIR_SRC := app/scan_dir.c app/scan_dir_range.c
 APP_LIB_SRC := $(filter app/%,$(CONFIG_SRC)) app/frame_writer.c app/patterns.c app/report.c app/rig.c $(SCAN_DIR_SRC) app/job.c app/job_events.c app/job_live.c app/answer.c app/job_model.c app/job_texture.c app/job_offline.c app/white_cal.c board/board_frame.c
 SIM_SRC := $(filter-out host_sim/turntable_sim_main.c,$(wildcard host_sim/*.c)) board/board_sim.c board/board_albedo.c

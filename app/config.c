@@ -715,18 +715,6 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
     return load(cfg, path, 0, err, err_len);
 }
 
-/* Bytes a view keeps per camera pixel, measured on the simulator's bunny at 1280 x 960 with
- * [colour] method multi (2026-12-04, the simulator's truth files left out): every frame 21.9,
- * the colour frames 13.8, none 4.6 (range.bin and cloud.ply); the object filling more of the
- * picture, or noisier frames compressing less, keep more: half again as margin. */
-uint64_t config_view_bytes(const struct app_config *cfg)
-{
-    const double per_pixel = cfg->keep_frames == KEEP_FRAMES_ALL      ? 21.9
-                             : cfg->keep_frames == KEEP_FRAMES_COLOUR ? 13.8
-                                                                      : 4.6;
-    return (uint64_t)(1.5 * per_pixel * cfg->camera.width * cfg->camera.height);
-}
-
 int config_load_offline(struct app_config *cfg, const char *path, char *err, size_t err_len)
 {
     return load(cfg, path, 1, err, err_len);

@@ -67,10 +67,6 @@ int config_load(struct app_config *cfg, const char *path, char *err, size_t err_
  *  @retval as config_load */
 int config_load_offline(struct app_config *cfg, const char *path, char *err, size_t err_len);
 
-/** About how many bytes a view of @p cfg keeps on disk (frames as [output] keep_frames says,
- *  range.bin, cloud.ply): measured per camera pixel, with half again as margin. */
-uint64_t config_view_bytes(const struct app_config *cfg);
-
 /** Check that the files the config names beyond its calibration can be read (the simulator's
  *  mesh_file and merl_file, where used; [sim] rig is read at load). A scan kept with its config
  *  does not need them again, so config_load leaves this to the commands that run the rig.

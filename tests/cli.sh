@@ -147,9 +147,29 @@ read_only_test() {
     [ "$rc" -eq 1 ] && grep -q "error: cannot write $out/ro/view_000/.*: Read-only file system" \
         "$out/ro.txt"
 }
+# A disk without room for the scan's frames (a 4 MB tmpfs; a view keeps ~40 MB): the scan and the
+# resume of a stopped scan are refused before the rig is touched, one line saying what is free,
+# what is needed and what to do; nothing is made on the disk, the stopped scan is left as it was.
+small_disk_test() {
+    mkdir -p "$out/small" && mount -t tmpfs -o size=4m tmpfs "$out/small" || return 2
+    "$bin" scan --config config/sim.ini --out "$out/small/scan" 2>"$out/small-scan.txt"
+    rc_scan=$?
+    made=$(ls -A "$out/small")
+    mkdir "$out/small/stopped" && cp "$out/scan/config.ini" "$out/scan/calibration.ini" "$out/small/stopped/"
+    "$bin" resume "$out/small/stopped" 2>"$out/small-resume.txt"
+    rc_resume=$?
+    left=$(ls -A "$out/small/stopped" | tr '\n' ' ')
+    umount "$out/small"
+    cat "$out/small-scan.txt" "$out/small-resume.txt"
+    [ "$rc_scan" -eq 1 ] && [ -z "$made" ] && [ "$rc_resume" -eq 1 ] &&
+        [ "$left" = "calibration.ini config.ini " ] &&
+        grep -q "error: $out/small/scan: the disk holds [0-9]* MB free; this scan needs about [0-9]* MB (8 views of about [0-9]* MB, \\[output\\] keep_frames = all): delete a scan, or keep fewer frames" "$out/small-scan.txt" &&
+        grep -q "error: $out/small/stopped: the disk holds [0-9]* MB free; this scan needs about [0-9]* MB (8 views" "$out/small-resume.txt"
+}
 if mkdir -p "$out/mnt-probe" && mount -t tmpfs -o size=1m tmpfs "$out/mnt-probe" 2>/dev/null; then
     umount "$out/mnt-probe"
     check process_on_read_only_says_why read_only_test
+    check scan_and_resume_refused_without_disk_room small_disk_test
 else
     echo "(process_on_read_only_says_why not run: mount is not allowed here)"
 fi

@@ -4,6 +4,7 @@
 #include "api.h"
 
 #include "config.h"
+#include "disk_room.h"
 #include "guard.h"
 #include "report.h"
 #include "scan_dir.h"
@@ -294,14 +295,13 @@ static const struct web_profile *resume_profile(const struct web_server *s, cons
 }
 
 /* Whether the scans' disk holds what profile @p p's scan (or the views a resume of @p resume_id
- * still takes) will keep, by config_view_bytes; @p why says what is short. @retval 1 it does */
+ * still takes) will keep (disk_room_check); @p why says what is short. @retval 1 it does */
 static int disk_holds(struct web_server *s, const struct web_profile *p, const char *resume_id,
                       char *why, size_t why_len)
 {
     struct app_config cfg;
-    struct statvfs fs;
     char err[WEB_PATH + 128];
-    if (config_load(&cfg, p->path, err, sizeof(err)) != 0 || statvfs(s->scans, &fs) != 0)
+    if (config_load(&cfg, p->path, err, sizeof(err)) != 0)
         return 1; /* the scanner itself says what is wrong with the profile */
     unsigned views = cfg.views * cfg.passes, done = 0, total = 0;
     enum web_state state;
@@ -309,16 +309,7 @@ static int disk_holds(struct web_server *s, const struct web_profile *p, const c
     if (resume_id != NULL &&
         jobs_describe(s, resume_id, &state, &done, &total, error, sizeof(error)) == 0)
         views = total > done ? total - done : 0;
-    double need = (double)views * (double)config_view_bytes(&cfg);
-    double free_bytes = (double)fs.f_bavail * fs.f_frsize;
-    if (need <= free_bytes)
-        return 1;
-    snprintf(why, why_len,
-             "the disk holds %.0f MB free; this scan needs about %.0f MB (%u views of about %.0f "
-             "MB, [output] keep_frames = %s): delete a scan, or keep fewer frames",
-             free_bytes / 1e6, need / 1e6, views, (double)config_view_bytes(&cfg) / 1e6,
-             cfg.keep_frames_name);
-    return 0;
+    return disk_room_check(&cfg, s->scans, views, why, why_len) == 0;
 }
 
 /* POST /api/scans (a new scan) or /api/scans/ID/resume. */
