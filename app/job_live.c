@@ -32,8 +32,9 @@ struct capture {
     char dir[SCAN_DIR_PATH_MAX];
 };
 
-/* A frame goes to the storage thread; a write of an earlier frame that failed is said here,
- * once, with its file. */
+/* A frame goes to the storage thread (a grey pattern frame copied: the decoder's lasts only until
+ * the next, scan_frame_sink); a write of an earlier frame that failed is said here, once, with
+ * its file. */
 static int save_frame(void *priv, uint32_t pattern, const uint8_t *pixels, uint32_t width,
                       uint32_t height, uint32_t channels)
 {
@@ -43,7 +44,8 @@ static int save_frame(void *priv, uint32_t pattern, const uint8_t *pixels, uint3
     if (!keeps_frame(j, pattern))
         return 0;
     int rc = frame_writer_put(j->out_dir, c->view, pattern, pixels, width, height, channels,
-                              (enum scan_frame_format)j->cfg->frame_format, failed, sizeof(failed));
+                              (enum scan_frame_format)j->cfg->frame_format, channels == 1, failed,
+                              sizeof(failed));
     if (rc != 0)
         j->hal->log(HAL_LOG_ERROR, "cannot write %s: %s", failed[0] ? failed : c->dir,
                     strerror(-rc));

@@ -1,4 +1,4 @@
-/* Gray-code decoding of a whole view from its kept frames, block by block. */
+/* Gray-code decoding of a view: each frame's bit read into the pixels as it is handed over. */
 #include "decode.h"
 
 #include "lsq.h"
@@ -73,76 +73,104 @@ int decode_begin(struct decode_ctx *d, const struct scan_params *params,
     d->next_pattern = 0;
     for (uint32_t c = 0; c < 256; c++) {
         d->bit_threshold[c] = (uint8_t)decode_bit_threshold(params, c);
-        d->mean_threshold[c] = (uint8_t)decode_mean_threshold(params, c);
+        d->mean_threshold_of[c] = (uint8_t)decode_mean_threshold(params, c);
     }
     d->xor_col = gray_code_xor_mask(layout->code, layout->col_bits);
     d->xor_row = gray_code_xor_mask(layout->code, layout->row_bits);
     return 0;
 }
 
+/* Pattern @p pattern's bit @p k of the columns or rows: whether it has an inverse, and whether
+ * it is that inverse. @retval 0 @retval -1 white, black or outside the layout */
+static int pattern_bit(const struct decode_ctx *d, uint32_t pattern, int *is_row, uint32_t *k,
+                       int *paired, int *is_inverse)
+{
+    uint32_t stripes;
+    int32_t inverse;
+    if (gray_layout_pattern(&d->layout, pattern, is_row, k, is_inverse) != 0)
+        return -1;
+    gray_layout_bit(&d->layout, *is_row, *k, &stripes, &inverse);
+    *paired = inverse >= 0;
+    return 0;
+}
+
 uint8_t *decode_frame_slot(struct decode_ctx *d, uint32_t pattern)
 {
-    return pattern < gray_layout_count(&d->layout) ? d->frame_store[pattern] : NULL;
+    int is_row, paired, is_inverse;
+    uint32_t k;
+    if (pattern >= gray_layout_count(&d->layout))
+        return NULL;
+    if (pattern == GRAY_PATTERN_WHITE)
+        return d->white;
+    if (pattern == GRAY_PATTERN_BLACK)
+        return d->black;
+    if (pattern_bit(d, pattern, &is_row, &k, &paired, &is_inverse) != 0)
+        return NULL;
+    return paired && !is_inverse ? d->stage[0] : d->stage[1];
+}
+
+/* Black handed over: each pixel's thresholds from its contrast, the mean its bits without
+ * inverse are read against, and no bits read yet. */
+static void begin_bits(struct decode_ctx *d, size_t n)
+{
+    const uint8_t *restrict white = d->white, *restrict black = d->black;
+    for (size_t i = 0; i < n; i++) {
+        uint8_t contrast = (uint8_t)(white[i] > black[i] ? white[i] - black[i] : 0);
+        d->threshold[i] = d->bit_threshold[contrast];
+        d->mean_threshold[i] = d->mean_threshold_of[contrast];
+        d->mean[i] = (uint8_t)(((unsigned)white[i] + black[i] + 1u) >> 1);
+    }
+    memset(d->sat, 0, n);
+    for (int axis = 0; axis < 2; axis++) {
+        memset(d->word_hi[axis], 0, n);
+        memset(d->word_lo[axis], 0, n);
+        memset(d->unclear_hi[axis], 0, n);
+        memset(d->unclear_lo[axis], 0, n);
+    }
+}
+
+/* Bit @p k of a coordinate into every pixel: the Gray word and the unclear mask take it as their
+ * next (lower) bit, in the byte plane of bits 0-7 or of the rest. |I - I_inverse| from two
+ * saturating subtractions, compared with the pixel's own threshold; a pair is saturated when
+ * both frames reached DECODE_SATURATED (one saturated frame still says which is brighter). Only
+ * 8-bit arithmetic and no branches, so that it runs 16 (or 32) pixels per instruction once
+ * vectorised. decode_reference is the same, plainly. */
+static void read_bit(struct decode_ctx *d, int is_row, uint32_t k, const uint8_t *restrict pos,
+                     const uint8_t *restrict neg, const uint8_t *restrict thr, size_t n)
+{
+    uint8_t *restrict word = k < 8 ? d->word_hi[is_row] : d->word_lo[is_row];
+    uint8_t *restrict unc = k < 8 ? d->unclear_hi[is_row] : d->unclear_lo[is_row];
+    uint8_t *restrict sat = d->sat;
+    for (size_t i = 0; i < n; i++) {
+        uint8_t a = pos[i], b = neg[i];
+        uint8_t up = (uint8_t)(a > b ? a - b : 0), down = (uint8_t)(b > a ? b - a : 0);
+        word[i] = (uint8_t)((word[i] << 1) | (up != 0));
+        unc[i] = (uint8_t)((unc[i] << 1) | ((up | down) <= thr[i]));
+        sat[i] = (uint8_t)(sat[i] | ((a & b) == DECODE_SATURATED));
+    }
 }
 
 int decode_frame(struct decode_ctx *d, uint32_t pattern, const uint8_t *grey)
 {
+    int is_row, paired, is_inverse;
+    uint32_t k;
     if (pattern != d->next_pattern || pattern >= gray_layout_count(&d->layout))
         return -EINVAL;
-    if (grey != d->frame_store[pattern])
-        memcpy(d->frame_store[pattern], grey, (size_t)d->params.width * d->params.height);
+    const size_t n = (size_t)d->params.width * d->params.height;
+    uint8_t *slot = decode_frame_slot(d, pattern);
+    if (grey != slot)
+        memcpy(slot, grey, n);
+    if (pattern == GRAY_PATTERN_BLACK)
+        begin_bits(d, n);
+    else if (pattern_bit(d, pattern, &is_row, &k, &paired, &is_inverse) == 0) {
+        /* a bit without inverse is read against the mean of white and black */
+        if (!paired)
+            read_bit(d, is_row, k, d->stage[1], d->mean, d->mean_threshold, n);
+        else if (is_inverse)
+            read_bit(d, is_row, k, d->stage[0], d->stage[1], d->threshold, n);
+    }
     d->next_pattern++;
     return 0;
-}
-
-/* The bits of one coordinate for a block: Gray code, unclear-bit mask, saturated pairs.
- * Only 8-bit arithmetic in the loop over pixels, so that it runs 16 (or 32) pixels per
- * instruction once vectorised: the code and the unclear mask are gathered in byte planes (the
- * first 8 bits, then the rest), |I - I_inverse| comes from two saturating subtractions and is
- * compared with the pixel's own threshold, and a pair is saturated when both frames reached
- * DECODE_SATURATED (one saturated frame still says which is brighter). decode_reference is the
- * same, plainly. */
-static void accumulate(const struct decode_ctx *d, struct decode_block *blk, int is_row,
-                       uint32_t bits, size_t start, size_t len, const uint8_t *threshold,
-                       uint16_t *code, uint16_t *unclear, uint8_t *both_saturated)
-{
-    const uint16_t xor_mask = (uint16_t)gray_code_xor_mask(d->layout.code, bits);
-    uint8_t *plane_hi = blk->plane_hi, *plane_lo = blk->plane_lo;
-    uint8_t *unclear_hi = blk->unclear_hi, *unclear_lo = blk->unclear_lo;
-    memset(plane_hi, 0, len);
-    memset(plane_lo, 0, len);
-    memset(unclear_hi, 0, len);
-    memset(unclear_lo, 0, len);
-    for (uint32_t k = 0; k < bits; k++) {
-        uint32_t stripes;
-        int32_t inverse;
-        gray_layout_bit(&d->layout, is_row, k, &stripes, &inverse);
-        /* a bit without its inverse is read against the mean of white and black */
-        const uint8_t *restrict pos = d->frame_store[stripes] + start;
-        const uint8_t *restrict neg = inverse >= 0 ? d->frame_store[inverse] + start : blk->mean;
-        const uint8_t *restrict thr = inverse >= 0 ? threshold : blk->mean_threshold;
-        uint8_t *restrict plane = k < 8 ? plane_hi : plane_lo;
-        uint8_t *restrict unc = k < 8 ? unclear_hi : unclear_lo;
-        uint8_t *restrict sat = both_saturated;
-        for (size_t i = 0; i < len; i++) {
-            uint8_t a = pos[i], b = neg[i];
-            uint8_t up = (uint8_t)(a > b ? a - b : 0), down = (uint8_t)(b > a ? b - a : 0);
-            plane[i] = (uint8_t)((plane[i] << 1) | (up != 0));
-            unc[i] = (uint8_t)((unc[i] << 1) | ((up | down) <= thr[i]));
-            sat[i] = (uint8_t)(sat[i] | ((a & b) == DECODE_SATURATED));
-        }
-    }
-    const uint32_t lo_bits = bits > 8 ? bits - 8 : 0;
-    for (size_t i = 0; i < len; i++) {
-        uint16_t g = (uint16_t)(((unsigned)plane_hi[i] << lo_bits) | plane_lo[i]);
-        g ^= (uint16_t)(-((g >> 1) & 1u) & xor_mask); /* XOR-04: the base bit off again */
-        g ^= (uint16_t)(g >> 1);                      /* Gray to binary: prefix XOR */
-        g ^= (uint16_t)(g >> 2);
-        g ^= (uint16_t)(g >> 4);
-        g ^= (uint16_t)(g >> 8);
-        code[i] = g;
-        unclear[i] = (uint16_t)(((unsigned)unclear_hi[i] << lo_bits) | unclear_lo[i]);
-    }
 }
 
 /* Set bits of @p v, in a handful of operations (Hacker's Delight 5-2): the baseline x86-64 and
@@ -184,41 +212,47 @@ static uint8_t classify(const struct scan_params *p, int white, int black, int b
     return out_of_range ? SCAN_INCONSISTENT : SCAN_VALID;
 }
 
-static void decode_block(struct decode_ctx *d, struct decode_block *blk, size_t start, size_t len,
-                         uint8_t *reason)
+/* A Gray word (XOR-04 or plain) as its value: the base bit off the coarser ones again, then
+ * Gray to binary by prefix XOR, in 16 bits. */
+static inline uint16_t word_value(uint16_t g, uint16_t xor_mask)
 {
-    uint16_t *code_col = blk->code_col, *code_row = blk->code_row;
-    uint8_t *threshold = blk->threshold, *sat = blk->sat;
-    const uint8_t *white = d->frame_store[GRAY_PATTERN_WHITE] + start;
-    const uint8_t *black = d->frame_store[GRAY_PATTERN_BLACK] + start;
-    const struct gray_layout *l = &d->layout;
-    uint8_t *mean = blk->mean, *mean_threshold = blk->mean_threshold;
-    for (size_t i = 0; i < len; i++) {
-        uint8_t contrast = (uint8_t)(white[i] > black[i] ? white[i] - black[i] : 0);
-        threshold[i] = d->bit_threshold[contrast];
-        mean_threshold[i] = d->mean_threshold[contrast];
-        mean[i] = (uint8_t)(((unsigned)white[i] + black[i] + 1u) >> 1);
-        sat[i] = 0;
-    }
-    accumulate(d, blk, 0, l->col_bits, start, len, threshold, code_col, d->unclear_col + start,
-               sat);
-    if (l->row_bits > 0)
-        accumulate(d, blk, 1, l->row_bits, start, len, threshold, code_row, d->unclear_row + start,
-                   sat);
-    else
-        memset(d->unclear_row + start, 0, len * sizeof(uint16_t));
+    g ^= (uint16_t)(-((g >> 1) & 1u) & xor_mask);
+    g ^= (uint16_t)(g >> 1);
+    g ^= (uint16_t)(g >> 2);
+    g ^= (uint16_t)(g >> 4);
+    g ^= (uint16_t)(g >> 8);
+    return g;
+}
+
+static void decode_block(struct decode_ctx *d, size_t start, size_t len, uint8_t *reason)
+{
     /* Locals: the stores to reason[] (bytes) may alias anything, and would make the compiler
      * read the settings again for every pixel. */
     const struct scan_params params = d->params;
-    const uint32_t xor_col = d->xor_col, xor_row = d->xor_row, rows = l->row_bits;
+    const uint32_t xor_col = d->xor_col, xor_row = d->xor_row, rows = d->layout.row_bits;
     const uint32_t width = d->proj_width, height = d->proj_height;
-    for (size_t i = 0; i < len; i++) {
-        int out = code_col[i] >= width || (rows > 0 && code_row[i] >= height);
-        reason[start + i] = classify(&params, white[i], black[i], sat[i],
-                                     unclear_count(d->unclear_col[start + i], xor_col),
-                                     unclear_count(d->unclear_row[start + i], xor_row), out);
-        d->column_map[start + i] = code_col[i];
-        d->row_map[start + i] = rows > 0 ? code_row[i] : 0;
+    const uint32_t lo_col = d->layout.col_bits > 8 ? d->layout.col_bits - 8 : 0;
+    const uint32_t lo_row = rows > 8 ? rows - 8 : 0;
+    for (size_t i = start; i < start + len; i++) {
+        uint16_t col =
+            word_value((uint16_t)(((unsigned)d->word_hi[0][i] << lo_col) | d->word_lo[0][i]),
+                       (uint16_t)xor_col);
+        uint16_t row =
+            rows > 0
+                ? word_value((uint16_t)(((unsigned)d->word_hi[1][i] << lo_row) | d->word_lo[1][i]),
+                             (uint16_t)xor_row)
+                : 0;
+        d->unclear_col[i] =
+            (uint16_t)(((unsigned)d->unclear_hi[0][i] << lo_col) | d->unclear_lo[0][i]);
+        d->unclear_row[i] =
+            rows > 0 ? (uint16_t)(((unsigned)d->unclear_hi[1][i] << lo_row) | d->unclear_lo[1][i])
+                     : 0;
+        int out = col >= width || (rows > 0 && row >= height);
+        reason[i] = classify(&params, d->white[i], d->black[i], d->sat[i],
+                             unclear_count(d->unclear_col[i], xor_col),
+                             unclear_count(d->unclear_row[i], xor_row), out);
+        d->column_map[i] = col;
+        d->row_map[i] = row;
     }
 }
 
@@ -236,8 +270,7 @@ static void decode_part(void *arg, unsigned k)
     size_t blocks = (p->pixels + DECODE_BLOCK - 1u) / DECODE_BLOCK;
     for (size_t b = blocks * k / p->parts; b < blocks * (k + 1u) / p->parts; b++) {
         size_t start = b * DECODE_BLOCK, left = p->pixels - start;
-        decode_block(p->d, &p->d->block[k], start, left < DECODE_BLOCK ? left : DECODE_BLOCK,
-                     p->reason);
+        decode_block(p->d, start, left < DECODE_BLOCK ? left : DECODE_BLOCK, p->reason);
     }
 }
 
@@ -248,7 +281,7 @@ int decode_pixels(struct decode_ctx *d, const struct hal_thread *threads, uint8_
         return -EINVAL;
     /* every pixel on its own: the same maps however the pixels are split */
     struct pixel_parts p = {d, reason, (size_t)d->params.width * d->params.height,
-                            hal_thread_parts(threads, HAL_MAX_THREADS)}; /* a block set each */
+                            hal_thread_parts(threads, HAL_MAX_THREADS)};
     hal_thread_run(threads, p.parts, decode_part, &p);
     maps->column = d->column_map;
     maps->row = d->layout.row_bits > 0 ? d->row_map : NULL;

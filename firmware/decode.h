@@ -1,7 +1,6 @@
 /* Structured-light decoding: per-pixel projector column (and row) and a reason code for every
- * rejected pixel. The frames of a view are kept in the decoder's store (struct decode_ctx) and
- * decoded together, in blocks of pixels small enough for the first-level cache, so each frame is
- * read from memory once. */
+ * rejected pixel. Each frame is read into the pixels' bits as it is handed over (a bit's stripes
+ * when their inverse comes), so the decoder keeps a few bytes a pixel, not the view's frames. */
 #ifndef DECODE_H
 #define DECODE_H
 
@@ -34,33 +33,39 @@ struct decode_maps {
 
 /* Patterns a view can have: DECODE_MAX_PATTERNS (hal_limits.h). */
 
-/** Pixels decoded together: a block's accumulators stay in the first-level cache while every
- *  frame streams through once. */
+/** Pixels converted together by decode_pixels, a block a thread at a time. */
 #define DECODE_BLOCK 4096u
 
-/** One view's decoder: its frames, maps and settings (several MB at the compiled limits: kept
- *  static by its owner, a struct scan_ctx, never on the stack). Fields are the decoder's own. */
+/** One view's decoder (several MB at the compiled limits: kept static by its owner, a struct
+ *  scan_ctx, never on the stack). It keeps what it needs of each pixel, not the frames: white
+ *  and black, the thresholds they give, and the bits read so far, so its size does not grow
+ *  with the patterns. Fields are the decoder's own. */
 struct decode_ctx {
-    uint8_t frame_store[DECODE_MAX_PATTERNS][HAL_MAX_PIXELS];
+    uint8_t white[HAL_MAX_PIXELS], black[HAL_MAX_PIXELS]; /* patterns 0 and 1, kept */
+    /* Frames being handed over: a bit's stripes wait in stage[0] for their inverse, which (like
+     * a bit projected without inverse) comes into stage[1]. */
+    uint8_t stage[2][HAL_MAX_PIXELS];
+    uint8_t threshold[HAL_MAX_PIXELS];      /* of a bit with its inverse, by the contrast */
+    uint8_t mean[HAL_MAX_PIXELS];           /* (white + black) / 2: read against by the bits */
+    uint8_t mean_threshold[HAL_MAX_PIXELS]; /* without inverse, and their threshold */
+    uint8_t sat[HAL_MAX_PIXELS];            /* some pair had both frames saturated */
+    /* The bits read so far, first high: the Gray word and which bits were unclear, of the
+     * columns [0] and rows [1], in byte planes (bits 0-7, then the rest) so that reading a bit
+     * is 8-bit arithmetic on one plane. */
+    uint8_t word_hi[2][HAL_MAX_PIXELS], word_lo[2][HAL_MAX_PIXELS];
+    uint8_t unclear_hi[2][HAL_MAX_PIXELS], unclear_lo[2][HAL_MAX_PIXELS];
     uint16_t column_map[HAL_MAX_PIXELS];
     uint16_t row_map[HAL_MAX_PIXELS];
     uint16_t unclear_col[HAL_MAX_PIXELS]; /* bit k: Gray bit k of the column was unclear */
     uint16_t unclear_row[HAL_MAX_PIXELS];
     uint8_t scratch[HAL_MAX_PIXELS]; /* the neighbourhood stages' verdicts, applied after */
-    struct decode_block {            /* one block's accumulators, one set a thread */
-        uint16_t code_col[DECODE_BLOCK], code_row[DECODE_BLOCK];
-        uint8_t threshold[DECODE_BLOCK], sat[DECODE_BLOCK];
-        uint8_t mean[DECODE_BLOCK], mean_threshold[DECODE_BLOCK]; /* bits without inverse */
-        uint8_t plane_hi[DECODE_BLOCK], plane_lo[DECODE_BLOCK];
-        uint8_t unclear_hi[DECODE_BLOCK], unclear_lo[DECODE_BLOCK];
-    } block[HAL_MAX_THREADS];
     struct scan_params params;
     struct gray_layout layout;
     uint32_t proj_width, proj_height;
     uint32_t next_pattern;
-    uint8_t bit_threshold[256];  /* |I - I_inverse| at or below this is unclear, per contrast */
-    uint8_t mean_threshold[256]; /* |I - (white + black) / 2| likewise, a bit without inverse */
-    uint32_t xor_col, xor_row;   /* gray_code_xor_mask of the columns and rows */
+    uint8_t bit_threshold[256];     /* |I - I_inverse| at or below this is unclear, per contrast */
+    uint8_t mean_threshold_of[256]; /* |I - (white + black) / 2| likewise, a bit without inverse */
+    uint32_t xor_col, xor_row;      /* gray_code_xor_mask of the columns and rows */
 };
 
 /** Short name of a reason code, for logs and reports. */
@@ -88,13 +93,15 @@ uint32_t decode_mean_threshold(const struct scan_params *params, uint32_t contra
  *  @retval 0 ok @retval -EINVAL size or pattern count above the compiled limits */
 int decode_begin(struct decode_ctx *d, const struct scan_params *params,
                  const struct gray_layout *layout, uint32_t proj_width, uint32_t proj_height);
-/** Where frame @p pattern is kept: a capture may write its grey frame there directly.
- *  @retval NULL when @p pattern is outside the layout */
+/** Where frame @p pattern is handed over: a capture may write its grey frame there directly.
+ *  It holds the frame until the next frame after it is handed over (white and black: until
+ *  the next view begins). @retval NULL when @p pattern is outside the layout */
 uint8_t *decode_frame_slot(struct decode_ctx *d, uint32_t pattern);
 /** Hand over the grey frame of pattern @p pattern, in sequence order (copied into its slot
- *  unless it already is the slot). @retval 0 ok @retval -EINVAL out of order */
+ *  unless it already is the slot), and read its bit into every pixel.
+ *  @retval 0 ok @retval -EINVAL out of order */
 int decode_frame(struct decode_ctx *d, uint32_t pattern, const uint8_t *grey);
-/** Decode every pixel from the kept frames (decode_pixels); then pixels with several unclear
+/** Decode every pixel from the bits read (decode_pixels); then pixels with several unclear
  *  bits take the reading their neighbourhood agrees with; then the neighbour check.
  *  @param threads  the cores to split the pixels across (NULL: this thread alone); the result
  *  is the same to the byte however many
@@ -103,7 +110,8 @@ int decode_frame(struct decode_ctx *d, uint32_t pattern, const uint8_t *grey);
  *  @retval 0 ok @retval -EINVAL frames missing */
 int decode_finish(struct decode_ctx *d, const struct hal_thread *threads, uint8_t *reason,
                   struct decode_maps *maps);
-/** The per-pixel stage of decode_finish alone (for tests and benchmarks); same parameters. */
+/** The per-pixel stage of decode_finish alone (for tests and benchmarks; it may run again, the
+ *  bits read are kept until the next view begins); same parameters. */
 int decode_pixels(struct decode_ctx *d, const struct hal_thread *threads, uint8_t *reason,
                   struct decode_maps *maps);
 

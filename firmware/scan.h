@@ -94,7 +94,9 @@ int scan_open(const struct hal *hal, const struct hal_camera_config *cam_cfg);
 
 /** Where the frames of a view go to be kept (the scan directory); optional. */
 struct scan_frame_sink {
-    /** Keep frame @p pattern: RGB24 (channels 3, the white frame) or the decoder's grey.
+    /** Keep frame @p pattern: RGB24 (channels 3: the white frame, the colour frames; they stay
+     *  as they are until the next view begins) or the decoder's grey (channels 1: valid only
+     *  during the call, the decoder reads each frame and lets it go).
      *  @retval 0 ok @retval -errno, which stops the view */
     int (*save)(void *priv, uint32_t pattern, const uint8_t *pixels, uint32_t width,
                 uint32_t height, uint32_t channels);

@@ -18,6 +18,7 @@
 #include <unistd.h>
 
 #include "clock_posix.h"
+#include "frame_writer.h"
 #include "scan_dir.h"
 #include "scan_job.h"
 #include "storage_posix.h"
@@ -360,6 +361,42 @@ static void test_process_other_frames_refused(void **state)
         "RGB', but these settings need 'light 0 alone, 20000 us, RGB' there"));
 }
 
+/* The storage thread keeps a grey frame handed to it for copying as it was when handed over,
+ * although the caller reuses its buffer at once (the decoder's frames last only until the next):
+ * more frames than it has copies, so that it waits for its own writes; a frame too large to copy
+ * is refused, nothing queued. */
+static void test_frame_writer_copies_grey_frames(void **state)
+{
+    (void)state;
+    static uint8_t buf[W * H], back[W * H * 3];
+    const char *dir = view_with("writer", "");
+    const uint32_t frames = 3u * FRAME_WRITER_COPIES;
+    char failed[SCAN_DIR_PATH_MAX] = "";
+    assert_int_equal(frame_writer_start(&hal.storage), 0);
+    for (uint32_t f = 0; f < frames; f++) {
+        memset(buf, (int)(f + 1u), sizeof(buf));
+        assert_int_equal(frame_writer_put(dir, 0, f, buf, W, H, 1, SCAN_FRAMES_PNM, 1, failed,
+                                          sizeof(failed)),
+                         0);
+        memset(buf, 0xEE, sizeof(buf)); /* the next frame comes into the same buffer */
+    }
+    assert_int_equal(frame_writer_put(dir, 0, frames, back, HAL_MAX_WIDTH, HAL_MAX_HEIGHT, 3,
+                                      SCAN_FRAMES_PNM, 1, failed, sizeof(failed)),
+                     -EINVAL);
+    assert_int_equal(frame_writer_flush(failed, sizeof(failed)), 0);
+    frame_writer_stop();
+    for (uint32_t f = 0; f < frames; f++) {
+        assert_int_equal(scan_dir_read_frame(dir, 0, f, back, sizeof(back), W, H, 1, err,
+                                             sizeof(err)),
+                         0);
+        for (size_t i = 0; i < (size_t)W * H; i += 4099)
+            assert_int_equal(back[i], f + 1u);
+    }
+    assert_int_equal(scan_dir_read_frame(dir, 0, frames, back, sizeof(back), W, H, 1, err,
+                                         sizeof(err)),
+                     -ENOENT);
+}
+
 /* A view taken again loses its old view.ini before its first frame: were it cut short, it could
  * not pass for finished with frames of two takes. */
 static void test_begin_view_removes_view_ini(void **state)
@@ -382,6 +419,7 @@ int main(void)
         cmocka_unit_test(test_process_damaged_frame_one_error),
         cmocka_unit_test(test_process_other_frames_refused),
         cmocka_unit_test(test_begin_view_removes_view_ini),
+        cmocka_unit_test(test_frame_writer_copies_grey_frames),
     };
     return cmocka_run_group_tests(tests, setup, NULL);
 }

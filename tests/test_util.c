@@ -7,9 +7,11 @@
 #include "vec3.h"
 
 #include <dirent.h>
+#include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 char test_last_log[512];
@@ -262,4 +264,34 @@ void test_measure_view(const struct sim_rig *rig, const struct scan_view *view,
     q->depth_rms_mm = q->valid ? sqrt(sum_sq / q->valid) : 0.0;
     q->normal_err_deg = q->valid ? sum_angle / q->valid : 0.0;
     q->distance_mm = q->lit ? sum_dist / q->lit : 0.0;
+}
+
+static int keep_frame(void *priv, uint32_t pattern, const uint8_t *pixels, uint32_t width,
+                      uint32_t height, uint32_t channels)
+{
+    struct test_frames *f = priv;
+    (void)width;
+    (void)height;
+    if (pattern >= DECODE_MAX_PATTERNS || (channels == 3 && pattern != GRAY_PATTERN_WHITE))
+        return 0; /* a colour frame */
+    if (f->grey[pattern] == NULL && (f->grey[pattern] = malloc(f->pixels)) == NULL)
+        return -ENOMEM;
+    if (channels == 3)
+        decode_rgb_to_grey(pixels, f->grey[pattern], f->pixels, f->saturation_dn);
+    else
+        memcpy(f->grey[pattern], pixels, f->pixels);
+    return 0;
+}
+
+struct scan_frame_sink test_frames_sink(struct test_frames *f)
+{
+    return (struct scan_frame_sink){.save = keep_frame, .priv = f};
+}
+
+void test_frames_free(struct test_frames *f)
+{
+    for (uint32_t i = 0; i < DECODE_MAX_PATTERNS; i++) {
+        free(f->grey[i]);
+        f->grey[i] = NULL;
+    }
 }

@@ -14,6 +14,20 @@ struct test_rig {
     struct scan_ctx *scan; /* the view buffers: the process's (scan_job_views) */
 };
 
+/** Every pattern frame of a view as the decoder saw it (grey; the white frame converted from
+ *  RGB as the scan converts it): the decoder reads each frame and lets it go, so a test that
+ *  compares it with decode_reference keeps them through this frame sink. */
+struct test_frames {
+    uint8_t *grey[DECODE_MAX_PATTERNS]; /* malloc'd, as they come */
+    size_t pixels;
+    uint32_t saturation_dn;
+};
+/** A sink (for scan_take_view) that fills @p f, which must start zeroed with @p pixels and
+ *  @p saturation_dn set. */
+struct scan_frame_sink test_frames_sink(struct test_frames *f);
+/** Free what @p f holds. */
+void test_frames_free(struct test_frames *f);
+
 /** Last message logged through the test logger, and how many errors were logged. */
 extern char test_last_log[512];
 extern int test_error_count;

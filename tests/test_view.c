@@ -176,7 +176,10 @@ static void blocked_matches_reference(uint32_t inverse_bits, uint32_t patterns)
     assert_int_equal(test_rig_start(&t), 0);
     struct scan_view view;
     struct scan_view_info info;
-    assert_int_equal(scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info),
+    struct test_frames kept = {.pixels = (size_t)t.cfg.scan.width * t.cfg.scan.height,
+                               .saturation_dn = t.cfg.scan.saturation_dn};
+    struct scan_frame_sink sink = test_frames_sink(&kept);
+    assert_int_equal(scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, &sink, &view, &info),
                      0);
     /* rows and columns, then the colour frames of config/sim.ini's method */
     assert_int_equal(info.frames_captured,
@@ -184,8 +187,10 @@ static void blocked_matches_reference(uint32_t inverse_bits, uint32_t patterns)
     struct gray_layout layout;
     scan_layout(&t.cfg.scan, &t.calib, &layout);
     const uint8_t *frames[DECODE_MAX_PATTERNS];
-    for (uint32_t p = 0; p < gray_layout_count(&layout); p++)
-        frames[p] = decode_frame_slot(&t.scan->decode, p);
+    for (uint32_t p = 0; p < gray_layout_count(&layout); p++) {
+        assert_non_null(kept.grey[p]);
+        frames[p] = kept.grey[p];
+    }
     static uint8_t pixel_reason[HAL_MAX_PIXELS];
     struct decode_maps pixel_maps;
     /* again, without the neighbour check */
@@ -208,6 +213,7 @@ static void blocked_matches_reference(uint32_t inverse_bits, uint32_t patterns)
         row_right += fabs((double)row[i] - floor(rig->truth.proj_v[i] + 0.5)) <= 1.0;
     }
     test_rig_stop(&t);
+    test_frames_free(&kept);
     print_message("%zu valid pixels identical; rows right (+-1) at %.2f%%\n", valid,
                   100.0 * row_right / valid);
     assert_true(valid > 100000);
