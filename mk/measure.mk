@@ -24,8 +24,9 @@ eval-cycles: deps $(BUILD)/scanner $(BUILD)/texture-eval $(BUILD)/mesh-compare
 	tools/cycles_eval.sh $(BUILD) $(EVAL_DIR)
 
 ## eval: intrinsic colour compared on the simulator into docs/colour-eval/ (about 25 min)
+# EVAL_SCENES: some of tests/eval/'s scenes only (.ci/run: two, to see it run end to end).
 eval: deps $(BUILD)/scanner $(BUILD)/colour-eval $(BUILD)/relight-eval
-	tools/colour_eval.sh $(BUILD) $(EVAL_DIR)
+	tools/colour_eval.sh $(BUILD) $(EVAL_DIR) $(EVAL_SCENES)
 
 # Full simulated scans measured against the true surface, with a turntable that misses its
 # angle by up to 1 and 2 degrees (each view's angle as reported, registered and true), and peak
