@@ -375,9 +375,9 @@ static void test_frame_writer_copies_grey_frames(void **state)
     assert_int_equal(frame_writer_start(&hal.storage), 0);
     for (uint32_t f = 0; f < frames; f++) {
         memset(buf, (int)(f + 1u), sizeof(buf));
-        assert_int_equal(frame_writer_put(dir, 0, f, buf, W, H, 1, SCAN_FRAMES_PNM, 1, failed,
-                                          sizeof(failed)),
-                         0);
+        assert_int_equal(
+            frame_writer_put(dir, 0, f, buf, W, H, 1, SCAN_FRAMES_PNM, 1, failed, sizeof(failed)),
+            0);
         memset(buf, 0xEE, sizeof(buf)); /* the next frame comes into the same buffer */
     }
     assert_int_equal(frame_writer_put(dir, 0, frames, back, HAL_MAX_WIDTH, HAL_MAX_HEIGHT, 3,
@@ -386,15 +386,14 @@ static void test_frame_writer_copies_grey_frames(void **state)
     assert_int_equal(frame_writer_flush(failed, sizeof(failed)), 0);
     frame_writer_stop();
     for (uint32_t f = 0; f < frames; f++) {
-        assert_int_equal(scan_dir_read_frame(dir, 0, f, back, sizeof(back), W, H, 1, err,
-                                             sizeof(err)),
-                         0);
+        assert_int_equal(
+            scan_dir_read_frame(dir, 0, f, back, sizeof(back), W, H, 1, err, sizeof(err)), 0);
         for (size_t i = 0; i < (size_t)W * H; i += 4099)
             assert_int_equal(back[i], f + 1u);
     }
-    assert_int_equal(scan_dir_read_frame(dir, 0, frames, back, sizeof(back), W, H, 1, err,
-                                         sizeof(err)),
-                     -ENOENT);
+    assert_int_equal(
+        scan_dir_read_frame(dir, 0, frames, back, sizeof(back), W, H, 1, err, sizeof(err)),
+        -ENOENT);
 }
 
 /* A view taken again loses its old view.ini before its first frame: were it cut short, it could
