@@ -150,7 +150,7 @@ int job_begin_model(struct job *j)
 static int report_registration(struct job *j, const struct reg_report *r, double cpu_seconds,
                                const char *scan_dir)
 {
-    char detail[512];
+    char detail[768];
     uint32_t turning = j->views - j->cfg->passes; /* the views whose angle is registered */
     int no_turn_seen = r->solved && r->turns_from_table > 0 && r->turns_from_table >= turning;
     if (!r->solved)
@@ -196,7 +196,13 @@ static int report_registration(struct job *j, const struct reg_report *r, double
                  (unsigned)r->apart_pairs, r->apart_pairs == 1 ? "" : "s", r->apart_against,
                  r->apart_view);
     }
-    if (r->axis_from_calibration && !no_turn_seen) {
+    if (r->views_alike && !no_turn_seen) {
+        n = strlen(detail);
+        snprintf(detail + n, sizeof(detail) - n,
+                 "; each view looks like its neighbour as they stand (the object's symmetry "
+                 "matches the table's step): the calibrated axis kept, which such views cannot "
+                 "place (a number of views its symmetry does not divide lets them)");
+    } else if (r->axis_from_calibration && !no_turn_seen) {
         n = strlen(detail);
         snprintf(detail + n, sizeof(detail) - n,
                  "; the views share too little to place the axis: the calibrated one kept");

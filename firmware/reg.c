@@ -387,8 +387,10 @@ static void add_prior(struct reg_ctx *r)
     /* the unknowns' own measures of how far the axis is: shifts along e1, e2 and the tilts
      * that gauss_newton_step applies (d += (e1 t1 + e2 t2) x d moves d by -t1 e2 + t2 e1) */
     const double off[4] = {v3_dot(da, e1), v3_dot(da, e2), -v3_dot(dd, e2), v3_dot(dd, e1)};
-    const double sigma_shift = fmax(r->p.max_axis_shift_mm / 3.0, 1e-3);
-    const double sigma_tilt = fmax(r->p.max_axis_tilt_deg / 3.0, 1e-3) * M_PI / 180.0;
+    /* views alike as they stand cannot place the axis (reg_views_alike): held where calibrated */
+    const double hold = r->views_alike ? 1e-3 : 1.0;
+    const double sigma_shift = hold * fmax(r->p.max_axis_shift_mm / 3.0, 1e-3);
+    const double sigma_tilt = hold * fmax(r->p.max_axis_tilt_deg / 3.0, 1e-3) * M_PI / 180.0;
     for (int k = 0; k < 4; k++) {
         uint32_t i = r->views - r->passes + (uint32_t)k;
         double w = pow(huber_mm(r) / (k < 2 ? sigma_shift : sigma_tilt), 2.0);
@@ -450,7 +452,8 @@ static void keep_unfixed_turns(struct reg_ctx *r)
     uint32_t unfixed = 0;
     for (uint32_t v = 0; v < r->views; v++)
         unfixed += r->from_table[v];
-    r->axis_from_calib = unfixed > 0 && unfixed + r->passes >= r->views; /* no turn seen */
+    r->axis_from_calib = (unfixed > 0 && unfixed + r->passes >= r->views) || /* no turn seen */
+                         r->views_alike;
     for (int k = 0; k < 2; k++)
         if (r->shift_whole[k] > 0.0 &&
             r->shift_seen[k] < REG_TURN_SEEN * REG_TURN_SEEN * r->shift_whole[k])
@@ -531,6 +534,7 @@ static void summarise(struct reg_ctx *r, struct reg_report *rep)
     for (uint32_t v = 0; v < r->views; v++)
         rep->turns_from_table += r->from_table[v];
     rep->axis_from_calibration = r->axis_from_calib;
+    rep->views_alike = r->views_alike;
     for (uint32_t v = 0; v < r->views; v++) {
         struct reg_view rv;
         if (reg_view_pose(r, v, NULL, &rv) == 0 && rv.coupled > 0 &&
@@ -548,6 +552,7 @@ static void solve_joint(struct reg_ctx *r, struct reg_report *rep)
 {
     make_edges(r);
     start_from_table(r);
+    r->views_alike = reg_views_alike(r);
     r->use_solution = 0;
     pass(r, r->p.max_pair_mm, 0);
     rep->score_before_mm = rep->score_after_mm = score(r);

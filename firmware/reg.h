@@ -74,8 +74,10 @@ struct reg_report {
     double second_rms_mm;          /**< and their residual */
     uint32_t turns_from_table;     /**< views whose turn the geometry does not fix (reg_view) */
     int axis_from_calibration;     /**< 1: the pairs do not see the axis's place: calibrated kept */
-    int moved_view;                /**< -1, or the first view after the object moved on the table
-                                        (one pass): from it, moved_views views were placed freely */
+    int views_alike; /**< 1: each view looked like its neighbour as they stood (the object's
+                          symmetry matches the table's step): the calibrated axis kept */
+    int moved_view;  /**< -1, or the first view after the object moved on the table
+                          (one pass): from it, moved_views views were placed freely */
     uint32_t moved_views;
     double moved_mm, moved_deg; /**< how far the object had moved, and turned */
     int moved_by_colour; /**< the directions its shape left free, which its paint fixed (1 or 2;
@@ -124,6 +126,7 @@ struct reg_ctx {
     double turn_seen[REG_MAX_VIEWS], turn_whole[REG_MAX_VIEWS];
     double shift_seen[2], shift_whole[2]; /**< the same for a shift of the axis across it */
     int axis_from_calib;                  /**< the pairs do not see the axis: calibrated kept */
+    int views_alike;                      /**< reg_views_alike: the axis held to the calibrated */
     uint8_t from_table[REG_MAX_VIEWS];    /**< the turn kept at the table's angle */
     vec3 a, d;                            /**< the axis */
     int use_solution;                     /**< poses from theta, a, d rather than the turntable's */

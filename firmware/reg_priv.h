@@ -119,4 +119,9 @@ int reg_find_quiet_breaks(struct reg_ctx *r, struct reg_report *rep);
  * becomes group 1). @retval 1 cut @retval 0 not so */
 int reg_cut_at_the_move(struct reg_ctx *r);
 
+/* @retval 1 every pair of neighbouring views looks alike as the two stand, on REG_SIDE_MIN
+ * sideways samples or more (the object's symmetry matches the table's step: its pairs cannot
+ * place the axis) */
+int reg_views_alike(const struct reg_ctx *r);
+
 #endif
