@@ -9,7 +9,7 @@
 # model against the truth once aligned (mean, mm), the truth within 1 mm of the model (above the
 # table), holes and pieces of the model, and the registration's CPU.
 # Usage: scripts/measure-objects.sh BUILD; OBJECTS="box gear", VIEWS="4 8", METHODS="none" and
-# CONDITIONS="exact" (exact table1 table2 slip slip30 push6) choose a subset; KEEP=1 keeps the frames
+# CONDITIONS="exact" (exact table1 table2 slip slip30 push6; slip6v and slip12v: the 6 mm slip in 6 and 12 views) choose a subset; KEEP=1 keeps the frames
 # (scanner process DIR computes a scan again from them).
 set -eu
 build=$1
@@ -96,6 +96,10 @@ for obj in $objects; do
             row "$obj" 8 none "30 mm slip" "$obj-slip30" ;;
         push6) config "$obj" 6 none "slip_mm = 30, 0, 0\nslip_at_deg = 170\n" "$obj-push6"
             row "$obj" 6 none "30 mm slip" "$obj-push6" ;;
+        slip6v) config "$obj" 6 none "slip_mm = 6, 0, 0\nslip_at_deg = 170\n" "$obj-slip6v"
+            row "$obj" 6 none "6 mm slip" "$obj-slip6v" ;;
+        slip12v) config "$obj" 12 none "slip_mm = 6, 0, 0\nslip_at_deg = 170\n" "$obj-slip12v"
+            row "$obj" 12 none "6 mm slip" "$obj-slip12v" ;;
         esac
     done
 done
