@@ -229,9 +229,11 @@ static void add_hue_rows(struct reg_ctx *r, struct lsq_rigid *eq, const struct r
  * @retval pairs coupled; @p rms their residual, @p overlap the samples that landed on a group-0
  * surface facing the same way (coupled or not), @p hold how well the pairs hold a shift in every
  * direction: @p share and @p axis as lsq_rigid_shift_axes gives them (share[0] is
- * lsq_rigid_shift_hold), of the shape's pairs alone */
+ * lsq_rigid_shift_hold), of the shape's pairs alone. @p hold_turn: the turn about the table's
+ * axis (object frame z) is not moved (untwist_placement says why) */
 static uint32_t refine_second_step(struct reg_ctx *r, double gate_mm, double hue_weight,
-                                   double *rms, uint32_t *overlap, double share[3], vec3 axis[3])
+                                   int hold_turn, double *rms, uint32_t *overlap, double share[3],
+                                   vec3 axis[3])
 {
     *overlap = 0;
     const double min_cos = cos(r->p.max_normal_deg * M_PI / 180.0);
@@ -287,6 +289,12 @@ static uint32_t refine_second_step(struct reg_ctx *r, double gate_mm, double hue
                 eq.a[(3 + i) * 6 + 3 + j] += a_u * u[i] * u[j];
         }
     }
+    if (hold_turn) { /* x[2], the turn about z, fixed at 0 */
+        for (int i = 0; i < 6; i++)
+            eq.a[2 * 6 + i] = eq.a[i * 6 + 2] = 0.0;
+        eq.a[2 * 6 + 2] = 1.0;
+        eq.b[2] = 0.0;
+    }
     struct frame_xform s, moved;
     if (lsq_rigid_step(&eq, &s) == 0) {
         frame_compose(&s, &r->first_from_second, &moved);
@@ -323,7 +331,7 @@ void reg_align_group(struct reg_ctx *r, struct reg_report *rep)
     double rms = 0.0;
     uint32_t overlap;
     for (int it = 0; it < 15; it++)
-        rep->second_coupled = refine_second_step(r, r->p.max_pair_mm, 0.0, &rms, &overlap,
+        rep->second_coupled = refine_second_step(r, r->p.max_pair_mm, 0.0, 0, &rms, &overlap,
                                                  r->placed_share, r->placed_axis);
     rep->second_rms_mm = rms;
     rep->second_turned_deg = ar.turned_deg;
@@ -356,7 +364,7 @@ int reg_place_near_table(struct reg_ctx *r, double ring_rms_mm, double reach)
     r->second_aligned = 1;
     for (int it = 0; it <= 20; it++) {
         double gate = r->p.max_pair_mm * fmax(1.0, reach / (double)(1u << (it < 8 ? it : 8)));
-        coupled = refine_second_step(r, it < 20 ? gate : r->p.max_pair_mm, 0.0, &rms, &overlap,
+        coupled = refine_second_step(r, it < 20 ? gate : r->p.max_pair_mm, 0.0, 0, &rms, &overlap,
                                      r->placed_share, r->placed_axis);
     }
     r->second_aligned = placement_fits(r, coupled, overlap, rms, ring_rms_mm);
@@ -550,6 +558,21 @@ static double search_level(struct reg_ctx *r, const vec3 axes[2], int n, const d
     return sum / count;
 }
 
+/* The placement's turn about the table's axis (the object frames' z) taken off, its shift and
+ * tilt kept: where the shape holds no shift along the table (a top, and little else), it holds
+ * no turn about the table's axis either (a plane turns into itself), and ICP leaves one from
+ * noise (the box slipped 6 mm in 6 views: 1.9 deg, its model 0.21 mm off); the colour search
+ * moves shifts only, so it starts from the table's turn instead. The twist of a rotation about
+ * z is atan2(R10 - R01, R00 + R11), exact for a turn about z alone. */
+static void untwist_placement(struct reg_ctx *r)
+{
+    const double *m = r->first_from_second.rot;
+    double phi = atan2(m[3] - m[1], m[0] + m[4]), c = cos(phi), s = sin(phi);
+    struct frame_xform back = {{c, s, 0, -s, c, 0, 0, 0, 1}, {0, 0, 0}}, out;
+    frame_compose(&back, &r->first_from_second, &out);
+    r->first_from_second = out;
+}
+
 int reg_place_by_colour(struct reg_ctx *r, double ring_rms_mm)
 {
     /* One free direction (two parallel faces and a top), or two (a plate: its top and little
@@ -557,6 +580,9 @@ int reg_place_by_colour(struct reg_ctx *r, double ring_rms_mm)
     int n = r->placed_share[1] >= REG_COLOUR_MIN_NEXT ? 1 : 2;
     if (!r->second_aligned || r->placed_share[2] < REG_COLOUR_MIN_NEXT)
         return 0;
+    struct frame_xform before = r->first_from_second;
+    if (n == 2)
+        untwist_placement(r);
     const vec3 axes[2] = {r->placed_axis[0], n > 1 ? r->placed_axis[1] : v3(0, 0, 0)};
     /* Coarse to fine: a step, how many either way (the first level spans the search). */
     static const double levels[2][4][2] = {
@@ -572,16 +598,17 @@ int reg_place_by_colour(struct reg_ctx *r, double ring_rms_mm)
                                 at, &best_misfit, &best_compared);
         mean = l == 0 ? m : mean;
     }
-    if (best_compared < REG_COLOUR_MIN_COMPARED || !(best_misfit < REG_COLOUR_MAX_DIP * mean))
+    if (best_compared < REG_COLOUR_MIN_COMPARED || !(best_misfit < REG_COLOUR_MAX_DIP * mean)) {
+        r->first_from_second = before;
         return 0; /* no dip: plain paint (all grey: 0 everywhere) or nothing compared */
-    struct frame_xform before = r->first_from_second;
+    }
     shift_placement(r, v3_add(v3_scale(axes[0], at[0]), v3_scale(axes[1], at[1])));
     double rms = 0.0, share[3];
     uint32_t overlap = 0, coupled = 0;
     vec3 axis[3];
     for (int it = 0; it < REG_COLOUR_ITERATIONS; it++) /* shape and colour: every direction */
-        coupled =
-            refine_second_step(r, r->p.max_pair_mm, REG_HUE_WEIGHT, &rms, &overlap, share, axis);
+        coupled = refine_second_step(r, r->p.max_pair_mm, REG_HUE_WEIGHT, n == 2, &rms, &overlap,
+                                     share, axis);
     uint64_t compared;
     double misfit = colour_misfit(r, v3(0.0, 0.0, 0.0), &compared);
     if (!placement_fits(r, coupled, overlap, rms, ring_rms_mm) ||
