@@ -562,12 +562,16 @@ static double search_level(struct reg_ctx *r, const vec3 axes[2], int n, const d
  * tilt kept: where the shape holds no shift along the table (a top, and little else), it holds
  * no turn about the table's axis either (a plane turns into itself), and ICP leaves one from
  * noise (the box slipped 6 mm in 6 views: 1.9 deg, its model 0.21 mm off); the colour search
- * moves shifts only, so it starts from the table's turn instead. The twist of a rotation about
- * z is atan2(R10 - R01, R00 + R11), exact for a turn about z alone. */
+ * moves shifts only, so it starts from the table's turn instead (the plate pushed 30 mm in 6
+ * views: 4.4 deg taken off). The twist of a rotation about z is atan2(R10 - R01, R00 + R11),
+ * exact for a turn about z alone. */
+#define REG_UNTWIST_MAX_DEG 10.0 /* a larger turn is no noise: the shape found it, kept */
 static void untwist_placement(struct reg_ctx *r)
 {
     const double *m = r->first_from_second.rot;
     double phi = atan2(m[3] - m[1], m[0] + m[4]), c = cos(phi), s = sin(phi);
+    if (fabs(phi) > REG_UNTWIST_MAX_DEG * M_PI / 180.0)
+        return;
     struct frame_xform back = {{c, s, 0, -s, c, 0, 0, 0, 1}, {0, 0, 0}}, out;
     frame_compose(&back, &r->first_from_second, &out);
     r->first_from_second = out;
