@@ -159,7 +159,9 @@ static const struct ini_key config_keys[] = {
     ENUM("output", "keep_frames", keep_frames_name, "all|colour|none", "all",
          "which camera frames a scan keeps: all (scanner process can decode and colour again), "
          "colour (the colour frames, not the stripe patterns), or none; each view's range image "
-         "(range.bin) is kept in every case, so process can still register and fuse again"),
+         "(range.bin) is kept in every case, so process can still register and fuse again. A scan "
+         "or resume the disk cannot hold as kept (about 33, 21 or 7 bytes a camera pixel a view) "
+         "is refused before it starts"),
     U32("output", "texture", texture, 0, 1, "1",
         "1: the model's colour also as a texture at the camera's resolution (texture.png, with "
         "mesh.obj's mesh.mtl and inside mesh.glb); vertex colours are kept either way"),
