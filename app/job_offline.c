@@ -64,9 +64,7 @@ int scan_job_resume(const struct hal *hal, const struct app_config *cfg,
     int rc = job_open_out(&j, SCAN_DIR_EXISTING, &lock_fd);
     if (rc != 0)
         return rc;
-    uint32_t first = 0;
-    while (first < j.views && scan_dir_view_complete(scan_dir, first))
-        first++;
+    uint32_t first = scan_dir_first_missing(scan_dir, j.views);
     snprintf(detail, sizeof(detail), "%u of %u views kept", (unsigned)first, (unsigned)j.views);
     job_progress(&j, EV_RESUME, -1, first, detail);
     if (first < j.views) {

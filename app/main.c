@@ -180,10 +180,8 @@ static int cmd_resume(const char *scan_dir, const struct scan_job_opts *opts)
         fprintf(stderr, "scanner: error: %s\n", err);
         return 2;
     }
-    uint32_t left = 0;
-    for (uint32_t v = 0; v < cfg.views * cfg.passes; v++)
-        left += !scan_dir_view_complete(scan_dir, v);
-    if (check_disk_room(&cfg, scan_dir, left) != 0)
+    const uint32_t views = cfg.views * cfg.passes; /* a resume takes them from the first missing */
+    if (check_disk_room(&cfg, scan_dir, views - scan_dir_first_missing(scan_dir, views)) != 0)
         return 1;
     int rc = rig_up(&cfg, &calib);
     if (rc == 0)

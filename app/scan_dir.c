@@ -291,6 +291,14 @@ int scan_dir_view_complete(const char *dir, uint32_t view)
     return done;
 }
 
+uint32_t scan_dir_first_missing(const char *dir, uint32_t views)
+{
+    uint32_t first = 0;
+    while (first < views && scan_dir_view_complete(dir, first))
+        first++;
+    return first;
+}
+
 int scan_dir_make_new(const char *parent, char *out, size_t len, const char **name)
 {
     char stamp[32];

@@ -104,6 +104,10 @@ int scan_dir_view_count(const char *dir, uint32_t *views);
 /** @retval 1 when view @p view finished (its view.ini is there and reads). Thread-safe. */
 int scan_dir_view_complete(const char *dir, uint32_t view);
 
+/** The first of @p views views of the scan in @p dir that did not finish: where a resume takes
+ *  up again (every view from it on is taken again), @p views when all finished. */
+uint32_t scan_dir_first_missing(const char *dir, uint32_t views);
+
 /** A new scan's folder under @p parent (which exists), named by when it began, UTC
  *  (2026-12-03_080907, then -2, -3 ... in the same second), made at once so that no two scans,
  *  nor a scan and the web server, take the same. @param out  its path @param name  out: its
