@@ -232,10 +232,9 @@ int reg_cut_at_the_move(struct reg_ctx *r)
 /* The share of view @p v's samples on surfaces facing sideways whose pixel in view @p w, as the
  * two stand (no turn: the same pixel of the same camera), holds a sample within max_pair_mm
  * facing within max_normal_deg; @p sideways: how many there were. */
-static double alike_share(const struct reg_ctx *r, uint32_t v, uint32_t w, uint32_t *sideways)
+static double alike_share(struct reg_ctx *r, uint32_t v, uint32_t w, uint32_t *sideways)
 {
-    const struct reg_cell *a = reg_view_cells((struct reg_ctx *)r, v);
-    const struct reg_cell *b = reg_view_cells((struct reg_ctx *)r, w);
+    const struct reg_cell *a = reg_view_cells(r, v), *b = reg_view_cells(r, w);
     const double min_cos = cos(r->p.max_normal_deg * M_PI / 180.0);
     const double gate_sq = r->p.max_pair_mm * r->p.max_pair_mm;
     uint32_t n = 0, alike = 0;
@@ -258,7 +257,7 @@ static double alike_share(const struct reg_ctx *r, uint32_t v, uint32_t w, uint3
     return n > 0 ? (double)alike / n : 0.0;
 }
 
-int reg_views_alike(const struct reg_ctx *r)
+int reg_views_alike(struct reg_ctx *r)
 {
     for (uint32_t e = 0; e < r->edges; e++) {
         uint32_t sideways;

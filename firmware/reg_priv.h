@@ -122,6 +122,6 @@ int reg_cut_at_the_move(struct reg_ctx *r);
 /* @retval 1 every pair of neighbouring views looks alike as the two stand, on REG_SIDE_MIN
  * sideways samples or more (the object's symmetry matches the table's step: its pairs cannot
  * place the axis) */
-int reg_views_alike(const struct reg_ctx *r);
+int reg_views_alike(struct reg_ctx *r);
 
 #endif
