@@ -166,6 +166,21 @@ small_disk_test() {
         grep -q "error: $out/small/scan: the disk holds [0-9]* MB free; this scan needs about [0-9]* MB (8 views of about [0-9]* MB, \\[output\\] keep_frames = all): delete a scan, or keep fewer frames" "$out/small-scan.txt" &&
         grep -q "error: $out/small/stopped: the disk holds [0-9]* MB free; this scan needs about [0-9]* MB (8 views" "$out/small-resume.txt"
 }
+# The disk check reads the free space of whatever --out names: a FIFO, a symbolic-link loop and a
+# path longer than the scanner takes are not waited on, nor taken for a full disk; the scan then
+# names what is wrong with the directory.
+hostile_out_test() {
+    rm -rf "$out/hostile" && mkdir -p "$out/hostile" && mkfifo "$out/hostile/fifo" &&
+        ln -s loop "$out/hostile/loop" || return 2
+    long=$out/hostile/$(printf '%0600d' 0)
+    timeout 60 "$bin" scan --config config/sim.ini --out "$out/hostile/fifo" 2>"$out/hostile.txt"
+    [ $? -eq 1 ] && grep -q 'cannot make the scan directory .*/fifo: Not a directory' "$out/hostile.txt" || return 1
+    timeout 60 "$bin" scan --config config/sim.ini --out "$out/hostile/loop/x" 2>"$out/hostile.txt"
+    [ $? -eq 1 ] && grep -q 'loop/x: Too many levels of symbolic links' "$out/hostile.txt" || return 1
+    timeout 60 "$bin" scan --config config/sim.ini --out "$long" 2>"$out/hostile.txt"
+    [ $? -eq 1 ] && grep -q 'error: ' "$out/hostile.txt" && ! grep -q 'the disk holds' "$out/hostile.txt"
+}
+check scan_out_fifo_loop_long_said hostile_out_test
 if mkdir -p "$out/mnt-probe" && mount -t tmpfs -o size=1m tmpfs "$out/mnt-probe" 2>/dev/null; then
     umount "$out/mnt-probe"
     check process_on_read_only_says_why read_only_test
