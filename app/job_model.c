@@ -199,9 +199,10 @@ static int report_registration(struct job *j, const struct reg_report *r, double
     if (r->views_alike && !no_turn_seen) {
         n = strlen(detail);
         snprintf(detail + n, sizeof(detail) - n,
-                 "; each view looks like its neighbour as they stand (the object's symmetry "
+                 "; each view%s looks like its neighbour as they stand (the object's symmetry "
                  "matches the table's step): the calibrated axis kept, which such views cannot "
-                 "place (a number of views its symmetry does not divide lets them)");
+                 "place (a number of views its symmetry does not divide lets them)",
+                 r->moved_view >= 0 ? " before the object moved" : "");
     } else if (r->axis_from_calibration && !no_turn_seen) {
         n = strlen(detail);
         snprintf(detail + n, sizeof(detail) - n,

@@ -462,6 +462,12 @@ static double colour_misfit(struct reg_ctx *r, vec3 shift, uint64_t *compared)
 
 double reg_pair_colour_misfit(struct reg_ctx *r, uint32_t v, uint32_t w, uint64_t *compared)
 {
+    return reg_pair_colour_misfit_at(r, v, w, v3(0.0, 0.0, 0.0), compared);
+}
+
+double reg_pair_colour_misfit_at(struct reg_ctx *r, uint32_t v, uint32_t w, vec3 shift,
+                                 uint64_t *compared)
+{
     const double min_cos = cos(r->p.max_normal_deg * M_PI / 180.0);
     double sum = 0.0;
     *compared = 0;
@@ -474,7 +480,7 @@ double reg_pair_colour_misfit(struct reg_ctx *r, uint32_t v, uint32_t w, uint64_
             continue;
         cell_in_object(cl, &r->first_pose[v], &p, &n);
         const struct reg_cell *cq =
-            land_in(r, w, p, n, min_cos, r->p.max_pair_mm, &landed, &facing, &q, &nq, grid_xy);
+            land_in(r, w, v3_add(p, shift), n, min_cos, r->p.max_pair_mm, &landed, &facing, &q, &nq, grid_xy);
         if (cq == NULL || !hue_of(cq, hq))
             continue;
         sum += hue_miss(hp, hq);

@@ -99,6 +99,10 @@ void reg_prepare_landing(struct reg_ctx *r);
  * as a share of a full miss. @retval 0 .. 1 */
 double reg_pair_colour_misfit(struct reg_ctx *r, uint32_t v, uint32_t w, uint64_t *compared);
 
+/* The same with @p v's samples moved by @p shift (group 0's object frame, mm) first. */
+double reg_pair_colour_misfit_at(struct reg_ctx *r, uint32_t v, uint32_t w, vec3 shift,
+                                 uint64_t *compared);
+
 /* The share of edge @p e's overlap that couples (@p st: its counts), on its sideways surfaces
  * where they are enough to judge by. */
 double reg_edge_share(const struct reg_ctx *r, const struct reg_edge_stats *st);
@@ -119,9 +123,9 @@ int reg_find_quiet_breaks(struct reg_ctx *r, struct reg_report *rep);
  * becomes group 1). @retval 1 cut @retval 0 not so */
 int reg_cut_at_the_move(struct reg_ctx *r);
 
-/* @retval 1 every pair of neighbouring views looks alike as the two stand, on REG_SIDE_MIN
- * sideways samples or more (the object's symmetry matches the table's step: its pairs cannot
- * place the axis) */
+/* @retval 1 every pair of neighbouring views of group 0 (all of them, or the arc with view 0
+ * after a slip) looks alike as the two stand, on REG_SIDE_MIN sideways samples or more (the
+ * object's symmetry matches the table's step: its pairs cannot place the axis) */
 int reg_views_alike(struct reg_ctx *r);
 
 #endif
