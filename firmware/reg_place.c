@@ -479,8 +479,8 @@ double reg_pair_colour_misfit_at(struct reg_ctx *r, uint32_t v, uint32_t w, vec3
         if (!cl->valid || !hue_of(cl, hp))
             continue;
         cell_in_object(cl, &r->first_pose[v], &p, &n);
-        const struct reg_cell *cq =
-            land_in(r, w, v3_add(p, shift), n, min_cos, r->p.max_pair_mm, &landed, &facing, &q, &nq, grid_xy);
+        const struct reg_cell *cq = land_in(r, w, v3_add(p, shift), n, min_cos, r->p.max_pair_mm,
+                                            &landed, &facing, &q, &nq, grid_xy);
         if (cq == NULL || !hue_of(cq, hq))
             continue;
         sum += hue_miss(hp, hq);
