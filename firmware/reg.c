@@ -594,9 +594,11 @@ static void place_moved_views(struct reg_ctx *r, struct reg_report *rep)
     int failed = rep->failed_view, against = rep->failed_against;
     double share = rep->failed_share;
     solve_joint(r, rep); /* each arc registered on its own */
-    if (!reg_place_near_table(r, rep->rms_mm, 8.0) && !reg_place_near_table(r, rep->rms_mm, 32.0))
+    if (!reg_place_near_table(r, rep->rms_mm, 8.0) && !reg_place_near_table(r, rep->rms_mm, 32.0) &&
+        !reg_place_slid_by_colour(r, rep->rms_mm))
         reg_align_group(r, rep);
-    if (r->second_aligned && !reg_placement_holds(r) && !reg_place_by_colour(r, rep->rms_mm)) {
+    if (r->second_aligned && !reg_placement_holds(r) && !r->placed_by_colour &&
+        !reg_place_by_colour(r, rep->rms_mm)) {
         r->second_aligned = 0; /* a slide neither shape nor colour sees: it could be anywhere */
         rep->moved_unfixed = 1;
     }

@@ -632,3 +632,17 @@ int reg_place_by_colour(struct reg_ctx *r, double ring_rms_mm)
     r->placed_by_colour = n;
     return 1;
 }
+
+int reg_place_slid_by_colour(struct reg_ctx *r, double ring_rms_mm)
+{
+    if (reg_placement_holds(r))
+        return 0; /* the shape held every direction and did not fit: no slide */
+    r->first_from_second = (struct frame_xform){{1, 0, 0, 0, 1, 0, 0, 0, 1}, {0, 0, 0}};
+    r->placed_axis[0] = v3(1.0, 0.0, 0.0), r->placed_axis[1] = v3(0.0, 1.0, 0.0);
+    r->placed_share[1] = 0.0, r->placed_share[2] = 1.0; /* the table's plane: both searched */
+    r->second_aligned = 1;
+    if (reg_place_by_colour(r, ring_rms_mm))
+        return 1;
+    r->second_aligned = 0;
+    return 0;
+}

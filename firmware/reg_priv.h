@@ -79,6 +79,12 @@ void reg_align_group(struct reg_ctx *r, struct reg_report *rep);
  * first. @retval 1 placed (second_aligned) */
 int reg_place_near_table(struct reg_ctx *r, double ring_rms_mm, double reach);
 
+/* Where ICP from the table's place (reg_place_near_table) found no placement that fits and
+ * its pairs did not hold every shift, group 1 searched by its colour across the table from the
+ * table's place (reg_place_by_colour), taken only where the shape fits too.
+ * @retval 1 placed (placed_by_colour) */
+int reg_place_slid_by_colour(struct reg_ctx *r, double ring_rms_mm);
+
 /* @retval 1 the last placement's pairs hold a shift in every direction */
 int reg_placement_holds(const struct reg_ctx *r);
 
