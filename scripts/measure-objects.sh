@@ -9,8 +9,9 @@
 # model against the truth once aligned (mean, mm), the truth within 1 mm of the model (above the
 # table), holes and pieces of the model, and the registration's CPU.
 # Usage: scripts/measure-objects.sh BUILD; OBJECTS="box gear", VIEWS="4 8", METHODS="none" and
-# CONDITIONS="exact" (exact table1 table2 slip slip30 push6; slip6v and slip12v: the 6 mm slip in 6 and 12 views) choose a subset; KEEP=1 keeps the frames
-# (scanner process DIR computes a scan again from them).
+# CONDITIONS="exact" (exact table1 table2 slip slip30 push6; slip6v and slip12v: the 6 mm slip in 6 and 12 views) choose a subset; KEEP=1 keeps each
+# scan and its frames (scanner process DIR computes a scan again from them); else only its log
+# and its comparison with the truth are kept.
 set -eu
 build=$1
 out=$build/measure-objects
@@ -67,6 +68,9 @@ row() { # object, views, method, table, name: scan it and print its row
         result=$(grep -o 'error: .*' "$out/$5.log" | head -n 1 | cut -c8-90)
         mean=- within=- holes=- pieces=-
     fi
+    # a scan's views are 20 to 30 MB each without frames (range images, the simulator's truth):
+    # four runs' scans kept filled this machine's 80 GB free; KEEP=1 keeps them
+    [ "${KEEP:-0}" = 1 ] || rm -rf "${out:?}/$5"
     cpu=$(sed -n 's/^registration: .*; \([0-9.]*\) s CPU.*/\1/p' "$out/$5.log")
     note=$(grep -o "does not fix the [a-z' ]*turn" "$out/$5.log" | head -n 1 || true)
     printf '| %s | %s | %s | %s | %s | %s | %s%% | %s | %s | %s | %s |\n' "$1" "$2" "$3" "$4" "$result" \
