@@ -5,7 +5,6 @@
 #include "reg.h"
 #include "reg_priv.h"
 
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -198,9 +197,6 @@ static int pair_shifted(struct reg_ctx *r, uint32_t e, double *misfit)
     shift_search(r, a, b, REG_SHIFT_STEP_MM / 2.0, 1, at, &best);
     double back = reg_pair_colour_misfit_at(r, b, a, v3(-at[0], -at[1], 0.0), &n_back);
     *misfit = fmin(still_ab, still_ba);
-    if (getenv("REG_DEBUG_SHIFT"))
-        fprintf(stderr, "edge %u-%u: still %.3f/%.3f best %.3f at %.1f,%.1f back %.3f\n", a, b,
-                still_ab, still_ba, best, at[0], at[1], back);
     return hypot(at[0], at[1]) >= REG_SHIFT_MIN_MM && n_back >= REG_BREAK_SAMPLES &&
            still_ab + still_ba >= 2.0 * REG_SHIFT_MIN_MISS &&
            best + back <= REG_SHIFT_DIP * (still_ab + still_ba);
