@@ -583,17 +583,14 @@ static void untwist_placement(struct reg_ctx *r)
     r->first_from_second = out;
 }
 
-int reg_place_by_colour(struct reg_ctx *r, double ring_rms_mm)
+/* The placement moved along @p n (1 or 2) directions @p axes to where the colours agree, then
+ * refined by the shape and the hues (reg_place_by_colour says how and when it is taken).
+ * @retval 1 placed @retval 0 left as it was */
+static int place_along(struct reg_ctx *r, const vec3 axes[2], int n, double ring_rms_mm)
 {
-    /* One free direction (two parallel faces and a top), or two (a plate: its top and little
-     * else), the shape holding the rest. */
-    int n = r->placed_share[1] >= REG_COLOUR_MIN_NEXT ? 1 : 2;
-    if (!r->second_aligned || r->placed_share[2] < REG_COLOUR_MIN_NEXT)
-        return 0;
     struct frame_xform before = r->first_from_second;
     if (n == 2)
         untwist_placement(r);
-    const vec3 axes[2] = {r->placed_axis[0], n > 1 ? r->placed_axis[1] : v3(0, 0, 0)};
     /* Coarse to fine: a step, how many either way (the first level spans the search). */
     static const double levels[2][4][2] = {
         {{REG_COLOUR_STEP_MM, REG_COLOUR_SEARCH_MM / REG_COLOUR_STEP_MM},
@@ -633,16 +630,24 @@ int reg_place_by_colour(struct reg_ctx *r, double ring_rms_mm)
     return 1;
 }
 
+int reg_place_by_colour(struct reg_ctx *r, double ring_rms_mm)
+{
+    /* One free direction (two parallel faces and a top), or two (a plate: its top and little
+     * else), the shape holding the rest. */
+    int n = r->placed_share[1] >= REG_COLOUR_MIN_NEXT ? 1 : 2;
+    if (!r->second_aligned || r->placed_share[2] < REG_COLOUR_MIN_NEXT)
+        return 0;
+    const vec3 axes[2] = {r->placed_axis[0], n > 1 ? r->placed_axis[1] : v3(0, 0, 0)};
+    return place_along(r, axes, n, ring_rms_mm);
+}
+
 int reg_place_slid_by_colour(struct reg_ctx *r, double ring_rms_mm)
 {
+    static const vec3 table_plane[2] = {{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}}; /* object frame */
     if (reg_placement_holds(r))
         return 0; /* the shape held every direction and did not fit: no slide */
     r->first_from_second = (struct frame_xform){{1, 0, 0, 0, 1, 0, 0, 0, 1}, {0, 0, 0}};
-    r->placed_axis[0] = v3(1.0, 0.0, 0.0), r->placed_axis[1] = v3(0.0, 1.0, 0.0);
-    r->placed_share[1] = 0.0, r->placed_share[2] = 1.0; /* the table's plane: both searched */
-    r->second_aligned = 1;
-    if (reg_place_by_colour(r, ring_rms_mm))
-        return 1;
-    r->second_aligned = 0;
-    return 0;
+    r->second_aligned = 1; /* group 1 where the table put it, moved by the search */
+    r->second_aligned = place_along(r, table_plane, 2, ring_rms_mm);
+    return r->second_aligned;
 }
