@@ -109,7 +109,7 @@ test-run: format-check $(BUILD)/scanner $(CALIB_TOOL) $(WEB_TOOL) $(SIM_TOOLS) $
 
 # The two lanes tests/run.sh runs side by side (two cores), about as long as each other.
 # LONG_SCRIPTS=0 leaves out the two scripts that scan and calibrate most (tests/objects.sh,
-# tests/calibrate.sh: two thirds of the scripts' time under the sanitizers, whose code runs in
+# tests/calibrate.sh: 19 of the 33 minutes the scripts take under the sanitizers, whose code runs in
 # the plain make test too): .ci/run's make test SAN=1 does, to stay under its 45 minutes; make
 # test SAN=1 alone runs everything.
 LONG_SCRIPTS ?= 1
