@@ -692,8 +692,8 @@ static int remove_rigid(vec3 *drawn, const vec3 *truth, size_t count)
  * calibration that turns or shifts the camera's frame (a camera principal point 0.4 px off
  * turns it by 0.01 deg, 0.1 mm at the table) finds the turntable's axis in that same frame, from
  * the same board poses, so the model comes out the same shape, only placed differently.
- * @retval 0 @retval -EDOM a lens that folds over, or a sample it does not see: not one to
- * judge by */
+ * @retval 0 @retval -EDOM a lens that folds over where a sample is, or a sample it does not see:
+ * not one to judge by */
 static int draw_error(const struct scan_calib *ck, struct tri_maps *maps, struct depth_samples *d,
                       double *dl_pct)
 {

@@ -49,18 +49,29 @@ int camray_prepare(const struct scan_calib *c, struct camray *out)
     return 0;
 }
 
-vec3 camray_at(const struct scan_calib *c, struct camray rays, uint32_t x, uint32_t y)
+int camray_ray(const struct scan_calib *c, struct camray rays, uint32_t x, uint32_t y, vec3 *ray)
 {
-    if (lens_is_pinhole(c->cam_dist))
-        return pinhole_ray(c, x, y);
+    if (lens_is_pinhole(c->cam_dist)) {
+        *ray = pinhole_ray(c, x, y);
+        return 0;
+    }
     if (rays.xy != NULL) {
         size_t i = (size_t)y * c->cam_width + x;
-        return v3(rays.xy[2 * i], rays.xy[2 * i + 1], 1.0);
+        *ray = v3(rays.xy[2 * i], rays.xy[2 * i + 1], 1.0);
+        return 0;
     }
     vec3 d = pinhole_ray(c, x, y);
     double ux = d.x, uy = d.y;
-    (void)lens_undistort(c->cam_dist, d.x, d.y, &ux, &uy); /* prepare refused a folding lens */
-    return v3(ux, uy, 1.0);
+    int rc = lens_undistort(c->cam_dist, d.x, d.y, &ux, &uy);
+    *ray = v3(ux, uy, 1.0);
+    return rc != 0 ? -EDOM : 0;
+}
+
+vec3 camray_at(const struct scan_calib *c, struct camray rays, uint32_t x, uint32_t y)
+{
+    vec3 ray;
+    (void)camray_ray(c, rays, x, y, &ray); /* prepare refused a folding lens */
+    return ray;
 }
 
 void camray_project(const struct scan_calib *c, vec3 p, double *u, double *v)

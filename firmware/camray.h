@@ -27,6 +27,12 @@ struct camray camray_lookup(const struct scan_calib *calib);
  *  or camray_lookup of the same @p calib). */
 vec3 camray_at(const struct scan_calib *calib, struct camray rays, uint32_t x, uint32_t y);
 
+/** The same, saying whether the lens could be inverted there: without a table the ray is
+ *  computed here, and a lens that folds over at (x, y) has none (what camray_prepare says of the
+ *  whole image). @param ray  out @retval 0 @retval -EDOM the lens folds over at (x, y) */
+int camray_ray(const struct scan_calib *calib, struct camray rays, uint32_t x, uint32_t y,
+               vec3 *ray);
+
 /** Where the camera-frame point @p p (z > 0) is seen: continuous pixel coordinates, pixel centres
  *  at integers. */
 void camray_project(const struct scan_calib *calib, vec3 p, double *u, double *v);

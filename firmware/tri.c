@@ -43,6 +43,17 @@ static int distorted_column_depth(const struct scan_calib *c, vec3 d, double col
 /* A ray table is made when at least 1 in this many pixels is to be triangulated. */
 #define TRI_TABLE_SHARE 32u
 
+/* @retval 1 enough of the @p n pixels are to be triangulated for a ray table to pay (counted
+ * only as far as that: a scan's view reaches it within its first rows) */
+static int worth_a_table(const uint8_t *reason, size_t n)
+{
+    size_t valid = 0;
+    for (size_t i = 0; i < n; i++)
+        if (reason[i] == SCAN_VALID && ++valid >= n / TRI_TABLE_SHARE)
+            return 1;
+    return 0;
+}
+
 int tri_range_image(const struct scan_calib *c, struct tri_maps *maps, uint32_t width,
                     uint32_t height, const float *column, uint8_t *reason, struct tri_range *range)
 {
@@ -51,12 +62,11 @@ int tri_range_image(const struct scan_calib *c, struct tri_maps *maps, uint32_t 
     /* The ray table costs a lens inversion a pixel: with few pixels to triangulate (the
      * calibration's depth-error prediction triangulates every 16th pixel for each of 64 drawn
      * calibrations, and spent a quarter of its time tabulating rays it never read) they are
-     * inverted one by one instead (camray_at without a table). */
-    size_t valid = 0;
-    for (size_t i = 0; i < (size_t)width * height; i++)
-        valid += reason[i] == SCAN_VALID;
+     * inverted one by one instead (camray_ray without a table), a lens that folds over at one
+     * of them refused as the table refuses it anywhere in the image. */
     struct camray rays = camray_lookup(c);
-    if (rays.xy == NULL && valid >= (size_t)width * height / TRI_TABLE_SHARE) {
+    if (rays.xy == NULL && !lens_is_pinhole(c->cam_dist) &&
+        worth_a_table(reason, (size_t)width * height)) {
         int rc = camray_prepare(c, &rays);
         if (rc != 0)
             return rc;
@@ -78,7 +88,9 @@ int tri_range_image(const struct scan_calib *c, struct tri_maps *maps, uint32_t 
             size_t i = (size_t)y * width + x;
             if (reason[i] != SCAN_VALID)
                 continue;
-            vec3 ray = camray_at(c, rays, x, y);
+            vec3 ray;
+            if (camray_ray(c, rays, x, y, &ray) != 0)
+                return -EDOM;
             double a = ((double)column[i] - c->proj_cx_px) / c->proj_fx_px;
             vec3 normal = v3_sub(rt_ex, v3_scale(rt_ez, a));
             double denom = v3_dot(normal, ray);

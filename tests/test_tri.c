@@ -5,6 +5,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include <errno.h>
 #include <math.h>
 #include <string.h>
 
@@ -107,6 +108,12 @@ static void test_few_pixels_same_points(void **state)
         checked++;
     }
     assert_true(checked > 10000);
+    /* a lens folding over in the image's corners is refused either way, as the table refuses
+     * it: the few include pixel 0, a corner */
+    const double fold[5] = {-5.0, 0.0, 0.0, 0.0, 0.0};
+    memcpy(calib.cam_dist, fold, sizeof(fold));
+    assert_int_equal(tri_range_image(&calib, &few, w, h, col, sparse, &b), -EDOM);
+    assert_int_equal(tri_range_image(&calib, &whole, w, h, col, reason, &a), -EDOM);
     calib = pinhole;
 }
 
