@@ -115,8 +115,10 @@ test-run: format-check $(BUILD)/scanner $(CALIB_TOOL) $(WEB_TOOL) $(SIM_TOOLS) $
 LONG_SCRIPTS ?= 1
 ifeq ($(LONG_SCRIPTS),1)
 TEST_LANES = $(TEST_BIN) tests/layers.sh tests/interop.sh tests/fuzz/replay.sh tests/resume.sh tests/objects.sh tests/web.sh -- tests/cli.sh tests/calibrate.sh
-else
+else ifeq ($(LONG_SCRIPTS),0)
 TEST_LANES = $(TEST_BIN) tests/layers.sh tests/interop.sh tests/fuzz/replay.sh tests/web.sh -- tests/cli.sh tests/resume.sh
+else
+$(error LONG_SCRIPTS must be 1 or 0, not '$(LONG_SCRIPTS)')
 endif
 
 # make test VALGRIND=1: every cmocka test under valgrind memcheck; any invalid access,
