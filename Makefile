@@ -130,7 +130,7 @@ FW_OBJ := $(call obj,$(FW_SRC))
 HOST_OBJ := $(call obj,$(POSIX_SRC) $(APP_LIB_SRC) $(BOARD_SRC)) $(if $(filter linux,$(HAL)),$(LIBCAMERA_OBJ),)
 MAIN_OBJ := $(call obj,app/main.c)
 
-.PHONY: help format-check serve test-browser check-blender seccomp-tool vivid-tool all deps opencv-deps test-deps test test-run run-complete linux-build small-build install check-stack size fuzz errors-doc test-arm64 test-arm64-full test-gpio-chip arm64-check-elf arm64-run-tests run clean format docs check-firmware bench measure measure-inverse measure-scan measure-objects interop-meshlab bench-callgrind eval eval-texture eval-cycles calibrate-demo measure-calib measure-calib-sigma measure-calib-advice
+.PHONY: help format-check serve test-browser check-blender seccomp-tool vivid-tool all deps opencv-deps test-deps test test-build test-run run-complete linux-build small-build install check-stack size fuzz errors-doc test-arm64 test-arm64-full test-gpio-chip arm64-check-elf arm64-run-tests run clean format docs check-firmware bench measure measure-inverse measure-scan measure-objects interop-meshlab bench-callgrind eval eval-texture eval-cycles calibrate-demo measure-calib measure-calib-sigma measure-calib-advice
 SIM_TOOLS := $(if $(filter sim,$(HAL)),$(BUILD)/turntable-sim $(BUILD)/tt-client $(BUILD)/mesh-compare $(BUILD)/colour-eval $(BUILD)/relight-eval $(BUILD)/texture-eval,)
 ## all: build/scanner with the simulator, scanner-calibrate and scanner-web where their libraries are (the default)
 all: deps $(BUILD)/scanner $(CALIB_TOOL) $(WEB_TOOL) $(SIM_TOOLS)

@@ -1,4 +1,4 @@
-/* BVH built by median split of triangle centroids along the longest axis; stack traversal. */
+/* BVH built by the binned surface-area heuristic; front-to-back stack traversal. */
 #include "sim_bvh.h"
 
 #include <errno.h>
@@ -33,22 +33,125 @@ static void node_bounds(struct sim_bvh *b, struct sim_bvh_node *n)
             }
 }
 
-/* Sort a node's triangles by centroid along one axis; the build runs once, at start-up, so a
- * plain qsort with file-scope context is simpler than an in-place selection and fast enough. */
-static const struct sim_mesh *sort_mesh;
-static int sort_axis;
-static int by_centroid(const void *pa, const void *pb)
+/* Surface-area heuristic, binned (Wald, "On fast construction of SAH-based bounding volume
+ * hierarchies", 2007): a node's triangles are split where
+ *   cost = area(left) * count(left) + area(right) * count(right)
+ * is least over SAH_BINS bins of centroid along each axis; rays then open about half the nodes a
+ * median split makes them open. Where every centroid falls in one bin, the median split. */
+#define SAH_BINS 16
+
+struct box {
+    float lo[3], hi[3];
+};
+
+static void box_empty(struct box *b)
 {
-    float a = centroid(sort_mesh, *(const uint32_t *)pa, sort_axis);
-    float b = centroid(sort_mesh, *(const uint32_t *)pb, sort_axis);
-    return (a > b) - (a < b);
+    for (int a = 0; a < 3; a++) {
+        b->lo[a] = 1e30f;
+        b->hi[a] = -1e30f;
+    }
 }
 
-static void select_median(struct sim_bvh *b, uint32_t lo, uint32_t hi, int axis)
+static void box_grow(struct box *b, const struct box *o)
 {
-    sort_mesh = b->mesh;
-    sort_axis = axis;
-    qsort(b->tri_order + lo, hi - lo, sizeof(uint32_t), by_centroid);
+    for (int a = 0; a < 3; a++) {
+        b->lo[a] = o->lo[a] < b->lo[a] ? o->lo[a] : b->lo[a];
+        b->hi[a] = o->hi[a] > b->hi[a] ? o->hi[a] : b->hi[a];
+    }
+}
+
+static double box_area(const struct box *b)
+{
+    double e[3];
+    for (int a = 0; a < 3; a++)
+        e[a] = b->hi[a] > b->lo[a] ? (double)b->hi[a] - b->lo[a] : 0.0;
+    return e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
+}
+
+static void tri_box(const struct sim_mesh *m, uint32_t tri, struct box *b)
+{
+    box_empty(b);
+    for (int k = 0; k < 3; k++)
+        for (int a = 0; a < 3; a++) {
+            float p = vert(m, tri, k)[a];
+            b->lo[a] = p < b->lo[a] ? p : b->lo[a];
+            b->hi[a] = p > b->hi[a] ? p : b->hi[a];
+        }
+}
+
+static int bin_of(float c, float lo, float scale)
+{
+    int k = (int)((c - lo) * scale);
+    return k < 0 ? 0 : k >= SAH_BINS ? SAH_BINS - 1 : k;
+}
+
+/* Split tri_order[lo, hi) in two. @retval the first index of the right part */
+static uint32_t split_sah(struct sim_bvh *b, uint32_t lo, uint32_t hi)
+{
+    const struct sim_mesh *m = b->mesh;
+    float clo[3] = {1e30f, 1e30f, 1e30f}, chi[3] = {-1e30f, -1e30f, -1e30f};
+    for (uint32_t i = lo; i < hi; i++)
+        for (int a = 0; a < 3; a++) {
+            float c = centroid(m, b->tri_order[i], a);
+            clo[a] = c < clo[a] ? c : clo[a];
+            chi[a] = c > chi[a] ? c : chi[a];
+        }
+    double best = 1e300;
+    int best_axis = -1, best_bin = 0;
+    for (int a = 0; a < 3; a++) {
+        if (!(chi[a] > clo[a]))
+            continue;
+        float scale = SAH_BINS / (chi[a] - clo[a]);
+        struct box bins[SAH_BINS], tb, acc;
+        uint32_t counts[SAH_BINS] = {0};
+        double right_area[SAH_BINS];
+        uint32_t right_count[SAH_BINS];
+        for (int k = 0; k < SAH_BINS; k++)
+            box_empty(&bins[k]);
+        for (uint32_t i = lo; i < hi; i++) {
+            int k = bin_of(centroid(m, b->tri_order[i], a), clo[a], scale);
+            tri_box(m, b->tri_order[i], &tb);
+            box_grow(&bins[k], &tb);
+            counts[k]++;
+        }
+        box_empty(&acc);
+        uint32_t n = 0;
+        for (int k = SAH_BINS - 1; k > 0; k--) { /* right of plane k: bins k.. */
+            box_grow(&acc, &bins[k]);
+            n += counts[k];
+            right_area[k] = box_area(&acc);
+            right_count[k] = n;
+        }
+        box_empty(&acc);
+        n = 0;
+        for (int k = 1; k < SAH_BINS; k++) { /* left of plane k: bins ..k-1 */
+            box_grow(&acc, &bins[k - 1]);
+            n += counts[k - 1];
+            if (n == 0 || right_count[k] == 0)
+                continue;
+            double cost = box_area(&acc) * n + right_area[k] * right_count[k];
+            if (cost < best) {
+                best = cost;
+                best_axis = a;
+                best_bin = k;
+            }
+        }
+    }
+    if (best_axis < 0) { /* one bin holds them all: halve in the order given */
+        return lo + (hi - lo) / 2;
+    }
+    float scale = SAH_BINS / (chi[best_axis] - clo[best_axis]);
+    uint32_t i = lo, j = hi;
+    while (i < j) {
+        if (bin_of(centroid(m, b->tri_order[i], best_axis), clo[best_axis], scale) < best_bin) {
+            i++;
+        } else {
+            uint32_t t = b->tri_order[i];
+            b->tri_order[i] = b->tri_order[--j];
+            b->tri_order[j] = t;
+        }
+    }
+    return i;
 }
 
 int sim_bvh_build(struct sim_bvh *b, const struct sim_mesh *m)
@@ -66,19 +169,19 @@ int sim_bvh_build(struct sim_bvh *b, const struct sim_mesh *m)
     b->nodes[0].first = 0;
     b->nodes[0].count = m->tri_count;
     b->node_count = 1;
-    uint32_t stack[STACK_DEPTH * 2], sp = 0;
+    /* depth first; a node STACK_DEPTH deep stays a leaf, so that traversal's stack (two entries
+     * a level) never overflows */
+    uint32_t stack[STACK_DEPTH * 2], depth[STACK_DEPTH * 2], sp = 0;
+    depth[sp] = 0;
     stack[sp++] = 0;
     while (sp > 0) {
-        struct sim_bvh_node *n = &b->nodes[stack[--sp]];
+        sp--;
+        struct sim_bvh_node *n = &b->nodes[stack[sp]];
+        uint32_t level = depth[sp];
         node_bounds(b, n);
-        if (n->count <= LEAF_TRIS || sp + 2 > STACK_DEPTH * 2)
+        if (n->count <= LEAF_TRIS || level + 1 >= STACK_DEPTH)
             continue;
-        int axis = 0;
-        for (int a = 1; a < 3; a++)
-            if (n->hi[a] - n->lo[a] > n->hi[axis] - n->lo[axis])
-                axis = a;
-        uint32_t mid = n->first + n->count / 2;
-        select_median(b, n->first, n->first + n->count, axis);
+        uint32_t mid = split_sah(b, n->first, n->first + n->count);
         uint32_t left = b->node_count;
         b->node_count += 2;
         b->nodes[left].first = n->first;
@@ -87,7 +190,9 @@ int sim_bvh_build(struct sim_bvh *b, const struct sim_mesh *m)
         b->nodes[left + 1].count = n->first + n->count - mid;
         n->first = left;
         n->count = 0;
+        depth[sp] = level + 1;
         stack[sp++] = left;
+        depth[sp] = level + 1;
         stack[sp++] = left + 1;
     }
     return 0;
@@ -100,24 +205,20 @@ void sim_bvh_free(struct sim_bvh *b)
     memset(b, 0, sizeof(*b));
 }
 
-/* Slab test. @retval entry distance, or a negative value on a miss */
-static double box_hit(const struct sim_bvh_node *n, vec3 o, vec3 inv, double t_max)
+/* Slab test, without a branch on the ray (each comparison is a min or a max; a NaN, from a
+ * direction parallel to a slab through its plane, leaves the interval as it was).
+ * @retval entry distance, or a negative value on a miss */
+static inline double box_hit(const struct sim_bvh_node *n, vec3 o, vec3 inv, double t_max)
 {
     double t0 = 0.0, t1 = t_max;
     double oa[3] = {o.x, o.y, o.z}, ia[3] = {inv.x, inv.y, inv.z};
     for (int a = 0; a < 3; a++) {
         double ta = (n->lo[a] - oa[a]) * ia[a], tb = (n->hi[a] - oa[a]) * ia[a];
-        if (ta > tb) {
-            double t = ta;
-            ta = tb;
-            tb = t;
-        }
-        t0 = ta > t0 ? ta : t0;
-        t1 = tb < t1 ? tb : t1;
-        if (t0 > t1)
-            return -1.0;
+        double near = ta > tb ? tb : ta, far = ta > tb ? ta : tb;
+        t0 = near > t0 ? near : t0;
+        t1 = far < t1 ? far : t1;
     }
-    return t0;
+    return t0 > t1 ? -1.0 : t0;
 }
 
 /* Moller-Trumbore ray/triangle intersection. */
@@ -144,20 +245,46 @@ static int tri_hit(const struct sim_mesh *m, uint32_t tri, vec3 o, vec3 d, doubl
     return 1;
 }
 
+/* Front to back: of an inner node's two children the nearer is searched first, so that a
+ * closest hit found there shortens the ray before the farther one is opened; a node entered
+ * beyond the hit found so far is skipped when taken off the stack (the same test box_hit makes
+ * with the shortened ray, so the hits are those of any order but for exact ties in t). */
 static int traverse(const struct sim_bvh *b, vec3 o, vec3 d, double t_min, double t_max,
                     struct sim_hit *hit, int any)
 {
     vec3 inv = v3(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
     uint32_t stack[STACK_DEPTH * 2], sp = 0;
+    double entry[STACK_DEPTH * 2];
     int found = 0;
+    double t_root = box_hit(&b->nodes[0], o, inv, t_max);
+    if (t_root < 0.0)
+        return 0;
+    entry[sp] = t_root;
     stack[sp++] = 0;
     while (sp > 0) {
-        const struct sim_bvh_node *n = &b->nodes[stack[--sp]];
-        if (box_hit(n, o, inv, t_max) < 0.0)
+        sp--;
+        if (entry[sp] > t_max)
             continue;
+        const struct sim_bvh_node *n = &b->nodes[stack[sp]];
         if (n->count == 0) {
-            stack[sp++] = n->first;
-            stack[sp++] = n->first + 1;
+            double t0 = box_hit(&b->nodes[n->first], o, inv, t_max);
+            double t1 = box_hit(&b->nodes[n->first + 1], o, inv, t_max);
+            uint32_t near = n->first, far = n->first + 1;
+            if (t1 >= 0.0 && (t0 < 0.0 || t1 < t0)) {
+                double t = t0;
+                t0 = t1;
+                t1 = t;
+                near = n->first + 1;
+                far = n->first;
+            }
+            if (t1 >= 0.0) {
+                entry[sp] = t1;
+                stack[sp++] = far;
+            }
+            if (t0 >= 0.0) {
+                entry[sp] = t0;
+                stack[sp++] = near;
+            }
             continue;
         }
         for (uint32_t i = n->first; i < n->first + n->count; i++) {

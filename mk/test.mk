@@ -102,9 +102,13 @@ test-deps: deps
 
 # A second make, so that what test-deps installed (libcamera-dev) is seen when it starts.
 ## test: every test (the README's test command; SAN=1 under ASan and UBSan, VALGRIND=1 under memcheck)
+# The build on every core (TEST_JOBS, nproc by default), then the tests in their two lanes.
+TEST_JOBS ?= $(shell nproc 2>/dev/null || echo 1)
 test: deps test-deps
+	@$(MAKE) --no-print-directory -j$(TEST_JOBS) test-build
 	@$(MAKE) --no-print-directory test-run
-test-run: format-check $(BUILD)/scanner $(CALIB_TOOL) $(WEB_TOOL) $(SIM_TOOLS) $(BUILD)/seccomp-run $(TEST_BIN) $(FUZZ_REPLAY) check-firmware $(if $(filter 0,$(SAN)),check-stack,) linux-build small-build
+test-build: format-check $(BUILD)/scanner $(CALIB_TOOL) $(WEB_TOOL) $(SIM_TOOLS) $(BUILD)/seccomp-run $(TEST_BIN) $(FUZZ_REPLAY) check-firmware $(if $(filter 0,$(SAN)),check-stack,) linux-build small-build
+test-run: test-build
 	@RUN_WITH="$(VALGRIND_RUN)" BUILD=$(BUILD) tests/run.sh $(TEST_LANES)
 
 # The two lanes tests/run.sh runs side by side (two cores), about as long as each other.
@@ -114,7 +118,7 @@ test-run: format-check $(BUILD)/scanner $(CALIB_TOOL) $(WEB_TOOL) $(SIM_TOOLS) $
 # test SAN=1 alone runs everything.
 LONG_SCRIPTS ?= 1
 ifeq ($(LONG_SCRIPTS),1)
-TEST_LANES = $(TEST_BIN) tests/layers.sh tests/interop.sh tests/fuzz/replay.sh tests/resume.sh tests/objects.sh tests/web.sh -- tests/cli.sh tests/calibrate.sh
+TEST_LANES = $(TEST_BIN) tests/layers.sh tests/interop.sh tests/fuzz/replay.sh tests/resume.sh tests/objects.sh -- tests/cli.sh tests/calibrate.sh tests/web.sh
 else ifeq ($(LONG_SCRIPTS),0)
 TEST_LANES = $(TEST_BIN) tests/layers.sh tests/interop.sh tests/fuzz/replay.sh tests/web.sh -- tests/cli.sh tests/resume.sh
 else
