@@ -83,6 +83,52 @@ static void test_bvh_matches_brute_force(void **state)
     sim_mesh_free(&m);
 }
 
+/* Two meshes the surface-area split meets badly: 500 copies of one square (every centroid in one
+ * bin: halved instead) and 500 squares at x = +-2^-125 ... +-2^124 mm (each split parts a few from
+ * the rest: 64 levels, where the build stops so that traversal's stack cannot overflow, with a
+ * leaf of many). Every closest hit is still the nearest square, and a ray beside them misses. */
+static void test_bvh_degenerate_meshes(void **state)
+{
+    (void)state;
+    enum { N = 500 };
+    static float pos[3 * 4 * N];
+    static uint32_t tri[3 * 2 * N];
+    struct sim_mesh m = {.vert_count = 4 * N, .tri_count = 2 * N, .pos = pos, .tri = tri};
+    for (int stacked = 0; stacked < 2; stacked++) {
+        for (uint32_t k = 0; k < N; k++) {
+            int e = (int)(k % (N / 2)) - 125;
+            float x = stacked ? 5.0f : k < N / 2 ? ldexpf(1.0f, e) : -ldexpf(1.0f, e);
+            const float corner[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+            for (int c = 0; c < 4; c++) {
+                pos[3 * (4 * k + c)] = x;
+                pos[3 * (4 * k + c) + 1] = corner[c][0];
+                pos[3 * (4 * k + c) + 2] = corner[c][1];
+            }
+            const uint32_t q[6] = {0, 1, 2, 0, 2, 3};
+            for (int i = 0; i < 6; i++)
+                tri[6 * k + i] = 4 * k + q[i];
+        }
+        struct sim_bvh bvh;
+        assert_int_equal(sim_bvh_build(&bvh, &m), 0);
+        for (int r = 0; r < 49; r++) {
+            struct sim_hit h;
+            vec3 o = v3(0.75, (r % 7 - 3) * 0.25, (r / 7 - 3) * 0.25); /* towards +x: 1 or 5 */
+            assert_int_equal(sim_bvh_intersect(&bvh, o, v3(1, 0, 0), 1e-6, 1e39, &h), 1);
+            assert_true(fabs(h.t - (stacked ? 4.25 : 0.25)) < 1e-12);
+            assert_int_equal(sim_bvh_occluded(&bvh, o, v3(1, 0, 0), 1e-6, 1e39), 1);
+            int got = sim_bvh_intersect(&bvh, o, v3(-1, 0, 0), 1e-6, 1e39, &h); /* 0.5 or none */
+            assert_int_equal(got, !stacked);
+            assert_true(stacked || fabs(h.t - 0.25) < 1e-12);
+            o.x = 1e38; /* from beyond the far end, towards -x: 2^124 or 5 */
+            assert_int_equal(sim_bvh_intersect(&bvh, o, v3(-1, 0, 0), 1e-6, 1e39, &h), 1);
+            double want = 1e38 - (stacked ? 5.0 : ldexp(1.0, 124));
+            assert_true(fabs(h.t - want) <= 1e-12 * want);
+        }
+        assert_int_equal(sim_bvh_occluded(&bvh, v3(0.75, 3, 0), v3(1, 0, 0), 1e-6, 1e39), 0);
+        sim_bvh_free(&bvh);
+    }
+}
+
 static void test_closed_shapes_have_outward_normals(void **state)
 {
     (void)state;
@@ -264,6 +310,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_bunny_ply_loads),
         cmocka_unit_test(test_bvh_matches_brute_force),
+        cmocka_unit_test(test_bvh_degenerate_meshes),
         cmocka_unit_test(test_closed_shapes_have_outward_normals),
         cmocka_unit_test(test_deterministic_noise_and_black_level),
         cmocka_unit_test(test_merl_material),
