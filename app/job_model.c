@@ -10,6 +10,7 @@
 #include "reflect.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -365,6 +366,59 @@ static int fit_reflectance(struct job *j, const char *scan_dir)
     return 0;
 }
 
+/* The smallest multiple of 5 mm at least @p mm + 5 (a suggested bound with room). */
+static double bound_with_room(double mm)
+{
+    return 5.0 * ceil((mm + 5.0) / 5.0);
+}
+
+/* An object taller or wider than [fusion]'s volume is cut at its walls: said, with the key to
+ * change and the value that holds what the views saw, or that this build cannot (the grid's
+ * compiled limits), so that a cut model is never taken for the object; and one that runs off
+ * the camera's image, which no setting of the volume brings back. Points are counted where
+ * they are many enough not to be stray ones (at least 100, and a thousandth of those fused). */
+static void report_outside(struct job *j)
+{
+    struct fusion_outside o;
+    fusion_outside(j->vol, &o);
+    const struct fusion_params *fp = &j->cfg->fusion;
+    if (o.views_cut > 0)
+        j->hal->log(HAL_LOG_WARN,
+                    "the object runs off the camera's image in %u of %u views: what lies beyond "
+                    "the image's edge is not scanned (the camera farther away, or the object "
+                    "laid down for a second pass, [scan] passes = 2)",
+                    (unsigned)o.views_cut, (unsigned)j->views);
+    for (int side = 0; side < 2; side++) {
+        uint64_t n = side ? o.beside : o.above;
+        if (n < 100 || n * 1000 < o.fused)
+            continue;
+        struct fusion_params want = *fp;
+        double seen = side ? o.reach_seen_mm : o.top_seen_mm;
+        if (side)
+            want.radius_mm = bound_with_room(seen);
+        else
+            want.top_mm = bound_with_room(seen);
+        uint32_t dims[3];
+        char fix[160];
+        if (fusion_dims(&want, dims) == 0)
+            snprintf(fix, sizeof(fix), "set %s = %.0f", side ? "radius_mm" : "top_mm",
+                     side ? want.radius_mm : want.top_mm);
+        else
+            snprintf(fix, sizeof(fix),
+                     "%s = %.0f is more than this build fuses at voxel_mm = %g (%u voxels a side, "
+                     "%u in all): a larger voxel_mm",
+                     side ? "radius_mm" : "top_mm", side ? want.radius_mm : want.top_mm,
+                     fp->voxel_mm, FUSION_MAX_DIM, FUSION_MAX_VOXELS);
+        j->hal->log(HAL_LOG_WARN,
+                    "the object %s the fused volume: %.1f%% of the views' points lie %s [fusion] "
+                    "%s = %g, up to %.0f mm, and are not in the model: %s in [fusion]",
+                    side ? "reaches beyond the sides of" : "rises above",
+                    100.0 * (double)n / (double)o.fused,
+                    side ? "farther from the axis than" : "higher than",
+                    side ? "radius_mm" : "top_mm", side ? fp->radius_mm : fp->top_mm, seen, fix);
+    }
+}
+
 /* Once every view is in: register them jointly, then fuse each at its registered pose. The
  * fusion must wait for the registration, and the views' range images are not kept in memory
  * (a view's are 40 MB): each is read back from its range.bin in the output directory, or, for a
@@ -399,5 +453,7 @@ int job_make_model(struct job *j, const char *scan_dir)
             job_progress_with(j, EV_FUSED, (int)v, v + 1, fields, detail);
         }
     }
+    if (rc == 0)
+        report_outside(j);
     return rc == 0 ? write_model(j, scan_dir) : rc;
 }

@@ -39,6 +39,7 @@ int fusion_begin(struct fusion_volume *vol, const struct fusion_params *p)
     memset(vol->grid, 0, (size_t)vol->dims[0] * vol->dims[1] * vol->dims[2] * sizeof(vol->grid[0]));
     vol->mp.prepared = 0; /* an earlier model's mesh tables are no longer this one's */
     vol->grid_spent = 0;
+    memset(&vol->outside, 0, sizeof(vol->outside));
     mc_table_build();
     return 0;
 }
@@ -199,7 +200,61 @@ static size_t bidx(const uint32_t nb[3], uint32_t x, uint32_t y, uint32_t z)
     return ((size_t)z * nb[1] + y) * nb[0] + x;
 }
 
-/* Mark the blocks of the view's fused points. @retval 0 when the view has none */
+void fusion_outside(const struct fusion_volume *vol, struct fusion_outside *out)
+{
+    *out = vol->outside;
+}
+
+#define TABLE_CLEARANCE_MM 5.0 /* nearer the table, a point beside the grid is the table's */
+
+/* Is @p p (object frame) over the table, where the object stands (struct fusion_outside)? */
+static int over_table(const struct fusion_volume *vol, vec3 p)
+{
+    double r = vol->p.radius_mm;
+    return p.z >= TABLE_CLEARANCE_MM && p.x * p.x + p.y * p.y <= 4.0 * r * r;
+}
+
+/* A fused point @p p (object frame) counted where the grid cuts it (struct fusion_outside). */
+static void count_outside(struct fusion_volume *vol, vec3 p)
+{
+    const struct fusion_params *fp = &vol->p;
+    struct fusion_outside *o = &vol->outside;
+    double reach = fabs(p.x) > fabs(p.y) ? fabs(p.x) : fabs(p.y);
+    o->fused++;
+    if (!over_table(vol, p))
+        return;
+    if (p.z > fp->top_mm) {
+        o->above++;
+        o->top_seen_mm = p.z > o->top_seen_mm ? p.z : o->top_seen_mm;
+    }
+    if (reach > fp->radius_mm) {
+        o->beside++;
+        o->reach_seen_mm = reach > o->reach_seen_mm ? reach : o->reach_seen_mm;
+    }
+}
+
+/* Does the object run off the view's image? Its valid pixels on the image's border, whatever
+ * their weight (the weights fade to 0 there), counted where they are over the table. */
+static void count_frame_edge(struct fusion_volume *vol, const struct frame_xform *obj_from_cam,
+                             const struct decode_maps *m, const struct tri_range *r)
+{
+    const uint32_t w = m->width, h = m->height;
+    uint32_t n = 0;
+    for (uint32_t k = 0; k < 2 * (w + h); k++) {
+        /* top row, bottom row, left column, right column */
+        uint32_t x = k < 2 * w ? k % w : k < 2 * w + h ? 0 : w - 1;
+        uint32_t y = k < w ? 0 : k < 2 * w ? h - 1 : (k - 2 * w) % h;
+        size_t i = (size_t)y * w + x;
+        if (m->reason[i] == SCAN_VALID &&
+            over_table(vol, frame_point(obj_from_cam, v3(r->xyz_mm[3 * i], r->xyz_mm[3 * i + 1],
+                                                         r->xyz_mm[3 * i + 2]))))
+            n++;
+    }
+    vol->outside.views_cut += n >= FUSION_EDGE_POINTS;
+}
+
+/* Mark the blocks of the view's fused points, and count those beyond the grid.
+ * @retval 0 when the view has none */
 static int mark_blocks(struct fusion_volume *vol, const struct frame_xform *obj_from_cam,
                        const struct decode_maps *m, const struct tri_range *r, const uint32_t nb[3])
 {
@@ -210,9 +265,10 @@ static int mark_blocks(struct fusion_volume *vol, const struct frame_xform *obj_
         for (size_t i = y * m->width + vol->rect.x0; i < y * m->width + vol->rect.x1; i++) {
             if (vol->weight_map[i] <= 0.0f)
                 continue;
-            vec3 p = v3_sub(frame_point(obj_from_cam, v3(r->xyz_mm[3 * i], r->xyz_mm[3 * i + 1],
-                                                         r->xyz_mm[3 * i + 2])),
-                            vol->origin);
+            vec3 p_obj = frame_point(
+                obj_from_cam, v3(r->xyz_mm[3 * i], r->xyz_mm[3 * i + 1], r->xyz_mm[3 * i + 2]));
+            count_outside(vol, p_obj);
+            vec3 p = v3_sub(p_obj, vol->origin);
             double g[3] = {p.x * scale, p.y * scale, p.z * scale};
             uint32_t b[3];
             int inside = 1;
@@ -350,6 +406,7 @@ int fusion_integrate(struct fusion_volume *vol, const struct hal_thread *threads
                        .nb = {(dims[0] + BLOCK - 1) / BLOCK, (dims[1] + BLOCK - 1) / BLOCK,
                               (dims[2] + BLOCK - 1) / BLOCK},
                        .parts = hal_thread_parts(threads, 64)};
+    count_frame_edge(vol, obj_from_cam, m, r);
     if (!mark_blocks(vol, obj_from_cam, m, r, s.nb))
         return 0;
     /* a point's band reaches truncation / voxel voxels (and one for rounding) from its block */

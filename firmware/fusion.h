@@ -44,6 +44,25 @@ int fusion_integrate(struct fusion_volume *vol, const struct hal_thread *threads
                      const struct decode_maps *maps, const struct tri_range *range,
                      const uint8_t *rgb, const float *confidence);
 
+/** What the views held beyond the grid, counted by fusion_integrate since fusion_begin: an
+ *  object taller or wider than the volume is cut there, and the scan should say so. */
+struct fusion_outside {
+    uint64_t fused;       /**< the views' points fused (weight above 0) */
+    uint64_t above;       /**< of them over the table (5 mm up, within twice radius_mm of the
+                               axis) and higher than top_mm */
+    uint64_t beside;      /**< of them over the table and beyond the grid's square (|x| or |y|
+                               over radius_mm); a point may be both */
+    double top_seen_mm;   /**< the highest point above (0: none) */
+    double reach_seen_mm; /**< the largest |x| or |y| of the points beside (0: none) */
+    uint32_t views_cut;   /**< views whose object runs off the image: at least
+                               FUSION_EDGE_POINTS valid pixels on its border rows and columns
+                               are points above the table (5 mm up, within twice radius_mm) */
+};
+#define FUSION_EDGE_POINTS 16u
+
+/** What fusion_integrate counted beyond the grid (above). @param out  out: the counts */
+void fusion_outside(const struct fusion_volume *vol, struct fusion_outside *out);
+
 /** The weight fusion_integrate gives each pixel of a view (above; 0: not fused), in @p vol's
  *  work space, which the mesh's hole filling shares: once the mesh is made (the texture atlas).
  *  @retval the weights, width x height @retval NULL no pixel is valid */
@@ -211,6 +230,7 @@ struct fusion_volume {
     struct {
         uint32_t x0, y0, x1, y1;
     } rect;
+    struct fusion_outside outside; /* since fusion_begin */
     uint8_t block_mark[FUSION_BLOCKS_MAX * FUSION_BLOCKS_MAX * FUSION_BLOCKS_MAX];
     uint8_t block_grown[FUSION_BLOCKS_MAX * FUSION_BLOCKS_MAX * FUSION_BLOCKS_MAX];
     /* fusion_extract's: vertex numbers of the grid edges of two sample planes (x, y edges) and

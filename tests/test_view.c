@@ -15,6 +15,9 @@
 #include "test_util.h"
 #include "thread_posix.h"
 
+/* The fusion volume of the tests that fuse (one: it is most of a gigabyte at the limits). */
+static struct fusion_volume test_volume;
+
 /* One view of the rig @p t (loaded, its settings as the test wants them), measured. */
 static void take_and_measure(struct test_rig *t, struct view_quality *q,
                              struct scan_view_info *info)
@@ -272,21 +275,21 @@ static void test_threads_decode_the_same(void **state)
     assert_memory_equal(view.confidence, conf1, n * sizeof(float));
     assert_int_equal(t.cfg.scan.colour.method, COLOUR_MULTI);
     /* and the view fused: every voxel the same on 1 and 4 threads */
-    static struct fusion_volume vol;
+    struct fusion_volume *vol = &test_volume;
     struct frame_xform pose;
     frame_object_from_camera(&t.calib, view.angle_mdeg, &pose);
     assert_int_equal(scan_finish_view(t.scan, NULL, &t.calib, view.angle_mdeg, &view, &info), 0);
-    assert_int_equal(fusion_begin(&vol, &t.cfg.fusion), 0);
-    assert_int_equal(scan_fuse_view(&vol, NULL, &t.calib, &view, &pose), 0);
-    size_t voxels = (size_t)vol.dims[0] * vol.dims[1] * vol.dims[2], observed = 0;
+    assert_int_equal(fusion_begin(vol, &t.cfg.fusion), 0);
+    assert_int_equal(scan_fuse_view(vol, NULL, &t.calib, &view, &pose), 0);
+    size_t voxels = (size_t)vol->dims[0] * vol->dims[1] * vol->dims[2], observed = 0;
     struct voxel *one = malloc(voxels * sizeof(*one));
     assert_non_null(one);
-    memcpy(one, vol.grid, voxels * sizeof(*one));
+    memcpy(one, vol->grid, voxels * sizeof(*one));
     for (size_t i = 0; i < voxels; i++)
         observed += one[i].weight > 0;
-    assert_int_equal(fusion_begin(&vol, &t.cfg.fusion), 0);
-    assert_int_equal(scan_fuse_view(&vol, &four, &t.calib, &view, &pose), 0);
-    assert_memory_equal(vol.grid, one, voxels * sizeof(*one));
+    assert_int_equal(fusion_begin(vol, &t.cfg.fusion), 0);
+    assert_int_equal(scan_fuse_view(vol, &four, &t.calib, &view, &pose), 0);
+    assert_memory_equal(vol->grid, one, voxels * sizeof(*one));
     free(one);
     test_rig_stop(&t);
     print_message("%zu valid pixels, the same maps on 1, 2, 4 and 8 threads; %zu voxels observed, "
@@ -294,6 +297,61 @@ static void test_threads_decode_the_same(void **state)
                   valid, observed);
     assert_true(valid > 100000);
     assert_true(observed > 100000);
+}
+
+/* One view of @p object, @p height_mm tall, fused with @p top_mm and @p radius_mm: what the
+ * fusion counted beyond its volume and the image (struct fusion_outside). */
+static void fuse_one_view(const char *object, double height_mm, double top_mm, double radius_mm,
+                          struct fusion_outside *o)
+{
+    static struct test_rig t;
+    struct fusion_volume *vol = &test_volume;
+    assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
+    snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "%s", object);
+    t.cfg.sim.object_height_mm = height_mm;
+    t.cfg.scan.colour.method = COLOUR_NONE;
+    assert_int_equal(test_rig_start(&t), 0);
+    struct scan_view view;
+    struct scan_view_info info;
+    assert_int_equal(scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info),
+                     0);
+    assert_int_equal(scan_finish_view(t.scan, NULL, &t.calib, view.angle_mdeg, &view, &info), 0);
+    struct frame_xform pose;
+    frame_object_from_camera(&t.calib, view.angle_mdeg, &pose);
+    struct fusion_params p = t.cfg.fusion;
+    p.top_mm = top_mm;
+    p.radius_mm = radius_mm;
+    assert_int_equal(fusion_begin(vol, &p), 0);
+    assert_int_equal(scan_fuse_view(vol, NULL, &t.calib, &view, &pose), 0);
+    fusion_outside(vol, o);
+    test_rig_stop(&t);
+    print_message("%s %.0f mm, top_mm %.0f, radius_mm %.0f: %llu points fused, %llu above (up to "
+                  "%.1f mm), %llu beside (out to %.1f mm), %u views off the image\n",
+                  object, height_mm, top_mm, radius_mm, (unsigned long long)o->fused,
+                  (unsigned long long)o->above, o->top_seen_mm, (unsigned long long)o->beside,
+                  o->reach_seen_mm, (unsigned)o->views_cut);
+}
+
+/* An object taller than the volume and the image (a cylinder 290 mm tall, 87 mm in radius; the
+ * camera sees up to about 200 mm of it) is counted above the volume's top and off the image; with
+ * a narrower volume, beside it; the bunny, 150 mm, inside both (job_model.c says it). */
+static void test_object_beyond_the_volume_counted(void **state)
+{
+    (void)state;
+    struct fusion_outside o;
+    fuse_one_view("cylinder", 290.0, 165.0, 100.0, &o);
+    assert_int_equal(o.views_cut, 1);
+    assert_true(o.above > 20000 && o.above * 10 > o.fused);
+    assert_true(o.top_seen_mm > 180.0 && o.top_seen_mm < 290.0);
+    assert_int_equal(o.beside, 0);
+    fuse_one_view("cylinder", 290.0, 300.0, 60.0, &o);
+    assert_int_equal(o.above, 0);
+    assert_true(o.beside > 20000);
+    assert_true(o.reach_seen_mm > 80.0 && o.reach_seen_mm < 88.0);
+    assert_int_equal(o.views_cut, 1);
+    fuse_one_view("mesh", 150.0, 165.0, 100.0, &o);
+    assert_true(o.fused > 100000);
+    assert_int_equal(o.above + o.beside + o.views_cut, 0);
 }
 
 /* Inverses for the finest 3 bits only ([scan] inverse_bits = 3: 28 patterns with rows, 15
@@ -368,6 +426,7 @@ int main(void)
         cmocka_unit_test(test_interreflection_gray_against_xor04),
         cmocka_unit_test(test_blocked_decoder_matches_reference),
         cmocka_unit_test(test_threads_decode_the_same),
+        cmocka_unit_test(test_object_beyond_the_volume_counted),
         cmocka_unit_test(test_fewer_inverses),
         cmocka_unit_test(test_two_scan_contexts_are_independent),
     };
