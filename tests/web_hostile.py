@@ -101,6 +101,9 @@ def write_configs():
     for name, views in [("fast", 4), ("long", 100)]:
         with open(os.path.join(OUT, f"{name}.ini"), "w") as f:
             f.write(base.format(views=views, out=OUT))
+    # cut: the fast scan in a volume 40 mm tall, which the sphere rises above (a warning)
+    with open(os.path.join(OUT, "cut.ini"), "w") as f:
+        f.write(base.format(views=4, out=OUT) + "[fusion]\ntop_mm = 40\n")
     # asked: a calibration at the simulated rig whose person waits to be told to go on
     with open(os.path.join(OUT, "asked.ini"), "w") as f:
         f.write(base.format(views=4, out=OUT).replace("[sim]\n", "[sim]\nperson = asked\n"))
@@ -313,6 +316,8 @@ def manage_cases(port, key, scans):
     gone = json.loads(body)["id"] if st == 200 else ""
     state = wait_state(port, gone, ("finished", "failed")) if st == 200 else None
     check(state is not None and state["state"] == "finished", "a scan to manage is made", body)
+    check(state is not None and state.get("warnings") == [] and state.get("warning_count") == 0,
+          "a scan of an object inside the volume has no warning", state)
     lbl = f"/api/scans/{gone}/label"
     st, _, _ = request(port, "POST", lbl, {"Content-Type": "application/json"}, '{"label": "x"}')
     check(st == 403, f"a label without the session key is refused ({st})")
@@ -623,6 +628,19 @@ def token_cases():
         check(srv.stop() == 0, "the token server ends cleanly")
 
 
+def warning_cases(port, key):
+    """The scanner's warnings reach the page: a sphere the volume cuts (issue 30) is said."""
+    js = {"Content-Type": "application/json", "X-Scanner-Key": key}
+    st, _, body = request(port, "POST", "/api/scans", js, '{"profile": "cut"}')
+    sid = json.loads(body)["id"] if st == 200 else ""
+    state = wait_state(port, sid, ("finished", "failed")) if st == 200 else None
+    warnings = state.get("warnings", []) if state else []
+    check(state is not None and state["state"] == "finished" and state["warning_count"] == 1 and
+          len(warnings) == 1 and "rises above the fused volume" in warnings[0] and
+          "top_mm = 40," in warnings[0] and "set top_mm = " in warnings[0],
+          "a scan the volume cuts says so on the page, with the value that holds it", state)
+
+
 def main():
     shutil.rmtree(OUT, ignore_errors=True)
     os.makedirs(OUT)
@@ -630,7 +648,8 @@ def main():
     scans = os.path.join(OUT, "scans")
     port = free_port()
     args = ["--config", os.path.join(OUT, "fast.ini"), "--config", os.path.join(OUT, "long.ini"),
-            "--config", os.path.join(OUT, "asked.ini"), "--listen", f"127.0.0.1:{port}",
+            "--config", os.path.join(OUT, "asked.ini"), "--config", os.path.join(OUT, "cut.ini"),
+            "--listen", f"127.0.0.1:{port}",
             "--scans", scans]
     srv = Server(args)
     sid = error = None
@@ -640,6 +659,7 @@ def main():
         error = resume_cases(port, key, sid, scans)
         path_cases(port, key, scans, sid)
         manage_cases(port, key, scans)
+        warning_cases(port, key)
         profile_cases(port, key)
         calibration_cases(port, key, scans)
     finally:

@@ -184,6 +184,10 @@ static cJSON *job_json(struct web_server *s, const char *id)
         cJSON_AddNumberToObject(o, "elapsed_s", j->elapsed_s);
         cJSON_AddNumberToObject(o, "left_s", j->left_s);
         cJSON_AddStringToObject(o, "profile", j->profile);
+        cJSON *warnings = cJSON_AddArrayToObject(o, "warnings");
+        for (unsigned k = 0; k < j->warning_count && k < WEB_MAX_WARNINGS; k++)
+            cJSON_AddItemToArray(warnings, cJSON_CreateString(j->warnings[k]));
+        cJSON_AddNumberToObject(o, "warning_count", j->warning_count);
     }
     pthread_mutex_unlock(&j->lock);
     char path[WEB_PATH + 80];

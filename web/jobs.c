@@ -13,6 +13,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <ftw.h>
+#include <limits.h>
 #include <poll.h>
 #include <signal.h>
 #include <stdio.h>
@@ -186,14 +187,22 @@ static void on_event(struct web_job *j, const char *line)
 }
 
 /* The scanner's messages: the first error is the cause (each fault is said once, by the layer
- * that met it); the rest stays in the server's log. */
+ * that met it), its warnings are for the page too (a model cut by the volume must not pass for
+ * the object); the rest stays in the server's log. */
 static void on_message(struct web_job *j, const char *line)
 {
-    static const char prefix[] = "scanner: error: ";
+    static const char prefix[] = "scanner: error: ", warn[] = "scanner: warning: ";
     fprintf(stderr, "%s\n", line);
     pthread_mutex_lock(&j->lock);
     if (j->error[0] == '\0' && strncmp(line, prefix, sizeof(prefix) - 1) == 0)
         snprintf(j->error, sizeof(j->error), "%s", line + sizeof(prefix) - 1);
+    if (strncmp(line, warn, sizeof(warn) - 1) == 0 && j->warning_count < UINT_MAX) {
+        if (j->warning_count < WEB_MAX_WARNINGS)
+            snprintf(j->warnings[j->warning_count], WEB_WARNING_LEN, "%s", line + sizeof(warn) - 1);
+        j->warning_count++;
+        j->seq++;
+        pthread_cond_broadcast(&j->changed);
+    }
     pthread_mutex_unlock(&j->lock);
 }
 
@@ -409,6 +418,7 @@ static int run_job(struct web_server *s, enum web_kind kind, const char *const *
     j->elapsed_s = 0;
     j->left_s = -1;
     j->error[0] = j->detail[0] = '\0';
+    j->warning_count = 0;
     j->calib_log[0] = j->calib_live[0] = j->calib_result[0] = j->calib_choice[0] = '\0';
     j->calib_log_len = 0;
     j->calib_pictures = 0;

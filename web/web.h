@@ -35,6 +35,9 @@ enum web_kind { WEB_SCAN, WEB_CALIBRATION, WEB_VERIFY };
 #define WEB_CALIB_CAPTURES "captures"
 #define WEB_CALIB_RESULT 16384 /* bytes of its result (the calibration event) */
 
+#define WEB_MAX_WARNINGS 8
+#define WEB_WARNING_LEN 400
+
 /* The scan (or resume) the rig runs now, or ran last: a child process, `scanner scan --json`,
  * whose event lines a thread of ours reads. Every field under @c lock. */
 struct web_job {
@@ -62,7 +65,11 @@ struct web_job {
     char stage[32];                   /* the last event: capturing, registration, meshing ... */
     char detail[512];
     double elapsed_s, left_s;
-    char error[512];   /* the scanner's own error line, when it failed */
+    char error[512]; /* the scanner's own error line, when it failed */
+    /* its warnings (an object cut by the volume, a weak calibration ...): the first
+     * WEB_MAX_WARNINGS kept, each cut at WEB_WARNING_LEN bytes; warning_count counts all */
+    char warnings[WEB_MAX_WARNINGS][WEB_WARNING_LEN];
+    unsigned warning_count;
     unsigned long seq; /* events so far */
     /* a calibration: its events (one JSON object a line, the live pictures' left out), the
      * last live picture's event, its result, and what the person chose to do with it */

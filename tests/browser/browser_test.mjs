@@ -122,6 +122,11 @@ async function pageTest(browser) {
   await page.waitForFunction(() => /8 of 8 views · finished/.test(document.getElementById('progress').textContent),
     null, { timeout: 180000 });
   check(true, 'progress reached 8 of 8 and the scan finished');
+  const warned = await page.evaluate(() => {
+    const w = document.getElementById('warnings');
+    return w === null ? 'no #warnings list' : w.hidden ? '' : w.textContent;
+  });
+  check(warned === '', `the bunny, inside the volume and the image, shows no warning ("${warned}")`);
   await page.waitForFunction(() => document.getElementById('viewer').dataset.loaded, null, { timeout: 60000 });
   const id = await page.evaluate(() => document.getElementById('viewer').dataset.loaded);
   await sleep(300);

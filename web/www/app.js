@@ -85,6 +85,7 @@ function showProgress(s) {
   }
   $('progress').textContent = text;
   $('error').textContent = s.error || '';
+  showWarnings(s.warnings || [], s.warning_count || 0);
   $('stop').disabled = !running;
   $('start').disabled = running;
   $('resume').hidden = s.state !== 'stopped' && s.state !== 'failed';
@@ -102,6 +103,23 @@ function showProgress(s) {
     placeLive = null;
     $('place-live').hidden = true;
   }
+}
+
+// The scanner's warnings (an object the volume or the image cut, a weak calibration): a model
+// that is not the whole object must not pass for it. Text only, never markup.
+function showWarnings(warnings, count) {
+  const list = $('warnings');
+  list.replaceChildren(...warnings.map((w) => {
+    const li = document.createElement('li');
+    li.textContent = w;
+    return li;
+  }));
+  if (count > warnings.length) {
+    const li = document.createElement('li');
+    li.textContent = `and ${count - warnings.length} more (the server's log has them)`;
+    list.append(li);
+  }
+  list.hidden = count === 0;
 }
 
 // While the scan waits for the object to be laid, what the camera sees (the scanner writes it
