@@ -18,6 +18,8 @@
 #include <stdint.h>
 
 #define JOB_MAX_STAGES 8u
+#define JOB_MAX_WARNINGS 4u /* what the model lacks, kept for summary.ini (job_warn) */
+#define JOB_WARNING_LEN 400u
 
 /* A captured view, processed and saved by a thread of its own while the table turns to the next
  * view (the firmware is used by one thread at a time: the next capture waits for it). */
@@ -57,6 +59,10 @@ struct job {
         uint32_t first_done, last_done;
         double first_ms, last_ms;
     } eta;
+    struct job_warnings { /* what the model lacks, as said (summary.ini, report.html) */
+        char text[JOB_MAX_WARNINGS][JOB_WARNING_LEN];
+        unsigned n;
+    } warnings;
     struct stages { /* when each stage ended (summary.ini), in the order they first did */
         const char *name[JOB_MAX_STAGES];
         double end_s[JOB_MAX_STAGES];
@@ -98,6 +104,9 @@ void job_json_string(FILE *out, const char *s);
 void job_progress_with(struct job *j, const char *event, int view, uint32_t done,
                        const char *fields, const char *detail);
 void job_progress(struct job *j, const char *event, int view, uint32_t done, const char *detail);
+/** A warning about the model (an object the volume cut ...): logged, and kept for summary.ini's
+ *  [warnings] and report.html (the first JOB_MAX_WARNINGS). */
+void job_warn(struct job *j, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 /** The end of a job that made its model: what it cost (EV_COST, "@p what N s CPU ..."),
  *  summary.ini and report.html (@p command: "scan" or "processing"), then @p event (EV_SCAN_DONE,
  *  EV_PROCESS_DONE) saying where the results are. */

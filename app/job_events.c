@@ -10,6 +10,7 @@
 
 #include <errno.h>
 #include <pthread.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -184,6 +185,18 @@ void job_progress(struct job *j, const char *event, int view, uint32_t done, con
     job_progress_with(j, event, view, done, NULL, detail);
 }
 
+void job_warn(struct job *j, const char *fmt, ...)
+{
+    char text[JOB_WARNING_LEN];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(text, sizeof(text), fmt, ap);
+    va_end(ap);
+    j->hal->log(HAL_LOG_WARN, "%s", text);
+    if (j->warnings.n < JOB_MAX_WARNINGS)
+        memcpy(j->warnings.text[j->warnings.n++], text, sizeof(text));
+}
+
 /* Where the results are, and the peak memory. */
 static const char *job_finished_detail(struct job *j, char *buf, size_t len)
 {
@@ -192,11 +205,33 @@ static const char *job_finished_detail(struct job *j, char *buf, size_t len)
     return buf;
 }
 
+/* warnings.txt: the job's warnings about the model, a line each (a line of an ini file is cut at
+ * 200 bytes by inih), or none: an earlier run's, processed again in place, go. */
+static void job_write_warnings(struct job *j)
+{
+    char text[JOB_MAX_WARNINGS * (JOB_WARNING_LEN + 1)], path[SCAN_DIR_PATH_MAX];
+    size_t n = 0;
+    for (unsigned i = 0; i < j->warnings.n; i++) {
+        size_t len = strlen(j->warnings.text[i]);
+        memcpy(text + n, j->warnings.text[i], len);
+        n += len;
+        text[n++] = '\n';
+    }
+    int rc = n == 0 ? scan_dir_remove(j->out_dir, -1, SCAN_FILE_WARNINGS)
+                    : scan_dir_path(path, sizeof(path), j->out_dir, -1, SCAN_FILE_WARNINGS);
+    if (rc == 0 && n > 0)
+        rc = hal_storage_write_file(&j->hal->storage, path, text, n);
+    if (rc != 0)
+        j->hal->log(HAL_LOG_WARN, "cannot write %s/%s: %s", j->out_dir, SCAN_FILE_WARNINGS,
+                    strerror(-rc));
+}
+
 /* summary.ini (what report.html shows of the job: its stages, time and memory), then
  * report.html. Neither is the scan's result: a failure is said and the job goes on. */
 static void job_write_summary_and_report(struct job *j, const char *command)
 {
     char text[1024], path[SCAN_DIR_PATH_MAX], finished[32], err[SCAN_DIR_PATH_MAX + 64];
+    job_write_warnings(j);
     job_utc_now(finished, sizeof(finished));
     double sim, cpu = job_own_cpu_s(j, &sim);
     int n = snprintf(text, sizeof(text),

@@ -383,11 +383,11 @@ static void report_outside(struct job *j)
     fusion_outside(j->vol, &o);
     const struct fusion_params *fp = &j->cfg->fusion;
     if (o.views_cut > 0)
-        j->hal->log(HAL_LOG_WARN,
-                    "the object runs off the camera's image in %u of %u views: what lies beyond "
-                    "the image's edge is not scanned (the camera farther away, or the object "
-                    "laid down for a second pass, [scan] passes = 2)",
-                    (unsigned)o.views_cut, (unsigned)j->views);
+        job_warn(j,
+                 "the object runs off the camera's image in %u of %u views: what lies beyond "
+                 "the image's edge is not scanned (the camera farther away, or the object "
+                 "laid down for a second pass, [scan] passes = 2)",
+                 (unsigned)o.views_cut, (unsigned)j->views);
     for (int side = 0; side < 2; side++) {
         uint64_t n = side ? o.beside : o.above;
         if (n < 100 || n * 1000 < o.fused)
@@ -409,13 +409,13 @@ static void report_outside(struct job *j)
                      "%u in all): a larger voxel_mm",
                      side ? "radius_mm" : "top_mm", side ? want.radius_mm : want.top_mm,
                      fp->voxel_mm, FUSION_MAX_DIM, FUSION_MAX_VOXELS);
-        j->hal->log(HAL_LOG_WARN,
-                    "the object %s the fused volume: %.1f%% of the views' points lie %s [fusion] "
-                    "%s = %g, up to %.0f mm, and are not in the model: %s in [fusion]",
-                    side ? "reaches beyond the sides of" : "rises above",
-                    100.0 * (double)n / (double)o.fused,
-                    side ? "farther from the axis than" : "higher than",
-                    side ? "radius_mm" : "top_mm", side ? fp->radius_mm : fp->top_mm, seen, fix);
+        job_warn(j,
+                 "the object %s the fused volume: %.1f%% of the views' points lie %s [fusion] "
+                 "%s = %g, up to %.0f mm, and are not in the model: %s in [fusion]",
+                 side ? "reaches beyond the sides of" : "rises above",
+                 100.0 * (double)n / (double)o.fused,
+                 side ? "farther from the axis than" : "higher than", side ? "radius_mm" : "top_mm",
+                 side ? fp->radius_mm : fp->top_mm, seen, fix);
     }
 }
 

@@ -552,6 +552,37 @@ static void timings_section(struct text *t, const char *dir)
                 kv_num(&k, "summary", "cpu_s", 0));
 }
 
+/* What the model lacks (warnings.txt, as the scan said it), first: a model cut by the volume or
+ * the image must not pass for the object. Nothing when there is none. A line is read to 1 KB. */
+static void warnings_section(struct text *t, const char *dir)
+{
+    char path[SCAN_DIR_PATH_MAX], line[1024];
+    unsigned shown = 0;
+    if (scan_dir_path(path, sizeof(path), dir, -1, SCAN_FILE_WARNINGS) != 0)
+        return;
+    FILE *f = file_open_regular(path, "r"); /* a pipe planted there must not hang the report */
+    if (f == NULL)
+        return;
+    for (int c = 0; fgets(line, sizeof(line), f) != NULL && shown < 16;) {
+        size_t len = strlen(line);
+        if (len > 0 && line[len - 1] == '\n')
+            line[--len] = '\0';
+        else
+            while ((c = fgetc(f)) != EOF && c != '\n') /* the rest of a longer line */
+                ;
+        if (len == 0)
+            continue;
+        if (shown++ == 0)
+            text_printf(t, "<h2>Warnings</h2>\n<ul class=warnings>\n");
+        text_printf(t, "<li>");
+        text_html(t, line);
+        text_printf(t, "</li>\n");
+    }
+    fclose(f);
+    if (shown > 0)
+        text_printf(t, "</ul>\n");
+}
+
 static void registration_section(struct text *t, const char *dir)
 {
     struct kvs k;
@@ -640,7 +671,7 @@ static const char report_style[] =
     "vertical-align:middle;text-align:left}figure{display:inline-block;margin:0 8px 8px 0}"
     "figcaption{text-align:center;color:#555}.missing{color:#999}.legend span{margin-right:1em}"
     ".legend i{display:inline-block;width:12px;height:12px;margin-right:4px;"
-    "vertical-align:middle;border:1px solid #888}img{display:block}";
+    "vertical-align:middle;border:1px solid #888}img{display:block}.warnings{color:#92400e}";
 
 /* The name a scan directory goes by: its last path component. */
 static const char *dir_name(const char *dir)
@@ -686,6 +717,7 @@ int report_write(const struct hal_storage *st, const char *dir, char *err, size_
             text_printf(&t, "<a href=\"%s\">%s</a> (%.1f MB) ", files[f], files[f],
                         sb.st_size / 1e6);
     text_printf(&t, "</p>\n");
+    warnings_section(&t, dir);
     model_section(&t, dir);
     timings_section(&t, dir);
     registration_section(&t, dir);

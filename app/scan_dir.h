@@ -27,6 +27,7 @@
 #define SCAN_FILE_MESH_MTL "mesh.mtl"           /* mesh.obj's material: its texture */
 #define SCAN_FILE_TEXTURE "texture.png"         /* the model's texture atlas (sRGB) */
 #define SCAN_FILE_REFLECTANCE "reflectance.ini" /* [colour] method = fit's materials */
+#define SCAN_FILE_WARNINGS "warnings.txt"       /* what the model lacks, a line each */
 #define SCAN_FILE_SUMMARY "summary.ini"         /* last: the scan is complete */
 #define SCAN_FILE_REPORT "report.html"
 #define SCAN_FILE_LIVE "live.png" /* the camera's picture while a scan asks (a second pass) */

@@ -376,20 +376,24 @@ check texture_off_removes_the_old_texture sh -c "test -f $out/inplace/texture.pn
 # An object the volume cuts (issue 30: one taller or wider than [fusion]'s volume came out cut
 # without a word): processed with top_mm = 100 and radius_mm = 50, the bunny (150 mm tall, 76 mm
 # from the axis) is said to rise above it and reach beyond its sides, each with the value that
-# holds it; processed with those values, nothing is said. It never ran off the camera's image.
+# holds it, in the log, warnings.txt and the report; processed with those values, nothing is said.
+# It never ran off the camera's image.
 cut_test() {
     { cat "$out/scan/config.ini"; printf '[fusion]\ntop_mm = 100\nradius_mm = 50\n'; } >"$out/cut.ini"
     "$bin" process "$out/scan" --out "$out/cut" --config "$out/cut.ini" >"$out/cut.log" 2>&1 || return 1
     grep 'fused volume' "$out/cut.log"
     grep -q 'rises above the fused volume: .* top_mm = 100, up to 15[0-9] mm' "$out/cut.log" &&
         grep -q 'reaches beyond the sides of the fused volume: .* radius_mm = 50, up to 7[0-9] mm' \
-            "$out/cut.log" && ! grep -q "off the camera's image" "$out/cut.log" || return 1
+            "$out/cut.log" && ! grep -q "off the camera's image" "$out/cut.log" &&
+        test "$(grep -c 'fused volume' "$out/cut/warnings.txt")" -eq 2 &&
+        grep -q '<h2>Warnings</h2>' "$out/cut/report.html" || return 1
     top=$(sed -n 's/.*set top_mm = \([0-9]*\) in \[fusion\].*/\1/p' "$out/cut.log")
     radius=$(sed -n 's/.*set radius_mm = \([0-9]*\) in \[fusion\].*/\1/p' "$out/cut.log")
     { cat "$out/scan/config.ini"; printf '[fusion]\ntop_mm = %s\nradius_mm = %s\n' "$top" "$radius"; } \
         >"$out/uncut.ini"
     "$bin" process "$out/scan" --out "$out/uncut" --config "$out/uncut.ini" >"$out/uncut.log" 2>&1 &&
-        ! grep -q 'fused volume' "$out/uncut.log" && ! grep -q 'fused volume' "$out/notexture.log"
+        ! grep -q 'fused volume' "$out/uncut.log" && ! grep -q 'fused volume' "$out/notexture.log" &&
+        ! test -e "$out/uncut/warnings.txt" && ! grep -q '<h2>Warnings' "$out/uncut/report.html"
 }
 check object_cut_by_the_volume_said cut_test
 rm -rf "$out/cut" "$out/uncut"

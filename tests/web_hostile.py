@@ -639,6 +639,36 @@ def warning_cases(port, key):
           len(warnings) == 1 and "rises above the fused volume" in warnings[0] and
           "top_mm = 40," in warnings[0] and "set top_mm = " in warnings[0],
           "a scan the volume cuts says so on the page, with the value that holds it", state)
+    return sid
+
+
+def saved_warning_cases(port, cut, scans):
+    """After a restart, a scan's warnings come from its warnings.txt: kept, bounded, and a pipe
+    planted there hangs nothing."""
+    s = json.loads(request(port, "GET", f"/api/scans/{cut}")[2])
+    check(s.get("warning_count") == 1 and "rises above the fused volume" in s["warnings"][0],
+          "after a restart the cut scan still says what its model lacks", s)
+    path = os.path.join(scans, cut, "warnings.txt")
+    with open(path, "w") as f:
+        f.write(("x" * 5000 + "\n") + "".join(f"line {i}\n" for i in range(1, 200)))
+    s = json.loads(request(port, "GET", f"/api/scans/{cut}")[2])
+    w = s.get("warnings", [])
+    check(len(w) == 8 and len(w[0]) < 400 and w[1] == "line 1" and s["warning_count"] == 64,
+          f"a long warnings.txt is read to 8 lines of under 400 bytes, 64 counted "
+          f"({len(w)}, {s.get('warning_count')})")
+    os.unlink(path)
+    os.mkfifo(path)
+    t0 = time.time()
+    st, _, body = request(port, "GET", f"/api/scans/{cut}", timeout=15)
+    check(time.time() - t0 < 10 and st == 200 and json.loads(body)["warnings"] == [],
+          f"a named pipe planted as warnings.txt hangs no answer ({st})")
+    try:
+        p = subprocess.run([SCANNER, "report", os.path.join(scans, cut)], capture_output=True,
+                           text=True, timeout=60)
+        check(p.returncode == 0, "nor the report (warnings.txt a pipe)", p.stderr[-600:])
+    except subprocess.TimeoutExpired:
+        check(False, "scanner report passes over a planted pipe as warnings.txt (it hung)")
+    os.unlink(path)
 
 
 def main():
@@ -652,14 +682,14 @@ def main():
             "--listen", f"127.0.0.1:{port}",
             "--scans", scans]
     srv = Server(args)
-    sid = error = None
+    sid = error = cut = None
     try:
         key = admission(port, scans)
         sid = dos_and_stop(port, key, srv)
         error = resume_cases(port, key, sid, scans)
         path_cases(port, key, scans, sid)
         manage_cases(port, key, scans)
-        warning_cases(port, key)
+        cut = warning_cases(port, key)
         profile_cases(port, key)
         calibration_cases(port, key, scans)
     finally:
@@ -671,6 +701,7 @@ def main():
         check(s.get("state") == "failed" and s.get("error") == error and "mesh.stl" in error,
               f"after a restart the failed scan is still failed, with its error ({s})")
         concurrent_thumbs(port, sid)
+        saved_warning_cases(port, cut, scans)
         fifo_cases(port, sid, scans)
     finally:
         check(srv.stop() == 0, "the restarted server ends cleanly")

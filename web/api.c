@@ -5,6 +5,7 @@
 
 #include "config.h"
 #include "disk_room.h"
+#include "file_posix.h"
 #include "guard.h"
 #include "report.h"
 #include "scan_dir.h"
@@ -162,6 +163,30 @@ int api_read_body(struct mg_connection *conn, cJSON **body)
 
 /* ---- scans ---- */
 
+/* A scan's warnings as it kept them (warnings.txt, a line each; the first WEB_MAX_WARNINGS, each
+ * cut at WEB_WARNING_LEN bytes), for a scan this server does not run now. */
+static void saved_warnings(cJSON *o, const char *scans, const char *id)
+{
+    char path[WEB_PATH + 80], line[WEB_WARNING_LEN];
+    unsigned count = 0;
+    cJSON *list = cJSON_AddArrayToObject(o, "warnings");
+    snprintf(path, sizeof(path), "%s/%s/" SCAN_FILE_WARNINGS, scans, id);
+    FILE *f = file_open_regular(path, "r"); /* a pipe planted there must not hang the answer */
+    for (int c = 0; f != NULL && count < 64 && fgets(line, sizeof(line), f) != NULL; count++) {
+        size_t len = strlen(line);
+        if (len > 0 && line[len - 1] == '\n')
+            line[--len] = '\0';
+        else
+            while ((c = fgetc(f)) != EOF && c != '\n') /* the rest of a longer line */
+                ;
+        if (count < WEB_MAX_WARNINGS)
+            cJSON_AddItemToArray(list, cJSON_CreateString(line));
+    }
+    if (f != NULL)
+        fclose(f);
+    cJSON_AddNumberToObject(o, "warning_count", count);
+}
+
 static cJSON *job_json(struct web_server *s, const char *id)
 {
     enum web_state state;
@@ -177,7 +202,8 @@ static cJSON *job_json(struct web_server *s, const char *id)
     cJSON_AddStringToObject(o, "error", error);
     struct web_job *j = &s->job;
     pthread_mutex_lock(&j->lock);
-    if (strcmp(j->id, id) == 0 && j->state != WEB_IDLE && j->kind == WEB_SCAN) { /* live */
+    int live = strcmp(j->id, id) == 0 && j->state != WEB_IDLE && j->kind == WEB_SCAN;
+    if (live) {
         cJSON_AddStringToObject(o, "stage", j->stage);
         cJSON_AddNumberToObject(o, "stage_views_done", j->step_done);
         cJSON_AddStringToObject(o, "detail", j->detail);
@@ -190,6 +216,8 @@ static cJSON *job_json(struct web_server *s, const char *id)
         cJSON_AddNumberToObject(o, "warning_count", j->warning_count);
     }
     pthread_mutex_unlock(&j->lock);
+    if (!live)
+        saved_warnings(o, s->scans, id);
     char path[WEB_PATH + 80];
     snprintf(path, sizeof(path), "%s/%s/" SCAN_FILE_REPORT, s->scans, id);
     cJSON_AddBoolToObject(o, "report", access(path, F_OK) == 0);
