@@ -59,7 +59,8 @@ struct job {
         uint32_t first_done, last_done;
         double first_ms, last_ms;
     } eta;
-    struct job_warnings { /* what the model lacks, as said (summary.ini, report.html) */
+    int said_off_image;   /* a view's object ran off the image: said once, at that view */
+    struct job_warnings { /* what the model lacks, as said (warnings.txt, report.html) */
         char text[JOB_MAX_WARNINGS][JOB_WARNING_LEN];
         unsigned n;
     } warnings;

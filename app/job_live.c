@@ -134,6 +134,26 @@ static void view_not_finished(const struct job *j, uint32_t v, int32_t angle_mde
 
 /* Decode a captured view, keep its frames and range image, then its view.ini last (its
  * presence says the view is complete). @retval 0 @retval -errno (said) */
+/* The object running off the image is said at the first view that shows it, at the table's pose
+ * (the registration has not run): the person can stop and move the camera instead of waiting for
+ * the scan's end, where the model says it too (job_model.c). */
+static void say_if_off_image(struct job *j, uint32_t v, const struct scan_view *view)
+{
+    struct frame_xform pose;
+    if (j->said_off_image)
+        return;
+    frame_object_from_camera(j->calib, view->angle_mdeg, &pose);
+    if (fusion_border_points(&j->cfg->fusion, &pose, &view->maps, &view->range) <
+        FUSION_EDGE_POINTS)
+        return;
+    j->said_off_image = 1;
+    j->hal->log(HAL_LOG_WARN,
+                "view %u: the object runs off the camera's image: what lies beyond its edge will "
+                "not be scanned (stop the scan and place the camera farther away, or lay the "
+                "object down)",
+                (unsigned)v + 1);
+}
+
 static int save_view(struct pending *p)
 {
     struct job *j = p->j;
@@ -150,6 +170,7 @@ static int save_view(struct pending *p)
         return rc;
     }
     job_progress(j, EV_SAVING, (int)p->view, p->view, "");
+    say_if_off_image(j, p->view, &view);
     rc = scan_keep_for_registration(j->reg, p->view,
                                     &view); /* the model is made once every view is in */
     if (rc == 0) /* what the model is made of, so that it is not decoded again */

@@ -208,9 +208,9 @@ void fusion_outside(const struct fusion_volume *vol, struct fusion_outside *out)
 #define TABLE_CLEARANCE_MM 5.0 /* nearer the table, a point beside the grid is the table's */
 
 /* Is @p p (object frame) over the table, where the object stands (struct fusion_outside)? */
-static int over_table(const struct fusion_volume *vol, vec3 p)
+static int over_table(const struct fusion_params *fp, vec3 p)
 {
-    double r = vol->p.radius_mm;
+    double r = fp->radius_mm;
     return p.z >= TABLE_CLEARANCE_MM && p.x * p.x + p.y * p.y <= 4.0 * r * r;
 }
 
@@ -221,7 +221,7 @@ static void count_outside(struct fusion_volume *vol, vec3 p)
     struct fusion_outside *o = &vol->outside;
     double reach = fabs(p.x) > fabs(p.y) ? fabs(p.x) : fabs(p.y);
     o->fused++;
-    if (!over_table(vol, p))
+    if (!over_table(fp, p))
         return;
     if (p.z > fp->top_mm) {
         o->above++;
@@ -233,10 +233,9 @@ static void count_outside(struct fusion_volume *vol, vec3 p)
     }
 }
 
-/* Does the object run off the view's image? Its valid pixels on the image's border, whatever
- * their weight (the weights fade to 0 there), counted where they are over the table. */
-static void count_frame_edge(struct fusion_volume *vol, const struct frame_xform *obj_from_cam,
-                             const struct decode_maps *m, const struct tri_range *r)
+uint32_t fusion_border_points(const struct fusion_params *fp,
+                              const struct frame_xform *obj_from_cam, const struct decode_maps *m,
+                              const struct tri_range *r)
 {
     const uint32_t w = m->width, h = m->height;
     uint32_t n = 0;
@@ -246,11 +245,11 @@ static void count_frame_edge(struct fusion_volume *vol, const struct frame_xform
         uint32_t y = k < w ? 0 : k < 2 * w ? h - 1 : (k - 2 * w) % h;
         size_t i = (size_t)y * w + x;
         if (m->reason[i] == SCAN_VALID &&
-            over_table(vol, frame_point(obj_from_cam, v3(r->xyz_mm[3 * i], r->xyz_mm[3 * i + 1],
-                                                         r->xyz_mm[3 * i + 2]))))
+            over_table(fp, frame_point(obj_from_cam, v3(r->xyz_mm[3 * i], r->xyz_mm[3 * i + 1],
+                                                        r->xyz_mm[3 * i + 2]))))
             n++;
     }
-    vol->outside.views_cut += n >= FUSION_EDGE_POINTS;
+    return n;
 }
 
 /* Mark the blocks of the view's fused points, and count those beyond the grid.
@@ -406,7 +405,8 @@ int fusion_integrate(struct fusion_volume *vol, const struct hal_thread *threads
                        .nb = {(dims[0] + BLOCK - 1) / BLOCK, (dims[1] + BLOCK - 1) / BLOCK,
                               (dims[2] + BLOCK - 1) / BLOCK},
                        .parts = hal_thread_parts(threads, 64)};
-    count_frame_edge(vol, obj_from_cam, m, r);
+    vol->outside.views_cut +=
+        fusion_border_points(&vol->p, obj_from_cam, m, r) >= FUSION_EDGE_POINTS;
     if (!mark_blocks(vol, obj_from_cam, m, r, s.nb))
         return 0;
     /* a point's band reaches truncation / voxel voxels (and one for rounding) from its block */

@@ -60,6 +60,13 @@ struct fusion_outside {
 };
 #define FUSION_EDGE_POINTS 16u
 
+/** A view's valid pixels on its image's border (its outer rows and columns, whatever their
+ *  weight) that are points over the table (5 mm up, within twice @p p's radius_mm of the axis),
+ *  seen through @p obj_from_cam: the object runs off the image where there are
+ *  FUSION_EDGE_POINTS or more (a scan can say so at its first view). @retval their count */
+uint32_t fusion_border_points(const struct fusion_params *p, const struct frame_xform *obj_from_cam,
+                              const struct decode_maps *maps, const struct tri_range *range);
+
 /** What fusion_integrate counted beyond the grid (above). @param out  out: the counts */
 void fusion_outside(const struct fusion_volume *vol, struct fusion_outside *out);
 

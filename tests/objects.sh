@@ -229,4 +229,21 @@ slip_plain_test() {
         test -f "$out/slip-uniform/view_007/view.ini" && test ! -f "$out/slip-uniform/mesh.ply"
 }
 check plain_box_slipped_along_its_faces_is_refused_naming_the_view slip_plain_test
+# A cylinder 290 mm tall with every default (issue 30: it came out cut at the volume's 165 mm and
+# at the image's top, without a word): said at its first view, which shows the object running off
+# the image, and at the end, with top_mm's value that holds what the views saw, in warnings.txt
+# and the report too.
+tall_test() {
+    config cylinder 2
+    sed -e "s/^object_height_mm = .*/object_height_mm = 290/" "$out/cylinder-2.ini" >"$out/tall.ini"
+    printf '[output]\nkeep_frames = none\n' >>"$out/tall.ini"
+    "$bin" scan --config "$out/tall.ini" --out "$out/tall" >"$out/tall.log" 2>&1 || return 1
+    grep warning "$out/tall.log"
+    grep -q "warning: view 1: the object runs off the camera's image" "$out/tall.log" &&
+        grep -q "warning: the object runs off the camera's image in 2 of 2 views" "$out/tall.log" &&
+        grep -q 'warning: the object rises above the fused volume: .* top_mm = 165, up to 2[0-9][0-9] mm.*set top_mm = 2[0-9][05] in \[fusion\]' \
+            "$out/tall.log" &&
+        test "$(wc -l <"$out/tall/warnings.txt")" -eq 2 && grep -q '<h2>Warnings' "$out/tall/report.html"
+}
+check tall_object_is_said_cut_at_its_first_view_and_at_the_end tall_test
 check_summary "$out"
