@@ -286,13 +286,16 @@ static const struct ini_key config_keys[] = {
         "moved?): the scan fails and names the view instead of fusing a wrong pose"),
     F64("fusion", "voxel_mm", fusion.voxel_mm, 0.1, 20, "1.0", "edge of a fusion voxel"),
     F64("fusion", "radius_mm", fusion.radius_mm, 5, 2000, "100",
-        "the fused volume spans this radius around the turntable axis (an object reaching "
-        "beyond it is said, with the radius that holds it)"),
+        "the fused volume spans this radius around the turntable axis (grown to hold a wider "
+        "object: fit_volume)"),
     F64("fusion", "bottom_mm", fusion.bottom_mm, -1000, 1000, "-3",
         "lowest height fused (table surface = 0)"),
     F64("fusion", "top_mm", fusion.top_mm, -1000, 2000, "165",
-        "highest height fused (an object rising above it is said, with the height that holds "
-        "it)"),
+        "highest height fused (grown to hold a taller object: fit_volume)"),
+    U32("fusion", "fit_volume", fusion.fit_volume, 0, 1, "1",
+        "1: the volume grows past radius_mm and top_mm to hold what the registered views saw "
+        "(within this build's limits), and says so; 0: they cut the object, and the scan says "
+        "what was left out"),
     F64("fusion", "truncation_mm", fusion.truncation_mm, 0.1, 100, "2.5",
         "signed distances are clamped to +- this"),
     F64("fusion", "max_weight", fusion.max_weight, 1, 60, "50", "a voxel's weight stops here"),

@@ -366,6 +366,40 @@ static int fit_reflectance(struct job *j, const char *scan_dir)
     return 0;
 }
 
+/* What the registered views saw, against the configured volume (fit_volume). */
+struct seen {
+    struct fusion_outside o;
+    const struct fusion_params *p;
+};
+
+static void count_seen(void *priv, vec3 p_obj)
+{
+    struct seen *seen = priv;
+    fusion_outside_add(&seen->o, seen->p, p_obj);
+}
+
+/* [fusion] fit_volume: the volume grown to hold what the registered views saw (their samples),
+ * so that a taller or wider object than radius_mm and top_mm is not cut; said when it grows.
+ * @param fp  out: the volume to fuse in */
+static void fit_volume(struct job *j, struct fusion_params *fp)
+{
+    const struct fusion_params *cfg = &j->cfg->fusion;
+    struct seen seen = {.p = cfg};
+    reg_each_point(j->reg, count_seen, &seen);
+    if (fusion_fit(cfg, &seen.o, fp) != 1)
+        return;
+    char top[96] = "", radius[96] = "";
+    if (fp->top_mm != cfg->top_mm)
+        snprintf(top, sizeof(top), "top_mm %g -> %.1f (it reaches %.0f mm up)", cfg->top_mm,
+                 fp->top_mm, seen.o.top_seen_mm);
+    if (fp->radius_mm != cfg->radius_mm)
+        snprintf(radius, sizeof(radius), "radius_mm %g -> %g (%.0f mm out)", cfg->radius_mm,
+                 fp->radius_mm, seen.o.reach_seen_mm);
+    j->hal->log(HAL_LOG_INFO,
+                "the fused volume grown to hold the object ([fusion] fit_volume): %s%s%s", top,
+                top[0] != '\0' && radius[0] != '\0' ? ", " : "", radius);
+}
+
 /* The smallest multiple of 5 mm at least @p mm + 5 (a suggested bound with room). */
 static double bound_with_room(double mm)
 {
@@ -377,11 +411,10 @@ static double bound_with_room(double mm)
  * compiled limits), so that a cut model is never taken for the object; and one that runs off
  * the camera's image, which no setting of the volume brings back. Points are counted where
  * they are many enough not to be stray ones (at least 100, and a thousandth of those fused). */
-static void report_outside(struct job *j)
+static void report_outside(struct job *j, const struct fusion_params *fp)
 {
     struct fusion_outside o;
     fusion_outside(j->vol, &o);
-    const struct fusion_params *fp = &j->cfg->fusion;
     if (o.views_cut > 0)
         job_warn(j,
                  "the object runs off the camera's image in %u of %u views: what lies beyond "
@@ -431,8 +464,10 @@ int job_make_model(struct job *j, const char *scan_dir)
     int rc = report_registration(j, &rep, clock_posix_thread_cpu_s() - t0, scan_dir);
     if (rc == 0)
         rc = fit_reflectance(j, scan_dir);
+    struct fusion_params fp;
+    fit_volume(j, &fp);
     if (rc == 0)
-        rc = fusion_begin(j->vol, &j->cfg->fusion);
+        rc = fusion_begin(j->vol, &fp);
     for (uint32_t v = 0; v < j->views && rc == 0; v++) {
         struct scan_view view;
         struct scan_view_info info;
@@ -454,6 +489,6 @@ int job_make_model(struct job *j, const char *scan_dir)
         }
     }
     if (rc == 0)
-        report_outside(j);
+        report_outside(j, &fp);
     return rc == 0 ? write_model(j, scan_dir) : rc;
 }

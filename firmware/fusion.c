@@ -214,11 +214,8 @@ static int over_table(const struct fusion_params *fp, vec3 p)
     return p.z >= TABLE_CLEARANCE_MM && p.x * p.x + p.y * p.y <= 4.0 * r * r;
 }
 
-/* A fused point @p p (object frame) counted where the grid cuts it (struct fusion_outside). */
-static void count_outside(struct fusion_volume *vol, vec3 p)
+void fusion_outside_add(struct fusion_outside *o, const struct fusion_params *fp, vec3 p)
 {
-    const struct fusion_params *fp = &vol->p;
-    struct fusion_outside *o = &vol->outside;
     double reach = fabs(p.x) > fabs(p.y) ? fabs(p.x) : fabs(p.y);
     o->fused++;
     if (!over_table(fp, p))
@@ -231,6 +228,44 @@ static void count_outside(struct fusion_volume *vol, vec3 p)
         o->beside++;
         o->reach_seen_mm = reach > o->reach_seen_mm ? reach : o->reach_seen_mm;
     }
+}
+
+/* Are @p n points beyond the volume, of @p fused, many enough to say (or grow) for? Fewer are
+ * stray ones: at least @p least, and a thousandth. */
+static int many_beyond(uint64_t n, uint64_t fused, uint64_t least)
+{
+    return n >= least && n * 1000 >= fused;
+}
+
+int fusion_fit(const struct fusion_params *p, const struct fusion_outside *seen,
+               struct fusion_params *fitted)
+{
+    *fitted = *p;
+    if (!p->fit_volume)
+        return 0;
+    double spare = p->truncation_mm + 2.0 * p->voxel_mm;
+    int grown = 0;
+    if (many_beyond(seen->above, seen->fused, 8) && seen->top_seen_mm + spare > p->top_mm) {
+        fitted->top_mm = seen->top_seen_mm + spare;
+        grown = 1;
+    }
+    if (many_beyond(seen->beside, seen->fused, 8) && seen->reach_seen_mm + spare > p->radius_mm) {
+        double voxels = ceil((seen->reach_seen_mm + spare - p->radius_mm) / p->voxel_mm);
+        fitted->radius_mm = p->radius_mm + voxels * p->voxel_mm;
+        grown = 1;
+    }
+    uint32_t dims[3];
+    if (grown && fusion_dims(fitted, dims) != 0) {
+        *fitted = *p;
+        return -E2BIG;
+    }
+    return grown;
+}
+
+/* A fused point @p p (object frame) counted where the grid cuts it (struct fusion_outside). */
+static void count_outside(struct fusion_volume *vol, vec3 p)
+{
+    fusion_outside_add(&vol->outside, &vol->p, p);
 }
 
 uint32_t fusion_border_points(const struct fusion_params *fp,

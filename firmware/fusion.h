@@ -22,6 +22,7 @@ struct fusion_params {
     double truncation_mm;     /**< distances are clamped to +-this */
     double max_weight;        /**< a voxel's weight stops growing here (older views fade) */
     uint32_t edge_fade_px;    /**< view weights ramp up over this many pixels from its edge */
+    uint32_t fit_volume;      /**< 1: fusion_fit may grow radius and top to hold the object */
     double min_weight;        /**< pixels weighing less are not fused (grazing views) */
 };
 
@@ -66,6 +67,20 @@ struct fusion_outside {
  *  FUSION_EDGE_POINTS or more (a scan can say so at its first view). @retval their count */
 uint32_t fusion_border_points(const struct fusion_params *p, const struct frame_xform *obj_from_cam,
                               const struct decode_maps *maps, const struct tri_range *range);
+
+/** Count @p p_obj (object frame) in @p o as fusion_integrate counts a fused point against the
+ *  grid of @p p (struct fusion_outside). */
+void fusion_outside_add(struct fusion_outside *o, const struct fusion_params *p, vec3 p_obj);
+
+/** The volume grown to hold what @p seen counted beyond @p p's (points beyond it by the
+ *  thousand of them, and at least 8): top_mm to their highest, radius_mm to their farthest,
+ *  each with the truncation band and two voxels to spare, the radius by whole voxels (the
+ *  grid's voxels stay where they were). A part already inside is left as it is.
+ *  @param fitted  out: the grown parameters (@p p where nothing grows, or beyond the limits)
+ *  @retval 1 grown @retval 0 nothing to grow, or p->fit_volume is 0 @retval -E2BIG the grown
+ *  volume is beyond the compiled limits (FUSION_MAX_*) */
+int fusion_fit(const struct fusion_params *p, const struct fusion_outside *seen,
+               struct fusion_params *fitted);
 
 /** What fusion_integrate counted beyond the grid (above). @param out  out: the counts */
 void fusion_outside(const struct fusion_volume *vol, struct fusion_outside *out);

@@ -674,3 +674,18 @@ int reg_view_pose(struct reg_ctx *r, uint32_t v, struct frame_xform *obj_from_ca
     }
     return 0;
 }
+
+void reg_each_point(struct reg_ctx *r, void (*each)(void *priv, vec3 p_obj), void *priv)
+{
+    for (uint32_t v = 0; v < r->views; v++) {
+        struct frame_xform pose;
+        struct reg_view info;
+        if (reg_view_pose(r, v, &pose, &info) != 0)
+            continue;
+        const struct reg_cell *cells = reg_view_cells(r, v);
+        for (size_t i = 0; i < reg_cell_count(r); i++)
+            if (cells[i].valid)
+                each(priv,
+                     frame_point(&pose, v3(cells[i].xyz[0], cells[i].xyz[1], cells[i].xyz[2])));
+    }
+}

@@ -172,4 +172,8 @@ int reg_solve(struct reg_ctx *r, struct reg_report *report);
 int reg_view_pose(struct reg_ctx *r, uint32_t index, struct frame_xform *obj_from_cam,
                   struct reg_view *view);
 
+/** Every valid kept sample of every added view (every stride-th pixel), at its view's pose
+ *  after reg_solve (reg_view_pose): handed to @p each in the object frame, mm. */
+void reg_each_point(struct reg_ctx *r, void (*each)(void *priv, vec3 p_obj), void *priv);
+
 #endif

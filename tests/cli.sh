@@ -374,12 +374,22 @@ check texture_off_removes_the_old_texture sh -c "test -f $out/inplace/texture.pn
     ! test -e $out/inplace/texture.png && ! test -e $out/inplace/mesh.mtl &&
     ! grep -q mtllib $out/inplace/mesh.obj"
 # An object the volume cuts (issue 30: one taller or wider than [fusion]'s volume came out cut
-# without a word): processed with top_mm = 100 and radius_mm = 50, the bunny (150 mm tall, 76 mm
-# from the axis) is said to rise above it and reach beyond its sides, each with the value that
-# holds it, in the log, warnings.txt and the report; processed with those values, nothing is said.
-# It never ran off the camera's image.
+# without a word). With fit_volume = 1 (the default) the volume grows to hold what the views saw:
+# processed with top_mm = 100 and radius_mm = 50, the bunny (150 mm tall, 76 mm from the axis)
+# is said to have grown it and comes out as the scan's own model. With fit_volume = 0 it is said
+# to rise above the volume and reach beyond its sides, each with the value that holds it, in the
+# log, warnings.txt and the report; processed with those values, nothing is said. It never ran
+# off the camera's image.
 cut_test() {
-    { cat "$out/scan/config.ini"; printf '[fusion]\ntop_mm = 100\nradius_mm = 50\n'; } >"$out/cut.ini"
+    { cat "$out/scan/config.ini"; printf '[fusion]\ntop_mm = 100\nradius_mm = 50\n'; } >"$out/grown.ini"
+    "$bin" process "$out/scan" --out "$out/grown" --config "$out/grown.ini" >"$out/grown.log" 2>&1 || return 1
+    grep 'fused volume' "$out/grown.log"
+    grep -q 'info: the fused volume grown to hold the object (\[fusion\] fit_volume): top_mm 100 -> 15[0-9].[0-9] (it reaches 15[0-9] mm up), radius_mm 50 -> [78][0-9] (7[0-9] mm out)' \
+        "$out/grown.log" && ! grep -q 'warning: .*fused volume' "$out/grown.log" &&
+        ! test -e "$out/grown/warnings.txt" || return 1
+    "${BUILD:-build}/mesh-compare" "$out/grown/mesh.ply" "$out/scan/mesh.ply" | tee "$out/grown.compare" |
+        grep -q 'result -> truth: mean 0.00[0-9] mm' || return 1
+    { cat "$out/grown.ini"; printf 'fit_volume = 0\n'; } >"$out/cut.ini"
     "$bin" process "$out/scan" --out "$out/cut" --config "$out/cut.ini" >"$out/cut.log" 2>&1 || return 1
     grep 'fused volume' "$out/cut.log"
     grep -q 'rises above the fused volume: .* top_mm = 100, up to 15[0-9] mm' "$out/cut.log" &&
@@ -389,14 +399,14 @@ cut_test() {
         grep -q '<h2>Warnings</h2>' "$out/cut/report.html" || return 1
     top=$(sed -n 's/.*set top_mm = \([0-9]*\) in \[fusion\].*/\1/p' "$out/cut.log")
     radius=$(sed -n 's/.*set radius_mm = \([0-9]*\) in \[fusion\].*/\1/p' "$out/cut.log")
-    { cat "$out/scan/config.ini"; printf '[fusion]\ntop_mm = %s\nradius_mm = %s\n' "$top" "$radius"; } \
+    { cat "$out/scan/config.ini"; printf '[fusion]\ntop_mm = %s\nradius_mm = %s\nfit_volume = 0\n' "$top" "$radius"; } \
         >"$out/uncut.ini"
     "$bin" process "$out/scan" --out "$out/uncut" --config "$out/uncut.ini" >"$out/uncut.log" 2>&1 &&
         ! grep -q 'fused volume' "$out/uncut.log" && ! grep -q 'fused volume' "$out/notexture.log" &&
         ! test -e "$out/uncut/warnings.txt" && ! grep -q '<h2>Warnings' "$out/uncut/report.html"
 }
 check object_cut_by_the_volume_said cut_test
-rm -rf "$out/cut" "$out/uncut"
+rm -rf "$out/grown" "$out/cut" "$out/uncut"
 rm -rf "$out/inplace"
 cp -r "$out/scan" "$out/broken" 2>/dev/null; rm -f "$out/broken/view_000/frame_07.pgm.zst"
 check process_names_missing_frame sh -c "$bin process $out/broken --out $out/broken_out 2>&1 | \

@@ -230,9 +230,9 @@ slip_plain_test() {
 }
 check plain_box_slipped_along_its_faces_is_refused_naming_the_view slip_plain_test
 # A cylinder 290 mm tall with every default (issue 30: it came out cut at the volume's 165 mm and
-# at the image's top, without a word): said at its first view, which shows the object running off
-# the image, and at the end, with top_mm's value that holds what the views saw, in warnings.txt
-# and the report too.
+# at the image's top, without a word): the volume grows to hold what the views saw (fit_volume),
+# said; the image's top, which no volume brings back, is said at its first view and at the end,
+# in warnings.txt and the report too.
 tall_test() {
     config cylinder 2
     sed -e "s/^object_height_mm = .*/object_height_mm = 290/" "$out/cylinder-2.ini" >"$out/tall.ini"
@@ -241,9 +241,9 @@ tall_test() {
     grep warning "$out/tall.log"
     grep -q "warning: view 1: the object runs off the camera's image" "$out/tall.log" &&
         grep -q "warning: the object runs off the camera's image in 2 of 2 views" "$out/tall.log" &&
-        grep -q 'warning: the object rises above the fused volume: .* top_mm = 165, up to 2[0-9][0-9] mm.*set top_mm = 2[0-9][05] in \[fusion\]' \
-            "$out/tall.log" &&
-        test "$(wc -l <"$out/tall/warnings.txt")" -eq 2 && grep -q '<h2>Warnings' "$out/tall/report.html"
+        grep -q 'info: the fused volume grown to hold the object (\[fusion\] fit_volume): top_mm 165 -> 2[0-9][0-9].[0-9] (it reaches 2[0-9][0-9] mm up)$' \
+            "$out/tall.log" && ! grep -q 'fused volume:' "$out/tall.log" &&
+        test "$(wc -l <"$out/tall/warnings.txt")" -eq 1 && grep -q '<h2>Warnings' "$out/tall/report.html"
 }
 check tall_object_is_said_cut_at_its_first_view_and_at_the_end tall_test
 check_summary "$out"

@@ -435,6 +435,50 @@ static void test_table_properties(void **state)
 /* Two volumes (struct fusion_volume) are two models: a torus fused and meshed in a second one
  * between the sphere's preparation and its writing leaves the sphere's mesh.ply byte for byte
  * what it was written as before. */
+/* fit_volume: points over the table beyond the volume grow it to hold them (the radius by whole
+ * voxels), with the band and two voxels to spare; a few stray ones, points off the table, a
+ * volume beyond the compiled limits or fit_volume = 0 leave it as it is. */
+static void test_volume_fitted_to_what_was_seen(void **state)
+{
+    (void)state;
+    struct fusion_params p = grid_params(), f; /* radius 30, top 60, voxel 1, band 3 */
+    p.voxel_mm = 0.7;
+    p.fit_volume = 1;
+    struct fusion_outside seen = {0};
+    for (int i = 0; i < 5000; i++) /* inside: nothing grows */
+        fusion_outside_add(&seen, &p, v3(10.0 * sin(i), 10.0 * cos(i), 1.0 + i % 55));
+    assert_int_equal(fusion_fit(&p, &seen, &f), 0);
+    assert_memory_equal(&f, &p, sizeof(p));
+    for (int i = 0; i < 7; i++) /* 7 stray points far above and beside: still nothing */
+        fusion_outside_add(&seen, &p, v3(40.0, 0.0, 90.0));
+    for (int i = 0; i < 50; i++) /* under the table's clearance, or far off it: not the object */
+        fusion_outside_add(&seen, &p, v3(50.0, 0.0, 2.0)),
+            fusion_outside_add(&seen, &p, v3(70, 0, 30));
+    assert_int_equal(fusion_fit(&p, &seen, &f), 0);
+    for (int i = 0; i < 10; i++) /* now 17 above (90 mm), 17 beside (40 mm): grown */
+        fusion_outside_add(&seen, &p, v3(0.0, -40.0, 90.0));
+    assert_int_equal(seen.above, 17);
+    assert_int_equal(seen.beside, 17);
+    assert_int_equal(fusion_fit(&p, &seen, &f), 1);
+    assert_true(fabs(f.top_mm - (90.0 + 3.0 + 1.4)) < 1e-9);
+    double voxels = (f.radius_mm - p.radius_mm) / p.voxel_mm; /* whole voxels, enough */
+    assert_true(fabs(voxels - round(voxels)) < 1e-9 && f.radius_mm >= 40.0 + 3.0 + 1.4 &&
+                f.radius_mm < 40.0 + 3.0 + 1.4 + p.voxel_mm);
+    assert_true(f.bottom_mm == p.bottom_mm && f.voxel_mm == p.voxel_mm);
+    /* a thousandth of what was fused at least: 17 of 50,000 are strays */
+    for (int i = 0; i < 45000; i++)
+        fusion_outside_add(&seen, &p, v3(0.0, 0.0, 30.0));
+    assert_int_equal(fusion_fit(&p, &seen, &f), 0);
+    seen.fused = 1000;
+    p.fit_volume = 0;
+    assert_int_equal(fusion_fit(&p, &seen, &f), 0);
+    assert_memory_equal(&f, &p, sizeof(p));
+    p.fit_volume = 1; /* 1,000 m tall: beyond any grid this build has */
+    seen.top_seen_mm = 1e6;
+    assert_int_equal(fusion_fit(&p, &seen, &f), -E2BIG);
+    assert_memory_equal(&f, &p, sizeof(p));
+}
+
 static void test_two_volumes_are_independent(void **state)
 {
     (void)state;
@@ -470,6 +514,7 @@ int main(void)
         cmocka_unit_test(test_small_hole_closed_on_the_mesh),
         cmocka_unit_test(test_uncoloured_surface_takes_its_neighbours_colour),
         cmocka_unit_test(test_watertight_closes_at_the_table),
+        cmocka_unit_test(test_volume_fitted_to_what_was_seen),
         cmocka_unit_test(test_two_volumes_are_independent),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -101,9 +101,9 @@ def write_configs():
     for name, views in [("fast", 4), ("long", 100)]:
         with open(os.path.join(OUT, f"{name}.ini"), "w") as f:
             f.write(base.format(views=views, out=OUT))
-    # cut: the fast scan in a volume 40 mm tall, which the sphere rises above (a warning)
+    # cut: the fast scan in a volume 40 mm tall that may not grow, which the sphere rises above
     with open(os.path.join(OUT, "cut.ini"), "w") as f:
-        f.write(base.format(views=4, out=OUT) + "[fusion]\ntop_mm = 40\n")
+        f.write(base.format(views=4, out=OUT) + "[fusion]\ntop_mm = 40\nfit_volume = 0\n")
     # asked: a calibration at the simulated rig whose person waits to be told to go on
     with open(os.path.join(OUT, "asked.ini"), "w") as f:
         f.write(base.format(views=4, out=OUT).replace("[sim]\n", "[sim]\nperson = asked\n"))
