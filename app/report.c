@@ -552,34 +552,31 @@ static void timings_section(struct text *t, const char *dir)
                 kv_num(&k, "summary", "cpu_s", 0));
 }
 
+/* The report's list of warnings, begun at the first. */
+struct warning_list {
+    struct text *t;
+    unsigned shown;
+};
+
+static void warning_item(void *priv, const char *line)
+{
+    struct warning_list *w = priv;
+    if (line[0] == '\0')
+        return;
+    if (w->shown++ == 0)
+        text_printf(w->t, "<h2>Warnings</h2>\n<ul class=warnings>\n");
+    text_printf(w->t, "<li>");
+    text_html(w->t, line);
+    text_printf(w->t, "</li>\n");
+}
+
 /* What the model lacks (warnings.txt, as the scan said it), first: a model cut by the volume or
- * the image must not pass for the object. Nothing when there is none. A line is read to 1 KB. */
+ * the image must not pass for the object. Nothing when there is none. */
 static void warnings_section(struct text *t, const char *dir)
 {
-    char path[SCAN_DIR_PATH_MAX], line[1024];
-    unsigned shown = 0;
-    if (scan_dir_path(path, sizeof(path), dir, -1, SCAN_FILE_WARNINGS) != 0)
-        return;
-    FILE *f = file_open_regular(path, "r"); /* a pipe planted there must not hang the report */
-    if (f == NULL)
-        return;
-    for (int c = 0; fgets(line, sizeof(line), f) != NULL && shown < 16;) {
-        size_t len = strlen(line);
-        if (len > 0 && line[len - 1] == '\n')
-            line[--len] = '\0';
-        else
-            while ((c = fgetc(f)) != EOF && c != '\n') /* the rest of a longer line */
-                ;
-        if (len == 0)
-            continue;
-        if (shown++ == 0)
-            text_printf(t, "<h2>Warnings</h2>\n<ul class=warnings>\n");
-        text_printf(t, "<li>");
-        text_html(t, line);
-        text_printf(t, "</li>\n");
-    }
-    fclose(f);
-    if (shown > 0)
+    struct warning_list w = {t, 0};
+    scan_dir_each_warning(dir, 16, 1024, warning_item, &w);
+    if (w.shown > 0)
         text_printf(t, "</ul>\n");
 }
 

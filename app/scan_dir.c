@@ -690,3 +690,26 @@ int scan_dir_begin_view(const struct hal_storage *st, const char *dir, uint32_t 
         rc = hal_storage_mkdir_p(st, path);
     return rc == 0 ? scan_dir_remove(dir, (int)view, SCAN_FILE_VIEW) : rc;
 }
+
+unsigned scan_dir_each_warning(const char *dir, unsigned max, size_t line_len,
+                               void (*each)(void *priv, const char *line), void *priv)
+{
+    char path[SCAN_DIR_PATH_MAX], line[1024];
+    unsigned count = 0;
+    line_len = line_len < sizeof(line) ? line_len : sizeof(line);
+    FILE *f = scan_dir_path(path, sizeof(path), dir, -1, SCAN_FILE_WARNINGS) == 0
+                  ? file_open_regular(path, "r") /* a pipe planted there must hang nothing */
+                  : NULL;
+    for (int c = 0; f != NULL && count < max && fgets(line, (int)line_len, f) != NULL; count++) {
+        size_t len = strlen(line);
+        if (len > 0 && line[len - 1] == '\n')
+            line[--len] = '\0';
+        else
+            while ((c = fgetc(f)) != EOF && c != '\n') /* the rest of a longer line */
+                ;
+        each(priv, line);
+    }
+    if (f != NULL)
+        fclose(f);
+    return count;
+}

@@ -193,6 +193,13 @@ void scan_dir_close(int lock_fd);
  *  -errno */
 int scan_dir_begin_view(const struct hal_storage *st, const char *dir, uint32_t view);
 
+/** The lines of @p dir's warnings.txt, in order, to @p each (its newline taken off; a line
+ *  longer than @p line_len - 1 bytes cut there), the first @p max of them: a report and the web
+ *  page read it alike. A file that is not a regular one (a pipe planted there) is not read.
+ *  @retval the lines read (0: no file) */
+unsigned scan_dir_each_warning(const char *dir, unsigned max, size_t line_len,
+                               void (*each)(void *priv, const char *line), void *priv);
+
 /** Remove file @p name of @p dir (of view @p view, or -1: the scan's own) when it is there.
  *  @retval 0 removed, or there was none @retval -errno */
 int scan_dir_remove(const char *dir, int view, const char *name);

@@ -5,7 +5,6 @@
 
 #include "config.h"
 #include "disk_room.h"
-#include "file_posix.h"
 #include "guard.h"
 #include "report.h"
 #include "scan_dir.h"
@@ -163,27 +162,21 @@ int api_read_body(struct mg_connection *conn, cJSON **body)
 
 /* ---- scans ---- */
 
-/* A scan's warnings as it kept them (warnings.txt, a line each; the first WEB_MAX_WARNINGS, each
- * cut at WEB_WARNING_LEN bytes), for a scan this server does not run now. */
+static void add_warning(void *priv, const char *line)
+{
+    cJSON *list = priv;
+    if (cJSON_GetArraySize(list) < (int)WEB_MAX_WARNINGS)
+        cJSON_AddItemToArray(list, cJSON_CreateString(line));
+}
+
+/* A scan's warnings as it kept them (warnings.txt, a line each: the first WEB_MAX_WARNINGS,
+ * each cut at WEB_WARNING_LEN bytes; up to 64 counted), for a scan this server does not run now. */
 static void saved_warnings(cJSON *o, const char *scans, const char *id)
 {
-    char path[WEB_PATH + 80], line[WEB_WARNING_LEN];
-    unsigned count = 0;
+    char dir[WEB_PATH + 80];
+    snprintf(dir, sizeof(dir), "%s/%s", scans, id);
     cJSON *list = cJSON_AddArrayToObject(o, "warnings");
-    snprintf(path, sizeof(path), "%s/%s/" SCAN_FILE_WARNINGS, scans, id);
-    FILE *f = file_open_regular(path, "r"); /* a pipe planted there must not hang the answer */
-    for (int c = 0; f != NULL && count < 64 && fgets(line, sizeof(line), f) != NULL; count++) {
-        size_t len = strlen(line);
-        if (len > 0 && line[len - 1] == '\n')
-            line[--len] = '\0';
-        else
-            while ((c = fgetc(f)) != EOF && c != '\n') /* the rest of a longer line */
-                ;
-        if (count < WEB_MAX_WARNINGS)
-            cJSON_AddItemToArray(list, cJSON_CreateString(line));
-    }
-    if (f != NULL)
-        fclose(f);
+    unsigned count = scan_dir_each_warning(dir, 64, WEB_WARNING_LEN, add_warning, list);
     cJSON_AddNumberToObject(o, "warning_count", count);
 }
 
