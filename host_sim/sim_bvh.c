@@ -18,26 +18,12 @@ static float centroid(const struct sim_mesh *m, uint32_t tri, int axis)
     return (vert(m, tri, 0)[axis] + vert(m, tri, 1)[axis] + vert(m, tri, 2)[axis]) / 3.0f;
 }
 
-static void node_bounds(struct sim_bvh *b, struct sim_bvh_node *n)
-{
-    for (int a = 0; a < 3; a++) {
-        n->lo[a] = 1e30f;
-        n->hi[a] = -1e30f;
-    }
-    for (uint32_t i = n->first; i < n->first + n->count; i++)
-        for (int k = 0; k < 3; k++)
-            for (int a = 0; a < 3; a++) {
-                float p = vert(b->mesh, b->tri_order[i], k)[a];
-                n->lo[a] = p < n->lo[a] ? p : n->lo[a];
-                n->hi[a] = p > n->hi[a] ? p : n->hi[a];
-            }
-}
-
 /* Surface-area heuristic, binned (Wald, "On fast construction of SAH-based bounding volume
  * hierarchies", 2007): a node's triangles are split where
  *   cost = area(left) * count(left) + area(right) * count(right)
  * is least over SAH_BINS bins of centroid along each axis; rays then open about half the nodes a
- * median split makes them open. Where every centroid falls in one bin, the median split. */
+ * median split makes them open. Where every centroid falls in one bin, halved in the order they
+ * are in. */
 #define SAH_BINS 16
 
 struct box {
@@ -77,6 +63,19 @@ static void tri_box(const struct sim_mesh *m, uint32_t tri, struct box *b)
             b->lo[a] = p < b->lo[a] ? p : b->lo[a];
             b->hi[a] = p > b->hi[a] ? p : b->hi[a];
         }
+}
+
+/* A node's bounds: of its triangles' boxes. */
+static void node_bounds(struct sim_bvh *b, struct sim_bvh_node *n)
+{
+    struct box all, one;
+    box_empty(&all);
+    for (uint32_t i = n->first; i < n->first + n->count; i++) {
+        tri_box(b->mesh, b->tri_order[i], &one);
+        box_grow(&all, &one);
+    }
+    memcpy(n->lo, all.lo, sizeof(n->lo));
+    memcpy(n->hi, all.hi, sizeof(n->hi));
 }
 
 static int bin_of(float c, float lo, float scale)
