@@ -18,7 +18,7 @@
 #include <stdint.h>
 
 #define JOB_MAX_STAGES 8u
-#define JOB_MAX_WARNINGS 4u /* what the model lacks, kept for summary.ini (job_warn) */
+#define JOB_MAX_WARNINGS 4u /* what the model lacks, kept for warnings.txt (job_warn) */
 #define JOB_WARNING_LEN 400u
 
 /* A captured view, processed and saved by a thread of its own while the table turns to the next
@@ -105,8 +105,8 @@ void job_json_string(FILE *out, const char *s);
 void job_progress_with(struct job *j, const char *event, int view, uint32_t done,
                        const char *fields, const char *detail);
 void job_progress(struct job *j, const char *event, int view, uint32_t done, const char *detail);
-/** A warning about the model (an object the volume cut ...): logged, and kept for summary.ini's
- *  [warnings] and report.html (the first JOB_MAX_WARNINGS). */
+/** A warning about the model (an object the volume cut ...): logged, and kept for the scan's
+ *  warnings.txt, which report.html and the page list (the first JOB_MAX_WARNINGS). */
 void job_warn(struct job *j, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 /** The end of a job that made its model: what it cost (EV_COST, "@p what N s CPU ..."),
  *  summary.ini and report.html (@p command: "scan" or "processing"), then @p event (EV_SCAN_DONE,

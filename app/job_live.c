@@ -132,8 +132,6 @@ static void view_not_finished(const struct job *j, uint32_t v, int32_t angle_mde
                 kept_views(j, v, "", kept, sizeof(kept)));
 }
 
-/* Decode a captured view, keep its frames and range image, then its view.ini last (its
- * presence says the view is complete). @retval 0 @retval -errno (said) */
 /* The object running off the image is said at the first view that shows it, at the table's pose
  * (the registration has not run): the person can stop and move the camera instead of waiting for
  * the scan's end, where the model says it too (job_model.c). */
@@ -154,6 +152,8 @@ static void say_if_off_image(struct job *j, uint32_t v, const struct scan_view *
                 (unsigned)v + 1);
 }
 
+/* Decode a captured view, keep its frames and range image, then its view.ini last (its
+ * presence says the view is complete). @retval 0 @retval -errno (said) */
 static int save_view(struct pending *p)
 {
     struct job *j = p->j;

@@ -423,7 +423,7 @@ static void report_outside(struct job *j, const struct fusion_params *fp)
                  (unsigned)o.views_cut, (unsigned)j->views);
     for (int side = 0; side < 2; side++) {
         uint64_t n = side ? o.beside : o.above;
-        if (n < 100 || n * 1000 < o.fused)
+        if (!fusion_outside_many(n, o.fused, 100))
             continue;
         struct fusion_params want = *fp;
         double seen = side ? o.reach_seen_mm : o.top_seen_mm;
@@ -464,10 +464,11 @@ int job_make_model(struct job *j, const char *scan_dir)
     int rc = report_registration(j, &rep, clock_posix_thread_cpu_s() - t0, scan_dir);
     if (rc == 0)
         rc = fit_reflectance(j, scan_dir);
-    struct fusion_params fp;
-    fit_volume(j, &fp);
-    if (rc == 0)
+    struct fusion_params fp = j->cfg->fusion;
+    if (rc == 0) {
+        fit_volume(j, &fp);
         rc = fusion_begin(j->vol, &fp);
+    }
     for (uint32_t v = 0; v < j->views && rc == 0; v++) {
         struct scan_view view;
         struct scan_view_info info;

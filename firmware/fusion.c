@@ -230,9 +230,7 @@ void fusion_outside_add(struct fusion_outside *o, const struct fusion_params *fp
     }
 }
 
-/* Are @p n points beyond the volume, of @p fused, many enough to say (or grow) for? Fewer are
- * stray ones: at least @p least, and a thousandth. */
-static int many_beyond(uint64_t n, uint64_t fused, uint64_t least)
+int fusion_outside_many(uint64_t n, uint64_t fused, uint64_t least)
 {
     return n >= least && n * 1000 >= fused;
 }
@@ -245,11 +243,11 @@ int fusion_fit(const struct fusion_params *p, const struct fusion_outside *seen,
         return 0;
     double spare = p->truncation_mm + 2.0 * p->voxel_mm;
     int grown = 0;
-    if (many_beyond(seen->above, seen->fused, 8) && seen->top_seen_mm + spare > p->top_mm) {
+    if (fusion_outside_many(seen->above, seen->fused, 8)) { /* each of them above top_mm */
         fitted->top_mm = seen->top_seen_mm + spare;
         grown = 1;
     }
-    if (many_beyond(seen->beside, seen->fused, 8) && seen->reach_seen_mm + spare > p->radius_mm) {
+    if (fusion_outside_many(seen->beside, seen->fused, 8)) { /* each beyond radius_mm */
         double voxels = ceil((seen->reach_seen_mm + spare - p->radius_mm) / p->voxel_mm);
         fitted->radius_mm = p->radius_mm + voxels * p->voxel_mm;
         grown = 1;
@@ -260,12 +258,6 @@ int fusion_fit(const struct fusion_params *p, const struct fusion_outside *seen,
         return -E2BIG;
     }
     return grown;
-}
-
-/* A fused point @p p (object frame) counted where the grid cuts it (struct fusion_outside). */
-static void count_outside(struct fusion_volume *vol, vec3 p)
-{
-    fusion_outside_add(&vol->outside, &vol->p, p);
 }
 
 uint32_t fusion_border_points(const struct fusion_params *fp,
@@ -301,7 +293,7 @@ static int mark_blocks(struct fusion_volume *vol, const struct frame_xform *obj_
                 continue;
             vec3 p_obj = frame_point(
                 obj_from_cam, v3(r->xyz_mm[3 * i], r->xyz_mm[3 * i + 1], r->xyz_mm[3 * i + 2]));
-            count_outside(vol, p_obj);
+            fusion_outside_add(&vol->outside, &vol->p, p_obj);
             vec3 p = v3_sub(p_obj, vol->origin);
             double g[3] = {p.x * scale, p.y * scale, p.z * scale};
             uint32_t b[3];

@@ -45,10 +45,11 @@ int fusion_integrate(struct fusion_volume *vol, const struct hal_thread *threads
                      const struct decode_maps *maps, const struct tri_range *range,
                      const uint8_t *rgb, const float *confidence);
 
-/** What the views held beyond the grid, counted by fusion_integrate since fusion_begin: an
- *  object taller or wider than the volume is cut there, and the scan should say so. */
+/** What the views held beyond the grid, counted by fusion_integrate since fusion_begin (or by
+ *  fusion_outside_add, of the registration's samples): an object taller or wider than the
+ *  volume is cut there, and the scan should say so or grow it. */
 struct fusion_outside {
-    uint64_t fused;       /**< the views' points fused (weight above 0) */
+    uint64_t fused;       /**< the points counted (those fused: weight above 0) */
     uint64_t above;       /**< of them over the table (5 mm up, within twice radius_mm of the
                                axis) and higher than top_mm */
     uint64_t beside;      /**< of them over the table and beyond the grid's square (|x| or |y|
@@ -71,6 +72,10 @@ uint32_t fusion_border_points(const struct fusion_params *p, const struct frame_
 /** Count @p p_obj (object frame) in @p o as fusion_integrate counts a fused point against the
  *  grid of @p p (struct fusion_outside). */
 void fusion_outside_add(struct fusion_outside *o, const struct fusion_params *p, vec3 p_obj);
+
+/** Are @p n points beyond the volume, of @p fused counted, many enough to say or grow for, not
+ *  stray ones: at least @p least, and a thousandth of them. @retval 1 yes @retval 0 no */
+int fusion_outside_many(uint64_t n, uint64_t fused, uint64_t least);
 
 /** The volume grown to hold what @p seen counted beyond @p p's (points beyond it by the
  *  thousand of them, and at least 8): top_mm to their highest, radius_mm to their farthest,
