@@ -698,7 +698,8 @@ unsigned scan_dir_each_warning(const char *dir, unsigned max, size_t line_len,
     unsigned count = 0;
     line_len = line_len < sizeof(line) ? line_len : sizeof(line);
     FILE *f = scan_dir_path(path, sizeof(path), dir, -1, SCAN_FILE_WARNINGS) == 0
-                  ? file_open_regular(path, "r") /* a pipe planted there must hang nothing */
+                  /* a pipe planted there must hang nothing, a link lead nowhere */
+                  ? file_open_regular_nolink(path, "r")
                   : NULL;
     for (int c = 0; f != NULL && count < max && fgets(line, (int)line_len, f) != NULL; count++) {
         size_t len = strlen(line);

@@ -195,7 +195,8 @@ int scan_dir_begin_view(const struct hal_storage *st, const char *dir, uint32_t 
 
 /** The lines of @p dir's warnings.txt, in order, to @p each (its newline taken off; a line
  *  longer than @p line_len - 1 bytes cut there), the first @p max of them: a report and the web
- *  page read it alike. A file that is not a regular one (a pipe planted there) is not read.
+ *  page read it alike. A file that is not a regular one (a pipe planted there) or a symbolic
+ *  link (to /etc/passwd) is not read.
  *  @retval the lines read (0: no file) */
 unsigned scan_dir_each_warning(const char *dir, unsigned max, size_t line_len,
                                void (*each)(void *priv, const char *line), void *priv);

@@ -657,6 +657,16 @@ def saved_warning_cases(port, cut, scans):
           f"a long warnings.txt is read to 8 lines of under 400 bytes, 64 counted "
           f"({len(w)}, {s.get('warning_count')})")
     os.unlink(path)
+    os.symlink("/etc/passwd", path)
+    st, _, body = request(port, "GET", f"/api/scans/{cut}")
+    p = subprocess.run([SCANNER, "report", os.path.join(scans, cut)], capture_output=True,
+                       text=True, timeout=60)
+    with open(os.path.join(scans, cut, "report.html")) as f:
+        report = f.read()
+    check(st == 200 and json.loads(body)["warnings"] == [] and b"root:" not in body and
+          p.returncode == 0 and "root:" not in report and "<h2>Warnings" not in report,
+          f"a link to /etc/passwd as warnings.txt shows nothing of it, nor does the report ({st})")
+    os.unlink(path)
     os.mkfifo(path)
     t0 = time.time()
     st, _, body = request(port, "GET", f"/api/scans/{cut}", timeout=15)

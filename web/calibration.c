@@ -370,9 +370,7 @@ static int send_live(struct mg_connection *conn, struct web_server *s)
     snprintf(path, sizeof(path), "%s/" WEB_CALIB_CAPTURES "/live.png", j->dir);
     pthread_mutex_unlock(&j->lock);
     /* the scanner writes a plain file there: a link put in its place leads nowhere */
-    struct stat sb;
-    FILE *f =
-        have && lstat(path, &sb) == 0 && S_ISREG(sb.st_mode) ? file_open_regular(path, "rb") : NULL;
+    FILE *f = have ? file_open_regular_nolink(path, "rb") : NULL;
     char *png = f != NULL ? malloc(CAL_MAX_FILE) : NULL;
     size_t n = png != NULL ? fread(png, 1, CAL_MAX_FILE, f) : 0;
     if (f != NULL)

@@ -8,10 +8,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-int file_open_regular_fd(const char *path)
+/* @p flags: more of open()'s (O_NOFOLLOW) */
+static int open_regular(const char *path, int flags)
 {
     /* O_NONBLOCK: opening a FIFO must not wait for a writer */
-    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC | flags);
     struct stat st;
     if (fd < 0)
         return -errno;
@@ -29,9 +30,14 @@ int file_open_regular_fd(const char *path)
     return fd;
 }
 
-FILE *file_open_regular(const char *path, const char *mode)
+int file_open_regular_fd(const char *path)
 {
-    int fd = file_open_regular_fd(path);
+    return open_regular(path, 0);
+}
+
+/* A descriptor as a stream, or NULL with errno. */
+static FILE *stream_of(int fd, const char *mode)
+{
     if (fd < 0) {
         errno = -fd;
         return NULL;
@@ -43,6 +49,16 @@ FILE *file_open_regular(const char *path, const char *mode)
         errno = e;
     }
     return f;
+}
+
+FILE *file_open_regular(const char *path, const char *mode)
+{
+    return stream_of(open_regular(path, 0), mode);
+}
+
+FILE *file_open_regular_nolink(const char *path, const char *mode)
+{
+    return stream_of(open_regular(path, O_NOFOLLOW), mode);
 }
 
 const char *file_strerror(int err)

@@ -12,6 +12,10 @@
  *  socket, or open's own (ENOENT, ELOOP for a symlink loop, ...) */
 FILE *file_open_regular(const char *path, const char *mode);
 
+/** The same, refusing a symbolic link there too (ELOOP): for a file only the scanner writes,
+ *  read on behalf of someone who must not be led out of its folder by a link (the web API). */
+FILE *file_open_regular_nolink(const char *path, const char *mode);
+
 /** Like file_open_regular, for a descriptor (O_RDONLY | O_CLOEXEC, blocking once checked).
  *  @retval the descriptor @retval -errno */
 int file_open_regular_fd(const char *path);
