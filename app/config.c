@@ -325,6 +325,10 @@ static const struct ini_key config_keys[] = {
      "the object turned by these angles (degrees, about x, then y, then z) before it is stood on "
      "the table at its lowest point: 90, 0, 0 lays an upright object on its side (a second pass)",
      NULL, NULL},
+    {"sim", "object_offset_mm", INI_VEC, C(sim.object_offset_mm), 2, -200, 200, 0, "0, 0", NULL,
+     "where the object stands on the table (x, y in mm, the table's frame at angle 0): a person "
+     "seldom puts it on the axis; 0, 0 centres it there",
+     NULL, NULL},
     {"sim", "slip_mm", INI_VEC, C(sim.slip_mm), 3, -100, 100, 0, "0, 0, 0", NULL,
      "the object slips on the table by this much (mm, table frame at angle 0) once the table "
      "has reached slip_at_deg: a registration that must fail and name the view",

@@ -366,7 +366,7 @@ static const char *type_name(const struct ini_key *k, char *buf, size_t len)
         return buf;
     }
     case INI_VEC:
-        return k->size == 3 ? "x, y, z" : "list of numbers";
+        return k->size == 3 ? "x, y, z" : k->size == 2 ? "x, y" : "list of numbers";
     case INI_LIST:
         snprintf(buf, len, "up to %zu numbers", k->size);
         return buf;

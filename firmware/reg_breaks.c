@@ -181,13 +181,13 @@ static void shift_search(struct reg_ctx *r, uint32_t a, uint32_t b, double step_
         }
 }
 
-/* @retval 1 edge @p e's paint lines up REG_SHIFT_MIN_MM or more away from where its views stand
- * (its misfit there into @p misfit) */
-static int pair_shifted(struct reg_ctx *r, uint32_t e, double *misfit)
+/* @retval 1 edge @p e's paint lines up REG_SHIFT_MIN_MM or more away from where its views stand,
+ * at @p at (mm across the table; its misfit where they stand into @p misfit) */
+static int pair_shifted(struct reg_ctx *r, uint32_t e, double *misfit, double at[2])
 {
     uint32_t a = r->edge_from[e], b = r->edge_to[e];
     uint64_t n_ab, n_ba, n_back;
-    double at[2] = {0.0, 0.0};
+    at[0] = at[1] = 0.0;
     double still_ab = reg_pair_colour_misfit(r, a, b, &n_ab), best = still_ab;
     double still_ba = reg_pair_colour_misfit(r, b, a, &n_ba);
     if (n_ab < REG_BREAK_SAMPLES || n_ba < REG_BREAK_SAMPLES)
@@ -202,19 +202,50 @@ static int pair_shifted(struct reg_ctx *r, uint32_t e, double *misfit)
            best + back <= REG_SHIFT_DIP * (still_ab + still_ba);
 }
 
-/* The pairs that share a top and no side, and whose paint lines up elsewhere (quiet_break_after),
- * the first as the failed pair in @p rep. @retval the breaks */
+/* A slip is one move: the pair it happened across lines up at the move, the closing pair (the
+ * views after it against view 0) at the opposite one. Two pairs whose paint lines up elsewhere
+ * are the slip's breaks when their two places sum to within REG_SHIFT_AGREE_MM (the search's
+ * step; each place is found on a 1 mm grid). Measured (2026-12-05): the thin box slipped
+ * 6 mm in 6 views, (6.0, 0.0) and (-6.0, 0.0); the simulator's box in 4, 5 and 6 views stood
+ * 20 to 50 mm off the table's axis (every default, as a person puts it down), its tops alone
+ * shared by neighbours 72 and 90 degrees apart, lined up 6 to 18 mm away at two or three pairs
+ * (dips 0.49 to 0.73 of where they stood, against the slip's 0.49), which took the box for
+ * moved: refused, or a model 0.6 to 4.1 mm from the truth. Those places sum to 3.6 mm and more. */
+#define REG_SHIFT_AGREE_MM 2.0
+
+/* The pair of a slip its shapes let through: a pair that shares a top and no side, whose paint
+ * lines up elsewhere, and another pair (any) whose paint lines up at the opposite place. Both
+ * into quiet_break_after, the first as the failed pair in @p rep. @retval the breaks (0 or 2) */
 static int shift_breaks(struct reg_ctx *r, struct reg_report *rep)
 {
-    int found = 0;
-    double misfit;
+    static double at[REG_EDGES][2], misfit[REG_EDGES]; /* static: off the stack */
+    static int shifted[REG_EDGES];
+    int top_shifted = 0;
     if (!r->p.use_colour)
         return 0;
     reg_prepare_landing(r);
+    for (uint32_t e = 0; e < r->edges; e++) {
+        shifted[e] =
+            r->stats[e].side_overlap < REG_SIDE_MIN && pair_shifted(r, e, &misfit[e], at[e]);
+        top_shifted |= shifted[e];
+    }
+    if (!top_shifted)
+        return 0;
+    for (uint32_t e = 0; e < r->edges; e++) /* the partner may see sides too */
+        if (!shifted[e] && r->stats[e].side_overlap >= REG_SIDE_MIN)
+            shifted[e] = pair_shifted(r, e, &misfit[e], at[e]);
     for (uint32_t e = 0; e < r->edges; e++)
-        if (r->stats[e].side_overlap < REG_SIDE_MIN && pair_shifted(r, e, &misfit))
-            note_break(r, rep, e, found++, misfit);
-    return found;
+        for (uint32_t f = e + 1; f < r->edges; f++) {
+            int top =
+                r->stats[e].side_overlap < REG_SIDE_MIN || r->stats[f].side_overlap < REG_SIDE_MIN;
+            if (top && shifted[e] && shifted[f] &&
+                hypot(at[e][0] + at[f][0], at[e][1] + at[f][1]) <= REG_SHIFT_AGREE_MM) {
+                note_break(r, rep, e, 0, misfit[e]);
+                note_break(r, rep, f, 1, misfit[f]);
+                return 2;
+            }
+        }
+    return 0;
 }
 
 /* The breaks of a ring its pairs' shapes let through (a push along the object's faces): on

@@ -16,12 +16,13 @@ struct sim_config {
     double second_pass_pose_deg[3]; /**< the object_pose of a scan's second pass */
     char person[8]; /**< auto: the simulated person lays the object at once; asked: the scanner
                          asks, as on a real rig, and waits for the answer */
-    double object_pose_deg[3]; /**< turned about x, then y, then z before it is stood on the
-                                    table (90, 0, 0: an upright object on its side) */
-    double slip_mm[3];         /**< the object slips on the table by this (object frame) ... */
-    double slip_at_deg;        /**< ... from this table angle on */
-    uint32_t segments;         /**< tessellation of analytic shapes */
-    char material[16];         /**< lambert | phong | merl */
+    double object_pose_deg[3];  /**< turned about x, then y, then z before it is stood on the
+                                     table (90, 0, 0: an upright object on its side) */
+    double object_offset_mm[2]; /**< ... and stood this far from the table's axis (x, y) */
+    double slip_mm[3];          /**< the object slips on the table by this (object frame) ... */
+    double slip_at_deg;         /**< ... from this table angle on */
+    uint32_t segments;          /**< tessellation of analytic shapes */
+    char material[16];          /**< lambert | phong | merl */
     char merl_file[HAL_MAX_PATH];
     char merl_name[64];
     double phong_ks, phong_ke;

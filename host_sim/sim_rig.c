@@ -68,8 +68,8 @@ double sim_rig_placed_height(const struct sim_config *cfg)
 }
 
 /* [sim] object_pose: turn the standing object (R = Rz Ry Rx), then stand it on the table again,
- * centred on the axis at its lowest point; the paint stays on the object (sim_albedo_at is
- * asked in the standing frame, q = R^T (p - shift)). */
+ * centred on the axis at its lowest point, and [sim] object_offset_mm from it; the paint stays
+ * on the object (sim_albedo_at is asked in the standing frame, q = R^T (p - shift)). */
 static void pose_object(struct sim_rig *rig)
 {
     const double *d = rig->cfg.object_pose_deg;
@@ -80,9 +80,10 @@ static void pose_object(struct sim_rig *rig)
     double t[9], *r = rig->pose_rot;
     m3_mul_m3(ry, rx, t);
     m3_mul_m3(rz, t, r);
+    const double *off = rig->cfg.object_offset_mm;
     rig->pose_shift = v3(0, 0, 0);
-    if (d[0] == 0.0 && d[1] == 0.0 && d[2] == 0.0)
-        return; /* standing as it is: the mesh is not touched */
+    if (d[0] == 0.0 && d[1] == 0.0 && d[2] == 0.0 && off[0] == 0.0 && off[1] == 0.0)
+        return; /* standing as it is, on the axis: the mesh is not touched */
     struct sim_mesh *m = &rig->mesh;
     vec3 lo = v3(1e30, 1e30, 1e30), hi = v3(-1e30, -1e30, -1e30);
     for (uint32_t i = 0; i < m->vert_count; i++) {
@@ -91,7 +92,7 @@ static void pose_object(struct sim_rig *rig)
         lo = v3(fmin(lo.x, q.x), fmin(lo.y, q.y), fmin(lo.z, q.z));
         hi = v3(fmax(hi.x, q.x), fmax(hi.y, q.y), fmax(hi.z, q.z));
     }
-    rig->pose_shift = v3(-0.5 * (lo.x + hi.x), -0.5 * (lo.y + hi.y), -lo.z);
+    rig->pose_shift = v3(off[0] - 0.5 * (lo.x + hi.x), off[1] - 0.5 * (lo.y + hi.y), -lo.z);
     for (uint32_t i = 0; i < m->vert_count; i++) {
         float *p = &m->pos[3 * i];
         vec3 q = v3_add(m3_mul(r, v3(p[0], p[1], p[2])), rig->pose_shift);

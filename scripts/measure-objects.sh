@@ -5,11 +5,13 @@
 # simulator's sphere, cylinder and torus, and two scanned meshes, the Stanford bunny and
 # armadillo. For each object: every view count with [colour] method none and multi and the table
 # exact; at 8 views the table 1 and 2 degrees off; at 8 views a 6 mm and a 30 mm slip after 170
-# degrees, and at 6 views the 30 mm one (push6: the pairs across it see the faces it slid along). Columns: finished (and how the views after a slip were placed) or the error, the
+# degrees, and at 6 views the 30 mm one (push6: the pairs across it see the faces it slid along);
+# in 4, 6 and 8 views stood 30, 20 mm off the table's axis (offaxis), as a person puts it down. Columns: finished (and how the views after a slip were placed) or the error, the
 # model against the truth once aligned (mean, mm), the truth within 1 mm of the model (above the
 # table), holes and pieces of the model, and the registration's CPU.
 # Usage: scripts/measure-objects.sh BUILD; OBJECTS="box gear", VIEWS="4 8", METHODS="none" and
-# CONDITIONS="exact" (exact table1 table2 slip slip30 push6; slip6v and slip12v: the 6 mm slip in 6 and 12 views) choose a subset; KEEP=1 keeps each
+# CONDITIONS="exact" (exact table1 table2 slip slip30 push6; slip6v and slip12v: the 6 mm slip in 6 and 12 views;
+# offaxis: the object stood 30, 20 mm off the table's axis in 4, 6 and 8 views) choose a subset; KEEP=1 keeps each
 # scan and its frames (scanner process DIR computes a scan again from them); else only its log
 # and its comparison with the truth are kept.
 set -eu
@@ -19,7 +21,7 @@ top=$(pwd)
 objects=${OBJECTS:-"box thin_box l_bracket plate_holes hex_nut gear stepped_block cup cone sphere cylinder torus bunny armadillo"}
 views_list=${VIEWS:-"3 4 6 8 12 24"}
 methods=${METHODS:-"none multi"}
-conditions=${CONDITIONS:-"exact table1 table2 slip slip30 push6"}
+conditions=${CONDITIONS:-"exact table1 table2 slip slip30 push6 offaxis"}
 command -v openscad >/dev/null 2>&1 || {
     echo "measure-objects: openscad is missing (make measure-objects installs it)" >&2
     exit 1
@@ -104,6 +106,10 @@ for obj in $objects; do
             row "$obj" 6 none "6 mm slip" "$obj-slip6v" ;;
         slip12v) config "$obj" 12 none "slip_mm = 6, 0, 0\nslip_at_deg = 170\n" "$obj-slip12v"
             row "$obj" 12 none "6 mm slip" "$obj-slip12v" ;;
+        offaxis) for v in 4 6 8; do
+                config "$obj" $v none "object_offset_mm = 30, 20\n" "$obj-$v-offaxis"
+                row "$obj" $v none "30, 20 mm off the axis" "$obj-$v-offaxis"
+            done ;;
         esac
     done
 done

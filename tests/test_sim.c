@@ -198,15 +198,18 @@ static void test_deterministic_noise_and_black_level(void **state)
     test_rig_stop(&t);
 }
 
-/* Dark-paint and object pixels of the rig at @p angle_mdeg, with the object posed as @p pose. */
-static void posed_counts(const double pose[3], int32_t angle_mdeg, size_t *hit, size_t *dark,
-                         double *height_mm)
+/* Dark-paint and object pixels of the rig at @p angle_mdeg, with the object posed as @p pose
+ * (and stood @p offset_mm off the axis, if not NULL; where its middle came into @p centre_mm). */
+static void posed_counts_at(const double pose[3], const double *offset_mm, int32_t angle_mdeg,
+                            size_t *hit, size_t *dark, double *height_mm, double centre_mm[2])
 {
     static struct test_rig t;
     assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
     snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "box");
     t.cfg.sim.segments = 16;
     memcpy(t.cfg.sim.object_pose_deg, pose, 3 * sizeof(double));
+    if (offset_mm != NULL)
+        memcpy(t.cfg.sim.object_offset_mm, offset_mm, 2 * sizeof(double));
     assert_int_equal(test_rig_start(&t), 0);
     struct sim_rig *rig = sim_ctl_rig();
     rig->table_angle_mdeg = angle_mdeg;
@@ -216,14 +219,24 @@ static void posed_counts(const double pose[3], int32_t angle_mdeg, size_t *hit, 
         *hit += rig->truth.hit[i];
         *dark += rig->truth.dark[i];
     }
-    float lo = 1e30f, hi = -1e30f;
-    for (uint32_t v = 0; v < rig->mesh.vert_count; v++) {
-        lo = fminf(lo, rig->mesh.pos[3 * v + 2]);
-        hi = fmaxf(hi, rig->mesh.pos[3 * v + 2]);
-    }
-    assert_true(fabsf(lo) < 1e-3f); /* stood on the table */
-    *height_mm = hi - lo;
+    float lo[3] = {1e30f, 1e30f, 1e30f}, hi[3] = {-1e30f, -1e30f, -1e30f};
+    for (uint32_t v = 0; v < rig->mesh.vert_count; v++)
+        for (int c = 0; c < 3; c++) {
+            lo[c] = fminf(lo[c], rig->mesh.pos[3 * v + (uint32_t)c]);
+            hi[c] = fmaxf(hi[c], rig->mesh.pos[3 * v + (uint32_t)c]);
+        }
+    assert_true(fabsf(lo[2]) < 1e-3f); /* stood on the table */
+    *height_mm = hi[2] - lo[2];
+    centre_mm[0] = 0.5 * (lo[0] + hi[0]);
+    centre_mm[1] = 0.5 * (lo[1] + hi[1]);
     test_rig_stop(&t);
+}
+
+static void posed_counts(const double pose[3], int32_t angle_mdeg, size_t *hit, size_t *dark,
+                         double *height_mm)
+{
+    double centre[2];
+    posed_counts_at(pose, NULL, angle_mdeg, hit, dark, height_mm, centre);
 }
 
 /* [sim] object_pose: the box (0.6 h x 0.45 h x h) laid on its side is 0.45 h tall; turned a
@@ -246,6 +259,31 @@ static void test_object_pose(void **state)
     assert_true(labs((long)hit2 - (long)hit0) <= (long)(hit0 / 1000));
     assert_true(labs((long)dark2 - (long)dark0) <= (long)(dark0 / 100) + 5);
     assert_true(hit1 != hit0);
+}
+
+/* [sim] object_offset_mm: the box stands that far off the axis (truth_mesh.ply is written from
+ * the same mesh), its height and paint with it: seen from the table turned half a turn, the box
+ * stood at -offset shows the camera the same pixels, dark stripe included, as the box stood at
+ * +offset seen from the front turned half a turn too (the same object, the same place). */
+static void test_object_offset(void **state)
+{
+    (void)state;
+    const double none[3] = {0, 0, 0}, off[2] = {30, -20}, minus[2] = {-30, 20};
+    const double turned[3] = {0, 0, 180};
+    size_t hit0, dark0, hit1, dark1, hit2, dark2;
+    double h0, h1, h2, c0[2], c1[2], c2[2];
+    posed_counts_at(none, NULL, 0, &hit0, &dark0, &h0, c0);
+    posed_counts_at(none, off, 0, &hit1, &dark1, &h1, c1);
+    posed_counts_at(turned, minus, -180000, &hit2, &dark2, &h2, c2);
+    print_message("centred %zu px (%zu dark); 30, -20 mm off %zu (%zu); turned, -30, 20 mm off, "
+                  "the table half a turn back %zu (%zu)\n",
+                  hit0, dark0, hit1, dark1, hit2, dark2);
+    assert_true(fabs(c1[0] - 30.0) < 1e-3 && fabs(c1[1] + 20.0) < 1e-3);
+    assert_true(fabs(c2[0] + 30.0) < 1e-3 && fabs(c2[1] - 20.0) < 1e-3);
+    assert_true(fabs(h1 - h0) < 1e-3 && fabs(h2 - h0) < 1e-3);
+    assert_true(hit1 != hit0); /* it moved in the picture */
+    assert_true(labs((long)hit2 - (long)hit1) <= (long)(hit1 / 1000));
+    assert_true(labs((long)dark2 - (long)dark1) <= (long)(dark1 / 100) + 5);
 }
 
 /* The ABC model of a measured material reflects more near the mirror direction. */
@@ -315,6 +353,7 @@ int main(void)
         cmocka_unit_test(test_deterministic_noise_and_black_level),
         cmocka_unit_test(test_merl_material),
         cmocka_unit_test(test_object_pose),
+        cmocka_unit_test(test_object_offset),
         cmocka_unit_test(test_board_placement_jitter),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
