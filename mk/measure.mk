@@ -108,7 +108,7 @@ bench: deps $(BUILD)/bench_view $(BUILD)/bench_decode $(BUILD)/bench_frames $(BU
 	@echo
 	$(BUILD)/bench_view config/sim.ini
 	@echo
-	@bench/static_memory.sh $(BUILD)/libfirmware.a
+	@bench/static_memory.sh $(BUILD)/scanner
 	@echo
 	bench/bench_scan.sh $(BUILD) config/sim.ini
 	@echo

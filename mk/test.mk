@@ -83,12 +83,12 @@ STACK_LIMIT := $(shell sed -n 's/^\#define HAL_STACK_FRAME_MAX \([0-9]*\)u.*/\1/
 check-stack: $(FW_OBJ)
 	@scripts/check-stack.sh $(STACK_LIMIT) $(FW_OBJ:.o=.su)
 
-# Static memory of the default build: the scanner's sections, and the firmware's buffers.
+# Static memory of the default build: the scanner's sections, and its static buffers.
 ## size: static memory of the default build
-size: deps $(BUILD)/scanner $(BUILD)/libfirmware.a
+size: deps $(BUILD)/scanner
 	@size -A $(BUILD)/scanner | awk '$$1 ~ /^\.(text|rodata|data|bss)$$/ { printf "%-8s %12d bytes\n", $$1, $$2; \
 		if ($$1 != ".text" && $$1 != ".rodata") ram += $$2 } END { printf "static RAM (.data + .bss): %.1f MiB\n", ram / 1048576 }'
-	@bench/static_memory.sh $(BUILD)/libfirmware.a
+	@bench/static_memory.sh $(BUILD)/scanner
 
 # Test-only packages: Open3D reads our PLY (tests/cli.sh); pymodbus and socat are the Modbus
 # peers of tests/interop.sh; OpenCV builds scanner-calibrate (tests/calibrate.sh); the Khronos
