@@ -6,12 +6,13 @@
 # armadillo. For each object: every view count with [colour] method none and multi and the table
 # exact; at 8 views the table 1 and 2 degrees off; at 8 views a 6 mm and a 30 mm slip after 170
 # degrees, and at 6 views the 30 mm one (push6: the pairs across it see the faces it slid along);
-# in 4, 6 and 8 views stood 30, 20 mm off the table's axis (offaxis), as a person puts it down. Columns: finished (and how the views after a slip were placed) or the error, the
+# in 4, 6 and 8 views stood off the table's axis (offaxis: at 20, 0; 0, 30 and 30, 20 mm), as a
+# person puts it down. Columns: finished (and how the views after a slip were placed) or the error, the
 # model against the truth once aligned (mean, mm), the truth within 1 mm of the model (above the
 # table), holes and pieces of the model, and the registration's CPU.
 # Usage: scripts/measure-objects.sh BUILD; OBJECTS="box gear", VIEWS="4 8", METHODS="none" and
 # CONDITIONS="exact" (exact table1 table2 slip slip30 push6; slip6v and slip12v: the 6 mm slip in 6 and 12 views;
-# offaxis: the object stood 30, 20 mm off the table's axis in 4, 6 and 8 views) choose a subset; KEEP=1 keeps each
+# offaxis: the object stood off the table's axis, three places, in 4, 6 and 8 views) choose a subset; KEEP=1 keeps each
 # scan and its frames (scanner process DIR computes a scan again from them); else only its log
 # and its comparison with the truth are kept.
 set -eu
@@ -107,8 +108,11 @@ for obj in $objects; do
         slip12v) config "$obj" 12 none "slip_mm = 6, 0, 0\nslip_at_deg = 170\n" "$obj-slip12v"
             row "$obj" 12 none "6 mm slip" "$obj-slip12v" ;;
         offaxis) for v in 4 6 8; do
-                config "$obj" $v none "object_offset_mm = 30, 20\n" "$obj-$v-offaxis"
-                row "$obj" $v none "30, 20 mm off the axis" "$obj-$v-offaxis"
+                for at in "20, 0" "0, 30" "30, 20"; do
+                    name="$obj-$v-off$(echo "$at" | tr -d ' ,')"
+                    config "$obj" $v none "object_offset_mm = $at\n" "$name"
+                    row "$obj" $v none "$at mm off the axis" "$name"
+                done
             done ;;
         esac
     done
