@@ -197,6 +197,14 @@ static int report_registration(struct job *j, const struct reg_report *r, double
                  (unsigned)r->apart_pairs, r->apart_pairs == 1 ? "" : "s", r->apart_against,
                  r->apart_view);
     }
+    if (r->accepted && r->arcs_held > 0 && !no_turn_seen) {
+        n = strlen(detail);
+        snprintf(detail + n, sizeof(detail) - n,
+                 "; pairs of neighbouring views that share only a top cut the views into %u "
+                 "arcs whose turns against each other the object's shape does not fix: the "
+                 "table's angles hold between them",
+                 (unsigned)(r->arcs_held + 1));
+    }
     if (r->views_alike && !no_turn_seen) {
         n = strlen(detail);
         snprintf(detail + n, sizeof(detail) - n,

@@ -58,11 +58,14 @@ struct reg_report {
     double axis_shift_mm, axis_tilt_deg; /**< the axis against the calibrated one */
     uint32_t worst_view;                 /**< the view with the largest residual */
     double worst_rms_mm;
-    int failed_view;               /**< -1, or a view that does not match the one before it (or
-                                        the first view of a second pass that matches nothing) */
-    int failed_against;            /**< the view it was compared with (-1: the first pass) */
-    uint32_t apart_pairs;          /**< neighbouring views that share no surface to compare (two
-                                        views half a turn apart): no failure, the table's angle */
+    int failed_view;      /**< -1, or a view that does not match the one before it (or
+                               the first view of a second pass that matches nothing) */
+    int failed_against;   /**< the view it was compared with (-1: the first pass) */
+    uint32_t arcs_held;   /**< pairs sharing no side (only a top) cut the views into arcs whose
+                               turns against each other no pair sees: the arcs (but the first)
+                               held to the table's angles against the first */
+    uint32_t apart_pairs; /**< neighbouring views that share no surface to compare (two
+                               views half a turn apart): no failure, the table's angle */
     int apart_view, apart_against; /**< the first such pair, or -1 */
     double failed_share;           /**< the share of their overlap that coupled */
     double failed_colour;          /**< > 0: they couple, but their paint misses by this share of
@@ -104,6 +107,7 @@ struct reg_edge_stats {
     uint32_t overlap, coupled;
     uint32_t side_overlap, side_coupled; /**< of them, on surfaces facing sideways (reg.c) */
     double sq, trunc_sq; /**< squared residuals of coupled pairs; truncated over the overlap */
+    double turn_seen, turn_whole; /**< as reg_ctx's, of this pair's coupled samples */
 };
 
 /** A registration: every view's samples and the joint solution, in one place (about
