@@ -93,6 +93,12 @@ static void test_errors_name_file_line_and_key(void **state)
                  "bad.ini:9: [camera] pixel_format: 'bgr' is not one of rgb24|yuyv|grey");
     expect_error("[sim]\nalbedo = 0.5, 0.5\n", "bad.ini:9: [sim] albedo: '0.5, 0.5' is not a list");
     expect_error("[sim]\nseed = 1.5\n", "[sim] seed: '1.5' is not a whole number");
+    expect_error("[sim]\nobject_offset_mm = 30\n",
+                 "bad.ini:9: [sim] object_offset_mm: '30' is not a list of 2 numbers");
+    expect_error("[sim]\nobject_offset_mm = 30, 20, 10\n", "'30, 20, 10' is not a list of 2");
+    expect_error("[sim]\nobject_offset_mm = 30, nan\n", "'30, nan' is not a list of 2");
+    expect_error("[sim]\nobject_offset_mm = 300, 0\n",
+                 "[sim] object_offset_mm: 300 is out of range -200..200");
     expect_error("garbage line\n", "bad.ini:8: syntax error");
     /* fit reads the colour frames again: a scan that keeps none could not make its model */
     expect_error("[lights]\ncount = 4\n[colour]\nmethod = fit\n[output]\nkeep_frames = none\n",
