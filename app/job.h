@@ -59,6 +59,7 @@ struct job {
         uint32_t first_done, last_done;
         double first_ms, last_ms;
     } eta;
+    int said_dark;        /* a view's object was too dark to decode: said once, at that view */
     int said_off_image;   /* a view's object ran off the image: said once, at that view */
     struct job_warnings { /* what the model lacks, as said (warnings.txt, report.html) */
         char text[JOB_MAX_WARNINGS][JOB_WARNING_LEN];

@@ -269,6 +269,15 @@ static int report_registration(struct job *j, const struct reg_report *r, double
                     "from it fits the others. No model was made; the views are kept in %s. "
                     "Scan again without touching the object",
                     r->failed_view, r->failed_against, 100.0 * r->failed_colour, scan_dir);
+    else if (j->said_dark) /* the views are nearly empty: that, not the calibration */
+        j->hal->log(HAL_LOG_ERROR,
+                    "registration failed: view %d does not match view %d (%.0f%% of their "
+                    "overlap couples): the views hold almost nothing, the object too dark to "
+                    "decode at exposure_us = %u (the warning above says how much longer). No "
+                    "model was made; the views are kept in %s. Scan again with the longer "
+                    "exposure",
+                    r->failed_view, r->failed_against, 100.0 * r->failed_share,
+                    (unsigned)j->cfg->camera.exposure_us, scan_dir);
     else
         j->hal->log(
             HAL_LOG_ERROR,

@@ -427,8 +427,8 @@ static void add_prior(struct reg_ctx *r)
 static uint32_t find_arcs(const struct reg_ctx *r, uint32_t pass, uint8_t arc[REG_MAX_VIEWS])
 {
     const uint32_t n = r->per_pass, first = pass * n;
-    int out[REG_MAX_VIEWS];
-    uint8_t blind[REG_MAX_VIEWS];
+    static int out[REG_MAX_VIEWS]; /* static: off the stack */
+    static uint8_t blind[REG_MAX_VIEWS];
     uint32_t blinds = 0, at = 0;
     if (n < 3)
         return 0;

@@ -265,10 +265,22 @@ int scan_finish_view(struct scan_ctx *s, const struct hal_thread *threads,
         return rc;
     info->angle_mdeg = angle_mdeg;
     memset(info->reason_count, 0, sizeof(info->reason_count));
+    uint32_t dark_hist[256] = {0}, dark_n = 0;
     size_t n = (size_t)view->width * view->height;
-    for (size_t i = 0; i < n; i++)
+    for (size_t i = 0; i < n; i++) {
         info->reason_count[s->view_reason[i]]++;
+        if (s->view_reason[i] == SCAN_DARK && s->decode.white[i] > s->decode.black[i])
+            dark_hist[s->decode.white[i] - s->decode.black[i]]++, dark_n++;
+    }
     info->valid_points = info->reason_count[SCAN_VALID];
+    info->dark_contrast_dn = 0;
+    for (uint32_t c = 0, seen = 0; c < 256; c++) { /* the median of the histogram */
+        seen += dark_hist[c];
+        if (2 * seen >= dark_n && seen > 0) {
+            info->dark_contrast_dn = c;
+            break;
+        }
+    }
     return 0;
 }
 

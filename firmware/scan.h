@@ -45,6 +45,8 @@ struct scan_view_info {
     uint32_t capture_retries;                 /**< captures that had to be repeated */
     uint32_t valid_points;                    /**< pixels with depth and normal */
     uint32_t reason_count[SCAN_REASON_COUNT]; /**< pixels per reason code */
+    uint32_t dark_contrast_dn; /**< the median white minus black of the pixels lit but too dark
+                                    to decode (SCAN_DARK), grey levels; 0: none */
 };
 
 /** One processed view, as a value: what scan_finish_view hands to the stages after it
