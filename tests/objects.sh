@@ -23,6 +23,10 @@ scan() { # object, views: the scan, its log in $out/NAME.log
     config "$1" "$2"
     "$bin" scan --config "$out/$1-$2.ini" --out "$out/$1-$2" >"$out/$1-$2.log" 2>&1
 }
+scan_ini() { # NAME: the scan of $out/NAME.ini into $out/NAME, its log in $out/NAME.log
+    "$bin" scan --config "$out/$1.ini" --out "$out/$1" >"$out/$1.log" 2>&1 ||
+        { tail -n 5 "$out/$1.log"; return 1; }
+}
 aligned_mean() { # the model -> truth mean distance (mm), the model moved onto the truth first
     "$compare" --align "$out/$1/mesh.ply" "$out/$1/truth_mesh.ply" |
         sed -n 's/^result -> truth: mean \([0-9.]*\) mm.*/\1/p'
@@ -44,8 +48,7 @@ off_axis_test() {
     config box 4
     sed -e '/^\[sim\]/a object_offset_mm = 0, 30' "$out/box-4.ini" >"$out/box-off.ini"
     printf '[output]\nkeep_frames = none\n' >>"$out/box-off.ini"
-    "$bin" scan --config "$out/box-off.ini" --out "$out/box-off" >"$out/box-off.log" 2>&1 ||
-        { tail -n 5 "$out/box-off.log"; return 1; }
+    scan_ini box-off || return 1
     m=$(aligned_mean box-off)
     echo "box, 4 views, 30 mm off the axis: model -> truth mean $m mm"
     grep '^registration' "$out/box-off.log" && ! grep -q 'moved on the table' "$out/box-off.log" &&
@@ -62,8 +65,7 @@ arcs_test() {
         -e "s/^object_height_mm = .*/object_height_mm = 60/" \
         -e '/^\[sim\]/a object_offset_mm = 30, 20' "$out/box-6.ini" >"$out/steps-off.ini"
     printf '[output]\nkeep_frames = none\n' >>"$out/steps-off.ini"
-    "$bin" scan --config "$out/steps-off.ini" --out "$out/steps-off" >"$out/steps-off.log" 2>&1 ||
-        { tail -n 5 "$out/steps-off.log"; return 1; }
+    scan_ini steps-off || return 1
     m=$(aligned_mean steps-off)
     echo "stepped block, 6 views, 30, 20 mm off the axis: model -> truth mean $m mm"
     grep -o 'cut the views into 2 arcs.*' "$out/steps-off.log" &&
@@ -87,8 +89,7 @@ dark_test() {
     want=$(sed -n 's/.*raise \[camera\] exposure_us from 10000 to about \([0-9]*\).*/\1/p' "$out/dark.log")
     [ -n "$want" ] && [ "$want" -gt 10000 ] || return 1
     sed "s/^exposure_us = .*/exposure_us = $want/" "$out/mesh-2.ini" >"$out/dark-lit.ini"
-    "$bin" scan --config "$out/dark-lit.ini" --out "$out/dark-lit" >"$out/dark-lit.log" 2>&1 ||
-        { tail -n 3 "$out/dark-lit.log"; return 1; }
+    scan_ini dark-lit || return 1
     points=$(sed -n 's/^view 1 of 2: \([0-9]*\) points.*/\1/p' "$out/dark-lit.log")
     echo "at exposure_us = $want: $points points in view 1"
     ! grep -q 'too dark' "$out/dark-lit.log" && [ "${points:-0}" -gt 50000 ]
@@ -127,8 +128,7 @@ slip_config() { # pattern [mm]: the box in 8 views, slipped (6 mm), into $out/sl
 }
 slip_painted_test() {
     slip_config patches
-    "$bin" scan --config "$out/slip-patches.ini" --out "$out/slip-patches" >"$out/slip-patches.log" 2>&1 ||
-        { tail -n 5 "$out/slip-patches.log"; return 1; }
+    scan_ini slip-patches || return 1
     m=$(aligned_mean slip-patches)
     echo "box, 8 views, 6 mm slip at view 4, painted: model -> truth mean $m mm"
     grep -o 'the object moved on the table at view 4: 4 views placed by .*' "$out/slip-patches.log" &&
@@ -149,8 +149,7 @@ part_pushed() { # name, part of data/objects, its height (mm), [views6], [mm]: p
     sed -e "s|^object = .*|object = mesh\nmesh_file = $PWD/data/objects/$2.ply|" \
         -e "s/^object_height_mm = .*/object_height_mm = $3/" "$out/slip-patches.ini" >"$out/$1.ini"
     [ "${4:-}" != views6 ] || sed -i 's/^views = .*/views = 6/' "$out/$1.ini"
-    "$bin" scan --config "$out/$1.ini" --out "$out/$1" >"$out/$1.log" 2>&1 ||
-        { tail -n 5 "$out/$1.log"; return 1; }
+    scan_ini "$1"
 }
 # a part pushed (part_pushed's name, part, height, views6 or "", mm), placed: its log says $6
 # and the model is less than $7 mm from the truth; $8 says what it is
@@ -175,8 +174,7 @@ nut_six_test() {
     sed -e "s|^object = .*|object = mesh\nmesh_file = $PWD/data/objects/hex_nut.ply|" \
         -e "s/^object_height_mm = .*/object_height_mm = 30/" "$out/box-6.ini" >"$out/nut-6.ini"
     printf '[output]\nkeep_frames = none\n' >>"$out/nut-6.ini"
-    "$bin" scan --config "$out/nut-6.ini" --out "$out/nut-6" >"$out/nut-6.log" 2>&1 ||
-        { tail -n 5 "$out/nut-6.log"; return 1; }
+    scan_ini nut-6 || return 1
     m=$(aligned_mean nut-6)
     echo "hex nut, 6 views: model -> truth mean $m mm"
     grep -o "each view looks like its neighbour as they stand.*" "$out/nut-6.log" &&
