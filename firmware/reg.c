@@ -283,8 +283,6 @@ static void pair_views(struct reg_ctx *r, uint32_t src, uint32_t dst, double gat
         st->turn_seen += w * dth * dth, st->turn_whole += w * v3_dot(along, along);
         if (!solve)
             continue;
-        r->turn_seen[src] += w * dth * dth, r->turn_whole[src] += w * v3_dot(along, along);
-        r->turn_seen[dst] += w * dth * dth, r->turn_whole[dst] += w * v3_dot(along, along);
         vec3 tilt1 = v3_sub(v3_cross(e1, rpa), m3_mul(rot, v3_cross(e1, pa)));
         vec3 tilt2 = v3_sub(v3_cross(e2, rpa), m3_mul(rot, v3_cross(e2, pa)));
         double jac[6] = {-dth,
@@ -309,8 +307,6 @@ static void pass(struct reg_ctx *r, double gate_mm, int solve)
         uint32_t n = n_params(r);
         memset(r->normal_a, 0, (size_t)n * n * sizeof(double));
         memset(r->normal_b, 0, n * sizeof(double));
-        memset(r->turn_seen, 0, sizeof(r->turn_seen));
-        memset(r->turn_whole, 0, sizeof(r->turn_whole));
         memset(r->shift_seen, 0, sizeof(r->shift_seen));
         memset(r->shift_whole, 0, sizeof(r->shift_whole));
     }
@@ -456,18 +452,26 @@ static uint32_t find_arcs(const struct reg_ctx *r, uint32_t pass, uint8_t arc[RE
     return blinds - 1;
 }
 
-/* The arcs of every pass held to their pass's first (find_arcs). @retval the arcs held */
-static uint32_t hold_arcs(struct reg_ctx *r, int add)
+/* The arcs of every pass that find_arcs holds. */
+static uint32_t arcs_held(const struct reg_ctx *r)
+{
+    static uint8_t arc[REG_MAX_VIEWS];
+    uint32_t held = 0;
+    for (uint32_t pass = 0; pass < r->passes; pass++)
+        held += find_arcs(r, pass, arc);
+    return held;
+}
+
+/* The arcs of every pass held to their pass's first (find_arcs), in the normal equations. */
+static void hold_arcs(struct reg_ctx *r)
 {
     static uint8_t arc[REG_MAX_VIEWS];
     static double g[REG_PARAMS]; /* static: off the stack */
     const uint32_t n = n_params(r);
     const double sigma = REG_ARC_HOLD_DEG * M_PI / 180.0, w = pow(pair_sigma_mm(r) / sigma, 2.0);
-    uint32_t held = 0;
     for (uint32_t pass = 0; pass < r->passes; pass++) {
         uint32_t arcs = find_arcs(r, pass, arc), first = pass * r->per_pass;
-        held += arcs;
-        for (uint32_t a = 1; a <= arcs && add; a++) {
+        for (uint32_t a = 1; a <= arcs; a++) {
             double count[2] = {0.0, 0.0}, res = 0.0;
             for (uint32_t v = first; v < first + r->per_pass; v++)
                 if (r->present[v] && (arc[v] == a || arc[v] == 0))
@@ -490,7 +494,6 @@ static uint32_t hold_arcs(struct reg_ctx *r, int add)
             }
         }
     }
-    return held;
 }
 
 /* Solve and apply one Gauss-Newton step. @retval the largest angle change (rad) */
@@ -498,7 +501,7 @@ static double gauss_newton_step(struct reg_ctx *r)
 {
     const uint32_t n = n_params(r);
     add_prior(r);
-    hold_arcs(r, 1);
+    hold_arcs(r);
     /* A little damping keeps unknowns the data barely see (the axis of two views) in place. */
     double trace = 0.0;
     for (uint32_t i = 0; i < n; i++)
@@ -530,7 +533,13 @@ static double gauss_newton_step(struct reg_ctx *r)
 static void keep_unfixed_turns(struct reg_ctx *r)
 {
     for (uint32_t v = 0; v < r->views; v++) {
-        double seen = r->turn_whole[v] > 0.0 ? r->turn_seen[v] / r->turn_whole[v] : 0.0;
+        double turn_seen = 0.0, turn_whole = 0.0; /* over the view's pairs of the last pass */
+        for (uint32_t e = 0; e < r->edges; e++)
+            if (r->edge_from[e] == v || r->edge_to[e] == v) {
+                turn_seen += r->stats[e].turn_seen;
+                turn_whole += r->stats[e].turn_whole;
+            }
+        double seen = turn_whole > 0.0 ? turn_seen / turn_whole : 0.0;
         r->from_table[v] =
             angle_param(r, v) >= 0 && r->present[v] && seen < REG_TURN_SEEN * REG_TURN_SEEN;
         if (r->from_table[v])
@@ -600,7 +609,7 @@ static void summarise(struct reg_ctx *r, struct reg_report *rep)
     rep->failed_view = rep->failed_against = -1;
     rep->apart_view = rep->apart_against = -1;
     rep->apart_pairs = 0;
-    rep->arcs_held = r->use_solution ? hold_arcs(r, 0) : 0;
+    rep->arcs_held = r->use_solution ? arcs_held(r) : 0;
     for (uint32_t e = 0; e < r->edges; e++) {
         const struct reg_edge_stats *st = &r->stats[e];
         coupled += st->coupled;

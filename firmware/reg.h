@@ -107,7 +107,11 @@ struct reg_edge_stats {
     uint32_t overlap, coupled;
     uint32_t side_overlap, side_coupled; /**< of them, on surfaces facing sideways (reg.c) */
     double sq, trunc_sq; /**< squared residuals of coupled pairs; truncated over the overlap */
-    double turn_seen, turn_whole; /**< as reg_ctx's, of this pair's coupled samples */
+    /** How much of a turn about the axis the pair's coupled samples see: the sums of
+     *  (n . (d x (p - a)))^2 and |d x (p - a)|^2, the motion across the surface and the whole
+     *  motion of a turn (their ratio is 0 on a surface of revolution about the axis, about 0.5
+     *  on a box); a view's are those of its pairs. */
+    double turn_seen, turn_whole;
 };
 
 /** A registration: every view's samples and the joint solution, in one place (about
@@ -121,14 +125,10 @@ struct reg_ctx {
     uint32_t views, passes, per_pass, stride, gw, gh;
     int32_t reported_mdeg[REG_MAX_VIEWS];
     uint8_t present[REG_MAX_VIEWS];
-    uint32_t valid_cells[REG_MAX_VIEWS]; /**< each view's valid samples */
-    double theta[REG_MAX_VIEWS];         /**< radians */
-    /** How much of a turn about the axis each view's pairs see: the sums over its pairs of
-     *  (n . (d x (p - a)))^2 and |d x (p - a)|^2, the motion across the surface and the whole
-     *  motion of a turn (their ratio is 0 on a surface of revolution about the axis, about 0.5
-     *  on a box). */
-    double turn_seen[REG_MAX_VIEWS], turn_whole[REG_MAX_VIEWS];
-    double shift_seen[2], shift_whole[2]; /**< the same for a shift of the axis across it */
+    uint32_t valid_cells[REG_MAX_VIEWS];  /**< each view's valid samples */
+    double theta[REG_MAX_VIEWS];          /**< radians */
+    double shift_seen[2], shift_whole[2]; /**< as reg_edge_stats' turn, for a shift of the axis
+                                               across it, over every pair */
     int axis_from_calib;                  /**< the pairs do not see the axis: calibrated kept */
     int views_alike;                      /**< reg_views_alike: the axis held to the calibrated */
     uint8_t from_table[REG_MAX_VIEWS];    /**< the turn kept at the table's angle */
