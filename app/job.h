@@ -114,6 +114,10 @@ void job_warn(struct job *j, const char *fmt, ...) __attribute__((format(printf,
  *  EV_PROCESS_DONE) saying where the results are. */
 void job_finished(struct job *j, const char *what, const char *command, const char *event);
 
+/** Warn once when view @p v's object was too dark to decode, and how to lift it (@p live: while
+ * scanning; else processing a kept scan). */
+void job_say_if_dark(struct job *j, uint32_t v, const struct scan_view_info *info, int live);
+
 /* ---- job_live.c ---- */
 /** "N points at A deg -> DIR" of a view. */
 void job_describe(char *buf, size_t len, const struct scan_view_info *info, const char *dir);

@@ -153,34 +153,6 @@ static void say_if_off_image(struct job *j, uint32_t v, const struct scan_view *
                 (unsigned)v + 1);
 }
 
-/* A dark object (black plastic, dark paint) lights too little at the camera's exposure for its
- * stripes to be told apart: its pixels are counted 'dark' (lit, white minus black under [scan]
- * min_contrast_dn), every view comes out almost empty, and the registration, given nothing,
- * failed at the end naming the calibration. Said at the first view where the pixels too dark
- * outnumber those decoded (and are JOB_DARK_PIXELS or more: a dark stripe of paint on a bright
- * object is not a dark object), with the exposure that lifts their median contrast to twice the
- * threshold: the contrast grows with the exposure. Measured (2026-12-05): the bunny at albedo
- * 0.04, every default, 0 to 98 points a view, 48,044 pixels too dark at a median contrast of 7. */
-#define JOB_DARK_PIXELS 1000u
-static void say_if_dark(struct job *j, uint32_t v, const struct scan_view_info *info)
-{
-    uint32_t dark = info->reason_count[SCAN_DARK], c = info->dark_contrast_dn;
-    if (j->said_dark || dark < JOB_DARK_PIXELS || dark <= info->valid_points || c == 0)
-        return;
-    j->said_dark = 1;
-    const uint32_t now_us = j->cfg->camera.exposure_us, threshold = j->cfg->scan.min_contrast_dn;
-    double want = (double)now_us * 2.0 * threshold / c;
-    uint32_t want_us = (uint32_t)fmin(ceil(want / 1000.0) * 1000.0, 10000000.0);
-    job_warn(j,
-             "view %u: %u pixels lit but too dark to decode (white minus black %u grey levels, "
-             "under [scan] min_contrast_dn = %u) against %u decoded: a dark object? Stop the scan "
-             "and raise [camera] exposure_us from %u to about %u (or [scan] exposures_us = %u, %u "
-             "for an object with dark and bright parts)",
-             (unsigned)v + 1, (unsigned)dark, (unsigned)c, (unsigned)threshold,
-             (unsigned)info->valid_points, (unsigned)now_us, (unsigned)want_us, (unsigned)now_us,
-             (unsigned)want_us);
-}
-
 /* Decode a captured view, keep its frames and range image, then its view.ini last (its
  * presence says the view is complete). @retval 0 @retval -errno (said) */
 static int save_view(struct pending *p)
@@ -200,7 +172,7 @@ static int save_view(struct pending *p)
     }
     job_progress(j, EV_SAVING, (int)p->view, p->view, "");
     say_if_off_image(j, p->view, &view);
-    say_if_dark(j, p->view, &p->info);
+    job_say_if_dark(j, p->view, &p->info, 1);
     rc = scan_keep_for_registration(j->reg, p->view,
                                     &view); /* the model is made once every view is in */
     if (rc == 0) /* what the model is made of, so that it is not decoded again */

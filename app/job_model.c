@@ -273,7 +273,7 @@ static int report_registration(struct job *j, const struct reg_report *r, double
         j->hal->log(HAL_LOG_ERROR,
                     "registration failed: view %d does not match view %d (%.0f%% of their "
                     "overlap couples): the views hold almost nothing, the object too dark to "
-                    "decode at exposure_us = %u (the warning above says how much longer). No "
+                    "decode at exposure_us = %u (the warning above says more). No "
                     "model was made; the views are kept in %s. Scan again with the longer "
                     "exposure",
                     r->failed_view, r->failed_against, 100.0 * r->failed_share,

@@ -152,6 +152,9 @@ static int read_range(struct job *j, const char *dir, uint32_t v, struct scan_vi
         memset(info, 0, sizeof(*info));
         info->angle_mdeg = view->angle_mdeg;
         info->valid_points = view->range.valid_count;
+        for (size_t i = 0, n = (size_t)view->width * view->height; i < n; i++)
+            if (view->maps.reason[i] < SCAN_REASON_COUNT)
+                info->reason_count[view->maps.reason[i]]++;
     }
     return rc;
 }
@@ -266,8 +269,10 @@ int scan_job_process(const struct hal *hal, const char *scan_dir, const struct s
             rc = cfg.keep_frames == KEEP_FRAMES_ALL
                      ? load_view(&j, scan_dir, v, &view, &info)
                      : load_kept_range(&j, scan_dir, v, &view, &info);
-        if (rc == 0)
+        if (rc == 0) {
+            job_say_if_dark(&j, v, &info, 0);
             rc = scan_keep_for_registration(j.reg, v, &view);
+        }
         /* the model is made of this one, not of an older range.bin (one read back from where
          * it goes is that one already) */
         if (rc == 0 && (cfg.keep_frames == KEEP_FRAMES_ALL || elsewhere) &&

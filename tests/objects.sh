@@ -75,8 +75,8 @@ arcs_test() {
 check stepped_block_off_the_axis_keeps_the_table_between_blind_pairs arcs_test
 # A dark object (the bunny at albedo 0.04: black plastic) at every default: every view came out
 # almost empty (0 to 98 points), and after the last the registration failed naming the
-# calibration. Now the first view says it is too dark and what exposure lifts it; the scan
-# taken at that exposure makes its views.
+# calibration. Now the first view says it is too dark and what exposure lifts it (and so does
+# processing the scan again); the scan taken at that exposure makes its views.
 dark_test() {
     config mesh 2
     sed -i -e "/^object = mesh/a mesh_file = $PWD/data/bunny/bun_zipper.ply" \
@@ -86,6 +86,11 @@ dark_test() {
     grep -o 'warning: view 1: .* too dark to decode.*' "$out/dark.log" || return 1
     grep -q 'error: registration failed: .*too dark to decode at exposure_us = 10000' "$out/dark.log" ||
         return 1
+    # processed again from its range images alone (no frames kept), it says so too
+    "$bin" process "$out/dark" >"$out/dark-process.log" 2>&1 && return 1
+    grep -o 'warning: view 1: .* too dark to decode against .*longer \[camera\] exposure_us than 10000.*' \
+        "$out/dark-process.log" &&
+        grep -q 'error: registration failed: .*too dark to decode' "$out/dark-process.log" || return 1
     want=$(sed -n 's/.*raise \[camera\] exposure_us from 10000 to about \([0-9]*\).*/\1/p' "$out/dark.log")
     [ -n "$want" ] && [ "$want" -gt 10000 ] || return 1
     sed "s/^exposure_us = .*/exposure_us = $want/" "$out/mesh-2.ini" >"$out/dark-lit.ini"
