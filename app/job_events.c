@@ -298,6 +298,6 @@ void job_say_if_dark(struct job *j, uint32_t v, const struct scan_view_info *inf
              "raise [camera] exposure_us from %u to about %u (or [scan] exposures_us = %u, %u "
              "for an object with dark and bright parts)",
              (unsigned)v + 1, (unsigned)dark, (unsigned)c, (unsigned)threshold,
-             (unsigned)info->valid_points, live ? "Stop the scan and" : "Scan it again and",
+             (unsigned)info->valid_points, live ? "Stop the scan and" : "To scan it again,",
              (unsigned)now_us, (unsigned)want_us, (unsigned)now_us, (unsigned)want_us);
 }

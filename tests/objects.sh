@@ -93,6 +93,12 @@ dark_test() {
         grep -q 'error: registration failed: .*too dark to decode' "$out/dark-process.log" || return 1
     want=$(sed -n 's/.*raise \[camera\] exposure_us from 10000 to about \([0-9]*\).*/\1/p' "$out/dark.log")
     [ -n "$want" ] && [ "$want" -gt 10000 ] || return 1
+    # kept with its frames, processing says the same exposure
+    sed '/^keep_frames = none/d' "$out/mesh-2.ini" >"$out/dark-frames.ini"
+    scan_ini dark-frames && return 1
+    "$bin" process "$out/dark-frames" >"$out/dark-frames-process.log" 2>&1 && return 1
+    grep -o "warning: view 1: .*To scan it again, raise \[camera\] exposure_us from 10000 to about $want .*" \
+        "$out/dark-frames-process.log" || return 1
     sed "s/^exposure_us = .*/exposure_us = $want/" "$out/mesh-2.ini" >"$out/dark-lit.ini"
     scan_ini dark-lit || return 1
     points=$(sed -n 's/^view 1 of 2: \([0-9]*\) points.*/\1/p' "$out/dark-lit.log")
