@@ -2,7 +2,8 @@
  * passed to each part by pointer. A view is always named by its number (job_view_dir gives its
  * folder); nothing remembers "the current view" between calls.
  *   job.c          state, clocks, the output directory, a failed write said once
- *   job_events.c   events (scan_events.h), the time left, stages, cost, summary and report
+ *   job_events.c   events (scan_events.h), the time left, stages, cost, summary and report,
+ *                  the warning that the object is too dark (live and processed)
  *   job_live.c     on the rig: homing, each view taken and processed while the table turns
  *   job_model.c    registration, reflectance fit, fusion, the mesh's four files
  *   job_offline.c  settings of a kept scan, resume, process from the kept frames */

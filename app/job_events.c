@@ -1,6 +1,7 @@
 /* A scan job's events (job.h): a status line on a terminal, plain lines in a log, JSON for a
  * front end (scan_events.h names them), the estimate of the time left, the stages' times, what
- * the job cost, and summary.ini and report.html at its end. */
+ * the job cost, summary.ini and report.html at its end, and the warning that a view's object is
+ * too dark to decode (job_say_if_dark). */
 #define _POSIX_C_SOURCE 200809L
 #include "job.h"
 
