@@ -152,22 +152,25 @@ static int read_range(struct job *j, const char *dir, uint32_t v, struct scan_vi
         memset(info, 0, sizeof(*info));
         info->angle_mdeg = view->angle_mdeg;
         info->valid_points = view->range.valid_count;
-        for (size_t i = 0, n = (size_t)view->width * view->height; i < n; i++)
-            if (view->maps.reason[i] < SCAN_REASON_COUNT)
-                info->reason_count[view->maps.reason[i]]++;
     }
     return rc;
 }
 
-/* View @p v of a scan that kept no pattern frames: its range.bin in @p scan_dir. */
+/* View @p v of a scan that kept no pattern frames: its range.bin in @p scan_dir, its pixels
+ * counted by reason as the decoder counts them (job_say_if_dark reads the dark ones; the reader
+ * has refused a reason beyond SCAN_REASON_COUNT). */
 static int load_kept_range(struct job *j, const char *scan_dir, uint32_t v, struct scan_view *view,
                            struct scan_view_info *info)
 {
     char err[SCAN_DIR_PATH_MAX + 128];
     int rc = read_range(j, scan_dir, v, view, info, err, sizeof(err));
-    if (rc != 0)
+    if (rc != 0) {
         j->hal->log(HAL_LOG_ERROR, "%s; the scan kept no pattern frames to decode it from", err);
-    return rc;
+        return rc;
+    }
+    for (size_t i = 0, n = (size_t)view->width * view->height; i < n; i++)
+        info->reason_count[view->maps.reason[i]]++;
+    return 0;
 }
 
 /* View @p v as the model is made of it: its range.bin in the output directory, else (a scan
