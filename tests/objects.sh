@@ -91,6 +91,17 @@ dark_test() {
     grep -o 'warning: view 1: .* too dark to decode against .*longer \[camera\] exposure_us than 10000.*' \
         "$out/dark-process.log" &&
         grep -q 'error: registration failed: .*too dark to decode' "$out/dark-process.log" || return 1
+    # its range images damaged (a reason byte beyond the codes, a FIFO where one belongs): one
+    # error naming the file, before any view is counted, and no hang
+    cp -r "$out/dark" "$out/dark-bad"
+    printf '\377' | dd of="$out/dark-bad/view_000/range.bin" bs=1 seek=32 conv=notrunc 2>/dev/null
+    timeout 60 "$bin" process "$out/dark-bad" >"$out/dark-bad.log" 2>&1 && return 1
+    grep -q 'error: .*dark-bad/view_000/range.bin: cut short or damaged' "$out/dark-bad.log" &&
+        ! grep -q 'too dark' "$out/dark-bad.log" || return 1
+    cp "$out/dark/view_000/range.bin" "$out/dark-bad/view_000/range.bin"
+    rm "$out/dark-bad/view_001/range.bin" && mkfifo "$out/dark-bad/view_001/range.bin"
+    timeout 60 "$bin" process "$out/dark-bad" >"$out/dark-bad.log" 2>&1 && return 1
+    grep -q 'error: .*dark-bad/view_001/range.bin: not a range image' "$out/dark-bad.log" || return 1
     want=$(sed -n 's/.*raise \[camera\] exposure_us from 10000 to about \([0-9]*\).*/\1/p' "$out/dark.log")
     [ -n "$want" ] && [ "$want" -gt 10000 ] || return 1
     # kept with its frames, processing says the same exposure
