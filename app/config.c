@@ -204,6 +204,14 @@ static const struct ini_key config_keys[] = {
         "how far the table's reported angle may be from the true one (one standard deviation): "
         "the registration keeps the table's angle where the object's shape cannot fix the turn "
         "(a sphere, a cylinder, any surface of revolution about the axis)"),
+    F64("turntable", "axis_accuracy_mm", registration.axis_accuracy_mm, 0.001, 100, "0.1",
+        "how far the calibrated axis may be from the true one, across it (one standard "
+        "deviation): the registration moves the axis only as far as the views' pairs outweigh "
+        "this (never looser than a third of [registration] max_axis_shift_mm)"),
+    F64("turntable", "axis_tilt_accuracy_deg", registration.axis_tilt_accuracy_deg, 0.001, 45,
+        "0.033",
+        "how far the calibrated axis's direction may be from the true one (one standard "
+        "deviation; never looser than a third of [registration] max_axis_tilt_deg)"),
     U32("turntable", "move_timeout_ms", turntable.move_timeout_ms, 100, 600000, "30000",
         "a move or homing must finish within this"),
     F64("turntable", "speed_dps", turntable.speed_dps, 0.1, 6000, "30", "table speed, deg/s"),

@@ -175,6 +175,13 @@ static int report_registration(struct job *j, const struct reg_report *r, double
                  "views %d and %d share no surface to register (too few views for this "
                  "object?): the table's angles kept, the axis as calibrated",
                  r->apart_against, r->apart_view);
+    else if (no_turn_seen && r->turns_little_shared > 0)
+        snprintf(detail + n, sizeof(detail) - n,
+                 "the views' turns are not fixed by the object (%u of %u share too little "
+                 "surface with their neighbours: more views would): the table's angles kept, "
+                 "the axis %s",
+                 (unsigned)r->turns_little_shared, (unsigned)turning,
+                 r->axis_from_calibration || !r->accepted ? "as calibrated" : "registered");
     else if (no_turn_seen) /* the table's answer, whatever the solve did */
         snprintf(detail + n, sizeof(detail) - n,
                  "the object's shape does not fix the views' turns (a surface of revolution "
@@ -182,6 +189,12 @@ static int report_registration(struct job *j, const struct reg_report *r, double
                  r->axis_from_calibration || !r->accepted ? "as calibrated" : "registered");
     else if (r->solved && r->accepted && r->turns_from_table == 0)
         snprintf(detail + n, sizeof(detail) - n, "the views' angles corrected");
+    else if (r->solved && r->accepted && r->turns_little_shared > 0)
+        snprintf(detail + n, sizeof(detail) - n,
+                 "the views' angles corrected but for %u whose turn the object's shape does not "
+                 "fix or that share too little surface with their neighbours (%u; the table's "
+                 "angle kept there)",
+                 (unsigned)r->turns_from_table, (unsigned)r->turns_little_shared);
     else if (r->solved && r->accepted)
         snprintf(detail + n, sizeof(detail) - n,
                  "the views' angles corrected but for %u whose turn the object's shape does not "

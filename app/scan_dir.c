@@ -448,8 +448,10 @@ int scan_dir_write_registration(const struct hal_storage *st, const char *dir, u
         : r->moved_by_colour ? "shape and colour"
                              : "shape",
         v->reported_mdeg / 1000.0, v->angle_deg, v->correction_deg,
-        v->turn_from_table ? "table (the shape does not fix it)" : "registered", v->placed_freely,
-        (unsigned)v->overlap, (unsigned)v->coupled,
+        !v->turn_from_table     ? "registered"
+        : v->turn_little_shared ? "table (too little surface shared with its neighbours)"
+                                : "table (the shape does not fix it)",
+        v->placed_freely, (unsigned)v->overlap, (unsigned)v->coupled,
         v->overlap ? (double)v->coupled / v->overlap : 0.0, v->rms_mm);
     const double *m = pose->rot;
     if (len > 0 && (size_t)len < sizeof(text))

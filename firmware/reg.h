@@ -12,24 +12,27 @@
 #include "vec3.h"
 
 struct reg_params {
-    uint32_t enabled;          /**< 0: keep the turntable poses */
-    uint32_t sample_stride;    /**< keep every n-th pixel of a view in x and y (at least) */
-    uint32_t iterations;       /**< Gauss-Newton steps, each with new pairs */
-    double max_pair_mm;        /**< a pair farther apart does not couple */
-    double max_normal_deg;     /**< nor one whose normals differ more */
-    uint32_t use_colour;       /**< 1: colours must agree too (multi-feature matching) */
-    double max_colour_dn;      /**< largest per-channel colour difference of a pair */
-    uint32_t colour_intrinsic; /**< 1: the views' colours are intrinsic (compensated for the
-                                    light) and compared as they are; 0: raw colours, whose
-                                    brightness follows the shading, compared at one
-                                    brightness (not a config key: the job sets it) */
-    double max_correction_deg; /**< a view's angle may move this far from the reported one */
-    double max_axis_shift_mm;  /**< the axis may move this far from the calibrated one */
-    double max_axis_tilt_deg;  /**< and tilt this far */
-    double min_coupled_share;  /**< two neighbouring views coupling less of their overlap do
-                                    not match: the registration fails and names the view */
-    double angle_accuracy_deg; /**< the table's angles as a prior of this standard deviation: a
-                                    turn the geometry does not fix keeps the table's angle */
+    uint32_t enabled;              /**< 0: keep the turntable poses */
+    uint32_t sample_stride;        /**< keep every n-th pixel of a view in x and y (at least) */
+    uint32_t iterations;           /**< Gauss-Newton steps, each with new pairs */
+    double max_pair_mm;            /**< a pair farther apart does not couple */
+    double max_normal_deg;         /**< nor one whose normals differ more */
+    uint32_t use_colour;           /**< 1: colours must agree too (multi-feature matching) */
+    double max_colour_dn;          /**< largest per-channel colour difference of a pair */
+    uint32_t colour_intrinsic;     /**< 1: the views' colours are intrinsic (compensated for the
+                                        light) and compared as they are; 0: raw colours, whose
+                                        brightness follows the shading, compared at one
+                                        brightness (not a config key: the job sets it) */
+    double max_correction_deg;     /**< a view's angle may move this far from the reported one */
+    double max_axis_shift_mm;      /**< the axis may move this far from the calibrated one */
+    double max_axis_tilt_deg;      /**< and tilt this far */
+    double min_coupled_share;      /**< two neighbouring views coupling less of their overlap do
+                                        not match: the registration fails and names the view */
+    double angle_accuracy_deg;     /**< the table's angles as a prior of this standard deviation: a
+                                        turn the geometry does not fix keeps the table's angle */
+    double axis_accuracy_mm;       /**< the calibrated axis as a prior: its point across it, one
+                                        standard deviation (0: a third of max_axis_shift_mm) */
+    double axis_tilt_accuracy_deg; /**< and its direction (0: a third of max_axis_tilt_deg) */
 };
 
 /** One view after registration. */
@@ -42,6 +45,8 @@ struct reg_view {
     double rms_mm;             /**< point-to-plane residual of its coupled pairs */
     int turn_from_table;       /**< 1: the geometry does not fix its turn (a surface of
                                     revolution, a plane): the table's angle is kept */
+    int turn_little_shared;    /**< 1, with turn_from_table: the reason is that its pairs
+                                    share too little surface to outweigh the table */
     int placed_freely;         /**< 1: the object had moved: placed by its shape alone */
 };
 
@@ -76,6 +81,7 @@ struct reg_report {
     uint32_t second_coupled;       /**< pairs of the final refinement against the first pass */
     double second_rms_mm;          /**< and their residual */
     uint32_t turns_from_table;     /**< views whose turn the geometry does not fix (reg_view) */
+    uint32_t turns_little_shared;  /**< of them, those sharing too little surface */
     int axis_from_calibration;     /**< 1: the pairs do not see the axis's place: calibrated kept */
     int views_alike; /**< 1: each view looked like its neighbour as they stood (the object's
                           symmetry matches the table's step): the calibrated axis kept */
@@ -112,6 +118,7 @@ struct reg_edge_stats {
      *  motion of a turn (their ratio is 0 on a surface of revolution about the axis, about 0.5
      *  on a box); a view's are those of its pairs. */
     double turn_seen, turn_whole;
+    double area_mm2; /**< the surface the coupled samples stand for (a stride's square each) */
 };
 
 /** A registration: every view's samples and the joint solution, in one place (about
@@ -132,8 +139,10 @@ struct reg_ctx {
     int axis_from_calib;                  /**< the pairs do not see the axis: calibrated kept */
     int views_alike;                      /**< reg_views_alike: the axis held to the calibrated */
     uint8_t from_table[REG_MAX_VIEWS];    /**< the turn kept at the table's angle */
-    vec3 a, d;                            /**< the axis */
-    int use_solution;                     /**< poses from theta, a, d rather than the turntable's */
+    uint8_t
+        little_shared[REG_MAX_VIEWS]; /**< why: too little surface shared (REG_TURN_PATCH_MM2) */
+    vec3 a, d;                        /**< the axis */
+    int use_solution;                 /**< poses from theta, a, d rather than the turntable's */
     uint32_t edges, edge_from[REG_EDGES], edge_to[REG_EDGES];
     struct reg_edge_stats stats[REG_EDGES];
     /** The views placed through first_from_second (1): the second pass's, or those the object

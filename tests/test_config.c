@@ -89,6 +89,14 @@ static void test_errors_name_file_line_and_key(void **state)
                  "bad.ini:9: [scan] min_contrast_dn: 300 is out of range 1..255");
     expect_error("[turntable]\nangle_accuracy_deg = 0\n",
                  "bad.ini:9: [turntable] angle_accuracy_deg: 0 is out of range");
+    expect_error("[turntable]\naxis_accuracy_mm = -0.1\n",
+                 "bad.ini:9: [turntable] axis_accuracy_mm: -0.1 is out of range");
+    expect_error("[turntable]\naxis_accuracy_mm = nan\n",
+                 "bad.ini:9: [turntable] axis_accuracy_mm:");
+    expect_error("[turntable]\naxis_tilt_accuracy_deg = 90\n",
+                 "bad.ini:9: [turntable] axis_tilt_accuracy_deg: 90 is out of range");
+    expect_error("[turntable]\naxis_tilt_accuracy_deg = 0.1 deg\n",
+                 "bad.ini:9: [turntable] axis_tilt_accuracy_deg:");
     expect_error("[camera]\npixel_format = bgr\n",
                  "bad.ini:9: [camera] pixel_format: 'bgr' is not one of rgb24|yuyv|grey");
     expect_error("[sim]\nalbedo = 0.5, 0.5\n", "bad.ini:9: [sim] albedo: '0.5, 0.5' is not a list");

@@ -115,7 +115,9 @@ static struct reg_params params(void)
                                .max_axis_shift_mm = 3,
                                .max_axis_tilt_deg = 1,
                                .min_coupled_share = 0.2,
-                               .angle_accuracy_deg = 1};
+                               .angle_accuracy_deg = 1,
+                               .axis_accuracy_mm = 0.1,
+                               .axis_tilt_accuracy_deg = 0.033};
 }
 
 static int setup(void **state)
