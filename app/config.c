@@ -203,7 +203,8 @@ static const struct ini_key config_keys[] = {
     F64("turntable", "angle_accuracy_deg", registration.angle_accuracy_deg, 0.001, 45, "1",
         "how far the table's reported angle may be from the true one (one standard deviation): "
         "the registration keeps the table's angle where the object's shape cannot fix the turn "
-        "(a sphere, a cylinder, any surface of revolution about the axis)"),
+        "(a sphere, a cylinder, any surface of revolution about the axis) or where neighbouring "
+        "views share too little of it to outweigh this"),
     F64("turntable", "axis_accuracy_mm", registration.axis_accuracy_mm, 0.001, 100, "0.1",
         "how far the calibrated axis may be from the true one, across it (one standard "
         "deviation): the registration moves the axis only as far as the views' pairs outweigh "

@@ -44,7 +44,8 @@ struct reg_view {
     uint32_t overlap, coupled; /**< with its neighbours, at the final poses */
     double rms_mm;             /**< point-to-plane residual of its coupled pairs */
     int turn_from_table;       /**< 1: the geometry does not fix its turn (a surface of
-                                    revolution, a plane): the table's angle is kept */
+                                    revolution, a plane, too little surface shared): the
+                                    table's angle is kept */
     int turn_little_shared;    /**< 1, with turn_from_table: the reason is that its pairs
                                     share too little surface to outweigh the table */
     int placed_freely;         /**< 1: the object had moved: placed by its shape alone */
