@@ -248,12 +248,13 @@ static int report_registration(struct job *j, const struct reg_report *r, double
                  "; second pass found turned %.1f deg, residual %.3f mm over %u pairs",
                  r->second_turned_deg, r->second_rms_mm, (unsigned)r->second_coupled);
     }
-    char fields[160];
+    char fields[224];
     snprintf(fields, sizeof(fields),
              "\"solved\":%d,\"accepted\":%d,\"residual_mm\":%.4f,\"loop_closure_mm\":%.4f,"
-             "\"cpu_s\":%.3f,\"turns_from_table\":%u,\"moved_view\":%d",
+             "\"cpu_s\":%.3f,\"turns_from_table\":%u,\"turns_little_shared\":%u,"
+             "\"moved_view\":%d",
              r->solved, r->accepted, r->rms_mm, r->loop_rms_mm, cpu_seconds,
-             (unsigned)r->turns_from_table, r->moved_view);
+             (unsigned)r->turns_from_table, (unsigned)r->turns_little_shared, r->moved_view);
     job_progress_with(j, EV_REGISTRATION, -1, j->views, fields, detail);
     if (r->failed_view >= 0 && r->failed_against < 0) {
         j->hal->log(HAL_LOG_ERROR,

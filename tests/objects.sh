@@ -90,6 +90,7 @@ bracket_test() {
     grep '^registration' "$out/bracket-off.log" &&
         grep -q "1 of 3 share too little surface with their neighbours" "$out/bracket-off.log" &&
         grep -q '^turn = table (too little surface' "$out/bracket-off/view_002/registration.ini" &&
+        grep -q '^turns_little_shared = 1$' "$out/bracket-off/view_002/registration.ini" &&
         awk -v m="$m" 'BEGIN { exit !(m != "" && m < 0.12) }'
 }
 check l_bracket_off_the_axis_keeps_the_table_where_little_surface_is_shared bracket_test
