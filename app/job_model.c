@@ -170,6 +170,7 @@ static int report_registration(struct job *j, const struct reg_report *r, double
                  r->accepted || no_turn_seen ? "" : "turntable angles kept: ");
     }
     size_t n = strlen(detail);
+    const char *axis = r->axis_from_calibration || !r->accepted ? "as calibrated" : "registered";
     if (no_turn_seen && r->apart_pairs > 0) /* nothing to compare, not a shape that hides it */
         snprintf(detail + n, sizeof(detail) - n,
                  "views %d and %d share no surface to register (too few views for this "
@@ -180,27 +181,25 @@ static int report_registration(struct job *j, const struct reg_report *r, double
                  "the views' turns are not fixed by the object (%u of %u share too little "
                  "surface with their neighbours: more views would): the table's angles kept, "
                  "the axis %s",
-                 (unsigned)r->turns_little_shared, (unsigned)turning,
-                 r->axis_from_calibration || !r->accepted ? "as calibrated" : "registered");
+                 (unsigned)r->turns_little_shared, (unsigned)turning, axis);
     else if (no_turn_seen) /* the table's answer, whatever the solve did */
         snprintf(detail + n, sizeof(detail) - n,
                  "the object's shape does not fix the views' turns (a surface of revolution "
                  "about the axis?): the table's angles kept, the axis %s",
-                 r->axis_from_calibration || !r->accepted ? "as calibrated" : "registered");
+                 axis);
     else if (r->solved && r->accepted && r->turns_from_table == 0)
         snprintf(detail + n, sizeof(detail) - n, "the views' angles corrected");
-    else if (r->solved && r->accepted && r->turns_little_shared > 0)
+    else if (r->solved && r->accepted) {
+        char shared[80] = " ("; /* and how many of them share too little surface, if any */
+        if (r->turns_little_shared > 0)
+            snprintf(shared, sizeof(shared),
+                     " or that share too little surface with their neighbours (%u; ",
+                     (unsigned)r->turns_little_shared);
         snprintf(detail + n, sizeof(detail) - n,
                  "the views' angles corrected but for %u whose turn the object's shape does not "
-                 "fix or that share too little surface with their neighbours (%u; the table's "
-                 "angle kept there)",
-                 (unsigned)r->turns_from_table, (unsigned)r->turns_little_shared);
-    else if (r->solved && r->accepted)
-        snprintf(detail + n, sizeof(detail) - n,
-                 "the views' angles corrected but for %u whose turn the object's shape does not "
-                 "fix (the table's angle kept there)",
-                 (unsigned)r->turns_from_table);
-    else if (r->solved)
+                 "fix%sthe table's angle kept there)",
+                 (unsigned)r->turns_from_table, shared);
+    } else if (r->solved)
         snprintf(detail + n, sizeof(detail) - n, "%s", r->refused);
     if (r->apart_pairs > 0 && !no_turn_seen) {
         n = strlen(detail);

@@ -234,6 +234,7 @@ static void pair_views(struct reg_ctx *r, uint32_t src, uint32_t dst, double gat
                        struct reg_edge_stats *st)
 {
     const double min_cos = cos(r->p.max_normal_deg * M_PI / 180.0);
+    const double side_per_z = r->stride / r->calib.cam_fx_px; /* a sample's side per mm of depth */
     double rot[9];
     axis_rotation(r->d, r->theta[dst] - r->theta[src], rot);
     vec3 e1, e2;
@@ -281,7 +282,7 @@ static void pair_views(struct reg_ctx *r, uint32_t src, uint32_t dst, double gat
         vec3 along = v3_cross(r->d, rpa); /* a turn's motion of the point, per radian */
         double dth = v3_dot(nq, along), w = w_of(r, res);
         st->turn_seen += w * dth * dth, st->turn_whole += w * v3_dot(along, along);
-        double side_mm = r->stride * cq->xyz[2] / r->calib.cam_fx_px; /* a sample's, face on */
+        double side_mm = side_per_z * cq->xyz[2]; /* the sample's, face on */
         st->area_mm2 += side_mm * side_mm;
         if (!solve)
             continue;

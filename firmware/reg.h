@@ -140,10 +140,9 @@ struct reg_ctx {
     int axis_from_calib;                  /**< the pairs do not see the axis: calibrated kept */
     int views_alike;                      /**< reg_views_alike: the axis held to the calibrated */
     uint8_t from_table[REG_MAX_VIEWS];    /**< the turn kept at the table's angle */
-    uint8_t
-        little_shared[REG_MAX_VIEWS]; /**< why: too little surface shared (REG_TURN_PATCH_MM2) */
-    vec3 a, d;                        /**< the axis */
-    int use_solution;                 /**< poses from theta, a, d rather than the turntable's */
+    uint8_t little_shared[REG_MAX_VIEWS]; /**< why: too little surface shared (reg.c) */
+    vec3 a, d;                            /**< the axis */
+    int use_solution;                     /**< poses from theta, a, d rather than the turntable's */
     uint32_t edges, edge_from[REG_EDGES], edge_to[REG_EDGES];
     struct reg_edge_stats stats[REG_EDGES];
     /** The views placed through first_from_second (1): the second pass's, or those the object

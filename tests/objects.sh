@@ -55,10 +55,6 @@ off_axis_test() {
         awk -v m="$m" 'BEGIN { exit !(m != "" && m < 0.1) }'
 }
 check box_off_the_axis_in_4_views_is_not_taken_for_moved off_axis_test
-# The stepped block 30, 20 mm off the axis in 6 views: its pairs 120 -> 180 and 300 -> 0 degrees
-# share only its steps' tops, which see no turn, so the views fall into two arcs the pairs cannot
-# turn against each other; the depth's bias turned the second 0.58 degrees (0.123 mm from the
-# truth, 0.067 centred). Now the table's angles hold between the arcs, said.
 # name, part of data/objects, its height (mm), views: the part stood 30, 20 mm off the axis,
 # scanned without frames into $out/NAME
 part_off_axis() {
@@ -69,6 +65,10 @@ part_off_axis() {
     printf '[output]\nkeep_frames = none\n' >>"$out/$1.ini"
     scan_ini "$1"
 }
+# The stepped block 30, 20 mm off the axis in 6 views: its pairs 120 -> 180 and 300 -> 0 degrees
+# share only its steps' tops, which see no turn, so the views fall into two arcs the pairs cannot
+# turn against each other; the depth's bias turned the second 0.58 degrees (0.123 mm from the
+# truth, 0.067 centred). Now the table's angles hold between the arcs, said.
 arcs_test() {
     part_off_axis steps-off stepped_block 60 6 || return 1
     m=$(aligned_mean steps-off)
