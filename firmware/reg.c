@@ -667,6 +667,9 @@ static void summarise(struct reg_ctx *r, struct reg_report *rep)
     rep->loop_rms_mm = loop_coupled > 0 ? sqrt(loop_sq / (double)loop_coupled) : 0.0;
     rep->rms_mm = coupled > 0 ? sqrt(sq / (double)coupled) : 0.0;
     rep->worst_rms_mm = -1.0;
+    /* counted afresh: a moved object's views are solved again (place_moved_views), and each
+     * solve ends here */
+    rep->turns_from_table = rep->turns_little_shared = 0;
     for (uint32_t v = 0; v < r->views; v++)
         rep->turns_from_table += r->from_table[v], rep->turns_little_shared += r->little_shared[v];
     rep->axis_from_calibration = r->axis_from_calib;
