@@ -186,7 +186,9 @@ check box_slipped_along_its_faces_is_placed_by_its_paint slip_painted_test
 # their paint to within a tenth of a millimetre: each sample's hue is the mean of its pixels' (the hue of their mean colour leaned
 # towards the brighter paint by how obliquely a view saw it, and placed them 0.43 mm off: the
 # model 0.122 mm from the truth against 0.050 unmoved), and the hues move only the slide the
-# shape leaves (on every motion they turned the views 0.3 degrees). Now 0.064 mm.
+# shape leaves (on every motion they turned the views 0.3 degrees): 0.064 mm. The hues of every
+# second cell only (every second column of the image) placed them 0.1 mm off along the faces;
+# with every cell's, 0.055: within the issue's 1.2 times the unmoved box.
 part_pushed() { # name, part of data/objects, its height (mm), [views6], [mm]: painted, 8 (6) views, pushed 30 (mm) mm
     slip_config patches "${5:-30}"
     sed -e "s|^object = .*|object = mesh\nmesh_file = $PWD/data/objects/$2.ply|" \
@@ -203,10 +205,10 @@ placed_within() {
     grep -q "$6" "$out/$1.log" && awk -v m="$m" -v x="$7" 'BEGIN { exit !(m != "" && m < x) }'
 }
 slip_far_test() {
-    placed_within slip-far box 80 "" 30 "placed by the object's shape and colour" 0.08 \
+    placed_within slip-far box 80 "" 30 "placed by the object's shape and colour" 0.06 \
         "box, 8 views, 30 mm slip at view 4, painted"
 }
-check box_pushed_30mm_is_placed_by_its_paint_within_a_tenth slip_far_test
+check box_pushed_30mm_is_placed_by_its_paint_within_1_2_times_unmoved slip_far_test
 # A hex nut in 6 views: its six-fold symmetry is the table's 60-degree step, so each view looks
 # like its neighbour as they stand, and the pairs fit the table's turn about the nut's own axis
 # as measured, which the depth's small bias (the same in every view) moves: the axis went 0.27 mm
@@ -316,11 +318,15 @@ check box_pushed_in_six_views_is_not_a_silent_wrong_model slip_six_test
 # table's place slid 18 mm along its top and stopped where its steps did not fit, and the search
 # without a starting pose placed it turned half a turn. Now its paint, searched across the table
 # from the table's place, finds the push (30.0 mm) and the shape fits there: placed, 0.070 mm
-# from the truth (0.067 unpushed).
+# from the truth (0.067 unpushed). With the hues of every cell (reg_place.c) it says 30.074 mm,
+# the model 0.069 mm from the truth: the placement within a tenth of a millimetre of the push.
 steps_six_test() {
     placed_within steps-six stepped_block 60 views6 30 \
-        "moved on the table at view 3: 3 views placed by the object's shape and colour.*as it had moved 30.0 mm" \
-        0.09 "stepped block, 6 views, 30 mm push at view 3"
+        "moved on the table at view 3: 3 views placed by the object's shape and colour" \
+        0.09 "stepped block, 6 views, 30 mm push at view 3" || return 1
+    moved=$(sed -n 's/^moved_mm = //p' "$out/steps-six/view_003/registration.ini")
+    echo "moved_mm = $moved"
+    awk -v m="$moved" 'BEGIN { exit !(m != "" && m > 29.9 && m < 30.1) }'
 }
 check stepped_block_pushed_in_six_views_is_placed_by_its_paint steps_six_test
 slip_plain_test() {
