@@ -223,6 +223,46 @@ static void add_hue_rows(struct reg_ctx *r, struct lsq_rigid *eq, const struct r
     }
 }
 
+/* The hues' equations @p hues added to the shape's @p eq along the motions the shape does not
+ * hold: each shift axis it holds under REG_COLOUR_MIN_NEXT of its pairs (@p share, @p axis as
+ * lsq_rigid_shift_axes gives them) and, with @p turn, the turn about the table's axis (object
+ * frame z). The hues' block projected onto those motions: each shift axis on its own and the
+ * turn with each (two shift axes coupled too: measured on the 35 slipped parts, the box pushed
+ * 30 mm in 6 views 0.081 -> 0.084 mm, in 8 views 0.070 -> 0.066, the rest the same; not made). */
+static void hues_along(struct lsq_rigid *eq, const struct lsq_rigid *hues, const double share[3],
+                       const vec3 axis[3], int turn)
+{
+    double basis[4][6]; /* the motions, unit 6-vectors (turns, then shifts) */
+    int count = 0;
+    for (int k = 0; k < 3; k++)
+        if (share[k] < REG_COLOUR_MIN_NEXT) {
+            const double u[6] = {0.0, 0.0, 0.0, axis[k].x, axis[k].y, axis[k].z};
+            memcpy(basis[count++], u, sizeof(u));
+        }
+    if (turn) {
+        const double t[6] = {0.0, 0.0, 1.0, 0.0, 0.0, 0.0};
+        memcpy(basis[count++], t, sizeof(t));
+    }
+    for (int i = 0; i < count; i++) {
+        double b_i = 0.0;
+        for (int r = 0; r < 6; r++)
+            b_i += basis[i][r] * hues->b[r];
+        for (int r = 0; r < 6; r++)
+            eq->b[r] += b_i * basis[i][r]; /* b += (s_i . b_h) s_i */
+        for (int j = 0; j < count; j++) {
+            if (j != i && !(turn && (i == count - 1 || j == count - 1)))
+                continue; /* two shift axes: each on its own */
+            double h_ij = 0.0;
+            for (int r = 0; r < 6; r++)
+                for (int c = 0; c < 6; c++)
+                    h_ij += basis[i][r] * hues->a[r * 6 + c] * basis[j][c];
+            for (int r = 0; r < 6; r++) /* A += (s_i^T H s_j) s_i s_j^T */
+                for (int c = 0; c < 6; c++)
+                    eq->a[r * 6 + c] += h_ij * basis[i][r] * basis[j][c];
+        }
+    }
+}
+
 /* The group-1 samples against the group-0 views: one point-to-plane step of first_from_second
  * per call (object frame 1); with @p hue_weight > 0 their hues as well, where they land on paint
  * that changes (add_hue_rows): the colour holds what the shape lets slide.
@@ -252,6 +292,7 @@ static uint32_t refine_second_step(struct reg_ctx *r, double gate_mm, double hue
      * of the 35 worse by at most 0.004 mm. Twice the hues at half the weight gave the same; the
      * weight doubled at every second cell, nothing. */
     const size_t step = hue_weight > 0.0 ? 1 : 2;
+    double lever_sq = 0.0; /* the pairs' squared distance from the table's axis */
     for (uint32_t v = 0; v < r->views; v++) {
         struct frame_xform pose;
         struct reg_view rv;
@@ -267,8 +308,10 @@ static uint32_t refine_second_step(struct reg_ctx *r, double gate_mm, double hue
             cell_in_object(cl, &pose, &p, &n);
             const struct reg_cell *hit =
                 land(r, p, n, min_cos, gate_mm, hue_weight > 0.0, r->views, &landed, &q, &nq, NULL);
-            if (hit != NULL && shape)
+            if (hit != NULL && shape) {
                 lsq_rigid_add(&eq, p, q, nq);
+                lever_sq += p.x * p.x + p.y * p.y;
+            }
             if (hit != NULL && hue_weight > 0.0)
                 add_hue_rows(r, &hues, cl, p, hit, q, nq, min_cos, 4.0 * gate_mm, hue_weight);
             *overlap += shape ? (uint32_t)landed : 0u;
@@ -278,28 +321,23 @@ static uint32_t refine_second_step(struct reg_ctx *r, double gate_mm, double hue
     *rms = coupled > 0 ? sqrt(eq.sq / coupled) : 0.0;
     if (lsq_rigid_shift_axes(&eq, share, axis) != 0)
         memset(share, 0, 3 * sizeof(double)); /* no pairs: holds nothing */
-    /* The hues only along the shift axes the shape does not hold (where the colour search
-     * looked, reg_place_by_colour): elsewhere the shape's thousands of pairs fix the motion and
-     * the paint's few boundaries add nothing but their noise. Measured on the box of
-     * data/objects slipped 30 mm, against the simulator's true poses: the hues on every motion
-     * turned the views after the slip 0.25 to 0.3 degrees and tilted them 0.17; on the shifts
-     * the shape lets slide only, 0.06 to 0.15 and 0.01 (REG_COLOUR_ITERATIONS). */
-    for (int k = 0; k < 3 && hue_weight > 0.0; k++) {
-        if (share[k] >= REG_COLOUR_MIN_NEXT)
-            continue;
-        const double u[3] = {axis[k].x, axis[k].y, axis[k].z};
-        double a_u = 0.0, b_u = 0.0;
-        for (int i = 0; i < 3; i++) {
-            b_u += u[i] * hues.b[3 + i];
-            for (int j = 0; j < 3; j++)
-                a_u += u[i] * hues.a[(3 + i) * 6 + 3 + j] * u[j];
-        }
-        for (int i = 0; i < 3; i++) { /* A += a_u u u^T, b += b_u u on the shifts */
-            eq.b[3 + i] += b_u * u[i];
-            for (int j = 0; j < 3; j++)
-                eq.a[(3 + i) * 6 + 3 + j] += a_u * u[i] * u[j];
-        }
-    }
+    /* The hues only along the motions the shape does not hold: the shift axes it lets slide
+     * (where the colour search looked, reg_place_by_colour), and the turn about the table's axis
+     * where the pairs see under REG_COLOUR_MIN_NEXT of it (their information on the turn over
+     * what normals square to it would give, their squared distance from the axis). Elsewhere the
+     * shape's thousands of pairs fix the motion and the paint's few boundaries add nothing but
+     * their noise. Measured on the box of data/objects slipped 30 mm, against the simulator's true
+     * poses: the hues on every motion turned the views after the slip 0.25 to 0.3 degrees and
+     * tilted them 0.17; on the shifts the shape lets slide only, 0.06 to 0.15 and 0.01
+     * (REG_COLOUR_ITERATIONS). A long thin part's top and two small ends barely see its turn: the
+     * thin box slipped 6 mm along its length in 8 views, 0.5 % of it seen, was placed turned 0.3
+     * degrees (0.3 mm at its ends; its model 1.20 times its unmoved scan's distance from the
+     * truth); with the paint on the turn, 0.1 degrees and 1.03 times (2026-12-06). The other
+     * parts placed with one free shift see 3.8 % (the plate with holes) to 11 %; those under 5 %
+     * changed by 0.001 mm at most. */
+    if (hue_weight > 0.0)
+        hues_along(&eq, &hues, share, axis,
+                   !hold_turn && eq.a[2 * 6 + 2] < REG_COLOUR_MIN_NEXT * lever_sq);
     if (hold_turn) { /* x[2], the turn about z, fixed at 0 */
         for (int i = 0; i < 6; i++)
             eq.a[2 * 6 + i] = eq.a[i * 6 + 2] = 0.0;

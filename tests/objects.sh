@@ -280,6 +280,20 @@ thin_slip_six_test() {
     [ "$kept" -gt 0 ] && grep -q "^turns_from_table = $kept\$" "$out/thin-slip6/view_000/registration.ini"
 }
 check thin_box_slipped_in_six_views_is_placed thin_slip_six_test
+# The same thin box slipped 6 mm along its length in 8 views: across the slip its views share the
+# top and the two small ends, which see 0.5 % of a turn about the table's axis (reg_place.c); the
+# shape lets it slide one way, the paint placed that, and ICP left a turn of 0.3 degrees from
+# noise (0.3 mm at its ends; the model 0.083 mm from the truth, 0.069 unslipped). Now the paint
+# holds the turn too: 0.1 degrees, 0.071 mm.
+thin_slip_eight_test() {
+    placed_within thin-slip8 thin_box 15 "" 6 \
+        "moved on the table at view 4: 4 views placed by the object's shape and colour" 0.08 \
+        "thin box, 8 views, 6 mm slip at view 4" || return 1
+    turned=$(sed -n 's/^moved_deg = //p' "$out/thin-slip8/view_005/registration.ini")
+    echo "moved_deg = $turned"
+    awk -v t="$turned" 'BEGIN { exit !(t != "" && t < 0.2) }'
+}
+check thin_box_slipped_along_its_length_keeps_its_turn_by_its_paint thin_slip_eight_test
 # The plate pushed 30 mm in 6 views: across the push its views share the top and little else,
 # which holds neither its shifts along the table nor its turn about the axis; ICP left a turn of
 # 1.7 deg from noise, the paint's search moves shifts only, and the model came out 0.257 mm from
