@@ -228,7 +228,8 @@ static void add_hue_rows(struct reg_ctx *r, struct lsq_rigid *eq, const struct r
  * lsq_rigid_shift_axes gives them) and, with @p turn, the turn about the table's axis (object
  * frame z). The hues' block projected onto those motions: each shift axis on its own and the
  * turn with each (two shift axes coupled too: measured on the 35 slipped parts, the box pushed
- * 30 mm in 6 views 0.081 -> 0.084 mm, in 8 views 0.070 -> 0.066, the rest the same; not made). */
+ * 30 mm in 6 views 0.081 -> 0.084 mm, slipped 6 mm in 6 views 0.070 -> 0.066, the rest the
+ * same; not made). */
 static void hues_along(struct lsq_rigid *eq, const struct lsq_rigid *hues, const double share[3],
                        const vec3 axis[3], int turn)
 {
