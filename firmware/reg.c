@@ -240,6 +240,11 @@ static void pair_views(struct reg_ctx *r, uint32_t src, uint32_t dst, double gat
     vec3 e1, e2;
     v3_across(r->d, &e1, &e2);
     vec3 r_e1 = m3_mul(rot, e1), r_e2 = m3_mul(rot, e2);
+    struct scan_calib c = r->calib; /* the object frame at the unknowns: both ways in one frame */
+    c.axis_point_mm[0] = r->a.x, c.axis_point_mm[1] = r->a.y, c.axis_point_mm[2] = r->a.z;
+    c.axis_dir[0] = r->d.x, c.axis_dir[1] = r->d.y, c.axis_dir[2] = r->d.z;
+    struct frame_xform dst_pose;
+    frame_object_from_camera_rad(&c, r->theta[dst], &dst_pose);
     const int axis = (int)(r->views - r->passes);
     int idx[6] = {angle_param(r, src), angle_param(r, dst), axis, axis + 1, axis + 2, axis + 3};
     const struct reg_cell *from = reg_view_cells(r, src), *to = reg_view_cells(r, dst);
@@ -284,6 +289,9 @@ static void pair_views(struct reg_ctx *r, uint32_t src, uint32_t dst, double gat
         st->turn_seen += w * dth * dth, st->turn_whole += w * v3_dot(along, along);
         double side_mm = side_per_z * cq->xyz[2]; /* the sample's, face on */
         st->area_mm2 += side_mm * side_mm;
+        const vec3 n_obj = m3_mul(dst_pose.rot, nq);
+        st->slide[0] += n_obj.x * n_obj.x, st->slide[1] += n_obj.x * n_obj.y;
+        st->slide[2] += n_obj.y * n_obj.y;
         if (!solve)
             continue;
         vec3 tilt1 = v3_sub(v3_cross(e1, rpa), m3_mul(rot, v3_cross(e1, pa)));

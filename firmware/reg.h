@@ -120,6 +120,10 @@ struct reg_edge_stats {
      *  on a box); a view's are those of its pairs. */
     double turn_seen, turn_whole;
     double area_mm2; /**< the surface the coupled samples stand for (a stride's square each) */
+    /** The coupled samples' normals along the table (the object frame's x and y, the same
+     *  frame both ways): the sums of nx^2, nx ny, ny^2. A slide along the table in a direction
+     *  none of them has moves no residual (reg_breaks.c). */
+    double slide[3];
 };
 
 /** A registration: every view's samples and the joint solution, in one place (about
