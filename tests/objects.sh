@@ -200,9 +200,13 @@ part_pushed() { # name, part of data/objects, its height (mm), [views6], [mm]: p
 # and the model is less than $7 mm from the truth; $8 says what it is
 placed_within() {
     part_pushed "$1" "$2" "$3" "$4" "$5" || return 1
+    placed_check "$1" "$6" "$7" "$8"
+}
+# scan $1 placed: its log says $2 and the model is less than $3 mm from the truth; $4 says what it is
+placed_check() {
     m=$(aligned_mean "$1")
-    echo "$8: model -> truth mean $m mm"
-    grep -q "$6" "$out/$1.log" && awk -v m="$m" -v x="$7" 'BEGIN { exit !(m != "" && m < x) }'
+    echo "$4: model -> truth mean $m mm"
+    grep -q "$2" "$out/$1.log" && awk -v m="$m" -v x="$3" 'BEGIN { exit !(m != "" && m < x) }'
 }
 slip_far_test() {
     placed_within slip-far box 80 "" 30 "placed by the object's shape and colour" 0.06 \
@@ -218,10 +222,9 @@ slip_along_test() {
     slip_config patches
     sed -e 's/^slip_mm = .*/slip_mm = 0, 6, 0/' "$out/slip-patches.ini" >"$out/slip-along.ini"
     scan_ini slip-along || return 1
-    m=$(aligned_mean slip-along)
-    echo "box, 8 views, 6 mm slip along the shared faces at view 4: model -> truth mean $m mm"
-    grep -q "moved on the table at view 4: 4 views placed by the object's shape and colour.*as it had moved 6.0 mm" \
-        "$out/slip-along.log" && awk -v m="$m" 'BEGIN { exit !(m != "" && m < 0.06) }'
+    placed_check slip-along \
+        "moved on the table at view 4: 4 views placed by the object's shape and colour.*as it had moved 6.0 mm" \
+        0.06 "box, 8 views, 6 mm slip along the shared faces at view 4"
 }
 check box_slipped_along_the_faces_its_neighbours_share_is_placed slip_along_test
 # A hex nut in 6 views: its six-fold symmetry is the table's 60-degree step, so each view looks
@@ -319,10 +322,8 @@ thin_slip_seven_test() {
         -e "s/^object_height_mm = .*/object_height_mm = 15/" -e "s/^views = .*/views = 7/" \
         -e "s/^slip_at_deg = .*/slip_at_deg = 100/" "$out/slip-patches.ini" >"$out/thin-slip7.ini"
     scan_ini thin-slip7 || return 1
-    m=$(aligned_mean thin-slip7)
-    echo "thin box, 7 views, 6 mm slip at 100 degrees: model -> truth mean $m mm"
-    grep -q "moved on the table at view 2: 5 views placed by the object's shape and colour" \
-        "$out/thin-slip7.log" && awk -v m="$m" 'BEGIN { exit !(m != "" && m < 0.08) }'
+    placed_check thin-slip7 "moved on the table at view 2: 5 views placed by the object's shape and colour" \
+        0.08 "thin box, 7 views, 6 mm slip at 100 degrees"
 }
 check thin_box_slipped_early_in_seven_views_is_placed thin_slip_seven_test
 # The plate pushed 30 mm in 6 views: across the push its views share the top and little else,
