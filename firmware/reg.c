@@ -55,6 +55,14 @@ static void calibrated_axis(const struct reg_ctx *r, vec3 *a0, vec3 *d0)
     *d0 = v3_norm(v3_from(r->calib.axis_dir));
 }
 
+/* The calibration with the axis the unknowns have now (r->a, r->d) in place of the calibrated. */
+static void calib_at_axis(const struct reg_ctx *r, struct scan_calib *c)
+{
+    *c = r->calib;
+    c->axis_point_mm[0] = r->a.x, c->axis_point_mm[1] = r->a.y, c->axis_point_mm[2] = r->a.z;
+    c->axis_dir[0] = r->d.x, c->axis_dir[1] = r->d.y, c->axis_dir[2] = r->d.z;
+}
+
 int reg_begin(struct reg_ctx *r, const struct reg_params *p, const struct scan_calib *c,
               uint32_t views, uint32_t passes, uint32_t width, uint32_t height)
 {
@@ -240,10 +248,9 @@ static void pair_views(struct reg_ctx *r, uint32_t src, uint32_t dst, double gat
     vec3 e1, e2;
     v3_across(r->d, &e1, &e2);
     vec3 r_e1 = m3_mul(rot, e1), r_e2 = m3_mul(rot, e2);
-    struct scan_calib c = r->calib; /* the object frame at the unknowns: both ways in one frame */
-    c.axis_point_mm[0] = r->a.x, c.axis_point_mm[1] = r->a.y, c.axis_point_mm[2] = r->a.z;
-    c.axis_dir[0] = r->d.x, c.axis_dir[1] = r->d.y, c.axis_dir[2] = r->d.z;
+    struct scan_calib c; /* the object frame at the unknowns: both ways in one frame */
     struct frame_xform dst_pose;
+    calib_at_axis(r, &c);
     frame_object_from_camera_rad(&c, r->theta[dst], &dst_pose);
     const int axis = (int)(r->views - r->passes);
     int idx[6] = {angle_param(r, src), angle_param(r, dst), axis, axis + 1, axis + 2, axis + 3};
@@ -810,10 +817,8 @@ int reg_view_pose(struct reg_ctx *r, uint32_t v, struct frame_xform *obj_from_ca
     out->rms_mm = out->coupled > 0 ? sqrt(sq / out->coupled) : 0.0;
     if (obj_from_cam != NULL) {
         struct scan_calib c = r->calib;
-        if (r->use_solution) {
-            c.axis_point_mm[0] = r->a.x, c.axis_point_mm[1] = r->a.y, c.axis_point_mm[2] = r->a.z;
-            c.axis_dir[0] = r->d.x, c.axis_dir[1] = r->d.y, c.axis_dir[2] = r->d.z;
-        }
+        if (r->use_solution)
+            calib_at_axis(r, &c);
         frame_object_from_camera_rad(&c, theta, obj_from_cam);
         if (r->group[v] && r->second_aligned) { /* into group 0's object frame */
             struct frame_xform in_second = *obj_from_cam;

@@ -231,26 +231,28 @@ static int slip_pairs(const struct reg_ctx *r, uint32_t e, uint32_t f)
     return closing || r->edge_to[e] == r->edge_from[f] || r->edge_to[f] == r->edge_from[e];
 }
 
-/* Whether edge @p e's pairs hold no slide along the table in some direction: they share a top
- * and no side (REG_SIDE_MIN: no slide at all; @p dir NULL), or their normals have almost nothing
- * along one direction of the table (the weakest eigenvalue of reg_edge_stats' slide under
- * REG_SLIDE_HOLD of the coupled samples; that direction, object frame x and y, into @p dir). A
- * box seen in 8 views shares one face and its top with each neighbour: a push along that face
- * moves no residual, and the box pushed 6 mm along the faces its pairs across the push share
- * came out 1.84 mm from the truth without a word (its paint alone shows it; the pairs share a
- * side, so the rule for a top alone did not look). Measured (2026-12-06): that box's pairs
- * 0.003 to 0.008 of their coupled samples, the bunny's, the nut's and the gear's far above. */
+/* How edge @p e's pairs hold a slide along the table. They share a top and no side
+ * (REG_SIDE_MIN): no slide at all. Or their normals have almost nothing along one direction of
+ * the table (the weakest eigenvalue of reg_edge_stats' slide under REG_SLIDE_HOLD of the coupled
+ * samples): that direction, object frame x and y, into @p dir. A box seen in 8 views shares one
+ * face and its top with each neighbour: a push along that face moves no residual, and the box
+ * pushed 6 mm along the faces its pairs across the push share came out 1.84 mm from the truth
+ * without a word (its paint alone shows it; the pairs share a side, so the rule for a top alone
+ * did not look). Measured (2026-12-06): that box's pairs 0.003 to 0.008 of their coupled samples,
+ * the bunny's, the nut's and the gear's far above.
+ * @retval SLIDE_NONE held every way @retval SLIDE_ANY a top alone @retval SLIDE_ALONG along @p dir
+ */
 #define REG_SLIDE_HOLD 0.02
-static int edge_slides(const struct reg_ctx *r, uint32_t e, double dir[2], int *along)
+enum { SLIDE_NONE, SLIDE_ANY, SLIDE_ALONG };
+static int edge_slides(const struct reg_ctx *r, uint32_t e, double dir[2])
 {
     const struct reg_edge_stats *st = &r->stats[e];
+    if (st->side_overlap < REG_SIDE_MIN)
+        return SLIDE_ANY;
     const double a = st->slide[0], b = st->slide[1], c = st->slide[2];
     const double weakest = 0.5 * (a + c) - sqrt(0.25 * (a - c) * (a - c) + b * b);
-    *along = 0;
-    if (st->side_overlap < REG_SIDE_MIN)
-        return 1;
     if (st->coupled == 0 || weakest >= REG_SLIDE_HOLD * (double)st->coupled)
-        return 0;
+        return SLIDE_NONE;
     /* the eigenvector of [a b; b c] for the weakest: (b, weakest - a), or (weakest - c, b) */
     double x = b, y = weakest - a;
     if (fabs(a - weakest) < fabs(c - weakest))
@@ -261,38 +263,46 @@ static int edge_slides(const struct reg_ctx *r, uint32_t e, double dir[2], int *
     else
         x /= len, y /= len;
     dir[0] = x, dir[1] = y;
-    *along = 1;
-    return 1;
+    return SLIDE_ALONG;
+}
+
+/* Whether edge @p e's shape lets it slide (into @p slides, edge_slides) and its paint lines up
+ * elsewhere, searched along the free way only where there is one (pair_shifted's @p misfit,
+ * @p at). */
+static int slid_in_paint(struct reg_ctx *r, uint32_t e, int *slides, double *misfit, double at[2])
+{
+    double dir[2];
+    *slides = edge_slides(r, e, dir);
+    return *slides != SLIDE_NONE &&
+           pair_shifted(r, e, *slides == SLIDE_ALONG ? dir : NULL, misfit, at);
 }
 
 /* The pair of a slip its shapes let through: a pair whose shape lets it slide along the table
  * (edge_slides: a top alone, or faces that all hold one way), whose paint lines up elsewhere
- * (searched along the free way only where there is one), and another pair where the same move
- * parts the views (slip_pairs), whose paint lines up at the opposite place. Both into
- * quiet_break_after, the first as the failed pair in @p rep. @retval the breaks (0 or 2) */
+ * (slid_in_paint), and another pair where the same move parts the views (slip_pairs), whose
+ * paint lines up at the opposite place. Both into quiet_break_after, the first as the failed
+ * pair in @p rep. @retval the breaks (0 or 2) */
 static int shift_breaks(struct reg_ctx *r, struct reg_report *rep)
 {
-    static double at[REG_EDGES][2], misfit[REG_EDGES],
-        dir[REG_EDGES][2]; /* static: off the stack */
+    static double at[REG_EDGES][2], misfit[REG_EDGES]; /* static: off the stack */
     static int shifted[REG_EDGES], slides[REG_EDGES];
     int any_shifted = 0;
     if (!r->p.use_colour)
         return 0;
     reg_prepare_landing(r);
     for (uint32_t e = 0; e < r->edges; e++) {
-        int along;
-        slides[e] = edge_slides(r, e, dir[e], &along);
-        shifted[e] = slides[e] && pair_shifted(r, e, along ? dir[e] : NULL, &misfit[e], at[e]);
+        shifted[e] = slid_in_paint(r, e, &slides[e], &misfit[e], at[e]);
         any_shifted |= shifted[e];
     }
     if (!any_shifted)
         return 0;
     for (uint32_t e = 0; e < r->edges; e++) /* the partner may hold every slide */
-        if (!slides[e])
+        if (slides[e] == SLIDE_NONE)
             shifted[e] = pair_shifted(r, e, NULL, &misfit[e], at[e]);
     for (uint32_t e = 0; e < r->edges; e++)
         for (uint32_t f = e + 1; f < r->edges; f++) {
-            if ((slides[e] || slides[f]) && shifted[e] && shifted[f] && slip_pairs(r, e, f) &&
+            int slide = slides[e] != SLIDE_NONE || slides[f] != SLIDE_NONE;
+            if (slide && shifted[e] && shifted[f] && slip_pairs(r, e, f) &&
                 hypot(at[e][0] + at[f][0], at[e][1] + at[f][1]) <= REG_SHIFT_AGREE_MM) {
                 note_break(r, rep, e, 0, misfit[e]);
                 note_break(r, rep, f, 1, misfit[f]);
@@ -317,7 +327,7 @@ int reg_find_quiet_breaks(struct reg_ctx *r, struct reg_report *rep)
  * break, the other is the pair that shares no surface, if one alone does, or else the pair whose
  * paint misses most, when it misses REG_OTHER_BREAK_RATIO times the ring's median pair or more,
  * or else the one pair whose shape lets it slide (edge_slides) and whose paint lines up elsewhere
- * (pair_shifted). Measured (2026-12-05, data/objects slipped 6 mm in 6 views, every default):
+ * (slid_in_paint). Measured (2026-12-05, data/objects slipped 6 mm in 6 views, every default):
  * the L-bracket's pair across the slip shared no surface; the stepped block's missed 0.148
  * against a median 0.069 (2.1x), the box's 0.284 against 0.072 (3.9x); unseen, the three were
  * refused although 12 views of each were placed. The thin box slipped 6 mm along its length at
@@ -345,10 +355,9 @@ static int other_break(struct reg_ctx *r, uint32_t closing)
     /* else the one pair whose shape lets it slide and whose paint lines up elsewhere */
     int shifted = -1, count = 0;
     for (uint32_t e = 0; e < r->edges; e++) {
-        double dir[2], at[2], m;
-        int along;
-        if (e != closing && edge_slides(r, e, dir, &along) &&
-            pair_shifted(r, e, along ? dir : NULL, &m, at))
+        double at[2], m;
+        int slides;
+        if (e != closing && slid_in_paint(r, e, &slides, &m, at))
             shifted = (int)e, count++;
     }
     return count == 1 ? shifted : -1;

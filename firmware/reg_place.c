@@ -251,7 +251,7 @@ static void hues_along(struct lsq_rigid *eq, const struct lsq_rigid *hues, const
         for (int r = 0; r < 6; r++)
             eq->b[r] += b_i * basis[i][r]; /* b += (s_i . b_h) s_i */
         for (int j = 0; j < count; j++) {
-            if (j != i && !(turn && (i == count - 1 || j == count - 1)))
+            if (j != i && basis[i][2] == 0.0 && basis[j][2] == 0.0)
                 continue; /* two shift axes: each on its own */
             double h_ij = 0.0;
             for (int r = 0; r < 6; r++)
