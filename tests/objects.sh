@@ -189,12 +189,20 @@ check box_slipped_along_its_faces_is_placed_by_its_paint slip_painted_test
 # shape leaves (on every motion they turned the views 0.3 degrees): 0.064 mm. The hues of every
 # second cell only (every second column of the image) placed them 0.1 mm off along the faces;
 # with every cell's, 0.055: within the 1.2 times the unmoved box.
-part_pushed() { # name, part of data/objects, its height (mm), [views6], [mm]: painted, 8 (6) views, pushed 30 (mm) mm
+part_config() { # name, part of data/objects, its height (mm), [views6], [mm]: into $out/NAME.ini
     slip_config patches "${5:-30}"
     sed -e "s|^object = .*|object = mesh\nmesh_file = $PWD/data/objects/$2.ply|" \
         -e "s/^object_height_mm = .*/object_height_mm = $3/" "$out/slip-patches.ini" >"$out/$1.ini"
     [ "${4:-}" != views6 ] || sed -i 's/^views = .*/views = 6/' "$out/$1.ini"
-    scan_ini "$1"
+}
+part_pushed() { # name, part of data/objects, its height (mm), [views6], [mm]: painted, 8 (6) views, pushed 30 (mm) mm
+    part_config "$@" && scan_ini "$1"
+}
+# KEY of scan NAME's view VIEW's registration.ini, printed as "KEY = value" too: the value
+reg_value() {
+    v=$(sed -n "s/^$3 = //p" "$out/$1/view_$2/registration.ini")
+    echo "$3 = $v" >&2
+    echo "$v"
 }
 # a part pushed (part_pushed's name, part, height, views6 or "", mm), placed: its log says $6
 # and the model is less than $7 mm from the truth; $8 says what it is
@@ -307,8 +315,7 @@ thin_slip_eight_test() {
     placed_within thin-slip8 thin_box 15 "" 6 \
         "moved on the table at view 4: 4 views placed by the object's shape and colour" 0.08 \
         "thin box, 8 views, 6 mm slip at view 4" || return 1
-    turned=$(sed -n 's/^moved_deg = //p' "$out/thin-slip8/view_005/registration.ini")
-    echo "moved_deg = $turned"
+    turned=$(reg_value thin-slip8 005 moved_deg)
     awk -v t="$turned" 'BEGIN { exit !(t != "" && t < 0.2) }'
 }
 check thin_box_slipped_along_its_length_keeps_its_turn_by_its_paint thin_slip_eight_test
@@ -317,10 +324,8 @@ check thin_box_slipped_along_its_length_keeps_its_turn_by_its_paint thin_slip_ei
 # under what picks it, and the scan was refused. Its paint lines up 6 mm away, and no other
 # pair's does: placed (0.062 mm from the truth).
 thin_slip_seven_test() {
-    slip_config patches 6
-    sed -e "s|^object = .*|object = mesh\nmesh_file = $PWD/data/objects/thin_box.ply|" \
-        -e "s/^object_height_mm = .*/object_height_mm = 15/" -e "s/^views = .*/views = 7/" \
-        -e "s/^slip_at_deg = .*/slip_at_deg = 100/" "$out/slip-patches.ini" >"$out/thin-slip7.ini"
+    part_config thin-slip7 thin_box 15 "" 6
+    sed -i -e "s/^views = .*/views = 7/" -e "s/^slip_at_deg = .*/slip_at_deg = 100/" "$out/thin-slip7.ini"
     scan_ini thin-slip7 || return 1
     placed_check thin-slip7 "moved on the table at view 2: 5 views placed by the object's shape and colour" \
         0.08 "thin box, 7 views, 6 mm slip at 100 degrees"
@@ -370,8 +375,7 @@ steps_six_test() {
     placed_within steps-six stepped_block 60 views6 30 \
         "moved on the table at view 3: 3 views placed by the object's shape and colour" \
         0.09 "stepped block, 6 views, 30 mm push at view 3" || return 1
-    moved=$(sed -n 's/^moved_mm = //p' "$out/steps-six/view_003/registration.ini")
-    echo "moved_mm = $moved"
+    moved=$(reg_value steps-six 003 moved_mm)
     awk -v m="$moved" 'BEGIN { exit !(m != "" && m > 29.9 && m < 30.1) }'
 }
 check stepped_block_pushed_in_six_views_is_placed_by_its_paint steps_six_test
