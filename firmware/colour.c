@@ -73,8 +73,24 @@ struct frame_ctx {
     const uint8_t *const *frames;
     double ca_channel[COLOUR_MAX_FRAMES][3];
     double ca_slope[COLOUR_MAX_FRAMES][3];
-    const uint8_t *albedo; /* the first pass's albedo bytes (ca = albedo) */
+    /* each dark frame's Ca for every albedo byte, ca_channel + ca_slope x byte / 255 (a pixel's
+     * three lights read it up to 24 times: a table lookup, not a division, each time) */
+    double ca_of_albedo[COLOUR_MAX_FRAMES][3][256];
+    double gain[COLOUR_MAX_FRAMES]; /* the camera's exposure over the frame's */
+    const uint8_t *albedo;          /* the first pass's albedo bytes (ca = albedo) */
 };
+
+/* The tables of @p f from its Ca and the layout's exposures (again whenever the Ca changes);
+ * every slot, as frame_light would have computed it for any frame it is asked for. */
+static void frame_tables(struct frame_ctx *f)
+{
+    for (uint32_t k = 0; k < COLOUR_MAX_FRAMES; k++) {
+        f->gain[k] = (double)f->prm->exposure_us / f->lay->exposure_us[k];
+        for (int c = 0; c < 3 && f->lay->dark_of[k] == k; c++)
+            for (int a = 0; a < 256; a++)
+                f->ca_of_albedo[k][c][a] = f->ca_channel[k][c] + f->ca_slope[k][c] * a / 255.0;
+    }
+}
 
 /* A channel of RGB pixel @p px at or above the saturation level. */
 static int clipped(const struct colour_params *prm, const uint8_t *px)
@@ -86,33 +102,44 @@ static int clipped(const struct colour_params *prm, const uint8_t *px)
 /* Frame k's light at pixel i (@p px) with its Ca taken off, in grey levels at the camera's
  * exposure, so that one white reference serves every exposure. @retval 0 when a channel is
  * saturated (@p out is filled all the same), 1 otherwise */
-static int frame_light(const struct frame_ctx *f, uint32_t k, const uint8_t *px, size_t i,
-                       double out[3])
+static inline int frame_light(const struct frame_ctx *f, uint32_t k, const uint8_t *px, size_t i,
+                              double out[3])
 {
     uint32_t d = f->lay->dark_of[k];
-    double gain = (double)f->prm->exposure_us / f->lay->exposure_us[k];
+    double gain = f->gain[k];
     for (int c = 0; c < 3; c++) {
         size_t at = 3 * i + (size_t)c;
-        double ca = f->prm->ca == COLOUR_CA_PIXEL
-                        ? f->frames[d][at]
-                        : f->ca_channel[d][c] + f->ca_slope[d][c] * f->albedo[at] / 255.0;
+        double ca =
+            f->prm->ca == COLOUR_CA_PIXEL ? f->frames[d][at] : f->ca_of_albedo[d][c][f->albedo[at]];
         out[c] = (px[c] - ca) * gain;
     }
     return !clipped(f->prm, px);
 }
 
-/* cos(theta) of a source at @p src for surface point p with normal n, and the falloff factor. */
-static double incidence(const struct colour_params *prm, vec3 p, vec3 n, vec3 src, double *fall)
+/* A source as surface point @p p sees it: the unit vector toward it and its distance. */
+struct toward {
+    vec3 dir;
+    double dist_mm;
+};
+
+static struct toward toward(vec3 p, vec3 src)
 {
     vec3 to = v3_sub(src, p);
     double d = v3_len(to);
+    return (struct toward){v3_scale(to, 1.0 / d), d};
+}
+
+/* cos(theta) of a source in direction @p s for a surface of normal n, and the falloff factor. */
+static double incidence(const struct colour_params *prm, vec3 n, struct toward s, double *fall)
+{
+    double d = s.dist_mm;
     *fall = prm->falloff ? (d / prm->reference_mm) * (d / prm->reference_mm) : 1.0;
-    return v3_dot(n, v3_scale(to, 1.0 / d));
+    return v3_dot(n, s.dir);
 }
 
 /* @p x to the power @p e: by repeated squaring for a whole @p e up to 64 (the exponents of eq. 6
  * as people set them, 10 and 4 by default; pow() cost 5% of a re-processing's CPU), else pow. */
-static double power(double x, double e)
+static inline double power(double x, double e)
 {
     if (!(e >= 0.0 && e <= 64.0 && e == (double)(int)e))
         return pow(x, e);
@@ -123,12 +150,17 @@ static double power(double x, double e)
     return r;
 }
 
-/* How far a source's mirror reflection at p (normal n) is from the camera, as the weight of
- * Jost et al., eq. 6: (1 - cos^ke alpha)^ko; 0 in the middle of a highlight, 1 away from it. */
-static double specular_weight(const struct colour_params *prm, vec3 p, vec3 n, vec3 src)
+/* The unit vector from surface point @p p to the camera (at the origin). */
+static vec3 view_of(vec3 p)
 {
-    vec3 view = v3_norm(v3_scale(p, -1.0)); /* the camera is the origin */
-    vec3 s = v3_norm(v3_sub(src, p));
+    return v3_norm(v3_scale(p, -1.0));
+}
+
+/* How far the mirror reflection of a source in direction @p s at a surface of normal n is from
+ * the camera (direction @p view), as the weight of Jost et al., eq. 6: (1 - cos^ke alpha)^ko;
+ * 0 in the middle of a highlight, 1 away from it. */
+static double specular_weight(const struct colour_params *prm, vec3 n, vec3 view, vec3 s)
+{
     vec3 refl = v3_sub(v3_scale(n, 2.0 * v3_dot(s, n)), s);
     double cos_a = v3_dot(refl, view);
     return power(1.0 - power(cos_a > 0.0 ? cos_a : 0.0, prm->ke), prm->ko);
@@ -159,7 +191,7 @@ struct light_signals {
 };
 
 static void light_signals(const struct frame_ctx *f, const struct scan_calib *c, size_t i, vec3 p,
-                          vec3 nn, int relaxed, struct light_signals *out)
+                          vec3 nn, vec3 view, int relaxed, struct light_signals *out)
 {
     const struct colour_params *prm = f->prm;
     const double min_cos = relaxed ? 0.02 : prm->min_cos;
@@ -169,7 +201,8 @@ static void light_signals(const struct frame_ctx *f, const struct scan_calib *c,
         uint32_t k = COLOUR_FRAME_LIGHT0 + l, kl = f->lay->long_of[k];
         if (kl != 0 && !clipped(prm, &f->frames[kl][3 * i]))
             k = kl;
-        double fall, ct = incidence(prm, p, nn, v3_from(c->light_pos_mm[l]), &fall);
+        struct toward s = toward(p, v3_from(c->light_pos_mm[l]));
+        double fall, ct = incidence(prm, nn, s, &fall);
         double *lit = out->lit[l];
         int ok = frame_light(f, k, &f->frames[k][3 * i], i, lit);
         /* the signal in grey levels of the frame it was read in: below shadow_dn it is noise */
@@ -177,7 +210,7 @@ static void light_signals(const struct frame_ctx *f, const struct scan_calib *c,
         est[l] = -1.0;
         if ((!ok && !relaxed) || ct < min_cos || raw <= prm->shadow_dn)
             continue;
-        out->weight[l] = specular_weight(prm, p, nn, v3_from(c->light_pos_mm[l]));
+        out->weight[l] = specular_weight(prm, nn, view, s.dir);
         /* a brighter light gives more signal for the same albedo: its gain takes that out */
         double gain = c->light_gain[l] > 0.0 ? c->light_gain[l] : 1.0;
         for (int ch = 0; ch < 3; ch++)
@@ -223,8 +256,8 @@ static double half_angle(vec3 p, vec3 n, vec3 view, const double light_pos[3])
  * how much the fusion may trust it (@p confidence, 0..; not clamped). @p relaxed: the best
  * effort for a pixel without a reliable estimate (grazing or saturated light still used). */
 static double pixel_estimate(const struct frame_ctx *f, const struct scan_calib *c, vec3 proj,
-                             const uint8_t *white, size_t i, vec3 p, vec3 nn, int relaxed,
-                             double num[3], double *confidence)
+                             const uint8_t *white, size_t i, vec3 p, vec3 nn, vec3 view,
+                             int relaxed, double num[3], double *confidence)
 {
     const struct colour_params *prm = f->prm;
     const double min_cos = relaxed ? 0.02 : prm->min_cos;
@@ -232,13 +265,14 @@ static double pixel_estimate(const struct frame_ctx *f, const struct scan_calib 
     num[0] = num[1] = num[2] = 0.0;
     *confidence = 0.0;
     if (prm->method == COLOUR_SINGLE) { /* eq. 4 */
-        double fall, ct = incidence(prm, p, nn, proj, &fall);
+        struct toward s = toward(p, proj);
+        double fall, ct = incidence(prm, nn, s, &fall);
         int ok = frame_light(f, COLOUR_FRAME_DARK, &white[3 * i], i, light);
         if (ct < min_cos || (!ok && !relaxed))
             return 0.0;
         for (int k = 0; k < 3; k++)
             num[k] = light[k] * fall;
-        *confidence = ct * specular_weight(prm, p, nn, proj);
+        *confidence = ct * specular_weight(prm, nn, view, s.dir);
         return ct;
     }
     if (prm->method == COLOUR_UNIFORM) { /* method 2 */
@@ -249,14 +283,14 @@ static double pixel_estimate(const struct frame_ctx *f, const struct scan_calib 
         *confidence = 1.0;
         for (uint32_t l = 0; l < c->light_count; l++) {
             vec3 src = v3_from(c->light_pos_mm[l]);
-            double w = specular_weight(prm, p, nn, src);
+            double w = specular_weight(prm, nn, view, toward(p, src).dir);
             if (v3_dot(nn, v3_sub(src, p)) > 0.0 && w < *confidence)
                 *confidence = w;
         }
         return (ok && lit) || relaxed ? 1.0 : 0.0;
     }
     struct light_signals ls;
-    light_signals(f, c, i, p, nn, relaxed, &ls);
+    light_signals(f, c, i, p, nn, view, relaxed, &ls);
     den = multi_sum(&ls, c->light_count, num);
     *confidence = den;
     return den;
@@ -299,7 +333,7 @@ static void add_sample(struct reflect_pool *pool, const struct colour_params *pr
 {
     struct reflect_obs o;
     memset(&o, 0, sizeof(o));
-    vec3 view = v3_norm(v3_scale(p, -1.0)); /* the camera is the origin */
+    vec3 view = view_of(p);
     o.cos_r = (float)v3_dot(nn, view);
     o.lights = ls->used;
     for (int ch = 0; ch < 3; ch++)
@@ -326,9 +360,10 @@ static void fit_pixel(const struct frame_ctx *f, const struct scan_calib *c, str
     const struct colour_params *prm = f->prm;
     struct light_signals ls;
     int relaxed = 0;
-    light_signals(f, c, i, p, nn, 0, &ls);
+    vec3 view = view_of(p);
+    light_signals(f, c, i, p, nn, view, 0, &ls);
     if (ls.used == 0) { /* a best effort, weighing nothing (as multi) */
-        light_signals(f, c, i, p, nn, 1, &ls);
+        light_signals(f, c, i, p, nn, view, 1, &ls);
         relaxed = 1;
     }
     double num[3], rho0[3], den = multi_sum(&ls, c->light_count, num);
@@ -348,7 +383,7 @@ static void fit_pixel(const struct frame_ctx *f, const struct scan_calib *c, str
         return;
     }
     const struct reflect_cluster *cl = &fs->model->cluster[reflect_cluster_of(fs->model, rho0)];
-    vec3 view = v3_norm(v3_scale(p, -1.0)), ln = lobe_normal(m, r, i);
+    vec3 ln = lobe_normal(m, r, i);
     double cos_r = v3_dot(ln, view), sp[HAL_MAX_LIGHTS][3], rho[3];
     for (uint32_t l = 0; l < c->light_count; l++)
         reflect_specular(cl, half_angle(p, ln, view, c->light_pos_mm[l]), cos_r, sp[l]);
@@ -383,8 +418,8 @@ static void fit_pixel(const struct frame_ctx *f, const struct scan_calib *c, str
         *confidence *= (float)(share_sum / share_den);
 }
 
-/* One pass over the pixels with the Ca of @p f: albedo and confidence of every valid pixel. */
-/* One pass over the pixels of a view, or part of them (pixels i0 .. i1 - 1). */
+/* One pass over the pixels of a view with the Ca of @p f, or part of them (pixels i0 .. i1 - 1):
+ * albedo and confidence of every valid pixel. */
 struct pass {
     const struct frame_ctx *f;
     const struct scan_calib *c;
@@ -397,6 +432,7 @@ struct pass {
     vec3 proj;
     size_t pixels;
     unsigned parts;
+    int again; /* the second pass (ca = albedo): a pixel without depth keeps what the first gave */
 };
 
 static void pass_pixels(struct pass *ps, size_t i0, size_t i1)
@@ -411,6 +447,8 @@ static void pass_pixels(struct pass *ps, size_t i0, size_t i1)
     float *confidence = ps->confidence;
     for (size_t i = i0; i < i1; i++) {
         if (prm->method == COLOUR_NONE || m->reason[i] != SCAN_VALID) {
+            if (ps->again)
+                continue;
             memcpy(&albedo[3 * i], &white[3 * i], 3); /* the raw colour */
             /* trusted where valid, but not where the white frame clipped (a highlight now has
              * depth, its colour is blown out): other views colour it if they can */
@@ -428,11 +466,13 @@ static void pass_pixels(struct pass *ps, size_t i0, size_t i1)
             fit_pixel(f, c, &ps->fs, m, r, i, p, nn, &albedo[3 * i], &confidence[i]);
             continue;
         }
-        double num[3], trust, den = pixel_estimate(f, c, ps->proj, white, i, p, nn, 0, num, &trust);
+        vec3 view = view_of(p);
+        double num[3], trust;
+        double den = pixel_estimate(f, c, ps->proj, white, i, p, nn, view, 0, num, &trust);
         float conf = (float)(trust > 1.0 ? 1.0 : trust);
         if (den <= 1e-6) { /* no reliable estimate: a best effort that weighs nothing in the
                               fusion unless no view has better (raw colour is not an albedo) */
-            den = pixel_estimate(f, c, ps->proj, white, i, p, nn, 1, num, &trust);
+            den = pixel_estimate(f, c, ps->proj, white, i, p, nn, view, 1, num, &trust);
             conf = 0.0f;
         }
         if (den <= 1e-6) { /* no estimate at all: no colour, rather than the raw one (which
@@ -458,7 +498,7 @@ static void pass_part(void *arg, unsigned k)
 static void compute_pass(const struct frame_ctx *f, const struct hal_thread *threads,
                          const struct scan_calib *c, const struct decode_maps *m,
                          const struct tri_range *r, const uint8_t *white, uint8_t *albedo,
-                         float *confidence, struct reflect_pool *pool, int last)
+                         float *confidence, struct reflect_pool *pool, int again, int last)
 {
     struct pass ps = {.f = f,
                       .c = c,
@@ -472,7 +512,8 @@ static void compute_pass(const struct frame_ctx *f, const struct hal_thread *thr
                              pool != NULL ? reflect_stride(pool, r->valid_count) : UINT32_MAX, 0},
                       .proj = v3_scale(m3_tmul(c->proj_rot, v3_from(c->proj_trans_mm)), -1.0),
                       .pixels = (size_t)m->width * m->height,
-                      .parts = hal_thread_parts(threads, 64)};
+                      .parts = hal_thread_parts(threads, 64),
+                      .again = again};
     if (f->prm->method == COLOUR_FIT) { /* its samples are kept in pixel order: one thread */
         pass_pixels(&ps, 0, ps.pixels);
         return;
@@ -487,21 +528,24 @@ static void fit_ambient(struct frame_ctx *f, const struct decode_maps *m, const 
                         const float *confidence, uint32_t k)
 {
     size_t n = (size_t)m->width * m->height;
-    for (int c = 0; c < 3; c++) {
-        double s1 = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
-        for (size_t i = 0; i < n; i++) {
-            if (m->reason[i] != SCAN_VALID || confidence[i] <= 0.0f)
-                continue;
+    double s1 = 0, sx[3] = {0, 0, 0}, sy[3] = {0, 0, 0}, sxx[3] = {0, 0, 0}, sxy[3] = {0, 0, 0};
+    for (size_t i = 0; i < n; i++) {
+        if (m->reason[i] != SCAN_VALID || confidence[i] <= 0.0f)
+            continue;
+        s1 += 1.0;
+        for (int c = 0; c < 3; c++) {
             double x = albedo[3 * i + (size_t)c] / 255.0, y = f->frames[k][3 * i + (size_t)c];
-            s1 += 1.0, sx += x, sy += y, sxx += x * x, sxy += x * y;
+            sx[c] += x, sy[c] += y, sxx[c] += x * x, sxy[c] += x * y;
         }
-        double det = s1 * sxx - sx * sx;
+    }
+    for (int c = 0; c < 3; c++) {
+        double det = s1 * sxx[c] - sx[c] * sx[c];
         if (s1 < 100.0 || det <= 1e-9 * s1 * s1)
             continue; /* too few, or one albedo only: the mean stands */
-        double slope = (s1 * sxy - sx * sy) / det;
+        double slope = (s1 * sxy[c] - sx[c] * sy[c]) / det;
         slope = slope > 0.0 ? slope : 0.0; /* light is never taken away */
         f->ca_slope[k][c] = slope;
-        f->ca_channel[k][c] = (sy - slope * sx) / s1;
+        f->ca_channel[k][c] = (sy[c] - slope * sx[c]) / s1;
     }
 }
 
@@ -526,13 +570,15 @@ int colour_compute(const struct colour_params *prm, const struct hal_thread *thr
         if (lights[k] != NULL && lay.dark_of[k] == k)
             channel_offset(m, lights[k], f.ca_channel[k]);
     }
+    frame_tables(&f);
     int two = prm->method != COLOUR_NONE && prm->ca == COLOUR_CA_ALBEDO;
-    compute_pass(&f, threads, c, m, r, white, albedo, confidence, pool, !two);
+    compute_pass(&f, threads, c, m, r, white, albedo, confidence, pool, 0, !two);
     if (!two)
         return 0;
     for (uint32_t k = 0; k < lay.count; k++)
         if (lights[k] != NULL && lay.dark_of[k] == k)
             fit_ambient(&f, m, albedo, confidence, k);
-    compute_pass(&f, threads, c, m, r, white, albedo, confidence, pool, 1);
+    frame_tables(&f);
+    compute_pass(&f, threads, c, m, r, white, albedo, confidence, pool, 1, 1);
     return 0;
 }

@@ -4,14 +4,6 @@
 #include <errno.h>
 #include <math.h>
 
-int lens_is_pinhole(const double d[LENS_COEFFS])
-{
-    for (int i = 0; i < LENS_COEFFS; i++)
-        if (d[i] != 0.0)
-            return 0;
-    return 1;
-}
-
 void lens_distort(const double d[LENS_COEFFS], double x, double y, double *xd, double *yd)
 {
     double r2 = x * x + y * y;

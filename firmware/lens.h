@@ -6,8 +6,14 @@
 /** Index of each coefficient in a distortion array of LENS_COEFFS doubles. */
 enum { LENS_K1 = 0, LENS_K2, LENS_P1, LENS_P2, LENS_K3, LENS_COEFFS };
 
-/** 1 if every coefficient is 0 (a pinhole: nothing to do). */
-int lens_is_pinhole(const double dist[LENS_COEFFS]);
+/** 1 if every coefficient is 0 (a pinhole: nothing to do). Inline: asked once a pixel. */
+static inline int lens_is_pinhole(const double dist[LENS_COEFFS])
+{
+    for (int i = 0; i < LENS_COEFFS; i++)
+        if (dist[i] != 0.0)
+            return 0;
+    return 1;
+}
 
 /** Distort normalised image coordinates (x = X/Z, y = Y/Z):
  *  r2 = x^2 + y^2, radial = 1 + k1 r2 + k2 r2^2 + k3 r2^3,
