@@ -321,6 +321,8 @@ static int recolour_from_frames(struct job *j, const char *scan_dir, uint32_t v,
     int rc = scan_begin_view(j->scan, p, j->calib);
     for (uint32_t f = count; rc == 0 && f <= count + lights; f++) {
         uint32_t frame = f < count + lights ? f : white; /* the lights, then the white colour */
+        if (f < count + lights && !scan_needs_light_frame(p, j->calib, f - count))
+            continue; /* taken for another method */
         uint8_t *pixels;
         rc = job_read_into_buffer(j->scan, scan_dir, v, frame, 3, p, &pixels, err, sizeof(err));
         if (rc == 0 && f < count + lights)

@@ -130,6 +130,8 @@ int scan_job_feed_view(struct scan_ctx *s, const char *scan_dir, uint32_t v,
     uint32_t channels;
     int rc = scan_begin_view(s, params, calib);
     for (uint32_t f = 0; rc == 0 && (channels = scan_frame_channels(params, calib, f)) != 0; f++) {
+        if (f >= count && f < count + lights && !scan_needs_light_frame(params, calib, f - count))
+            continue; /* taken for another method: not read back */
         uint8_t *pixels;
         rc = job_read_into_buffer(s, scan_dir, v, f, channels, params, &pixels, err, err_len);
         if (rc == 0)

@@ -48,6 +48,25 @@ void colour_layout(const struct colour_params *p, uint32_t light_count, struct c
         out->dark_of[k] = dark_at(out, out->exposure_us[k]);
 }
 
+int colour_needs_frame(const struct colour_params *p, const struct colour_layout *l, uint32_t k)
+{
+    if (k >= l->count)
+        return 0;
+    switch (p->method) {
+    case COLOUR_NONE:
+        return 0;
+    case COLOUR_SINGLE: /* the projector's white (a pattern frame) less the dark frame */
+        return k == COLOUR_FRAME_DARK;
+    case COLOUR_UNIFORM:
+        return k == COLOUR_FRAME_ALL || k == l->dark_of[COLOUR_FRAME_ALL];
+    default: /* multi, fit */
+        for (uint32_t m = COLOUR_FRAME_LIGHT0; m < l->count; m++)
+            if (l->lights_mask[m] != 0 && (m == k || l->dark_of[m] == k))
+                return 1;
+        return 0;
+    }
+}
+
 /* Ca per channel: the mean of a dark frame over the pixels that have depth (the object), so
  * that ambient light on the object counts and the background does not. */
 static void channel_offset(const struct decode_maps *m, const uint8_t *dark, double ca[3])
@@ -563,9 +582,7 @@ int colour_compute(const struct colour_params *prm, const struct hal_thread *thr
     f.frames = lights;
     f.albedo = albedo;
     for (uint32_t k = 0; k < lay.count; k++) {
-        if (lights[k] == NULL &&
-            (prm->method >= COLOUR_MULTI || k == COLOUR_FRAME_DARK || lay.dark_of[k] == k ||
-             (prm->method == COLOUR_UNIFORM && k == COLOUR_FRAME_ALL)))
+        if (lights[k] == NULL && colour_needs_frame(prm, &lay, k))
             return -EINVAL;
         if (lights[k] != NULL && lay.dark_of[k] == k)
             channel_offset(m, lights[k], f.ca_channel[k]);

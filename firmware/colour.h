@@ -39,6 +39,12 @@ struct colour_layout {
 /** The colour frames of @p p with @p light_count lights (none when the method is none). */
 void colour_layout(const struct colour_params *p, uint32_t light_count, struct colour_layout *out);
 
+/** Whether method @p p reads colour frame @p k of layout @p l (single: the dark frame; uniform:
+ *  the all-lights frame and its dark; multi and fit: each light alone, its longer frame and
+ *  their dark frames; none: no frame). A scan takes them all, so that one scan serves every
+ *  method; the others need not be read back. @retval 1 needed @retval 0 not */
+int colour_needs_frame(const struct colour_params *p, const struct colour_layout *l, uint32_t k);
+
 /** Confidence of a pixel with no colour estimate at all (every light shadowed or too dark for
  *  its frames): its colour is 0 and the fusion leaves it out. */
 #define COLOUR_NO_ESTIMATE (-1.0f)

@@ -224,6 +224,13 @@ uint32_t scan_light_frame_count(const struct scan_params *p, const struct scan_c
     return lay.count;
 }
 
+int scan_needs_light_frame(const struct scan_params *p, const struct scan_calib *c, uint32_t k)
+{
+    struct colour_layout lay;
+    colour_layout(&p->colour, c->light_count, &lay);
+    return colour_needs_frame(&p->colour, &lay, k);
+}
+
 int scan_feed_light_frame(struct scan_ctx *s, uint32_t k, const uint8_t *rgb)
 {
     if (k >= COLOUR_MAX_FRAMES)

@@ -198,6 +198,10 @@ int scan_feed_white_colour(struct scan_ctx *s, const uint8_t *rgb);
 
 /** Colour frames a view takes after its patterns (0 when [colour] method = none). */
 uint32_t scan_light_frame_count(const struct scan_params *params, const struct scan_calib *calib);
+/** Whether [colour] method reads colour frame @p k (colour_needs_frame): offline, a frame it
+ *  does not read is not read back either. @retval 1 @retval 0 */
+int scan_needs_light_frame(const struct scan_params *params, const struct scan_calib *calib,
+                           uint32_t k);
 /** Offline: hand over colour frame @p k (colour.h numbering), RGB24. @retval 0 or -EINVAL */
 int scan_feed_light_frame(struct scan_ctx *s, uint32_t k, const uint8_t *rgb);
 

@@ -411,6 +411,15 @@ rm -rf "$out/inplace"
 cp -r "$out/scan" "$out/broken" 2>/dev/null; rm -f "$out/broken/view_000/frame_07.pgm.zst"
 check process_names_missing_frame sh -c "$bin process $out/broken --out $out/broken_out 2>&1 | \
     grep -q 'view_000/frame_07: no such frame'; test \$? -eq 0"
+# The all-lights frame is uniform's: multi reads it neither live nor back from the disk (a scan
+# takes every colour frame so that it serves every method), so without it the model is the
+# same; uniform, which reads it, names it (issue 33: a frame read back is CPU)
+rm -rf "$out/noall" && cp -r "$out/scan" "$out/noall" && rm -f "$out"/noall/view_*/frame_23.ppm.zst
+sed 's/^method = multi/method = uniform/' "$out/noall/config.ini" > "$out/uniform.ini"
+check process_reads_the_frames_its_method_needs sh -c "$bin process $out/noall >/dev/null 2>&1 &&
+    cmp $out/scan/mesh.ply $out/noall/mesh.ply && cmp $out/scan/texture.png $out/noall/texture.png &&
+    $bin process $out/noall --config $out/uniform.ini 2>&1 | grep -q 'view_000/frame_23: no such frame'"
+rm -rf "$out/noall"
 # A stop signal mid-scan (Ctrl-C, systemd's SIGTERM, a dropped ssh session's SIGHUP, Ctrl-\,
 # Ctrl-Z): the scan stops between frames, says so, and the rig ends in its safe state; the
 # process neither dies lit nor freezes lit.

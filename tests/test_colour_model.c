@@ -9,6 +9,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -185,6 +186,55 @@ static void test_cast_shadow_left_out(void **state)
     assert_true(without < paint[SHADOWED] - 0.05);
 }
 
+/* Which colour frames each method reads (a scan takes them all; scanner process reads back only
+ * these): with a bracket and the all-lights and single-light frames at their own exposures, so
+ * that each of them has a dark frame of its own. A frame a method reads, missing, is refused; one
+ * it does not read may be missing and changes nothing. */
+static void test_each_method_reads_its_frames(void **state)
+{
+    (void)state;
+    s.prm.bracket = 4;
+    s.prm.all_lights_exposure_us = EXPOSURE_US / 2;
+    s.prm.light_exposure_us = EXPOSURE_US * 2;
+    colour_layout(&s.prm, s.calib.light_count, &s.lay);
+    const struct colour_layout *l = &s.lay;
+    /* dark, all, 4 lights, 4 bracketed, then the darks at 5, 20 and 80 ms */
+    assert_int_equal(l->count, 13);
+    const uint32_t all_dark = l->dark_of[COLOUR_FRAME_ALL];
+    const uint32_t light_dark = l->dark_of[COLOUR_FRAME_LIGHT0];
+    const uint32_t long_dark = l->dark_of[l->long_of[COLOUR_FRAME_LIGHT0]];
+    assert_true(all_dark != COLOUR_FRAME_DARK && light_dark != all_dark && long_dark != light_dark);
+    for (uint32_t k = 0; k < l->count; k++) {
+        int light = k >= COLOUR_FRAME_LIGHT0 && l->lights_mask[k] != 0;
+        struct colour_params p = s.prm;
+        p.method = COLOUR_NONE;
+        assert_int_equal(colour_needs_frame(&p, l, k), 0);
+        p.method = COLOUR_SINGLE;
+        assert_int_equal(colour_needs_frame(&p, l, k), k == COLOUR_FRAME_DARK);
+        p.method = COLOUR_UNIFORM;
+        assert_int_equal(colour_needs_frame(&p, l, k), k == COLOUR_FRAME_ALL || k == all_dark);
+        for (p.method = COLOUR_MULTI; p.method <= COLOUR_FIT; p.method++)
+            assert_int_equal(colour_needs_frame(&p, l, k),
+                             light || k == light_dark || k == long_dark);
+    }
+    assert_int_equal(colour_needs_frame(&s.prm, l, l->count), 0);
+
+    compute(); /* multi, every frame there */
+    uint8_t every[3 * WIDTH];
+    memcpy(every, s.out, sizeof(every));
+    struct decode_maps m = {NULL, NULL, s.reason, WIDTH, 1};
+    struct tri_range r = {s.xyz, s.normal, WIDTH, 1, WIDTH};
+    s.frame_ptr[COLOUR_FRAME_ALL] = s.frame_ptr[all_dark] = s.frame_ptr[COLOUR_FRAME_DARK] = NULL;
+    assert_int_equal(colour_compute(&s.prm, NULL, &s.calib, &m, &r, s.white, s.frame_ptr, s.out,
+                                    s.confidence, NULL),
+                     0);
+    assert_memory_equal(s.out, every, sizeof(every));
+    s.frame_ptr[long_dark] = NULL;
+    assert_int_equal(colour_compute(&s.prm, NULL, &s.calib, &m, &r, s.white, s.frame_ptr, s.out,
+                                    s.confidence, NULL),
+                     -EINVAL);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -192,6 +242,7 @@ int main(void)
         cmocka_unit_test_setup(test_bracket_reads_dark_paint, setup),
         cmocka_unit_test_setup(test_ca_follows_the_albedo, setup),
         cmocka_unit_test_setup(test_cast_shadow_left_out, setup),
+        cmocka_unit_test_setup(test_each_method_reads_its_frames, setup),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
