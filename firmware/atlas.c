@@ -345,12 +345,14 @@ static void raster(struct atlas *a, const struct fusion_volume *vol, uint32_t t,
         for (long tx = xa; tx < xb; tx++) {
             size_t texel = (size_t)ty * a->width + (size_t)tx;
             double l[3];
+            if (mode == CLAIM_NEAR && a->owner[texel] != NONE)
+                continue; /* taken (most of the box is, by the triangles' own texels) */
             barycentric(x, y, inv, tx + 0.5, ty + 0.5, l);
             if (mode == CLAIM_INSIDE) {
                 if (l[0] >= 0.0 && l[1] >= 0.0 && l[2] >= 0.0)
                     claim(a, texel, t, l);
-            } else if (a->owner[texel] == NONE && l[0] * height[0] >= -ATLAS_REACH &&
-                       l[1] * height[1] >= -ATLAS_REACH && l[2] * height[2] >= -ATLAS_REACH) {
+            } else if (l[0] * height[0] >= -ATLAS_REACH && l[1] * height[1] >= -ATLAS_REACH &&
+                       l[2] * height[2] >= -ATLAS_REACH) {
                 claim(a, texel, t, l);
             }
         }
