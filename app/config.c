@@ -98,6 +98,12 @@ static const struct ini_key config_keys[] = {
      "[camera] exposure_us), per pixel the longest whose white frame is not saturated; for "
      "objects with dark and shiny parts. Empty: [camera] exposure_us alone",
      NULL, NULL},
+    U32("scan", "auto_exposure", auto_exposure, 0, 1, "1",
+        "1: before the first view a white and a black frame show whether most of what the "
+        "projector lights is too dark to decode (white minus black under min_contrast_dn); if "
+        "so, and exposures_us is not in the file, every pattern is also taken at the exposure "
+        "that lifts it (HDR), said in the log and kept in the scan's config.ini. 0: the "
+        "exposure as set"),
     F64("scan", "start_angle_deg", start_angle_deg, -360, 360, "0", "turntable angle of view 0"),
     U32("scan", "min_contrast_dn", scan.min_contrast_dn, 1, 255, "10",
         "white minus black (grey levels) below this: too dark to decode, flagged 'dark'"),
@@ -762,6 +768,25 @@ void config_print_doc(FILE *out)
     fprintf(out, "\n## Calibration file (e.g. `config/sim-calib.ini`)\n\nAll geometry is in the "
                  "camera frame (x right, y down, z forward), in millimetres.\n");
     calib_print_doc(out);
+}
+
+int config_file_sets(const char *path, const char *key)
+{
+    FILE *f = file_open_regular(path, "r");
+    if (f == NULL)
+        return 0;
+    char line[512];
+    int found = 0;
+    size_t key_len = strlen(key);
+    for (unsigned n = 0; !found && n < 10000u && fgets(line, sizeof(line), f) != NULL; n++) {
+        const char *p = line + strspn(line, " \t");
+        if (strncmp(p, key, key_len) == 0) {
+            p += key_len;
+            found = p[strspn(p, " \t")] == '=';
+        }
+    }
+    fclose(f);
+    return found;
 }
 
 /* How a scan's views were taken: what its frames are and where the table stood. */

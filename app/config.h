@@ -37,7 +37,8 @@ struct app_config {
     uint32_t views;  /**< per pass */
     uint32_t passes; /**< 1, or 2: the object laid another way for a second turn */
     double start_angle_deg;
-    struct ini_list exposures_us;        /**< [scan] exposures_us as written (HDR patterns) */
+    struct ini_list exposures_us; /**< [scan] exposures_us as written (HDR patterns) */
+    uint32_t auto_exposure; /**< [scan]: 1: a dark object's patterns also at a longer exposure */
     char calibration_file[HAL_MAX_PATH]; /**< resolved against the config file's directory */
     char output_dir[HAL_MAX_PATH];
     char frame_format_name[8]; /**< [output] frame_format, as written */
@@ -84,6 +85,11 @@ void config_board(const struct app_config *cfg, struct board_config *out);
  *  @retval 0 the same @retval -EINVAL they differ */
 int config_plan_differs(const struct app_config *taken, const struct app_config *now, int capturing,
                         char *what, size_t what_len);
+
+/** Whether the file @p path sets @p key (a line "key = ...", in any section, empty or not): the
+ *  scan's own choices (the HDR exposures of [scan] auto_exposure) are made only where the file
+ *  says nothing. @retval 1 @retval 0 (also: unreadable) */
+int config_file_sets(const char *path, const char *key);
 
 /** Write the documentation of every key (Markdown) to @p out. */
 void config_print_doc(FILE *out);

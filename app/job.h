@@ -115,11 +115,25 @@ void job_warn(struct job *j, const char *fmt, ...) __attribute__((format(printf,
  *  EV_PROCESS_DONE) saying where the results are. */
 void job_finished(struct job *j, const char *what, const char *command, const char *event);
 
+/** Pixels too dark to decode that make a dark object, not a dark stripe of paint on a bright one
+ *  (job_say_if_dark). */
+#define JOB_DARK_PIXELS 1000u
+/** Most of what the projector lights too dark to decode: @p dark pixels (JOB_DARK_PIXELS or
+ *  more) outnumber the @p decoded ones. @retval 1 @retval 0 */
+int job_mostly_dark(uint32_t dark, uint32_t decoded);
+/** The exposure that lifts a white minus black of @p contrast_dn at @p now_us to twice
+ *  @p min_contrast_dn (whole milliseconds, at most 10 s). */
+uint32_t job_dark_exposure_us(uint32_t now_us, uint32_t min_contrast_dn, uint32_t contrast_dn);
+
 /** Warn once when view @p v's object was too dark to decode, and how to lift it (@p live: while
  * scanning; else processing a kept scan). */
 void job_say_if_dark(struct job *j, uint32_t v, const struct scan_view_info *info, int live);
 
 /* ---- job_live.c ---- */
+/** The lines a scan's config.ini gets after its file's own for what the scan chose itself: the
+ *  HDR exposures of [scan] auto_exposure where the file sets no exposures_us ("" when none).
+ *  @retval 0 @retval -EOVERFLOW @p len too small */
+int job_chosen_lines(const struct app_config *cfg, char *buf, size_t len);
 /** "N points at A deg -> DIR" of a view. */
 void job_describe(char *buf, size_t len, const struct scan_view_info *info, const char *dir);
 int job_start_storage(const struct job *j);

@@ -275,11 +275,22 @@ void job_finished(struct job *j, const char *what, const char *command, const ch
  * 0.04, every default, 0 to 98 points a view, 48,044 pixels too dark at a median contrast of 7.
  * Processing a kept scan says it too: from its frames with the exposure, from its range images
  * alone (no contrast kept) without. */
-#define JOB_DARK_PIXELS 1000u
+uint32_t job_dark_exposure_us(uint32_t now_us, uint32_t min_contrast_dn, uint32_t contrast_dn)
+{
+    /* twice the contrast the decoder needs, in whole milliseconds, at most [camera]'s bound */
+    double want = (double)now_us * 2.0 * min_contrast_dn / (contrast_dn > 0 ? contrast_dn : 1);
+    return (uint32_t)fmin(ceil(want / 1000.0) * 1000.0, 10000000.0);
+}
+
+int job_mostly_dark(uint32_t dark, uint32_t decoded)
+{
+    return dark >= JOB_DARK_PIXELS && dark > decoded;
+}
+
 void job_say_if_dark(struct job *j, uint32_t v, const struct scan_view_info *info, int live)
 {
     uint32_t dark = info->reason_count[SCAN_DARK], c = info->dark_contrast_dn;
-    if (j->said_dark || dark < JOB_DARK_PIXELS || dark <= info->valid_points || (live && c == 0))
+    if (j->said_dark || !job_mostly_dark(dark, info->valid_points) || (live && c == 0))
         return;
     j->said_dark = 1;
     const uint32_t now_us = j->cfg->camera.exposure_us, threshold = j->cfg->scan.min_contrast_dn;
@@ -291,8 +302,7 @@ void job_say_if_dark(struct job *j, uint32_t v, const struct scan_view_info *inf
                  (unsigned)v + 1, (unsigned)dark, (unsigned)info->valid_points, (unsigned)now_us);
         return;
     }
-    double want = (double)now_us * 2.0 * threshold / c;
-    uint32_t want_us = (uint32_t)fmin(ceil(want / 1000.0) * 1000.0, 10000000.0);
+    uint32_t want_us = job_dark_exposure_us(now_us, threshold, c);
     job_warn(j,
              "view %u: %u pixels lit but too dark to decode (white minus black %u grey levels, "
              "under [scan] min_contrast_dn = %u) against %u decoded: a dark object? %s "

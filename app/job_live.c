@@ -386,6 +386,100 @@ int job_home_and_take_views(struct job *j, uint32_t first)
     return rc != 0 ? rc : rc_last;
 }
 
+int job_chosen_lines(const struct app_config *cfg, char *buf, size_t len)
+{
+    buf[0] = '\0';
+    if (cfg->scan.exposure_count != 2 || config_file_sets(cfg->path, "exposures_us"))
+        return 0;
+    int n = snprintf(buf, len,
+                     "\n; [scan] auto_exposure: most of what the projector lit was too dark to "
+                     "decode at %u us,\n; so every pattern is also taken at %u us\n[scan]\n"
+                     "exposures_us = %u, %u\n",
+                     (unsigned)cfg->scan.exposures_us[0], (unsigned)cfg->scan.exposures_us[1],
+                     (unsigned)cfg->scan.exposures_us[0], (unsigned)cfg->scan.exposures_us[1]);
+    return n > 0 && (size_t)n < len ? 0 : -EOVERFLOW;
+}
+
+/* The exposure check (probe_dark): @p run's patterns at @p now_us and @p want_us. */
+static void take_hdr(struct app_config *run, uint32_t now_us, uint32_t want_us)
+{
+    run->scan.exposures_us[0] = now_us;
+    run->scan.exposures_us[1] = want_us;
+    run->scan.exposure_count = 2;
+}
+
+/* Still too dark at the longer exposure: a tenth of what it lights (and JOB_DARK_PIXELS). */
+#define DARK_SHARE_LEFT 0.1
+
+/* [scan] auto_exposure: before the first view, a white and a black frame at [camera]
+ * exposure_us; where most of what the projector lights is too dark to decode (as
+ * job_say_if_dark would say after the whole turn, every view all but empty), pairs at the
+ * exposure that lifts the dark pixels' median contrast to twice the threshold, once more from
+ * there while a tenth is still too dark (at a longer exposure more of the object is lit: its
+ * grazing parts), and if the camera takes it, every pattern is also taken at the last (HDR: per
+ * pixel the longest exposure not saturated, so a bright part loses nothing). Not where the file
+ * sets exposures_us (empty too: the person chose), nor where the camera cannot change its
+ * exposure. Measured: the bunny at albedo 0.04 with every default, 10 ms: 54,338 of 56,199 lit
+ * pixels too dark; 29 ms: 31,172 of 148,168; 73 ms. @retval 0 (@p run as the views are to be
+ * taken) @retval -EINTR stop requested */
+static int probe_dark(struct job *j, struct app_config *run)
+{
+    const struct hal *hal = j->hal;
+    if (!run->auto_exposure || run->scan.exposure_count > 0 ||
+        config_file_sets(run->path, "exposures_us"))
+        return 0;
+    const uint32_t now_us = run->camera.exposure_us;
+    struct scan_contrast first, at;
+    int rc = scan_probe_contrast(j->scan, hal, &run->scan, j->calib, now_us, &first);
+    if (rc != 0 && rc != -EINTR)
+        hal->log(HAL_LOG_WARN, "the exposure check took no frames (%s): the exposure as set",
+                 strerror(-rc));
+    if (rc != 0 || !job_mostly_dark(first.dark, first.lit - first.dark))
+        return rc == -EINTR ? rc : 0;
+    uint32_t last_us = now_us;
+    at = first;
+    for (int step = 0; step < 2; step++) {
+        uint32_t want_us =
+            job_dark_exposure_us(last_us, run->scan.min_contrast_dn, at.dark_median_dn);
+        if (step > 0 && (at.dark < JOB_DARK_PIXELS || at.dark <= DARK_SHARE_LEFT * at.lit))
+            break;
+        if (want_us <= last_us)
+            break;
+        struct scan_contrast next;
+        rc = scan_probe_contrast(j->scan, hal, &run->scan, j->calib, want_us, &next);
+        if (rc == -EINTR)
+            return rc;
+        if (rc != 0) {
+            hal->log(HAL_LOG_WARN, "the exposure check: the camera could not take %u us (%s)",
+                     (unsigned)want_us, strerror(-rc));
+            break;
+        }
+        last_us = want_us;
+        at = next;
+    }
+    if (last_us == now_us) /* the views will say it (job_say_if_dark) */
+        return 0;
+    take_hdr(run, now_us, last_us);
+    char msg[160];
+    if (scan_check(&run->scan, j->calib, msg, sizeof(msg)) != 0) {
+        run->scan.exposure_count = 0;
+        hal->log(HAL_LOG_WARN,
+                 "a dark object, but its longer exposure cannot be taken (%s): the "
+                 "exposure as set",
+                 msg);
+        return 0;
+    }
+    hal->log(HAL_LOG_INFO,
+             "a dark object: %u of the %u pixels the projector lights are too dark to decode at "
+             "%u us (white minus black %u grey levels), %u of %u at %u us; every pattern is also "
+             "taken at %u us ([scan] exposures_us = %u, %u, kept in the scan's config.ini; "
+             "auto_exposure = 0 leaves the exposure as set)",
+             (unsigned)first.dark, (unsigned)first.lit, (unsigned)now_us,
+             (unsigned)first.dark_median_dn, (unsigned)at.dark, (unsigned)at.lit, (unsigned)last_us,
+             (unsigned)last_us, (unsigned)now_us, (unsigned)last_us);
+    return 0;
+}
+
 /* [output] dir/latest: a link to the newest scan's folder, replaced atomically. A convenience:
  * a failure is said and the scan goes on. */
 static void link_latest(const struct hal *hal, const char *parent, const char *name)
@@ -415,15 +509,25 @@ int scan_job_live(const struct hal *hal, const struct app_config *cfg,
             return rc;
         }
     }
+    static struct app_config run; /* the settings the views are taken with (probe_dark) */
+    run = *cfg;
     struct job j;
-    job_init(&j, hal, cfg, calib, opts, opts->out_dir ? opts->out_dir : auto_dir);
+    job_init(&j, hal, &run, calib, opts, opts->out_dir ? opts->out_dir : auto_dir);
     int lock_fd;
     int rc = job_open_out(&j, opts->replace ? SCAN_DIR_REPLACE : SCAN_DIR_NEW, &lock_fd);
     if (rc != 0)
         return rc;
     if (name != NULL)
         link_latest(hal, cfg->output_dir, name);
-    rc = scan_dir_keep_settings(&hal->storage, cfg->path, cfg->calibration_file, j.out_dir);
+    char chosen[320];
+    rc = probe_dark(&j, &run);
+    if (rc == 0)
+        rc = job_chosen_lines(&run, chosen, sizeof(chosen));
+    if (rc == 0)
+        rc = scan_dir_keep_settings(&hal->storage, cfg->path, cfg->calibration_file, j.out_dir,
+                                    chosen);
+    if (rc == -EINTR)
+        goto out_unlock; /* stopped before the first view: the rig safe, nothing to keep */
     if (rc != 0) {
         hal->log(HAL_LOG_ERROR, "cannot set up the scan directory %s: %s", j.out_dir,
                  strerror(-rc));

@@ -33,6 +33,13 @@ int scan_job_load_settings(const char *scan_dir, const char *config_path, int ca
     char what[160];
     if (rc == 0 && config_path != NULL && access(path, F_OK) == 0) {
         rc = config_load(&taken, path, err, err_len);
+        /* the exposures the scan chose itself ([scan] auto_exposure) are the scan's, as long as
+         * the config given leaves them to it */
+        if (rc == 0 && cfg->auto_exposure && cfg->scan.exposure_count == 0 &&
+            taken.scan.exposure_count > 0 && !config_file_sets(config_path, "exposures_us")) {
+            memcpy(cfg->scan.exposures_us, taken.scan.exposures_us, sizeof(cfg->scan.exposures_us));
+            cfg->scan.exposure_count = taken.scan.exposure_count;
+        }
         if (rc == 0 && config_plan_differs(&taken, cfg, capturing, what, sizeof(what)) != 0) {
             /* the scan's own config.ini fixes how its views are taken: views taken otherwise
              * would not fit with those it has (another turn, exposure, pattern set ...) */
@@ -253,8 +260,10 @@ int scan_job_process(const struct hal *hal, const char *scan_dir, const struct s
         return rc;
     /* summary.ini says every output is written (docs/scan-format.md): they are made again */
     scan_dir_remove(j.out_dir, -1, SCAN_FILE_SUMMARY);
-    if (elsewhere && (rc = scan_dir_keep_settings(&hal->storage, cfg.path, cfg.calibration_file,
-                                                  j.out_dir)) != 0) /* how they were made */
+    char chosen[320];
+    if (elsewhere && ((rc = job_chosen_lines(&cfg, chosen, sizeof(chosen))) != 0 ||
+                      (rc = scan_dir_keep_settings(&hal->storage, cfg.path, cfg.calibration_file,
+                                                   j.out_dir, chosen)) != 0)) /* how made */
         hal->log(HAL_LOG_ERROR, "cannot keep the settings in %s: %s", j.out_dir, strerror(-rc));
     if (rc == 0)
         rc = job_begin_model(&j);

@@ -504,7 +504,9 @@ int scan_dir_read_pose(const char *dir, uint32_t view, struct frame_xform *pose)
     return have_rot && have_origin ? 0 : -EINVAL;
 }
 
-int scan_dir_copy_file(const struct hal_storage *st, const char *from, const char *to)
+/* @p from's bytes with @p extra after them (NULL: none) written durably to @p to. */
+static int copy_with(const struct hal_storage *st, const char *from, const char *to,
+                     const char *extra)
 {
     char buf[1 << 16]; /* config and calibration files are small */
     FILE *f = file_open_regular(from, "rb");
@@ -513,11 +515,21 @@ int scan_dir_copy_file(const struct hal_storage *st, const char *from, const cha
     size_t n = fread(buf, 1, sizeof(buf), f);
     int too_big = !feof(f);
     fclose(f);
-    return too_big ? -EFBIG : hal_storage_write_file(st, to, buf, n);
+    size_t more = extra != NULL ? strlen(extra) : 0;
+    if (too_big || more > sizeof(buf) - n)
+        return -EFBIG;
+    if (more > 0)
+        memcpy(buf + n, extra, more);
+    return hal_storage_write_file(st, to, buf, n + more);
+}
+
+int scan_dir_copy_file(const struct hal_storage *st, const char *from, const char *to)
+{
+    return copy_with(st, from, to, NULL);
 }
 
 int scan_dir_keep_settings(const struct hal_storage *st, const char *config_path,
-                           const char *calibration_path, const char *dir)
+                           const char *calibration_path, const char *dir, const char *chosen)
 {
     /* The calibration first: config.ini's presence says the settings are complete (resume
      * takes a directory with config.ini as a scan; a kill between the two left it without its
@@ -528,7 +540,7 @@ int scan_dir_keep_settings(const struct hal_storage *st, const char *config_path
         rc = scan_dir_copy_file(st, calibration_path, path);
     if (rc == 0)
         rc = scan_dir_path(path, sizeof(path), dir, -1, SCAN_FILE_CONFIG);
-    return rc != 0 ? rc : scan_dir_copy_file(st, config_path, path);
+    return rc != 0 ? rc : copy_with(st, config_path, path, chosen);
 }
 
 /* ---- opening: a lock, and what is already there ---- */

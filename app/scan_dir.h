@@ -209,12 +209,14 @@ int scan_dir_remove(const char *dir, int view, const char *name);
  *  in the directories of its views 0 .. @p views - 1. @retval 0 @retval -errno */
 int scan_dir_sweep(const struct hal_storage *st, const char *dir, uint32_t views);
 
-/** Keep the config and the calibration a scan ran with (config.ini, calibration.ini). */
 /** Copy a small file (config, calibration: up to 64 KiB) durably. @retval 0 @retval -errno
  *  @retval -EFBIG larger */
 int scan_dir_copy_file(const struct hal_storage *st, const char *from, const char *to);
 
+/** Keep the config and the calibration a scan ran with (config.ini, calibration.ini).
+ *  @param chosen  lines config.ini gets after the config's own (what the scan chose itself:
+ *  [scan] auto_exposure), or NULL @retval 0 @retval -errno @retval -EFBIG too large */
 int scan_dir_keep_settings(const struct hal_storage *st, const char *config_path,
-                           const char *calibration_path, const char *dir);
+                           const char *calibration_path, const char *dir, const char *chosen);
 
 #endif

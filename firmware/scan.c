@@ -468,6 +468,69 @@ int scan_snapshot(struct scan_ctx *s, const struct hal *hal, const struct scan_p
     return rc != 0 ? rc : rc_off;
 }
 
+/* The white (in s->colour_rgb) and black (in s->frame_rgb) projector frames at @p exposure_us,
+ * the camera back at the colour exposure after. */
+static int capture_white_black(struct scan_ctx *s, const struct hal *hal,
+                               const struct scan_params *p, const struct scan_calib *c,
+                               uint32_t exposure_us, struct scan_view_info *info)
+{
+    int rc = exposure_us == p->colour.exposure_us
+                 ? 0
+                 : hal_cam_set_exposure(&hal->camera, exposure_us, p->colour.gain_milli);
+    if (rc == 0)
+        rc = projector_start(s, hal, p, c->light_count); /* it shows the white pattern */
+    if (rc == 0 && hal_should_stop(hal))
+        rc = -EINTR;
+    if (rc == 0)
+        rc = capture(s, hal, p, s->colour_rgb, GRAY_PATTERN_WHITE, info);
+    if (rc == 0)
+        rc = hal_gpio_pulse(&hal->gpio, &hal->clock, HAL_GPIO_PROJECTOR_TRIGGER,
+                            p->trigger_pulse_us);
+    if (rc == 0)
+        rc = settle(s, hal, p);
+    if (rc == 0)
+        rc = capture(s, hal, p, s->frame_rgb, GRAY_PATTERN_BLACK, info);
+    int rc_exp = camera_exposure_back(hal, p, exposure_us);
+    return rc != 0 ? rc : rc_exp;
+}
+
+int scan_probe_contrast(struct scan_ctx *s, const struct hal *hal, const struct scan_params *p,
+                        const struct scan_calib *c, uint32_t exposure_us, struct scan_contrast *out)
+{
+    struct scan_view_info info;
+    memset(&info, 0, sizeof(info));
+    memset(out, 0, sizeof(*out));
+    int rc = capture_white_black(s, hal, p, c, exposure_us, &info);
+    /* the projector off again at once, and the rig safe on every failure */
+    int rc_off = hal_gpio_set(&hal->gpio, HAL_GPIO_PROJECTOR_ENABLE, 0);
+    if (rc != 0 || rc_off != 0) {
+        hal->gpio.ops->safe_state(hal->gpio.priv);
+        return rc != 0 ? rc : rc_off;
+    }
+    const size_t n = (size_t)p->width * p->height;
+    uint8_t *white = s->hdr_grey, *black = s->hdr_choice; /* both free between views */
+    decode_rgb_to_grey(s->colour_rgb, white, n, p->saturation_dn);
+    decode_rgb_to_grey(s->frame_rgb, black, n, p->saturation_dn);
+    uint32_t hist[256] = {0};
+    for (size_t i = 0; i < n; i++) {
+        if (white[i] == DECODE_SATURATED || white[i] <= black[i] ||
+            (uint32_t)(white[i] - black[i]) <= p->shadow_contrast_dn)
+            continue;
+        uint32_t contrast = (uint32_t)(white[i] - black[i]);
+        out->lit++;
+        if (contrast < p->min_contrast_dn)
+            out->dark++, hist[contrast]++;
+    }
+    for (uint32_t v = 0, seen = 0; v < 256 && out->dark > 0; v++) { /* the dark ones' median */
+        seen += hist[v];
+        if (2 * seen >= out->dark) {
+            out->dark_median_dn = v;
+            break;
+        }
+    }
+    return 0;
+}
+
 int scan_capture_view(struct scan_ctx *s, const struct hal *hal, const struct scan_params *p,
                       const struct scan_calib *c, int32_t angle_mdeg,
                       const struct scan_frame_sink *sink, struct scan_view_info *info)

@@ -105,6 +105,24 @@ struct scan_frame_sink {
     void *priv;
 };
 
+/** What the camera sees of the projector's light at one exposure, from a white and a black
+ *  frame: how much of the object it lights, and how much of that is too dark to decode. */
+struct scan_contrast {
+    uint32_t lit;            /**< pixels whose white minus black is over shadow_contrast_dn */
+    uint32_t dark;           /**< of them, under min_contrast_dn: too dark to decode */
+    uint32_t dark_median_dn; /**< the median white minus black of the dark ones (0: none) */
+};
+
+/** A white and a black projector frame at @p exposure_us (the camera back at the colour
+ *  exposure after), without turning the table, measured as the decoder would read them
+ *  (decode_rgb_to_grey; a saturated pixel is not dark); projector off again when it returns.
+ *  @param out  what they show
+ *  @retval 0 ok @retval -EINTR stop requested @retval the camera's or GPIO's error (-ENOSYS: the
+ *  camera cannot change its exposure) */
+int scan_probe_contrast(struct scan_ctx *s, const struct hal *hal, const struct scan_params *params,
+                        const struct scan_calib *calib, uint32_t exposure_us,
+                        struct scan_contrast *out);
+
 /** One picture of what the camera sees lit by the projector's white (the web page's live view),
  *  without turning the table; the projector is off again when it returns.
  *  @param rgb  out: the RGB24 frame (params' width x height), valid until the next capture

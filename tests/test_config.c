@@ -107,6 +107,8 @@ static void test_errors_name_file_line_and_key(void **state)
     expect_error("[sim]\nobject_offset_mm = 30, nan\n", "'30, nan' is not a list of 2");
     expect_error("[sim]\nobject_offset_mm = 300, 0\n",
                  "[sim] object_offset_mm: 300 is out of range -200..200");
+    expect_error("[scan]\nauto_exposure = 2\n",
+                 "bad.ini:9: [scan] auto_exposure: 2 is out of range 0..1");
     expect_error("garbage line\n", "bad.ini:8: syntax error");
     /* fit reads the colour frames again: a scan that keeps none could not make its model */
     expect_error("[lights]\ncount = 4\n[colour]\nmethod = fit\n[output]\nkeep_frames = none\n",
@@ -185,6 +187,34 @@ static void test_calibration_errors(void **state)
 
 /* A line longer than the parser's buffer is refused; before, the tail of a long comment was
  * read as a key of its own (start_angle_deg = 45 took effect). */
+/* [scan] auto_exposure chooses the HDR exposures only where the file sets no exposures_us, in
+ * any form: config_file_sets sees a key however it is spaced, empty or not, and nothing else
+ * (a comment, a longer key, a value, an unreadable file). */
+static void test_file_sets_a_key(void **state)
+{
+    (void)state;
+    const char *path = write_file("good.ini", base);
+    assert_int_equal(config_load(&cfg, path, err, sizeof(err)), 0);
+    assert_int_equal(cfg.auto_exposure, 1); /* the default */
+    assert_int_equal(config_file_sets(path, "exposures_us"), 0);
+    static const char *const sets[] = {"exposures_us =\n", "  exposures_us=10000, 20000\n",
+                                       "\texposures_us \t = 10000\n"};
+    static const char *const not_sets[] = {"; exposures_us = 10000\n", "exposures_us_x = 1\n",
+                                           "my_exposures_us = 1\n", "views = exposures_us\n",
+                                           "exposures_us\n"};
+    char text[1024];
+    for (size_t k = 0; k < sizeof(sets) / sizeof(sets[0]); k++) {
+        snprintf(text, sizeof(text), "%s%s", base, sets[k]);
+        assert_int_equal(config_file_sets(write_file("sets.ini", text), "exposures_us"), 1);
+    }
+    for (size_t k = 0; k < sizeof(not_sets) / sizeof(not_sets[0]); k++) {
+        snprintf(text, sizeof(text), "%s%s", base, not_sets[k]);
+        assert_int_equal(config_file_sets(write_file("sets.ini", text), "exposures_us"), 0);
+    }
+    assert_int_equal(config_file_sets(DIR "/no-such.ini", "exposures_us"), 0);
+    assert_int_equal(config_file_sets(DIR, "exposures_us"), 0); /* a directory */
+}
+
 static void test_overlong_line_refused(void **state)
 {
     (void)state;
@@ -341,6 +371,7 @@ int main(void)
         cmocka_unit_test(test_backend_not_built_in),
         cmocka_unit_test(test_docs_cover_every_key),
         cmocka_unit_test(test_overlong_line_refused),
+        cmocka_unit_test(test_file_sets_a_key),
         cmocka_unit_test(test_not_a_regular_file),
         cmocka_unit_test(test_empty_calibration_and_zero_baseline),
         cmocka_unit_test(test_calibration_values_within_bounds),

@@ -203,6 +203,40 @@ static void test_stop_request_leaves_rig_dark(void **state)
     assert_true(test_rig_dark());
 }
 
+/* The exposure check's frames ([scan] auto_exposure): a white and a black at the exposure asked,
+ * measured as the decoder reads them, the camera back at its own and the rig dark after; a
+ * 25th of the exposure makes the box mostly too dark (white minus black scales with it); a
+ * fault on its second frame stops it after the retries, projector off. */
+static void test_probe_contrast(void **state)
+{
+    (void)state;
+    struct scan_contrast at_own, at_short;
+    uint64_t start = sim_ctl_frames();
+    const uint32_t own_us = t.cfg.scan.colour.exposure_us;
+    assert_int_equal(scan_probe_contrast(t.scan, &t.hal, &t.cfg.scan, &t.calib, own_us, &at_own),
+                     0);
+    assert_int_equal(sim_ctl_frames() - start, 2);
+    assert_true(test_rig_dark());
+    assert_true(at_own.lit > 10000 && at_own.dark < at_own.lit / 10);
+    assert_int_equal(
+        scan_probe_contrast(t.scan, &t.hal, &t.cfg.scan, &t.calib, own_us / 25, &at_short), 0);
+    assert_true(test_rig_dark());
+    assert_true(at_short.dark > at_short.lit - at_short.dark && at_short.dark > 1000);
+    assert_true(at_short.dark_median_dn > t.cfg.scan.shadow_contrast_dn &&
+                at_short.dark_median_dn < t.cfg.scan.min_contrast_dn);
+    /* the camera at its own exposure again: the same frames give the same measure */
+    struct scan_contrast again;
+    assert_int_equal(scan_probe_contrast(t.scan, &t.hal, &t.cfg.scan, &t.calib, own_us, &again), 0);
+    assert_memory_equal(&again, &at_own, sizeof(again));
+    start = sim_ctl_frames();
+    sim_ctl_inject_camera_fault(SIM_FAULT_CORRUPT, start + 1, 100);
+    assert_int_equal(scan_probe_contrast(t.scan, &t.hal, &t.cfg.scan, &t.calib, own_us, &again),
+                     -EIO);
+    sim_ctl_inject_camera_fault(SIM_FAULT_NONE, 0, 0);
+    assert_int_equal(sim_ctl_frames() - start, 2 + t.cfg.scan.capture_retries);
+    assert_true(test_rig_dark());
+}
+
 /* Lights on and projector on, then the one shutdown path: everything off. */
 static void test_safe_state_turns_everything_off(void **state)
 {
@@ -256,6 +290,7 @@ int main(void)
         cmocka_unit_test(test_camera_drops_the_frame_in_flight),
         cmocka_unit_test(test_stop_request_leaves_rig_dark),
         cmocka_unit_test(test_safe_state_turns_everything_off),
+        cmocka_unit_test(test_probe_contrast),
         cmocka_unit_test(test_projector_sequence),
         cmocka_unit_test(test_missing_ops_answer_enosys),
     };

@@ -292,7 +292,7 @@ static void fake_scan(const char *dir, const char *config_text, const void *fram
     write_text(cfg_path, config_text);
     assert_non_null(realpath("config/sim-calib.ini", calib));
     assert_int_equal(test_rig_load(&t, cfg_path), 0);
-    assert_int_equal(scan_dir_keep_settings(&hal.storage, cfg_path, calib, dir), 0);
+    assert_int_equal(scan_dir_keep_settings(&hal.storage, cfg_path, calib, dir, NULL), 0);
     memset(&v, 0, sizeof(v));
     scan_dir_describe_frames(&t.cfg.scan, &t.calib, &v);
     v.frames = v.frame_count;
