@@ -389,14 +389,17 @@ int job_home_and_take_views(struct job *j, uint32_t first)
 int job_chosen_lines(const struct app_config *cfg, char *buf, size_t len)
 {
     buf[0] = '\0';
-    if (cfg->scan.exposure_count != 2 || config_file_sets(cfg->path, "exposures_us"))
+    if (cfg->scan.exposure_count == 0 || config_file_sets(cfg->path, "exposures_us"))
         return 0;
+    char list[SCAN_MAX_EXPOSURES * 12] = "";
+    for (uint32_t e = 0; e < cfg->scan.exposure_count; e++)
+        snprintf(list + strlen(list), sizeof(list) - strlen(list), e > 0 ? ", %u" : "%u",
+                 (unsigned)cfg->scan.exposures_us[e]);
     int n = snprintf(buf, len,
-                     "\n; [scan] auto_exposure: most of what the projector lit was too dark to "
-                     "decode at %u us,\n; so every pattern is also taken at %u us\n[scan]\n"
-                     "exposures_us = %u, %u\n",
-                     (unsigned)cfg->scan.exposures_us[0], (unsigned)cfg->scan.exposures_us[1],
-                     (unsigned)cfg->scan.exposures_us[0], (unsigned)cfg->scan.exposures_us[1]);
+                     "\n; the exposures every pattern was taken at: the config set none, and most "
+                     "of what\n; the projector lit was too dark to decode at the first "
+                     "([scan] auto_exposure)\n[scan]\nexposures_us = %s\n",
+                     list);
     return n > 0 && (size_t)n < len ? 0 : -EOVERFLOW;
 }
 
@@ -526,8 +529,10 @@ int scan_job_live(const struct hal *hal, const struct app_config *cfg,
     if (rc == 0)
         rc = scan_dir_keep_settings(&hal->storage, cfg->path, cfg->calibration_file, j.out_dir,
                                     chosen);
-    if (rc == -EINTR)
-        goto out_unlock; /* stopped before the first view: the rig safe, nothing to keep */
+    if (rc == -EINTR) { /* the rig is safe (scan_probe_contrast) */
+        hal->log(HAL_LOG_WARN, "scan stopped by request before its first view: nothing taken");
+        goto out_unlock;
+    }
     if (rc != 0) {
         hal->log(HAL_LOG_ERROR, "cannot set up the scan directory %s: %s", j.out_dir,
                  strerror(-rc));
