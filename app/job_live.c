@@ -522,15 +522,22 @@ int scan_job_live(const struct hal *hal, const struct app_config *cfg,
         return rc;
     if (name != NULL)
         link_latest(hal, cfg->output_dir, name);
-    char chosen[320];
-    rc = probe_dark(&j, &run);
+    /* the settings first, as the file has them: a scan stopped in the exposure check is still a
+     * scan to resume; then again with what the check chose */
+    char chosen[320] = "";
+    rc = scan_dir_keep_settings(&hal->storage, cfg->path, cfg->calibration_file, j.out_dir, NULL);
+    if (rc == 0)
+        rc = probe_dark(&j, &run);
     if (rc == 0)
         rc = job_chosen_lines(&run, chosen, sizeof(chosen));
-    if (rc == 0)
+    if (rc == 0 && chosen[0] != '\0')
         rc = scan_dir_keep_settings(&hal->storage, cfg->path, cfg->calibration_file, j.out_dir,
                                     chosen);
     if (rc == -EINTR) { /* the rig is safe (scan_probe_contrast) */
-        hal->log(HAL_LOG_WARN, "scan stopped by request before its first view: nothing taken");
+        hal->log(HAL_LOG_WARN,
+                 "scan stopped by request before its first view: nothing taken; 'scanner resume "
+                 "%s' takes the views",
+                 j.out_dir);
         goto out_unlock;
     }
     if (rc != 0) {

@@ -174,12 +174,45 @@ static void test_camera_lost_mid_view_then_resume_finishes_it(void **state)
     assert_true(test_rig_dark());
 }
 
+static int stop_now(void)
+{
+    return 1;
+}
+
+/* Stopped before its first view, in the exposure check ([scan] auto_exposure): no frame taken,
+ * the rig dark, and the settings kept (before the check they were kept first too), so that
+ * resume takes every view and the model is the reference's. */
+static void test_stop_in_the_exposure_check_then_resume(void **state)
+{
+    (void)state;
+    const char *dir = OUT "/checked";
+    char path[256], ref[256];
+    uint64_t start = sim_ctl_frames();
+    test_log_clear();
+    t.hal.stop_requested = stop_now;
+    int rc = scan(dir);
+    t.hal.stop_requested = NULL;
+    assert_int_equal(rc, -EINTR);
+    assert_int_equal(sim_ctl_frames(), start);
+    assert_true(test_rig_dark());
+    assert_true(test_log_has("scan stopped by request before its first view: nothing taken; "
+                             "'scanner resume build/test_scan_faults/checked' takes the views"));
+    assert_views(dir, 0);
+    assert_int_equal(resume(dir, 0), 0);
+    assert_views(dir, VIEWS);
+    scan_dir_path(path, sizeof(path), dir, -1, "mesh.ply");
+    scan_dir_path(ref, sizeof(ref), OUT "/reference", -1, "mesh.ply");
+    assert_true(test_files_equal(path, ref));
+    assert_true(test_rig_dark());
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_reference_scan),
         cmocka_unit_test(test_stall_stops_scan_then_resume_finishes_it),
         cmocka_unit_test(test_camera_lost_mid_view_then_resume_finishes_it),
+        cmocka_unit_test(test_stop_in_the_exposure_check_then_resume),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
