@@ -770,23 +770,29 @@ void config_print_doc(FILE *out)
     calib_print_doc(out);
 }
 
+/* config_file_sets: a key named @c key seen by inih, as the loader's own parse sees it. */
+struct key_seen {
+    const char *key;
+    int seen;
+};
+
+static int note_key(void *user, const char *section, const char *name, const char *value)
+{
+    struct key_seen *k = user;
+    (void)section, (void)value;
+    k->seen |= strcmp(name, k->key) == 0;
+    return 1;
+}
+
 int config_file_sets(const char *path, const char *key)
 {
+    struct key_seen k = {key, 0};
     FILE *f = file_open_regular(path, "r");
     if (f == NULL)
         return 0;
-    char line[512];
-    int found = 0;
-    size_t key_len = strlen(key);
-    for (unsigned n = 0; !found && n < 10000u && fgets(line, sizeof(line), f) != NULL; n++) {
-        const char *p = line + strspn(line, " \t");
-        if (strncmp(p, key, key_len) == 0) {
-            p += key_len;
-            found = p[strspn(p, " \t")] == '=';
-        }
-    }
+    ini_parse_file(f, note_key, &k); /* a line it cannot read sets nothing */
     fclose(f);
-    return found;
+    return k.seen;
 }
 
 /* How a scan's views were taken: what its frames are and where the table stood. */

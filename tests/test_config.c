@@ -188,8 +188,9 @@ static void test_calibration_errors(void **state)
 /* A line longer than the parser's buffer is refused; before, the tail of a long comment was
  * read as a key of its own (start_angle_deg = 45 took effect). */
 /* [scan] auto_exposure chooses the HDR exposures only where the file sets no exposures_us, in
- * any form: config_file_sets sees a key however it is spaced, empty or not, and nothing else
- * (a comment, a longer key, a value, an unreadable file). */
+ * any form: config_file_sets sees the key as the loader does (inih), however it is spaced,
+ * empty or not, in whatever section, and nothing else (a comment, a longer key, a value, a line
+ * without "=", an unreadable file). */
 static void test_file_sets_a_key(void **state)
 {
     (void)state;
@@ -197,8 +198,8 @@ static void test_file_sets_a_key(void **state)
     assert_int_equal(config_load(&cfg, path, err, sizeof(err)), 0);
     assert_int_equal(cfg.auto_exposure, 1); /* the default */
     assert_int_equal(config_file_sets(path, "exposures_us"), 0);
-    static const char *const sets[] = {"exposures_us =\n", "  exposures_us=10000, 20000\n",
-                                       "\texposures_us \t = 10000\n"};
+    static const char *const sets[] = {"exposures_us =\n", "[scan]\n  exposures_us=10000, 20000\n",
+                                       "[sim]\nexposures_us \t = 10000\n"};
     static const char *const not_sets[] = {"; exposures_us = 10000\n", "exposures_us_x = 1\n",
                                            "my_exposures_us = 1\n", "views = exposures_us\n",
                                            "exposures_us\n"};
