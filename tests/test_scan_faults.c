@@ -88,6 +88,15 @@ static void set_stall(int32_t at_mdeg)
     pthread_mutex_unlock(&server->lock);
 }
 
+/* The model of the scan in @p dir is the reference's, to the byte. */
+static void assert_model_is_the_reference(const char *dir)
+{
+    char path[256], ref[256];
+    scan_dir_path(path, sizeof(path), dir, -1, "mesh.ply");
+    scan_dir_path(ref, sizeof(ref), OUT "/reference", -1, "mesh.ply");
+    assert_true(test_files_equal(path, ref));
+}
+
 /* The reference: the same scan, nothing going wrong. */
 static uint64_t reference_frames; /* captures it took, all views */
 
@@ -131,9 +140,7 @@ static void test_stall_stops_scan_then_resume_finishes_it(void **state)
 
     assert_int_equal(resume(dir, 1), 0);
     assert_views(dir, VIEWS);
-    scan_dir_path(path, sizeof(path), dir, -1, "mesh.ply");
-    scan_dir_path(ref, sizeof(ref), OUT "/reference", -1, "mesh.ply");
-    assert_true(test_files_equal(path, ref));
+    assert_model_is_the_reference(dir);
     for (uint32_t v = 0; v < VIEWS; v++) { /* each view's frames too, e.g. the white one */
         assert_int_equal(scan_dir_find_frame(path, sizeof(path), dir, v, 0), 0);
         assert_int_equal(scan_dir_find_frame(ref, sizeof(ref), OUT "/reference", v, 0), 0);
@@ -148,7 +155,6 @@ static void test_camera_lost_mid_view_then_resume_finishes_it(void **state)
 {
     (void)state;
     const char *dir = OUT "/camera";
-    char path[256], ref[256];
     /* a scan begins with the exposure check's white and black ([scan] auto_exposure) */
     const uint64_t check = 2;
     uint64_t per_view = (reference_frames - check) / VIEWS;
@@ -168,9 +174,7 @@ static void test_camera_lost_mid_view_then_resume_finishes_it(void **state)
 
     assert_int_equal(resume(dir, 0), 0);
     assert_views(dir, VIEWS);
-    scan_dir_path(path, sizeof(path), dir, -1, "mesh.ply");
-    scan_dir_path(ref, sizeof(ref), OUT "/reference", -1, "mesh.ply");
-    assert_true(test_files_equal(path, ref));
+    assert_model_is_the_reference(dir);
     assert_true(test_rig_dark());
 }
 
@@ -186,7 +190,6 @@ static void test_stop_in_the_exposure_check_then_resume(void **state)
 {
     (void)state;
     const char *dir = OUT "/checked";
-    char path[256], ref[256];
     uint64_t start = sim_ctl_frames();
     test_log_clear();
     t.hal.stop_requested = stop_now;
@@ -200,9 +203,7 @@ static void test_stop_in_the_exposure_check_then_resume(void **state)
     assert_views(dir, 0);
     assert_int_equal(resume(dir, 0), 0);
     assert_views(dir, VIEWS);
-    scan_dir_path(path, sizeof(path), dir, -1, "mesh.ply");
-    scan_dir_path(ref, sizeof(ref), OUT "/reference", -1, "mesh.ply");
-    assert_true(test_files_equal(path, ref));
+    assert_model_is_the_reference(dir);
     assert_true(test_rig_dark());
 }
 
