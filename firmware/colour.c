@@ -266,7 +266,7 @@ static double multi_sum(const struct light_signals *ls, uint32_t light_count, do
  * (at the origin, direction @p view from @p p): alpha of the lobe (reflect.h). */
 static double half_angle(vec3 p, vec3 n, vec3 view, const double light_pos[3])
 {
-    vec3 to = v3_norm(v3_sub(v3_from(light_pos), p));
+    vec3 to = toward(p, v3_from(light_pos)).dir;
     double nh = v3_dot(n, v3_norm(v3_add(to, view)));
     return acos(nh > 1.0 ? 1.0 : nh < -1.0 ? -1.0 : nh);
 }
