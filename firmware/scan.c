@@ -241,6 +241,17 @@ int scan_feed_light_frame(struct scan_ctx *s, uint32_t k, const uint8_t *rgb)
     return 0;
 }
 
+/* The median grey level of a histogram of @p total pixels (0: none). */
+static uint32_t hist_median(const uint32_t hist[256], uint32_t total)
+{
+    for (uint32_t v = 0, seen = 0; v < 256 && total > 0; v++) {
+        seen += hist[v];
+        if (2 * seen >= total)
+            return v;
+    }
+    return 0;
+}
+
 int scan_finish_view(struct scan_ctx *s, const struct hal_thread *threads,
                      const struct scan_calib *c, int32_t angle_mdeg, struct scan_view *view,
                      struct scan_view_info *info)
@@ -280,14 +291,7 @@ int scan_finish_view(struct scan_ctx *s, const struct hal_thread *threads,
             dark_hist[s->decode.white[i] - s->decode.black[i]]++, dark_n++;
     }
     info->valid_points = info->reason_count[SCAN_VALID];
-    info->dark_contrast_dn = 0;
-    for (uint32_t c = 0, seen = 0; c < 256; c++) { /* the median of the histogram */
-        seen += dark_hist[c];
-        if (2 * seen >= dark_n && seen > 0) {
-            info->dark_contrast_dn = c;
-            break;
-        }
-    }
+    info->dark_contrast_dn = hist_median(dark_hist, dark_n);
     return 0;
 }
 
@@ -521,13 +525,7 @@ int scan_probe_contrast(struct scan_ctx *s, const struct hal *hal, const struct 
         if (contrast < p->min_contrast_dn)
             out->dark++, hist[contrast]++;
     }
-    for (uint32_t v = 0, seen = 0; v < 256 && out->dark > 0; v++) { /* the dark ones' median */
-        seen += hist[v];
-        if (2 * seen >= out->dark) {
-            out->dark_median_dn = v;
-            break;
-        }
-    }
+    out->dark_median_dn = hist_median(hist, out->dark);
     return 0;
 }
 
