@@ -214,6 +214,14 @@ static void test_file_sets_a_key(void **state)
     }
     assert_int_equal(config_file_sets(DIR "/no-such.ini", "exposures_us"), 0);
     assert_int_equal(config_file_sets(DIR, "exposures_us"), 0); /* a directory */
+    unlink(DIR "/sets-fifo"); /* a FIFO where the file belongs: not waited on */
+    assert_int_equal(mkfifo(DIR "/sets-fifo", 0600), 0);
+    assert_int_equal(config_file_sets(DIR "/sets-fifo", "exposures_us"), 0);
+    unlink(DIR "/sets-link"); /* a link to a file that sets it is that file, as for the loader */
+    snprintf(text, sizeof(text), "%s%s", base, sets[0]);
+    write_file("sets.ini", text);
+    assert_int_equal(symlink("sets.ini", DIR "/sets-link"), 0);
+    assert_int_equal(config_file_sets(DIR "/sets-link", "exposures_us"), 1);
 }
 
 static void test_overlong_line_refused(void **state)
