@@ -2,14 +2,10 @@
 #define _POSIX_C_SOURCE 200809L
 #include "config.h"
 #include "calib_file.h"
-#include "file_posix.h"
-
 #include "gray.h"
-
 #include "ini_schema.h"
 
 #include <errno.h>
-#include <ini.h>
 #include <libgen.h>
 #include <limits.h>
 #include <stddef.h>
@@ -768,31 +764,6 @@ void config_print_doc(FILE *out)
     fprintf(out, "\n## Calibration file (e.g. `config/sim-calib.ini`)\n\nAll geometry is in the "
                  "camera frame (x right, y down, z forward), in millimetres.\n");
     calib_print_doc(out);
-}
-
-/* config_file_sets: a key named @c key seen by inih, as the loader's own parse sees it. */
-struct key_seen {
-    const char *key;
-    int seen;
-};
-
-static int note_key(void *user, const char *section, const char *name, const char *value)
-{
-    struct key_seen *k = user;
-    (void)section, (void)value;
-    k->seen |= strcmp(name, k->key) == 0;
-    return 1;
-}
-
-int config_file_sets(const char *path, const char *key)
-{
-    struct key_seen k = {key, 0};
-    FILE *f = file_open_regular(path, "r");
-    if (f == NULL)
-        return 0;
-    ini_parse_file(f, note_key, &k); /* a line it cannot read sets nothing */
-    fclose(f);
-    return k.seen;
 }
 
 /* How a scan's views were taken: what its frames are and where the table stood. */

@@ -86,11 +86,6 @@ void config_board(const struct app_config *cfg, struct board_config *out);
 int config_plan_differs(const struct app_config *taken, const struct app_config *now, int capturing,
                         char *what, size_t what_len);
 
-/** Whether the file @p path sets @p key (in any section, empty or not), read by inih as
- *  config_load reads it: the scan's own choices (the HDR exposures of [scan] auto_exposure) are
- *  made only where the file says nothing. @retval 1 @retval 0 (also: unreadable) */
-int config_file_sets(const char *path, const char *key);
-
 /** Write the documentation of every key (Markdown) to @p out. */
 void config_print_doc(FILE *out);
 

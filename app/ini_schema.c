@@ -203,6 +203,7 @@ static int set_value(const struct ini_key *k, void *target, const char *value, c
         char buf[512];
         snprintf(buf, sizeof(buf), "%s", value);
         list->count = 0;
+        list->given = 1; /* ini_schema_load_with takes it back for a default */
         for (char *save = NULL, *tok = strtok_r(buf, ",", &save); tok != NULL;
              tok = strtok_r(NULL, ",", &save)) {
             while (*tok == ' ' || *tok == '\t')
@@ -337,6 +338,8 @@ int ini_schema_load_with(const struct ini_key *keys, size_t key_count, void *tar
             format_where(err, err_len, "(built-in default)", 0, &keys[i], msg);
             return -EINVAL;
         }
+        if (keys[i].type == INI_LIST) /* a default is not the file's */
+            ((struct ini_list *)(void *)((char *)target + keys[i].offset))->given = 0;
     }
     return 0;
 }

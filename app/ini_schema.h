@@ -13,9 +13,12 @@ enum ini_type { INI_U32, INI_I32, INI_F64, INI_STR, INI_ENUM, INI_VEC, INI_LINE,
 
 #define INI_LIST_MAX 8
 
-/** The value of an INI_LIST key: how many numbers were given, and them. */
+/** The value of an INI_LIST key: how many numbers were given, and them; @c given: the file set
+ *  the key (empty too), not its default or a fallback (what a person chose, left to the scanner
+ *  otherwise: [scan] auto_exposure). */
 struct ini_list {
     unsigned count;
+    unsigned given;
     double value[INI_LIST_MAX];
 };
 

@@ -389,7 +389,7 @@ int job_home_and_take_views(struct job *j, uint32_t first)
 int job_chosen_lines(const struct app_config *cfg, char *buf, size_t len)
 {
     buf[0] = '\0';
-    if (cfg->scan.exposure_count == 0 || config_file_sets(cfg->path, "exposures_us"))
+    if (cfg->scan.exposure_count == 0 || cfg->exposures_us.given)
         return 0;
     char list[SCAN_MAX_EXPOSURES * 12] = "";
     for (uint32_t e = 0; e < cfg->scan.exposure_count; e++)
@@ -428,8 +428,7 @@ static void take_hdr(struct app_config *run, uint32_t now_us, uint32_t want_us)
 static int probe_dark(struct job *j, struct app_config *run)
 {
     const struct hal *hal = j->hal;
-    if (!run->auto_exposure || run->scan.exposure_count > 0 ||
-        config_file_sets(run->path, "exposures_us"))
+    if (!run->auto_exposure || run->scan.exposure_count > 0 || run->exposures_us.given)
         return 0;
     const uint32_t now_us = run->camera.exposure_us;
     struct scan_contrast first, at;

@@ -36,7 +36,7 @@ int scan_job_load_settings(const char *scan_dir, const char *config_path, int ca
         /* the exposures the scan chose itself ([scan] auto_exposure) are the scan's, as long as
          * the config given leaves them to it */
         if (rc == 0 && cfg->auto_exposure && cfg->scan.exposure_count == 0 &&
-            taken.scan.exposure_count > 0 && !config_file_sets(config_path, "exposures_us")) {
+            taken.scan.exposure_count > 0 && !cfg->exposures_us.given) {
             memcpy(cfg->scan.exposures_us, taken.scan.exposures_us, sizeof(cfg->scan.exposures_us));
             cfg->scan.exposure_count = taken.scan.exposure_count;
         }

@@ -187,41 +187,33 @@ static void test_calibration_errors(void **state)
 
 /* A line longer than the parser's buffer is refused; before, the tail of a long comment was
  * read as a key of its own (start_angle_deg = 45 took effect). */
-/* [scan] auto_exposure chooses the HDR exposures only where the file sets no exposures_us, in
- * any form: config_file_sets sees the key as the loader does (inih), however it is spaced,
- * empty or not, in whatever section, and nothing else (a comment, a longer key, a value, a line
- * without "=", an unreadable file). */
+/* [scan] auto_exposure chooses the HDR exposures only where the file sets no exposures_us: the
+ * loader says whether [scan] exposures_us was in the file (empty too, however spaced), not its
+ * default, nor a comment; a file loaded after one that set it has its own. */
 static void test_file_sets_a_key(void **state)
 {
     (void)state;
     const char *path = write_file("good.ini", base);
     assert_int_equal(config_load(&cfg, path, err, sizeof(err)), 0);
     assert_int_equal(cfg.auto_exposure, 1); /* the default */
-    assert_int_equal(config_file_sets(path, "exposures_us"), 0);
-    static const char *const sets[] = {"exposures_us =\n", "[scan]\n  exposures_us=10000, 20000\n",
-                                       "[sim]\nexposures_us \t = 10000\n"};
-    static const char *const not_sets[] = {"; exposures_us = 10000\n", "exposures_us_x = 1\n",
-                                           "my_exposures_us = 1\n", "views = exposures_us\n",
-                                           "exposures_us\n"};
+    assert_int_equal(cfg.exposures_us.given, 0);
+    static const struct {
+        const char *text;
+        unsigned given, count;
+    } cases[] = {{"exposures_us =\n", 1, 0},
+                 {"exposures_us=10000, 20000\n", 1, 2},
+                 {"exposures_us \t = 10000\n", 1, 1},
+                 {"; exposures_us = 10000\n", 0, 0}};
     char text[1024];
-    for (size_t k = 0; k < sizeof(sets) / sizeof(sets[0]); k++) {
-        snprintf(text, sizeof(text), "%s%s", base, sets[k]);
-        assert_int_equal(config_file_sets(write_file("sets.ini", text), "exposures_us"), 1);
+    for (size_t k = 0; k < sizeof(cases) / sizeof(cases[0]); k++) {
+        snprintf(text, sizeof(text), "%s%s", base, cases[k].text);
+        assert_int_equal(config_load(&cfg, write_file("sets.ini", text), err, sizeof(err)), 0);
+        assert_int_equal(cfg.exposures_us.given, cases[k].given);
+        assert_int_equal(cfg.exposures_us.count, cases[k].count);
     }
-    for (size_t k = 0; k < sizeof(not_sets) / sizeof(not_sets[0]); k++) {
-        snprintf(text, sizeof(text), "%s%s", base, not_sets[k]);
-        assert_int_equal(config_file_sets(write_file("sets.ini", text), "exposures_us"), 0);
-    }
-    assert_int_equal(config_file_sets(DIR "/no-such.ini", "exposures_us"), 0);
-    assert_int_equal(config_file_sets(DIR, "exposures_us"), 0); /* a directory */
-    unlink(DIR "/sets-fifo"); /* a FIFO where the file belongs: not waited on */
-    assert_int_equal(mkfifo(DIR "/sets-fifo", 0600), 0);
-    assert_int_equal(config_file_sets(DIR "/sets-fifo", "exposures_us"), 0);
-    unlink(DIR "/sets-link"); /* a link to a file that sets it is that file, as for the loader */
-    snprintf(text, sizeof(text), "%s%s", base, sets[0]);
-    write_file("sets.ini", text);
-    assert_int_equal(symlink("sets.ini", DIR "/sets-link"), 0);
-    assert_int_equal(config_file_sets(DIR "/sets-link", "exposures_us"), 1);
+    /* a loaded file that sets it, then one that does not: the flag is the second file's */
+    assert_int_equal(config_load(&cfg, path, err, sizeof(err)), 0);
+    assert_int_equal(cfg.exposures_us.given, 0);
 }
 
 static void test_overlong_line_refused(void **state)
