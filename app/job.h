@@ -151,13 +151,15 @@ int job_view_for_model(struct job *j, const char *scan_dir, uint32_t v, struct s
                        struct scan_view_info *info);
 
 /* ---- job_texture.c ---- */
-/** The texture atlas of the prepared mesh ([output] texture): charts, every view's colour,
- *  texture.png and mesh.mtl beside the mesh; @p said tells what was made, for the mesh's line;
- *  @p png, @p png_len: the texture's PNG for mesh.glb, the caller's to free. A texture that
- *  cannot be made is said (a warning) and left out: the vertex colours stand.
- *  @retval 0 made @retval -errno not made (*png NULL) */
-int job_make_texture(struct job *j, const char *scan_dir, char *said, size_t said_len,
-                     uint8_t **png, size_t *png_len);
+/** The views' colour on the prepared mesh (atlas.h): every vertex a view saw takes their
+ *  weighted colour (16 bits), and with [output] texture the texture atlas (texture.png and
+ *  mesh.mtl beside the mesh); @p said tells what was made, for the mesh's line; @p png,
+ *  @p png_len: the texture's PNG for mesh.glb, the caller's to free (NULL: none). What cannot be
+ *  made is said (a warning) and left out: without a texture the vertex colours stand, without
+ *  the views' the fusion grid's.
+ *  @retval 0 (a texture made when *png is not NULL) @retval -errno the views' colours not made */
+int job_colour_mesh(struct job *j, const char *scan_dir, char *said, size_t said_len, uint8_t **png,
+                    size_t *png_len);
 
 /* ---- job_offline.c ---- */
 /** Frame @p f of view @p v read from @p scan_dir into the firmware's buffer for it. */

@@ -75,8 +75,9 @@ static int write_model(struct job *j, const char *scan_dir)
     char texture[256] = "";
     uint8_t *png = NULL; /* the texture, once encoded: texture.png and inside mesh.glb */
     size_t png_len = 0;
-    int textured = fits && rc == 0 && j->cfg->texture &&
-                   job_make_texture(j, scan_dir, texture, sizeof(texture), &png, &png_len) == 0;
+    if (fits && rc == 0)
+        (void)job_colour_mesh(j, scan_dir, texture, sizeof(texture), &png, &png_len); /* said */
+    int textured = png != NULL;
     for (int k = 0; k < 2 && !textured; k++) { /* an earlier model's texture is not this one's */
         static const char *const texture_files[] = {SCAN_FILE_TEXTURE, SCAN_FILE_MESH_MTL};
         int gone = scan_dir_remove(j->out_dir, -1, texture_files[k]);

@@ -203,7 +203,8 @@ static int carve(struct atlas *a, const struct fusion_volume *vol, void *work, s
         return -ENOSPC;
     a->chart = work;
     a->vertex_cam = (float *)(void *)(a->chart + ATLAS_MAX_CHARTS);
-    a->tri_chart = (uint32_t *)(void *)(a->vertex_cam + 5 * nv);
+    a->vertex_accum = a->vertex_cam + 5 * nv;
+    a->tri_chart = (uint32_t *)(void *)(a->vertex_accum + 4 * nv);
     a->vertex_tri = a->tri_chart + nt;
     a->tri_axis = (uint8_t *)(void *)(a->vertex_tri + nv);
     uintptr_t texel_start = ((uintptr_t)(a->tri_axis + nt) + 7u) & ~(uintptr_t)7u;
@@ -225,14 +226,21 @@ int atlas_build(struct atlas *a, const struct fusion_volume *vol, double texel_m
                 size_t work_bytes, struct atlas_report *rep)
 {
     memset(rep, 0, sizeof(*rep));
+    a->built = 0;
     a->width = a->height = a->chart_count = 0;
-    if (!vol->mp.prepared || !(texel_mm > 0.0) || work == NULL || ((uintptr_t)work & 7u) != 0)
+    if (!vol->mp.prepared || !(texel_mm >= 0.0) || work == NULL || ((uintptr_t)work & 7u) != 0)
         return -EINVAL;
     if (!vol->mp.fits)
         return -E2BIG;
     int rc = carve(a, vol, work, work_bytes);
     if (rc != 0)
         return rc;
+    memset(a->vertex_accum, 0, 4 * sizeof(float) * (size_t)vol->mp.s.vertices);
+    if (texel_mm == 0.0) { /* no texture: the vertices' colours only */
+        place_texels(a, 0);
+        a->built = 1;
+        return 0;
+    }
     double(*far_uv)[2] = (double(*)[2])(void *)a->accum;
     uint64_t *keys = (uint64_t *)(void *)(far_uv + ATLAS_MAX_CHARTS);
     rc = make_charts(a, vol, far_uv);
@@ -268,6 +276,7 @@ int atlas_build(struct atlas *a, const struct fusion_volume *vol, double texel_m
     place_texels(a, (size_t)a->width * a->height);
     memset(a->accum, 0, (size_t)a->width * a->height * 4 * sizeof(a->accum[0]));
     assign_texels(a, vol);
+    a->built = 1;
     rep->width = a->width, rep->height = a->height;
     rep->texel_mm = a->texel_mm;
     rep->charts = a->chart_count;
@@ -395,14 +404,12 @@ static void view_triangle(struct view_ctx *s, const struct fusion_volume *vol, u
     s->t = t;
 }
 
-/* One texel of the triangle seen by the view (atlas_add_view): where it is seen and its depth
- * interpolated from the corners' (a triangle spans a pixel or two: the lens's bending and the
- * perspective's across it are thousandths of a pixel). */
-static void view_texel(struct view_ctx *s, size_t texel, const double l[3])
+/* The view's colour about pixel (@p fu, @p fv) of a surface point at depth @p z, bilinear over
+ * the pixels that measured the surface there (their depth within @p ray: the point's distance
+ * over its depth, times the tolerance), weighed, added to @p acc (colour and weight). */
+static void sample(const struct view_ctx *s, double fu, double fv, double z, double ray,
+                   float acc[4])
 {
-    double fu = l[0] * s->u[0] + l[1] * s->u[1] + l[2] * s->u[2];
-    double fv = l[0] * s->v[0] + l[1] * s->v[1] + l[2] * s->v[2];
-    double z = l[0] * s->z[0] + l[1] * s->z[1] + l[2] * s->z[2];
     if (!(fu >= 0.0 && fv >= 0.0))
         return;
     long x0 = (long)fu, y0 = (long)fv;
@@ -411,7 +418,7 @@ static void view_texel(struct view_ctx *s, size_t texel, const double l[3])
     const double fx = fu - x0, fy = fv - y0;
     const double wx[2] = {1.0 - fx, fx}, wy[2] = {1.0 - fy, fy};
     const size_t first = (size_t)y0 * s->m->width + (size_t)x0;
-    const double z_tol = s->depth_tol_mm / s->ray;
+    const double z_tol = s->depth_tol_mm / ray;
     double sum[3] = {0.0, 0.0, 0.0}, wsum = 0.0;
     for (int q = 0; q < 4; q++) {
         size_t i = first + (q / 2 ? s->m->width : 0u) + (size_t)(q % 2);
@@ -423,17 +430,42 @@ static void view_texel(struct view_ctx *s, size_t texel, const double l[3])
             sum[k] += w * s->rgb[3 * i + k];
         wsum += w;
     }
-    float *acc = &s->a->accum[4 * texel];
     for (int k = 0; k < 3; k++)
         acc[k] += (float)sum[k];
     acc[3] += (float)wsum;
+}
+
+/* One texel of the triangle seen by the view (atlas_add_view): where it is seen and its depth
+ * interpolated from the corners' (a triangle spans a pixel or two: the lens's bending and the
+ * perspective's across it are thousandths of a pixel). */
+static void view_texel(struct view_ctx *s, size_t texel, const double l[3])
+{
+    double fu = l[0] * s->u[0] + l[1] * s->u[1] + l[2] * s->u[2];
+    double fv = l[0] * s->v[0] + l[1] * s->v[1] + l[2] * s->v[2];
+    double z = l[0] * s->z[0] + l[1] * s->z[1] + l[2] * s->z[2];
+    sample(s, fu, fv, z, s->ray, &s->a->accum[4 * texel]);
+}
+
+/* Each vertex that faces the view (its normal against the ray to it) and lies in front of the
+ * camera: the view's colour there (vertex_cam: where the view sees it). */
+static void view_vertices(struct view_ctx *s, const struct fusion_volume *vol,
+                          const struct frame_xform *obj_from_cam)
+{
+    for (uint32_t v = 0; v < vol->mp.s.vertices; v++) {
+        const float *c = &s->a->vertex_cam[5 * (size_t)v], *n = &vol->mesh_nrm[3 * (size_t)v];
+        vec3 p = v3(c[0], c[1], c[2]);
+        if (vol->mesh_index[v] == MESH_DROPPED || c[2] <= 1.0f ||
+            v3_dot(frame_dir_inv(obj_from_cam, v3(n[0], n[1], n[2])), p) >= 0.0)
+            continue;
+        sample(s, c[3], c[4], c[2], v3_len(p) / p.z, &s->a->vertex_accum[4 * (size_t)v]);
+    }
 }
 
 int atlas_add_view(struct atlas *a, struct fusion_volume *vol, const struct scan_calib *calib,
                    const struct frame_xform *obj_from_cam, const struct decode_maps *maps,
                    const struct tri_range *range, const uint8_t *rgb, const float *confidence)
 {
-    if (a->width == 0)
+    if (!a->built)
         return -EINVAL;
     const float *weight = fusion_view_weights(vol, calib, maps, range);
     if (weight == NULL)
@@ -460,6 +492,9 @@ int atlas_add_view(struct atlas *a, struct fusion_volume *vol, const struct scan
             camray_project(calib, p, &u, &w);
         c[0] = (float)p.x, c[1] = (float)p.y, c[2] = (float)p.z, c[3] = (float)u, c[4] = (float)w;
     }
+    view_vertices(&s, vol, obj_from_cam);
+    if (a->width == 0)
+        return 0; /* no texture */
     for (uint32_t c = 0; c < a->chart_count; c++)
         a->chart[c].facing = 0;
     for (uint32_t t = 0; t < vol->mp.s.triangles; t++) {
@@ -515,7 +550,7 @@ static void mesh_texel(struct atlas *a, const struct fusion_volume *vol, size_t 
         double c = 0.0;
         for (int j = 0; j < 3; j++)
             c += bary[j] * vol->mesh_rgb[3 * (size_t)tri_at(vol, t)[j] + (size_t)k];
-        acc[k] = (float)c;
+        acc[k] = (float)(c / 257.0); /* the texels' scale: a linear byte */
     }
     acc[3] = FROM_MESH;
 }
@@ -554,10 +589,34 @@ static void fill_gutters(struct atlas *a, int passes)
     }
 }
 
-int atlas_finish(struct atlas *a, const struct fusion_volume *vol, uint32_t *uncoloured)
+/* Each vertex a view saw: its weighted colour into the tables, 16 bits (a linear byte x 257).
+ * @retval the vertices coloured */
+static uint32_t finish_vertices(const struct atlas *a, struct fusion_volume *vol)
 {
-    if (a->width == 0)
+    uint32_t seen = 0;
+    for (uint32_t v = 0; v < vol->mp.s.vertices; v++) {
+        const float *acc = &a->vertex_accum[4 * (size_t)v];
+        if (!(acc[3] > 0.0f))
+            continue;
+        for (int k = 0; k < 3; k++) {
+            double c = acc[k] / acc[3] * 257.0 + 0.5;
+            vol->mesh_rgb[3 * (size_t)v + (size_t)k] = (uint16_t)(c < 0.0            ? 0.0
+                                                                  : c > MESH_RGB_ONE ? MESH_RGB_ONE
+                                                                                     : c);
+        }
+        vol->mesh_coloured[v] = 1;
+        seen++;
+    }
+    return seen;
+}
+
+int atlas_finish(struct atlas *a, struct fusion_volume *vol, uint32_t *uncoloured,
+                 uint32_t *vertices)
+{
+    *uncoloured = *vertices = 0;
+    if (!a->built)
         return -EINVAL;
+    *vertices = finish_vertices(a, vol); /* first: a texel no view saw takes them */
     const size_t n = (size_t)a->width * a->height;
     for (size_t i = 0; i < n; i++) {
         float *acc = &a->accum[4 * i];

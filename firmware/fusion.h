@@ -122,12 +122,17 @@ int fusion_fill_holes(struct fusion_volume *vol, double max_hole_mm, uint32_t *f
 int fusion_close_watertight(struct fusion_volume *vol, double max_hole_mm, int one_pass,
                             uint32_t *inside);
 
-/** A vertex of the mesh: object frame, mm; its colour linear (0..255), and whether any view gave
- *  the surface there a colour estimate (else rgb is 0 and the writers fill it from the mesh
- *  around it: mesh_io.c). */
+/** A vertex's colour channel at full scale (mesh_vertex.rgb, linear): 16 bits, so that the mean
+ *  of several views keeps the shades between two linear bytes (on a paint of albedo 0.03 a byte
+ *  is a step of 13%). A linear byte b is b x 257. */
+#define MESH_RGB_ONE 65535u
+
+/** A vertex of the mesh: object frame, mm; its colour linear (0..MESH_RGB_ONE), and whether any
+ *  view gave the surface there a colour estimate (else rgb is 0 and the writers fill it from the
+ *  mesh around it: mesh_io.c). */
 struct mesh_vertex {
     float pos[3], normal[3];
-    uint8_t rgb[3];
+    uint16_t rgb[3];
     uint8_t coloured;
 };
 
@@ -271,7 +276,7 @@ struct fusion_volume {
     /* the prepared mesh (mesh_io.c) */
     float mesh_pos[MESH_MAX_VERTICES * 3];
     float mesh_nrm[MESH_MAX_VERTICES * 3];
-    uint8_t mesh_rgb[MESH_MAX_VERTICES * 3];
+    uint16_t mesh_rgb[MESH_MAX_VERTICES * 3]; /* linear, 0..MESH_RGB_ONE */
     uint8_t mesh_coloured[MESH_MAX_VERTICES]; /* 1: a view gave the surface there a colour */
     uint32_t mesh_tri[MESH_MAX_TRIANGLES * 3];
     uint32_t mesh_index[MESH_MAX_VERTICES]; /* union-find parent; after prepare, new number or

@@ -87,7 +87,10 @@ static int normal_vertex(void *priv, const struct mesh_vertex *v)
 static int colour_vertex(void *priv, const struct mesh_vertex *v)
 {
     struct outbuf *o = priv;
-    const uint8_t rgba[4] = {v->rgb[0], v->rgb[1], v->rgb[2], 255};
+    /* normalized bytes, linear (the vertex's 16 bits rounded: a viewer shows no more) */
+    uint8_t rgba[4] = {0, 0, 0, 255};
+    for (int k = 0; k < 3; k++)
+        rgba[k] = (uint8_t)((v->rgb[k] + 128u) / 257u);
     outbuf_put(o, rgba, 4);
     return o->rc;
 }
@@ -249,7 +252,8 @@ static int scan_vertex(void *priv, const struct mesh_vertex *v)
         gs->bounds.lo[k] = q[k] < gs->bounds.lo[k] ? q[k] : gs->bounds.lo[k];
         gs->bounds.hi[k] = q[k] > gs->bounds.hi[k] ? q[k] : gs->bounds.hi[k];
     }
-    double rho[3] = {v->rgb[0] / 255.0, v->rgb[1] / 255.0, v->rgb[2] / 255.0};
+    double rho[3] = {(double)v->rgb[0] / MESH_RGB_ONE, (double)v->rgb[1] / MESH_RGB_ONE,
+                     (double)v->rgb[2] / MESH_RGB_ONE};
     gs->vertex_part[gs->vertices++] = m != NULL ? (uint8_t)reflect_cluster_of(m, rho) : 0;
     return 0;
 }

@@ -145,7 +145,7 @@ static int fan_loop(struct fusion_volume *vol, const uint32_t *loop, uint32_t le
     for (int i = 0; i < 3; i++) {
         vol->mesh_pos[3 * (size_t)c + i] = (float)pos[i];
         vol->mesh_nrm[3 * (size_t)c + i] = nl > 0.0 ? (float)(nrm[i] / nl) : 0.0f;
-        vol->mesh_rgb[3 * (size_t)c + i] = coloured > 0 ? (uint8_t)lround(rgb[i] / coloured)
+        vol->mesh_rgb[3 * (size_t)c + i] = coloured > 0 ? (uint16_t)lround(rgb[i] / coloured)
                                                         : vol->mesh_rgb[3 * (size_t)loop[0] + i];
     }
     vol->mesh_coloured[c] = coloured > 0 || vol->mesh_coloured[loop[0]];

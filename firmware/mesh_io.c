@@ -27,7 +27,7 @@ static int keep_vertex(void *priv, const struct mesh_vertex *mv)
     if (v < MESH_MAX_VERTICES) {
         memcpy(&vol->mesh_pos[3 * (size_t)v], mv->pos, 3 * sizeof(float));
         memcpy(&vol->mesh_nrm[3 * (size_t)v], mv->normal, 3 * sizeof(float));
-        memcpy(&vol->mesh_rgb[3 * (size_t)v], mv->rgb, 3);
+        memcpy(&vol->mesh_rgb[3 * (size_t)v], mv->rgb, sizeof(mv->rgb));
         vol->mesh_coloured[v] = mv->coloured;
         vol->mesh_index[v] = v;
     }
@@ -107,7 +107,8 @@ static void colour_fill(struct fusion_volume *vol)
             if (vol->mesh_tris[v] == NO_SOURCE)
                 continue;
             /* sources were coloured before this pass: one ring a pass, whatever the numbering */
-            memcpy(&vol->mesh_rgb[3 * (size_t)v], &vol->mesh_rgb[3 * (size_t)vol->mesh_tris[v]], 3);
+            memcpy(&vol->mesh_rgb[3 * (size_t)v], &vol->mesh_rgb[3 * (size_t)vol->mesh_tris[v]],
+                   3 * sizeof(vol->mesh_rgb[0]));
             filled++;
         }
         for (uint32_t v = 0; v < n; v++)
@@ -119,7 +120,8 @@ static void colour_fill(struct fusion_volume *vol)
     }
     for (uint32_t v = 0; v < n && missing > 0; v++)
         if (vol->mesh_index[v] != MESH_DROPPED && !vol->mesh_coloured[v]) {
-            memset(&vol->mesh_rgb[3 * (size_t)v], GREY_LINEAR, 3);
+            for (int k = 0; k < 3; k++)
+                vol->mesh_rgb[3 * (size_t)v + (size_t)k] = GREY_LINEAR * 257u;
             vol->mp.s.uncoloured++;
         }
 }
@@ -192,7 +194,7 @@ static int ply_vertex(void *priv, const struct mesh_vertex *v)
 {
     struct outbuf *o = priv;
     const float *p = v->pos, *n = v->normal;
-    ply_put_vertex(o, v3(p[0], p[1], p[2]), v3(n[0], n[1], n[2]), v->rgb);
+    ply_put_vertex16(o, v3(p[0], p[1], p[2]), v3(n[0], n[1], n[2]), v->rgb);
     return o->rc;
 }
 
@@ -255,7 +257,7 @@ static int obj_vertex(void *priv, const struct mesh_vertex *v)
 {
     struct outbuf *o = priv;
     const float *p = v->pos, *n = v->normal;
-    const uint8_t *rgb = v->rgb;
+    const uint16_t *rgb = v->rgb;
     /* "v x y z r g b": vertex colours as MeshLab, Blender and Open3D read them (and show them:
      * sRGB-encoded, see srgb.h). Y up, as OBJ readers assume (Blender's importer turns Y up
      * into its Z up): the object frame's (x, y, z) with z up is written (x, z, -y), a
@@ -263,9 +265,9 @@ static int obj_vertex(void *priv, const struct mesh_vertex *v)
     const double vertex[6] = {p[0],
                               p[2],
                               -p[1],
-                              srgb_encode(rgb[0]) / 255.0,
-                              srgb_encode(rgb[1]) / 255.0,
-                              srgb_encode(rgb[2]) / 255.0};
+                              srgb_encode16(rgb[0]) / 255.0,
+                              srgb_encode16(rgb[1]) / 255.0,
+                              srgb_encode16(rgb[2]) / 255.0};
     const double normal[3] = {n[0], n[2], -n[1]};
     obj_numbers(o, "v", vertex, 6, 4);
     obj_numbers(o, "vn", normal, 3, 5);

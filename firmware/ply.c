@@ -13,7 +13,10 @@ static uint32_t count_valid(const struct decode_maps *maps)
     return n;
 }
 
-void ply_put_vertex(struct outbuf *o, vec3 p, vec3 n, const uint8_t rgb[3])
+/* A vertex: its position and normal, @p encoded (sRGB bytes: viewers show 8-bit colours as
+ * sRGB), then the linear values @p num / @p den as floats. */
+static void put_vertex(struct outbuf *o, vec3 p, vec3 n, const uint8_t encoded[3],
+                       const float num[3], float den)
 {
     outbuf_f32le(o, (float)p.x);
     outbuf_f32le(o, (float)p.y);
@@ -21,11 +24,24 @@ void ply_put_vertex(struct outbuf *o, vec3 p, vec3 n, const uint8_t rgb[3])
     outbuf_f32le(o, (float)n.x);
     outbuf_f32le(o, (float)n.y);
     outbuf_f32le(o, (float)n.z);
-    /* viewers show 8-bit colours as sRGB; the fused linear values follow as floats */
-    const uint8_t encoded[3] = {srgb_encode(rgb[0]), srgb_encode(rgb[1]), srgb_encode(rgb[2])};
     outbuf_put(o, encoded, 3);
     for (int k = 0; k < 3; k++)
-        outbuf_f32le(o, rgb[k] / 255.0f);
+        outbuf_f32le(o, num[k] / den);
+}
+
+void ply_put_vertex(struct outbuf *o, vec3 p, vec3 n, const uint8_t rgb[3])
+{
+    const uint8_t encoded[3] = {srgb_encode(rgb[0]), srgb_encode(rgb[1]), srgb_encode(rgb[2])};
+    const float num[3] = {rgb[0], rgb[1], rgb[2]};
+    put_vertex(o, p, n, encoded, num, 255.0f);
+}
+
+void ply_put_vertex16(struct outbuf *o, vec3 p, vec3 n, const uint16_t rgb[3])
+{
+    const uint8_t encoded[3] = {srgb_encode16(rgb[0]), srgb_encode16(rgb[1]),
+                                srgb_encode16(rgb[2])};
+    const float num[3] = {rgb[0], rgb[1], rgb[2]};
+    put_vertex(o, p, n, encoded, num, 65535.0f);
 }
 
 void ply_put_header(struct outbuf *o, const char *what, uint32_t vertices, uint32_t faces,

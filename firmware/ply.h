@@ -31,4 +31,8 @@ void ply_put_header(struct outbuf *o, const char *what, uint32_t vertices, uint3
  *  float red_linear green_linear blue_linear (@p rgb / 255): 39 bytes. */
 void ply_put_vertex(struct outbuf *o, vec3 pos, vec3 normal, const uint8_t rgb[3]);
 
+/** The same with a 16-bit linear colour (0..65535, a mesh vertex's: fusion.h MESH_RGB_ONE); a
+ *  linear byte b given as b x 257 is written as ply_put_vertex writes b. */
+void ply_put_vertex16(struct outbuf *o, vec3 pos, vec3 normal, const uint16_t rgb[3]);
+
 #endif

@@ -27,19 +27,25 @@ uint8_t srgb_encode(uint8_t linear)
     return encode_table[linear];
 }
 
-#define FINE_STEPS 4096
-uint8_t srgb_encode_unit(double linear)
+/* The formula at every 16-bit linear value, made on the first call (64 KB: a pow() per channel
+ * of a texture's millions of texels cost a third of its time). */
+uint8_t srgb_encode16(uint16_t linear)
 {
-    static uint8_t fine[FINE_STEPS]; /* the formula at i / (FINE_STEPS - 1), made on first use */
+    static uint8_t fine[65536];
     static int made;
     if (!made) {
-        for (int i = 0; i < FINE_STEPS; i++) {
-            double x = (double)i / (FINE_STEPS - 1);
-            double e = x < 0.0031308 ? 12.92 * x : 1.055 * pow(x, 1.0 / 2.4) - 0.055;
-            fine[i] = (uint8_t)lround(255.0 * e);
+        for (int i = 0; i < 65536; i++) {
+            double x = (double)i / 65535.0;
+            double e = x <= 0.0031308 ? 12.92 * x : 1.055 * pow(x, 1.0 / 2.4) - 0.055;
+            fine[i] = (uint8_t)(255.0 * e + 0.5);
         }
         made = 1;
     }
+    return fine[linear];
+}
+
+uint8_t srgb_encode_unit(double linear)
+{
     double x = linear < 0.0 ? 0.0 : linear > 1.0 ? 1.0 : linear;
-    return fine[(int)(x * (FINE_STEPS - 1) + 0.5)]; /* rounded (lround's call cost a third) */
+    return srgb_encode16((uint16_t)(x * 65535.0 + 0.5)); /* rounded (lround's call cost a third) */
 }

@@ -28,8 +28,16 @@ void sim_mesh_free(struct sim_mesh *m)
     free(m->normal);
     free(m->tri);
     free(m->rgb);
+    free(m->lin);
     free(m->quality);
     memset(m, 0, sizeof(*m));
+}
+
+void sim_mesh_linear(const struct sim_mesh *m, uint32_t i, double out[3])
+{
+    for (int k = 0; k < 3; k++)
+        out[k] = m->lin != NULL ? m->lin[3 * (size_t)i + (size_t)k]
+                                : m->rgb[3 * (size_t)i + (size_t)k] / 255.0;
 }
 
 static void set_vert(struct sim_mesh *m, uint32_t i, vec3 p)

@@ -11,8 +11,14 @@ struct sim_mesh {
     uint32_t *tri;  /**< 3 vertex indices per triangle, counter-clockwise seen from outside */
     uint8_t *rgb;   /**< 3 per vertex when the PLY file has vertex colours, else NULL; the linear
                        floats (red_linear...) where the file has them, else its bytes as they are */
+    float *lin;     /**< 3 per vertex, 0..1, when the file has the linear floats, else NULL: the
+                       colour as written, finer than a byte (sim_mesh_linear reads either) */
     float *quality; /**< per vertex when the PLY file has `quality` (clouds: colour confidence) */
 };
+
+/** Vertex @p i's linear colour 0..1: the file's floats where it has them, else its bytes / 255.
+ *  @p m must have colours (rgb not NULL). */
+void sim_mesh_linear(const struct sim_mesh *m, uint32_t i, double out[3]);
 
 /** @retval 0 ok @retval -ENOMEM */
 int sim_mesh_sphere(struct sim_mesh *m, double radius_mm, uint32_t segments);

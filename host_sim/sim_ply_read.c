@@ -252,11 +252,12 @@ static int read_element(FILE *f, const struct ply_header *h, const struct ply_el
                     m->rgb[3 * r + (unsigned long)(p->role - ROLE_RED)] = (uint8_t)(v < 0     ? 0
                                                                                     : v > 255 ? 255
                                                                                               : v);
-                else if (is_vertex && p->role >= ROLE_RED_LINEAR && m->rgb != NULL)
+                else if (is_vertex && p->role >= ROLE_RED_LINEAR && m->rgb != NULL) {
+                    double c = v < 0.0 ? 0.0 : v > 1.0 ? 1.0 : v;
                     m->rgb[3 * r + (unsigned long)(p->role - ROLE_RED_LINEAR)] =
-                        (uint8_t)(v < 0   ? 0
-                                  : v > 1 ? 255
-                                          : v * 255.0 + 0.5);
+                        (uint8_t)(c * 255.0 + 0.5);
+                    m->lin[3 * r + (unsigned long)(p->role - ROLE_RED_LINEAR)] = (float)c;
+                }
                 continue;
             }
             double cnt;
@@ -370,14 +371,17 @@ static int load_ply(struct sim_mesh *m, const char *path, int need_faces, char *
     m->normal = calloc((size_t)m->vert_count * 3, sizeof(float));
     int has_rgb = ply_has_role(&h, ROLE_RED) || ply_has_role(&h, ROLE_RED_LINEAR);
     int has_quality = ply_has_role(&h, ROLE_QUALITY);
-    if (ply_has_role(&h, ROLE_RED_LINEAR))
+    int has_lin = ply_has_role(&h, ROLE_RED_LINEAR);
+    if (has_lin)
         ply_drop_roles(&h, ROLE_RED, ROLE_BLUE); /* the sRGB bytes only repeat them */
     if (has_rgb)
         m->rgb = calloc((size_t)m->vert_count * 3, 1);
+    if (has_lin)
+        m->lin = calloc((size_t)m->vert_count * 3, sizeof(float));
     if (has_quality)
         m->quality = calloc(m->vert_count, sizeof(float));
     if (m->pos == NULL || m->normal == NULL || (has_rgb && m->rgb == NULL) ||
-        (has_quality && m->quality == NULL)) {
+        (has_lin && m->lin == NULL) || (has_quality && m->quality == NULL)) {
         rc = -ENOMEM;
         snprintf(err, err_len, "%s: out of memory", path);
         goto out_free;

@@ -1,6 +1,8 @@
-/* The texture atlas: charts that cover the mesh without overlapping, texture coordinates inside
- * their chart, and a view's colour landing where the view saw it (a sphere painted by octant,
- * seen by a pinhole camera; what no view saw takes the vertex colours). */
+/* The views' colour on the mesh and its texture atlas: charts that cover the mesh without
+ * overlapping, texture coordinates inside their chart, and a view's colour landing where the view
+ * saw it, in the texture and on the vertices, with a texture or without (a sphere painted by
+ * octant, seen by a pinhole camera; what no view saw takes the vertex colours, which keep the
+ * fusion grid's there). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -131,13 +133,9 @@ static void render_view(const struct scan_calib *c, const struct frame_xform *ob
         }
 }
 
-static void test_a_view_colours_what_it_saw(void **state)
+/* The view of test_a_view_colours_what_it_saw, added to the atlas built. */
+static void add_the_view(void)
 {
-    (void)state;
-    struct atlas_report rep;
-    uint32_t uncoloured;
-    prepare_sphere();
-    assert_int_equal(build(0.25, &rep), 0);
     struct scan_calib c = {.cam_fx_px = 800,
                            .cam_fy_px = 800,
                            .cam_cx_px = 319.5,
@@ -154,7 +152,47 @@ static void test_a_view_colours_what_it_saw(void **state)
     struct decode_maps m = {.reason = reason, .width = W, .height = H};
     struct tri_range r = {.xyz_mm = xyz, .normal = normal, .width = W, .height = H};
     assert_int_equal(atlas_add_view(&atlas, &vol, &c, &obj_from_cam, &m, &r, rgb, confidence), 0);
-    assert_int_equal(atlas_finish(&atlas, &vol, &uncoloured), 0);
+}
+
+/* Each vertex facing the camera away from the paint's edges has the paint's colour (16 bits,
+ * from the view's linear bytes); the far side keeps the grid's grey (fusion_fill: 128). */
+static void check_vertices(uint32_t coloured)
+{
+    uint32_t seen = 0, right = 0, back = 0, grey = 0;
+    for (uint32_t v = 0; v < vol.mp.s.vertices; v++) {
+        const float *q = &vol.mesh_pos[3 * (size_t)v];
+        const uint16_t *got = &vol.mesh_rgb[3 * (size_t)v];
+        vec3 p = v3(q[0], q[1], q[2]), from_centre = v3_sub(p, centre);
+        if (from_centre.y < -0.5 * RADIUS && from_boundary(p) > 2.0) {
+            uint8_t want[3];
+            paint(p, want);
+            int ok = 1;
+            for (int k = 0; k < 3; k++)
+                ok &= abs((int)got[k] - 257 * (int)want[k]) <= 257;
+            seen++;
+            right += (uint32_t)ok;
+        } else if (from_centre.y > 0.5 * RADIUS) {
+            back++;
+            grey += got[0] == 128 * 257 && got[1] == 128 * 257 && got[2] == 128 * 257;
+        }
+    }
+    assert_true(seen > 100);
+    assert_int_equal(right, seen);
+    assert_true(back > 100);
+    assert_int_equal(grey, back);
+    assert_true(coloured >= seen && coloured < vol.mp.s.vertices - back);
+}
+
+static void test_a_view_colours_what_it_saw(void **state)
+{
+    (void)state;
+    struct atlas_report rep;
+    uint32_t uncoloured, vertices;
+    prepare_sphere();
+    assert_int_equal(build(0.25, &rep), 0);
+    add_the_view();
+    assert_int_equal(atlas_finish(&atlas, &vol, &uncoloured, &vertices), 0);
+    check_vertices(vertices);
     assert_true(uncoloured > 0); /* the far side: no view */
     uint32_t seen = 0, right = 0, back = 0, grey = 0;
     for (uint32_t t = 0; t < vol.mp.s.triangles; t++) {
@@ -191,20 +229,40 @@ static void test_a_view_colours_what_it_saw(void **state)
     assert_int_equal(grey, back);
 }
 
+/* No texture ([output] texture = 0, texel 0): the vertices take the view's colour all the same,
+ * and there is no texture to place a corner in. */
+static void test_vertices_coloured_without_a_texture(void **state)
+{
+    (void)state;
+    struct atlas_report rep;
+    uint32_t uncoloured, vertices;
+    prepare_sphere();
+    assert_int_equal(build(0.0, &rep), 0);
+    assert_true(rep.width == 0 && rep.height == 0 && rep.charts == 0);
+    add_the_view();
+    assert_int_equal(atlas_finish(&atlas, &vol, &uncoloured, &vertices), 0);
+    assert_int_equal(uncoloured, 0);
+    check_vertices(vertices);
+    float uv[2];
+    assert_int_equal(atlas_uv(&atlas, &vol, 0, 0, uv), -EINVAL);
+    assert_int_equal(atlas_vertex_uv(&atlas, &vol, 0, uv), -EINVAL);
+}
+
 static void test_unprepared_or_no_texel_refused(void **state)
 {
     (void)state;
     struct atlas_report rep;
-    uint32_t n;
+    uint32_t n, nv;
     static uint64_t work[1u << 16]; /* 512 KB */
     memset(&vol.mp, 0, sizeof(vol.mp));
     size_t bytes;
     assert_null(fusion_spend_grid(&vol, &bytes)); /* no mesh made: the grid is the model's */
     assert_int_equal(atlas_build(&atlas, &vol, 0.25, work, sizeof(work), &rep), -EINVAL);
-    assert_int_equal(atlas_finish(&atlas, &vol, &n), -EINVAL);
+    assert_int_equal(atlas_finish(&atlas, &vol, &n, &nv), -EINVAL);
     prepare_sphere();
-    assert_int_equal(atlas_build(&atlas, &vol, 0.0, work, sizeof(work), &rep), -EINVAL);
+    assert_int_equal(atlas_build(&atlas, &vol, -0.25, work, sizeof(work), &rep), -EINVAL);
     assert_int_equal(atlas_build(&atlas, &vol, NAN, work, sizeof(work), &rep), -EINVAL);
+    assert_int_equal(atlas_build(&atlas, &vol, 0.0, work, sizeof(work), &rep), -ENOSPC);
     assert_int_equal(atlas_build(&atlas, &vol, 0.25, NULL, sizeof(work), &rep), -EINVAL);
     assert_int_equal(atlas_build(&atlas, &vol, 0.25, (char *)work + 4, 1000, &rep), -EINVAL);
     /* a work space too small for the charts' own bookkeeping */
@@ -234,6 +292,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_charts_cover_the_mesh_without_overlap),
         cmocka_unit_test(test_a_view_colours_what_it_saw),
+        cmocka_unit_test(test_vertices_coloured_without_a_texture),
         cmocka_unit_test(test_unprepared_or_no_texel_refused),
         cmocka_unit_test(test_too_fine_a_texel_grows_until_it_fits),
     };

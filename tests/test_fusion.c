@@ -366,7 +366,7 @@ static int check_colour(void *priv, const struct mesh_vertex *v)
 {
     struct colour_check *c = priv;
     c->vertices++;
-    c->red += v->rgb[0] == 200 && v->rgb[1] == 30 && v->rgb[2] == 20;
+    c->red += v->rgb[0] == 200 * 257 && v->rgb[1] == 30 * 257 && v->rgb[2] == 20 * 257;
     c->not_coloured += !v->coloured;
     return 0;
 }

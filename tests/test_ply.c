@@ -91,6 +91,23 @@ static void test_srgb_table(void **state)
     assert_int_equal(srgb_encode(46), 118); /* 18% grey reads as the middle of the scale */
 }
 
+/* A mesh vertex's 16-bit linear colour: a linear byte b given as b x 257 is encoded as the table
+ * encodes b (a vertex the fusion grid coloured is written as before); every value the formula
+ * rounded, rising. */
+static void test_srgb_of_sixteen_bits(void **state)
+{
+    (void)state;
+    for (int b = 0; b < 256; b++)
+        assert_int_equal(srgb_encode16((uint16_t)(b * 257)), srgb_encode((uint8_t)b));
+    for (int i = 0; i <= 65535; i++) {
+        double x = i / 65535.0;
+        double e = x <= 0.0031308 ? 12.92 * x : 1.055 * pow(x, 1.0 / 2.4) - 0.055;
+        assert_true(fabs(srgb_encode16((uint16_t)i) - e * 255.0) <= 0.5);
+        if (i > 0)
+            assert_true(srgb_encode16((uint16_t)i) >= srgb_encode16((uint16_t)(i - 1)));
+    }
+}
+
 /* outbuf_fixed and outbuf_u32 (the OBJ writer's numbers) write what printf's "%.*f" and "%u"
  * write: values of a mesh (mm, unit normals, colours, texture coordinates), their negatives,
  * negative zero, exact halves at the last digit (rounded to even, as printf), and values beyond
@@ -149,6 +166,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_srgb_table),
+        cmocka_unit_test(test_srgb_of_sixteen_bits),
         cmocka_unit_test(test_outbuf_numbers),
         cmocka_unit_test(test_ply_roundtrip),
     };

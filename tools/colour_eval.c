@@ -232,9 +232,10 @@ static int cloud_colour(const struct cloud *c, vec3 p, uint8_t rgb[3], double *m
                     if (v3_len(v3_sub(p, v3(q[0], q[1], q[2]))) >= MATCH_MM ||
                         (c->pts.quality != NULL && c->pts.quality[i] <= 0.0f))
                         continue; /* no colour estimate there (saturated, every light grazing) */
-                    double w = c->pts.quality != NULL ? c->pts.quality[i] : 1.0;
+                    double w = c->pts.quality != NULL ? c->pts.quality[i] : 1.0, lin[3];
+                    sim_mesh_linear(&c->pts, i, lin);
                     for (int k = 0; k < 3; k++)
-                        sum[k] += w * c->pts.rgb[3 * i + (size_t)k];
+                        sum[k] += w * 255.0 * lin[k];
                     weight += w;
                     count++;
                 }
@@ -318,8 +319,7 @@ static int highlight_shares(const struct sim_mesh *res, const struct vertex_eval
     }
     for (uint32_t i = 0; i < res->vert_count; i++) {
         double got[3];
-        for (int k = 0; k < 3; k++)
-            got[k] = res->rgb[3 * i + k] / 255.0;
+        sim_mesh_linear(res, i, got);
         paint[i] = -1;
         if (ve[i].usable && white_fit(got, ve[i].albedo, &fa[i], &fb[i]) == 0)
             paint[i] = paint_index(paints, &npaint, ve[i].albedo);
@@ -459,10 +459,9 @@ static int cmd_measure(const char *scan_dir, const char *result_dir, const char 
         if (true_albedo(&r, q, albedo, &ve[i].dark) != 0)
             continue;
         ve[i].usable = 1;
-        for (int k = 0; k < 3; k++) {
-            got[k] = res.rgb[3 * i + k] / 255.0;
+        sim_mesh_linear(&res, i, got);
+        for (int k = 0; k < 3; k++)
             mae[k] += fabs(got[k] - albedo[k]);
-        }
         colour_linear_rgb_to_lab(albedo, ve[i].lab_true);
         colour_linear_rgb_to_lab(got, ve[i].lab_got);
         de[used] = colour_ciede2000(ve[i].lab_true, ve[i].lab_got);
@@ -573,9 +572,11 @@ static void render_panel(const struct sim_mesh *m, const struct sim_bvh *bvh,
             vec3 p = v3(0, 0, 0);
             for (int k = 0; k < 3; k++) {
                 const float *pp = &m->pos[3 * tv[k]];
+                double got[3];
                 p = v3_add(p, v3_scale(v3(pp[0], pp[1], pp[2]), w[k]));
+                sim_mesh_linear(m, tv[k], got);
                 for (int c = 0; truth_of == NULL && c < 3; c++)
-                    lin[c] += w[k] * m->rgb[3 * tv[k] + c] / 255.0;
+                    lin[c] += w[k] * got[c];
             }
             if (truth_of != NULL)
                 sim_albedo_at(&truth_of->cfg.sim, truth_of->height_mm, p, lin);

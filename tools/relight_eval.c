@@ -101,9 +101,11 @@ static int model_at(const struct sim_mesh *m, const struct sim_bvh *bvh,
     vec3 n = v3(0, 0, 0);
     for (int k = 0; k < 3; k++) {
         const float *nn = &m->normal[3 * tv[k]];
+        double lin[3];
         n = v3_add(n, v3_scale(v3(nn[0], nn[1], nn[2]), w[k]));
+        sim_mesh_linear(m, tv[k], lin);
         for (int c = 0; c < 3; c++)
-            rho[c] += w[k] * m->rgb[3 * tv[k] + c] / 255.0;
+            rho[c] += w[k] * lin[c];
     }
     n = v3_norm(frame_dir_inv(obj, v3_norm(n))); /* to the camera frame */
     vec3 p = v3_scale(v3_norm(p_cam), h.t), to = v3_sub(v3_from(novel_light_mm), p);

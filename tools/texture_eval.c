@@ -142,8 +142,7 @@ static void views_stage(const char *result, const struct app_config *cfg, double
                 continue;
             double albedo[3], got[3], lab_true[3], lab_got[3];
             sim_albedo_at(&cfg->sim, height, q, albedo);
-            for (int k = 0; k < 3; k++)
-                got[k] = c.rgb[3 * i + (size_t)k] / 255.0;
+            sim_mesh_linear(&c, i, got);
             colour_linear_rgb_to_lab(albedo, lab_true);
             colour_linear_rgb_to_lab(got, lab_got);
             if (n == cap)

@@ -64,17 +64,18 @@
 #endif
 #define MESH_MAX_TRIANGLES (2u * MESH_MAX_VERTICES)
 /* The texture atlas (atlas.h): its longer side and its texels, and its charts. It costs no memory
- * of its own: it is made in the fusion grid's, spent once the mesh is (atlas.c asserts it fits).
- * 4 M texels hold 0.36 m^2 of surface at 0.3 mm (a camera pixel at 600 mm), less the packing's
- * waste. */
+ * of its own: it is made in the fusion grid's, spent once the mesh is, beside the vertices'
+ * colours from the views (atlas.c asserts it fits). 3 M texels hold 0.27 m^2 of surface at
+ * 0.3 mm (a camera pixel at 600 mm), less the packing's waste; a larger surface gets a coarser
+ * texel, said. The bunny of make run has 370 charts. */
 #ifdef HAL_LIMITS_SMALL
 #define ATLAS_MAX_SIDE 2048u
 #define ATLAS_MAX_TEXELS (2u << 20)
 #else
 #define ATLAS_MAX_SIDE 4096u
-#define ATLAS_MAX_TEXELS (4u << 20)
+#define ATLAS_MAX_TEXELS (3u << 20)
 #endif
-#define ATLAS_MAX_CHARTS (1u << 16)
+#define ATLAS_MAX_CHARTS (1u << 15)
 /* [colour] method = fit (reflect.h): the light x view samples its lobes are fitted from, ~180
  * bytes each. */
 #ifdef HAL_LIMITS_SMALL
