@@ -77,7 +77,7 @@ int atlas_build(struct atlas *a, const struct fusion_volume *vol, double texel_m
  *  it, projected into the view through @p obj_from_cam, takes the colour about where it lands
  *  (bilinear over valid pixels) when the view measured the surface there (the view's own depth
  *  within two voxels: else the point is hidden or off the view's surface), weighed as fusion
- *  weighs the pixel (fusion.h), squared so the most head-on view dominates, times the colour's
+ *  weighs the pixel (fusion.h: head-on, near, away from the view's edge) times the colour's
  *  @p confidence (NULL: 1).
  *  Uses @p vol's pixel weights (fusion_view_weights): after the mesh is prepared.
  *  @retval 0 @retval -EINVAL no atlas built */
