@@ -99,15 +99,16 @@ int job_colour_mesh(struct job *j, const char *scan_dir, char *said, size_t said
         no_texture(j, rc_tex);
         textured = 0;
     }
+    int n = snprintf(said, said_len, "; %u vertices coloured from the views", (unsigned)vertices);
+    size_t at = n > 0 && (size_t)n < said_len ? (size_t)n : 0;
     if (textured)
-        snprintf(said, said_len,
+        snprintf(said + at, said_len - at,
                  "; texture %u x %u, %.3f mm a texel%s, %u charts, %.0f%% of it used, %u texels "
                  "no view saw (%.2f s CPU)",
                  (unsigned)ar.width, (unsigned)ar.height, ar.texel_mm,
                  ar.texel_mm > texel * 1.01 ? " (the finest that fits)" : "", (unsigned)ar.charts,
                  100.0 * ar.used_share, (unsigned)uncoloured, clock_posix_thread_cpu_s() - t0);
     else
-        snprintf(said, said_len, "; %u vertices coloured from the views (%.2f s CPU)",
-                 (unsigned)vertices, clock_posix_thread_cpu_s() - t0);
+        snprintf(said + at, said_len - at, " (%.2f s CPU)", clock_posix_thread_cpu_s() - t0);
     return 0;
 }
