@@ -574,8 +574,10 @@ static void render_panel(const struct sim_mesh *m, const struct sim_bvh *bvh,
                 const float *pp = &m->pos[3 * tv[k]];
                 double got[3];
                 p = v3_add(p, v3_scale(v3(pp[0], pp[1], pp[2]), w[k]));
+                if (truth_of != NULL)
+                    continue; /* the truth's colour, below: its mesh has none */
                 sim_mesh_linear(m, tv[k], got);
-                for (int c = 0; truth_of == NULL && c < 3; c++)
+                for (int c = 0; c < 3; c++)
                     lin[c] += w[k] * got[c];
             }
             if (truth_of != NULL)
