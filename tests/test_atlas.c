@@ -183,17 +183,24 @@ static void check_vertices(uint32_t coloured)
     assert_true(coloured >= seen && coloured < vol.mp.s.vertices - back);
 }
 
+/* The sphere's atlas at @p texel_mm (0: no texture) coloured by the view, its vertices checked.
+ * @retval the texels no view coloured */
+static uint32_t colour_from_the_view(double texel_mm, struct atlas_report *rep)
+{
+    uint32_t uncoloured, vertices;
+    prepare_sphere();
+    assert_int_equal(build(texel_mm, rep), 0);
+    add_the_view();
+    assert_int_equal(atlas_finish(&atlas, &vol, &uncoloured, &vertices), 0);
+    check_vertices(vertices);
+    return uncoloured;
+}
+
 static void test_a_view_colours_what_it_saw(void **state)
 {
     (void)state;
     struct atlas_report rep;
-    uint32_t uncoloured, vertices;
-    prepare_sphere();
-    assert_int_equal(build(0.25, &rep), 0);
-    add_the_view();
-    assert_int_equal(atlas_finish(&atlas, &vol, &uncoloured, &vertices), 0);
-    check_vertices(vertices);
-    assert_true(uncoloured > 0); /* the far side: no view */
+    assert_true(colour_from_the_view(0.25, &rep) > 0); /* the far side: no view */
     uint32_t seen = 0, right = 0, back = 0, grey = 0;
     for (uint32_t t = 0; t < vol.mp.s.triangles; t++) {
         const uint32_t *tri = &vol.mesh_tri[3 * (size_t)t];
@@ -235,14 +242,8 @@ static void test_vertices_coloured_without_a_texture(void **state)
 {
     (void)state;
     struct atlas_report rep;
-    uint32_t uncoloured, vertices;
-    prepare_sphere();
-    assert_int_equal(build(0.0, &rep), 0);
+    assert_int_equal(colour_from_the_view(0.0, &rep), 0);
     assert_true(rep.width == 0 && rep.height == 0 && rep.charts == 0);
-    add_the_view();
-    assert_int_equal(atlas_finish(&atlas, &vol, &uncoloured, &vertices), 0);
-    assert_int_equal(uncoloured, 0);
-    check_vertices(vertices);
     float uv[2];
     assert_int_equal(atlas_uv(&atlas, &vol, 0, 0, uv), -EINVAL);
     assert_int_equal(atlas_vertex_uv(&atlas, &vol, 0, uv), -EINVAL);
