@@ -39,14 +39,19 @@ ifeq ($(SAN),1)
 BUILD := $(BUILD)/san
 OPT := -O2 -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
 endif
-# Compile-time limits (hal/include/hal_limits.h): default, or small for a board with 512 MB.
-# Every object depends on them, so each set builds in its own directory.
+# Compile-time limits (hal/include/hal_limits.h): default, small for a board with 512 MB, or
+# large for full-resolution frames on a computer with memory to spare. Every object depends on
+# them, so each set builds in its own directory.
 LIMITS ?= default
 ifeq ($(LIMITS),small)
 BUILD := $(BUILD)/small
 LIMITS_CFLAGS := -DHAL_LIMITS_SMALL
+else ifeq ($(LIMITS),large)
+BUILD := $(BUILD)/large
+# more than 2 GB of static buffers: x86-64's medium code model puts them beyond the code's reach
+LIMITS_CFLAGS := -DHAL_LIMITS_LARGE $(if $(filter x86_64,$(shell uname -m)),-mcmodel=medium,)
 else ifneq ($(LIMITS),default)
-$(error LIMITS must be default or small, not '$(LIMITS)')
+$(error LIMITS must be default, small or large, not '$(LIMITS)')
 endif
 
 # HAL=linux objects live apart so that the two builds never mix (also when cross-built).
@@ -130,7 +135,7 @@ FW_OBJ := $(call obj,$(FW_SRC))
 HOST_OBJ := $(call obj,$(POSIX_SRC) $(APP_LIB_SRC) $(BOARD_SRC)) $(if $(filter linux,$(HAL)),$(LIBCAMERA_OBJ),)
 MAIN_OBJ := $(call obj,app/main.c)
 
-.PHONY: help format-check serve test-browser check-blender seccomp-tool vivid-tool all deps opencv-deps test-deps test test-build test-run run-complete linux-build small-build install check-stack size fuzz errors-doc test-arm64 test-arm64-full test-gpio-chip arm64-check-elf arm64-run-tests run clean format docs check-firmware bench measure measure-inverse measure-scan measure-objects interop-meshlab bench-callgrind eval eval-texture eval-cycles calibrate-demo measure-calib measure-calib-sigma measure-calib-advice
+.PHONY: help format-check serve test-browser check-blender seccomp-tool vivid-tool all deps opencv-deps test-deps test test-build test-run run-complete linux-build small-build large-build install check-stack size fuzz errors-doc test-arm64 test-arm64-full test-gpio-chip arm64-check-elf arm64-run-tests run clean format docs check-firmware bench measure measure-inverse measure-scan measure-objects measure-large interop-meshlab bench-callgrind eval eval-texture eval-cycles calibrate-demo measure-calib measure-calib-sigma measure-calib-advice
 SIM_TOOLS := $(if $(filter sim,$(HAL)),$(BUILD)/turntable-sim $(BUILD)/tt-client $(BUILD)/mesh-compare $(BUILD)/colour-eval $(BUILD)/relight-eval $(BUILD)/texture-eval,)
 ## all: build/scanner with the simulator, scanner-calibrate and scanner-web where their libraries are (the default)
 all: deps $(BUILD)/scanner $(CALIB_TOOL) $(WEB_TOOL) $(SIM_TOOLS)

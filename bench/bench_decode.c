@@ -171,6 +171,8 @@ int main(void)
            "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     int rc = run(1280, 960);
     rc |= run(2028, 1520);
+    if (HAL_MAX_PIXELS >= 4896u * 3264u) /* make LIMITS=large: a DSLR's frames, unbinned */
+        rc |= run(4896, 3264);
     printf("\nWhat follows the last frame (codes, reasons, neighbour checks: decode_finish) split "
            "across threads (hal_thread; "
            "this machine has %ld cores online: more threads than cores share them), best of 5 "

@@ -49,3 +49,8 @@ linux-build: deps
 ## small-build: the simulator build with LIMITS=small (a 512 MB board)
 small-build: deps
 	@$(MAKE) --no-print-directory LIMITS=small SAN=$(SAN) $(BUILD)/small/scanner
+# The simulator build with LIMITS=large (full-resolution frames, 3 GB of static buffers), for
+# tests/cli.sh; not under the sanitizers (their shadow of 3 GB of buffers is no test of ours).
+## large-build: the simulator build with LIMITS=large (4928 x 3456 frames)
+large-build: deps
+	@$(MAKE) --no-print-directory LIMITS=large $(BUILD)/large/scanner

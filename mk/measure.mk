@@ -99,6 +99,15 @@ $(BUILD)/bench/bench_decode.o: bench/bench_decode.c | deps
 	@mkdir -p $(dir $@)
 	$(CC) $(HOST_CFLAGS) -Itests -Ibench -c $< -o $@
 
+## measure-large: make run's scan at a DSLR's full 4896 x 3264 by the LIMITS=large build (10 min, 5 GB)
+# and the decode against OpenCV at that size; the build is build/large (BUILD=x: x/large).
+LARGE_BUILD := $(if $(filter large,$(LIMITS)),$(BUILD),$(BUILD)/large)
+measure-large: deps
+	@$(MAKE) --no-print-directory LIMITS=large $(LARGE_BUILD)/scanner $(LARGE_BUILD)/mesh-compare $(LARGE_BUILD)/bench_decode
+	$(LARGE_BUILD)/bench_decode
+	@echo
+	scripts/measure-large.sh $(LARGE_BUILD)
+
 ## bench: benchmarks: decode against OpenCV, frames, stages, memory, fusion, a whole scan
 bench: deps $(BUILD)/bench_view $(BUILD)/bench_decode $(BUILD)/bench_frames $(BUILD)/bench_fusion $(BUILD)/scanner $(BUILD)/mesh-compare
 	@/usr/bin/python3 -c 'import open3d' 2>/dev/null || scripts/install-deps.sh bench

@@ -107,7 +107,7 @@ TEST_JOBS ?= $(shell nproc 2>/dev/null || echo 1)
 test: deps test-deps
 	@$(MAKE) --no-print-directory -j$(TEST_JOBS) test-build
 	@$(MAKE) --no-print-directory test-run
-test-build: format-check $(BUILD)/scanner $(CALIB_TOOL) $(WEB_TOOL) $(SIM_TOOLS) $(BUILD)/seccomp-run $(TEST_BIN) $(FUZZ_REPLAY) check-firmware $(if $(filter 0,$(SAN)),check-stack,) linux-build small-build
+test-build: format-check $(BUILD)/scanner $(CALIB_TOOL) $(WEB_TOOL) $(SIM_TOOLS) $(BUILD)/seccomp-run $(TEST_BIN) $(FUZZ_REPLAY) check-firmware $(if $(filter 0,$(SAN)),check-stack large-build,) linux-build small-build
 test-run: test-build
 	@RUN_WITH="$(VALGRIND_RUN)" BUILD=$(BUILD) tests/run.sh $(TEST_LANES)
 

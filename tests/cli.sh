@@ -336,6 +336,17 @@ check hdr_scan_and_process_agree sh -c "$bin scan --config $out/hdr.ini --out $o
     $bin process $out/hdr-scan --out $out/hdr-processed >/dev/null 2>&1 &&
     cmp $out/hdr-scan/mesh.ply $out/hdr-processed/mesh.ply"
 rm -rf "$out/hdr-scan" "$out/hdr-processed"
+# make LIMITS=large (issue 33): a DSLR's 4896 x 3264 frames, unbinned. The default build refuses
+# the config, naming the compiled limit; the large one takes the frames and goes on to the next
+# check, the calibration of a 1280 x 960 camera (make measure-large scans with one of its own).
+lbin_large=${BUILD:-build}/large/scanner
+sed -e 's/^width = 1280$/width = 4896/' -e 's/^height = 960$/height = 3264/' \
+    -e "s|^calibration = .*|calibration = $PWD/config/sim-calib.ini|" \
+    -e "s|^mesh_file = ../|mesh_file = $PWD/|" config/sim.ini > "$out/dslr.ini"
+[ -x "$lbin_large" ] && check large_limits_take_dslr_frames sh -c "! $bin check-config --config $out/dslr.ini 2> $out/dslr.txt &&
+    grep -q 'width: 4896 exceeds the compiled limit 2048' $out/dslr.txt &&
+    $lbin_large --version > /dev/null && $lbin_large check-config --config $out/dslr.ini 2>&1 |
+    grep -q 'calibration is for a 1280x960 camera but the camera is set to 4896x3264'"
 # make LIMITS=small, for a board with 512 MB: under a 512 MiB address-space limit the default
 # build cannot even start (784 MiB of static buffers), the small one takes the same scan and
 # gives the same model. (ASan reserves terabytes of address space: no limit under SAN=1.)

@@ -13,6 +13,13 @@
  * colour frames; about 335 MiB of static buffers instead of 872 (make size). */
 #define HAL_MAX_WIDTH 1296u
 #define HAL_MAX_HEIGHT 972u
+#elif defined(HAL_LIMITS_LARGE)
+/* make LIMITS=large, for a computer with memory to spare (about 3 GB of static buffers, mapped
+ * as they are used): full-resolution frames of the sensors people put on these rigs, the
+ * Raspberry Pi HQ camera's 4056 x 3040, Camera Module 3's 4608 x 2592, a 16 MP 4608 x 3456 and
+ * the 4896 x 3264 of a DSLR (docs/performance.md). */
+#define HAL_MAX_WIDTH 4928u
+#define HAL_MAX_HEIGHT 3456u
 #else
 /* The Raspberry Pi HQ camera's 2x2 binned mode is 2028 x 1520; leave room for it. */
 #define HAL_MAX_WIDTH 2048u
@@ -49,6 +56,9 @@
 #ifdef HAL_LIMITS_SMALL
 #define FUSION_MAX_DIM 320u
 #define FUSION_MAX_VOXELS (256u * 256u * 224u)
+#elif defined(HAL_LIMITS_LARGE) /* and, spent, the atlas of a 16 MP camera's pixels */
+#define FUSION_MAX_DIM 400u
+#define FUSION_MAX_VOXELS (400u * 400u * 320u)
 #else
 #define FUSION_MAX_DIM 400u
 #define FUSION_MAX_VOXELS (320u * 320u * 280u)
@@ -71,6 +81,9 @@
 #ifdef HAL_LIMITS_SMALL
 #define ATLAS_MAX_SIDE 2048u
 #define ATLAS_MAX_TEXELS (2u << 20)
+#elif defined(HAL_LIMITS_LARGE)
+#define ATLAS_MAX_SIDE 4096u
+#define ATLAS_MAX_TEXELS (4u << 20)
 #else
 #define ATLAS_MAX_SIDE 4096u
 #define ATLAS_MAX_TEXELS (3u << 20)
@@ -116,7 +129,7 @@
 #endif
 
 HAL_STATIC_ASSERT(HAL_MAX_WIDTH % 2u == 0u, "YUYV conversion needs an even width");
-HAL_STATIC_ASSERT(HAL_MAX_PIXELS <= (1u << 23), "pixel indices must fit comfortably in 32 bits");
+HAL_STATIC_ASSERT(HAL_MAX_PIXELS <= (1u << 25), "pixel indices must fit comfortably in 32 bits");
 HAL_STATIC_ASSERT(HAL_MAX_PROJECTOR_WIDTH <= 65535u, "projector columns are stored as uint16_t");
 HAL_STATIC_ASSERT((1u << HAL_MAX_CODE_BITS) >= HAL_MAX_PROJECTOR_WIDTH &&
                       (1u << HAL_MAX_CODE_BITS) >= HAL_MAX_PROJECTOR_HEIGHT,
