@@ -166,7 +166,8 @@ static const struct ini_key config_keys[] = {
          "is refused before it starts"),
     U32("output", "texture", texture, 0, 1, "1",
         "1: the model's colour also as a texture at the camera's resolution (texture.png, with "
-        "mesh.obj's mesh.mtl and inside mesh.glb); vertex colours are kept either way"),
+        "mesh.obj's mesh.mtl and inside mesh.glb); the vertices take the views' colour either "
+        "way, in the same pass"),
     F64("output", "texel_mm", texel_mm, 0, 10, "0",
         "a texel's edge on the object; 0: a camera pixel's at the turntable's axis (larger when "
         "the surface does not fit the compiled texture size, said)"),
