@@ -148,7 +148,7 @@ static int run(uint32_t width, uint32_t height)
              "| %ux%u | %.2f | %.2f (%.2fx) | %.2f (%.2fx) |\n", (unsigned)width, (unsigned)height,
              thread_ms[1], thread_ms[2], thread_ms[1] / thread_ms[2], thread_ms[4],
              thread_ms[1] / thread_ms[4]);
-    printf("| %ux%u | %u | %.1f | %.2f | %.2f | %.2f | **%.0fx** | **%.2fx** | %zu | %zu | %zu | "
+    printf("| %ux%u | %u | %.1f | %.2f | %.2f | %.2f | **%.1fx** | **%.2fx** | %zu | %zu | %zu | "
            "%zu | %ld |\n",
            (unsigned)width, (unsigned)height, (unsigned)patterns, cv_ms, ours_ms, ours_full_ms,
            floor_ms, cv_ms / ours_ms, ours_ms / floor_ms, cv_valid, ours_valid, both, differ, bad);
