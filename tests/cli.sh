@@ -348,7 +348,7 @@ sed -e 's/^width = 1280$/width = 4896/' -e 's/^height = 960$/height = 3264/' \
     $lbin_large --version > /dev/null && $lbin_large check-config --config $out/dslr.ini 2>&1 |
     grep -q 'calibration is for a 1280x960 camera but the camera is set to 4896x3264'"
 # make LIMITS=small, for a board with 512 MB: under a 512 MiB address-space limit the default
-# build cannot even start (784 MiB of static buffers), the small one takes the same scan and
+# build cannot even start (878 MiB of static buffers), the small one takes the same scan and
 # gives the same model. (ASan reserves terabytes of address space: no limit under SAN=1.)
 sbin=${BUILD:-build}/small/scanner
 rm -rf "$out/scan_small"

@@ -10,7 +10,7 @@
 #ifdef HAL_LIMITS_SMALL
 /* make LIMITS=small, for a board with 512 MB (a Pi Zero 2 W, a Pi 3A+): frames up to the Pi
  * camera v1's 2x2 binned mode, 1296 x 972, a smaller fusion grid (fusion.h), no bracketed
- * colour frames; about 335 MiB of static buffers instead of 872 (make size). */
+ * colour frames; about 337 MiB of static buffers instead of 878 (make size). */
 #define HAL_MAX_WIDTH 1296u
 #define HAL_MAX_HEIGHT 972u
 #elif defined(HAL_LIMITS_LARGE)
