@@ -256,7 +256,9 @@ static int read_element(FILE *f, const struct ply_header *h, const struct ply_el
                     double c = v < 0.0 ? 0.0 : v > 1.0 ? 1.0 : v;
                     m->rgb[3 * r + (unsigned long)(p->role - ROLE_RED_LINEAR)] =
                         (uint8_t)(c * 255.0 + 0.5);
-                    m->lin[3 * r + (unsigned long)(p->role - ROLE_RED_LINEAR)] = (float)c;
+                    if (m->lin != NULL) /* kept where red_linear is (a file of bytes and a
+                                           stray float green_linear has none) */
+                        m->lin[3 * r + (unsigned long)(p->role - ROLE_RED_LINEAR)] = (float)c;
                 }
                 continue;
             }

@@ -43,6 +43,40 @@ static void test_bunny_ply_loads(void **state)
     assert_non_null(strstr(err, "not a PLY file"));
 }
 
+/* A scan's mesh.ply carries its colour twice, sRGB bytes and linear floats: the reader keeps the
+ * floats as written (sim_mesh_linear), finer than a byte, and their bytes; a file of bytes with a
+ * stray float channel (no red_linear) keeps bytes only, that channel from its float (it crashed
+ * the reader once: tests/fuzz/crashes/ply/bytes-and-a-stray-linear-float). */
+static void test_ply_linear_colours(void **state)
+{
+    (void)state;
+    struct sim_mesh m;
+    double lin[3];
+    FILE *f = fopen("build/test_sim_linear.ply", "w");
+    assert_non_null(f);
+    fputs("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+          "property float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\n"
+          "property float red_linear\nproperty float green_linear\nproperty float blue_linear\n"
+          "end_header\n1 2 3 9 99 255 0.0123 0.5 1.5\n",
+          f);
+    fclose(f);
+    char err[256];
+    assert_int_equal(sim_mesh_load_ply_points(&m, "build/test_sim_linear.ply", err, sizeof(err)),
+                     0);
+    assert_non_null(m.lin);
+    sim_mesh_linear(&m, 0, lin);
+    assert_true(fabs(lin[0] - 0.0123) < 1e-7 && lin[1] == 0.5 && lin[2] == 1.0); /* clamped */
+    assert_true(m.rgb[0] == 3 && m.rgb[1] == 128 && m.rgb[2] == 255);
+    sim_mesh_free(&m);
+    assert_int_equal(sim_mesh_load_ply(&m, "tests/fuzz/crashes/ply/bytes-and-a-stray-linear-float",
+                                       err, sizeof(err)),
+                     0);
+    assert_null(m.lin);
+    sim_mesh_linear(&m, 0, lin);
+    assert_true(lin[0] == 1.0 && fabs(lin[1] - 128 / 255.0) < 1e-12 && lin[2] == 0.0);
+    sim_mesh_free(&m);
+}
+
 /* The BVH finds the same closest hit as testing every triangle. */
 static void test_bvh_matches_brute_force(void **state)
 {
@@ -347,6 +381,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_bunny_ply_loads),
+        cmocka_unit_test(test_ply_linear_colours),
         cmocka_unit_test(test_bvh_matches_brute_force),
         cmocka_unit_test(test_bvh_degenerate_meshes),
         cmocka_unit_test(test_closed_shapes_have_outward_normals),
