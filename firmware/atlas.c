@@ -446,8 +446,15 @@ static void view_texel(struct view_ctx *s, size_t texel, const double l[3])
     sample(s, fu, fv, z, s->ray, &s->a->accum[4 * texel]);
 }
 
-/* Each vertex that faces the view (its normal against the ray to it) and lies in front of the
- * camera: the view's colour there (vertex_cam: where the view sees it). */
+/* A surface of normal @p n_obj (object frame) at @p p_cam (camera frame) faces the camera: its
+ * normal against the ray to it. */
+static int faces(const struct frame_xform *obj_from_cam, vec3 n_obj, vec3 p_cam)
+{
+    return v3_dot(frame_dir_inv(obj_from_cam, n_obj), p_cam) < 0.0;
+}
+
+/* Each vertex that faces the view and lies in front of the camera: the view's colour there
+ * (vertex_cam: where the view sees it). */
 static void view_vertices(struct view_ctx *s, const struct fusion_volume *vol,
                           const struct frame_xform *obj_from_cam)
 {
@@ -455,7 +462,7 @@ static void view_vertices(struct view_ctx *s, const struct fusion_volume *vol,
         const float *c = &s->a->vertex_cam[5 * (size_t)v], *n = &vol->mesh_nrm[3 * (size_t)v];
         vec3 p = v3(c[0], c[1], c[2]);
         if (vol->mesh_index[v] == MESH_DROPPED || c[2] <= 1.0f ||
-            v3_dot(frame_dir_inv(obj_from_cam, v3(n[0], n[1], n[2])), p) >= 0.0)
+            !faces(obj_from_cam, v3(n[0], n[1], n[2]), p))
             continue;
         sample(s, c[3], c[4], c[2], v3_len(p) / p.z, &s->a->vertex_accum[4 * (size_t)v]);
     }
@@ -507,9 +514,9 @@ int atlas_add_view(struct atlas *a, struct fusion_volume *vol, const struct scan
         for (int k = 0; k < 3; k++)
             c[k] = &a->vertex_cam[5 * (size_t)tri_at(vol, t)[k]];
         vec3 p0 = v3(c[0][0], c[0][1], c[0][2]);
-        /* facing the camera: the normal against the ray to its first corner */
-        if (v3_dot(frame_dir_inv(obj_from_cam, tri_normal(vol, t)), p0) < 0.0 && c[0][2] > 1.0 &&
-            c[1][2] > 1.0 && c[2][2] > 1.0) {
+        /* facing the camera at its first corner, every corner in front of it */
+        if (faces(obj_from_cam, tri_normal(vol, t), p0) && c[0][2] > 1.0 && c[1][2] > 1.0 &&
+            c[2][2] > 1.0) {
             a->tri_axis[t] |= FACING;
             a->chart[a->tri_chart[t]].facing = 1;
         }
@@ -552,7 +559,7 @@ static void mesh_texel(struct atlas *a, const struct fusion_volume *vol, size_t 
         double c = 0.0;
         for (int j = 0; j < 3; j++)
             c += bary[j] * vol->mesh_rgb[3 * (size_t)tri_at(vol, t)[j] + (size_t)k];
-        acc[k] = (float)(c / 257.0); /* the texels' scale: a linear byte */
+        acc[k] = (float)(c / MESH_RGB_PER_BYTE); /* the texels' scale: a linear byte */
     }
     acc[3] = FROM_MESH;
 }
@@ -591,7 +598,8 @@ static void fill_gutters(struct atlas *a, int passes)
     }
 }
 
-/* Each vertex a view saw: its weighted colour into the tables, 16 bits (a linear byte x 257).
+/* Each vertex a view saw: its weighted colour into the tables, 16 bits (MESH_RGB_PER_BYTE a
+ * linear byte).
  * @retval the vertices coloured */
 static uint32_t finish_vertices(const struct atlas *a, struct fusion_volume *vol)
 {
@@ -601,7 +609,7 @@ static uint32_t finish_vertices(const struct atlas *a, struct fusion_volume *vol
         if (!(acc[3] > 0.0f))
             continue;
         for (int k = 0; k < 3; k++) {
-            double c = acc[k] / acc[3] * 257.0 + 0.5;
+            double c = acc[k] / acc[3] * (double)MESH_RGB_PER_BYTE + 0.5;
             vol->mesh_rgb[3 * (size_t)v + (size_t)k] = (uint16_t)(c < 0.0            ? 0.0
                                                                   : c > MESH_RGB_ONE ? MESH_RGB_ONE
                                                                                      : c);

@@ -520,7 +520,8 @@ static int edge_vertex(struct fusion_volume *vol, struct extract_state *st, cons
     /* a sample no view coloured does not darken its neighbour's colour */
     double fc = va->colour_weight == 0 ? 1.0 : vb->colour_weight == 0 ? 0.0 : f;
     for (int k = 0; k < 3; k++) /* the voxels' bytes to the vertex's 16 bits (MESH_RGB_ONE) */
-        mv.rgb[k] = (uint16_t)((va->rgb[k] * (1.0 - fc) + vb->rgb[k] * fc) * 257.0 + 0.5);
+        mv.rgb[k] =
+            (uint16_t)((va->rgb[k] * (1.0 - fc) + vb->rgb[k] * fc) * MESH_RGB_PER_BYTE + 0.5);
     int rc = st->sink->vertex != NULL ? st->sink->vertex(st->sink->priv, &mv) : 0;
     *slot = *out = st->next_vertex++;
     return rc;

@@ -124,8 +124,9 @@ int fusion_close_watertight(struct fusion_volume *vol, double max_hole_mm, int o
 
 /** A vertex's colour channel at full scale (mesh_vertex.rgb, linear): 16 bits, so that the mean
  *  of several views keeps the shades between two linear bytes (on a paint of albedo 0.03 a byte
- *  is a step of 13%). A linear byte b is b x 257. */
+ *  is a step of 13%). A linear byte b is b x MESH_RGB_PER_BYTE. */
 #define MESH_RGB_ONE 65535u
+#define MESH_RGB_PER_BYTE (MESH_RGB_ONE / 255u) /* 257 */
 
 /** A vertex of the mesh: object frame, mm; its colour linear (0..MESH_RGB_ONE), and whether any
  *  view gave the surface there a colour estimate (else rgb is 0 and the writers fill it from the

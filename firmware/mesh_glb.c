@@ -90,7 +90,7 @@ static int colour_vertex(void *priv, const struct mesh_vertex *v)
     /* normalized bytes, linear (the vertex's 16 bits rounded: a viewer shows no more) */
     uint8_t rgba[4] = {0, 0, 0, 255};
     for (int k = 0; k < 3; k++)
-        rgba[k] = (uint8_t)((v->rgb[k] + 128u) / 257u);
+        rgba[k] = (uint8_t)((v->rgb[k] + MESH_RGB_PER_BYTE / 2u) / MESH_RGB_PER_BYTE);
     outbuf_put(o, rgba, 4);
     return o->rc;
 }

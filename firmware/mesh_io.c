@@ -121,7 +121,7 @@ static void colour_fill(struct fusion_volume *vol)
     for (uint32_t v = 0; v < n && missing > 0; v++)
         if (vol->mesh_index[v] != MESH_DROPPED && !vol->mesh_coloured[v]) {
             for (int k = 0; k < 3; k++)
-                vol->mesh_rgb[3 * (size_t)v + (size_t)k] = GREY_LINEAR * 257u;
+                vol->mesh_rgb[3 * (size_t)v + (size_t)k] = GREY_LINEAR * MESH_RGB_PER_BYTE;
             vol->mp.s.uncoloured++;
         }
 }

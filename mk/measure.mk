@@ -99,7 +99,7 @@ $(BUILD)/bench/bench_decode.o: bench/bench_decode.c | deps
 	@mkdir -p $(dir $@)
 	$(CC) $(HOST_CFLAGS) -Itests -Ibench -c $< -o $@
 
-## measure-large: make run's scan at a DSLR's full 4896 x 3264 by the LIMITS=large build (10 min, 5 GB)
+## measure-large: make run's scan at a DSLR's full 4896 x 3264 by the LIMITS=large build (4 min, 5 GB)
 # and the decode against OpenCV at that size; the build is build/large (BUILD=x: x/large).
 LARGE_BUILD := $(if $(filter large,$(LIMITS)),$(BUILD),$(BUILD)/large)
 measure-large: deps

@@ -3,7 +3,7 @@
 # and fused without binning by the LIMITS=large build, beside the same rig at 1280 x 960: the
 # points a view, the model against the truth, the scan's CPU and rig time, its peak memory and
 # the build's static buffers. The sensor sits behind the same lens: the focal length and the
-# principal point in pixels scale with the width. Writes BUILD/measure-large/; about 10 minutes
+# principal point in pixels scale with the width. Writes BUILD/measure-large/; about 4 minutes
 # and 5 GB of kept frames here (removed once measured; KEEP=1 keeps them).
 # Usage: scripts/measure-large.sh BUILD_DIR   (the LIMITS=large build: build/large)
 set -eu
