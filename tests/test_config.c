@@ -214,6 +214,16 @@ static void test_file_sets_a_key(void **state)
     /* a loaded file that sets it, then one that does not: the flag is the second file's */
     assert_int_equal(config_load(&cfg, path, err, sizeof(err)), 0);
     assert_int_equal(cfg.exposures_us.given, 0);
+    /* a link to a file that sets it is that file; a FIFO where it belongs is refused, not read */
+    unlink(DIR "/sets-link");
+    assert_int_equal(symlink("sets.ini", DIR "/sets-link"), 0);
+    snprintf(text, sizeof(text), "%s%s", base, cases[0].text);
+    write_file("sets.ini", text);
+    assert_int_equal(config_load(&cfg, DIR "/sets-link", err, sizeof(err)), 0);
+    assert_int_equal(cfg.exposures_us.given, 1);
+    unlink(DIR "/sets-fifo");
+    assert_int_equal(mkfifo(DIR "/sets-fifo", 0600), 0);
+    assert_int_equal(config_load(&cfg, DIR "/sets-fifo", err, sizeof(err)), -EINVAL);
 }
 
 static void test_overlong_line_refused(void **state)
