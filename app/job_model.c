@@ -196,10 +196,14 @@ static int report_registration(struct job *j, const struct reg_report *r, double
             snprintf(shared, sizeof(shared),
                      " or that share too little surface with their neighbours (%u; ",
                      (unsigned)r->turns_little_shared);
+        char paint[96] = ""; /* and how many of them their paint turned */
+        if (r->turns_by_paint > 0)
+            snprintf(paint, sizeof(paint), "; %u turned from it to where the paint agrees",
+                     (unsigned)r->turns_by_paint);
         snprintf(detail + n, sizeof(detail) - n,
                  "the views' angles corrected but for %u whose turn the object's shape does not "
-                 "fix%sthe table's angle kept there)",
-                 (unsigned)r->turns_from_table, shared);
+                 "fix%sthe table's angle kept there%s)",
+                 (unsigned)r->turns_from_table, shared, paint);
     } else if (r->solved)
         snprintf(detail + n, sizeof(detail) - n, "%s", r->refused);
     if (r->apart_pairs > 0 && !no_turn_seen) {
@@ -225,7 +229,13 @@ static int report_registration(struct job *j, const struct reg_report *r, double
                  "matches the table's step): the calibrated axis kept, which such views cannot "
                  "place (a number of views its symmetry does not divide lets them)",
                  r->moved_view >= 0 ? " before the object moved" : "");
-    } else if (r->axis_from_calibration && !no_turn_seen) {
+    } else if (r->axis_unpaid && r->accepted && !no_turn_seen) {
+        n = strlen(detail);
+        snprintf(detail + n, sizeof(detail) - n,
+                 "; the calibrated axis kept: moving it fitted the views no better than their "
+                 "own errors explain (F %.2f)",
+                 r->axis_f);
+    } else if (r->axis_from_calibration && !r->axis_unpaid && !no_turn_seen) {
         n = strlen(detail);
         snprintf(detail + n, sizeof(detail) - n,
                  "; the views share too little to place the axis: the calibrated one kept");

@@ -434,7 +434,8 @@ int scan_dir_write_registration(const struct hal_storage *st, const char *dir, u
         "loop_closure_rms_mm = %.4f\naxis_shift_mm = %.4f\naxis_tilt_deg = %.4f\n"
         "worst_view = %u\nworst_rms_mm = %.4f\nsecond_pass_turned_deg = %.3f\n"
         "second_pass_rms_mm = %.4f\nsecond_pass_pairs = %u\nturns_from_table = %u\n"
-        "turns_little_shared = %u\narcs_held = %u\n"
+        "turns_little_shared = %u\nturns_by_paint = %u\naxis_kept_unpaid = %d\naxis_f = %.3f\n"
+        "arcs_held = %u\n"
         "moved_at_view = %d\nmoved_views = %u\nmoved_mm = %.3f\nmoved_deg = %.3f\n"
         "moved_placed_by = %s\n"
         "[view]\nreported_angle_deg = %.3f\nangle_deg = %.4f\ncorrection_deg = %.4f\n"
@@ -444,13 +445,16 @@ int scan_dir_write_registration(const struct hal_storage *st, const char *dir, u
         r->score_before_mm, r->score_after_mm, r->rms_mm, r->loop_rms_mm, r->axis_shift_mm,
         r->axis_tilt_deg, (unsigned)r->worst_view, r->worst_rms_mm, r->second_turned_deg,
         r->second_rms_mm, (unsigned)r->second_coupled, (unsigned)r->turns_from_table,
-        (unsigned)r->turns_little_shared, (unsigned)r->arcs_held, r->moved_view,
-        (unsigned)r->moved_views, r->moved_mm, r->moved_deg,
+        (unsigned)r->turns_little_shared, (unsigned)r->turns_by_paint, r->axis_unpaid, r->axis_f,
+        (unsigned)r->arcs_held, r->moved_view, (unsigned)r->moved_views, r->moved_mm, r->moved_deg,
         r->moved_view < 0    ? "-"
         : r->moved_by_colour ? "shape and colour"
                              : "shape",
         v->reported_mdeg / 1000.0, v->angle_deg, v->correction_deg,
-        !v->turn_from_table     ? "registered"
+        !v->turn_from_table ? "registered"
+        : v->turn_by_paint
+            ? (v->turn_little_shared ? "paint (too little surface shared with its neighbours)"
+                                     : "paint (the shape does not fix it)")
         : v->turn_little_shared ? "table (too little surface shared with its neighbours)"
                                 : "table (the shape does not fix it)",
         v->placed_freely, (unsigned)v->overlap, (unsigned)v->coupled,

@@ -48,6 +48,8 @@ struct reg_view {
                                     table's angle is kept */
     int turn_little_shared;    /**< 1, with turn_from_table: the reason is that its pairs
                                     share too little surface to outweigh the table */
+    int turn_by_paint;         /**< 1, with turn_from_table: turned from the table's angle to
+                                    where its paint agrees with its neighbours' */
     int placed_freely;         /**< 1: the object had moved: placed by its shape alone */
 };
 
@@ -83,7 +85,11 @@ struct reg_report {
     double second_rms_mm;          /**< and their residual */
     uint32_t turns_from_table;     /**< views whose turn the geometry does not fix (reg_view) */
     uint32_t turns_little_shared;  /**< of them, those sharing too little surface */
+    uint32_t turns_by_paint;       /**< of them, those turned by their paint */
     int axis_from_calibration;     /**< 1: the pairs do not see the axis's place: calibrated kept */
+    int axis_unpaid;               /**< 1: kept so because moving it gained the pairs no more than
+                                        their own errors explain (reg.c) */
+    double axis_f;                 /**< what moving it gained, as an F value (reg.c) */
     int views_alike; /**< 1: each view looked like its neighbour as they stood (the object's
                           symmetry matches the table's step): the calibrated axis kept */
     int moved_view;  /**< -1, or the first view after the object moved on the table
@@ -145,6 +151,8 @@ struct reg_ctx {
     int views_alike;                      /**< reg_views_alike: the axis held to the calibrated */
     uint8_t from_table[REG_MAX_VIEWS];    /**< the turn kept at the table's angle */
     uint8_t little_shared[REG_MAX_VIEWS]; /**< why: too little surface shared (reg.c) */
+    uint8_t by_paint[REG_MAX_VIEWS];      /**< of those, turned where its paint agrees */
+    int axis_held;                        /**< 1: solving with the axis held where calibrated */
     vec3 a, d;                            /**< the axis */
     int use_solution;                     /**< poses from theta, a, d rather than the turntable's */
     uint32_t edges, edge_from[REG_EDGES], edge_to[REG_EDGES];

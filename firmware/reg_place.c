@@ -701,3 +701,103 @@ int reg_place_slid_by_colour(struct reg_ctx *r, double ring_rms_mm)
     r->second_aligned = place_along(r, table_plane, 2, ring_rms_mm);
     return r->second_aligned;
 }
+
+/* The paint's search for a turn the shape does not fix (reg_turn_by_paint): turns this far apart
+ * (0.26 mm at 60 mm from the axis, a sixth of a sample's cell), at most REG_PAINT_TURN_MAX of
+ * them; the V fitted through them (v_bottom) taken where its flanks rise, at the search's ends,
+ * REG_PAINT_TURN_MIN_RISE times its bottom or more (the thin box end on: 0.91; a plain paint,
+ * nothing compared or a flat curve: none). */
+#define REG_PAINT_TURN_STEP_DEG 0.25
+#define REG_PAINT_TURN_MAX 256
+#define REG_PAINT_TURN_MIN_RISE 0.5
+
+/* View @p v's pose (and its inverse) for landing at angle @p theta_rad, the axis as solved. */
+static void pose_at(struct reg_ctx *r, uint32_t v, double theta_rad)
+{
+    struct reg_view rv;
+    r->theta[v] = theta_rad;
+    if (reg_view_pose(r, v, &r->first_pose[v], &rv) == 0)
+        frame_invert(&r->first_pose[v], &r->first_cam[v]);
+}
+
+/* How badly view @p v's hues and its @p n registered neighbours' @p nb agree, both ways, as a
+ * share of a full miss over @p compared samples. */
+static double turn_misfit(struct reg_ctx *r, uint32_t v, const uint32_t *nb, int n,
+                          uint64_t *compared)
+{
+    double sum = 0.0;
+    *compared = 0;
+    for (int k = 0; k < 2 * n; k++) {
+        uint64_t c;
+        uint32_t a = k % 2 ? nb[k / 2] : v, b = k % 2 ? v : nb[k / 2];
+        double m = reg_pair_colour_misfit(r, a, b, &c);
+        sum += m * (double)c;
+        *compared += c;
+    }
+    return *compared > 0 ? sum / (double)*compared : 1.0;
+}
+
+/* Where a misfit curve sampled at @p n turns @p d (degrees) has its bottom: the symmetric V
+ * m = b + s |d - d0| fitted by least squares for each d0 within @p span_deg, 0.01 degree apart,
+ * the best kept (@p b, @p s). The paint's boundaries make the curve a V whose flanks are clear
+ * and whose bottom is flat within the noise (mixed pixels at the boundaries, cells 1.5 to 2 mm
+ * apart): the thin box of data/objects seen end on, its table 0.61 degrees off, bottomed
+ * anywhere from 0.5 to 1.0 degrees, its flanks met at 0.58. @retval d0 */
+static double v_bottom(const double *d, const double *m, int n, double span_deg, double *b,
+                       double *s)
+{
+    double best_sse = HUGE_VAL, at = 0.0;
+    *b = *s = 0.0;
+    for (double d0 = -span_deg; d0 <= span_deg + 1e-9; d0 += 0.01) {
+        double sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
+        for (int i = 0; i < n; i++) {
+            double x = fabs(d[i] - d0);
+            sx += x, sy += m[i], sxx += x * x, sxy += x * m[i], syy += m[i] * m[i];
+        }
+        double det = n * sxx - sx * sx;
+        if (!(det > 0.0))
+            continue;
+        double slope = (n * sxy - sx * sy) / det, base = (sy - slope * sx) / n;
+        double sse = syy - base * sy - slope * sxy;
+        if (slope > 0.0 && sse < best_sse)
+            best_sse = sse, at = d0, *b = base, *s = slope;
+    }
+    return at;
+}
+
+int reg_turn_by_paint(struct reg_ctx *r, uint32_t v, double span_deg, double *turned_deg)
+{
+    uint32_t nb[2];
+    int n = 0;
+    *turned_deg = 0.0;
+    for (uint32_t e = 0; e < r->edges && n < 2; e++) {
+        uint32_t w = r->edge_from[e] == v ? r->edge_to[e]
+                     : r->edge_to[e] == v ? r->edge_from[e]
+                                          : v;
+        if (w != v && reg_turn_registered(r, w))
+            nb[n++] = w;
+    }
+    if (n == 0 || span_deg < 2.0 * REG_PAINT_TURN_STEP_DEG)
+        return 0; /* no neighbour registered by its shape to turn against (a surface of
+                     revolution: none is); no room to search */
+    const double start = r->theta[v], rad = M_PI / 180.0;
+    for (int k = 0; k < n; k++)
+        pose_at(r, nb[k], r->theta[nb[k]]);
+    static double d[REG_PAINT_TURN_MAX], m[REG_PAINT_TURN_MAX];
+    int count = 0, half = (int)fmin(span_deg / REG_PAINT_TURN_STEP_DEG, REG_PAINT_TURN_MAX / 2 - 1);
+    for (int i = -half; i <= half; i++) {
+        uint64_t c;
+        pose_at(r, v, start + i * REG_PAINT_TURN_STEP_DEG * rad);
+        double mi = turn_misfit(r, v, nb, n, &c);
+        if (c >= REG_COLOUR_MIN_COMPARED)
+            d[count] = i * REG_PAINT_TURN_STEP_DEG, m[count++] = mi;
+    }
+    double b = 0.0, s = 0.0, span = half * REG_PAINT_TURN_STEP_DEG;
+    double at = count >= half ? v_bottom(d, m, count, span, &b, &s) : 0.0;
+    /* a clear V: at the search's ends half as bad again as at its bottom, and not at an end */
+    int taken = count >= half && s * span >= REG_PAINT_TURN_MIN_RISE * b &&
+                fabs(at) <= span - 2.0 * REG_PAINT_TURN_STEP_DEG;
+    pose_at(r, v, taken ? start + at * rad : start);
+    *turned_deg = taken ? at : 0.0;
+    return taken;
+}

@@ -346,6 +346,29 @@ thin_slip_eight_test() {
     awk -v t="$turned" 'BEGIN { exit !(t != "" && t < 0.2) }'
 }
 check thin_box_slipped_along_its_length_keeps_its_turn_by_its_paint thin_slip_eight_test
+# The thin box in 8 views, the table 2 degrees off (issue 30: within 1.15 times the exact table's
+# scan). The view that sees it end on kept the table's angle (its shape does not fix its turn),
+# 0.6 degrees off, and the pairs moved the axis 0.09 mm from the calibrated one on their depth
+# bias alone: 0.086 mm from the truth against 0.069 with the table exact, 1.25 times. Now the
+# paint turns that view to where it agrees with its neighbours', and the axis stays as calibrated
+# where moving it gains no more than the pairs' own errors explain: 0.060 and 0.060.
+thin_table_test() {
+    for t in 0 2000; do
+        part_config "thin-table$t" thin_box 15 "" 0
+        sed -i -e '/^slip_mm = /d' -e '/^slip_at_deg = /d'             -e "/^\[sim\]/a table_angle_error_mdeg = $t" "$out/thin-table$t.ini"
+        printf '[output]\nkeep_frames = none\n' >>"$out/thin-table$t.ini"
+        scan_ini "thin-table$t" || return 1
+    done
+    exact=$(aligned_mean thin-table0) off=$(aligned_mean thin-table2000)
+    echo "thin box, 8 views: model -> truth mean $exact mm, the table 2 deg off $off mm"
+    grep '^registration' "$out/thin-table2000.log" &&
+        grep -q "turned from it to where the paint agrees" "$out/thin-table2000.log" &&
+        grep -q "the calibrated axis kept: moving it fitted" "$out/thin-table2000.log" &&
+        grep -q '^turn = paint (the shape does not fix it)' \
+            "$out/thin-table2000/view_004/registration.ini" &&
+        awk -v e="$exact" -v o="$off" 'BEGIN { exit !(e != "" && o != "" && o <= 1.15 * e) }'
+}
+check thin_box_with_the_table_2_degrees_off_within_1_15_times_exact thin_table_test
 # The thin box slipped 6 mm along its length at 100 degrees in 7 views: only the closing pair
 # broke in shape, the pair across the slip missed in paint 2.0 times the ring's median, just
 # under what picks it, and the scan was refused. Its paint lines up 6 mm away, and no other
