@@ -13,8 +13,10 @@
 # Usage: scripts/measure-objects.sh BUILD; OBJECTS="box gear", VIEWS="4 8", METHODS="none" and
 # CONDITIONS="exact" (exact table1 table2 slip slip30 push6; slip6v and slip12v: the 6 mm slip in 6 and 12 views;
 # offaxis: the object stood off the table's axis, three places, in 4, 6 and 8 views) choose a subset; KEEP=1 keeps each
-# scan and its frames (scanner process DIR computes a scan again from them); else only its log
-# and its comparison with the truth are kept.
+# scan and its frames (scanner process DIR computes a scan again from them); KEEP=range keeps
+# each scan without its frames (its range images: enough to register and fuse it again, about
+# 8 MB a view, scripts/reprocess-objects.sh); else only its log and its comparison with the
+# truth are kept.
 set -eu
 build=$1
 out=$build/measure-objects
@@ -73,7 +75,11 @@ row() { # object, views, method, table, name: scan it and print its row
     fi
     # a scan's views are 20 to 30 MB each without frames (range images, the simulator's truth):
     # four runs' scans kept filled this machine's 80 GB free; KEEP=1 keeps them
-    [ "${KEEP:-0}" = 1 ] || rm -rf "${out:?}/$5"
+    case ${KEEP:-0} in
+    1) ;;
+    range) rm -f "$out/$5"/view_*/truth_*.pfm "$out/$5"/view_*/truth_*.png ;;
+    *) rm -rf "${out:?}/$5" ;;
+    esac
     cpu=$(sed -n 's/^registration: .*; \([0-9.]*\) s CPU.*/\1/p' "$out/$5.log")
     note=$(grep -o "does not fix the [a-z' ]*turn" "$out/$5.log" | head -n 1 || true)
     printf '| %s | %s | %s | %s | %s | %s | %s%% | %s | %s | %s | %s |\n' "$1" "$2" "$3" "$4" "$result" \
