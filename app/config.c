@@ -211,7 +211,9 @@ static const struct ini_key config_keys[] = {
     F64("turntable", "axis_accuracy_mm", registration.axis_accuracy_mm, 0.001, 100, "0.1",
         "how far the calibrated axis may be from the true one, across it (one standard "
         "deviation): the registration moves the axis only as far as the views' pairs outweigh "
-        "this (never looser than a third of [registration] max_axis_shift_mm)"),
+        "this (never looser than a third of [registration] max_axis_shift_mm), and only where "
+        "moving it fits the views better than their own errors explain (else the calibrated "
+        "axis is kept and said: docs/architecture.md)"),
     F64("turntable", "axis_tilt_accuracy_deg", registration.axis_tilt_accuracy_deg, 0.001, 45,
         "0.033",
         "how far the calibrated axis's direction may be from the true one (one standard "
