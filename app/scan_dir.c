@@ -421,6 +421,19 @@ int scan_dir_write_reflectance(const struct hal_storage *st, const char *dir,
     return rc != 0 ? rc : hal_storage_write_file(st, path, text, len);
 }
 
+/* registration.ini's turn of view @p v: registered, or kept at the table's angle (turned from
+ * it by the paint), and why. */
+static const char *turn_said(const struct reg_view *v)
+{
+    static const char *const kept[2][2] = {
+        {"table (the shape does not fix it)",
+         "table (too little surface shared with its neighbours)"},
+        {"paint (the shape does not fix it)",
+         "paint (too little surface shared with its neighbours)"}};
+    return v->turn_from_table ? kept[v->turn_by_paint != 0][v->turn_little_shared != 0]
+                              : "registered";
+}
+
 int scan_dir_write_registration(const struct hal_storage *st, const char *dir, uint32_t view,
                                 const struct reg_report *r, const struct reg_view *v,
                                 const struct frame_xform *pose)
@@ -450,14 +463,8 @@ int scan_dir_write_registration(const struct hal_storage *st, const char *dir, u
         r->moved_view < 0    ? "-"
         : r->moved_by_colour ? "shape and colour"
                              : "shape",
-        v->reported_mdeg / 1000.0, v->angle_deg, v->correction_deg,
-        !v->turn_from_table ? "registered"
-        : v->turn_by_paint
-            ? (v->turn_little_shared ? "paint (too little surface shared with its neighbours)"
-                                     : "paint (the shape does not fix it)")
-        : v->turn_little_shared ? "table (too little surface shared with its neighbours)"
-                                : "table (the shape does not fix it)",
-        v->placed_freely, (unsigned)v->overlap, (unsigned)v->coupled,
+        v->reported_mdeg / 1000.0, v->angle_deg, v->correction_deg, turn_said(v), v->placed_freely,
+        (unsigned)v->overlap, (unsigned)v->coupled,
         v->overlap ? (double)v->coupled / v->overlap : 0.0, v->rms_mm);
     const double *m = pose->rot;
     if (len > 0 && (size_t)len < sizeof(text))

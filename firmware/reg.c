@@ -621,11 +621,11 @@ static void keep_unfixed_turns(struct reg_ctx *r)
  * agrees with its registered neighbours' (reg_turn_by_paint), within the table's accuracy. */
 static void turn_unfixed_by_paint(struct reg_ctx *r)
 {
-    double span = fmin(r->p.max_correction_deg, 3.0 * r->p.angle_accuracy_deg), turned;
+    double span = fmin(r->p.max_correction_deg, 3.0 * r->p.angle_accuracy_deg);
     int was = r->use_solution;
     r->use_solution = 1; /* the poses at the solved angles and axis */
     for (uint32_t v = 0; v < r->views; v++)
-        r->by_paint[v] = r->from_table[v] && reg_turn_by_paint(r, v, span, &turned);
+        r->by_paint[v] = r->from_table[v] && reg_turn_by_paint(r, v, span);
     r->use_solution = was;
 }
 

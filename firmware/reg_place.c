@@ -765,11 +765,10 @@ static double v_bottom(const double *d, const double *m, int n, double span_deg,
     return at;
 }
 
-int reg_turn_by_paint(struct reg_ctx *r, uint32_t v, double span_deg, double *turned_deg)
+int reg_turn_by_paint(struct reg_ctx *r, uint32_t v, double span_deg)
 {
     uint32_t nb[2];
     int n = 0;
-    *turned_deg = 0.0;
     for (uint32_t e = 0; e < r->edges && n < 2; e++) {
         uint32_t w = r->edge_from[e] == v ? r->edge_to[e]
                      : r->edge_to[e] == v ? r->edge_from[e]
@@ -798,6 +797,5 @@ int reg_turn_by_paint(struct reg_ctx *r, uint32_t v, double span_deg, double *tu
     int taken = count >= half && s * span >= REG_PAINT_TURN_MIN_RISE * b &&
                 fabs(at) <= span - 2.0 * REG_PAINT_TURN_STEP_DEG;
     pose_at(r, v, taken ? start + at * rad : start);
-    *turned_deg = taken ? at : 0.0;
     return taken;
 }

@@ -116,10 +116,10 @@ int reg_turn_registered(const struct reg_ctx *r, uint32_t v);
 /* View @p v, whose turn about the axis its shape does not fix, turned within @p span_deg of its
  * angle to where its paint and its neighbours' whose turns are registered agree (the hues, as the
  * colour search compares them), when the paint draws a clear V there; its first_pose and
- * first_cam, and its neighbours', at the poses (use_solution set). @p turned_deg: how far.
+ * first_cam, and its neighbours', at the poses (use_solution set).
  * @retval 1 turned
  * @retval 0 left (no such neighbour, plain paint, or no clear V) */
-int reg_turn_by_paint(struct reg_ctx *r, uint32_t v, double span_deg, double *turned_deg);
+int reg_turn_by_paint(struct reg_ctx *r, uint32_t v, double span_deg);
 
 /* The share of edge @p e's overlap that couples (@p st: its counts), on its sideways surfaces
  * where they are enough to judge by. */
