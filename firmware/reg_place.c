@@ -143,44 +143,6 @@ static double footprint_miss(const double a[9], const double b[9])
     return sqrt(diff / size);
 }
 
-/* Where group-1 cell @p cl (at @p p, @p n in group 0's frame, its view's pose @p pose) lands on
- * group 0 (@p q, @p nq within @p gate_mm) in the view that saw that place most alike: its
- * pixels' footprint there the nearest to the cell's own (cell_footprint). A cell's colour is
- * the mean over its footprint, and two views place a paint boundary alike only where their
- * footprints are alike: a face seen at a slant is blurred along the slant, and the most squarely
- * facing view of a top seen at a slant from every side (as a turntable sees it) is one whose
- * slant crosses the sample's. The view seeing the top from the opposite side, slanted along the
- * same line, sees it alike. Measured on the parts of data/objects slipped 6 and 30 mm in 6, 8
- * and 12 views (35 scans, 2026-12-06; docs/objects.md): the hues from the most facing view placed
- * the thin box slipped 30 mm 0.15 mm off across its length (1.19 times its unmoved scan's
- * distance from the truth), from the most alike view 0.08 (1.10 times); the box pushed 30 mm in
- * 6 views 1.03 -> 1.06 times, the rest within 0.04 either way.
- * @retval its cell @retval NULL none */
-static const struct reg_cell *land_alike(struct reg_ctx *r, const struct reg_cell *cl,
-                                         const struct frame_xform *pose, vec3 p, vec3 n,
-                                         double min_cos, double gate_mm, vec3 *q, vec3 *nq)
-{
-    const struct reg_cell *best = NULL;
-    double mine[9], best_miss = HUGE_VAL;
-    cell_footprint(cl, pose, mine);
-    for (uint32_t j = 0; j < r->views; j++) {
-        int landed;
-        double facing, grid_xy[2], theirs[9];
-        vec3 qj, nqj;
-        if (!r->present[j] || r->group[j])
-            continue;
-        const struct reg_cell *cq =
-            land_in(r, j, p, n, min_cos, gate_mm, &landed, &facing, &qj, &nqj, grid_xy);
-        if (cq == NULL)
-            continue;
-        cell_footprint(cq, &r->first_pose[j], theirs);
-        double miss = footprint_miss(mine, theirs);
-        if (miss < best_miss)
-            best = cq, best_miss = miss, *q = qj, *nq = nqj;
-    }
-    return best;
-}
-
 /* Two hues further apart than this (the chord between their unit vectors, 0.43: 25 degrees) are
  * a miss: the palette's colours are 45 degrees and more apart. */
 #define REG_HUE_TAU 0.43
@@ -285,6 +247,60 @@ static void add_hue_rows(struct reg_ctx *r, struct lsq_rigid *eq, const struct r
     }
 }
 
+/* A footprint this unlike the sample's own (footprint_miss) weighs half as much as an alike one
+ * (add_hues_alike). */
+#define REG_ALIKE_MISS 0.1
+
+/* The weight of group-0 view @p j's reading of the hue where group-1 cell @p cl (footprint
+ * @p mine, at @p p, @p n) lands, by how alike the view's footprint there is to the cell's.
+ * @retval the weight @retval 0 the view does not see it within @p gate_mm (@p q, @p nq, @p hit
+ * set when it does) */
+static double alike_weight(struct reg_ctx *r, uint32_t j, const double mine[9], vec3 p, vec3 n,
+                           double min_cos, double gate_mm, const struct reg_cell **hit, vec3 *q,
+                           vec3 *nq)
+{
+    int landed;
+    double facing, grid_xy[2], theirs[9];
+    if (!r->present[j] || r->group[j])
+        return 0.0;
+    *hit = land_in(r, j, p, n, min_cos, gate_mm, &landed, &facing, q, nq, grid_xy);
+    if (*hit == NULL)
+        return 0.0;
+    cell_footprint(*hit, &r->first_pose[j], theirs);
+    double miss = footprint_miss(mine, theirs);
+    return 1.0 / (REG_ALIKE_MISS * REG_ALIKE_MISS + miss * miss);
+}
+
+/* Group-1 cell @p cl's hue rows (add_hue_rows; at @p p, @p n in group 0's frame, its view's pose
+ * @p pose) against every group-0 view that sees it within @p gate_mm, each weighed by how alike
+ * that view's footprint there is to the cell's own (cell_footprint), the weights summing to
+ * @p weight. A cell's colour is the mean over its footprint, and two views place a paint boundary
+ * alike only where their footprints are alike: a top seen at a slant from every side (as a
+ * turntable sees it) is blurred along each view's slant, and the view that sees it from the
+ * opposite side, slanted along the same line, sees its paint alike, the most squarely facing one
+ * not. Measured on the parts of data/objects slipped 6 and 30 mm in 6, 8 and 12 views (35 scans,
+ * 2026-12-06; docs/objects.md): the hues from the most facing view alone placed the thin box
+ * slipped 30 mm 0.15 mm off across its length (1.19 times its unmoved scan's distance from the
+ * truth); from the most alike alone 0.08 (1.10 times); weighed as here 1.10 times, and the sum
+ * of the 35 ratios 36.06 -> 35.90. Two passes over the views (the weights first): no array of
+ * them on the stack. */
+static void add_hues_alike(struct reg_ctx *r, struct lsq_rigid *eq, const struct reg_cell *cl,
+                           const struct frame_xform *pose, vec3 p, vec3 n, double min_cos,
+                           double gate_mm, double weight)
+{
+    double mine[9], sum = 0.0;
+    const struct reg_cell *hit;
+    vec3 q, nq;
+    cell_footprint(cl, pose, mine);
+    for (uint32_t j = 0; j < r->views; j++)
+        sum += alike_weight(r, j, mine, p, n, min_cos, gate_mm, &hit, &q, &nq);
+    for (uint32_t j = 0; j < r->views && sum > 0.0; j++) {
+        double w = alike_weight(r, j, mine, p, n, min_cos, gate_mm, &hit, &q, &nq);
+        if (w > 0.0)
+            add_hue_rows(r, eq, cl, p, hit, q, nq, min_cos, 4.0 * gate_mm, weight * w / sum);
+    }
+}
+
 /* The hues' equations @p hues added to the shape's @p eq along the motions the shape does not
  * hold: each shift axis it holds under REG_COLOUR_MIN_NEXT of its pairs (@p share, @p axis as
  * lsq_rigid_shift_axes gives them) and, with @p turn, the turn about the table's axis (object
@@ -375,12 +391,8 @@ static uint32_t refine_second_step(struct reg_ctx *r, double gate_mm, double hue
                 lsq_rigid_add(&eq, p, q, nq);
                 lever_sq += p.x * p.x + p.y * p.y;
             }
-            const struct reg_cell *alike =
-                hit != NULL && hue_weight > 0.0
-                    ? land_alike(r, cl, &pose, p, n, min_cos, gate_mm, &q, &nq)
-                    : NULL;
-            if (alike != NULL)
-                add_hue_rows(r, &hues, cl, p, alike, q, nq, min_cos, 4.0 * gate_mm, hue_weight);
+            if (hit != NULL && hue_weight > 0.0)
+                add_hues_alike(r, &hues, cl, &pose, p, n, min_cos, gate_mm, hue_weight);
             *overlap += shape ? (uint32_t)landed : 0u;
         }
     }
@@ -541,8 +553,8 @@ static int hue_between(struct reg_ctx *r, const struct reg_cell *hit, vec3 q, ve
  * fall differently, and their mean is nearer the paint. Measured on the parts of data/objects
  * slipped 6 and 30 mm in 6, 8 and 12 views (35 scans, 2026-12-06): the search's place for the box
  * pushed 30 mm in 6 views 0.23 and 0.14 mm off along its faces from the most facing view's
- * hue, 0.04 from the views' mean; with the hues of the refinement from the most alike view
- * (land_alike), the box refused before (its paint agreeing 3.2 times worse than its arcs') is
+ * hue, 0.04 from the views' mean; with the hues of the refinement from the views seen alike
+ * (add_hues_alike), the box refused before (its paint agreeing 3.2 times worse than its arcs') is
  * placed, and the rest change by 0.04 times their unmoved scan's distance from the truth or less.
  * @retval the views read (0: none) */
 static int group0_hue(struct reg_ctx *r, vec3 p, vec3 n, double min_cos, uint32_t skip,

@@ -440,7 +440,8 @@ static int object_albedo(const struct sim_rig *rig, vec3 p_obj, double albedo[3]
  * pixel grid: up to half a pixel (0.17 mm at 600 mm) off where it is, the same way in every
  * frame of a view, and views seeing the paint from opposite sides disagreed by twice that
  * where the colour is all that places them (issue 30: a box pushed 30 mm, placed by its
- * paint 0.15 to 0.35 mm off). @retval 1 the pixel's centre is on the very dark paint */
+ * paint 0.15 to 0.35 mm off). @retval 1 the pixel sees the very dark paint alone (at its edges
+ * a pixel mixes it with the paint beside it, brighter) */
 static int object_paint(const struct sim_rig *rig, const struct frame_xform *obj, vec3 cam_obj,
                         vec3 d_cam, vec3 p_obj, vec3 n_obj, double albedo[3])
 {
@@ -452,7 +453,7 @@ static int object_paint(const struct sim_rig *rig, const struct frame_xform *obj
     double sum[3] = {0.0, 0.0, 0.0};
     for (uint32_t k = 0; k < n; k++) {
         double a[3];
-        object_albedo(rig, pts[k], a);
+        dark &= object_albedo(rig, pts[k], a);
         for (int c = 0; c < 3; c++)
             sum[c] += a[c];
     }
