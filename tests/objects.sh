@@ -252,13 +252,16 @@ check box_pushed_30mm_is_placed_by_its_paint_within_1_2_times_unmoved slip_far_t
 # views each neighbour shares one face and the top, and a push along that face moves no residual;
 # only a pair sharing a top alone was searched for a slip its paint shows, so the model came out
 # 1.84 mm from the truth without a word (3 mm: 0.90; the plate with holes: 0.92). Now a pair whose
-# normals all hold one way is searched along the other: placed, 0.050 mm (0.050 unmoved).
+# normals all hold one way is searched along the other: placed, 0.050 mm (0.050 unmoved). Its
+# paint alone places it along the push: since the simulator takes the paint over each pixel
+# (2026-12-06) 0.08 mm off that way (0.059 mm from the truth), so the move is said as 6.1 mm,
+# and a tenth of a millimetre either way is taken.
 slip_along_test() {
     slip_config patches
     sed -e 's/^slip_mm = .*/slip_mm = 0, 6, 0/' "$out/slip-patches.ini" >"$out/slip-along.ini"
     scan_ini slip-along || return 1
     placed_check slip-along \
-        "moved on the table at view 4: 4 views placed by the object's shape and colour.*as it had moved 6.0 mm" \
+        "moved on the table at view 4: 4 views placed by the object's shape and colour.*as it had moved \(5\.9\|6\.0\|6\.1\) mm" \
         0.06 "box, 8 views, 6 mm slip along the shared faces at view 4"
 }
 check box_slipped_along_the_faces_its_neighbours_share_is_placed slip_along_test
