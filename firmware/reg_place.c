@@ -553,9 +553,9 @@ static int hue_between(struct reg_ctx *r, const struct reg_cell *hit, vec3 q, ve
  * fall differently, and their mean is nearer the paint. Measured on the parts of data/objects
  * slipped 6 and 30 mm in 6, 8 and 12 views (35 scans, 2026-12-06): the search's place for the box
  * pushed 30 mm in 6 views 0.23 and 0.14 mm off along its faces from the most facing view's
- * hue, 0.04 from the views' mean; with the hues of the refinement from the views seen alike
- * (add_hues_alike), the box refused before (its paint agreeing 3.2 times worse than its arcs') is
- * placed, and the rest change by 0.04 times their unmoved scan's distance from the truth or less.
+ * hue, 0.04 from the views' mean; with the refinement's hues from the views seen alike
+ * (add_hues_alike) the box, refused before (its paint agreeing 3.2 times worse than its arcs'),
+ * is placed 0.98 times its unmoved scan's distance from the truth.
  * @retval the views read (0: none) */
 static int group0_hue(struct reg_ctx *r, vec3 p, vec3 n, double min_cos, uint32_t skip,
                       double hue[2])
