@@ -399,23 +399,20 @@ plate_six_test() {
 check plate_pushed_in_six_views_keeps_the_tables_turn plate_six_test
 # The same box pushed 30 mm in 6 views: the pairs across the push see the faces it slid along
 # and couple (91% of their overlap); only the paint shows the slide. The scan once finished with
-# a model 3.9 mm from the truth and no word; now it finds the two pairs whose paint misses
-# (0.99 of a full miss, the others under 0.1) and places the views after the push by their
-# paint (the model 0.087 mm from the truth, unmoved 0.067), or says it cannot, naming the view,
-# the views kept.
+# a model 3.9 mm from the truth and no word; then it found the two pairs whose paint misses (0.99
+# of a full miss, the others under 0.1) and placed the views after the push by their paint (the
+# model 0.087 mm from the truth, unmoved 0.067), or said it could not. Since the simulator takes
+# the paint over each pixel and the placed views' hues are read as the other arc's views see
+# them alike (2026-12-06, reg_place.c add_hues_alike), it is placed within issue 30's 1.2 times
+# the unmoved box in 6 views (0.064 mm, unmoved 0.065; refused before).
 slip_six_test() {
-    part_pushed slip-six box 80 views6 || true
-    if [ -f "$out/slip-six/mesh.ply" ]; then
-        m=$(aligned_mean slip-six)
-        echo "box, 6 views, 30 mm slip at view 3: placed, model -> truth mean $m mm"
-        grep -q "moved on the table at view 3: 3 views placed" "$out/slip-six.log" &&
-            awk -v m="$m" 'BEGIN { exit !(m != "" && m < 0.2) }'
-    else
-        grep -o "error: registration failed: .*view 3.*" "$out/slip-six.log" &&
-            test -f "$out/slip-six/view_005/view.ini"
-    fi
+    part_pushed slip-six box 80 views6 || return 1
+    m=$(aligned_mean slip-six)
+    echo "box, 6 views, 30 mm slip at view 3: placed, model -> truth mean $m mm"
+    grep -q "moved on the table at view 3: 3 views placed" "$out/slip-six.log" &&
+        awk -v m="$m" 'BEGIN { exit !(m != "" && m < 1.2 * 0.065) }'
 }
-check box_pushed_in_six_views_is_not_a_silent_wrong_model slip_six_test
+check box_pushed_30mm_in_six_views_is_placed_within_1_2_times_unmoved slip_six_test
 # The stepped block pushed 30 mm in 6 views: the views across the push land beside each other's
 # surfaces, two pairs that share nothing where every other pair couples; it finished 3.0 mm
 # from the truth without a word, then was cut there and refused, naming view 3: ICP from the
