@@ -447,9 +447,9 @@ static int object_paint(const struct sim_rig *rig, const struct frame_xform *obj
 {
     vec3 pts[PAINT_SAMPLES * PAINT_SAMPLES];
     uint32_t n = footprint_on_plane(rig, obj, cam_obj, d_cam, p_obj, n_obj, PAINT_SAMPLES, pts);
-    int dark = object_albedo(rig, p_obj, albedo);
-    if (n == 0)
-        return dark;
+    if (n == 0) /* the ray along the plane: the paint at the hit */
+        return object_albedo(rig, p_obj, albedo);
+    int dark = 1;
     double sum[3] = {0.0, 0.0, 0.0};
     for (uint32_t k = 0; k < n; k++) {
         double a[3];
