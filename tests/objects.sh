@@ -417,11 +417,8 @@ check plate_pushed_in_six_views_keeps_the_tables_turn plate_six_test
 # them alike (2026-12-06, reg_place.c add_hues_alike), it is placed within issue 30's 1.2 times
 # the unmoved box in 6 views (0.064 mm, unmoved 0.065; refused before).
 slip_six_test() {
-    part_pushed slip-six box 80 views6 || return 1
-    m=$(aligned_mean slip-six)
-    echo "box, 6 views, 30 mm slip at view 3: placed, model -> truth mean $m mm"
-    grep -q "moved on the table at view 3: 3 views placed" "$out/slip-six.log" &&
-        awk -v m="$m" 'BEGIN { exit !(m != "" && m < 1.2 * 0.065) }'
+    placed_within slip-six box 80 views6 30 "moved on the table at view 3: 3 views placed" \
+        "$(awk 'BEGIN { print 1.2 * 0.065 }')" "box, 6 views, 30 mm slip at view 3"
 }
 check box_pushed_30mm_in_six_views_is_placed_within_1_2_times_unmoved slip_six_test
 # The stepped block pushed 30 mm in 6 views: the views across the push land beside each other's
