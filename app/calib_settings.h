@@ -30,6 +30,7 @@ struct calib_settings {
     double max_camera_rms_px, max_projector_rms_px;
     double max_sigma_centre_px, max_sigma_focal_share;       /**< a lens this uncertain: weak */
     double max_sigma_translation_mm, max_sigma_rotation_deg; /**< the pose this uncertain: weak */
+    double max_depth_error_mm; /**< a predicted depth error at the volume's edge above: weak */
 };
 
 #endif

@@ -453,6 +453,10 @@ static const struct ini_key config_keys[] = {
         "1", "the camera -> projector translation less certain than this flags it weak"),
     F64("calibrate", "max_sigma_rotation_deg", calibrate.max_sigma_rotation_deg, 1e-4, 90, "0.05",
         "the camera -> projector rotation less certain than this flags it weak"),
+    F64("calibrate", "max_depth_error_mm", calibrate.max_depth_error_mm, 1e-4, 100, "0.05",
+        "a depth error predicted at the working volume's edge (the lenses', the pose's and the "
+        "axis's uncertainty carried to a scan) above this flags it weak: about the scanner's own "
+        "mean error on the demo rig, which such a calibration could add again"),
 };
 
 #undef C

@@ -98,9 +98,9 @@ void calcv_pose_through(const double rvec[3], const double tvec[3], const double
 double calcv_reprojection_rms(const struct calcv_corners *v, const struct calcv_lens *lens,
                               const double rvec[3], const double tvec[3]);
 
-/** One standard deviation of each calibrated value (the solve's own covariance: the inverse of
- *  JᵀJ of every reprojection residual over every unknown, board poses included, scaled by the
- *  residuals' variance). Lens order: fx, fy, cx, cy, k1, k2, p1, p2, k3 (0 where fixed). */
+/** One standard deviation of each calibrated value (the weighted solve's own covariance: the
+ *  inverse of Σ J_gᵀJ_g / var_g over each group g of reprojection residuals and every unknown,
+ *  board poses included). Lens order: fx, fy, cx, cy, k1, k2, p1, p2, k3 (0 where fixed). */
 struct calcv_sigma {
     double cam[9], proj[9];
     double rot_deg[3];  /**< the camera -> projector rotation vector's components */
@@ -109,23 +109,27 @@ struct calcv_sigma {
     int residuals, unknowns;
 };
 
-/** A calibration drawn from the uncertainty (calcv_uncertainty's covariance of the lenses and
+/** A calibration drawn from the uncertainty (calcv_refine_weighted's covariance of the lenses and
  *  the pose, board poses marginalised): what the captures allow as well as the one found. */
 struct calcv_draw {
     struct calcv_lens cam, proj;
     double rot[9], trans[3]; /**< p_proj = rot p_cam + trans */
 };
 
-/** The uncertainty of a calibration: @p cam corners (and, unless @p proj is NULL, the same
- *  corners in the projector) of @p n views, through the lenses and the pose found.
- *  @param sigma  out @param draws, draw_count  out: that many calibrations drawn from the
- *  covariance (a fixed random sequence: the same captures give the same draws); NULL, 0: none
+/** A calibration solved once more, and its uncertainty: @p cam corners (and, unless @p proj is
+ *  NULL, the same corners in the projector) of @p n views, from the lenses and the pose found.
+ *  Each view's corners' x and y in the camera and in the projector are weighed by their own
+ *  variance, estimated from their residuals (the corners of a board seen at a slant are found
+ *  less exactly); the covariance is that weighted solve's.
+ *  @param cam_lens, proj_lens, rot, trans  in: the unweighted solve's; out: the weighted one's
+ *  (left as they were on an error). @param sigma  out @param draws, draw_count  out: that many
+ *  calibrations drawn from the covariance (a fixed random sequence: the same captures give the
+ *  same draws); NULL, 0: none
  *  @retval 0 @retval -EINVAL fewer residuals than unknowns @retval -EDOM */
-int calcv_uncertainty(const struct calcv_corners *cam, const struct calcv_corners *proj, int n,
-                      int fix_k3, const struct calcv_lens *cam_lens,
-                      const struct calcv_lens *proj_lens, const double rot[9],
-                      const double trans[3], struct calcv_sigma *sigma, struct calcv_draw *draws,
-                      int draw_count);
+int calcv_refine_weighted(const struct calcv_corners *cam, const struct calcv_corners *proj, int n,
+                          int fix_k3, struct calcv_lens *cam_lens, struct calcv_lens *proj_lens,
+                          double rot[9], double trans[3], struct calcv_sigma *sigma,
+                          struct calcv_draw *draws, int draw_count);
 
 #ifdef __cplusplus
 }

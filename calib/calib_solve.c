@@ -506,16 +506,19 @@ static void say_lens_sigma(struct solve *s, const char *name, const double sd[9]
         name, sd[0], sd[1], sd[2], sd[3], sd[4], sd[5], sd[6], sd[7], sd[8]);
 }
 
+/* The lenses @p cl and @p pl (and the pose in s->out) solved once more with each view's corners
+ * weighed by their own variance (calcv_refine_weighted), and their uncertainty, said in the
+ * report. Left as the unweighted solve found them when it cannot be computed. */
 static void find_sigma(struct solve *s, const struct calcv_corners *cam,
-                       const struct calcv_corners *proj, int n, const struct calcv_lens *cl,
-                       const struct calcv_lens *pl)
+                       const struct calcv_corners *proj, int n, struct calcv_lens *cl,
+                       struct calcv_lens *pl)
 {
     if (proj != NULL && s->draws == NULL)
         s->draws = calloc(CALIB_DEPTH_DRAWS, sizeof(*s->draws));
     s->draw_count = proj != NULL && s->draws != NULL ? CALIB_DEPTH_DRAWS : 0;
     s->have_sigma =
-        calcv_uncertainty(cam, proj, n, (int)s->cfg->calibrate.fix_k3, cl, pl, s->out.proj_rot,
-                          s->out.proj_trans_mm, &s->sigma, s->draws, s->draw_count) == 0;
+        calcv_refine_weighted(cam, proj, n, (int)s->cfg->calibrate.fix_k3, cl, pl, s->out.proj_rot,
+                              s->out.proj_trans_mm, &s->sigma, s->draws, s->draw_count) == 0;
     if (!s->have_sigma) {
         say(s, "uncertainty: not computed (fewer corners than unknowns)\n");
         return;
@@ -553,11 +556,13 @@ static int weak_lens(const struct calib_settings *cs, const char *name, const do
     return weak;
 }
 
-/* A calibration whose values are less certain than [calibrate] max_sigma_* is written, but
- * flagged weak (its file says so, check-config warns), with what would constrain them: a lens's
+/* A calibration whose values are less certain than [calibrate] max_sigma_*, or whose predicted
+ * depth error at the working volume's edge is above max_depth_error_mm, is written, but flagged
+ * weak (its file says so, check-config warns), with what would constrain them: a lens's
  * principal point and focal length are fixed by boards seen tilted and off the image's centre;
- * the projector's, and the pose between it and the camera, by boards tilted towards and away
- * from the projector and at other distances. */
+ * the projector's, and the pose between it and the camera (what a scan's depth depends on
+ * beyond the camera), by boards tilted towards and away from the projector and at other
+ * distances. */
 static void judge_uncertainty(struct solve *s)
 {
     const struct calib_settings *cs = &s->cfg->calibrate;
@@ -571,11 +576,20 @@ static void judge_uncertainty(struct solve *s)
     double t = fmax(s->sigma.trans_mm[0], fmax(s->sigma.trans_mm[1], s->sigma.trans_mm[2]));
     double r = fmax(s->sigma.rot_deg[0], fmax(s->sigma.rot_deg[1], s->sigma.rot_deg[2]));
     size_t n = strlen(what);
-    if (!s->camera_only && (t > cs->max_sigma_translation_mm || r > cs->max_sigma_rotation_deg)) {
-        snprintf(what + n, sizeof(what) - n, "%sprojector pose +-%.2g mm, +-%.2g deg",
-                 n ? ", " : "", t, r);
-        proj = 1;
+    int pose =
+        !s->camera_only && (t > cs->max_sigma_translation_mm || r > cs->max_sigma_rotation_deg);
+    if (pose)
+        n += (size_t)snprintf(what + n, sizeof(what) - n, "%sprojector pose +-%.2g mm, +-%.2g deg",
+                              n ? ", " : "", t, r);
+    int depth = !s->camera_only && s->depth_worst_mm > cs->max_depth_error_mm;
+    if (depth && n < sizeof(what)) {
+        char why[64] = "";
+        if (!pose) /* what the depth depends on beyond the camera */
+            snprintf(why, sizeof(why), " (projector pose +-%.2g mm, +-%.2g deg)", t, r);
+        snprintf(what + n, sizeof(what) - n, "%spredicted depth error %.2g mm at the edge%s",
+                 n ? ", " : "", s->depth_worst_mm, why);
     }
+    proj = proj || pose || depth;
     if (!cam && !proj)
         return;
     snprintf(s->weak, sizeof(s->weak), "%s", what);
@@ -904,6 +918,7 @@ static int solve_projector(struct solve *s)
         struct calcv_lens cl;
         calib_to_lens(&s->out, 0, &cl);
         find_sigma(s, cam, NULL, n, &cl, NULL);
+        lens_to_calib(&cl, 0, &s->out);
         return 0;
     }
     if (n < 3) {
@@ -922,6 +937,8 @@ static int solve_projector(struct solve *s)
         say(s, "refused: the joint camera-projector calibration did not converge\n");
         return -EINVAL;
     }
+    say(s, "joint camera-projector RMS %.4f px (each corner weighed alike)\n", s->stereo_rms);
+    find_sigma(s, cam, proj, n, &cl, &pl);
     lens_to_calib(&cl, 0, &s->out);
     lens_to_calib(&pl, 1, &s->out);
     /* The projector's own RMS, with the joint lenses: each view's board pose from the camera,
@@ -947,7 +964,6 @@ static int solve_projector(struct solve *s)
     s->proj_rms = count > 0 ? sqrt(sum / count) : 0.0;
     say(s, "projector: reprojection RMS %.4f px (joint RMS %.4f px over %d views)\n", s->proj_rms,
         s->stereo_rms, n);
-    find_sigma(s, cam, proj, n, &cl, &pl);
     if (s->proj_rms > cs->max_projector_rms_px) {
         say(s,
             "refused: the projector's reprojection RMS %.3f px is above [calibrate] "
@@ -1682,9 +1698,9 @@ int calibrate_solve(const struct hal_storage *st, const struct app_config *cfg, 
     if (rc == 0)
         rc = solve_lights(&s);
     if (rc == 0)
-        judge_uncertainty(&s);
-    if (rc == 0)
         predict_depth_error(&s);
+    if (rc == 0) /* after the prediction: a depth error too large makes it weak too */
+        judge_uncertainty(&s);
     if (!json) /* with --json the report is in its file only */
         fputs(s.report != NULL ? s.report : "", stdout);
     if (rc == 0)

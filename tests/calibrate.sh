@@ -82,7 +82,16 @@ uncertainty_test() {
         grep -q '^; to fix: add placements' "$out/tight.ini" &&
         sed "s|^calibration = .*|calibration = $PWD/$out/tight.ini|; s|^rig = ../|rig = $PWD/|" $cfg >"$out/tight-use.ini" &&
         "$bin" check-config --config "$out/tight-use.ini" 2>"$out/tight-check.txt" &&
-        grep -q 'warning: .*the calibration is weak: camera principal point' "$out/tight-check.txt"
+        grep -q 'warning: .*the calibration is weak: camera principal point' "$out/tight-check.txt" ||
+        return 1
+    # a depth error predicted above [calibrate] max_depth_error_mm flags it weak too, naming the
+    # projector's pose and asking for the placements that pin it
+    sed -e 's/^\[calibrate\]/[calibrate]\nmax_depth_error_mm = 0.001/' \
+        -e "s|^calibration = ../|calibration = $PWD/|; s|^rig = ../|rig = $PWD/|" $cfg >"$out/depth-cfg.ini"
+    "$bin" calibrate --config "$out/depth-cfg.ini" --from "$out/cal-captures" \
+        --out "$out/depth.ini" >"$out/depth.txt" 2>&1 &&
+        grep -q '^; weak: predicted depth error [0-9.e-]* mm at the edge (projector pose +-' "$out/depth.ini" &&
+        grep -q '^; to fix: add placements tilted towards and away from the projector' "$out/depth.ini"
 }
 check calibration_states_its_uncertainty uncertainty_test
 # Killed after three captures: the finished ones are kept, nothing is written; --from finishes.
