@@ -494,8 +494,8 @@ void group_variances(const cv::Mat &jac, const std::vector<double> &r, const std
         sum += ss;
         count += g[i].count;
     }
-    for (size_t i = 0; i < g.size(); i++)
-        var[i] = std::max(next[i], 0.01 * sum / count);
+    for (size_t i = 0; i < g.size(); i++) /* and above 1e-12 px^2: corners that fit exactly */
+        var[i] = std::max(next[i], std::max(0.01 * sum / count, 1e-12));
 }
 
 // The lenses (and, with @p projector, the projector's lens and the pose) of unknowns @p x.
@@ -601,7 +601,7 @@ int weighted_steps(const joint_problem &p, const std::vector<int> &free, std::ve
     double sse = 0.0;
     for (double e : r0)
         sse += e * e;
-    std::vector<double> var(g.size(), sse / (double)(m - k));
+    std::vector<double> var(g.size(), std::max(sse / (double)(m - k), 1e-12));
     double chi = weighted_normal(jac, r0, g, var, a, b);
     for (int pass = 0; pass < 12; pass++) {
         if (cv::invert(a, cov, cv::DECOMP_SVD) == 0.0)
