@@ -109,6 +109,13 @@ static void test_errors_name_file_line_and_key(void **state)
                  "[sim] object_offset_mm: 300 is out of range -200..200");
     expect_error("[scan]\nauto_exposure = 2\n",
                  "bad.ini:9: [scan] auto_exposure: 2 is out of range 0..1");
+    /* the predicted depth error that flags a calibration weak: a positive length in mm */
+    expect_error("[calibrate]\nmax_depth_error_mm = 0\n",
+                 "bad.ini:9: [calibrate] max_depth_error_mm: 0 is out of range");
+    expect_error("[calibrate]\nmax_depth_error_mm = 0.05 mm\n",
+                 "bad.ini:9: [calibrate] max_depth_error_mm:");
+    expect_error("[calibrate]\nmax_depth_error_mm = inf\n",
+                 "bad.ini:9: [calibrate] max_depth_error_mm:");
     expect_error("garbage line\n", "bad.ini:8: syntax error");
     /* fit reads the colour frames again: a scan that keeps none could not make its model */
     expect_error("[lights]\ncount = 4\n[colour]\nmethod = fit\n[output]\nkeep_frames = none\n",
