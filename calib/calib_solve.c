@@ -125,7 +125,8 @@ static int feed_patterns(struct solve *s, const char *dir, uint32_t v,
     scan_layout(&s->params, calib, &layout);
     if (!frame_exists(dir, v, gray_layout_count(&layout) - 1))
         return -ENOENT;
-    int rc = scan_job_feed_view(scan_job_views(), dir, v, &s->params, calib, err, sizeof(err));
+    int rc =
+        scan_job_feed_view(scan_job_views(), dir, v, &s->params, calib, NULL, err, sizeof(err));
     if (rc != 0)
         fprintf(stderr, "scanner: error: %s\n", err);
     return rc == -ENOENT ? -EINVAL : rc;

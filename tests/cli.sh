@@ -450,6 +450,19 @@ check process_reads_the_frames_its_method_needs sh -c "$bin process $out/noall >
     cmp $out/scan/mesh.ply $out/noall/mesh.ply && cmp $out/scan/texture.png $out/noall/texture.png &&
     $bin process $out/noall --config $out/uniform.ini 2>&1 | grep -q 'view_000/frame_23: no such frame'"
 rm -rf "$out/noall"
+# The colour frames are read side by side on [scan] threads (issue 33): on one thread or four the
+# same model as the scan's; a colour frame missing among them is named as before, nothing written
+sed 's/^\[scan\]/[scan]\nthreads = 1/' "$out/scan/config.ini" > "$out/one.ini"
+sed 's/^\[scan\]/[scan]\nthreads = 4/' "$out/scan/config.ini" > "$out/four.ini"
+rm -rf "$out/one" "$out/four"
+check process_same_on_one_or_four_threads sh -c "$bin process $out/scan --out $out/one --config $out/one.ini >/dev/null 2>&1 &&
+    $bin process $out/scan --out $out/four --config $out/four.ini >/dev/null 2>&1 &&
+    cmp $out/scan/mesh.ply $out/one/mesh.ply && cmp $out/one/mesh.ply $out/four/mesh.ply &&
+    cmp $out/one/texture.png $out/four/texture.png && cmp $out/scan/texture.png $out/four/texture.png"
+rm -rf "$out/one" "$out/four" "$out/nolight" && cp -r "$out/scan" "$out/nolight" && rm -f "$out"/nolight/view_002/frame_25.ppm.zst
+check process_names_missing_colour_frame sh -c "! $bin process $out/nolight --out $out/nolight_out --config $out/four.ini >$out/nolight.txt 2>&1 &&
+    grep -q 'view_002/frame_25: no such frame' $out/nolight.txt && ! test -e $out/nolight_out/mesh.ply"
+rm -rf "$out/nolight" "$out/nolight_out"
 # A stop signal mid-scan (Ctrl-C, systemd's SIGTERM, a dropped ssh session's SIGHUP, Ctrl-\,
 # Ctrl-Z): the scan stops between frames, says so, and the rig ends in its safe state; the
 # process neither dies lit nor freezes lit.
