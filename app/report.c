@@ -244,6 +244,38 @@ static int view_images_read(const char *dir, uint32_t view, int want_frame, stru
  * squared x 3 bytes at least): colour as a mean (the compensated colour encoded as a screen
  * shows it, sRGB, before averaging), reasons as the most common in the box.
  * @retval 0 @retval -ENOENT the camera's frame is not kept */
+/* The box of source pixels [x0, x1) x [y0, y1) of @p src (@p w wide) into thumbnail pixel @p o:
+ * the most common reason, or the mean of each channel (sRGB-encoded first when @p encode). The
+ * kind is decided once a box, not at each of the million source pixels a view has. */
+static void thumb_box(const uint8_t *src, uint32_t w, uint32_t x0, uint32_t x1, uint32_t y0,
+                      uint32_t y1, int reasons, int encode, uint8_t *o)
+{
+    uint32_t sum[3] = {0, 0, 0}, count[SCAN_REASON_COUNT] = {0}, n = (x1 - x0) * (y1 - y0);
+    for (uint32_t y = y0; y < y1; y++) {
+        const uint8_t *row = src + (size_t)y * w * (reasons ? 1 : 3);
+        if (reasons)
+            for (uint32_t x = x0; x < x1; x++)
+                count[row[x] < SCAN_REASON_COUNT ? row[x] : 0]++;
+        else if (encode)
+            for (uint32_t x = x0; x < x1; x++)
+                for (int c = 0; c < 3; c++)
+                    sum[c] += srgb_encode(row[3 * x + c]);
+        else
+            for (uint32_t x = x0; x < x1; x++)
+                for (int c = 0; c < 3; c++)
+                    sum[c] += row[3 * x + c];
+    }
+    if (reasons) {
+        unsigned best = 0;
+        for (unsigned r = 1; r < SCAN_REASON_COUNT; r++)
+            best = count[r] > count[best] ? r : best;
+        reason_rgb(best, o);
+        return;
+    }
+    for (int c = 0; c < 3; c++)
+        o[c] = (uint8_t)(n ? sum[c] / n : 0);
+}
+
 static int thumb_of(const struct view_images *vi, enum report_thumb kind, uint8_t *out,
                     uint32_t *tw, uint32_t *th)
 {
@@ -258,31 +290,10 @@ static int thumb_of(const struct view_images *vi, enum report_thumb kind, uint8_
     if (*th > REPORT_THUMB_WIDTH)
         *th = REPORT_THUMB_WIDTH;
     for (uint32_t ty = 0; ty < *th; ty++)
-        for (uint32_t tx = 0; tx < *tw; tx++) {
-            uint32_t x0 = tx * w / *tw, x1 = (tx + 1) * w / *tw, y0 = ty * h / *th;
-            uint32_t y1 = (ty + 1) * h / *th;
-            uint32_t sum[3] = {0, 0, 0}, count[SCAN_REASON_COUNT] = {0}, n = 0;
-            for (uint32_t y = y0; y < y1; y++)
-                for (uint32_t x = x0; x < x1; x++, n++) {
-                    size_t i = (size_t)y * w + x;
-                    if (kind == REPORT_THUMB_REASONS)
-                        count[src[i] < SCAN_REASON_COUNT ? src[i] : 0]++;
-                    else
-                        for (int c = 0; c < 3; c++)
-                            sum[c] += kind == REPORT_THUMB_INTRINSIC ? srgb_encode(src[3 * i + c])
-                                                                     : src[3 * i + c];
-                }
-            uint8_t *o = out + 3 * ((size_t)ty * *tw + tx);
-            if (kind == REPORT_THUMB_REASONS) {
-                unsigned best = 0;
-                for (unsigned r = 1; r < SCAN_REASON_COUNT; r++)
-                    best = count[r] > count[best] ? r : best;
-                reason_rgb(best, o);
-            } else {
-                for (int c = 0; c < 3; c++)
-                    o[c] = (uint8_t)(n ? sum[c] / n : 0);
-            }
-        }
+        for (uint32_t tx = 0; tx < *tw; tx++)
+            thumb_box(src, w, tx * w / *tw, (tx + 1) * w / *tw, ty * h / *th, (ty + 1) * h / *th,
+                      kind == REPORT_THUMB_REASONS, kind == REPORT_THUMB_INTRINSIC,
+                      out + 3 * ((size_t)ty * *tw + tx));
     return 0;
 }
 
