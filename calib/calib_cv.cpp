@@ -453,6 +453,17 @@ std::vector<group> joint_groups(const joint_problem &p)
     return g;
 }
 
+// The weighted sum of squares of residuals @p r, group @p g over its variance @p var.
+double weighted_squares(const std::vector<double> &r, const std::vector<group> &g,
+                        const std::vector<double> &var)
+{
+    double chi = 0.0;
+    for (size_t i = 0; i < g.size(); i++)
+        for (int row = g[i].row; row < g[i].row + g[i].count; row++)
+            chi += r[(size_t)row] * r[(size_t)row] / var[i];
+    return chi;
+}
+
 // The weighted normal equations of @p jac and residuals @p r, each group @p g weighed by the
 // inverse of its variance @p var: a = sum J_g^T J_g / var_g, b = sum J_g^T r_g / var_g; and the
 // weighted sum of squares.
@@ -463,15 +474,13 @@ double weighted_normal(const cv::Mat &jac, const std::vector<double> &r,
     const int k = jac.cols;
     a = cv::Mat::zeros(k, k, CV_64F);
     b = cv::Mat::zeros(k, 1, CV_64F);
-    double chi = 0.0;
     for (size_t i = 0; i < g.size(); i++) {
         cv::Mat jg = jac(cv::Range(g[i].row, g[i].row + g[i].count), cv::Range::all());
         cv::Mat rg(g[i].count, 1, CV_64F, const_cast<double *>(&r[(size_t)g[i].row]));
         a += jg.t() * jg / var[i];
         b += jg.t() * rg / var[i];
-        chi += rg.dot(rg) / var[i];
     }
-    return chi;
+    return weighted_squares(r, g, var); /* the sum a step's is compared with, summed alike */
 }
 
 // Each group's variance again from its residuals @p r over its redundancy (Foerstner's variance
@@ -569,17 +578,6 @@ int joint_start(const calcv_lens *cam_lens, const calcv_lens *proj_lens, const d
             x[24 + 6 * (size_t)v + i] = rv[i], x[24 + 6 * (size_t)v + 3 + i] = tv[i];
     }
     return 0;
-}
-
-// The weighted sum of squares of residuals @p r, group @p g over its variance @p var.
-double weighted_squares(const std::vector<double> &r, const std::vector<group> &g,
-                        const std::vector<double> &var)
-{
-    double chi = 0.0;
-    for (size_t i = 0; i < g.size(); i++)
-        for (int row = g[i].row; row < g[i].row + g[i].count; row++)
-            chi += r[(size_t)row] * r[(size_t)row] / var[i];
-    return chi;
 }
 
 // Gauss-Newton on unknowns @p x (@p free of them), each group of residuals weighed by its own
