@@ -462,6 +462,10 @@ check process_same_on_one_or_four_threads sh -c "$bin process $out/scan --out $o
 rm -rf "$out/one" "$out/four" "$out/nolight" && cp -r "$out/scan" "$out/nolight" && rm -f "$out"/nolight/view_002/frame_25.ppm.zst
 check process_names_missing_colour_frame sh -c "! $bin process $out/nolight --out $out/nolight_out --config $out/four.ini >$out/nolight.txt 2>&1 &&
     grep -q 'view_002/frame_25: no such frame' $out/nolight.txt && ! test -e $out/nolight_out/mesh.ply"
+# ... and a FIFO where a colour frame belongs is refused by its reader, not waited on by a thread
+rm -rf "$out/nolight_out" && mkfifo "$out"/nolight/view_002/frame_25.ppm.zst
+check process_refuses_fifo_colour_frame sh -c "! timeout 120 $bin process $out/nolight --out $out/nolight_out --config $out/four.ini >$out/fifo.txt 2>&1 &&
+    grep -q 'view_002/frame_25.ppm.zst: not a regular file' $out/fifo.txt && ! test -e $out/nolight_out/mesh.ply"
 rm -rf "$out/nolight" "$out/nolight_out"
 # A stop signal mid-scan (Ctrl-C, systemd's SIGTERM, a dropped ssh session's SIGHUP, Ctrl-\,
 # Ctrl-Z): the scan stops between frames, says so, and the rig ends in its safe state; the
