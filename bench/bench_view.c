@@ -55,12 +55,13 @@ __attribute__((noinline)) void process_view_once(struct test_rig *t, const uint8
                              .confidence = confidence};
     decode_finish(&sc->decode, NULL, reason, &view.maps); /* one thread: the stage's own cost */
     s[2] = now_ms();
-    refine_columns(&view.maps, (int)t->cfg.scan.refine, sc->column);
+    refine_columns(&view.maps, NULL, (int)t->cfg.scan.refine, sc->column);
     view.column = sc->column;
     s[3] = now_ms();
-    tri_range_image(&t->calib, &sc->tri, view.width, view.height, view.column, reason, &view.range);
+    tri_range_image(&t->calib, NULL, &sc->tri, view.width, view.height, view.column, reason,
+                    &view.range);
     s[4] = now_ms();
-    tri_normals(&sc->tri, &view.range, reason, t->cfg.scan.normal_radius_px,
+    tri_normals(&sc->tri, NULL, &view.range, reason, t->cfg.scan.normal_radius_px,
                 t->cfg.scan.max_depth_jump_mm);
     s[5] = now_ms();
     /* the joint registration keeps each view's samples now and solves once at the end */

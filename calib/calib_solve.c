@@ -716,7 +716,7 @@ static int draw_error(const struct scan_calib *ck, struct tri_maps *maps, struct
     memcpy(d->reason, d->valid, CALIB_DEPTH_PLANES * plane);
     for (size_t j = 0, k = 0; k < CALIB_DEPTH_PLANES; k++) {
         struct tri_range range;
-        if (tri_range_image(ck, maps, ck->cam_width, ck->cam_height, d->column + k * plane,
+        if (tri_range_image(ck, NULL, maps, ck->cam_width, ck->cam_height, d->column + k * plane,
                             d->reason + k * plane, &range) != 0)
             return -EDOM;
         for (; j < d->count && d->pixel[j] < (k + 1) * plane; j++) {

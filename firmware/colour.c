@@ -67,21 +67,72 @@ int colour_needs_frame(const struct colour_params *p, const struct colour_layout
     }
 }
 
+/* Sums over a frame's pixels that have depth, in integers (exact, so the same on any number
+ * of threads): the count and, per channel, the frame's bytes y and, for fit_ambient, the
+ * albedo bytes x of a first pass, x^2 and x y over its confident pixels. */
+struct pixel_sums {
+    uint64_t n, x[3], y[3], xx[3], xy[3];
+};
+
+struct sum_parts {
+    const struct decode_maps *m;
+    const uint8_t *frame;
+    const uint8_t *albedo;   /* NULL: the frame alone (channel_offset) */
+    const float *confidence; /* with albedo: only pixels with an estimate */
+    size_t pixels;
+    unsigned parts;
+    struct pixel_sums sum[HAL_MAX_THREADS * 4u];
+};
+
+static void sum_part(void *arg, unsigned k)
+{
+    struct sum_parts *p = arg;
+    struct pixel_sums t = {0};
+    for (size_t i = p->pixels * k / p->parts; i < p->pixels * (k + 1u) / p->parts; i++) {
+        if (p->m->reason[i] != SCAN_VALID || (p->albedo != NULL && p->confidence[i] <= 0.0f))
+            continue;
+        t.n++;
+        for (int c = 0; c < 3; c++) {
+            uint64_t y = p->frame[3 * i + (size_t)c];
+            uint64_t x = p->albedo != NULL ? p->albedo[3 * i + (size_t)c] : 0u;
+            t.y[c] += y, t.x[c] += x, t.xx[c] += x * x, t.xy[c] += x * y;
+        }
+    }
+    p->sum[k] = t;
+}
+
+/* The sums of sum_part over the whole frame, its parts split across @p threads. */
+static void pixel_sums(const struct hal_thread *threads, const struct decode_maps *m,
+                       const uint8_t *frame, const uint8_t *albedo, const float *confidence,
+                       struct pixel_sums *out)
+{
+    static struct sum_parts p; /* 4 KiB of sums: one view is coloured at a time */
+    p = (struct sum_parts){.m = m,
+                           .frame = frame,
+                           .albedo = albedo,
+                           .confidence = confidence,
+                           .pixels = (size_t)m->width * m->height,
+                           .parts = hal_thread_parts(threads, HAL_MAX_THREADS * 4u)};
+    hal_thread_run(threads, p.parts, sum_part, &p);
+    *out = (struct pixel_sums){0};
+    for (unsigned k = 0; k < p.parts; k++) {
+        out->n += p.sum[k].n;
+        for (int c = 0; c < 3; c++) {
+            out->x[c] += p.sum[k].x[c], out->y[c] += p.sum[k].y[c];
+            out->xx[c] += p.sum[k].xx[c], out->xy[c] += p.sum[k].xy[c];
+        }
+    }
+}
+
 /* Ca per channel: the mean of a dark frame over the pixels that have depth (the object), so
  * that ambient light on the object counts and the background does not. */
-static void channel_offset(const struct decode_maps *m, const uint8_t *dark, double ca[3])
+static void channel_offset(const struct hal_thread *threads, const struct decode_maps *m,
+                           const uint8_t *dark, double ca[3])
 {
-    double sum[3] = {0, 0, 0};
-    size_t n = (size_t)m->width * m->height, count = 0;
-    for (size_t i = 0; i < n; i++) {
-        if (m->reason[i] != SCAN_VALID)
-            continue;
-        for (int k = 0; k < 3; k++)
-            sum[k] += dark[3 * i + (size_t)k];
-        count++;
-    }
+    struct pixel_sums t;
+    pixel_sums(threads, m, dark, NULL, NULL, &t);
     for (int k = 0; k < 3; k++)
-        ca[k] = count ? sum[k] / count : 0.0;
+        ca[k] = t.n ? (double)t.y[k] / (double)t.n : 0.0;
 }
 
 /* What frame_light() needs: the frames in colour_layout() order and each dark frame's Ca:
@@ -543,28 +594,24 @@ static void compute_pass(const struct frame_ctx *f, const struct hal_thread *thr
 /* ca = albedo: each dark frame's value at a confident pixel, per channel, as offset + slope x
  * the pixel's albedo (least squares over the object): the black offset and the ambient light
  * the paint reflects. */
-static void fit_ambient(struct frame_ctx *f, const struct decode_maps *m, const uint8_t *albedo,
-                        const float *confidence, uint32_t k)
+static void fit_ambient(struct frame_ctx *f, const struct hal_thread *threads,
+                        const struct decode_maps *m, const uint8_t *albedo, const float *confidence,
+                        uint32_t k)
 {
-    size_t n = (size_t)m->width * m->height;
-    double s1 = 0, sx[3] = {0, 0, 0}, sy[3] = {0, 0, 0}, sxx[3] = {0, 0, 0}, sxy[3] = {0, 0, 0};
-    for (size_t i = 0; i < n; i++) {
-        if (m->reason[i] != SCAN_VALID || confidence[i] <= 0.0f)
-            continue;
-        s1 += 1.0;
-        for (int c = 0; c < 3; c++) {
-            double x = albedo[3 * i + (size_t)c] / 255.0, y = f->frames[k][3 * i + (size_t)c];
-            sx[c] += x, sy[c] += y, sxx[c] += x * x, sxy[c] += x * y;
-        }
-    }
+    struct pixel_sums t;
+    pixel_sums(threads, m, f->frames[k], albedo, confidence, &t);
+    /* x = albedo byte / 255, y = the dark frame's byte */
+    double s1 = (double)t.n;
     for (int c = 0; c < 3; c++) {
-        double det = s1 * sxx[c] - sx[c] * sx[c];
+        double sx = (double)t.x[c] / 255.0, sy = (double)t.y[c];
+        double sxx = (double)t.xx[c] / (255.0 * 255.0), sxy = (double)t.xy[c] / 255.0;
+        double det = s1 * sxx - sx * sx;
         if (s1 < 100.0 || det <= 1e-9 * s1 * s1)
             continue; /* too few, or one albedo only: the mean stands */
-        double slope = (s1 * sxy[c] - sx[c] * sy[c]) / det;
+        double slope = (s1 * sxy - sx * sy) / det;
         slope = slope > 0.0 ? slope : 0.0; /* light is never taken away */
         f->ca_slope[k][c] = slope;
-        f->ca_channel[k][c] = (sy[c] - slope * sx[c]) / s1;
+        f->ca_channel[k][c] = (sy - slope * sx) / s1;
     }
 }
 
@@ -585,7 +632,7 @@ int colour_compute(const struct colour_params *prm, const struct hal_thread *thr
         if (lights[k] == NULL && colour_needs_frame(prm, &lay, k))
             return -EINVAL;
         if (lights[k] != NULL && lay.dark_of[k] == k)
-            channel_offset(m, lights[k], f.ca_channel[k]);
+            channel_offset(threads, m, lights[k], f.ca_channel[k]);
     }
     frame_tables(&f);
     int two = prm->method != COLOUR_NONE && prm->ca == COLOUR_CA_ALBEDO;
@@ -594,7 +641,7 @@ int colour_compute(const struct colour_params *prm, const struct hal_thread *thr
         return 0;
     for (uint32_t k = 0; k < lay.count; k++)
         if (lights[k] != NULL && lay.dark_of[k] == k)
-            fit_ambient(&f, m, albedo, confidence, k);
+            fit_ambient(&f, threads, m, albedo, confidence, k);
     frame_tables(&f);
     compute_pass(&f, threads, c, m, r, white, albedo, confidence, pool, 1, 1);
     return 0;

@@ -440,19 +440,29 @@ static void resolve_rows(void *arg, unsigned k)
  * valid so; a valid one whose unclear bit read the wrong way (noise, not an edge) is corrected.
  * Verdicts go to d->scratch and corrections wait in the unclear maps (not needed after this) until
  * the pass ends, so that what this pass changes is not the reference of others. */
-static void resolve_unclear(struct decode_ctx *d, const struct hal_thread *threads, uint8_t *reason)
+/* Part @p k of the rows once every part has read them: the corrections applied, the verdicts
+ * made the reasons. */
+static void resolve_apply(void *arg, unsigned k)
 {
-    struct row_parts p = {d, reason, hal_thread_parts(threads, 64)};
-    hal_thread_run(threads, p.parts, resolve_rows, &p);
-    size_t n = (size_t)d->params.width * d->params.height;
-    for (size_t i = 0; i < n; i++) {
+    const struct row_parts *p = arg;
+    struct decode_ctx *d = p->d;
+    const size_t w = d->params.width, h = d->params.height;
+    const size_t i0 = w * (h * k / p->parts), i1 = w * (h * (k + 1u) / p->parts);
+    for (size_t i = i0; i < i1; i++) {
         if (d->scratch[i] == RESOLVE_CORRECTED) {
             d->column_map[i] = d->unclear_col[i];
             d->row_map[i] = d->unclear_row[i];
             d->scratch[i] = SCAN_VALID;
         }
     }
-    memcpy(reason, d->scratch, n);
+    memcpy(p->reason + i0, d->scratch + i0, i1 - i0);
+}
+
+static void resolve_unclear(struct decode_ctx *d, const struct hal_thread *threads, uint8_t *reason)
+{
+    struct row_parts p = {d, reason, hal_thread_parts(threads, 64)};
+    hal_thread_run(threads, p.parts, resolve_rows, &p);
+    hal_thread_run(threads, p.parts, resolve_apply, &p);
 }
 
 static int codes_agree(const struct decode_ctx *d, const uint8_t *reason, size_t a, size_t b)
@@ -501,6 +511,15 @@ static void check_rows(void *arg, unsigned k)
     }
 }
 
+/* Part @p k of the rows once every part has read them: the verdicts made the reasons. */
+static void verdicts_apply(void *arg, unsigned k)
+{
+    const struct row_parts *p = arg;
+    const size_t w = p->d->params.width, h = p->d->params.height;
+    const size_t i0 = w * (h * k / p->parts), i1 = w * (h * (k + 1u) / p->parts);
+    memcpy(p->reason + i0, p->d->scratch + i0, i1 - i0);
+}
+
 /* A wrong bit makes a lone jump: a pixel is inconsistent when more of its valid neighbours
  * disagree with it than agree, or when fewer than min_consistent_neighbours agree and none of
  * its 5 x 5 neighbourhood backs it. A pixel with only a few valid neighbours, all agreeing (on
@@ -510,7 +529,7 @@ static void check_neighbours(struct decode_ctx *d, const struct hal_thread *thre
 {
     struct row_parts p = {d, reason, hal_thread_parts(threads, 64)};
     hal_thread_run(threads, p.parts, check_rows, &p);
-    memcpy(reason, d->scratch, (size_t)d->params.width * d->params.height);
+    hal_thread_run(threads, p.parts, verdicts_apply, &p);
 }
 
 int decode_finish(struct decode_ctx *d, const struct hal_thread *threads, uint8_t *reason,

@@ -117,37 +117,76 @@ static void distance_to_edge(struct fusion_volume *vol, const struct decode_maps
     }
 }
 
-/* How much a pixel is trusted: head-on, close (finer sampling), and away from the view's edge,
- * where depth is least reliable and colour seams would show (Jost et al., boundary filtering).
- * @retval 0 when no pixel is valid */
-static int pixel_weights(struct fusion_volume *vol, const struct scan_calib *c,
-                         const struct decode_maps *m, const struct tri_range *r)
+/* What the rows of a view's weights share (pixel_weights). */
+struct weight_rows {
+    struct fusion_volume *vol;
+    const struct scan_calib *c;
+    const struct decode_maps *m;
+    const struct tri_range *r;
+    struct camray rays;
+    double fade;
+    unsigned parts;
+};
+
+/* Part @p k of the image's rows: each valid pixel's weight, 0 for every other pixel (its own
+ * pixels only); the rectangle's ring and the rows beyond it hold no valid pixel. */
+static void weight_rows(void *arg, unsigned k)
 {
-    const double fade = vol->p.edge_fade_px > 0 ? (double)vol->p.edge_fade_px : 1.0;
-    const struct camray rays = camray_lookup(c); /* the table, where it is this calibration's */
-    memset(vol->weight_map, 0, (size_t)m->width * m->height * sizeof(vol->weight_map[0]));
-    if (!find_rect(vol, m))
-        return 0;
-    distance_to_edge(vol, m, (uint16_t)(vol->p.edge_fade_px > 0 ? vol->p.edge_fade_px : 1));
-    for (uint32_t y = vol->rect.y0; y < vol->rect.y1; y++) {
-        for (uint32_t x = vol->rect.x0; x < vol->rect.x1; x++) {
+    const struct weight_rows *p = arg;
+    struct fusion_volume *vol = p->vol;
+    const struct decode_maps *m = p->m;
+    const uint32_t x0 = vol->rect.x0, x1 = vol->rect.x1;
+    for (uint32_t y = m->height * k / p->parts; y < m->height * (k + 1u) / p->parts; y++) {
+        float *row = &vol->weight_map[(size_t)y * m->width];
+        if (y < vol->rect.y0 || y >= vol->rect.y1) {
+            memset(row, 0, m->width * sizeof(*row));
+            continue;
+        }
+        memset(row, 0, x0 * sizeof(*row));
+        memset(row + x1, 0, (m->width - x1) * sizeof(*row));
+        for (uint32_t x = x0; x < x1; x++) {
             size_t i = (size_t)y * m->width + x;
+            row[x] = 0.0f;
             if (m->reason[i] != SCAN_VALID)
                 continue;
-            vec3 ray = v3_norm(camray_at(c, rays, x, y));
-            vec3 n = v3(r->normal[3 * i], r->normal[3 * i + 1], r->normal[3 * i + 2]);
-            double head_on = -v3_dot(n, ray), z = r->xyz_mm[3 * i + 2];
-            double w = head_on * (600.0 / z) * (600.0 / z) * fmin(1.0, vol->edge_dist[i] / fade);
-            vol->weight_map[i] = w >= vol->p.min_weight ? (float)w : 0.0f;
+            vec3 ray = v3_norm(camray_at(p->c, p->rays, x, y));
+            vec3 n = v3(p->r->normal[3 * i], p->r->normal[3 * i + 1], p->r->normal[3 * i + 2]);
+            double head_on = -v3_dot(n, ray), z = p->r->xyz_mm[3 * i + 2];
+            double w = head_on * (600.0 / z) * (600.0 / z) * fmin(1.0, vol->edge_dist[i] / p->fade);
+            row[x] = w >= vol->p.min_weight ? (float)w : 0.0f;
         }
     }
+}
+
+/* How much a pixel is trusted: head-on, close (finer sampling), and away from the view's edge,
+ * where depth is least reliable and colour seams would show (Jost et al., boundary filtering).
+ * The rows split across @p threads (NULL: this one).
+ * @retval 0 when no pixel is valid */
+static int pixel_weights(struct fusion_volume *vol, const struct hal_thread *threads,
+                         const struct scan_calib *c, const struct decode_maps *m,
+                         const struct tri_range *r)
+{
+    struct weight_rows p = {.vol = vol,
+                            .c = c,
+                            .m = m,
+                            .r = r,
+                            .rays =
+                                camray_lookup(c), /* the table, where it is this calibration's */
+                            .fade = vol->p.edge_fade_px > 0 ? (double)vol->p.edge_fade_px : 1.0,
+                            .parts = hal_thread_parts(threads, 64)};
+    if (!find_rect(vol, m)) {
+        memset(vol->weight_map, 0, (size_t)m->width * m->height * sizeof(vol->weight_map[0]));
+        return 0;
+    }
+    distance_to_edge(vol, m, (uint16_t)(vol->p.edge_fade_px > 0 ? vol->p.edge_fade_px : 1));
+    hal_thread_run(threads, p.parts, weight_rows, &p);
     return 1;
 }
 
 const float *fusion_view_weights(struct fusion_volume *vol, const struct scan_calib *calib,
                                  const struct decode_maps *maps, const struct tri_range *range)
 {
-    return pixel_weights(vol, calib, maps, range) ? vol->weight_map : NULL;
+    return pixel_weights(vol, NULL, calib, maps, range) ? vol->weight_map : NULL;
 }
 
 /* Blend colour @p rgb with weight @p cw into the voxel; a voxel no confident view has coloured
@@ -279,23 +318,40 @@ uint32_t fusion_border_points(const struct fusion_params *fp,
     return n;
 }
 
-/* Mark the blocks of the view's fused points, and count those beyond the grid.
- * @retval 0 when the view has none */
-static int mark_blocks(struct fusion_volume *vol, const struct frame_xform *obj_from_cam,
-                       const struct decode_maps *m, const struct tri_range *r, const uint32_t nb[3])
+/* What the rows of a view's block marks share (mark_blocks), and each part's count of the
+ * points beyond the grid and whether it marked a block. */
+struct mark_rows {
+    struct fusion_volume *vol;
+    const struct frame_xform *obj_from_cam;
+    const struct decode_maps *m;
+    const struct tri_range *r;
+    const uint32_t *nb;
+    unsigned parts;
+    struct fusion_outside outside[HAL_MAX_THREADS * 4u];
+    int any[HAL_MAX_THREADS * 4u];
+};
+
+/* Part @p k of the rectangle's rows: the block of each fused point marked (parts may mark the
+ * same block: each stores a 1, atomically), the points beyond the grid counted in its own. */
+static void mark_rows(void *arg, unsigned k)
 {
+    struct mark_rows *p = arg;
+    struct fusion_volume *vol = p->vol;
+    const float *xyz = p->r->xyz_mm;
+    const uint32_t *nb = p->nb, rows = vol->rect.y1 - vol->rect.y0;
     const double scale = 1.0 / (vol->p.voxel_mm * BLOCK);
+    struct fusion_outside outside = {0};
     int any = 0;
-    memset(vol->block_mark, 0, (size_t)nb[0] * nb[1] * nb[2]);
-    for (size_t y = vol->rect.y0; y < vol->rect.y1; y++) {
-        for (size_t i = y * m->width + vol->rect.x0; i < y * m->width + vol->rect.x1; i++) {
+    for (size_t y = vol->rect.y0 + rows * k / p->parts;
+         y < vol->rect.y0 + rows * (k + 1u) / p->parts; y++) {
+        for (size_t i = y * p->m->width + vol->rect.x0; i < y * p->m->width + vol->rect.x1; i++) {
             if (vol->weight_map[i] <= 0.0f)
                 continue;
-            vec3 p_obj = frame_point(
-                obj_from_cam, v3(r->xyz_mm[3 * i], r->xyz_mm[3 * i + 1], r->xyz_mm[3 * i + 2]));
-            fusion_outside_add(&vol->outside, &vol->p, p_obj);
-            vec3 p = v3_sub(p_obj, vol->origin);
-            double g[3] = {p.x * scale, p.y * scale, p.z * scale};
+            vec3 p_obj =
+                frame_point(p->obj_from_cam, v3(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]));
+            fusion_outside_add(&outside, &vol->p, p_obj);
+            vec3 q = v3_sub(p_obj, vol->origin);
+            double g[3] = {q.x * scale, q.y * scale, q.z * scale};
             uint32_t b[3];
             int inside = 1;
             for (int a = 0; a < 3; a++) {
@@ -304,10 +360,42 @@ static int mark_blocks(struct fusion_volume *vol, const struct frame_xform *obj_
                 b[a] = g[a] < 0.0 ? 0u : g[a] >= nb[a] ? nb[a] - 1u : (uint32_t)g[a];
             }
             if (inside) {
-                vol->block_mark[bidx(nb, b[0], b[1], b[2])] = 1;
+                __atomic_store_n(&vol->block_mark[bidx(nb, b[0], b[1], b[2])], 1, __ATOMIC_RELAXED);
                 any = 1;
             }
         }
+    }
+    p->outside[k] = outside;
+    p->any[k] = any;
+}
+
+/* Mark the blocks of the view's fused points, and count those beyond the grid; the rows split
+ * across @p threads, their counts added (and their highest and widest points taken) after.
+ * @retval 0 when the view has none */
+static int mark_blocks(struct fusion_volume *vol, const struct hal_thread *threads,
+                       const struct frame_xform *obj_from_cam, const struct decode_maps *m,
+                       const struct tri_range *r, const uint32_t nb[3])
+{
+    static struct mark_rows p; /* a kilobyte of counts: one view is fused at a time */
+    p = (struct mark_rows){.vol = vol,
+                           .obj_from_cam = obj_from_cam,
+                           .m = m,
+                           .r = r,
+                           .nb = nb,
+                           .parts = hal_thread_parts(threads, HAL_MAX_THREADS * 4u)};
+    memset(vol->block_mark, 0, (size_t)nb[0] * nb[1] * nb[2]);
+    hal_thread_run(threads, p.parts, mark_rows, &p);
+    int any = 0;
+    struct fusion_outside *o = &vol->outside;
+    for (unsigned k = 0; k < p.parts; k++) {
+        const struct fusion_outside *part = &p.outside[k];
+        any |= p.any[k];
+        o->fused += part->fused;
+        o->above += part->above;
+        o->beside += part->beside;
+        o->top_seen_mm = part->top_seen_mm > o->top_seen_mm ? part->top_seen_mm : o->top_seen_mm;
+        o->reach_seen_mm =
+            part->reach_seen_mm > o->reach_seen_mm ? part->reach_seen_mm : o->reach_seen_mm;
     }
     return any;
 }
@@ -416,7 +504,7 @@ int fusion_integrate(struct fusion_volume *vol, const struct hal_thread *threads
                      const struct decode_maps *m, const struct tri_range *r, const uint8_t *rgb,
                      const float *confidence)
 {
-    if (!pixel_weights(vol, c, m, r))
+    if (!pixel_weights(vol, threads, c, m, r))
         return 0;
     const uint32_t *dims = vol->dims;
     struct slices s = {.vol = vol,
@@ -434,7 +522,7 @@ int fusion_integrate(struct fusion_volume *vol, const struct hal_thread *threads
                        .parts = hal_thread_parts(threads, 64)};
     vol->outside.views_cut +=
         fusion_border_points(&vol->p, obj_from_cam, m, r) >= FUSION_EDGE_POINTS;
-    if (!mark_blocks(vol, obj_from_cam, m, r, s.nb))
+    if (!mark_blocks(vol, threads, obj_from_cam, m, r, s.nb))
         return 0;
     /* a point's band reaches truncation / voxel voxels (and one for rounding) from its block */
     double band = vol->p.truncation_mm / vol->p.voxel_mm + 1.0;

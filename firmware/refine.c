@@ -1,6 +1,8 @@
 /* Sub-stripe refinement by interpolating across runs of equal Gray codes along camera rows. */
 #include "refine.h"
 
+#include "hal_thread.h"
+
 /* Code of the run that ends just before x0 (dir -1) or starts just after x1 (dir +1), or -1 if
  * that pixel is not valid. */
 static int neighbour_code(const struct decode_maps *m, size_t row, uint32_t x, int dir)
@@ -29,9 +31,19 @@ static void refine_run(const struct decode_maps *m, float *column_sub, size_t ro
     }
 }
 
-int refine_columns(const struct decode_maps *m, int enabled, float *column_sub)
+/* The rows of one part of a refinement. */
+struct refine_parts {
+    const struct decode_maps *m;
+    int enabled;
+    float *column_sub;
+    unsigned parts;
+};
+
+static void refine_rows(void *arg, unsigned k)
 {
-    for (uint32_t y = 0; y < m->height; y++) {
+    const struct refine_parts *p = arg;
+    const struct decode_maps *m = p->m;
+    for (uint32_t y = m->height * k / p->parts; y < m->height * (k + 1u) / p->parts; y++) {
         size_t row = (size_t)y * m->width;
         uint32_t x = 0;
         while (x < m->width) {
@@ -43,14 +55,22 @@ int refine_columns(const struct decode_maps *m, int enabled, float *column_sub)
             while (end + 1 < m->width && m->reason[row + end + 1] == SCAN_VALID &&
                    m->column[row + end + 1] == m->column[row + x])
                 end++;
-            if (enabled) {
-                refine_run(m, column_sub, row, x, end);
+            if (p->enabled) {
+                refine_run(m, p->column_sub, row, x, end);
             } else {
-                for (uint32_t k = x; k <= end; k++)
-                    column_sub[row + k] = (float)m->column[row + k];
+                for (uint32_t j = x; j <= end; j++)
+                    p->column_sub[row + j] = (float)m->column[row + j];
             }
             x = end + 1;
         }
     }
+}
+
+int refine_columns(const struct decode_maps *m, const struct hal_thread *threads, int enabled,
+                   float *column_sub)
+{
+    struct refine_parts p = {m, enabled, column_sub,
+                             hal_thread_parts(threads, HAL_MAX_THREADS * 4u)};
+    hal_thread_run(threads, p.parts, refine_rows, &p);
     return 0;
 }

@@ -252,6 +252,50 @@ static uint32_t hist_median(const uint32_t hist[256], uint32_t total)
     return 0;
 }
 
+/* A view's pixels per reason and the contrast of its dark ones, counted by parts of the image
+ * (integers: the same counts on any number of threads). */
+struct reason_parts {
+    const struct scan_ctx *s;
+    size_t pixels;
+    unsigned parts;
+    uint32_t count[HAL_MAX_THREADS * 4u][SCAN_REASON_COUNT];
+    uint32_t dark_hist[HAL_MAX_THREADS * 4u][256];
+};
+
+static void reason_part(void *arg, unsigned k)
+{
+    struct reason_parts *p = arg;
+    const struct scan_ctx *s = p->s;
+    uint32_t *count = p->count[k], *dark_hist = p->dark_hist[k];
+    memset(count, 0, sizeof(p->count[k]));
+    memset(dark_hist, 0, sizeof(p->dark_hist[k]));
+    for (size_t i = p->pixels * k / p->parts; i < p->pixels * (k + 1u) / p->parts; i++) {
+        count[s->view_reason[i]]++;
+        if (s->view_reason[i] == SCAN_DARK && s->decode.white[i] > s->decode.black[i])
+            dark_hist[s->decode.white[i] - s->decode.black[i]]++;
+    }
+}
+
+static void count_reasons(const struct scan_ctx *s, const struct hal_thread *cores,
+                          struct scan_view_info *info)
+{
+    static struct reason_parts p; /* 34 KiB of counts: one view is finished at a time */
+    p.s = s;
+    p.pixels = (size_t)s->params.width * s->params.height;
+    p.parts = hal_thread_parts(cores, HAL_MAX_THREADS * 4u);
+    hal_thread_run(cores, p.parts, reason_part, &p);
+    uint32_t dark_hist[256] = {0}, dark_n = 0;
+    memset(info->reason_count, 0, sizeof(info->reason_count));
+    for (unsigned k = 0; k < p.parts; k++) {
+        for (unsigned r = 0; r < SCAN_REASON_COUNT; r++)
+            info->reason_count[r] += p.count[k][r];
+        for (unsigned v = 0; v < 256; v++)
+            dark_hist[v] += p.dark_hist[k][v], dark_n += p.dark_hist[k][v];
+    }
+    info->valid_points = info->reason_count[SCAN_VALID];
+    info->dark_contrast_dn = hist_median(dark_hist, dark_n);
+}
+
 int scan_finish_view(struct scan_ctx *s, const struct hal_thread *threads,
                      const struct scan_calib *c, int32_t angle_mdeg, struct scan_view *view,
                      struct scan_view_info *info)
@@ -268,13 +312,13 @@ int scan_finish_view(struct scan_ctx *s, const struct hal_thread *threads,
     view->confidence = s->view_confidence;
     int rc = decode_finish(&s->decode, &cores, s->view_reason, &view->maps);
     if (rc == 0)
-        rc = refine_columns(&view->maps, (int)s->params.refine, s->column);
+        rc = refine_columns(&view->maps, &cores, (int)s->params.refine, s->column);
     view->column = s->column;
     if (rc == 0)
-        rc = tri_range_image(c, &s->tri, view->width, view->height, view->column, s->view_reason,
-                             &view->range);
+        rc = tri_range_image(c, &cores, &s->tri, view->width, view->height, view->column,
+                             s->view_reason, &view->range);
     if (rc == 0)
-        rc = tri_normals(&s->tri, &view->range, s->view_reason, s->params.normal_radius_px,
+        rc = tri_normals(&s->tri, &cores, &view->range, s->view_reason, s->params.normal_radius_px,
                          s->params.max_depth_jump_mm);
     if (rc == 0)
         rc = scan_recolour(&s->params.colour, &cores, c, view, NULL); /* fit: multi's, until the
@@ -282,16 +326,7 @@ int scan_finish_view(struct scan_ctx *s, const struct hal_thread *threads,
     if (rc != 0)
         return rc;
     info->angle_mdeg = angle_mdeg;
-    memset(info->reason_count, 0, sizeof(info->reason_count));
-    uint32_t dark_hist[256] = {0}, dark_n = 0;
-    size_t n = (size_t)view->width * view->height;
-    for (size_t i = 0; i < n; i++) {
-        info->reason_count[s->view_reason[i]]++;
-        if (s->view_reason[i] == SCAN_DARK && s->decode.white[i] > s->decode.black[i])
-            dark_hist[s->decode.white[i] - s->decode.black[i]]++, dark_n++;
-    }
-    info->valid_points = info->reason_count[SCAN_VALID];
-    info->dark_contrast_dn = hist_median(dark_hist, dark_n);
+    count_reasons(s, &cores, info);
     return 0;
 }
 

@@ -2,10 +2,12 @@
 #include "tri.h"
 
 #include "camray.h"
+#include "hal_thread.h"
 #include "lens.h"
 #include "vec3.h"
 
 #include <errno.h>
+#include <math.h>
 
 /* Depth s along camera ray d (z = 1) where the projector's distorted column is @p col_n
  * (normalised: (u - cx) / fx). The point s d lands at q = s R d + t in the projector frame, at
@@ -54,8 +56,61 @@ static int worth_a_table(const uint8_t *reason, size_t n)
     return 0;
 }
 
-int tri_range_image(const struct scan_calib *c, struct tri_maps *maps, uint32_t width,
-                    uint32_t height, const float *column, uint8_t *reason, struct tri_range *range)
+/* What every part of a range image shares: the calibration, its rays, the projector planes'
+ * constants, the maps; each part's count of points and what it met. */
+struct range_parts {
+    const struct scan_calib *c;
+    struct camray rays;
+    int proj_pinhole;
+    vec3 rt_ex, rt_ez, t;
+    float *xyz_map;
+    const float *column;
+    uint8_t *reason;
+    uint32_t width, height;
+    unsigned parts;
+    uint32_t valid[HAL_MAX_THREADS * 4u];
+    int rc[HAL_MAX_THREADS * 4u];
+};
+
+/* Part @p k of the rows: each valid pixel's point, or SCAN_INCONSISTENT (its own pixel only). */
+static void range_rows(void *arg, unsigned k)
+{
+    struct range_parts *p = arg;
+    const struct scan_calib *c = p->c;
+    uint32_t valid = 0; /* counted here: the parts' counts share a cache line */
+    p->rc[k] = 0;
+    for (uint32_t y = p->height * k / p->parts; y < p->height * (k + 1u) / p->parts; y++) {
+        for (uint32_t x = 0; x < p->width; x++) {
+            size_t i = (size_t)y * p->width + x;
+            if (p->reason[i] != SCAN_VALID)
+                continue;
+            vec3 ray;
+            if (camray_ray(c, p->rays, x, y, &ray) != 0) {
+                p->rc[k] = -EDOM;
+                return;
+            }
+            double a = ((double)p->column[i] - c->proj_cx_px) / c->proj_fx_px;
+            vec3 normal = v3_sub(p->rt_ex, v3_scale(p->rt_ez, a));
+            double denom = v3_dot(normal, ray);
+            double s = denom != 0.0 ? -(p->t.x - a * p->t.z) / denom : -1.0;
+            /* A grazing plane (|denom| tiny) would put the point at infinity. */
+            if (s <= 0.0 || denom * denom < 1e-12 * v3_dot(ray, ray) ||
+                (!p->proj_pinhole && !distorted_column_depth(c, ray, a, s, &s))) {
+                p->reason[i] = SCAN_INCONSISTENT;
+                continue;
+            }
+            p->xyz_map[3 * i + 0] = (float)(ray.x * s);
+            p->xyz_map[3 * i + 1] = (float)(ray.y * s);
+            p->xyz_map[3 * i + 2] = (float)s;
+            valid++;
+        }
+    }
+    p->valid[k] = valid;
+}
+
+int tri_range_image(const struct scan_calib *c, const struct hal_thread *threads,
+                    struct tri_maps *maps, uint32_t width, uint32_t height, const float *column,
+                    uint8_t *reason, struct tri_range *range)
 {
     if (width != c->cam_width || height != c->cam_height)
         return -EINVAL;
@@ -71,41 +126,31 @@ int tri_range_image(const struct scan_calib *c, struct tri_maps *maps, uint32_t 
         if (rc != 0)
             return rc;
     }
-    const int proj_pinhole = lens_is_pinhole(c->proj_dist);
     /* Plane of projector column u: n_p = e_x - a e_z with a = (u - cx) / fx, through the
      * projector centre. n_p . (R p + t) = 0  <=>  (R^T n_p) . p + n_p . t = 0, and R^T n_p is
      * linear in a: R^T e_x - a R^T e_z. */
-    const vec3 rt_ex = m3_tmul(c->proj_rot, v3(1, 0, 0)), rt_ez = m3_tmul(c->proj_rot, v3(0, 0, 1));
-    const vec3 t = v3_from(c->proj_trans_mm);
-    float *xyz_map = maps->xyz_mm;
+    struct range_parts p = {.c = c,
+                            .rays = rays,
+                            .proj_pinhole = lens_is_pinhole(c->proj_dist),
+                            .rt_ex = m3_tmul(c->proj_rot, v3(1, 0, 0)),
+                            .rt_ez = m3_tmul(c->proj_rot, v3(0, 0, 1)),
+                            .t = v3_from(c->proj_trans_mm),
+                            .xyz_map = maps->xyz_mm,
+                            .column = column,
+                            .reason = reason,
+                            .width = width,
+                            .height = height,
+                            .parts = hal_thread_parts(threads, HAL_MAX_THREADS * 4u)};
+    hal_thread_run(threads, p.parts, range_rows, &p);
     range->xyz_mm = maps->xyz_mm;
     range->normal = maps->normal;
     range->width = width;
     range->height = height;
     range->valid_count = 0;
-    for (uint32_t y = 0; y < height; y++) {
-        for (uint32_t x = 0; x < width; x++) {
-            size_t i = (size_t)y * width + x;
-            if (reason[i] != SCAN_VALID)
-                continue;
-            vec3 ray;
-            if (camray_ray(c, rays, x, y, &ray) != 0)
-                return -EDOM;
-            double a = ((double)column[i] - c->proj_cx_px) / c->proj_fx_px;
-            vec3 normal = v3_sub(rt_ex, v3_scale(rt_ez, a));
-            double denom = v3_dot(normal, ray);
-            double s = denom != 0.0 ? -(t.x - a * t.z) / denom : -1.0;
-            /* A grazing plane (|denom| tiny) would put the point at infinity. */
-            if (s <= 0.0 || denom * denom < 1e-12 * v3_dot(ray, ray) ||
-                (!proj_pinhole && !distorted_column_depth(c, ray, a, s, &s))) {
-                reason[i] = SCAN_INCONSISTENT;
-                continue;
-            }
-            xyz_map[3 * i + 0] = (float)(ray.x * s);
-            xyz_map[3 * i + 1] = (float)(ray.y * s);
-            xyz_map[3 * i + 2] = (float)s;
-            range->valid_count++;
-        }
+    for (unsigned k = 0; k < p.parts; k++) {
+        if (p.rc[k] != 0)
+            return p.rc[k];
+        range->valid_count += p.valid[k];
     }
     return 0;
 }
@@ -148,35 +193,78 @@ static int tangent(const float *xyz_map, const uint8_t *reason, size_t i, uint32
     return 1;
 }
 
-int tri_normals(struct tri_maps *maps, struct tri_range *range, uint8_t *reason, uint32_t radius_px,
-                double max_depth_jump_mm)
+/* What every part of the normals shares, and each part's count of normals. */
+struct normal_parts {
+    const float *xyz_map;
+    float *normal_map;
+    const uint8_t *reason;
+    uint32_t width, height, radius_px;
+    double max_depth_jump_mm;
+    unsigned parts;
+    uint32_t valid[HAL_MAX_THREADS * 4u];
+};
+
+/* Part @p k of the rows: each valid pixel's normal, or NaN where it has none (no neighbour on
+ * its surface along an axis). The reasons are only read here, so every pixel's normal comes
+ * from the range image as triangulated, whichever part reaches it first. */
+static void normal_rows(void *arg, unsigned k)
 {
-    const uint32_t w = range->width, h = range->height;
-    const float *xyz_map = maps->xyz_mm;
-    float *normal_map = maps->normal;
-    uint32_t valid = 0;
-    for (uint32_t y = 0; y < h; y++) {
+    struct normal_parts *p = arg;
+    const uint32_t w = p->width, h = p->height;
+    const float *xyz_map = p->xyz_map;
+    uint32_t valid = 0; /* counted here: the parts' counts share a cache line */
+    for (uint32_t y = h * k / p->parts; y < h * (k + 1u) / p->parts; y++) {
         for (uint32_t x = 0; x < w; x++) {
             size_t i = (size_t)y * w + x;
-            if (reason[i] != SCAN_VALID)
+            if (p->reason[i] != SCAN_VALID)
                 continue;
-            vec3 du, dv;
-            if (!tangent(xyz_map, reason, i, x, w - 1 - x, 1, radius_px, max_depth_jump_mm, &du) ||
-                !tangent(xyz_map, reason, i, y, h - 1 - y, (long)w, radius_px, max_depth_jump_mm,
-                         &dv)) {
-                reason[i] = SCAN_INCONSISTENT;
-                continue;
+            vec3 du, dv, n = v3(NAN, NAN, NAN);
+            if (tangent(xyz_map, p->reason, i, x, w - 1 - x, 1, p->radius_px, p->max_depth_jump_mm,
+                        &du) &&
+                tangent(xyz_map, p->reason, i, y, h - 1 - y, (long)w, p->radius_px,
+                        p->max_depth_jump_mm, &dv)) {
+                n = v3_norm(v3_cross(du, dv));
+                if (v3_dot(n, point_at(xyz_map, i)) > 0.0) /* face the camera */
+                    n = v3_scale(n, -1.0);
+                valid++;
             }
-            vec3 n = v3_norm(v3_cross(du, dv));
-            if (v3_dot(n, point_at(xyz_map, i)) > 0.0) /* face the camera */
-                n = v3_scale(n, -1.0);
-            normal_map[3 * i + 0] = (float)n.x;
-            normal_map[3 * i + 1] = (float)n.y;
-            normal_map[3 * i + 2] = (float)n.z;
-            valid++;
+            p->normal_map[3 * i + 0] = (float)n.x;
+            p->normal_map[3 * i + 1] = (float)n.y;
+            p->normal_map[3 * i + 2] = (float)n.z;
         }
     }
-    range->valid_count = valid;
+    p->valid[k] = valid;
+}
+
+/* Part @p k of the rows: a valid pixel left without a normal becomes SCAN_INCONSISTENT, once
+ * every part has read the reasons. */
+static void normal_verdicts(void *arg, unsigned k)
+{
+    struct normal_parts *p = arg;
+    uint8_t *reason = (uint8_t *)p->reason; /* the caller's map: read-only until now */
+    size_t i0 = (size_t)p->width * (p->height * k / p->parts);
+    size_t i1 = (size_t)p->width * (p->height * (k + 1u) / p->parts);
+    for (size_t i = i0; i < i1; i++)
+        if (reason[i] == SCAN_VALID && isnan(p->normal_map[3 * i]))
+            reason[i] = SCAN_INCONSISTENT;
+}
+
+int tri_normals(struct tri_maps *maps, const struct hal_thread *threads, struct tri_range *range,
+                uint8_t *reason, uint32_t radius_px, double max_depth_jump_mm)
+{
+    struct normal_parts p = {.xyz_map = maps->xyz_mm,
+                             .normal_map = maps->normal,
+                             .reason = reason,
+                             .width = range->width,
+                             .height = range->height,
+                             .radius_px = radius_px,
+                             .max_depth_jump_mm = max_depth_jump_mm,
+                             .parts = hal_thread_parts(threads, HAL_MAX_THREADS * 4u)};
+    hal_thread_run(threads, p.parts, normal_rows, &p);
+    hal_thread_run(threads, p.parts, normal_verdicts, &p);
+    range->valid_count = 0;
+    for (unsigned k = 0; k < p.parts; k++)
+        range->valid_count += p.valid[k];
     return 0;
 }
 

@@ -74,6 +74,9 @@ measure-calib-sigma: deps $(BUILD)/scanner $(BUILD)/scanner-calibrate
 # Time per view, split between the simulated capture and the firmware's processing.
 $(BUILD)/bench_view: $(BUILD)/bench/bench_view.o $(BUILD)/tests/test_util.o $(HOST_OBJ) $(BUILD)/libfirmware.a
 	$(LINK) $(LDLIBS_COMMON) $(BOARD_LIBS)
+# One view's processing on 1, 2 and 4 threads.
+$(BUILD)/bench_threads: $(BUILD)/bench/bench_threads.o $(BUILD)/tests/test_util.o $(HOST_OBJ) $(BUILD)/libfirmware.a
+	$(LINK) $(LDLIBS_COMMON) $(BOARD_LIBS)
 # Fusion beside Open3D's ScalableTSDFVolume on the same depth (bench/fusion_open3d.py).
 $(BUILD)/bench_fusion: $(BUILD)/bench/bench_fusion.o $(BUILD)/tests/test_util.o $(HOST_OBJ) $(BUILD)/libfirmware.a
 	$(LINK) $(LDLIBS_COMMON) $(BOARD_LIBS)
@@ -109,13 +112,15 @@ measure-large: deps
 	scripts/measure-large.sh $(LARGE_BUILD)
 
 ## bench: benchmarks: decode against OpenCV, frames, stages, memory, fusion, a whole scan
-bench: deps $(BUILD)/bench_view $(BUILD)/bench_decode $(BUILD)/bench_frames $(BUILD)/bench_fusion $(BUILD)/scanner $(BUILD)/mesh-compare
+bench: deps $(BUILD)/bench_view $(BUILD)/bench_threads $(BUILD)/bench_decode $(BUILD)/bench_frames $(BUILD)/bench_fusion $(BUILD)/scanner $(BUILD)/mesh-compare
 	@/usr/bin/python3 -c 'import open3d' 2>/dev/null || scripts/install-deps.sh bench
 	$(BUILD)/bench_decode
 	@echo
 	$(BUILD)/bench_frames config/sim.ini
 	@echo
 	$(BUILD)/bench_view config/sim.ini
+	@echo
+	$(BUILD)/bench_threads config/sim.ini
 	@echo
 	@bench/static_memory.sh $(BUILD)/scanner
 	@echo

@@ -154,7 +154,7 @@ static void test_triangulates_through_both_lenses(void **state)
     }
     static struct tri_maps out;
     struct tri_range r;
-    assert_int_equal(tri_range_image(&rig, &out, w, h, column, reason, &r), 0);
+    assert_int_equal(tri_range_image(&rig, NULL, &out, w, h, column, reason, &r), 0);
     assert_true(r.valid_count > w * h / 2);
     double worst = 0.0;
     for (size_t i = 0; i < (size_t)w * h; i++)
@@ -167,7 +167,7 @@ static void test_triangulates_through_both_lenses(void **state)
         pinhole.proj_dist[k] = 0.0;
     for (size_t i = 0; i < (size_t)w * h; i++)
         reason[i] = column[i] >= 0 && column[i] < rig.proj_width - 0.5 ? SCAN_VALID : SCAN_SHADOW;
-    assert_int_equal(tri_range_image(&pinhole, &out, w, h, column, reason, &r), 0);
+    assert_int_equal(tri_range_image(&pinhole, NULL, &out, w, h, column, reason, &r), 0);
     worst = 0.0;
     for (size_t i = 0; i < (size_t)w * h; i++)
         if (reason[i] == SCAN_VALID)

@@ -13,6 +13,7 @@
 #include "config.h"
 #include "frames.h"
 #include "refine.h"
+#include "thread_posix.h"
 #include "tri.h"
 
 static struct scan_calib calib;
@@ -58,8 +59,8 @@ static void test_points_on_ray_and_plane(void **state)
     static float refined[HAL_MAX_PIXELS];
     static struct tri_maps out;
     struct tri_range range;
-    assert_int_equal(refine_columns(&maps, 0, refined), 0);
-    assert_int_equal(tri_range_image(&calib, &out, w, h, refined, reason, &range), 0);
+    assert_int_equal(refine_columns(&maps, NULL, 0, refined), 0);
+    assert_int_equal(tri_range_image(&calib, NULL, &out, w, h, refined, reason, &range), 0);
     const struct tri_range *r = &range;
     uint32_t checked = 0;
     for (size_t i = 0; i < (size_t)w * h; i += 97) {
@@ -95,9 +96,9 @@ static void test_few_pixels_same_points(void **state)
     static struct tri_maps whole, few;
     struct tri_range a, b;
     /* the few first: no table of this lens exists yet, and they must not make one */
-    assert_int_equal(tri_range_image(&calib, &few, w, h, col, sparse, &b), 0);
+    assert_int_equal(tri_range_image(&calib, NULL, &few, w, h, col, sparse, &b), 0);
     assert_null(camray_lookup(&calib).xy);
-    assert_int_equal(tri_range_image(&calib, &whole, w, h, col, reason, &a), 0);
+    assert_int_equal(tri_range_image(&calib, NULL, &whole, w, h, col, reason, &a), 0);
     assert_non_null(camray_lookup(&calib).xy);
     uint32_t checked = 0;
     for (size_t i = 0; i < (size_t)w * h; i += 97) {
@@ -112,8 +113,8 @@ static void test_few_pixels_same_points(void **state)
      * it: the few include pixel 0, a corner */
     const double fold[5] = {-5.0, 0.0, 0.0, 0.0, 0.0};
     memcpy(calib.cam_dist, fold, sizeof(fold));
-    assert_int_equal(tri_range_image(&calib, &few, w, h, col, sparse, &b), -EDOM);
-    assert_int_equal(tri_range_image(&calib, &whole, w, h, col, reason, &a), -EDOM);
+    assert_int_equal(tri_range_image(&calib, NULL, &few, w, h, col, sparse, &b), -EDOM);
+    assert_int_equal(tri_range_image(&calib, NULL, &whole, w, h, col, reason, &a), -EDOM);
     calib = pinhole;
 }
 
@@ -137,9 +138,9 @@ static double plane_normals(int refine)
     static float refined[HAL_MAX_PIXELS];
     static struct tri_maps out;
     struct tri_range range;
-    assert_int_equal(refine_columns(&maps, refine, refined), 0);
-    assert_int_equal(tri_range_image(&calib, &out, w, h, refined, reason, &range), 0);
-    assert_int_equal(tri_normals(&out, &range, reason, 4, 3.0), 0);
+    assert_int_equal(refine_columns(&maps, NULL, refine, refined), 0);
+    assert_int_equal(tri_range_image(&calib, NULL, &out, w, h, refined, reason, &range), 0);
+    assert_int_equal(tri_normals(&out, NULL, &range, reason, 4, 3.0), 0);
     const struct tri_range *r = &range;
     vec3 expect = v3_norm(v3(0.2, 0.0, -1.0));
     double sum = 0.0;
@@ -161,6 +162,42 @@ static void test_normals_of_a_plane(void **state)
     print_message("mean cos to the true normal: %.4f plain, %.4f refined\n", plain, refined);
     assert_true(plain > 0.95);           /* staircase of whole columns */
     assert_true(refined > plain + 0.01); /* 13 -> 8 degrees mean error on a noise-free plane */
+}
+
+/* A pixel that finds no normal (no neighbour on its surface along one axis) still serves as
+ * its neighbours' reach along the other: every normal is taken from the range image as
+ * triangulated, not from what the pixels before it in the scan order became, so that the rows
+ * can be split across threads. Here (0,1) has no pixel above or below and becomes
+ * inconsistent; (1,1) beside it reaches it along x and has pixels above and below: it keeps its
+ * normal, on one thread and on four. */
+static void test_normals_read_the_range_image_as_triangulated(void **state)
+{
+    (void)state;
+    enum { W = 4, H = 3 };
+    static struct tri_maps maps;
+    for (unsigned threads = 1; threads <= 4; threads *= 4) {
+        uint8_t why[W * H];
+        memset(why, SCAN_SHADOW, sizeof(why));
+        const uint32_t lit[][2] = {{0, 1}, {1, 1}, {1, 0}, {1, 2}};
+        for (size_t k = 0; k < sizeof(lit) / sizeof(lit[0]); k++) {
+            size_t i = lit[k][1] * W + lit[k][0];
+            why[i] = SCAN_VALID;
+            maps.xyz_mm[3 * i + 0] = (float)lit[k][0]; /* the plane z = 500, facing the camera */
+            maps.xyz_mm[3 * i + 1] = (float)lit[k][1];
+            maps.xyz_mm[3 * i + 2] = 500.0f;
+        }
+        struct hal_thread cores;
+        thread_posix_init(&cores, threads);
+        struct tri_range range = {maps.xyz_mm, maps.normal, W, H, 4};
+        assert_int_equal(tri_normals(&maps, &cores, &range, why, 4, 3.0), 0);
+        assert_int_equal(why[1 * W + 0], SCAN_INCONSISTENT);
+        assert_int_equal(why[1 * W + 1], SCAN_VALID);
+        assert_int_equal(range.valid_count, 1);
+        assert_float_equal(maps.normal[3 * (1 * W + 1) + 2], -1.0f, 1e-6f);
+        /* the pixels above and below have no neighbour along x: inconsistent too */
+        assert_int_equal(why[0 * W + 1], SCAN_INCONSISTENT);
+        assert_int_equal(why[2 * W + 1], SCAN_INCONSISTENT);
+    }
 }
 
 static void test_turntable_frame(void **state)
@@ -188,6 +225,7 @@ int main(void)
         cmocka_unit_test(test_points_on_ray_and_plane),
         cmocka_unit_test(test_few_pixels_same_points),
         cmocka_unit_test(test_normals_of_a_plane),
+        cmocka_unit_test(test_normals_read_the_range_image_as_triangulated),
         cmocka_unit_test(test_turntable_frame),
     };
     return cmocka_run_group_tests(tests, setup, NULL);

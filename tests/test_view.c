@@ -230,8 +230,9 @@ static void test_blocked_decoder_matches_reference(void **state)
 }
 
 /* The decode split across threads (hal_thread, POSIX threads; 1 to 8, more than this machine's
- * cores too) gives the maps of one thread to the byte: columns, rows, reasons; the view's colour
- * and its fusion likewise, pixel for pixel and voxel for voxel. */
+ * cores too) gives the maps of one thread to the byte: columns, rows, reasons; the view's colour,
+ * its range image (refined columns, points, normals) and its fusion likewise, pixel for pixel
+ * and voxel for voxel. */
 static void test_threads_decode_the_same(void **state)
 {
     (void)state;
@@ -279,6 +280,21 @@ static void test_threads_decode_the_same(void **state)
     struct frame_xform pose;
     frame_object_from_camera(&t.calib, view.angle_mdeg, &pose);
     assert_int_equal(scan_finish_view(t.scan, NULL, &t.calib, view.angle_mdeg, &view, &info), 0);
+    /* the whole view on 4 threads: refined columns, points, normals and reasons the same */
+    static float column1[HAL_MAX_PIXELS], xyz1[3 * HAL_MAX_PIXELS], normal1[3 * HAL_MAX_PIXELS];
+    memcpy(reason1, view.maps.reason, n);
+    memcpy(column1, view.column, n * sizeof(float));
+    memcpy(xyz1, view.range.xyz_mm, 3 * n * sizeof(float));
+    memcpy(normal1, view.range.normal, 3 * n * sizeof(float));
+    uint32_t points1 = view.range.valid_count;
+    assert_int_equal(scan_finish_view(t.scan, &four, &t.calib, view.angle_mdeg, &view, &info), 0);
+    assert_memory_equal(view.maps.reason, reason1, n);
+    assert_memory_equal(view.column, column1, n * sizeof(float));
+    assert_memory_equal(view.range.xyz_mm, xyz1, 3 * n * sizeof(float));
+    assert_memory_equal(view.range.normal, normal1, 3 * n * sizeof(float));
+    assert_int_equal(view.range.valid_count, points1);
+    assert_int_equal(info.valid_points, points1);
+    assert_true(points1 > 100000);
     assert_int_equal(fusion_begin(vol, &t.cfg.fusion), 0);
     assert_int_equal(scan_fuse_view(vol, NULL, &t.calib, &view, &pose), 0);
     size_t voxels = (size_t)vol->dims[0] * vol->dims[1] * vol->dims[2], observed = 0;
