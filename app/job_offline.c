@@ -126,61 +126,95 @@ int job_read_into_buffer(struct scan_ctx *s, const char *scan_dir, uint32_t v, u
                                params->width, params->height, channels, err, err_len);
 }
 
-/* A view's colour frames read side by side, each into its own buffer (their zstd decoding is
- * a fifth of `scanner process`, most of it in the 3.7 MB colour frames): item k reads frame
- * frame[k], then they are fed in order as the view took them. */
-#define FEED_MAX_COLOUR (COLOUR_MAX_FRAMES + 1)
-struct colour_reads {
+/* Frames of a view read side by side, each into its own buffer of the firmware's (their zstd
+ * decoding is a fifth of `scanner process`, most of it in the 3.7 MB colour frames): item k
+ * reads frame frame[k]; the caller then feeds them in the order the view took them. */
+#define FEED_MAX_SIDE (COLOUR_MAX_FRAMES + 1)
+struct frame_reads {
     struct scan_ctx *s;
     const char *scan_dir;
     uint32_t v;
     const struct scan_params *params;
     uint32_t count;
-    uint32_t frame[FEED_MAX_COLOUR], channels[FEED_MAX_COLOUR];
-    uint8_t *pixels[FEED_MAX_COLOUR];
-    int rc[FEED_MAX_COLOUR];
-    char err[FEED_MAX_COLOUR][SCAN_DIR_PATH_MAX + 128];
+    uint32_t frame[FEED_MAX_SIDE], channels[FEED_MAX_SIDE];
+    uint8_t *pixels[FEED_MAX_SIDE];
+    int rc[FEED_MAX_SIDE];
+    char err[FEED_MAX_SIDE][SCAN_DIR_PATH_MAX + 128];
 };
 
-static void read_colour_frame(void *arg, unsigned k)
+static void read_frame(void *arg, unsigned k)
 {
-    struct colour_reads *r = arg;
+    struct frame_reads *r = arg;
     r->rc[k] = job_read_into_buffer(r->s, r->scan_dir, r->v, r->frame[k], r->channels[k], r->params,
                                     &r->pixels[k], r->err[k], sizeof(r->err[k]));
 }
 
+/* @p r's frames read on @p cores. @retval 0 @retval the first failing frame's error (in the
+ * view's order), said in @p err */
+static int read_side_by_side(struct frame_reads *r, const struct hal_thread *cores, char *err,
+                             size_t err_len)
+{
+    hal_thread_run(cores, r->count, read_frame, r);
+    for (uint32_t k = 0; k < r->count; k++) {
+        if (r->rc[k] != 0) {
+            snprintf(err, err_len, "%s", r->err[k]);
+            return r->rc[k];
+        }
+    }
+    return 0;
+}
+
+/* Its error texts are 5 KiB: not on the stack; one view is fed at a time (the firmware is used
+ * by one thread at a time). */
+static struct frame_reads reads;
+
+/* The pattern frames, two at a time where their buffers differ (white and black, a bit's stripes
+ * and its inverse: a bit without inverse shares its buffer with the next), each pair read side
+ * by side and then fed in order. */
+static int feed_pattern_frames(struct scan_ctx *s, const char *scan_dir, uint32_t v,
+                               uint32_t count, const struct scan_params *params,
+                               const struct scan_calib *calib, const struct hal_thread *cores,
+                               char *err, size_t err_len)
+{
+    int rc = 0;
+    for (uint32_t f = 0; rc == 0 && f < count; f += reads.count) {
+        reads = (struct frame_reads){.s = s, .scan_dir = scan_dir, .v = v, .params = params};
+        for (uint32_t g = f; g < count && g < f + 2u; g++) {
+            if (g > f && scan_frame_buffer(s, g) == scan_frame_buffer(s, f))
+                break;
+            reads.frame[reads.count] = g;
+            reads.channels[reads.count++] = scan_frame_channels(params, calib, g);
+        }
+        rc = read_side_by_side(&reads, cores, err, err_len);
+        for (uint32_t k = 0; rc == 0 && k < reads.count; k++)
+            rc = scan_feed_frame(s, reads.frame[k], reads.pixels[k], reads.channels[k], NULL);
+    }
+    return rc;
+}
+
 /* The colour frames from @p first on (the lights the method reads, then the white colour when
- * there is one) read on @p threads, then fed. @retval 0 @retval as job_read_into_buffer, the
- * first failing frame's error in @p err */
+ * there is one), read side by side on @p cores, then fed. @retval 0 @retval as
+ * job_read_into_buffer, the first failing frame's error in @p err */
 static int feed_colour_frames(struct scan_ctx *s, const char *scan_dir, uint32_t v, uint32_t first,
                               const struct scan_params *params, const struct scan_calib *calib,
-                              const struct hal_thread *threads, char *err, size_t err_len)
+                              const struct hal_thread *cores, char *err, size_t err_len)
 {
-    /* its error texts are 5 KiB: not on the stack; one view is fed at a time (the firmware is
-     * used by one thread at a time) */
-    static struct colour_reads r;
     const uint32_t count = first, lights = scan_light_frame_count(params, calib);
     uint32_t channels;
-    r = (struct colour_reads){.s = s, .scan_dir = scan_dir, .v = v, .params = params};
+    reads = (struct frame_reads){.s = s, .scan_dir = scan_dir, .v = v, .params = params};
     for (uint32_t f = first; (channels = scan_frame_channels(params, calib, f)) != 0; f++) {
         if (f < count + lights && !scan_needs_light_frame(params, calib, f - count))
             continue; /* taken for another method: not read back */
-        if (r.count == FEED_MAX_COLOUR)
+        if (reads.count == FEED_MAX_SIDE)
             return -EINVAL;
-        r.frame[r.count] = f;
-        r.channels[r.count++] = channels;
+        reads.frame[reads.count] = f;
+        reads.channels[reads.count++] = channels;
     }
-    struct hal_thread cores = scan_cores(threads, params);
-    hal_thread_run(&cores, r.count, read_colour_frame, &r);
-    int rc = 0;
-    for (uint32_t k = 0; rc == 0 && k < r.count; k++) {
-        uint32_t f = r.frame[k];
-        rc = r.rc[k];
-        if (rc != 0)
-            snprintf(err, err_len, "%s", r.err[k]);
-        else
-            rc = f < count + lights ? scan_feed_light_frame(s, f - count, r.pixels[k])
-                                    : scan_feed_white_colour(s, r.pixels[k]);
+    int rc = read_side_by_side(&reads, cores, err, err_len);
+    for (uint32_t k = 0; rc == 0 && k < reads.count; k++) {
+        uint32_t f = reads.frame[k];
+        rc = f < count + lights ? scan_feed_light_frame(s, f - count, reads.pixels[k])
+                                : scan_feed_white_colour(s, reads.pixels[k]);
     }
     return rc;
 }
@@ -192,17 +226,12 @@ int scan_job_feed_view(struct scan_ctx *s, const char *scan_dir, uint32_t v,
     struct gray_layout layout;
     scan_layout(params, calib, &layout);
     uint32_t count = gray_layout_count(&layout);
-    uint32_t channels;
+    struct hal_thread cores = scan_cores(threads, params);
     int rc = scan_begin_view(s, params, calib);
-    for (uint32_t f = 0; rc == 0 && f < count; f++) {
-        uint8_t *pixels;
-        channels = scan_frame_channels(params, calib, f);
-        rc = job_read_into_buffer(s, scan_dir, v, f, channels, params, &pixels, err, err_len);
-        if (rc == 0)
-            rc = scan_feed_frame(s, f, pixels, channels, NULL);
-    }
     if (rc == 0)
-        rc = feed_colour_frames(s, scan_dir, v, count, params, calib, threads, err, err_len);
+        rc = feed_pattern_frames(s, scan_dir, v, count, params, calib, &cores, err, err_len);
+    if (rc == 0)
+        rc = feed_colour_frames(s, scan_dir, v, count, params, calib, &cores, err, err_len);
     return rc;
 }
 

@@ -467,6 +467,16 @@ rm -rf "$out/nolight_out" && mkfifo "$out"/nolight/view_002/frame_25.ppm.zst
 check process_refuses_fifo_colour_frame sh -c "! timeout 120 $bin process $out/nolight --out $out/nolight_out --config $out/four.ini >$out/fifo.txt 2>&1 &&
     grep -q 'view_002/frame_25.ppm.zst: not a regular file' $out/fifo.txt && ! test -e $out/nolight_out/mesh.ply"
 rm -rf "$out/nolight" "$out/nolight_out"
+# The pattern frames are read two at a time (a bit's stripes beside its inverse): a damaged inverse
+# is named, a FIFO where its stripes belong refused, on four threads; no mesh written either way
+rm -rf "$out/nopattern" && cp -r "$out/scan" "$out/nopattern"
+head -c 1000 "$out/scan/view_001/frame_03.pgm.zst" > "$out/nopattern/view_001/frame_03.pgm.zst"
+check process_names_damaged_pattern_frame sh -c "! $bin process $out/nopattern --out $out/nopattern_out --config $out/four.ini >$out/nopattern.txt 2>&1 &&
+    grep -q 'view_001/frame_03.pgm.zst: damaged zstd data' $out/nopattern.txt && ! test -e $out/nopattern_out/mesh.ply"
+rm -rf "$out/nopattern_out" && rm -f "$out/nopattern/view_001/frame_02.pgm.zst" && mkfifo "$out/nopattern/view_001/frame_02.pgm.zst"
+check process_refuses_fifo_pattern_frame sh -c "! timeout 120 $bin process $out/nopattern --out $out/nopattern_out --config $out/four.ini >$out/fifo2.txt 2>&1 &&
+    grep -q 'view_001/frame_02.pgm.zst: not a regular file' $out/fifo2.txt && ! test -e $out/nopattern_out/mesh.ply"
+rm -rf "$out/nopattern" "$out/nopattern_out"
 # A stop signal mid-scan (Ctrl-C, systemd's SIGTERM, a dropped ssh session's SIGHUP, Ctrl-\,
 # Ctrl-Z): the scan stops between frames, says so, and the rig ends in its safe state; the
 # process neither dies lit nor freezes lit.
