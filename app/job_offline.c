@@ -171,10 +171,9 @@ static struct frame_reads reads;
 /* The pattern frames, two at a time where their buffers differ (white and black, a bit's stripes
  * and its inverse: a bit without inverse shares its buffer with the next), each pair read side
  * by side and then fed in order. */
-static int feed_pattern_frames(struct scan_ctx *s, const char *scan_dir, uint32_t v,
-                               uint32_t count, const struct scan_params *params,
-                               const struct scan_calib *calib, const struct hal_thread *cores,
-                               char *err, size_t err_len)
+static int feed_pattern_frames(struct scan_ctx *s, const char *scan_dir, uint32_t v, uint32_t count,
+                               const struct scan_params *params, const struct scan_calib *calib,
+                               const struct hal_thread *cores, char *err, size_t err_len)
 {
     int rc = 0;
     for (uint32_t f = 0; rc == 0 && f < count; f += reads.count) {
