@@ -160,16 +160,21 @@ static vec3 point_at(const float *xyz_map, size_t i)
     return v3(xyz_map[3 * i], xyz_map[3 * i + 1], xyz_map[3 * i + 2]);
 }
 
+/* In the reason map between the normals' two passes: valid, but found without a normal by the
+ * first (a transient code, never left in the map). */
+#define NORMAL_PENDING SCAN_REASON_COUNT
+
 /* How far (in steps of @p step, at most @p max_steps) the surface continues from pixel i: every
- * pixel on the way must be valid and no depth step may exceed max_jump. */
+ * pixel on the way must be valid (or have the reason @p also) and no depth step may exceed
+ * max_jump. */
 static uint32_t reach(const float *xyz_map, const uint8_t *reason, size_t i, long step,
-                      uint32_t max_steps, double max_jump)
+                      uint32_t max_steps, double max_jump, uint8_t also)
 {
     uint32_t k = 0;
     size_t cur = i;
     while (k < max_steps) {
         size_t next = (size_t)((long)cur + step);
-        if (reason[next] != SCAN_VALID ||
+        if ((reason[next] != SCAN_VALID && reason[next] != also) ||
             fabs(xyz_map[3 * next + 2] - xyz_map[3 * cur + 2]) > max_jump)
             break;
         cur = next;
@@ -180,12 +185,16 @@ static uint32_t reach(const float *xyz_map, const uint8_t *reason, size_t i, lon
 
 /* Tangent along one image axis between the farthest continuous neighbours on either side.
  * Column quantisation makes the range image a staircase; a wide stencil averages it out.
- * @p before / @p after: how many steps exist in the image on each side. Returns 0 if none. */
+ * @p before / @p after: how many steps exist in the image on each side; @p ahead_also: a reason
+ * the steps ahead (to the right, down) may pass besides SCAN_VALID. Returns 0 if none. */
 static int tangent(const float *xyz_map, const uint8_t *reason, size_t i, uint32_t before,
-                   uint32_t after, long step, uint32_t radius, double max_jump, vec3 *out)
+                   uint32_t after, long step, uint32_t radius, double max_jump, uint8_t ahead_also,
+                   vec3 *out)
 {
-    uint32_t back = reach(xyz_map, reason, i, -step, before < radius ? before : radius, max_jump);
-    uint32_t fwd = reach(xyz_map, reason, i, step, after < radius ? after : radius, max_jump);
+    uint32_t back =
+        reach(xyz_map, reason, i, -step, before < radius ? before : radius, max_jump, SCAN_VALID);
+    uint32_t fwd =
+        reach(xyz_map, reason, i, step, after < radius ? after : radius, max_jump, ahead_also);
     if (back + fwd == 0)
         return 0;
     *out = v3_sub(point_at(xyz_map, (size_t)((long)i + step * (long)fwd)),
@@ -200,29 +209,51 @@ struct normal_parts {
     const uint8_t *reason;
     uint32_t width, height, radius_px;
     double max_depth_jump_mm;
+    int again; /* the second pass */
     unsigned parts;
     uint32_t valid[HAL_MAX_THREADS * 4u];
 };
 
+/* A pixel within @p radius before pixel i (to its left, above it) the first pass left without
+ * a normal: only then can the second pass find another. */
+static int pending_before(const uint8_t *reason, size_t i, uint32_t x, uint32_t y, uint32_t w,
+                          uint32_t radius)
+{
+    for (uint32_t d = 1; d <= radius; d++)
+        if ((d <= x && reason[i - d] == NORMAL_PENDING) ||
+            (d <= y && reason[i - (size_t)d * w] == NORMAL_PENDING))
+            return 1;
+    return 0;
+}
+
 /* Part @p k of the rows: each valid pixel's normal, or NaN where it has none (no neighbour on
- * its surface along an axis). The reasons are only read here, so every pixel's normal comes
- * from the range image as triangulated, whichever part reaches it first. */
+ * its surface along an axis). The first pass reads the reasons as triangulated. The second
+ * recomputes the pixels that have a pixel the first left without a normal just before them (to
+ * the left, above), whose reach now stops there: the normals one pass in the image's order made
+ * when it marked each pixel without a normal as it went (but that a pixel losing its normal in
+ * the second pass stops no other's reach), and the same on any number of threads (the reasons
+ * are only read during a pass). */
 static void normal_rows(void *arg, unsigned k)
 {
     struct normal_parts *p = arg;
     const uint32_t w = p->width, h = p->height;
     const float *xyz_map = p->xyz_map;
+    const uint8_t ahead_also = p->again ? NORMAL_PENDING : SCAN_VALID;
     uint32_t valid = 0; /* counted here: the parts' counts share a cache line */
     for (uint32_t y = h * k / p->parts; y < h * (k + 1u) / p->parts; y++) {
         for (uint32_t x = 0; x < w; x++) {
             size_t i = (size_t)y * w + x;
             if (p->reason[i] != SCAN_VALID)
                 continue;
+            if (p->again && !pending_before(p->reason, i, x, y, w, p->radius_px)) {
+                valid++; /* the first pass's normal stands */
+                continue;
+            }
             vec3 du, dv, n = v3(NAN, NAN, NAN);
             if (tangent(xyz_map, p->reason, i, x, w - 1 - x, 1, p->radius_px, p->max_depth_jump_mm,
-                        &du) &&
+                        ahead_also, &du) &&
                 tangent(xyz_map, p->reason, i, y, h - 1 - y, (long)w, p->radius_px,
-                        p->max_depth_jump_mm, &dv)) {
+                        p->max_depth_jump_mm, ahead_also, &dv)) {
                 n = v3_norm(v3_cross(du, dv));
                 if (v3_dot(n, point_at(xyz_map, i)) > 0.0) /* face the camera */
                     n = v3_scale(n, -1.0);
@@ -236,17 +267,21 @@ static void normal_rows(void *arg, unsigned k)
     p->valid[k] = valid;
 }
 
-/* Part @p k of the rows: a valid pixel left without a normal becomes SCAN_INCONSISTENT, once
- * every part has read the reasons. */
+/* Part @p k of the rows, once every part has read the reasons: after the first pass a valid
+ * pixel without a normal becomes NORMAL_PENDING; after the second it and every other valid
+ * pixel without one becomes SCAN_INCONSISTENT. */
 static void normal_verdicts(void *arg, unsigned k)
 {
     struct normal_parts *p = arg;
-    uint8_t *reason = (uint8_t *)p->reason; /* the caller's map: read-only until now */
+    uint8_t *reason = (uint8_t *)p->reason; /* the caller's map: read-only during a pass */
     size_t i0 = (size_t)p->width * (p->height * k / p->parts);
     size_t i1 = (size_t)p->width * (p->height * (k + 1u) / p->parts);
-    for (size_t i = i0; i < i1; i++)
+    for (size_t i = i0; i < i1; i++) {
         if (reason[i] == SCAN_VALID && isnan(p->normal_map[3 * i]))
+            reason[i] = p->again ? SCAN_INCONSISTENT : NORMAL_PENDING;
+        else if (p->again && reason[i] == NORMAL_PENDING)
             reason[i] = SCAN_INCONSISTENT;
+    }
 }
 
 int tri_normals(struct tri_maps *maps, const struct hal_thread *threads, struct tri_range *range,
@@ -260,8 +295,10 @@ int tri_normals(struct tri_maps *maps, const struct hal_thread *threads, struct 
                              .radius_px = radius_px,
                              .max_depth_jump_mm = max_depth_jump_mm,
                              .parts = hal_thread_parts(threads, HAL_MAX_THREADS * 4u)};
-    hal_thread_run(threads, p.parts, normal_rows, &p);
-    hal_thread_run(threads, p.parts, normal_verdicts, &p);
+    for (p.again = 0; p.again <= 1; p.again++) {
+        hal_thread_run(threads, p.parts, normal_rows, &p);
+        hal_thread_run(threads, p.parts, normal_verdicts, &p);
+    }
     range->valid_count = 0;
     for (unsigned k = 0; k < p.parts; k++)
         range->valid_count += p.valid[k];

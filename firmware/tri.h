@@ -40,9 +40,9 @@ int tri_range_image(const struct scan_calib *calib, const struct hal_thread *thr
                     uint8_t *reason, struct tri_range *range);
 /** Normals from differences across up to @p radius_px pixels each side along both image axes,
  *  stopping where the surface breaks (a depth step above @p max_depth_jump_mm between
- *  neighbours). Every pixel's neighbours are read as tri_range_image left them (a pixel this
- *  stage finds without a normal stops no other's reach), so the rows can be split across
- *  threads with the same result.
+ *  neighbours); a pixel found without a normal stops the reach of the pixels after it in the
+ *  image (to its right, below it). Two passes, each reading the reasons as the one before left
+ *  them, so that the rows can be split across threads with the same result.
  *  @param maps    the maps tri_range_image filled; the normals go there
  *  @param threads the cores the rows are split across (NULL: this thread)
  *  @param range   in/out: the points of tri_range_image; their normals and valid_count are set

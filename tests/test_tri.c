@@ -164,39 +164,52 @@ static void test_normals_of_a_plane(void **state)
     assert_true(refined > plain + 0.01); /* 13 -> 8 degrees mean error on a noise-free plane */
 }
 
-/* A pixel that finds no normal (no neighbour on its surface along one axis) still serves as
- * its neighbours' reach along the other: every normal is taken from the range image as
- * triangulated, not from what the pixels before it in the scan order became, so that the rows
- * can be split across threads. Here (0,1) has no pixel above or below and becomes
- * inconsistent; (1,1) beside it reaches it along x and has pixels above and below: it keeps its
- * normal, on one thread and on four. */
-static void test_normals_read_the_range_image_as_triangulated(void **state)
+/* Pixels lit on the plane z = 500 (facing the camera) in a W x H image, their normals made on
+ * @p threads threads. @retval the normals' count */
+enum { NW = 4, NH = 3 };
+static uint32_t normals_of(const uint32_t lit[][2], size_t count, unsigned threads, uint8_t *why)
+{
+    static struct tri_maps maps;
+    memset(why, SCAN_SHADOW, NW * NH);
+    for (size_t k = 0; k < count; k++) {
+        size_t i = lit[k][1] * NW + lit[k][0];
+        why[i] = SCAN_VALID;
+        maps.xyz_mm[3 * i + 0] = (float)lit[k][0];
+        maps.xyz_mm[3 * i + 1] = (float)lit[k][1];
+        maps.xyz_mm[3 * i + 2] = 500.0f;
+    }
+    struct hal_thread cores;
+    thread_posix_init(&cores, threads);
+    struct tri_range range = {maps.xyz_mm, maps.normal, NW, NH, (uint32_t)count};
+    assert_int_equal(tri_normals(&maps, &cores, &range, why, 4, 3.0), 0);
+    for (size_t i = 0; i < NW * NH; i++)
+        if (why[i] == SCAN_VALID)
+            assert_float_equal(maps.normal[3 * i + 2], -1.0f, 1e-6f);
+    return range.valid_count;
+}
+
+/* A pixel that finds no normal (no neighbour on its surface along one axis) stops the reach of
+ * the pixels after it in the image (to its right, below it), not of those before it, as when the
+ * normals were made one pixel after another in the image's order and each such pixel marked as
+ * they went; now in two passes, so that the rows can be split across threads with the same
+ * result. (2,1) has no pixel above or below: (1,1) before it reaches it and keeps its normal;
+ * (0,1) likewise, but (1,1) after it cannot reach it and has no other neighbour along x. The
+ * pixels above and below (1,1) have no neighbour along x: never a normal. One thread and four. */
+static void test_normals_stop_after_a_pixel_without_one(void **state)
 {
     (void)state;
-    enum { W = 4, H = 3 };
-    static struct tri_maps maps;
     for (unsigned threads = 1; threads <= 4; threads *= 4) {
-        uint8_t why[W * H];
-        memset(why, SCAN_SHADOW, sizeof(why));
-        const uint32_t lit[][2] = {{0, 1}, {1, 1}, {1, 0}, {1, 2}};
-        for (size_t k = 0; k < sizeof(lit) / sizeof(lit[0]); k++) {
-            size_t i = lit[k][1] * W + lit[k][0];
-            why[i] = SCAN_VALID;
-            maps.xyz_mm[3 * i + 0] = (float)lit[k][0]; /* the plane z = 500, facing the camera */
-            maps.xyz_mm[3 * i + 1] = (float)lit[k][1];
-            maps.xyz_mm[3 * i + 2] = 500.0f;
-        }
-        struct hal_thread cores;
-        thread_posix_init(&cores, threads);
-        struct tri_range range = {maps.xyz_mm, maps.normal, W, H, 4};
-        assert_int_equal(tri_normals(&maps, &cores, &range, why, 4, 3.0), 0);
-        assert_int_equal(why[1 * W + 0], SCAN_INCONSISTENT);
-        assert_int_equal(why[1 * W + 1], SCAN_VALID);
-        assert_int_equal(range.valid_count, 1);
-        assert_float_equal(maps.normal[3 * (1 * W + 1) + 2], -1.0f, 1e-6f);
-        /* the pixels above and below have no neighbour along x: inconsistent too */
-        assert_int_equal(why[0 * W + 1], SCAN_INCONSISTENT);
-        assert_int_equal(why[2 * W + 1], SCAN_INCONSISTENT);
+        uint8_t why[NW * NH];
+        const uint32_t right[][2] = {{1, 1}, {2, 1}, {1, 0}, {1, 2}};
+        assert_int_equal(normals_of(right, 4, threads, why), 1);
+        assert_int_equal(why[1 * NW + 1], SCAN_VALID);
+        assert_int_equal(why[1 * NW + 2], SCAN_INCONSISTENT);
+        assert_int_equal(why[0 * NW + 1], SCAN_INCONSISTENT);
+        assert_int_equal(why[2 * NW + 1], SCAN_INCONSISTENT);
+        const uint32_t left[][2] = {{0, 1}, {1, 1}, {1, 0}, {1, 2}};
+        assert_int_equal(normals_of(left, 4, threads, why), 0);
+        assert_int_equal(why[1 * NW + 0], SCAN_INCONSISTENT);
+        assert_int_equal(why[1 * NW + 1], SCAN_INCONSISTENT);
     }
 }
 
@@ -225,7 +238,7 @@ int main(void)
         cmocka_unit_test(test_points_on_ray_and_plane),
         cmocka_unit_test(test_few_pixels_same_points),
         cmocka_unit_test(test_normals_of_a_plane),
-        cmocka_unit_test(test_normals_read_the_range_image_as_triangulated),
+        cmocka_unit_test(test_normals_stop_after_a_pixel_without_one),
         cmocka_unit_test(test_turntable_frame),
     };
     return cmocka_run_group_tests(tests, setup, NULL);
