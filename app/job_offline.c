@@ -234,6 +234,23 @@ int scan_job_feed_view(struct scan_ctx *s, const char *scan_dir, uint32_t v,
     return rc;
 }
 
+int scan_job_feed_light_frame(struct scan_ctx *s, const char *scan_dir, uint32_t v, uint32_t k,
+                              const struct scan_params *params, const struct scan_calib *calib,
+                              char *err, size_t err_len)
+{
+    struct gray_layout layout;
+    scan_layout(params, calib, &layout);
+    uint32_t f = gray_layout_count(&layout) + k;
+    uint8_t *pixels;
+    if (k >= scan_light_frame_count(params, calib)) {
+        snprintf(err, err_len, "view %u: no colour frame %u in these settings", (unsigned)v,
+                 (unsigned)k);
+        return -EINVAL;
+    }
+    int rc = job_read_into_buffer(s, scan_dir, v, f, 3, params, &pixels, err, err_len);
+    return rc == 0 ? scan_feed_light_frame(s, k, pixels) : rc;
+}
+
 /* View @p v read back from its range.bin in @p dir, with what job_describe() says of it (the
  * reader has checked that the valid pixels are the header's count). @retval 0 @retval -ENOENT
  * none @retval -EINVAL (@p err says) */

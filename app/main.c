@@ -81,8 +81,37 @@ static int cmd_snapshot(const char *config_path, const char *out, uint32_t expos
     return rc == 0 ? 0 : 1;
 }
 
-/* One view of a white target with every colour frame: print each method's white_scale. */
-static int cmd_calibrate_white(const char *config_path, double target_albedo)
+/* The white target's view from the frames kept in @p from_dir (its first view, taken with every
+ * colour frame: a scan with [colour] method multi, or uniform's all-lights frame too), processed
+ * with @p cfg and @p calib as calibrate-white's own view would be. @retval 0 @retval -errno
+ * (said) */
+static int white_view_from(const char *from_dir, const struct app_config *cfg,
+                           const struct scan_calib *calib, struct scan_view *view)
+{
+    struct scan_view_info info;
+    char err[HAL_MAX_PATH + 256];
+    struct scan_ctx *s = scan_job_views();
+    int rc = scan_job_feed_view(s, from_dir, 0, &cfg->scan, calib, NULL, err, sizeof(err));
+    if (rc == 0) /* multi does not read it; uniform's white reference does */
+        rc = scan_job_feed_light_frame(s, from_dir, 0, COLOUR_FRAME_ALL, &cfg->scan, calib, err,
+                                       sizeof(err));
+    if (rc != 0) {
+        fprintf(stderr,
+                "scanner: error: %s (the white target's scan: view 0 with every colour "
+                "frame, taken with these [camera], [lights] and [colour] settings)\n",
+                err);
+        return rc;
+    }
+    rc = scan_finish_view(s, NULL, calib, 0, view, &info);
+    if (rc != 0)
+        fprintf(stderr, "scanner: error: %s/view_000: cannot be processed (%s)\n", from_dir,
+                strerror(-rc));
+    return rc;
+}
+
+/* One view of a white target with every colour frame (taken now, or kept in @p from_dir):
+ * print each method's white_scale. */
+static int cmd_calibrate_white(const char *config_path, double target_albedo, const char *from_dir)
 {
     struct app_config cfg;
     struct scan_calib calib;
@@ -93,22 +122,36 @@ static int cmd_calibrate_white(const char *config_path, double target_albedo)
                 config_path);
         return 2;
     }
+    if (!(target_albedo > 0.0 && target_albedo <= 1.0)) {
+        fprintf(stderr, "scanner calibrate-white: --albedo: the target's albedo, above 0 and at "
+                        "most 1 (0.95 for a white matte target)\n");
+        return 2;
+    }
     cfg.scan.colour.method = COLOUR_MULTI; /* captures the dark, all-lights and single frames */
     struct scan_view view;
     struct scan_view_info info;
     struct white_cal wc;
-    int rc = rig_up(&cfg, &calib);
-    if (rc == 0)
-        rc = hal_table_home(&rig_hal()->turntable);
-    if (rc == 0)
-        rc = scan_take_view(scan_job_views(), rig_hal(), &cfg.scan, &calib, 0, NULL, &view, &info);
+    int rc = 0;
+    if (from_dir != NULL) {
+        rc = white_view_from(from_dir, &cfg, &calib, &view);
+        if (rc != 0)
+            return 1;
+    } else {
+        rc = rig_up(&cfg, &calib);
+        if (rc == 0)
+            rc = hal_table_home(&rig_hal()->turntable);
+        if (rc == 0)
+            rc = scan_take_view(scan_job_views(), rig_hal(), &cfg.scan, &calib, 0, NULL, &view,
+                                &info);
+    }
     if (rc == 0) {
         rc = white_cal_from_view(&cfg, &calib, &view, target_albedo, &wc);
         if (rc != 0)
             rig_log(HAL_LOG_ERROR, "no usable white pixels: is the target in view, and not "
                                    "saturated (lower [camera] exposure_us)?");
     }
-    rig_down();
+    if (from_dir == NULL)
+        rig_down();
     if (rc != 0)
         return 1;
     static const char *const names[] = {"none", "single", "uniform", "multi"};
@@ -248,7 +291,9 @@ static const struct command {
      "    (BASE.png at 300 dpi, BASE.svg at true size)\n",
      NEEDS_CONFIG},
     {"calibrate-white",
-     "scanner calibrate-white --config FILE [--albedo A]  white reference scales\n", NEEDS_CONFIG},
+     "scanner calibrate-white --config FILE [--albedo A] [--from DIR]  white reference scales\n"
+     "           (--from: from the white target's scan kept in DIR, its first view)\n",
+     NEEDS_CONFIG},
     {"check-config",
      "scanner check-config --config FILE    check a config, its calibration and the files it "
      "names\n",
@@ -354,6 +399,7 @@ int main(int argc, char **argv)
     const char *config_path = NULL, *scan_dir = NULL;
     struct scan_job_opts opts = {0, NULL, NULL, 0, 0};
     double white_albedo = 0.95;        /* a typical white reference target */
+    const char *white_from = NULL;     /* calibrate-white --from: a kept scan of the target */
     uint32_t snapshot_exposure_us = 0; /* snapshot --exposure-us: 0 the config's */
     const struct command *cmd = NULL;
     int status = check_command_line(argc, argv, &cmd);
@@ -387,8 +433,14 @@ int main(int argc, char **argv)
         else if (strcmp(argv[i], "--replace") == 0 &&
                  (strcmp(argv[1], "scan") == 0 || strcmp(argv[1], "process") == 0))
             opts.replace = 1;
-        else if (strcmp(argv[i], "--albedo") == 0 && i + 1 < argc)
-            white_albedo = atof(argv[++i]);
+        else if (strcmp(argv[i], "--albedo") == 0 && i + 1 < argc) {
+            char *end;
+            white_albedo = strtod(argv[++i], &end);
+            if (end == argv[i] || *end != '\0')
+                white_albedo = -1.0; /* refused with the range below */
+        } else if (strcmp(argv[i], "--from") == 0 && i + 1 < argc &&
+                   strcmp(argv[1], "calibrate-white") == 0)
+            white_from = argv[++i];
         else if (strcmp(argv[i], "--exposure-us") == 0 && i + 1 < argc &&
                  strcmp(argv[1], "snapshot") == 0) {
             char *end;
@@ -403,7 +455,8 @@ int main(int argc, char **argv)
             snapshot_exposure_us = (uint32_t)v;
         } else {
             int valued = strcmp(argv[i], "--config") == 0 || strcmp(argv[i], "--out") == 0 ||
-                         strcmp(argv[i], "--albedo") == 0 || strcmp(argv[i], "--exposure-us") == 0;
+                         strcmp(argv[i], "--albedo") == 0 ||
+                         strcmp(argv[i], "--exposure-us") == 0 || strcmp(argv[i], "--from") == 0;
             fprintf(stderr, "scanner %s: %s '%s'\n", cmd->name,
                     valued ? "a value is missing after" : "unknown argument", argv[i]);
             usage_of(stderr, cmd);
@@ -473,6 +526,6 @@ int main(int argc, char **argv)
         return opts.out_dir == NULL ? missing(cmd, "--out FILE.png")
                                     : cmd_snapshot(config_path, opts.out_dir, snapshot_exposure_us);
     if (strcmp(argv[1], "calibrate-white") == 0)
-        return cmd_calibrate_white(config_path, white_albedo);
+        return cmd_calibrate_white(config_path, white_albedo, white_from);
     return cmd_selftest(config_path);
 }

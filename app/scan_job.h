@@ -57,6 +57,13 @@ int scan_job_feed_view(struct scan_ctx *s, const char *scan_dir, uint32_t v,
                        const struct scan_params *params, const struct scan_calib *calib,
                        const struct hal_thread *threads, char *err, size_t err_len);
 
+/** Feed colour frame @p k (colour.h's order) of view @p v in @p scan_dir to @p s, after
+ *  scan_job_feed_view: one that @p params' method does not read (the white reference reads
+ *  them all). @retval 0 @retval -ENOENT @retval -EINVAL (@p err names the frame) */
+int scan_job_feed_light_frame(struct scan_ctx *s, const char *scan_dir, uint32_t v, uint32_t k,
+                              const struct scan_params *params, const struct scan_calib *calib,
+                              char *err, size_t err_len);
+
 /** Recompute every result of the scan in @p scan_dir from its kept frames alone.
  *  @param hal  storage, clock and log only; no device is touched
  *  @retval 0 ok @retval -errno with the file named in the log */

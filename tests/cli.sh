@@ -31,6 +31,37 @@ check check_config_names_missing_mesh sh -c "$bin check-config --config $out/no-
 check sim_white_reference_current sh -c "$bin calibrate-white --config config/sim-white.ini 2>/dev/null |
     awk '\$2 == \"multi\" { getline; print }' > $out/white.txt && test -s $out/white.txt &&
     grep -qx \"\$(cat $out/white.txt)\" config/sim.ini"
+# The white reference from a scan of the target kept earlier (--from: captures made elsewhere, or
+# a scan taken from the page): the same scales as taken live. A directory that is not such a
+# scan, a scan of another size, one without the colour frames and an albedo out of range are
+# each refused, said, status 1 or 2.
+white_cal="s|^calibration = .*|calibration = $PWD/config/sim-calib.ini|"
+sed -e 's/^views = .*/views = 1/' -e "$white_cal" config/sim-white.ini > "$out/white-1.ini"
+sed -e 's/^views = .*/views = 1/' -e 's/^method = multi/method = none/' -e "$white_cal" \
+    config/sim-white.ini > "$out/white-none.ini"
+rm -rf "$out/white-scan" "$out/white-plain"
+check white_reference_from_kept_scan sh -c "$bin scan --config $out/white-1.ini --out $out/white-scan >/dev/null 2>&1 &&
+    $bin calibrate-white --config config/sim-white.ini --from $out/white-scan > $out/white-from.txt 2>&1 &&
+    $bin calibrate-white --config config/sim-white.ini 2>/dev/null | grep '^white_scale' > $out/white-live.txt &&
+    test \$(wc -l < $out/white-live.txt) -eq 5 && grep '^white_scale' $out/white-from.txt | cmp - $out/white-live.txt"
+check white_reference_from_refuses_what_it_cannot_use sh -c "
+    ! $bin calibrate-white --config config/sim-white.ini --from $out/no-such-scan 2> $out/wf1.txt &&
+    grep -q 'no-such-scan/view_000' $out/wf1.txt &&
+    rm -rf $out/white-small && cp -r $out/white-scan $out/white-small &&
+    rm $out/white-small/view_000/frame_00.ppm.zst && printf 'P6\n64 48\n255\n' > $out/white-small/view_000/frame_00.ppm &&
+    head -c 9216 /dev/zero >> $out/white-small/view_000/frame_00.ppm &&
+    ! $bin calibrate-white --config config/sim-white.ini --from $out/white-small 2> $out/wf2.txt &&
+    grep -q 'white-small/view_000/frame_00.*64x48' $out/wf2.txt &&
+    $bin scan --config $out/white-none.ini --out $out/white-plain >/dev/null 2>&1 &&
+    ! $bin calibrate-white --config config/sim-white.ini --from $out/white-plain 2> $out/wf3.txt &&
+    grep -q 'white-plain/view_000/frame_2[0-9]: no such frame' $out/wf3.txt &&
+    $bin calibrate-white --config config/sim-white.ini --from $out/white-scan --albedo abc 2> $out/wf4.txt;
+    test \$? -eq 2 && grep -q 'above 0 and at most 1' $out/wf4.txt &&
+    $bin calibrate-white --config config/sim-white.ini --from $out/white-scan --albedo 0 2>/dev/null;
+    test \$? -eq 2 && $bin calibrate-white --config config/sim-white.ini --albedo 1.5 2>/dev/null;
+    test \$? -eq 2 && $bin calibrate-white --config config/sim-white.ini --from 2>&1 |
+    grep -q \"a value is missing after '--from'\""
+rm -rf "$out/white-plain" "$out/white-small"
 check selftest_sim sh -c "$bin selftest --config config/sim.ini > $out/selftest.txt &&
     test \$(grep -c ' ok ' $out/selftest.txt) -eq 4"
 # The appliance build on a machine without its devices: each one MISSING with its path and
