@@ -12,7 +12,8 @@ simulator's camera model says. The frames are written over the scan's own (PGM/P
 
 SCAN_DIR: a simulated scan taken with [output] frame_format = pnm and [registration] icp = 0 (its
 registration.ini poses are then the table's, exact); PATTERN_DIR: `scanner patterns` of its
-config; IMAGE: the [sim] albedo_image; SAMPLES: Cycles samples a pixel of a stripe pattern (the
+config; IMAGE: the [sim] albedo_image, or uniform:A for a paint of albedo A all over (a white
+reference target); SAMPLES: Cycles samples a pixel of a stripe pattern (the
 decoder compares a pattern with its inverse: little noise matters), COLOUR_SAMPLES of the RGB
 frames the colour is made of; lambert: a Lambertian surface lit directly only (the simulator's
 own model, rendered by Cycles: what is left of the difference is the renderer's, not the
@@ -151,6 +152,12 @@ def setup_object(scan, image, height_mm, lambert):
         bsdf.inputs["Roughness"].default_value = 0.0
         links.new(bsdf.outputs[0], nodes["Material Output"].inputs["Surface"])
         colour_input = "Color"
+    if image.startswith("uniform:"):  # one paint all over: the white reference's target
+        a = float(image.split(":", 1)[1])
+        bsdf.inputs[colour_input].default_value = (a, a, a, 1.0)
+        obj.data.materials.clear()
+        obj.data.materials.append(mat)
+        return obj
     coord = nodes.new("ShaderNodeTexCoord")
     sep = nodes.new("ShaderNodeSeparateXYZ")
     links.new(coord.outputs["Object"], sep.inputs[0])
