@@ -89,9 +89,17 @@ static int white_view_from(const char *from_dir, const struct app_config *cfg,
                            const struct scan_calib *calib, struct scan_view *view)
 {
     struct scan_view_info info;
+    static struct scan_dir_view kept; /* its frame list: 2 KiB */
     char err[HAL_MAX_PATH + 256];
     struct scan_ctx *s = scan_job_views();
-    int rc = scan_job_feed_view(s, from_dir, 0, &cfg->scan, calib, NULL, err, sizeof(err));
+    int rc = scan_dir_read_view(from_dir, 0, &kept, err, sizeof(err));
+    if (rc == -ENOENT) {
+        fprintf(stderr, "scanner: error: %s: no view_000/view.ini: not a scan with a view taken\n",
+                from_dir);
+        return rc;
+    }
+    if (rc == 0)
+        rc = scan_job_feed_view(s, from_dir, 0, &cfg->scan, calib, NULL, err, sizeof(err));
     if (rc == 0) /* multi does not read it; uniform's white reference does */
         rc = scan_job_feed_light_frame(s, from_dir, 0, COLOUR_FRAME_ALL, &cfg->scan, calib, err,
                                        sizeof(err));
@@ -292,7 +300,7 @@ static const struct command {
      NEEDS_CONFIG},
     {"calibrate-white",
      "scanner calibrate-white --config FILE [--albedo A] [--from DIR]  white reference scales\n"
-     "           (--from: from the white target's scan kept in DIR, its first view)\n",
+     "    (--from: from the white target's scan kept in DIR, its first view)\n",
      NEEDS_CONFIG},
     {"check-config",
      "scanner check-config --config FILE    check a config, its calibration and the files it "

@@ -46,7 +46,7 @@ check white_reference_from_kept_scan sh -c "$bin scan --config $out/white-1.ini 
     test \$(wc -l < $out/white-live.txt) -eq 5 && grep '^white_scale' $out/white-from.txt | cmp - $out/white-live.txt"
 check white_reference_from_refuses_what_it_cannot_use sh -c "
     ! $bin calibrate-white --config config/sim-white.ini --from $out/no-such-scan 2> $out/wf1.txt &&
-    grep -q 'no-such-scan/view_000' $out/wf1.txt &&
+    grep -q 'no-such-scan: no view_000/view.ini: not a scan' $out/wf1.txt &&
     rm -rf $out/white-small && cp -r $out/white-scan $out/white-small &&
     rm $out/white-small/view_000/frame_00.ppm.zst && printf 'P6\n64 48\n255\n' > $out/white-small/view_000/frame_00.ppm &&
     head -c 9216 /dev/zero >> $out/white-small/view_000/frame_00.ppm &&
