@@ -266,14 +266,15 @@ static void reason_part(void *arg, unsigned k)
 {
     struct reason_parts *p = arg;
     const struct scan_ctx *s = p->s;
-    uint32_t *count = p->count[k], *dark_hist = p->dark_hist[k];
-    memset(count, 0, sizeof(p->count[k]));
-    memset(dark_hist, 0, sizeof(p->dark_hist[k]));
+    /* counted on the stack: the compiler cannot tell the reason bytes from counts in memory */
+    uint32_t count[SCAN_REASON_COUNT] = {0}, dark_hist[256] = {0};
     for (size_t i = p->pixels * k / p->parts; i < p->pixels * (k + 1u) / p->parts; i++) {
         count[s->view_reason[i]]++;
         if (s->view_reason[i] == SCAN_DARK && s->decode.white[i] > s->decode.black[i])
             dark_hist[s->decode.white[i] - s->decode.black[i]]++;
     }
+    memcpy(p->count[k], count, sizeof(count));
+    memcpy(p->dark_hist[k], dark_hist, sizeof(dark_hist));
 }
 
 static void count_reasons(const struct scan_ctx *s, const struct hal_thread *cores,

@@ -8,6 +8,7 @@
 
 #include <errno.h>
 #include <math.h>
+#include <string.h>
 
 /* Depth s along camera ray d (z = 1) where the projector's distorted column is @p col_n
  * (normalised: (u - cx) / fx). The point s d lands at q = s R d + t in the projector frame, at
@@ -167,8 +168,8 @@ static vec3 point_at(const float *xyz_map, size_t i)
 /* How far (in steps of @p step, at most @p max_steps) the surface continues from pixel i: every
  * pixel on the way must be valid (or have the reason @p also) and no depth step may exceed
  * max_jump. */
-static uint32_t reach(const float *xyz_map, const uint8_t *reason, size_t i, long step,
-                      uint32_t max_steps, double max_jump, uint8_t also)
+static inline uint32_t reach(const float *xyz_map, const uint8_t *reason, size_t i, long step,
+                             uint32_t max_steps, double max_jump, uint8_t also)
 {
     uint32_t k = 0;
     size_t cur = i;
@@ -187,9 +188,9 @@ static uint32_t reach(const float *xyz_map, const uint8_t *reason, size_t i, lon
  * Column quantisation makes the range image a staircase; a wide stencil averages it out.
  * @p before / @p after: how many steps exist in the image on each side; @p ahead_also: a reason
  * the steps ahead (to the right, down) may pass besides SCAN_VALID. Returns 0 if none. */
-static int tangent(const float *xyz_map, const uint8_t *reason, size_t i, uint32_t before,
-                   uint32_t after, long step, uint32_t radius, double max_jump, uint8_t ahead_also,
-                   vec3 *out)
+static inline int tangent(const float *xyz_map, const uint8_t *reason, size_t i, uint32_t before,
+                          uint32_t after, long step, uint32_t radius, double max_jump,
+                          uint8_t ahead_also, vec3 *out)
 {
     uint32_t back =
         reach(xyz_map, reason, i, -step, before < radius ? before : radius, max_jump, SCAN_VALID);
@@ -214,6 +215,14 @@ struct normal_parts {
     uint32_t valid[HAL_MAX_THREADS * 4u];
 };
 
+/* The first pixel from @p i on (before @p end) that is SCAN_VALID (0: memchr finds it, many
+ * bytes at a time, across the shadow and the background), or @p end. */
+static inline size_t next_valid(const uint8_t *reason, size_t i, size_t end)
+{
+    const uint8_t *at = i < end ? memchr(reason + i, SCAN_VALID, end - i) : NULL;
+    return at != NULL ? (size_t)(at - reason) : end;
+}
+
 /* A pixel within @p radius before pixel i (to its left, above it) the first pass left without
  * a normal: only then can the second pass find another. */
 static int pending_before(const uint8_t *reason, size_t i, uint32_t x, uint32_t y, uint32_t w,
@@ -233,38 +242,48 @@ static int pending_before(const uint8_t *reason, size_t i, uint32_t x, uint32_t 
  * when it marked each pixel without a normal as it went (but that a pixel losing its normal in
  * the second pass stops no other's reach), and the same on any number of threads (the reasons
  * are only read during a pass). */
-static void normal_rows(void *arg, unsigned k)
+static inline __attribute__((always_inline)) void normal_rows_of(struct normal_parts *p, unsigned k,
+                                                                 const int again)
 {
-    struct normal_parts *p = arg;
-    const uint32_t w = p->width, h = p->height;
+    const uint32_t w = p->width, h = p->height, radius = p->radius_px;
     const float *xyz_map = p->xyz_map;
-    const uint8_t ahead_also = p->again ? NORMAL_PENDING : SCAN_VALID;
+    const uint8_t *reason = p->reason;
+    float *normal_map = p->normal_map;
+    const double jump = p->max_depth_jump_mm;
+    const uint8_t ahead_also = again ? NORMAL_PENDING : SCAN_VALID;
     uint32_t valid = 0; /* counted here: the parts' counts share a cache line */
     for (uint32_t y = h * k / p->parts; y < h * (k + 1u) / p->parts; y++) {
-        for (uint32_t x = 0; x < w; x++) {
+        const uint8_t *row = reason + (size_t)y * w;
+        for (uint32_t x = next_valid(row, 0, w); x < w; x = next_valid(row, x + 1, w)) {
             size_t i = (size_t)y * w + x;
-            if (p->reason[i] != SCAN_VALID)
-                continue;
-            if (p->again && !pending_before(p->reason, i, x, y, w, p->radius_px)) {
+            if (again && !pending_before(reason, i, x, y, w, radius)) {
                 valid++; /* the first pass's normal stands */
                 continue;
             }
             vec3 du, dv, n = v3(NAN, NAN, NAN);
-            if (tangent(xyz_map, p->reason, i, x, w - 1 - x, 1, p->radius_px, p->max_depth_jump_mm,
-                        ahead_also, &du) &&
-                tangent(xyz_map, p->reason, i, y, h - 1 - y, (long)w, p->radius_px,
-                        p->max_depth_jump_mm, ahead_also, &dv)) {
+            if (tangent(xyz_map, reason, i, x, w - 1 - x, 1, radius, jump, ahead_also, &du) &&
+                tangent(xyz_map, reason, i, y, h - 1 - y, (long)w, radius, jump, ahead_also, &dv)) {
                 n = v3_norm(v3_cross(du, dv));
                 if (v3_dot(n, point_at(xyz_map, i)) > 0.0) /* face the camera */
                     n = v3_scale(n, -1.0);
                 valid++;
             }
-            p->normal_map[3 * i + 0] = (float)n.x;
-            p->normal_map[3 * i + 1] = (float)n.y;
-            p->normal_map[3 * i + 2] = (float)n.z;
+            normal_map[3 * i + 0] = (float)n.x;
+            normal_map[3 * i + 1] = (float)n.y;
+            normal_map[3 * i + 2] = (float)n.z;
         }
     }
     p->valid[k] = valid;
+}
+
+/* normal_rows_of for each pass, each its own copy (the pass a constant in it) */
+static void normal_rows(void *arg, unsigned k)
+{
+    struct normal_parts *p = arg;
+    if (p->again)
+        normal_rows_of(p, k, 1);
+    else
+        normal_rows_of(p, k, 0);
 }
 
 /* Part @p k of the rows, once every part has read the reasons: after the first pass a valid
@@ -274,14 +293,18 @@ static void normal_verdicts(void *arg, unsigned k)
 {
     struct normal_parts *p = arg;
     uint8_t *reason = (uint8_t *)p->reason; /* the caller's map: read-only during a pass */
-    size_t i0 = (size_t)p->width * (p->height * k / p->parts);
-    size_t i1 = (size_t)p->width * (p->height * (k + 1u) / p->parts);
-    for (size_t i = i0; i < i1; i++) {
-        if (reason[i] == SCAN_VALID && isnan(p->normal_map[3 * i]))
-            reason[i] = p->again ? SCAN_INCONSISTENT : NORMAL_PENDING;
-        else if (p->again && reason[i] == NORMAL_PENDING)
-            reason[i] = SCAN_INCONSISTENT;
-    }
+    const float *normal_map = p->normal_map;
+    const size_t i0 = (size_t)p->width * (p->height * k / p->parts);
+    const size_t i1 = (size_t)p->width * (p->height * (k + 1u) / p->parts);
+    const uint8_t verdict = p->again ? SCAN_INCONSISTENT : NORMAL_PENDING;
+    for (size_t i = next_valid(reason, i0, i1); i < i1; i = next_valid(reason, i + 1, i1))
+        if (isnan(normal_map[3 * i]))
+            reason[i] = verdict;
+    if (!p->again)
+        return;
+    const uint8_t *at = reason + i0, *end = reason + i1;
+    while ((at = memchr(at, NORMAL_PENDING, (size_t)(end - at))) != NULL)
+        *(uint8_t *)at++ = SCAN_INCONSISTENT;
 }
 
 int tri_normals(struct tri_maps *maps, const struct hal_thread *threads, struct tri_range *range,
