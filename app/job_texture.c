@@ -30,9 +30,10 @@ static int colour_view(struct job *j, const char *scan_dir, uint32_t v)
     int rc = job_view_for_model(j, scan_dir, v, &view, &info);
     if (rc == 0)
         rc = reg_view_pose(j->reg, v, &pose, &rv);
+    struct hal_thread cores = scan_cores(&j->hal->thread, &j->cfg->scan);
     if (rc == 0)
-        rc = atlas_add_view(j->atlas, j->vol, j->calib, &pose, &view.maps, &view.range, view.rgb,
-                            view.confidence);
+        rc = atlas_add_view(j->atlas, j->vol, &cores, j->calib, &pose, &view.maps, &view.range,
+                            view.rgb, view.confidence);
     return rc;
 }
 

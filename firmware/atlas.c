@@ -4,6 +4,8 @@
  * chart that folds back over itself, rare on a scan, shares the texels where it overlaps), packed
  * into shelves; then each texel's surface point projected into every view. */
 #include "atlas.h"
+
+#include "hal_thread.h"
 #include "camray.h"
 #include "frames.h"
 #include "srgb.h"
@@ -453,55 +455,113 @@ static int faces(const struct frame_xform *obj_from_cam, vec3 n_obj, vec3 p_cam)
     return v3_dot(frame_dir_inv(obj_from_cam, n_obj), p_cam) < 0.0;
 }
 
-/* Each vertex that faces the view and lies in front of the camera: the view's colour there
- * (vertex_cam: where the view sees it). */
-static void view_vertices(struct view_ctx *s, const struct fusion_volume *vol,
-                          const struct frame_xform *obj_from_cam)
+/* What the parts of a view's colouring share (atlas_add_view): its pixels, its vertices and its
+ * charts are split into @c parts, each part's writes its own (a pixel's, a vertex's, a chart's
+ * texels). */
+struct view_parts {
+    struct view_ctx s; /* each part starts from a copy */
+    struct fusion_volume *vol;
+    const struct scan_calib *calib;
+    const struct frame_xform *obj_from_cam;
+    const struct tri_range *range;
+    const float *weight, *confidence;
+    size_t pixels;
+    unsigned parts;
+};
+
+/* Part @p k of the pixels: each one's weight (fusion's times the colour's confidence, as the
+ * fusion grid weighs its colour; a negative confidence is no estimate) and depth, side by side:
+ * the texels read four pixels each, wherever they land. Squared, so that the most head-on view
+ * dominated, the mean dE00 came out 0.01-0.06 worse on the four eval scenes tried, texture and
+ * vertices alike (2026-12-06, docs/colour.md). */
+static void view_pixels(void *arg, unsigned k)
 {
-    for (uint32_t v = 0; v < vol->mp.s.vertices; v++) {
-        const float *c = &s->a->vertex_cam[5 * (size_t)v], *n = &vol->mesh_nrm[3 * (size_t)v];
-        vec3 p = v3(c[0], c[1], c[2]);
-        if (vol->mesh_index[v] == MESH_DROPPED || c[2] <= 1.0f ||
-            !faces(obj_from_cam, v3(n[0], n[1], n[2]), p))
-            continue;
-        sample(s, c[3], c[4], c[2], v3_len(p) / p.z, &s->a->vertex_accum[4 * (size_t)v]);
+    const struct view_parts *p = arg;
+    float *pixel = p->s.a->pixel;
+    for (size_t i = p->pixels * k / p->parts; i < p->pixels * (k + 1u) / p->parts; i++) {
+        double c = p->confidence != NULL ? p->confidence[i] : 1.0, w = p->weight[i];
+        pixel[2 * i] = w > 0.0 && c > 0.0 ? (float)(w * c) : 0.0f;
+        pixel[2 * i + 1] = w > 0.0 ? p->range->xyz_mm[3 * i + 2] : 0.0f;
     }
 }
 
-int atlas_add_view(struct atlas *a, struct fusion_volume *vol, const struct scan_calib *calib,
-                   const struct frame_xform *obj_from_cam, const struct decode_maps *maps,
-                   const struct tri_range *range, const uint8_t *rgb, const float *confidence)
+/* Part @p k of the vertices: each in the camera's frame and where it is seen (vertex_cam, once:
+ * a vertex has six triangles); one that faces the view and lies in front of the camera takes
+ * the view's colour there. */
+static void view_vertices(void *arg, unsigned k)
+{
+    const struct view_parts *p = arg;
+    const struct fusion_volume *vol = p->vol;
+    const uint32_t n = vol->mp.s.vertices;
+    for (uint32_t v = (uint32_t)((uint64_t)n * k / p->parts);
+         v < (uint32_t)((uint64_t)n * (k + 1u) / p->parts); v++) {
+        float *c = &p->s.a->vertex_cam[5 * (size_t)v];
+        const float *nrm = &vol->mesh_nrm[3 * (size_t)v];
+        vec3 q = frame_point_inv(p->obj_from_cam, vertex_pos(vol, v));
+        double u = 0.0, w = 0.0;
+        if (q.z > 1.0)
+            camray_project(p->calib, q, &u, &w);
+        c[0] = (float)q.x, c[1] = (float)q.y, c[2] = (float)q.z, c[3] = (float)u, c[4] = (float)w;
+        vec3 at = v3(c[0], c[1], c[2]);
+        if (vol->mesh_index[v] == MESH_DROPPED || c[2] <= 1.0f ||
+            !faces(p->obj_from_cam, v3(nrm[0], nrm[1], nrm[2]), at))
+            continue;
+        sample(&p->s, c[3], c[4], c[2], v3_len(at) / at.z, &p->s.a->vertex_accum[4 * (size_t)v]);
+    }
+}
+
+/* Part @p k of the charts: the texels of each chart that faces the view (half of them face
+ * away), each at its place in its triangle (a triangle's texels lie together along a row: its
+ * corners are looked up again only when the triangle changes). */
+static void view_charts(void *arg, unsigned k)
+{
+    const struct view_parts *p = arg;
+    struct view_ctx s = p->s;
+    const struct atlas *a = s.a;
+    s.t = NONE;
+    for (uint32_t c = a->chart_count * k / p->parts; c < a->chart_count * (k + 1u) / p->parts;
+         c++) {
+        const struct atlas_chart *ch = &a->chart[c];
+        for (uint32_t y = ch->y0; y < ch->y0 + ch->h && ch->facing; y++)
+            for (size_t i = (size_t)y * a->width + ch->x0;
+                 i < (size_t)y * a->width + ch->x0 + ch->w; i++) {
+                uint32_t t = a->owner[i];
+                if (t == NONE || !(a->tri_axis[t] & FACING))
+                    continue;
+                if (t != s.t)
+                    view_triangle(&s, p->vol, t);
+                const double l[3] = {a->bary[2 * i], a->bary[2 * i + 1],
+                                     1.0 - a->bary[2 * i] - a->bary[2 * i + 1]};
+                view_texel(&s, i, l);
+            }
+    }
+}
+
+int atlas_add_view(struct atlas *a, struct fusion_volume *vol, const struct hal_thread *threads,
+                   const struct scan_calib *calib, const struct frame_xform *obj_from_cam,
+                   const struct decode_maps *maps, const struct tri_range *range,
+                   const uint8_t *rgb, const float *confidence)
 {
     if (!a->built)
         return -EINVAL;
-    const float *weight = fusion_view_weights(vol, calib, maps, range);
+    const float *weight = fusion_view_weights(vol, threads, calib, maps, range);
     if (weight == NULL)
         return 0; /* a view of nothing */
-    /* each pixel's weight (fusion's times the colour's confidence, as the fusion grid weighs its
-     * colour; a negative confidence is no estimate) and depth, side by side: the texels read
-     * four pixels each, wherever they land. Squared, so that the most head-on view dominated,
-     * the mean dE00 came out 0.01-0.06 worse on the four eval scenes tried, texture and vertices
-     * alike (2026-12-06, docs/colour.md) */
     const size_t pixels = (size_t)maps->width * maps->height;
     if (pixels > HAL_MAX_PIXELS)
         return -EINVAL;
-    for (size_t i = 0; i < pixels; i++) {
-        double c = confidence != NULL ? confidence[i] : 1.0, w = weight[i];
-        a->pixel[2 * i] = w > 0.0 && c > 0.0 ? (float)(w * c) : 0.0f;
-        a->pixel[2 * i + 1] = w > 0.0 ? range->xyz_mm[3 * i + 2] : 0.0f;
-    }
-    struct view_ctx s = {
-        .a = a, .m = maps, .rgb = rgb, .depth_tol_mm = ATLAS_DEPTH_VOXELS * vol->p.voxel_mm};
-    /* every vertex in the camera's frame and where it is seen, once (a vertex has six triangles) */
-    for (uint32_t v = 0; v < vol->mp.s.vertices; v++) {
-        float *c = &a->vertex_cam[5 * (size_t)v];
-        vec3 p = frame_point_inv(obj_from_cam, vertex_pos(vol, v));
-        double u = 0.0, w = 0.0;
-        if (p.z > 1.0)
-            camray_project(calib, p, &u, &w);
-        c[0] = (float)p.x, c[1] = (float)p.y, c[2] = (float)p.z, c[3] = (float)u, c[4] = (float)w;
-    }
-    view_vertices(&s, vol, obj_from_cam);
+    struct view_parts p = {
+        .s = {.a = a, .m = maps, .rgb = rgb, .depth_tol_mm = ATLAS_DEPTH_VOXELS * vol->p.voxel_mm},
+        .vol = vol,
+        .calib = calib,
+        .obj_from_cam = obj_from_cam,
+        .range = range,
+        .weight = weight,
+        .confidence = confidence,
+        .pixels = pixels,
+        .parts = hal_thread_parts(threads, 64)};
+    hal_thread_run(threads, p.parts, view_pixels, &p);
+    hal_thread_run(threads, p.parts, view_vertices, &p);
     if (a->width == 0)
         return 0; /* no texture */
     for (uint32_t c = 0; c < a->chart_count; c++)
@@ -521,25 +581,7 @@ int atlas_add_view(struct atlas *a, struct fusion_volume *vol, const struct scan
             a->chart[a->tri_chart[t]].facing = 1;
         }
     }
-    /* the texels of each chart that faces the view (half of them face away), each at its place
-     * in its triangle (a triangle's texels lie together along a row: its corners are looked up
-     * again only when the triangle changes) */
-    s.t = NONE;
-    for (uint32_t c = 0; c < a->chart_count; c++) {
-        const struct atlas_chart *ch = &a->chart[c];
-        for (uint32_t y = ch->y0; y < ch->y0 + ch->h && ch->facing; y++)
-            for (size_t i = (size_t)y * a->width + ch->x0;
-                 i < (size_t)y * a->width + ch->x0 + ch->w; i++) {
-                uint32_t t = a->owner[i];
-                if (t == NONE || !(a->tri_axis[t] & FACING))
-                    continue;
-                if (t != s.t)
-                    view_triangle(&s, vol, t);
-                const double l[3] = {a->bary[2 * i], a->bary[2 * i + 1],
-                                     1.0 - a->bary[2 * i] - a->bary[2 * i + 1]};
-                view_texel(&s, i, l);
-            }
-    }
+    hal_thread_run(threads, p.parts, view_charts, &p);
     return 0;
 }
 

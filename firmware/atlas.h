@@ -79,11 +79,14 @@ int atlas_build(struct atlas *a, const struct fusion_volume *vol, double texel_m
  *  within two voxels: else the point is hidden or off the view's surface), weighed as fusion
  *  weighs the pixel (fusion.h: head-on, near, away from the view's edge) times the colour's
  *  @p confidence (NULL: 1).
- *  Uses @p vol's pixel weights (fusion_view_weights): after the mesh is prepared.
+ *  Uses @p vol's pixel weights (fusion_view_weights): after the mesh is prepared. The pixels,
+ *  the vertices and the charts split across @p threads (NULL: this one); each texel and vertex
+ *  takes one sample a view, so the sums are the same on any number of threads.
  *  @retval 0 @retval -EINVAL no atlas built */
-int atlas_add_view(struct atlas *a, struct fusion_volume *vol, const struct scan_calib *calib,
-                   const struct frame_xform *obj_from_cam, const struct decode_maps *maps,
-                   const struct tri_range *range, const uint8_t *rgb, const float *confidence);
+int atlas_add_view(struct atlas *a, struct fusion_volume *vol, const struct hal_thread *threads,
+                   const struct scan_calib *calib, const struct frame_xform *obj_from_cam,
+                   const struct decode_maps *maps, const struct tri_range *range,
+                   const uint8_t *rgb, const float *confidence);
 
 /** The vertices' colours and the texture: each vertex a view saw takes its weighted colour in
  *  @p vol's tables (16 bits, MESH_RGB_ONE; the others keep the fusion grid's); each texel its

@@ -183,10 +183,11 @@ static int pixel_weights(struct fusion_volume *vol, const struct hal_thread *thr
     return 1;
 }
 
-const float *fusion_view_weights(struct fusion_volume *vol, const struct scan_calib *calib,
-                                 const struct decode_maps *maps, const struct tri_range *range)
+const float *fusion_view_weights(struct fusion_volume *vol, const struct hal_thread *threads,
+                                 const struct scan_calib *calib, const struct decode_maps *maps,
+                                 const struct tri_range *range)
 {
-    return pixel_weights(vol, NULL, calib, maps, range) ? vol->weight_map : NULL;
+    return pixel_weights(vol, threads, calib, maps, range) ? vol->weight_map : NULL;
 }
 
 /* Blend colour @p rgb with weight @p cw into the voxel; a voxel no confident view has coloured

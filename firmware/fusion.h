@@ -92,9 +92,11 @@ void fusion_outside(const struct fusion_volume *vol, struct fusion_outside *out)
 
 /** The weight fusion_integrate gives each pixel of a view (above; 0: not fused), in @p vol's
  *  work space, which the mesh's hole filling shares: once the mesh is made (the texture atlas).
+ *  The rows split across @p threads (NULL: this one).
  *  @retval the weights, width x height @retval NULL no pixel is valid */
-const float *fusion_view_weights(struct fusion_volume *vol, const struct scan_calib *calib,
-                                 const struct decode_maps *maps, const struct tri_range *range);
+const float *fusion_view_weights(struct fusion_volume *vol, const struct hal_thread *threads,
+                                 const struct scan_calib *calib, const struct decode_maps *maps,
+                                 const struct tri_range *range);
 
 /** The grid's memory for another use once the mesh is made (fusion_mesh_prepare, and the whole
  *  mesh fit the tables: the writers read the tables, never the grid again): the texture atlas's

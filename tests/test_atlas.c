@@ -151,7 +151,8 @@ static void add_the_view(void)
     render_view(&c, &obj_from_cam);
     struct decode_maps m = {.reason = reason, .width = W, .height = H};
     struct tri_range r = {.xyz_mm = xyz, .normal = normal, .width = W, .height = H};
-    assert_int_equal(atlas_add_view(&atlas, &vol, &c, &obj_from_cam, &m, &r, rgb, confidence), 0);
+    assert_int_equal(atlas_add_view(&atlas, &vol, NULL, &c, &obj_from_cam, &m, &r, rgb, confidence),
+                     0);
 }
 
 /* Each vertex facing the camera away from the paint's edges has the paint's colour (16 bits,
