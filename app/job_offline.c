@@ -168,6 +168,23 @@ static int read_side_by_side(struct frame_reads *r, const struct hal_thread *cor
  * by one thread at a time). */
 static struct frame_reads reads;
 
+/* No frame to read yet, of view @p v in @p scan_dir. */
+static void reads_begin(struct scan_ctx *s, const char *scan_dir, uint32_t v,
+                        const struct scan_params *params)
+{
+    reads = (struct frame_reads){.s = s, .scan_dir = scan_dir, .v = v, .params = params};
+}
+
+/* Frame @p f, of @p channels, to be read with the others. @retval 0 @retval -EINVAL no room */
+static int reads_add(uint32_t f, uint32_t channels)
+{
+    if (reads.count == FEED_MAX_SIDE)
+        return -EINVAL;
+    reads.frame[reads.count] = f;
+    reads.channels[reads.count++] = channels;
+    return 0;
+}
+
 /* The pattern frames, two at a time where their buffers differ (white and black, a bit's stripes
  * and its inverse: a bit without inverse shares its buffer with the next), each pair read side
  * by side and then fed in order. */
@@ -177,14 +194,14 @@ static int feed_pattern_frames(struct scan_ctx *s, const char *scan_dir, uint32_
 {
     int rc = 0;
     for (uint32_t f = 0; rc == 0 && f < count; f += reads.count) {
-        reads = (struct frame_reads){.s = s, .scan_dir = scan_dir, .v = v, .params = params};
-        for (uint32_t g = f; g < count && g < f + 2u; g++) {
+        reads_begin(s, scan_dir, v, params);
+        for (uint32_t g = f; rc == 0 && g < count && g < f + 2u; g++) {
             if (g > f && scan_frame_buffer(s, g) == scan_frame_buffer(s, f))
                 break;
-            reads.frame[reads.count] = g;
-            reads.channels[reads.count++] = scan_frame_channels(params, calib, g);
+            rc = reads_add(g, scan_frame_channels(params, calib, g));
         }
-        rc = read_side_by_side(&reads, cores, err, err_len);
+        if (rc == 0)
+            rc = read_side_by_side(&reads, cores, err, err_len);
         for (uint32_t k = 0; rc == 0 && k < reads.count; k++)
             rc = scan_feed_frame(s, reads.frame[k], reads.pixels[k], reads.channels[k], NULL);
     }
@@ -200,16 +217,14 @@ static int feed_colour_frames(struct scan_ctx *s, const char *scan_dir, uint32_t
 {
     const uint32_t count = first, lights = scan_light_frame_count(params, calib);
     uint32_t channels;
-    reads = (struct frame_reads){.s = s, .scan_dir = scan_dir, .v = v, .params = params};
-    for (uint32_t f = first; (channels = scan_frame_channels(params, calib, f)) != 0; f++) {
-        if (f < count + lights && !scan_needs_light_frame(params, calib, f - count))
-            continue; /* taken for another method: not read back */
-        if (reads.count == FEED_MAX_SIDE)
-            return -EINVAL;
-        reads.frame[reads.count] = f;
-        reads.channels[reads.count++] = channels;
-    }
-    int rc = read_side_by_side(&reads, cores, err, err_len);
+    int rc = 0;
+    reads_begin(s, scan_dir, v, params);
+    for (uint32_t f = first; rc == 0 && (channels = scan_frame_channels(params, calib, f)) != 0;
+         f++)
+        if (f >= count + lights || scan_needs_light_frame(params, calib, f - count))
+            rc = reads_add(f, channels); /* else taken for another method: not read back */
+    if (rc == 0)
+        rc = read_side_by_side(&reads, cores, err, err_len);
     for (uint32_t k = 0; rc == 0 && k < reads.count; k++) {
         uint32_t f = reads.frame[k];
         rc = f < count + lights ? scan_feed_light_frame(s, f - count, reads.pixels[k])

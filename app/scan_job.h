@@ -50,9 +50,10 @@ void scan_job_view_meta(const struct app_config *cfg, const struct scan_params *
 
 /** Feed view @p v's kept frames in @p scan_dir to @p s as the live view fed them: the patterns
  *  of @p params, then its colour frames (begins the view; finish with scan_finish_view or
- *  decode_finish). The colour frames are read side by side on @p threads ([scan] threads of
- *  them; NULL: one after another), each into its own buffer. @p err names a frame that is
- *  missing or wrong. @retval 0 @retval -ENOENT @retval -EINVAL */
+ *  decode_finish). The frames are read side by side on @p threads ([scan] threads of them;
+ *  NULL: one after another), each into its own buffer: the colour frames all together, the
+ *  pattern frames two at a time (white and black, a bit's stripes and its inverse). @p err
+ *  names a frame that is missing or wrong. @retval 0 @retval -ENOENT @retval -EINVAL */
 int scan_job_feed_view(struct scan_ctx *s, const char *scan_dir, uint32_t v,
                        const struct scan_params *params, const struct scan_calib *calib,
                        const struct hal_thread *threads, char *err, size_t err_len);

@@ -81,7 +81,7 @@ struct sum_parts {
     const float *confidence; /* with albedo: only pixels with an estimate */
     size_t pixels;
     unsigned parts;
-    struct pixel_sums sum[HAL_MAX_THREADS * 4u];
+    struct pixel_sums sum[HAL_MAX_PARTS];
 };
 
 static void sum_part(void *arg, unsigned k)
@@ -112,7 +112,7 @@ static void pixel_sums(const struct hal_thread *threads, const struct decode_map
                            .albedo = albedo,
                            .confidence = confidence,
                            .pixels = (size_t)m->width * m->height,
-                           .parts = hal_thread_parts(threads, HAL_MAX_THREADS * 4u)};
+                           .parts = hal_thread_parts(threads, HAL_MAX_PARTS)};
     hal_thread_run(threads, p.parts, sum_part, &p);
     *out = (struct pixel_sums){0};
     for (unsigned k = 0; k < p.parts; k++) {

@@ -435,19 +435,31 @@ static void resolve_rows(void *arg, unsigned k)
     }
 }
 
-/* A pixel with unclear bits takes, of its possible readings, the one its decoded neighbourhood
- * predicts: one with more than max_ambiguous_bits (or decoding outside the projector) becomes
- * valid so; a valid one whose unclear bit read the wrong way (noise, not an edge) is corrected.
- * Verdicts go to d->scratch and corrections wait in the unclear maps (not needed after this) until
- * the pass ends, so that what this pass changes is not the reference of others. */
-/* Part @p k of the rows once every part has read them: the corrections applied, the verdicts
- * made the reasons. */
+/* The pixels of part @p k of the rows: [*i0, *i1). */
+static void part_pixels(const struct row_parts *p, unsigned k, size_t *i0, size_t *i1)
+{
+    const size_t w = p->d->params.width, h = p->d->params.height;
+    *i0 = w * (h * k / p->parts);
+    *i1 = w * (h * (k + 1u) / p->parts);
+}
+
+/* Part @p k of the rows once every part has read them: the verdicts made the reasons. */
+static void verdicts_apply(void *arg, unsigned k)
+{
+    const struct row_parts *p = arg;
+    size_t i0, i1;
+    part_pixels(p, k, &i0, &i1);
+    memcpy(p->reason + i0, p->d->scratch + i0, i1 - i0);
+}
+
+/* Part @p k of the rows once every part has read them: the corrections applied, then the
+ * verdicts made the reasons. */
 static void resolve_apply(void *arg, unsigned k)
 {
     const struct row_parts *p = arg;
     struct decode_ctx *d = p->d;
-    const size_t w = d->params.width, h = d->params.height;
-    const size_t i0 = w * (h * k / p->parts), i1 = w * (h * (k + 1u) / p->parts);
+    size_t i0, i1;
+    part_pixels(p, k, &i0, &i1);
     for (size_t i = i0; i < i1; i++) {
         if (d->scratch[i] == RESOLVE_CORRECTED) {
             d->column_map[i] = d->unclear_col[i];
@@ -455,9 +467,14 @@ static void resolve_apply(void *arg, unsigned k)
             d->scratch[i] = SCAN_VALID;
         }
     }
-    memcpy(p->reason + i0, d->scratch + i0, i1 - i0);
+    verdicts_apply(arg, k);
 }
 
+/* A pixel with unclear bits takes, of its possible readings, the one its decoded neighbourhood
+ * predicts: one with more than max_ambiguous_bits (or decoding outside the projector) becomes
+ * valid so; a valid one whose unclear bit read the wrong way (noise, not an edge) is corrected.
+ * Verdicts go to d->scratch and corrections wait in the unclear maps (not needed after this) until
+ * the pass ends, so that what this pass changes is not the reference of others. */
 static void resolve_unclear(struct decode_ctx *d, const struct hal_thread *threads, uint8_t *reason)
 {
     struct row_parts p = {d, reason, hal_thread_parts(threads, 64)};
@@ -509,15 +526,6 @@ static void check_rows(void *arg, unsigned k)
                 d->scratch[i] = SCAN_INCONSISTENT;
         }
     }
-}
-
-/* Part @p k of the rows once every part has read them: the verdicts made the reasons. */
-static void verdicts_apply(void *arg, unsigned k)
-{
-    const struct row_parts *p = arg;
-    const size_t w = p->d->params.width, h = p->d->params.height;
-    const size_t i0 = w * (h * k / p->parts), i1 = w * (h * (k + 1u) / p->parts);
-    memcpy(p->reason + i0, p->d->scratch + i0, i1 - i0);
 }
 
 /* A wrong bit makes a lone jump: a pixel is inconsistent when more of its valid neighbours

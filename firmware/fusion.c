@@ -270,6 +270,17 @@ void fusion_outside_add(struct fusion_outside *o, const struct fusion_params *fp
     }
 }
 
+/* @p part's counts into @p o: the counts added, the highest and widest points kept. */
+static void fusion_outside_merge(struct fusion_outside *o, const struct fusion_outside *part)
+{
+    o->fused += part->fused;
+    o->above += part->above;
+    o->beside += part->beside;
+    o->top_seen_mm = part->top_seen_mm > o->top_seen_mm ? part->top_seen_mm : o->top_seen_mm;
+    o->reach_seen_mm =
+        part->reach_seen_mm > o->reach_seen_mm ? part->reach_seen_mm : o->reach_seen_mm;
+}
+
 int fusion_outside_many(uint64_t n, uint64_t fused, uint64_t least)
 {
     return n >= least && n * 1000 >= fused;
@@ -328,8 +339,8 @@ struct mark_rows {
     const struct tri_range *r;
     const uint32_t *nb;
     unsigned parts;
-    struct fusion_outside outside[HAL_MAX_THREADS * 4u];
-    int any[HAL_MAX_THREADS * 4u];
+    struct fusion_outside outside[HAL_MAX_PARTS];
+    int any[HAL_MAX_PARTS];
 };
 
 /* Part @p k of the rectangle's rows: the block of each fused point marked (parts may mark the
@@ -383,20 +394,13 @@ static int mark_blocks(struct fusion_volume *vol, const struct hal_thread *threa
                            .m = m,
                            .r = r,
                            .nb = nb,
-                           .parts = hal_thread_parts(threads, HAL_MAX_THREADS * 4u)};
+                           .parts = hal_thread_parts(threads, HAL_MAX_PARTS)};
     memset(vol->block_mark, 0, (size_t)nb[0] * nb[1] * nb[2]);
     hal_thread_run(threads, p.parts, mark_rows, &p);
     int any = 0;
-    struct fusion_outside *o = &vol->outside;
     for (unsigned k = 0; k < p.parts; k++) {
-        const struct fusion_outside *part = &p.outside[k];
         any |= p.any[k];
-        o->fused += part->fused;
-        o->above += part->above;
-        o->beside += part->beside;
-        o->top_seen_mm = part->top_seen_mm > o->top_seen_mm ? part->top_seen_mm : o->top_seen_mm;
-        o->reach_seen_mm =
-            part->reach_seen_mm > o->reach_seen_mm ? part->reach_seen_mm : o->reach_seen_mm;
+        fusion_outside_merge(&vol->outside, &p.outside[k]);
     }
     return any;
 }

@@ -69,8 +69,7 @@ static void refine_rows(void *arg, unsigned k)
 int refine_columns(const struct decode_maps *m, const struct hal_thread *threads, int enabled,
                    float *column_sub)
 {
-    struct refine_parts p = {m, enabled, column_sub,
-                             hal_thread_parts(threads, HAL_MAX_THREADS * 4u)};
+    struct refine_parts p = {m, enabled, column_sub, hal_thread_parts(threads, HAL_MAX_PARTS)};
     hal_thread_run(threads, p.parts, refine_rows, &p);
     return 0;
 }

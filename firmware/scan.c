@@ -258,8 +258,8 @@ struct reason_parts {
     const struct scan_ctx *s;
     size_t pixels;
     unsigned parts;
-    uint32_t count[HAL_MAX_THREADS * 4u][SCAN_REASON_COUNT];
-    uint32_t dark_hist[HAL_MAX_THREADS * 4u][256];
+    uint32_t count[HAL_MAX_PARTS][SCAN_REASON_COUNT];
+    uint32_t dark_hist[HAL_MAX_PARTS][256];
 };
 
 static void reason_part(void *arg, unsigned k)
@@ -283,7 +283,7 @@ static void count_reasons(const struct scan_ctx *s, const struct hal_thread *cor
     static struct reason_parts p; /* 34 KiB of counts: one view is finished at a time */
     p.s = s;
     p.pixels = (size_t)s->params.width * s->params.height;
-    p.parts = hal_thread_parts(cores, HAL_MAX_THREADS * 4u);
+    p.parts = hal_thread_parts(cores, HAL_MAX_PARTS);
     hal_thread_run(cores, p.parts, reason_part, &p);
     uint32_t dark_hist[256] = {0}, dark_n = 0;
     memset(info->reason_count, 0, sizeof(info->reason_count));

@@ -69,8 +69,8 @@ struct range_parts {
     uint8_t *reason;
     uint32_t width, height;
     unsigned parts;
-    uint32_t valid[HAL_MAX_THREADS * 4u];
-    int rc[HAL_MAX_THREADS * 4u];
+    uint32_t valid[HAL_MAX_PARTS];
+    int rc[HAL_MAX_PARTS];
 };
 
 /* Part @p k of the rows: each valid pixel's point, or SCAN_INCONSISTENT (its own pixel only). */
@@ -141,7 +141,7 @@ int tri_range_image(const struct scan_calib *c, const struct hal_thread *threads
                             .reason = reason,
                             .width = width,
                             .height = height,
-                            .parts = hal_thread_parts(threads, HAL_MAX_THREADS * 4u)};
+                            .parts = hal_thread_parts(threads, HAL_MAX_PARTS)};
     hal_thread_run(threads, p.parts, range_rows, &p);
     range->xyz_mm = maps->xyz_mm;
     range->normal = maps->normal;
@@ -212,7 +212,7 @@ struct normal_parts {
     double max_depth_jump_mm;
     int again; /* the second pass */
     unsigned parts;
-    uint32_t valid[HAL_MAX_THREADS * 4u];
+    uint32_t valid[HAL_MAX_PARTS];
 };
 
 /* The first pixel from @p i on (before @p end) that is SCAN_VALID (0: memchr finds it, many
@@ -317,7 +317,7 @@ int tri_normals(struct tri_maps *maps, const struct hal_thread *threads, struct 
                              .height = range->height,
                              .radius_px = radius_px,
                              .max_depth_jump_mm = max_depth_jump_mm,
-                             .parts = hal_thread_parts(threads, HAL_MAX_THREADS * 4u)};
+                             .parts = hal_thread_parts(threads, HAL_MAX_PARTS)};
     for (p.again = 0; p.again <= 1; p.again++) {
         hal_thread_run(threads, p.parts, normal_rows, &p);
         hal_thread_run(threads, p.parts, normal_verdicts, &p);

@@ -175,7 +175,7 @@ unsigned hal_thread_parts(const struct hal_thread *t, unsigned most)
     unsigned threads = hal_thread_count(t);
     if (threads <= 1)
         return 1;
-    return 4u * threads < most ? 4u * threads : most;
+    return HAL_PARTS_PER_THREAD * threads < most ? HAL_PARTS_PER_THREAD * threads : most;
 }
 
 void hal_thread_run(const struct hal_thread *t, unsigned count, hal_thread_fn fn, void *arg)

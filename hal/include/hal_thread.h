@@ -3,6 +3,14 @@
 #ifndef HAL_THREAD_H
 #define HAL_THREAD_H
 
+#include "hal_limits.h"
+
+/** Parts a stage is cut into a thread (hal_thread_parts), so that one costly part (the object's
+ *  middle) does not hold the others up; HAL_MAX_PARTS, the most there can be, sizes the arrays
+ *  that keep a result a part. */
+#define HAL_PARTS_PER_THREAD 4u
+#define HAL_MAX_PARTS (HAL_PARTS_PER_THREAD * HAL_MAX_THREADS)
+
 /** One item of a parallel loop: @p k of the loop's count. Items write disjoint memory. */
 typedef void (*hal_thread_fn)(void *arg, unsigned k);
 
@@ -21,7 +29,8 @@ struct hal_thread {
 };
 
 /** Parts a stage splits into so that its threads stay busy when parts cost unequally (the
- *  image's edges, the object's middle): four a thread, at most @p most; 1 on one thread. */
+ *  image's edges, the object's middle): HAL_PARTS_PER_THREAD a thread, at most @p most (and so
+ *  never more than HAL_MAX_PARTS); 1 on one thread. */
 unsigned hal_thread_parts(const struct hal_thread *t, unsigned most);
 
 /** Run @p fn for k = 0 .. @p count - 1 on @p t's threads, or one after another here (@p t
