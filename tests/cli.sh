@@ -33,8 +33,9 @@ check sim_white_reference_current sh -c "$bin calibrate-white --config config/si
     grep -qx \"\$(cat $out/white.txt)\" config/sim.ini"
 # The white reference from a scan of the target kept earlier (--from: captures made elsewhere, or
 # a scan taken from the page): the same scales as taken live. A directory that is not such a
-# scan, a scan of another size, one without the colour frames and an albedo out of range are
-# each refused, said, status 1 or 2.
+# scan, a frame of another size, one without the colour frames, a view.ini that is a symlink to
+# a FIFO (refused, not waited on) and an albedo out of range are each refused, said, status 1
+# or 2.
 white_cal="s|^calibration = .*|calibration = $PWD/config/sim-calib.ini|"
 sed -e 's/^views = .*/views = 1/' -e "$white_cal" config/sim-white.ini > "$out/white-1.ini"
 sed -e 's/^views = .*/views = 1/' -e 's/^method = multi/method = none/' -e "$white_cal" \
@@ -60,8 +61,12 @@ check white_reference_from_refuses_what_it_cannot_use sh -c "
     $bin calibrate-white --config config/sim-white.ini --from $out/white-scan --albedo 0 2>/dev/null;
     test \$? -eq 2 && $bin calibrate-white --config config/sim-white.ini --albedo 1.5 2>/dev/null;
     test \$? -eq 2 && $bin calibrate-white --config config/sim-white.ini --from 2>&1 |
-    grep -q \"a value is missing after '--from'\""
-rm -rf "$out/white-plain" "$out/white-small"
+    grep -q \"a value is missing after '--from'\" &&
+    rm -rf $out/white-fifo && cp -r $out/white-scan $out/white-fifo && rm $out/white-fifo/view_000/view.ini &&
+    mkfifo $out/white-fifo/fifo && ln -s ../fifo $out/white-fifo/view_000/view.ini &&
+    ! timeout 60 $bin calibrate-white --config config/sim-white.ini --from $out/white-fifo 2> $out/wf5.txt &&
+    grep -q 'white-fifo/view_000/view.ini: not a regular file' $out/wf5.txt"
+rm -rf "$out/white-plain" "$out/white-small" "$out/white-fifo"
 check selftest_sim sh -c "$bin selftest --config config/sim.ini > $out/selftest.txt &&
     test \$(grep -c ' ok ' $out/selftest.txt) -eq 4"
 # The appliance build on a machine without its devices: each one MISSING with its path and
