@@ -240,14 +240,12 @@ static void test_lone_wrong_code_inconsistent(void **state)
 }
 
 /* The blocked decoder and the plain reference agree on frames with every kind of pixel: run the
- * ambiguous-bit scene through both. */
-static void test_blocked_matches_reference(void **state)
+ * ambiguous-bit scene through both, with settings @p p. @retval the kinds of reason seen */
+static unsigned blocked_matches_reference_with(const struct scan_params *p)
 {
-    (void)state;
     uint32_t bits = gray_bits_for_width(PROJ_W);
-    struct scan_params p = params();
     struct gray_layout l = layout_of(bits);
-    assert_int_equal(decode_begin(&dec, &p, &l, PROJ_W, 1), 0);
+    assert_int_equal(decode_begin(&dec, p, &l, PROJ_W, 1), 0);
     feed_ambiguous_scene(bits);
     assert_int_equal(decode_pixels(&dec, NULL, reason_out, &maps_out), 0);
     const uint8_t *frames[DECODE_MAX_PATTERNS];
@@ -255,7 +253,7 @@ static void test_blocked_matches_reference(void **state)
         frames[i] = fed[i];
     uint16_t col[W * H];
     uint8_t reason[W * H];
-    decode_reference(&p, &l, PROJ_W, 1, frames, W * H, col, NULL, reason);
+    decode_reference(p, &l, PROJ_W, 1, frames, W * H, col, NULL, reason);
     const struct decode_maps *m = &maps_out;
     unsigned kinds = 0;
     for (size_t i = 0; i < W * H; i++) {
@@ -264,8 +262,43 @@ static void test_blocked_matches_reference(void **state)
         if (reason[i] == SCAN_VALID)
             assert_int_equal(m->column[i], col[i]);
     }
+    return kinds;
+}
+
+static void test_blocked_matches_reference(void **state)
+{
+    (void)state;
+    struct scan_params p = params();
     /* valid, shadow, low contrast and saturated pixels were all compared */
-    assert_true((kinds & 0x1Bu) == 0x1Bu);
+    assert_true((blocked_matches_reference_with(&p) & 0x1Bu) == 0x1Bu);
+}
+
+/* The same at each end of every setting the per-pixel stage compares with (the ranges
+ * app/config.c allows), its planes left full of ones by an earlier view first: a view's bits
+ * are written whole by its own frames, none read from the view before. */
+static void test_blocked_matches_reference_at_every_limit(void **state)
+{
+    (void)state;
+    static const uint32_t shadow[] = {0, 4, 254}, dark[] = {1, 255, 255};
+    static const uint32_t ambiguous[] = {0, 1, 16};
+    unsigned kinds = 0;
+    for (int k = 0; k < 3; k++)
+        for (int a = 0; a < 3; a++) {
+            struct scan_params p = params();
+            p.shadow_contrast_dn = shadow[k];
+            p.min_contrast_dn = dark[k];
+            p.max_ambiguous_bits = ambiguous[a];
+            for (int axis = 0; axis < 2; axis++) {
+                memset(dec.word_hi[axis], 0xFF, W * H);
+                memset(dec.word_lo[axis], 0xFF, W * H);
+                memset(dec.unclear_hi[axis], 0xFF, W * H);
+                memset(dec.unclear_lo[axis], 0xFF, W * H);
+            }
+            memset(dec.sat, 0xFF, W * H);
+            kinds |= blocked_matches_reference_with(&p);
+        }
+    /* every reason but inconsistent (the neighbour check's) came up */
+    assert_int_equal(kinds, (1u << SCAN_INCONSISTENT) - 1u);
 }
 
 /* XOR-04 decodes the same scene to the same columns and reasons, blocked and plain alike. */
@@ -320,6 +353,7 @@ int main(void)
         cmocka_unit_test(test_bit_threshold_from_noise),
         cmocka_unit_test(test_lone_wrong_code_inconsistent),
         cmocka_unit_test(test_blocked_matches_reference),
+        cmocka_unit_test(test_blocked_matches_reference_at_every_limit),
         cmocka_unit_test(test_xor04_columns_and_reference),
         cmocka_unit_test(test_fewer_inverses),
         cmocka_unit_test(test_mean_threshold),
