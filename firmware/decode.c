@@ -317,11 +317,13 @@ static void block_reasons(uint8_t *restrict reason, const struct decode_ctx *d, 
     }
 }
 
+/* Pixels whose unclear bits are counted at a time: the counts live on the stack. */
+#define DECODE_COUNT_CHUNK 256u
+
 static void decode_block(struct decode_ctx *d, size_t start, size_t len, uint8_t *reason)
 {
     const unsigned cols = d->layout.col_bits, rows = d->layout.row_bits;
     const unsigned lo_col = cols > 8 ? cols - 8 : 0, lo_row = rows > 8 ? rows - 8 : 0;
-    uint8_t count_c[DECODE_BLOCK], count_r[DECODE_BLOCK];
     /* with no rows coded their planes stay as begin_bits cleared them: every row word 0 */
     block_words(d->column_map + start, d->word_hi[0] + start, d->word_lo[0] + start, lo_col, len);
     block_words(d->row_map + start, d->word_hi[1] + start, d->word_lo[1] + start, lo_row, len);
@@ -331,9 +333,13 @@ static void decode_block(struct decode_ctx *d, size_t start, size_t len, uint8_t
                 len);
     block_values(d->column_map + start, (uint16_t)d->xor_col, len);
     block_values(d->row_map + start, (uint16_t)d->xor_row, len);
-    block_unclear_counts(count_c, d->unclear_col + start, (uint16_t)d->xor_col, len);
-    block_unclear_counts(count_r, d->unclear_row + start, (uint16_t)d->xor_row, len);
-    block_reasons(reason + start, d, start, count_c, count_r, len);
+    for (size_t at = start; at < start + len; at += DECODE_COUNT_CHUNK) {
+        size_t n = start + len - at < DECODE_COUNT_CHUNK ? start + len - at : DECODE_COUNT_CHUNK;
+        uint8_t count_c[DECODE_COUNT_CHUNK], count_r[DECODE_COUNT_CHUNK];
+        block_unclear_counts(count_c, d->unclear_col + at, (uint16_t)d->xor_col, n);
+        block_unclear_counts(count_r, d->unclear_row + at, (uint16_t)d->xor_row, n);
+        block_reasons(reason + at, d, at, count_c, count_r, n);
+    }
 }
 
 /* Part @p k of @p parts of the pixels, whole blocks, with the accumulators of its own. */
