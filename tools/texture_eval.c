@@ -17,7 +17,11 @@
  * texture mean,p95,vertex mean,p95,dark samples,dark texture,dark vertex,seams,mean,max"), and
  * per channel the gain that brings the texture (and the vertex colours) to the truth in least
  * squares; --balanced applies them first (what a white reference of the renderer that made the
- * frames would set: make eval-cycles, whose frames are not the simulator's). */
+ * frames would set: make eval-cycles, whose frames are not the simulator's). Then the paint
+ * edges apart: the samples where the truth changes by more than EDGE_DE00 within EDGE_MM (six
+ * points at +-EDGE_MM along the axes), the texture's mean there and elsewhere, and the truth
+ * averaged over those seven points against itself: what a colour perfect but for a blur of about
+ * a texel would score ("edges,samples,texture mean on edges,elsewhere,blur alone"). */
 #define _POSIX_C_SOURCE 200809L
 #include "board_albedo.h"
 #include "colour_metrics.h"
@@ -34,6 +38,8 @@
 #include <string.h>
 
 #define MATCH_MM 1.0
+#define EDGE_MM 0.25  /* about a texel of make run's texture (0.268 mm) */
+#define EDGE_DE00 2.0 /* a change of paint a person sees side by side */
 #define MAX_SIDE 4096u
 
 struct obj_mesh {
@@ -119,15 +125,41 @@ static void texture_at(const uint8_t *tex, uint32_t w, uint32_t h, double u, dou
     }
 }
 
+/* Doubles a sample keeps: the truth, the texture's and the vertex colour (linear), the truth
+ * averaged round it and how much it changes there (truth_around). */
+#define SAMPLE 13
+
+/* The truth at @p q and at six points +-EDGE_MM along the axes round it: their mean (@p blur,
+ * linear) and the largest CIEDE2000 of one of them from @p at, the truth at q (@p change). */
+static void truth_around(const struct sim_config *sim, double height, vec3 q, const double at[3],
+                         double blur[3], double *change)
+{
+    double lab_at[3];
+    colour_linear_rgb_to_lab(at, lab_at);
+    memcpy(blur, at, 3 * sizeof(double));
+    *change = 0.0;
+    for (int k = 0; k < 6; k++) {
+        double d = k % 2 ? -EDGE_MM : EDGE_MM, a[3], lab[3];
+        vec3 o = v3(k / 2 == 0 ? d : 0.0, k / 2 == 1 ? d : 0.0, k / 2 == 2 ? d : 0.0);
+        sim_albedo_at(sim, height, v3_add(q, o), a);
+        colour_linear_rgb_to_lab(a, lab);
+        *change = fmax(*change, colour_ciede2000(lab_at, lab));
+        for (int c = 0; c < 3; c++)
+            blur[c] += a[c];
+    }
+    for (int c = 0; c < 3; c++)
+        blur[c] /= 7.0;
+}
+
 /* The stage before fusion: each view's own colour (RESULT_DIR/view_NNN/cloud.ply, at its
- * registered pose; every 8th point with a colour estimate) against the truth. Prints a line
- * "views,points,mean,p95". */
+ * registered pose; every 8th point with a colour estimate) against the truth, also apart on
+ * the paint edges. Prints a line "views,points,mean,p95". */
 static double p95(double *v, size_t n);
 static void views_stage(const char *result, const struct app_config *cfg, double height,
                         const struct sim_bvh *bvh)
 {
-    size_t n = 0, cap = 0;
-    double *de = NULL, sum = 0.0;
+    size_t n = 0, cap = 0, edges = 0;
+    double *de = NULL, sum = 0.0, edge_sum = 0.0;
     for (unsigned v = 0;; v++) {
         char path[HAL_MAX_PATH * 2 + 64], err[512];
         struct sim_mesh c;
@@ -140,8 +172,9 @@ static void views_stage(const char *result, const struct app_config *cfg, double
             if (!(c.quality[i] > 0.0f) ||
                 sim_bvh_closest(bvh, v3(p[0], p[1], p[2]), MATCH_MM, &q) >= MATCH_MM)
                 continue;
-            double albedo[3], got[3], lab_true[3], lab_got[3];
+            double albedo[3], got[3], lab_true[3], lab_got[3], blur[3], change;
             sim_albedo_at(&cfg->sim, height, q, albedo);
+            truth_around(&cfg->sim, height, q, albedo, blur, &change);
             sim_mesh_linear(&c, i, got);
             colour_linear_rgb_to_lab(albedo, lab_true);
             colour_linear_rgb_to_lab(got, lab_got);
@@ -150,14 +183,17 @@ static void views_stage(const char *result, const struct app_config *cfg, double
             if (de == NULL)
                 break;
             de[n] = colour_ciede2000(lab_true, lab_got);
+            if (change > EDGE_DE00)
+                edges++, edge_sum += de[n];
             sum += de[n++];
         }
         sim_mesh_free(&c);
     }
     if (n > 0)
         printf("texture-eval: each view's own colour before fusion (%zu points): dE00 mean %.3f "
-               "p95 %.3f\nviews,%zu,%.3f,%.3f\n",
-               n, sum / n, p95(de, n), n, sum / n, p95(de, n));
+               "p95 %.3f; on paint edges (%zu) %.3f, elsewhere %.3f\nviews,%zu,%.3f,%.3f\n",
+               n, sum / n, p95(de, n), edges, edges ? edge_sum / edges : 0.0,
+               n > edges ? (sum - edge_sum) / (n - edges) : 0.0, n, sum / n, p95(de, n));
     free(de);
 }
 
@@ -215,12 +251,12 @@ int main(int argc, char **argv)
                                       {1.0 / 6, 4.0 / 6, 1.0 / 6},
                                       {1.0 / 6, 1.0 / 6, 4.0 / 6}};
     /* every sample's true, texture and vertex colour (linear) first: the gains need them all */
-    double *smp = malloc(4 * m.nf * 9 * sizeof(double));
+    double *smp = malloc(4 * m.nf * SAMPLE * sizeof(double));
     size_t n = 0;
     for (size_t f = 0; f < m.nf && smp != NULL; f++) {
         const int64_t *c = &m.f[6 * f];
         for (int s = 0; s < 4; s++) {
-            double p[3] = {0, 0, 0}, uv[2] = {0, 0}, *o = &smp[9 * n];
+            double p[3] = {0, 0, 0}, uv[2] = {0, 0}, *o = &smp[SAMPLE * n];
             o[6] = o[7] = o[8] = 0.0;
             for (int k = 0; k < 3; k++) {
                 const float *v = &m.v[6 * (size_t)c[2 * k]], *t = &m.vt[2 * (size_t)c[2 * k + 1]];
@@ -235,6 +271,7 @@ int main(int argc, char **argv)
                 continue;
             sim_albedo_at(&cfg.sim, height, q, o);
             texture_at(tex, w, h, uv[0], uv[1], &o[3]);
+            truth_around(&cfg.sim, height, q, o, &o[9], &o[12]);
             n++;
         }
     }
@@ -245,20 +282,20 @@ int main(int argc, char **argv)
         for (int k = 0; k < 3; k++) {
             double num = 0.0, den = 0.0;
             for (size_t i = 0; i < n; i++)
-                num += smp[9 * i + k] * smp[9 * i + 3 + 3 * which + k],
-                    den += smp[9 * i + 3 + 3 * which + k] * smp[9 * i + 3 + 3 * which + k];
+                num += smp[SAMPLE * i + k] * smp[SAMPLE * i + 3 + 3 * which + k],
+                    den += smp[SAMPLE * i + 3 + 3 * which + k] * smp[SAMPLE * i + 3 + 3 * which + k];
             gain[which][k] = den > 0.0 ? num / den : 1.0;
         }
     double *de_tex = malloc((n + 1) * sizeof(double)), *de_vtx = malloc((n + 1) * sizeof(double));
-    size_t dark = 0;
-    double sum_tex = 0, sum_vtx = 0, dark_tex = 0, dark_vtx = 0;
+    size_t dark = 0, edges = 0;
+    double sum_tex = 0, sum_vtx = 0, dark_tex = 0, dark_vtx = 0, edge_tex = 0, blur_sum = 0;
     for (size_t i = 0; i < n && de_tex != NULL && de_vtx != NULL; i++) {
         double lab_true[3], lab_tex[3], lab_vtx[3], tc[3], vc[3];
         for (int k = 0; k < 3; k++) {
-            tc[k] = smp[9 * i + 3 + k] * (balanced ? gain[0][k] : 1.0);
-            vc[k] = smp[9 * i + 6 + k] * (balanced ? gain[1][k] : 1.0);
+            tc[k] = smp[SAMPLE * i + 3 + k] * (balanced ? gain[0][k] : 1.0);
+            vc[k] = smp[SAMPLE * i + 6 + k] * (balanced ? gain[1][k] : 1.0);
         }
-        colour_linear_rgb_to_lab(&smp[9 * i], lab_true);
+        colour_linear_rgb_to_lab(&smp[SAMPLE * i], lab_true);
         colour_linear_rgb_to_lab(tc, lab_tex);
         colour_linear_rgb_to_lab(vc, lab_vtx);
         de_tex[i] = colour_ciede2000(lab_true, lab_tex);
@@ -266,6 +303,11 @@ int main(int argc, char **argv)
         sum_tex += de_tex[i], sum_vtx += de_vtx[i];
         if (lab_true[0] < 30.0)
             dark++, dark_tex += de_tex[i], dark_vtx += de_vtx[i];
+        double lab_blur[3];
+        colour_linear_rgb_to_lab(&smp[SAMPLE * i + 9], lab_blur);
+        blur_sum += colour_ciede2000(lab_true, lab_blur);
+        if (smp[SAMPLE * i + 12] > EDGE_DE00)
+            edges++, edge_tex += de_tex[i];
     }
     free(smp);
     if (n == 0) {
@@ -308,6 +350,13 @@ int main(int argc, char **argv)
     printf("csv,%zu,%.3f,%.3f,%.3f,%.3f,%zu,%.3f,%.3f,%zu,%.3f,%.3f\n", n, tex_mean, tex_p95,
            vtx_mean, vtx_p95, dark, dark ? dark_tex / dark : 0.0, dark ? dark_vtx / dark : 0.0,
            seams, seams ? seam_sum / seams : 0.0, seam_max);
+    printf("texture-eval: paint edges (the truth changes by more than %.0f dE00 within %.2f mm): %zu "
+           "samples, texture dE00 mean %.3f there, %.3f elsewhere; the truth blurred over +-%.2f "
+           "mm alone: mean %.3f\nedges,%zu,%.3f,%.3f,%.3f\n",
+           EDGE_DE00, EDGE_MM, edges, edges ? edge_tex / edges : 0.0,
+           n > edges ? (sum_tex - edge_tex) / (n - edges) : 0.0, EDGE_MM, blur_sum / n, edges,
+           edges ? edge_tex / edges : 0.0, n > edges ? (sum_tex - edge_tex) / (n - edges) : 0.0,
+           blur_sum / n);
     views_stage(argv[2], &cfg, height, &bvh);
     free(de_tex);
     free(de_vtx);
