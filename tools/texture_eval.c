@@ -283,7 +283,8 @@ int main(int argc, char **argv)
             double num = 0.0, den = 0.0;
             for (size_t i = 0; i < n; i++)
                 num += smp[SAMPLE * i + k] * smp[SAMPLE * i + 3 + 3 * which + k],
-                    den += smp[SAMPLE * i + 3 + 3 * which + k] * smp[SAMPLE * i + 3 + 3 * which + k];
+                    den +=
+                    smp[SAMPLE * i + 3 + 3 * which + k] * smp[SAMPLE * i + 3 + 3 * which + k];
             gain[which][k] = den > 0.0 ? num / den : 1.0;
         }
     double *de_tex = malloc((n + 1) * sizeof(double)), *de_vtx = malloc((n + 1) * sizeof(double));
@@ -350,13 +351,14 @@ int main(int argc, char **argv)
     printf("csv,%zu,%.3f,%.3f,%.3f,%.3f,%zu,%.3f,%.3f,%zu,%.3f,%.3f\n", n, tex_mean, tex_p95,
            vtx_mean, vtx_p95, dark, dark ? dark_tex / dark : 0.0, dark ? dark_vtx / dark : 0.0,
            seams, seams ? seam_sum / seams : 0.0, seam_max);
-    printf("texture-eval: paint edges (the truth changes by more than %.0f dE00 within %.2f mm): %zu "
-           "samples, texture dE00 mean %.3f there, %.3f elsewhere; the truth blurred over +-%.2f "
-           "mm alone: mean %.3f\nedges,%zu,%.3f,%.3f,%.3f\n",
-           EDGE_DE00, EDGE_MM, edges, edges ? edge_tex / edges : 0.0,
-           n > edges ? (sum_tex - edge_tex) / (n - edges) : 0.0, EDGE_MM, blur_sum / n, edges,
-           edges ? edge_tex / edges : 0.0, n > edges ? (sum_tex - edge_tex) / (n - edges) : 0.0,
-           blur_sum / n);
+    printf(
+        "texture-eval: paint edges (the truth changes by more than %.0f dE00 within %.2f mm): %zu "
+        "samples, texture dE00 mean %.3f there, %.3f elsewhere; the truth blurred over +-%.2f "
+        "mm alone: mean %.3f\nedges,%zu,%.3f,%.3f,%.3f\n",
+        EDGE_DE00, EDGE_MM, edges, edges ? edge_tex / edges : 0.0,
+        n > edges ? (sum_tex - edge_tex) / (n - edges) : 0.0, EDGE_MM, blur_sum / n, edges,
+        edges ? edge_tex / edges : 0.0, n > edges ? (sum_tex - edge_tex) / (n - edges) : 0.0,
+        blur_sum / n);
     views_stage(argv[2], &cfg, height, &bvh);
     free(de_tex);
     free(de_vtx);
