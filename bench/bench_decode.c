@@ -1,9 +1,8 @@
 /* The decode benchmark of make bench: on the same simulated frames (8-bit grey, columns and rows
  * with inverses), time (a) OpenCV's getProjPixel over every pixel, (b) the scanner's decoder
  * (every frame handed over, then the codes and reasons; the two apart) and (c) one plain read of
- * all the frames
- * (the memory floor); check that both decoders agree on
- * every pixel both call valid, and that OpenCV's pattern set is ours. One core. */
+ * all the frames (the memory floor); check that both decoders agree on every pixel both call
+ * valid, and that OpenCV's pattern set is ours. One core. */
 #define _POSIX_C_SOURCE 200809L
 #include "decode.h"
 #include "gray.h"
