@@ -135,7 +135,6 @@ static void begin_bits(struct decode_ctx *d, size_t n)
             memset(d->unclear_lo[axis], 0, n);
         }
     }
-    d->sat_read = 0;
 }
 
 /* read_bit's loop; @p fresh (the plane's first bit) and @p first_sat (the view's first bit) are
@@ -168,13 +167,14 @@ static void read_bit(struct decode_ctx *d, int is_row, uint32_t k, const uint8_t
 {
     uint8_t *word = k < 8 ? d->word_hi[is_row] : d->word_lo[is_row];
     uint8_t *unc = k < 8 ? d->unclear_hi[is_row] : d->unclear_lo[is_row];
-    if (!d->sat_read) /* the view's first bit is its plane's first too */
+    /* a plane's first bit (0 or 8) writes it whole; the view's first, the columns' top bit
+     * (columns come first in every layout and have at least one bit), the saturation plane too */
+    if (!is_row && k == 0)
         read_bit_loop(word, unc, d->sat, pos, neg, thr, n, 1, 1);
     else if (k == 0 || k == 8)
         read_bit_loop(word, unc, d->sat, pos, neg, thr, n, 1, 0);
     else
         read_bit_loop(word, unc, d->sat, pos, neg, thr, n, 0, 0);
-    d->sat_read = 1;
 }
 
 int decode_frame(struct decode_ctx *d, uint32_t pattern, const uint8_t *grey)

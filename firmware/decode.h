@@ -63,8 +63,7 @@ struct decode_ctx {
     struct gray_layout layout;
     uint32_t proj_width, proj_height;
     uint32_t next_pattern;
-    int sat_read;               /* a bit was read into sat since black (which begins the bits) */
-    uint8_t bit_threshold[256]; /* |I - I_inverse| at or below this is unclear, per contrast */
+    uint8_t bit_threshold[256];     /* |I - I_inverse| at or below this is unclear, per contrast */
     uint8_t mean_threshold_of[256]; /* |I - (white + black) / 2| likewise, a bit without inverse */
     uint32_t xor_col, xor_row;      /* gray_code_xor_mask of the columns and rows */
 };
