@@ -98,7 +98,9 @@ static const struct ini_key config_keys[] = {
         "1: before the first view a white and a black frame show whether most of what the "
         "projector lights is too dark to decode (white minus black under min_contrast_dn); if "
         "so, and exposures_us is not in the file, every pattern is also taken at the exposure "
-        "that lifts it (HDR), said in the log and kept in the scan's config.ini. 0: the "
+        "that lifts it (HDR); and where the colour reads single-light frames and [colour] "
+        "light_exposure_us is not in the file, a dark frame and each light alone choose their "
+        "exposure; what is chosen is said in the log and kept in the scan's config.ini. 0: the "
         "exposure as set"),
     F64("scan", "start_angle_deg", start_angle_deg, -360, 360, "0", "turntable angle of view 0"),
     U32("scan", "min_contrast_dn", scan.min_contrast_dn, 1, 255, "10",
@@ -242,9 +244,13 @@ static const struct ini_key config_keys[] = {
     U32("colour", "all_lights_exposure_us", scan.colour.all_lights_exposure_us, 0, 10000000, "0",
         "exposure of the all-lights frame (0: [camera] exposure_us); a dark frame is taken at it "
         "too"),
-    U32("colour", "light_exposure_us", scan.colour.light_exposure_us, 0, 10000000, "0",
-        "exposure of each single-light frame (0: [camera] exposure_us); a dark frame is taken "
-        "at it too"),
+    {"colour", "light_exposure_us", INI_LIST, C(light_exposure_us), 1, 0, 10000000, 0, "", NULL,
+     "exposure of each single-light frame (0: [camera] exposure_us); a dark frame is taken at "
+     "it too. Empty: [camera] exposure_us, or with [scan] auto_exposure the exposure a dark "
+     "frame and each light alone before the first view call for (multi and fit: the brightest "
+     "light's 95th percentile brought to 95% of saturation_dn, at most 33 ms, a frame at 30 "
+     "fps), said in the log and kept in the scan's config.ini",
+     NULL, NULL},
     U32("colour", "bracket", scan.colour.bracket, 0, 64, "0",
         "each light is also taken at this many times its exposure (with a dark frame at it); "
         "multi reads each pixel in the longer frame where no channel saturates there, so dark "
@@ -574,7 +580,7 @@ static int load_sim_rig(struct app_config *cfg, const char *path, char *err, siz
 }
 
 /* [scan] exposures_us into the scan's exposures: ascending, and holding the camera's own (the
- * view's colour is taken at it). */
+ * view's colour is taken at it); and [colour] light_exposure_us (empty: 0). */
 static int config_exposures(struct app_config *cfg, const char *path, char *err, size_t err_len)
 {
     const struct ini_list *l = &cfg->exposures_us;
@@ -595,6 +601,8 @@ static int config_exposures(struct app_config *cfg, const char *path, char *err,
         return -EINVAL;
     }
     cfg->scan.exposure_count = l->count;
+    cfg->scan.colour.light_exposure_us =
+        cfg->light_exposure_us.count > 0 ? (uint32_t)cfg->light_exposure_us.value[0] : 0u;
     return 0;
 }
 

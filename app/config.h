@@ -38,7 +38,9 @@ struct app_config {
     uint32_t passes; /**< 1, or 2: the object laid another way for a second turn */
     double start_angle_deg;
     struct ini_list exposures_us; /**< [scan] exposures_us as written (HDR patterns) */
-    uint32_t auto_exposure; /**< [scan]: 1: a dark object's patterns also at a longer exposure */
+    uint32_t auto_exposure; /**< [scan]: 1: a dark object's patterns also at a longer exposure,
+                               the single-light frames at the exposure the lights call for */
+    struct ini_list light_exposure_us;   /**< [colour] light_exposure_us as written (one number) */
     char calibration_file[HAL_MAX_PATH]; /**< resolved against the config file's directory */
     char output_dir[HAL_MAX_PATH];
     char frame_format_name[8]; /**< [output] frame_format, as written */

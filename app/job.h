@@ -125,15 +125,40 @@ int job_mostly_dark(uint32_t dark, uint32_t decoded);
  *  @p min_contrast_dn (whole milliseconds, at most 10 s). */
 uint32_t job_dark_exposure_us(uint32_t now_us, uint32_t min_contrast_dn, uint32_t contrast_dn);
 
+/** The brightest light's 95th percentile is brought to this share of saturation_dn
+ *  (job_light_exposure_us). multi and fit leave a light out where it saturates (the others see
+ *  the pixel), so a few saturated readings cost less than noise in all of them: on eval-cycles'
+ *  bunny the texture's error was least with about 3% of a light's pixels saturated (2.02 mean
+ *  dE00 at the camera's exposure, 1.70 with 0.4% saturated, 1.66 with 3%, 1.74 with 10%:
+ *  docs/colour.md). */
+#define JOB_LIGHT_LEVEL_SHARE 0.95
+/** The longest single-light exposure the scan chooses itself: a frame at 30 fps (a longer one
+ *  would slow every capture after it). */
+#define JOB_LIGHT_MAX_US 33000u
+/** The single-light frames' exposure that brings what @p probe saw at @p now_us to
+ *  JOB_LIGHT_LEVEL_SHARE of @p saturation_dn (only the lights' lift over the dark frame grows
+ *  with the exposure), in whole milliseconds down, at most JOB_LIGHT_MAX_US, never under
+ *  @p now_us (@p now_us itself where the probe saw too little: under JOB_DARK_PIXELS lit). */
+uint32_t job_light_exposure_us(uint32_t now_us, const struct scan_light_probe *probe,
+                               uint32_t saturation_dn);
+
 /** Warn once when view @p v's object was too dark to decode, and how to lift it (@p live: while
  * scanning; else processing a kept scan). */
 void job_say_if_dark(struct job *j, uint32_t v, const struct scan_view_info *info, int live);
 
 /* ---- job_live.c ---- */
 /** The lines a scan's config.ini gets after its file's own for what the scan chose itself: the
- *  HDR exposures of [scan] auto_exposure where the file sets no exposures_us ("" when none).
+ *  HDR exposures of [scan] auto_exposure where the file sets no exposures_us, the single-light
+ *  frames' exposure where it sets no [colour] light_exposure_us ("" when none).
  *  @retval 0 @retval -EOVERFLOW @p len too small */
 int job_chosen_lines(const struct app_config *cfg, char *buf, size_t len);
+/** Before a scan's first view (a new scan, or a resume of one that has none): the exposure
+ *  checks of [scan] auto_exposure, which may change @p run (the patterns' HDR exposures, the
+ *  single-light frames' exposure), and what they chose kept in the scan's config.ini after the
+ *  lines of @p config_path (with @p calibration_path as its calibration.ini).
+ *  @retval 0 @retval -EINTR stop requested (said; the rig is safe) @retval -errno storage */
+int job_choose_exposures(struct job *j, struct app_config *run, const char *config_path,
+                         const char *calibration_path);
 /** "N points at A deg -> DIR" of a view. */
 void job_describe(char *buf, size_t len, const struct scan_view_info *info, const char *dir);
 int job_start_storage(const struct job *j);

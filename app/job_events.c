@@ -282,6 +282,21 @@ uint32_t job_dark_exposure_us(uint32_t now_us, uint32_t min_contrast_dn, uint32_
     return (uint32_t)fmin(ceil(want / 1000.0) * 1000.0, 10000000.0);
 }
 
+uint32_t job_light_exposure_us(uint32_t now_us, const struct scan_light_probe *probe,
+                               uint32_t saturation_dn)
+{
+    const double target_dn = JOB_LIGHT_LEVEL_SHARE * saturation_dn;
+    if (probe->lit < JOB_DARK_PIXELS || probe->level_dn <= probe->dark_dn ||
+        probe->level_dn >= target_dn)
+        return now_us;
+    /* the dark frame's level (black offset, ambient) is left as it is: the ambient grows too,
+     * but a dark frame is taken at the new exposure and the target leaves room */
+    double want =
+        (double)now_us * (target_dn - probe->dark_dn) / (probe->level_dn - probe->dark_dn);
+    want = floor(fmin(want, JOB_LIGHT_MAX_US) / 1000.0) * 1000.0;
+    return want > now_us ? (uint32_t)want : now_us;
+}
+
 int job_mostly_dark(uint32_t dark, uint32_t decoded)
 {
     return dark >= JOB_DARK_PIXELS && dark > decoded;

@@ -389,18 +389,30 @@ int job_home_and_take_views(struct job *j, uint32_t first)
 int job_chosen_lines(const struct app_config *cfg, char *buf, size_t len)
 {
     buf[0] = '\0';
-    if (cfg->scan.exposure_count == 0 || cfg->exposures_us.given)
-        return 0;
-    char list[SCAN_MAX_EXPOSURES * 12] = "";
-    for (uint32_t e = 0; e < cfg->scan.exposure_count; e++)
-        snprintf(list + strlen(list), sizeof(list) - strlen(list), e > 0 ? ", %u" : "%u",
-                 (unsigned)cfg->scan.exposures_us[e]);
-    int n = snprintf(buf, len,
+    int n = 0;
+    if (cfg->scan.exposure_count > 0 && !cfg->exposures_us.given) {
+        char list[SCAN_MAX_EXPOSURES * 12] = "";
+        for (uint32_t e = 0; e < cfg->scan.exposure_count; e++)
+            snprintf(list + strlen(list), sizeof(list) - strlen(list), e > 0 ? ", %u" : "%u",
+                     (unsigned)cfg->scan.exposures_us[e]);
+        n = snprintf(buf, len,
                      "\n; the exposures every pattern was taken at: the config set none, and most "
                      "of what\n; the projector lit was too dark to decode at the first "
                      "([scan] auto_exposure)\n[scan]\nexposures_us = %s\n",
                      list);
-    return n > 0 && (size_t)n < len ? 0 : -EOVERFLOW;
+        if (n < 0 || (size_t)n >= len)
+            return -EOVERFLOW;
+    }
+    if (cfg->scan.colour.light_exposure_us > 0 && !cfg->light_exposure_us.given) {
+        int m = snprintf(buf + n, len - (size_t)n,
+                         "\n; the exposure each light alone was taken at: the config set none, "
+                         "and the\n; lights called for it ([scan] auto_exposure)\n[colour]\n"
+                         "light_exposure_us = %u\n",
+                         (unsigned)cfg->scan.colour.light_exposure_us);
+        if (m < 0 || (size_t)m >= len - (size_t)n)
+            return -EOVERFLOW;
+    }
+    return 0;
 }
 
 /* The exposure check (probe_dark): @p run's patterns at @p now_us and @p want_us. */
@@ -482,6 +494,89 @@ static int probe_dark(struct job *j, struct app_config *run)
     return 0;
 }
 
+/* [scan] auto_exposure for the colour: before the first view, a dark frame and each light alone
+ * at [camera] exposure_us; where the brightest light leaves the object far under saturation,
+ * the single-light frames (and their dark frame) are taken longer, at the exposure that brings
+ * it near (job_light_exposure_us): each light's reading then carries less of the camera's
+ * noise, which in single-light frames at the camera's exposure was the larger part of a matte
+ * object's colour error (docs/colour.md, "Where the error is"). Not where the file sets
+ * light_exposure_us (empty too: no), nor for the methods that read no single-light frame. @retval 0
+ * (@p run as the views are to be taken) @retval -EINTR stop requested */
+static int probe_lights(struct job *j, struct app_config *run)
+{
+    const struct hal *hal = j->hal;
+    if (!run->auto_exposure || run->light_exposure_us.given || run->light_count == 0 ||
+        run->scan.colour.method < COLOUR_MULTI)
+        return 0;
+    const uint32_t now_us = run->camera.exposure_us;
+    struct scan_light_probe probe;
+    int rc = scan_probe_lights(j->scan, hal, &run->scan, j->calib, &probe);
+    if (rc == -EINTR)
+        return rc;
+    if (rc != 0) {
+        hal->log(HAL_LOG_WARN,
+                 "the lights' exposure check took no frames (%s): the exposure as set",
+                 strerror(-rc));
+        return 0;
+    }
+    uint32_t want_us = job_light_exposure_us(now_us, &probe, run->scan.saturation_dn);
+    if (want_us == now_us) {
+        hal->log(HAL_LOG_INFO,
+                 "the lights at %u us: the brightest (light %u) brings the object to %u of %u "
+                 "grey levels (95th percentile): each light alone is taken at it",
+                 (unsigned)now_us, (unsigned)probe.light, (unsigned)probe.level_dn,
+                 (unsigned)run->scan.saturation_dn);
+        return 0;
+    }
+    /* a camera that cannot change its exposure (-ENOSYS) is found here, not in the first view */
+    const uint32_t gain = run->scan.colour.gain_milli;
+    rc = hal_cam_set_exposure(&hal->camera, want_us, gain);
+    if (rc == 0 && (rc = hal_cam_set_exposure(&hal->camera, now_us, gain)) != 0) {
+        hal->log(HAL_LOG_ERROR, "camera: cannot set the exposure back to %u us: %s",
+                 (unsigned)now_us, strerror(-rc));
+        return rc; /* no view is taken at an exposure it was not meant for */
+    }
+    char msg[160] = "";
+    if (rc != 0)
+        snprintf(msg, sizeof(msg), "the camera: %s", strerror(-rc));
+    run->scan.colour.light_exposure_us = want_us;
+    if (rc != 0 || scan_check(&run->scan, j->calib, msg, sizeof(msg)) != 0) {
+        run->scan.colour.light_exposure_us = 0;
+        hal->log(HAL_LOG_WARN,
+                 "the lights call for %u us, which cannot be taken (%s): the exposure as set",
+                 (unsigned)want_us, msg);
+        return 0;
+    }
+    hal->log(HAL_LOG_INFO,
+             "the lights at %u us: the brightest (light %u) brings the object to %u of %u grey "
+             "levels (95th percentile, dark %u); each light alone is taken at %u us ([colour] "
+             "light_exposure_us, kept in the scan's config.ini; auto_exposure = 0 leaves the "
+             "exposure as set)",
+             (unsigned)now_us, (unsigned)probe.light, (unsigned)probe.level_dn,
+             (unsigned)run->scan.saturation_dn, (unsigned)probe.dark_dn, (unsigned)want_us);
+    return 0;
+}
+
+int job_choose_exposures(struct job *j, struct app_config *run, const char *config_path,
+                         const char *calibration_path)
+{
+    char chosen[640] = "";
+    int rc = probe_dark(j, run);
+    if (rc == 0)
+        rc = probe_lights(j, run);
+    if (rc == 0)
+        rc = job_chosen_lines(run, chosen, sizeof(chosen));
+    if (rc == 0 && chosen[0] != '\0')
+        rc = scan_dir_keep_settings(&j->hal->storage, config_path, calibration_path, j->out_dir,
+                                    chosen);
+    if (rc == -EINTR)
+        j->hal->log(HAL_LOG_WARN,
+                    "scan stopped by request before its first view: nothing taken; 'scanner "
+                    "resume %s' takes the views",
+                    j->out_dir);
+    return rc;
+}
+
 /* [output] dir/latest: a link to the newest scan's folder, replaced atomically. A convenience:
  * a failure is said and the scan goes on. */
 static void link_latest(const struct hal *hal, const char *parent, const char *name)
@@ -523,22 +618,11 @@ int scan_job_live(const struct hal *hal, const struct app_config *cfg,
         link_latest(hal, cfg->output_dir, name);
     /* the settings first, as the file has them: a scan stopped in the exposure check is still a
      * scan to resume; then again with what the check chose */
-    char chosen[320] = "";
     rc = scan_dir_keep_settings(&hal->storage, cfg->path, cfg->calibration_file, j.out_dir, NULL);
     if (rc == 0)
-        rc = probe_dark(&j, &run);
-    if (rc == 0)
-        rc = job_chosen_lines(&run, chosen, sizeof(chosen));
-    if (rc == 0 && chosen[0] != '\0')
-        rc = scan_dir_keep_settings(&hal->storage, cfg->path, cfg->calibration_file, j.out_dir,
-                                    chosen);
-    if (rc == -EINTR) { /* the rig is safe (scan_probe_contrast) */
-        hal->log(HAL_LOG_WARN,
-                 "scan stopped by request before its first view: nothing taken; 'scanner resume "
-                 "%s' takes the views",
-                 j.out_dir);
+        rc = job_choose_exposures(&j, &run, cfg->path, cfg->calibration_file);
+    if (rc == -EINTR) /* the rig is safe (scan_probe_contrast, scan_probe_lights); said */
         goto out_unlock;
-    }
     if (rc != 0) {
         hal->log(HAL_LOG_ERROR, "cannot set up the scan directory %s: %s", j.out_dir,
                  strerror(-rc));

@@ -40,6 +40,9 @@ int scan_job_load_settings(const char *scan_dir, const char *config_path, int ca
             memcpy(cfg->scan.exposures_us, taken.scan.exposures_us, sizeof(cfg->scan.exposures_us));
             cfg->scan.exposure_count = taken.scan.exposure_count;
         }
+        if (rc == 0 && cfg->auto_exposure && !cfg->light_exposure_us.given &&
+            taken.light_exposure_us.given) /* likewise the single-light frames' exposure */
+            cfg->scan.colour.light_exposure_us = taken.scan.colour.light_exposure_us;
         if (rc == 0 && config_plan_differs(&taken, cfg, capturing, what, sizeof(what)) != 0) {
             /* the scan's own config.ini fixes how its views are taken: views taken otherwise
              * would not fit with those it has (another turn, exposure, pattern set ...) */
@@ -64,8 +67,10 @@ int scan_job_resume(const struct hal *hal, const struct app_config *cfg,
                     const struct scan_calib *calib, const char *scan_dir,
                     const struct scan_job_opts *opts)
 {
+    static struct app_config run; /* the settings the views are taken with */
+    run = *cfg;
     struct job j;
-    job_init(&j, hal, cfg, calib, opts, scan_dir);
+    job_init(&j, hal, &run, calib, opts, scan_dir);
     char detail[64];
     int lock_fd;
     int rc = job_open_out(&j, SCAN_DIR_EXISTING, &lock_fd);
@@ -74,7 +79,16 @@ int scan_job_resume(const struct hal *hal, const struct app_config *cfg,
     uint32_t first = scan_dir_first_missing(scan_dir, j.views);
     snprintf(detail, sizeof(detail), "%u of %u views kept", (unsigned)first, (unsigned)j.views);
     job_progress(&j, EV_RESUME, -1, first, detail);
-    if (first < j.views) {
+    if (first == 0) { /* stopped before its first view: the checks a new scan makes, made now */
+        char config[SCAN_DIR_PATH_MAX], calibration[SCAN_DIR_PATH_MAX];
+        rc = scan_dir_path(config, sizeof(config), scan_dir, -1, SCAN_FILE_CONFIG);
+        if (rc == 0)
+            rc = scan_dir_path(calibration, sizeof(calibration), scan_dir, -1,
+                               SCAN_FILE_CALIBRATION);
+        if (rc == 0)
+            rc = job_choose_exposures(&j, &run, config, calibration);
+    }
+    if (rc == 0 && first < j.views) {
         rc = job_begin_model(&j); /* the model comes from scan_job_process afterwards */
         if (rc == 0)
             rc = job_start_storage(&j);
@@ -378,7 +392,7 @@ int scan_job_process(const struct hal *hal, const char *scan_dir, const struct s
         return rc;
     /* summary.ini says every output is written (docs/scan-format.md): they are made again */
     scan_dir_remove(j.out_dir, -1, SCAN_FILE_SUMMARY);
-    char chosen[320];
+    char chosen[640];
     if (elsewhere && ((rc = job_chosen_lines(&cfg, chosen, sizeof(chosen))) != 0 ||
                       (rc = scan_dir_keep_settings(&hal->storage, cfg.path, cfg.calibration_file,
                                                    j.out_dir, chosen)) != 0)) /* how made */

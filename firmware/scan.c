@@ -565,6 +565,87 @@ int scan_probe_contrast(struct scan_ctx *s, const struct hal *hal, const struct 
     return 0;
 }
 
+/* The 95th percentile of @p hist's @p total counts (0: none). */
+static uint32_t hist_p95(const uint32_t hist[256], uint32_t total)
+{
+    for (uint32_t v = 0, seen = 0; v < 256 && total > 0; v++) {
+        seen += hist[v];
+        if (100u * (uint64_t)seen >= 95u * (uint64_t)total)
+            return v;
+    }
+    return 0;
+}
+
+/* What light frame @p lit shows over @p dark (both RGB24, @p n pixels): of the pixels it lifts
+ * over @p shadow_dn in some channel, the brightest channel's level (DECODE_SATURATED where a
+ * channel reaches @p saturation_dn) and the dark frame's in that channel, counted. */
+static void light_levels(const uint8_t *lit, const uint8_t *dark, size_t n, double shadow_dn,
+                         uint32_t saturation_dn, uint32_t level_hist[256], uint32_t dark_hist[256],
+                         uint32_t *count)
+{
+    memset(level_hist, 0, 256 * sizeof(uint32_t));
+    memset(dark_hist, 0, 256 * sizeof(uint32_t));
+    *count = 0;
+    for (size_t i = 0; i < n; i++) {
+        const uint8_t *l = lit + 3 * i, *d = dark + 3 * i;
+        unsigned top = 0, lift = 0, sat = 0;
+        for (unsigned ch = 0; ch < 3; ch++) {
+            unsigned up = l[ch] > d[ch] ? (unsigned)(l[ch] - d[ch]) : 0u;
+            if (l[ch] > l[top])
+                top = ch;
+            lift = up > lift ? up : lift;
+            sat |= l[ch] >= saturation_dn;
+        }
+        if ((double)lift <= shadow_dn)
+            continue;
+        level_hist[sat ? DECODE_SATURATED : l[top]]++;
+        dark_hist[d[top]]++;
+        (*count)++;
+    }
+}
+
+int scan_probe_lights(struct scan_ctx *s, const struct hal *hal, const struct scan_params *p,
+                      const struct scan_calib *c, struct scan_light_probe *out)
+{
+    static uint32_t level_hist[256], dark_hist[256]; /* one probe at a time, as one view */
+    struct scan_view_info info;
+    memset(&info, 0, sizeof(info));
+    memset(out, 0, sizeof(*out));
+    const size_t n = (size_t)p->width * p->height;
+    uint8_t *dark = s->light_rgb[COLOUR_FRAME_DARK]; /* free between views */
+    int rc = hal_gpio_set(&hal->gpio, HAL_GPIO_PROJECTOR_ENABLE, 0);
+    for (uint32_t l = 0; l <= c->light_count && rc == 0; l++) { /* dark, then each light */
+        rc = lights_off(hal, c->light_count);
+        if (rc == 0 && l > 0)
+            rc = hal_gpio_set(&hal->gpio, (enum hal_gpio_line)(HAL_GPIO_LIGHT_0 + l - 1), 1);
+        if (rc == 0)
+            rc = settle(s, hal, p);
+        if (rc == 0 && hal_should_stop(hal))
+            rc = -EINTR;
+        if (rc == 0)
+            rc = capture(s, hal, p, l == 0 ? dark : s->frame_rgb,
+                         l == 0 ? COLOUR_FRAME_DARK : COLOUR_FRAME_LIGHT0 + l - 1, &info);
+        if (rc != 0 || l == 0)
+            continue;
+        uint32_t count;
+        light_levels(s->frame_rgb, dark, n, p->colour.shadow_dn, p->saturation_dn, level_hist,
+                     dark_hist, &count);
+        uint32_t level = hist_p95(level_hist, count);
+        if (count > 0 && (out->lit == 0 || level > out->level_dn))
+            *out = (struct scan_light_probe){.lit = count,
+                                             .level_dn = level,
+                                             .dark_dn = hist_median(dark_hist, count),
+                                             .light = l - 1};
+    }
+    /* the lights off again at once, and the rig safe on every failure */
+    int rc_off = lights_off(hal, c->light_count);
+    if (rc != 0 || rc_off != 0) {
+        hal->gpio.ops->safe_state(hal->gpio.priv);
+        return rc != 0 ? rc : rc_off;
+    }
+    return 0;
+}
+
 int scan_capture_view(struct scan_ctx *s, const struct hal *hal, const struct scan_params *p,
                       const struct scan_calib *c, int32_t angle_mdeg,
                       const struct scan_frame_sink *sink, struct scan_view_info *info)

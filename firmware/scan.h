@@ -123,6 +123,23 @@ int scan_probe_contrast(struct scan_ctx *s, const struct hal *hal, const struct 
                         const struct scan_calib *calib, uint32_t exposure_us,
                         struct scan_contrast *out);
 
+/** What the white lights show at the camera's exposure, one at a time over a dark frame: how
+ *  near the brightest of them brings the object to saturation. */
+struct scan_light_probe {
+    uint32_t lit;      /**< pixels the brightest light lifts over [colour] shadow_dn (0: none) */
+    uint32_t level_dn; /**< their 95th percentile, brightest channel (DECODE_SATURATED: reached
+                            saturation_dn) */
+    uint32_t dark_dn;  /**< the dark frame's median there, in the same channel */
+    uint32_t light;    /**< the brightest light: the one with the highest level_dn */
+};
+
+/** A dark frame and each light alone at the camera's exposure, projector off, without turning
+ *  the table ([colour] light_exposure_us chosen by the scan: app/job_live.c); lights off again
+ *  when it returns, the rig safe on every failure. @param out  what the brightest light shows
+ *  @retval 0 ok @retval -EINTR stop requested @retval the camera's or GPIO's error */
+int scan_probe_lights(struct scan_ctx *s, const struct hal *hal, const struct scan_params *params,
+                      const struct scan_calib *calib, struct scan_light_probe *out);
+
 /** One picture of what the camera sees lit by the projector's white (the web page's live view),
  *  without turning the table; the projector is off again when it returns.
  *  @param rgb  out: the RGB24 frame (params' width x height), valid until the next capture

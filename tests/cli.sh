@@ -355,8 +355,9 @@ check watertight_needs_max_hole sh -c "$bin check-config --config $out/watertigh
     grep -q 'watertight: a closed model needs max_hole_mm > 0'"
 # HDR patterns: the exposures must hold the camera's own (the view's colour is taken at it); a
 # scan with two exposures per pattern keeps the merged frames, the colour frames of sim.ini's
-# intrinsic colour (dark, all lights, each of 4 lights) and the view's colour after them, and
-# process makes the same model from them.
+# intrinsic colour (dark, all lights, each of 4 lights at the exposure the lights' check chose,
+# kept in config.ini, and a dark frame at it) and the view's colour after them, and process
+# makes the same model from them.
 sed 's/^views = 8$/views = 4\nexposures_us = 2500, 40000/' config/sim.ini > "$out/hdr-bad.ini"
 sed 's/^views = 8$/views = 4\nexposures_us = 10000, 40000/' config/sim.ini > "$out/hdr.ini"
 sed -i "s|^calibration = .*|calibration = $PWD/config/sim-calib.ini|; s|^mesh_file = ../|mesh_file = $PWD/|" \
@@ -367,11 +368,21 @@ rm -rf "$out/hdr-scan" "$out/hdr-processed"
 check hdr_scan_and_process_agree sh -c "$bin scan --config $out/hdr.ini --out $out/hdr-scan >/dev/null 2>&1 &&
     grep -q 'frame_00 = white, grey, HDR merged' $out/hdr-scan/view_000/view.ini &&
     grep -q 'frame_22 = dark: projector and lights off, 10000 us, RGB' $out/hdr-scan/view_000/view.ini &&
-    grep -q 'frame_28 = white, RGB (the view.s colour)' $out/hdr-scan/view_000/view.ini &&
-    grep -q '^frames = 50' $out/hdr-scan/view_000/view.ini &&
+    grep -qE '^light_exposure_us = [0-9]+' $out/hdr-scan/config.ini &&
+    grep -qE 'frame_28 = dark: projector and lights off, [0-9]+ us, RGB' $out/hdr-scan/view_000/view.ini &&
+    grep -q 'frame_29 = white, RGB (the view.s colour)' $out/hdr-scan/view_000/view.ini &&
+    grep -q '^frames = 51' $out/hdr-scan/view_000/view.ini &&
     $bin process $out/hdr-scan --out $out/hdr-processed >/dev/null 2>&1 &&
     cmp $out/hdr-scan/mesh.ply $out/hdr-processed/mesh.ply"
-rm -rf "$out/hdr-scan" "$out/hdr-processed"
+# The person's own file sets no light_exposure_us: process with it takes the scan's choice (the
+# same model); with auto_exposure = 0 it means the camera's exposure, and is refused, naming it.
+sed 's/^\[scan\]$/[scan]\nauto_exposure = 0/' "$out/hdr.ini" > "$out/hdr-fixed.ini"
+check light_exposure_chosen_is_the_scans sh -c "rm -rf $out/hdr-again &&
+    $bin process $out/hdr-scan --config $out/hdr.ini --out $out/hdr-again >/dev/null 2>&1 &&
+    cmp $out/hdr-scan/mesh.ply $out/hdr-again/mesh.ply &&
+    $bin process $out/hdr-scan --config $out/hdr-fixed.ini --out $out/hdr-again --replace 2>&1 |
+    grep -q 'was taken with \[colour\] light_exposure_us = [0-9]*, not 10000'"
+rm -rf "$out/hdr-scan" "$out/hdr-processed" "$out/hdr-again"
 # make LIMITS=large (issue 33): a DSLR's 4896 x 3264 frames, unbinned. The default build refuses
 # the config, naming the compiled limit; the large one takes the frames and goes on to the next
 # check, the calibration of a 1280 x 960 camera (make measure-large scans with one of its own).

@@ -15,6 +15,7 @@
 
 #include "board.h"
 #include "config.h"
+#include "job.h"
 #include "scan.h"
 
 #define DIR "build/test_config"
@@ -233,6 +234,52 @@ static void test_file_sets_a_key(void **state)
     assert_int_equal(config_load(&cfg, DIR "/sets-fifo", err, sizeof(err)), -EINVAL);
 }
 
+/* [colour] light_exposure_us: the loader says whether the file set it (empty: the camera's or
+ * the lights' choice, [scan] auto_exposure), one number at most, named by file, line and key
+ * when bad; what a scan chose is written after the file's own lines (job_chosen_lines) and read
+ * back as the file's, so a resume or a re-processing takes it as set. */
+static void test_light_exposure_given(void **state)
+{
+    (void)state;
+    static const struct {
+        const char *text;
+        unsigned given;
+        uint32_t us;
+    } cases[] = {{"", 0, 0},
+                 {"[colour]\nlight_exposure_us =\n", 1, 0},
+                 {"[colour]\nlight_exposure_us = 0\n", 1, 0},
+                 {"[colour]\nlight_exposure_us = 20000\n", 1, 20000}};
+    char text[2048];
+    for (size_t k = 0; k < sizeof(cases) / sizeof(cases[0]); k++) {
+        snprintf(text, sizeof(text), "%s%s", base, cases[k].text);
+        assert_int_equal(config_load(&cfg, write_file("light.ini", text), err, sizeof(err)), 0);
+        assert_int_equal(cfg.light_exposure_us.given, cases[k].given);
+        assert_int_equal(cfg.scan.colour.light_exposure_us, cases[k].us);
+    }
+    snprintf(text, sizeof(text), "%s[colour]\nlight_exposure_us = 10000, 20000\n", base);
+    assert_int_equal(config_load(&cfg, write_file("light.ini", text), err, sizeof(err)), -EINVAL);
+    assert_non_null(strstr(err, "light.ini:9: [colour] light_exposure_us"));
+    snprintf(text, sizeof(text), "%s[colour]\nlight_exposure_us = -5\n", base);
+    assert_int_equal(config_load(&cfg, write_file("light.ini", text), err, sizeof(err)), -EINVAL);
+    assert_non_null(strstr(err, "light.ini:9: [colour] light_exposure_us"));
+    /* chosen by the scan: kept after the file's lines, then the file's own */
+    assert_int_equal(config_load(&cfg, write_file("light.ini", base), err, sizeof(err)), 0);
+    char chosen[640];
+    assert_int_equal(job_chosen_lines(&cfg, chosen, sizeof(chosen)), 0);
+    assert_string_equal(chosen, ""); /* nothing chosen */
+    cfg.scan.colour.light_exposure_us = 19000;
+    assert_int_equal(job_chosen_lines(&cfg, chosen, sizeof(chosen)), 0);
+    assert_non_null(strstr(chosen, "\n[colour]\nlight_exposure_us = 19000\n"));
+    char small[40];
+    assert_int_equal(job_chosen_lines(&cfg, small, sizeof(small)), -EOVERFLOW);
+    snprintf(text, sizeof(text), "%s%s", base, chosen);
+    assert_int_equal(config_load(&cfg, write_file("light.ini", text), err, sizeof(err)), 0);
+    assert_int_equal(cfg.light_exposure_us.given, 1);
+    assert_int_equal(cfg.scan.colour.light_exposure_us, 19000);
+    assert_int_equal(job_chosen_lines(&cfg, chosen, sizeof(chosen)), 0);
+    assert_string_equal(chosen, ""); /* the file's now: not written twice */
+}
+
 static void test_overlong_line_refused(void **state)
 {
     (void)state;
@@ -390,6 +437,7 @@ int main(void)
         cmocka_unit_test(test_docs_cover_every_key),
         cmocka_unit_test(test_overlong_line_refused),
         cmocka_unit_test(test_file_sets_a_key),
+        cmocka_unit_test(test_light_exposure_given),
         cmocka_unit_test(test_not_a_regular_file),
         cmocka_unit_test(test_empty_calibration_and_zero_baseline),
         cmocka_unit_test(test_calibration_values_within_bounds),

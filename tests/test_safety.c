@@ -10,6 +10,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "job.h"
 #include "test_util.h"
 
 static struct test_rig t;
@@ -237,6 +238,76 @@ static void test_probe_contrast(void **state)
     assert_true(test_rig_dark());
 }
 
+static uint64_t stop_at_frame;
+static int stop_at(void)
+{
+    return sim_ctl_frames() >= stop_at_frame;
+}
+
+/* The lights' exposure check ([scan] auto_exposure, [colour] light_exposure_us): a dark frame
+ * and each light alone at the camera's exposure, the rig dark after; at half the exposure the
+ * brightest light's lift over the dark frame halves; a fault on a light's frame stops it after
+ * the retries, and a stop request before a frame, lights off both times. */
+static void test_probe_lights(void **state)
+{
+    (void)state;
+    struct scan_light_probe at_own, at_half, again;
+    const uint32_t own_us = t.cfg.scan.colour.exposure_us, lights = t.calib.light_count;
+    assert_true(lights >= 2);
+    uint64_t start = sim_ctl_frames();
+    assert_int_equal(scan_probe_lights(t.scan, &t.hal, &t.cfg.scan, &t.calib, &at_own), 0);
+    assert_int_equal(sim_ctl_frames() - start, 1 + lights);
+    assert_true(test_rig_dark());
+    assert_true(at_own.lit > 10000 && at_own.light < lights);
+    assert_true(at_own.level_dn > at_own.dark_dn + 20 && at_own.level_dn < DECODE_SATURATED);
+    assert_int_equal(hal_cam_set_exposure(&t.hal.camera, own_us / 2, t.cfg.scan.colour.gain_milli),
+                     0);
+    assert_int_equal(scan_probe_lights(t.scan, &t.hal, &t.cfg.scan, &t.calib, &at_half), 0);
+    assert_int_equal(hal_cam_set_exposure(&t.hal.camera, own_us, t.cfg.scan.colour.gain_milli), 0);
+    double lift = (double)at_own.level_dn - at_own.dark_dn;
+    double lift_half = (double)at_half.level_dn - at_half.dark_dn;
+    assert_true(fabs(lift_half - lift / 2) < 0.1 * lift);
+    /* the same frames give the same measure */
+    assert_int_equal(scan_probe_lights(t.scan, &t.hal, &t.cfg.scan, &t.calib, &again), 0);
+    assert_memory_equal(&again, &at_own, sizeof(again));
+    start = sim_ctl_frames();
+    sim_ctl_inject_camera_fault(SIM_FAULT_CORRUPT, start + 2, 100); /* the second light's */
+    assert_int_equal(scan_probe_lights(t.scan, &t.hal, &t.cfg.scan, &t.calib, &again), -EIO);
+    sim_ctl_inject_camera_fault(SIM_FAULT_NONE, 0, 0);
+    assert_int_equal(sim_ctl_frames() - start, 2 + 1 + t.cfg.scan.capture_retries);
+    assert_true(test_rig_dark());
+    stop_at_frame = sim_ctl_frames() + 2; /* the first light is on when it is asked */
+    t.hal.stop_requested = stop_at;
+    assert_int_equal(scan_probe_lights(t.scan, &t.hal, &t.cfg.scan, &t.calib, &again), -EINTR);
+    t.hal.stop_requested = NULL;
+    assert_true(test_rig_dark());
+}
+
+/* The exposure the lights call for (job_light_exposure_us): the brightest light's 95th
+ * percentile brought to 95% of saturation, in whole milliseconds down, at most a frame at 30 fps,
+ * never shorter than the camera's; the camera's own where the probe saw too little. */
+static void test_light_exposure_choice(void **state)
+{
+    (void)state;
+    struct scan_light_probe p = {.lit = 100000, .level_dn = 145, .dark_dn = 52};
+    /* 10 ms x (237.5 - 52) / (145 - 52) = 19.9 ms */
+    assert_int_equal(job_light_exposure_us(10000, &p, 250), 19000);
+    p.level_dn = 60; /* dim lights: a frame at 30 fps at most */
+    assert_int_equal(job_light_exposure_us(10000, &p, 250), JOB_LIGHT_MAX_US);
+    assert_int_equal(job_light_exposure_us(40000, &p, 250), 40000); /* never shorter */
+    p.level_dn = 238; /* already near saturation, or saturated */
+    assert_int_equal(job_light_exposure_us(10000, &p, 250), 10000);
+    p.level_dn = DECODE_SATURATED;
+    assert_int_equal(job_light_exposure_us(10000, &p, 250), 10000);
+    p = (struct scan_light_probe){.lit = JOB_DARK_PIXELS - 1, .level_dn = 100, .dark_dn = 52};
+    assert_int_equal(job_light_exposure_us(10000, &p, 250), 10000); /* too little lit */
+    p = (struct scan_light_probe){.lit = 100000, .level_dn = 52, .dark_dn = 52};
+    assert_int_equal(job_light_exposure_us(10000, &p, 250), 10000); /* no lift at all */
+    p = (struct scan_light_probe){.lit = 100000, .level_dn = 200, .dark_dn = 100};
+    assert_int_equal(job_light_exposure_us(10000, &p, 250), 13000); /* a lower saturation */
+    assert_int_equal(job_light_exposure_us(10000, &p, 200), 10000);
+}
+
 /* Lights on and projector on, then the one shutdown path: everything off. */
 static void test_safe_state_turns_everything_off(void **state)
 {
@@ -291,6 +362,8 @@ int main(void)
         cmocka_unit_test(test_stop_request_leaves_rig_dark),
         cmocka_unit_test(test_safe_state_turns_everything_off),
         cmocka_unit_test(test_probe_contrast),
+        cmocka_unit_test(test_probe_lights),
+        cmocka_unit_test(test_light_exposure_choice),
         cmocka_unit_test(test_projector_sequence),
         cmocka_unit_test(test_missing_ops_answer_enosys),
     };

@@ -54,10 +54,17 @@ static int scan(const char *dir)
     return scan_job_live(&t.hal, &t.cfg, &t.calib, &opts);
 }
 
+/* As 'scanner resume' does: the scan's own settings (its config.ini holds what it chose). */
 static int resume(const char *dir, int clear_alarm)
 {
     struct scan_job_opts opts = {.clear_alarm = clear_alarm};
-    int rc = scan_job_resume(&t.hal, &t.cfg, &t.calib, dir, &opts);
+    static struct app_config cfg;
+    static struct scan_calib calib;
+    char err[512];
+    int rc = scan_job_load_settings(dir, NULL, 1, &cfg, &calib, err, sizeof(err));
+    if (rc != 0)
+        return rc;
+    rc = scan_job_resume(&t.hal, &cfg, &calib, dir, &opts);
     return rc != 0 ? rc : scan_job_process(&t.hal, dir, &opts);
 }
 
@@ -155,8 +162,9 @@ static void test_camera_lost_mid_view_then_resume_finishes_it(void **state)
 {
     (void)state;
     const char *dir = OUT "/camera";
-    /* a scan begins with the exposure check's white and black ([scan] auto_exposure) */
-    const uint64_t check = 2;
+    /* a scan begins with the exposure checks ([scan] auto_exposure): a white and a black, then
+     * a dark frame and each light alone */
+    const uint64_t check = 2 + 1 + t.calib.light_count;
     uint64_t per_view = (reference_frames - check) / VIEWS;
     assert_true(per_view > 10 && (reference_frames - check) % VIEWS == 0);
     uint64_t start = sim_ctl_frames();
@@ -207,6 +215,45 @@ static void test_stop_in_the_exposure_check_then_resume(void **state)
     assert_true(test_rig_dark());
 }
 
+static uint64_t stop_frame;
+static int stop_at_frame(void)
+{
+    return sim_ctl_frames() >= stop_frame;
+}
+
+/* A camera that cannot change its exposure (a V4L2 device without the control): the lights'
+ * check finds it before the first view, says so once and takes the lights at the camera's own
+ * exposure, keeping nothing it did not choose (before the check, every view would have failed
+ * on its first light frame). Stopped in the first view: only the check matters here. */
+static void test_camera_without_exposure_control(void **state)
+{
+    (void)state;
+    const char *dir = OUT "/fixed-exposure";
+    const struct hal_camera_ops *own = t.hal.camera.ops;
+    static struct hal_camera_ops fixed;
+    fixed = *own;
+    fixed.set_exposure = NULL; /* hal_cam_set_exposure answers -ENOSYS */
+    t.hal.camera.ops = &fixed;
+    stop_frame = sim_ctl_frames() + 2 + 1 + t.calib.light_count + 3;
+    t.hal.stop_requested = stop_at_frame;
+    test_log_clear();
+    int rc = scan(dir);
+    t.hal.stop_requested = NULL;
+    t.hal.camera.ops = own;
+    assert_int_equal(rc, -EINTR);
+    assert_true(test_rig_dark());
+    assert_true(test_log_has("which cannot be taken (the camera: Function not implemented): the "
+                             "exposure as set"));
+    char path[256], text[8192];
+    scan_dir_path(path, sizeof(path), dir, -1, "config.ini");
+    FILE *f = fopen(path, "r");
+    assert_non_null(f);
+    size_t n = fread(text, 1, sizeof(text) - 1, f);
+    fclose(f);
+    text[n] = '\0';
+    assert_null(strstr(text, "light_exposure_us"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -214,6 +261,7 @@ int main(void)
         cmocka_unit_test(test_stall_stops_scan_then_resume_finishes_it),
         cmocka_unit_test(test_camera_lost_mid_view_then_resume_finishes_it),
         cmocka_unit_test(test_stop_in_the_exposure_check_then_resume),
+        cmocka_unit_test(test_camera_without_exposure_control),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
