@@ -16,8 +16,9 @@ mkdir -p "$work" "$report"
 # White reference: one view of the white sphere gives each method's white_scale; once more for
 # each variant below, which changes what the white sphere gives.
 variants="falloff=0 ca=channel ca=pixel"
-with_setting() { # KEY=VALUE FILE: the config with KEY set in its [colour] section
-    sed "/^\[colour\]/a ${1%%=*} = ${1#*=}" "$2"
+with_setting() { # KEY=VALUE FILE: the config with KEY set in its first [colour] section (a
+    # scan's config.ini may have a second, for what the scan chose: light_exposure_us)
+    sed "0,/^\[colour\]/s//[colour]\n${1%%=*} = ${1#*=}/" "$2"
 }
 "$build/scanner" calibrate-white --config tests/eval/white.ini > "$work/white.txt"
 for v in $variants; do
