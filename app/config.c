@@ -827,6 +827,19 @@ static double plan_hdr(const struct app_config *c, unsigned i)
     return i < c->scan.exposure_count ? (double)c->scan.exposures_us[i] : 0.0;
 }
 
+void config_adopt_chosen(struct app_config *now, const struct app_config *taken)
+{
+    if (!now->auto_exposure)
+        return;
+    if (now->scan.exposure_count == 0 && taken->scan.exposure_count > 0 &&
+        !now->exposures_us.given) {
+        memcpy(now->scan.exposures_us, taken->scan.exposures_us, sizeof(now->scan.exposures_us));
+        now->scan.exposure_count = taken->scan.exposure_count;
+    }
+    if (!now->light_exposure_us.given && taken->light_exposure_us.given)
+        now->scan.colour.light_exposure_us = taken->scan.colour.light_exposure_us;
+}
+
 int config_plan_differs(const struct app_config *taken, const struct app_config *now, int capturing,
                         char *what, size_t what_len)
 {

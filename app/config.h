@@ -79,6 +79,12 @@ int config_check_files(const struct app_config *cfg, char *err, size_t err_len);
 /** The devices' settings of @p cfg for board_init and board_selftest (pointers into @p cfg). */
 void config_board(const struct app_config *cfg, struct board_config *out);
 
+/** What a scan chose itself ([scan] auto_exposure: the patterns' HDR exposures, the
+ *  single-light frames' exposure), taken from @p taken, its config.ini, into @p now where
+ *  @p now leaves them to the scan (auto_exposure on, the key not in its file): a resume or a
+ *  re-processing with a person's own file reads the frames as they were taken. */
+void config_adopt_chosen(struct app_config *now, const struct app_config *taken);
+
 /** The first key of how views are taken (views, passes, start angle, resolution, exposures,
  *  gain, patterns, lights, colour frames) on which @p now differs from @p taken, the settings a
  *  scan was taken with: a resume or a re-processing must keep them, or its views would not fit

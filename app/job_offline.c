@@ -35,14 +35,8 @@ int scan_job_load_settings(const char *scan_dir, const char *config_path, int ca
         rc = config_load(&taken, path, err, err_len);
         /* the exposures the scan chose itself ([scan] auto_exposure) are the scan's, as long as
          * the config given leaves them to it */
-        if (rc == 0 && cfg->auto_exposure && cfg->scan.exposure_count == 0 &&
-            taken.scan.exposure_count > 0 && !cfg->exposures_us.given) {
-            memcpy(cfg->scan.exposures_us, taken.scan.exposures_us, sizeof(cfg->scan.exposures_us));
-            cfg->scan.exposure_count = taken.scan.exposure_count;
-        }
-        if (rc == 0 && cfg->auto_exposure && !cfg->light_exposure_us.given &&
-            taken.light_exposure_us.given) /* likewise the single-light frames' exposure */
-            cfg->scan.colour.light_exposure_us = taken.scan.colour.light_exposure_us;
+        if (rc == 0)
+            config_adopt_chosen(cfg, &taken);
         if (rc == 0 && config_plan_differs(&taken, cfg, capturing, what, sizeof(what)) != 0) {
             /* the scan's own config.ini fixes how its views are taken: views taken otherwise
              * would not fit with those it has (another turn, exposure, pattern set ...) */

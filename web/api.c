@@ -305,6 +305,7 @@ static const struct web_profile *resume_profile(const struct web_server *s, cons
             char what[160];
             if (config_load(&profile, s->profile[i].path, err, sizeof(err)) != 0)
                 continue;
+            config_adopt_chosen(&profile, &taken); /* as the scanner's resume will */
             if (config_plan_differs(&taken, &profile, 1, what, sizeof(what)) == 0)
                 found = &s->profile[i];
             else if (why[0] == '\0')
