@@ -521,11 +521,16 @@ static int probe_lights(struct job *j, struct app_config *run)
     }
     uint32_t want_us = job_light_exposure_us(now_us, &probe, run->scan.saturation_dn);
     if (want_us == now_us) {
+        char level[48];
+        if (probe.level_dn == DECODE_SATURATED)
+            snprintf(level, sizeof(level), "saturation");
+        else
+            snprintf(level, sizeof(level), "%u of %u grey levels", (unsigned)probe.level_dn,
+                     (unsigned)run->scan.saturation_dn);
         hal->log(HAL_LOG_INFO,
-                 "the lights at %u us: the brightest (light %u) brings the object to %u of %u "
-                 "grey levels (95th percentile): each light alone is taken at it",
-                 (unsigned)now_us, (unsigned)probe.light, (unsigned)probe.level_dn,
-                 (unsigned)run->scan.saturation_dn);
+                 "the lights at %u us: the brightest (light %u) brings the object to %s (95th "
+                 "percentile of what it lights, %u pixels): each light alone is taken at it",
+                 (unsigned)now_us, (unsigned)probe.light, level, (unsigned)probe.lit);
         return 0;
     }
     /* a camera that cannot change its exposure (-ENOSYS) is found here, not in the first view */
