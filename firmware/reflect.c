@@ -124,6 +124,13 @@ static void kmeans_rounds(struct reflect_pool *pl, struct reflect_model *m, int 
  * 16-33%, gold metallic paint 71-92%. */
 #define LOBE_MIN_SHARE 0.10
 
+/* The broadest lobe kept (GGX roughness). A highlight's is far narrower (make eval's red plastic
+ * 0.35-0.42, gold metallic paint 0.27-0.29); a broader one fits how a matte surface's light
+ * departs from Lambert's law (Burley's retro-reflection in Blender's Principled BSDF: 0.84-0.92
+ * on make eval-cycles' bunny, coloured like the paint), and taken off each light it darkened
+ * that texture from multi's 2.29 mean dE00 to 3.53 (2.18 without it). */
+#define LOBE_MAX_ROUGHNESS 0.7
+
 /* Colours nearer than this (feature_dist2; 0.17 in square-root units) are one paint: make
  * eval's nearest two paints, green and blue, are 0.19 apart. */
 #define SAME_PAINT 0.03
@@ -482,11 +489,12 @@ int reflect_fit(struct reflect_pool *pl, uint32_t clusters, struct reflect_model
         }
     }
     /* A cluster whose lobe takes less than LOBE_MIN_SHARE of the error its diffuse colours leave
-     * alone is matte (K = 0): what such a lobe fits is the diffuse model's own misfit, not a
-     * highlight, and taking it off darkens the colour */
+     * alone, or whose lobe is broader than LOBE_MAX_ROUGHNESS, is matte (K = 0): what such a
+     * lobe fits is the diffuse model's own misfit, not a highlight, and taking it off darkens
+     * the colour */
     for (uint32_t c = 0; c < m->count; c++)
-        if (share[c] < LOBE_MIN_SHARE)
-            memset(m->cluster[c].specular, 0, sizeof(m->cluster[c].specular));
+        if (share[c] < LOBE_MIN_SHARE || m->cluster[c].roughness > LOBE_MAX_ROUGHNESS)
+            share[c] = 0.0, memset(m->cluster[c].specular, 0, sizeof(m->cluster[c].specular));
     /* then the lobe's shape as measured, from GGX's: real materials' tails are not GGX's, and
      * where the paint is dark the tails are most of the light (make eval's gold metallic
      * paint: dark paint dE00 12.45 with GGX, 9.83 measured; relit 3.18, 2.94) */

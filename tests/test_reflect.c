@@ -207,14 +207,12 @@ static void test_one_paint_one_cluster(void **state)
     assert_int_equal(m.count, 1);
 }
 
-/* A matte paint whose light the model misses a little, as a real diffuse surface does (a few
- * percent more light at grazing incidence, as Burley's diffuse; the sensor's noise, 5% a
- * reading, as a light alone gives at the camera's exposure): a lobe fitted to
- * that would take a few percent of the error and darken the colour, so the cluster is kept
- * matte (K = 0) and its colour is the paint's. */
-static void test_matte_paint_gets_no_lobe(void **state)
+/* Samples of one matte paint whose light the model misses (@p burley: Burley's diffuse at
+ * roughness 1, Blender's Principled BSDF; else a few percent more light at grazing incidence),
+ * with the sensor's noise @p noise a reading (as a light alone gives at the camera's exposure):
+ * the cluster is kept matte (K = 0) and its colour is the paint's. */
+static void assert_kept_matte(int burley, double noise)
 {
-    (void)state;
     static const double rho[3] = {0.55, 0.25, 0.08};
     reflect_begin(&pool, 1);
     for (int i = 0; i < 6000; i++) {
@@ -227,10 +225,14 @@ static void test_matte_paint_gets_no_lobe(void **state)
             o.lights |= 1u << l;
             o.cos_i[l] = (float)(0.3 + 0.7 * uniform());
             o.alpha[l] = (float)(0.6 * uniform() * uniform());
-            double grazing = 1.0 + 0.1 * pow(1.0 - o.cos_i[l], 2.0);
+            double fl = pow(1.0 - o.cos_i[l], 5.0), fv = pow(1.0 - o.cos_r, 5.0);
+            double lh = cos(o.alpha[l]), rr = 2.0 * lh * lh; /* the half angle's, roughly */
+            double shape =
+                burley ? (1.0 - 0.5 * fv) * (1.0 - 0.5 * fl) + rr * (fl + fv + fl * fv * (rr - 1.0))
+                       : 1.0 + 0.1 * pow(1.0 - o.cos_i[l], 2.0);
             for (int c = 0; c < 3; c++)
                 o.signal[l][c] =
-                    (float)(rho[c] * o.cos_i[l] * grazing * (1.0 + 0.17 * (uniform() - 0.5)));
+                    (float)(rho[c] * o.cos_i[l] * shape * (1.0 + 2.0 * noise * (uniform() - 0.5)));
         }
         reflect_add(&pool, &o);
     }
@@ -238,8 +240,9 @@ static void test_matte_paint_gets_no_lobe(void **state)
     assert_int_equal(reflect_fit(&pool, 4, &m), 0);
     assert_int_equal(m.count, 1);
     const struct reflect_cluster *c = &m.cluster[0];
-    print_message("matte: K %.4f %.4f %.4f, diffuse %.3f %.3f %.3f\n", c->specular[0],
-                  c->specular[1], c->specular[2], c->centre[0], c->centre[1], c->centre[2]);
+    print_message("matte: K %.4f %.4f %.4f, roughness %.3f, diffuse %.3f %.3f %.3f\n",
+                  c->specular[0], c->specular[1], c->specular[2], c->roughness, c->centre[0],
+                  c->centre[1], c->centre[2]);
     for (int ch = 0; ch < 3; ch++) {
         assert_true(c->specular[ch] == 0.0);
         assert_true(fabs(c->centre[ch] - rho[ch]) < 0.05 * rho[ch] + 0.005);
@@ -247,6 +250,23 @@ static void test_matte_paint_gets_no_lobe(void **state)
     double sp[3];
     reflect_specular(c, 0.0, 1.0, sp); /* nothing at the lobe's peak either */
     assert_true(sp[0] == 0.0 && sp[1] == 0.0 && sp[2] == 0.0);
+}
+
+/* A little more light at grazing incidence and 8.5% noise: a lobe fitted to that takes a few
+ * percent of the error and would darken the colour (LOBE_MIN_SHARE). */
+static void test_matte_paint_gets_no_lobe(void **state)
+{
+    (void)state;
+    assert_kept_matte(0, 0.085);
+}
+
+/* Burley's diffuse with little noise: a lobe takes more of the error, but only one broader than
+ * any highlight (LOBE_MAX_ROUGHNESS) fits it; before, on Cycles' frames such lobes, coloured
+ * like the paint, darkened make eval-cycles' texture from multi's 2.29 to 3.53 mean dE00. */
+static void test_burley_diffuse_gets_no_lobe(void **state)
+{
+    (void)state;
+    assert_kept_matte(1, 0.01);
 }
 
 /* Too few samples: nothing is fitted. */
@@ -337,6 +357,7 @@ int main(void)
         cmocka_unit_test(test_measured_lobe_shape),
         cmocka_unit_test(test_one_paint_one_cluster),
         cmocka_unit_test(test_matte_paint_gets_no_lobe),
+        cmocka_unit_test(test_burley_diffuse_gets_no_lobe),
         cmocka_unit_test(test_too_few_samples),
         cmocka_unit_test(test_glb_with_every_cluster),
     };

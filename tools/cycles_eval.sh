@@ -61,27 +61,31 @@ white_of() { # renderer: the white_scale line its own white reference gives
 }
 out=$report/cycles-eval.md
 {
-    echo "| renderer | model -> truth mean mm | texture dE00 mean | p95 | vertex colours mean | p95 | dark paint: texture | vertex | seams mean | balanced: texture mean | vertex mean | truth / texture (r g b) |"
-    echo "|---|---|---|---|---|---|---|---|---|---|---|---|"
+    echo "| renderer | method | model -> truth mean mm | texture dE00 mean | p95 | vertex colours mean | p95 | dark paint: texture | vertex | seams mean | balanced: texture mean | vertex mean | truth / texture (r g b) |"
+    echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 } > "$out"
 for r in $renderers; do
     white=$(white_of "$r")
     [ -n "$white" ] || { echo "eval-cycles: no white reference for $r" >&2; exit 1; }
     echo "$r: $white" >> "$work/white-scales.txt"
-    sed -e 's/^icp = 0/icp = 1/' -e "s|^calibration = .*|calibration = calibration.ini|" \
-        -e "s|^white_scale = .*|$white|" "$work/$r/config.ini" > "$work/$r-multi.ini"
-    "$build/scanner" process "$work/$r" --config "$work/$r-multi.ini" --out "$work/$r-multi" \
-        > "$work/$r-multi.log" 2>&1
-    "$build/texture-eval" "$work/$r" "$work/$r-multi" tests/eval/cycles.ini > "$work/$r.eval"
-    "$build/texture-eval" "$work/$r" "$work/$r-multi" tests/eval/cycles.ini --balanced > "$work/$r.balanced"
-    head -n 1 "$work/$r.eval" >&2
-    mean=$("$build/mesh-compare" --align "$work/$r-multi/mesh.ply" "$work/$r/truth_mesh.ply" |
-        sed -n 's/^result -> truth: mean \([0-9.]*\) mm.*/\1/p')
-    gains=$(sed -n 's/.*per channel \([0-9.]* [0-9.]* [0-9.]*\); over.*/\1/p' "$work/$r.eval")
-    balanced=$(awk -F, '$1 == "csv" { print $3 " | " $5 }' "$work/$r.balanced")
-    awk -F, -v r="$r" -v mean="$mean" -v b="$balanced" -v g="$gains" '$1 == "csv" {
-        printf "| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n", r, mean, $3, $4, $5, $6,
-            $8, $9, $11, b, g }' "$work/$r.eval" >> "$out"
+    for m in multi fit; do # fit: its white reference is multi's (calibrate-white says so)
+        sed -e 's/^icp = 0/icp = 1/' -e "s|^calibration = .*|calibration = calibration.ini|" \
+            -e "s|^white_scale = .*|$white|" -e "s/^method = .*/method = $m/" \
+            "$work/$r/config.ini" > "$work/$r-$m.ini"
+        "$build/scanner" process "$work/$r" --config "$work/$r-$m.ini" --out "$work/$r-$m" \
+            > "$work/$r-$m.log" 2>&1
+        "$build/texture-eval" "$work/$r" "$work/$r-$m" tests/eval/cycles.ini > "$work/$r-$m.eval"
+        "$build/texture-eval" "$work/$r" "$work/$r-$m" tests/eval/cycles.ini --balanced \
+            > "$work/$r-$m.balanced"
+        echo "$r, $m: $(head -n 1 "$work/$r-$m.eval")" >&2
+        mean=$("$build/mesh-compare" --align "$work/$r-$m/mesh.ply" "$work/$r/truth_mesh.ply" |
+            sed -n 's/^result -> truth: mean \([0-9.]*\) mm.*/\1/p')
+        gains=$(sed -n 's/.*per channel \([0-9.]* [0-9.]* [0-9.]*\); over.*/\1/p' "$work/$r-$m.eval")
+        balanced=$(awk -F, '$1 == "csv" { print $3 " | " $5 }' "$work/$r-$m.balanced")
+        awk -F, -v r="$r" -v m="$m" -v mean="$mean" -v b="$balanced" -v g="$gains" '$1 == "csv" {
+            printf "| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n", r, m, mean, $3, $4,
+                $5, $6, $8, $9, $11, b, g }' "$work/$r-$m.eval" >> "$out"
+    done
 done
 echo "Cycles rendered $(grep -c '^cycles:' "$work/blender.log") frames in $took s (SAMPLES=${SAMPLES:-4}, COLOUR_SAMPLES=${COLOUR_SAMPLES:-32})." >> "$out"
 echo "White references (\`scanner calibrate-white --from\`, each renderer's frames of tests/eval/cycles-white.ini; cycles-simwhite: Cycles' frames with the simulator's):" >> "$out"
