@@ -90,7 +90,7 @@ done
 # Issue 34's target: on Cycles' frames (its own white reference) the best method's texture mean
 # under 2 dE00.
 awk -F' [|] ' '$1 == "| cycles" && (best == "" || $4 + 0 < best + 0) { best = $4; m = $2 }
-    END { printf "%s best method on the frames Cycles rendered (%s): texture mean dE00 %s < 2\n\n",
+    END { printf "\n%s best method on the frames Cycles rendered (%s): texture mean dE00 %s < 2\n\n",
         best + 0 < 2 ? "PASS" : "FAIL", m, best }' "$out" > "$work/target.txt"
 cat "$work/target.txt" >> "$out"
 echo "Cycles rendered $(grep -c '^cycles:' "$work/blender.log") frames in $took s (SAMPLES=${SAMPLES:-4}, COLOUR_SAMPLES=${COLOUR_SAMPLES:-32})." >> "$out"
