@@ -152,6 +152,8 @@ void job_say_if_dark(struct job *j, uint32_t v, const struct scan_view_info *inf
  *  frames' exposure where it sets no [colour] light_exposure_us ("" when none).
  *  @retval 0 @retval -EOVERFLOW @p len too small */
 int job_chosen_lines(const struct app_config *cfg, char *buf, size_t len);
+/** Room for job_chosen_lines' lines: both of them, with their comments. */
+#define JOB_CHOSEN_LINES_MAX 640u
 /** Before a scan's first view (a new scan, or a resume of one that has none): the exposure
  *  checks of [scan] auto_exposure, which may change @p run (the patterns' HDR exposures, the
  *  single-light frames' exposure), and what they chose kept in the scan's config.ini after the

@@ -565,7 +565,7 @@ static int probe_lights(struct job *j, struct app_config *run)
 int job_choose_exposures(struct job *j, struct app_config *run, const char *config_path,
                          const char *calibration_path)
 {
-    char chosen[640] = "";
+    char chosen[JOB_CHOSEN_LINES_MAX] = "";
     int rc = probe_dark(j, run);
     if (rc == 0)
         rc = probe_lights(j, run);

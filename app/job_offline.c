@@ -386,7 +386,7 @@ int scan_job_process(const struct hal *hal, const char *scan_dir, const struct s
         return rc;
     /* summary.ini says every output is written (docs/scan-format.md): they are made again */
     scan_dir_remove(j.out_dir, -1, SCAN_FILE_SUMMARY);
-    char chosen[640];
+    char chosen[JOB_CHOSEN_LINES_MAX];
     if (elsewhere && ((rc = job_chosen_lines(&cfg, chosen, sizeof(chosen))) != 0 ||
                       (rc = scan_dir_keep_settings(&hal->storage, cfg.path, cfg.calibration_file,
                                                    j.out_dir, chosen)) != 0)) /* how made */

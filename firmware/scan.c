@@ -241,12 +241,13 @@ int scan_feed_light_frame(struct scan_ctx *s, uint32_t k, const uint8_t *rgb)
     return 0;
 }
 
-/* The median grey level of a histogram of @p total pixels (0: none). */
-static uint32_t hist_median(const uint32_t hist[256], uint32_t total)
+/* The grey level at or under which @p percent of a histogram's @p total pixels lie (50: the
+ * median; 0: no pixels). */
+static uint32_t hist_percentile(const uint32_t hist[256], uint32_t total, uint32_t percent)
 {
     for (uint32_t v = 0, seen = 0; v < 256 && total > 0; v++) {
         seen += hist[v];
-        if (2 * seen >= total)
+        if (100u * (uint64_t)seen >= (uint64_t)percent * total)
             return v;
     }
     return 0;
@@ -294,7 +295,7 @@ static void count_reasons(const struct scan_ctx *s, const struct hal_thread *cor
             dark_hist[v] += p.dark_hist[k][v], dark_n += p.dark_hist[k][v];
     }
     info->valid_points = info->reason_count[SCAN_VALID];
-    info->dark_contrast_dn = hist_median(dark_hist, dark_n);
+    info->dark_contrast_dn = hist_percentile(dark_hist, dark_n, 50);
 }
 
 int scan_finish_view(struct scan_ctx *s, const struct hal_thread *threads,
@@ -561,18 +562,7 @@ int scan_probe_contrast(struct scan_ctx *s, const struct hal *hal, const struct 
         if (contrast < p->min_contrast_dn)
             out->dark++, hist[contrast]++;
     }
-    out->dark_median_dn = hist_median(hist, out->dark);
-    return 0;
-}
-
-/* The 95th percentile of @p hist's @p total counts (0: none). */
-static uint32_t hist_p95(const uint32_t hist[256], uint32_t total)
-{
-    for (uint32_t v = 0, seen = 0; v < 256 && total > 0; v++) {
-        seen += hist[v];
-        if (100u * (uint64_t)seen >= 95u * (uint64_t)total)
-            return v;
-    }
+    out->dark_median_dn = hist_percentile(hist, out->dark, 50);
     return 0;
 }
 
@@ -630,11 +620,11 @@ int scan_probe_lights(struct scan_ctx *s, const struct hal *hal, const struct sc
         uint32_t count;
         light_levels(s->frame_rgb, dark, n, p->colour.shadow_dn, p->saturation_dn, level_hist,
                      dark_hist, &count);
-        uint32_t level = hist_p95(level_hist, count);
+        uint32_t level = hist_percentile(level_hist, count, 95);
         if (count > 0 && (out->lit == 0 || level > out->level_dn))
             *out = (struct scan_light_probe){.lit = count,
                                              .level_dn = level,
-                                             .dark_dn = hist_median(dark_hist, count),
+                                             .dark_dn = hist_percentile(dark_hist, count, 50),
                                              .light = l - 1};
     }
     /* the lights off again at once, and the rig safe on every failure */

@@ -264,7 +264,7 @@ static void test_light_exposure_given(void **state)
     assert_non_null(strstr(err, "light.ini:9: [colour] light_exposure_us"));
     /* chosen by the scan: kept after the file's lines, then the file's own */
     assert_int_equal(config_load(&cfg, write_file("light.ini", base), err, sizeof(err)), 0);
-    char chosen[640];
+    char chosen[JOB_CHOSEN_LINES_MAX];
     assert_int_equal(job_chosen_lines(&cfg, chosen, sizeof(chosen)), 0);
     assert_string_equal(chosen, ""); /* nothing chosen */
     cfg.scan.colour.light_exposure_us = 19000;
