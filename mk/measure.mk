@@ -20,7 +20,7 @@ eval-texture: deps $(BUILD)/scanner $(BUILD)/texture-eval
 
 ## eval-cycles: the colour eval through Blender's Cycles, docs/colour-eval/cycles-eval.md (about 15 min; not in CI)
 eval-cycles: deps $(BUILD)/scanner $(BUILD)/texture-eval $(BUILD)/mesh-compare
-	@command -v blender >/dev/null || scripts/install-deps.sh blender
+	@scripts/install-deps.sh blender
 	tools/cycles_eval.sh $(BUILD) $(EVAL_DIR)
 
 ## eval: intrinsic colour compared on the simulator into docs/colour-eval/ (about 25 min)

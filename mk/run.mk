@@ -28,7 +28,7 @@ test-browser: deps
 # mesh.ply, mesh.obj, mesh.stl and mesh.glb upright and at the object's size in a millimetre scene.
 ## check-blender: Blender imports a simulated scan's four meshes (not in CI)
 check-blender: deps $(BUILD)/scanner
-	@command -v blender >/dev/null || scripts/install-deps.sh blender
+	@scripts/install-deps.sh blender
 	@rm -rf $(BUILD)/blender-scan
 	$(BUILD)/scanner scan --config config/sim.ini --out $(BUILD)/blender-scan > /dev/null
 	@blender -b --python-exit-code 1 -P tests/blender_import.py -- $(BUILD)/blender-scan 150 \

@@ -14,7 +14,7 @@ pkgs="build-essential pkg-config libinih-dev libpng-dev libzstd-dev libjpeg-dev 
 case "${1:-}" in *-linux-gnu*) ;; *) pkgs="$pkgs libcivetweb-dev libcjson-dev" ;; esac
 [ "${1:-}" = "bench" ] && pkgs="$pkgs g++ libopencv-dev libopencv-contrib-dev valgrind libspng-dev libzstd-dev python3-open3d"
 [ "${1:-}" = "fuzz" ] && pkgs="$pkgs clang libclang-rt-14-dev"
-[ "${1:-}" = "blender" ] && pkgs="blender"
+[ "${1:-}" = "blender" ] && pkgs="blender python3-numpy" # tools/cycles_scan.py: a Recommends, which --no-install-recommends leaves out
 # make measure-objects: OpenSCAD makes the mechanical parts of data/objects
 [ "${1:-}" = "objects" ] && pkgs="openscad"
 # make test-browser: Debian's Chromium, driven by playwright-core (tests/browser)
