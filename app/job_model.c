@@ -390,18 +390,18 @@ static int fit_reflectance(struct job *j, const char *scan_dir)
                                  scan_dir_write_reflectance(&j->hal->storage, j->out_dir, &m));
     if (rc != 0)
         return rc;
-    char detail[128 + REFLECT_MAX_CLUSTERS * 96];
+    char detail[128 + REFLECT_MAX_CLUSTERS * 112];
     size_t len = (size_t)snprintf(detail, sizeof(detail),
                                   "%u material clusters (%.2f s CPU):", (unsigned)m.count,
                                   clock_posix_thread_cpu_s() - t0);
     for (uint32_t k = 0; k < m.count && len < sizeof(detail); k++) {
         const struct reflect_cluster *c = &m.cluster[k];
-        len +=
-            (size_t)snprintf(detail + len, sizeof(detail) - len,
-                             "%s diffuse %.2f %.2f %.2f, specular %.3f %.3f %.3f, roughness "
-                             "%.3f (%u samples)",
-                             k ? ";" : "", c->centre[0], c->centre[1], c->centre[2], c->specular[0],
-                             c->specular[1], c->specular[2], c->roughness, (unsigned)c->samples);
+        len += (size_t)snprintf(detail + len, sizeof(detail) - len,
+                                "%s diffuse %.2f %.2f %.2f, specular %.3f %.3f %.3f, roughness "
+                                "%.3f, retro %.3f (%u samples)",
+                                k ? ";" : "", c->centre[0], c->centre[1], c->centre[2],
+                                c->specular[0], c->specular[1], c->specular[2], c->roughness,
+                                c->retro, (unsigned)c->samples);
     }
     char fields[64];
     snprintf(fields, sizeof(fields), "\"clusters\":%u", (unsigned)m.count);

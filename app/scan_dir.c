@@ -391,7 +391,9 @@ int scan_dir_write_reflectance(const struct hal_storage *st, const char *dir,
         text, sizeof(text),
         "; reflectance parameters of [colour] method = fit (docs/colour.md): per material\n"
         "; cluster, S = rho cos(theta_i) + specular D(alpha) / cos(theta_r), D the GGX\n"
-        "; distribution of alpha = roughness, 1 at its peak (firmware/reflect.h); then the\n"
+        "; distribution of alpha = roughness, 1 at its peak (firmware/reflect.h); where\n"
+        "; diffuse_roughness is not 0, rho cos(theta_i) is Burley's diffuse of that roughness\n"
+        "; (reflect_diffuse); then the\n"
         "; lobe as measured: lobe_specular x the shape lobe, its values at half-angles\n"
         "; 1.2 (k / 15)^2 rad, k = 0 .. 15 (linear between, 0 beyond)\n"
         "[reflectance]\nclusters = %u\n",
@@ -400,10 +402,11 @@ int scan_dir_write_reflectance(const struct hal_storage *st, const char *dir,
         const struct reflect_cluster *c = &m->cluster[k];
         len += (size_t)snprintf(text + len, sizeof(text) - len,
                                 "[cluster_%u]\ndiffuse = %.4f, %.4f, %.4f\nspecular = %.4f, %.4f, "
-                                "%.4f\nroughness = %.4f\nsamples = %u\nrms = %.4f\n",
+                                "%.4f\nroughness = %.4f\ndiffuse_roughness = %.4f\nsamples = "
+                                "%u\nrms = %.4f\n",
                                 (unsigned)k, c->centre[0], c->centre[1], c->centre[2],
                                 c->specular[0], c->specular[1], c->specular[2], c->roughness,
-                                (unsigned)c->samples, c->rms);
+                                c->retro, (unsigned)c->samples, c->rms);
         if (!c->measured || len >= sizeof(text))
             continue;
         len += (size_t)snprintf(text + len, sizeof(text) - len,

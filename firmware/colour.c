@@ -322,6 +322,14 @@ static double half_angle(vec3 p, vec3 n, vec3 view, const double light_pos[3])
     return acos(nh > 1.0 ? 1.0 : nh < -1.0 ? -1.0 : nh);
 }
 
+/* cos(theta_d) at @p p: half the angle between the light at @p light_pos and the camera (the
+ * unit vector @p view), from cos(2 theta_d) = L . V */
+static double half_cos(vec3 p, vec3 view, const double light_pos[3])
+{
+    double lv = v3_dot(toward(p, v3_from(light_pos)).dir, view);
+    return sqrt(lv > -1.0 ? 0.5 * (1.0 + lv) : 0.0);
+}
+
 /* Albedo estimate of valid pixel i: numerator per channel and the denominator (0: none), and
  * how much the fusion may trust it (@p confidence, 0..; not clamped). @p relaxed: the best
  * effort for a pixel without a reliable estimate (grazing or saturated light still used). */
@@ -412,6 +420,7 @@ static void add_sample(struct reflect_pool *pool, const struct colour_params *pr
         if (!(ls->used >> l & 1u))
             continue;
         o.alpha[l] = (float)half_angle(p, nn, view, c->light_pos_mm[l]);
+        o.cos_d[l] = (float)half_cos(p, view, c->light_pos_mm[l]);
         o.cos_i[l] = (float)ls->cosine[l];
         for (int ch = 0; ch < 3; ch++)
             o.signal[l][ch] = (float)(ls->lit[l][ch] * prm->white_scale[ch]);
@@ -469,7 +478,9 @@ static void fit_pixel(const struct frame_ctx *f, const struct scan_calib *c, str
         for (uint32_t l = 0; l < c->light_count; l++) {
             if (!(ls.used >> l & 1u))
                 continue;
-            double sp_grey = (sp[l][0] + sp[l][1] + sp[l][2]) / 3.0, ct = ls.cosine[l];
+            double sp_grey = (sp[l][0] + sp[l][1] + sp[l][2]) / 3.0;
+            double ct =
+                reflect_diffuse(cl, ls.cosine[l], cos_r, half_cos(p, view, c->light_pos_mm[l]));
             double share = rho_grey * ct / (rho_grey * ct + sp_grey);
             double w = ls.weight[l] * share * share;
             for (int ch = 0; ch < 3; ch++)

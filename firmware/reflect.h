@@ -40,6 +40,7 @@ struct reflect_obs {
     float signal[HAL_MAX_LIGHTS][3]; /**< S_l */
     float cos_i[HAL_MAX_LIGHTS];     /**< cos(theta_l) */
     float alpha[HAL_MAX_LIGHTS];     /**< alpha_l, radians */
+    float cos_d[HAL_MAX_LIGHTS];     /**< cos(theta_d): half the angle between light and camera */
 };
 
 /** Nodes of a cluster's measured lobe shape: at half-angles REFLECT_LOBE_MAX_RAD (k / (n-1))^2. */
@@ -48,9 +49,10 @@ struct reflect_obs {
 
 /** A material cluster's lobe and where it sits in diffuse colour. */
 struct reflect_cluster {
-    double centre[3];                /**< mean diffuse colour of its samples (linear) */
-    double specular[3];              /**< K: specular colour x strength */
-    double roughness;                /**< a, GGX's alpha */
+    double centre[3];   /**< mean diffuse colour of its samples (linear) */
+    double specular[3]; /**< K: specular colour x strength */
+    double roughness;   /**< a, GGX's alpha */
+    double retro;       /**< the diffuse's roughness (reflect_diffuse; 0: Lambert's law) */
     double lobe[REFLECT_LOBE_NODES]; /**< the lobe's shape as measured (1 at alpha = 0) */
     double lobe_specular[3];         /**< K of the measured shape */
     int measured;                    /**< lobe[] is fitted: reflect_specular uses it */
@@ -105,6 +107,13 @@ uint32_t reflect_cluster_of(const struct reflect_model *m, const double rho[3]);
 /** Cluster @p cl's specular part at @p alpha, @p cos_r: K D / cos(theta_r) per channel, with its
  *  measured shape (or its GGX lobe before that is fitted). */
 void reflect_specular(const struct reflect_cluster *cl, double alpha, double cos_r, double out[3]);
+
+/** Cluster @p cl's diffuse basis, what rho multiplies: Lambert's cos(theta_i) where cl->retro
+ *  is 0, else Burley's diffuse of roughness r = cl->retro (as Blender's Principled BSDF has it),
+ *      cos(theta_i) (1 + k F(cos theta_i)) (1 + k F(cos theta_r)),
+ *      k = F_D90 - 1 = 2 r cos^2(theta_d) - 0.5,  F(c) = (1 - c)^5
+ *  theta_d: the angle between the light and the half vector (@p cos_d). */
+double reflect_diffuse(const struct reflect_cluster *cl, double cos_i, double cos_r, double cos_d);
 
 /** The lobe's factor D(alpha) / cos(theta_r) (times K: the specular part), D as above. */
 double reflect_lobe(double roughness, double alpha, double cos_r);

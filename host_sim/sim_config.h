@@ -22,10 +22,11 @@ struct sim_config {
     double slip_mm[3];          /**< the object slips on the table by this (object frame) ... */
     double slip_at_deg;         /**< ... from this table angle on */
     uint32_t segments;          /**< tessellation of analytic shapes */
-    char material[16];          /**< lambert | phong | merl */
+    char material[16];          /**< lambert | phong | merl | burley */
     char merl_file[HAL_MAX_PATH];
     char merl_name[64];
     double phong_ks, phong_ke;
+    double burley_roughness;         /**< material = burley */
     char albedo_pattern[16];         /**< patches | uniform | image */
     char albedo_image[HAL_MAX_PATH]; /**< image: the PNG wrapped round the object */
     double albedo[3];

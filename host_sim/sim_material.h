@@ -1,11 +1,12 @@
-/* Reflectance of the simulated object: Lambert, Phong (Jost et al. eq. 2) and measured MERL
- * materials fitted to the ABC microfacet model (Low et al. 2012). */
+/* Reflectance of the simulated object: Lambert, Phong (Jost et al. eq. 2), measured MERL
+ * materials fitted to the ABC microfacet model (Low et al. 2012) and Burley's diffuse (the
+ * Disney BRDF's, as Blender's Principled BSDF renders a matte paint). */
 #ifndef SIM_MATERIAL_H
 #define SIM_MATERIAL_H
 
 #include "vec3.h"
 
-enum sim_material_kind { SIM_MAT_LAMBERT, SIM_MAT_PHONG, SIM_MAT_ABC };
+enum sim_material_kind { SIM_MAT_LAMBERT, SIM_MAT_PHONG, SIM_MAT_ABC, SIM_MAT_BURLEY };
 
 struct sim_material {
     enum sim_material_kind kind;
@@ -14,6 +15,7 @@ struct sim_material {
     double abc_a[3];     /**< ABC lobe height per channel */
     double abc_b, abc_c; /**< ABC lobe shape */
     double ior;          /**< index of refraction for the Fresnel term */
+    double roughness;    /**< Burley's diffuse roughness */
     char name[64];
 };
 

@@ -145,6 +145,9 @@ static int build_material(struct sim_rig *rig, const char *dir, char *err, size_
     memset(&rig->material, 0, sizeof(rig->material));
     if (strcmp(c->material, "lambert") == 0) {
         rig->material.kind = SIM_MAT_LAMBERT;
+    } else if (strcmp(c->material, "burley") == 0) {
+        rig->material.kind = SIM_MAT_BURLEY;
+        rig->material.roughness = c->burley_roughness;
     } else if (strcmp(c->material, "phong") == 0) {
         rig->material.kind = SIM_MAT_PHONG;
         rig->material.ks = c->phong_ks;

@@ -64,6 +64,8 @@ static int reflectance_key(void *user, const char *section, const char *name, co
         sscanf(value, "%lf, %lf, %lf", &c->specular[0], &c->specular[1], &c->specular[2]);
     else if (strcmp(name, "roughness") == 0)
         c->roughness = atof(value);
+    else if (strcmp(name, "diffuse_roughness") == 0)
+        c->retro = atof(value);
     else if (strcmp(name, "samples") == 0)
         c->samples = (uint32_t)strtoul(value, NULL, 10);
     else if (strcmp(name, "lobe_specular") == 0)
@@ -116,15 +118,16 @@ static int model_at(const struct sim_mesh *m, const struct sim_bvh *bvh,
         out[c] = 0.0;
     if (ci <= 0.0 || cr <= 0.0)
         return 1;
-    double spec[3] = {0, 0, 0};
+    double spec[3] = {0, 0, 0}, diffuse = ci;
     if (lobes->count > 0) {
         const struct reflect_cluster *cl = &lobes->cluster[reflect_cluster_of(lobes, rho)];
         double nh = v3_dot(n, v3_norm(v3_add(l, v)));
         reflect_specular(cl, acos(fmin(1.0, fmax(-1.0, nh))), cr, spec);
+        diffuse = reflect_diffuse(cl, ci, cr, sqrt(fmax(0.0, 0.5 * (1.0 + v3_dot(l, v)))));
     }
     /* the model's units hold at the reference distance: the new light's falloff times that */
     for (int c = 0; c < 3; c++)
-        out[c] = (rho[c] * ci + spec[c]) * fall;
+        out[c] = (rho[c] * diffuse + spec[c]) * fall;
     return 1;
 }
 
