@@ -108,6 +108,11 @@ static void test_errors_name_file_line_and_key(void **state)
     expect_error("[sim]\nobject_offset_mm = 30, nan\n", "'30, nan' is not a list of 2");
     expect_error("[sim]\nobject_offset_mm = 300, 0\n",
                  "[sim] object_offset_mm: 300 is out of range -200..200");
+    expect_error("[sim]\nmaterial = burly\n", "bad.ini:9: [sim] material: 'burly' is not one of");
+    expect_error("[sim]\nmaterial = burley\nburley_roughness = 1.5\n",
+                 "bad.ini:10: [sim] burley_roughness: 1.5 is out of range 0..1");
+    expect_error("[sim]\nburley_roughness = -0\nburley_roughness = nan\n",
+                 "bad.ini:10: [sim] burley_roughness:");
     expect_error("[scan]\nauto_exposure = 2\n",
                  "bad.ini:9: [scan] auto_exposure: 2 is out of range 0..1");
     /* the predicted depth error that flags a calibration weak: a positive length in mm */
