@@ -9,6 +9,8 @@
 #include "white_cal.h"
 #include "clock_posix.h"
 #include "image_io.h"
+#include "mem.h"
+#include "memory_posix.h"
 #include "patterns.h"
 #include "report.h"
 #include "scan_dir.h"
@@ -413,6 +415,7 @@ int main(int argc, char **argv)
     int status = check_command_line(argc, argv, &cmd);
     if (status >= 0)
         return status;
+    mem_use_prefault(memory_posix_prefault); /* the big static buffers mapped as they are begun */
     if (strcmp(argv[1], "--version") == 0) {
         printf("scanner %s (HAL=%s)\n", SCANNER_VERSION, board_name());
         return 0;

@@ -4,6 +4,7 @@
 #include "align.h"
 
 #include "lsq.h"
+#include "mem.h"
 #include "vec3.h"
 
 #include <errno.h>
@@ -114,8 +115,8 @@ static void build_field(struct align_ctx *a)
         if ((uint64_t)a->field.dims[0] * a->field.dims[1] * a->field.dims[2] <= ALIGN_MAX_CELLS)
             break;
     }
-    memset(a->nearest, 0,
-           sizeof(uint32_t) * a->field.dims[0] * a->field.dims[1] * a->field.dims[2]);
+    size_t cells = (size_t)a->field.dims[0] * a->field.dims[1] * a->field.dims[2];
+    mem_fill(a->nearest, 0, cells * sizeof(a->nearest[0]));
     for (uint32_t i = 0; i < a->npts[0]; i++) {
         vec3 g = v3_scale(v3_sub(point(a, 0, i), a->field.lo), 1.0 / a->field.cell);
         uint32_t x = (uint32_t)g.x, y = (uint32_t)g.y, z = (uint32_t)g.z;

@@ -4,6 +4,7 @@
  * chart that folds back over itself, rare on a scan, shares the texels where it overlaps), packed
  * into shelves; then each texel's surface point projected into every view. */
 #include "atlas.h"
+#include "mem.h"
 
 #include "hal_thread.h"
 #include "camray.h"
@@ -237,7 +238,7 @@ int atlas_build(struct atlas *a, const struct fusion_volume *vol, double texel_m
     int rc = carve(a, vol, work, work_bytes);
     if (rc != 0)
         return rc;
-    memset(a->vertex_accum, 0, 4 * sizeof(float) * (size_t)vol->mp.s.vertices);
+    mem_fill(a->vertex_accum, 0, 4 * sizeof(float) * (size_t)vol->mp.s.vertices);
     if (texel_mm == 0.0) { /* no texture: the vertices' colours only */
         place_texels(a, 0);
         a->built = 1;
@@ -250,7 +251,7 @@ int atlas_build(struct atlas *a, const struct fusion_volume *vol, double texel_m
         return rc;
     /* each vertex's chart: its first triangle's (a vertex on a chart's border has another
      * place in the texture for its other charts' triangles) */
-    memset(a->vertex_tri, 0xFF, vol->mp.s.vertices * sizeof(a->vertex_tri[0]));
+    mem_fill(a->vertex_tri, 0xFF, vol->mp.s.vertices * sizeof(a->vertex_tri[0]));
     for (uint32_t t = 0; t < vol->mp.s.triangles; t++)
         for (int k = 0; k < 3 && a->tri_chart[t] != NONE; k++)
             if (a->vertex_tri[tri_at(vol, t)[k]] == NONE)
@@ -276,7 +277,7 @@ int atlas_build(struct atlas *a, const struct fusion_volume *vol, double texel_m
         }
     }
     place_texels(a, (size_t)a->width * a->height);
-    memset(a->accum, 0, (size_t)a->width * a->height * 4 * sizeof(a->accum[0]));
+    mem_fill(a->accum, 0, (size_t)a->width * a->height * 4 * sizeof(a->accum[0]));
     assign_texels(a, vol);
     a->built = 1;
     rep->width = a->width, rep->height = a->height;
@@ -373,7 +374,7 @@ static void raster(struct atlas *a, const struct fusion_volume *vol, uint32_t t,
  * triangle's centre lies in, then the ones near a triangle that nobody owns. */
 static void assign_texels(struct atlas *a, const struct fusion_volume *vol)
 {
-    memset(a->owner, 0xFF, (size_t)a->width * a->height * sizeof(a->owner[0]));
+    mem_fill(a->owner, 0xFF, (size_t)a->width * a->height * sizeof(a->owner[0]));
     for (uint32_t t = 0; t < vol->mp.s.triangles; t++)
         if (a->tri_chart[t] != NONE)
             raster(a, vol, t, CLAIM_INSIDE);

@@ -2,6 +2,7 @@
 #include "decode.h"
 
 #include "lsq.h"
+#include "mem.h"
 
 #include <errno.h>
 #include <math.h>
@@ -59,6 +60,22 @@ uint32_t decode_mean_threshold(const struct scan_params *p, uint32_t contrast_dn
     return (decode_bit_threshold(p, contrast_dn) + 3u) / 4u;
 }
 
+/* Every per-pixel buffer of the decoder, for @p n pixels, mapped ahead (mem.h): each view
+ * writes all of them (the planes no bit reaches are cleared). */
+static void prefault(struct decode_ctx *d, size_t n)
+{
+    uint8_t *bytes[] = {d->white,         d->black,         d->stage[0],       d->stage[1],
+                        d->threshold,     d->mean,          d->mean_threshold, d->sat,
+                        d->word_hi[0],    d->word_hi[1],    d->word_lo[0],     d->word_lo[1],
+                        d->unclear_hi[0], d->unclear_hi[1], d->unclear_lo[0],  d->unclear_lo[1],
+                        d->scratch};
+    uint16_t *words[] = {d->column_map, d->row_map, d->unclear_col, d->unclear_row};
+    for (size_t k = 0; k < sizeof(bytes) / sizeof(bytes[0]); k++)
+        mem_prefault(bytes[k], n);
+    for (size_t k = 0; k < sizeof(words) / sizeof(words[0]); k++)
+        mem_prefault(words[k], n * sizeof(uint16_t));
+}
+
 int decode_begin(struct decode_ctx *d, const struct scan_params *params,
                  const struct gray_layout *layout, uint32_t proj_width, uint32_t proj_height)
 {
@@ -77,6 +94,7 @@ int decode_begin(struct decode_ctx *d, const struct scan_params *params,
     }
     d->xor_col = gray_code_xor_mask(layout->code, layout->col_bits);
     d->xor_row = gray_code_xor_mask(layout->code, layout->row_bits);
+    prefault(d, (size_t)params->width * params->height);
     return 0;
 }
 

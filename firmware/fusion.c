@@ -6,6 +6,7 @@
 #include "camray.h"
 #include "lens.h"
 #include "mc_table.h"
+#include "mem.h"
 #include "vec3.h"
 
 #include <errno.h>
@@ -36,7 +37,8 @@ int fusion_begin(struct fusion_volume *vol, const struct fusion_params *p)
         return rc;
     vol->p = *p;
     vol->origin = v3(-p->radius_mm, -p->radius_mm, p->bottom_mm);
-    memset(vol->grid, 0, (size_t)vol->dims[0] * vol->dims[1] * vol->dims[2] * sizeof(vol->grid[0]));
+    size_t grid_bytes = (size_t)vol->dims[0] * vol->dims[1] * vol->dims[2] * sizeof(vol->grid[0]);
+    mem_fill(vol->grid, 0, grid_bytes);
     vol->mp.prepared = 0; /* an earlier model's mesh tables are no longer this one's */
     vol->grid_spent = 0;
     memset(&vol->outside, 0, sizeof(vol->outside));

@@ -10,6 +10,7 @@
  * plane; inside otherwise; everything at or below the table plane outside. Marching cubes over
  * the whole grid then gives a closed surface (the object closed at the table). */
 #include "fusion_grid.h"
+#include "mem.h"
 
 #include <errno.h>
 #include <string.h>
@@ -47,7 +48,7 @@ static void set_mark(struct fusion_volume *vol, size_t i)
 
 static void clear_marks(struct fusion_volume *vol)
 {
-    memset(vol->mark, 0, (grid_voxels(vol) + 7) / 8);
+    mem_fill(vol->mark, 0, (grid_voxels(vol) + 7) / 8);
 }
 
 /* The six neighbours of (x, y, z) inside the grid: their indices, @retval how many. */
@@ -196,7 +197,7 @@ static void flood_from_outside(struct fusion_volume *vol, const uint8_t *through
                                int down_only)
 {
     const uint32_t *d = vol->dims;
-    memset(flood, 0, (grid_voxels(vol) + 7) / 8);
+    mem_fill(flood, 0, (grid_voxels(vol) + 7) / 8);
     for (uint32_t z = 0; z < d[2]; z++)
         for (uint32_t y = 0; y < d[1]; y++)
             for (uint32_t x = 0; x < d[0]; x++) {

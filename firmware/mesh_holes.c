@@ -9,6 +9,7 @@
  * while views are fused (struct fusion_volume's open_edge). The boundary edges, directed as
  * their triangle runs, are then sorted by their first vertex and walked into loops. */
 #include "fusion.h"
+#include "mem.h"
 
 #include <errno.h>
 #include <math.h>
@@ -217,7 +218,7 @@ int fusion_mesh_fill_holes(struct fusion_volume *vol, double max_hole_mm,
     if (!vol->mp.fits || max_hole_mm <= 0.0)
         return 0; /* nothing to do, or a mesh streamed from marching cubes: left as it is */
     uint32_t open = 0, triangles = vol->mp.s.triangles;
-    memset(vol->open_edge, 0, sizeof(vol->open_edge));
+    mem_fill(vol->open_edge, 0, sizeof(vol->open_edge));
     for (uint32_t t = 0; t < triangles; t++) {
         const uint32_t *tri = &vol->mesh_tri[3 * (size_t)t];
         if (vol->mesh_index[tri[0]] == MESH_DROPPED)

@@ -7,6 +7,7 @@
  * MESH_MAX_VERTICES or MESH_MAX_TRIANGLES) keeps every piece and gets no STL; PLY and OBJ then
  * stream from marching cubes again, which is deterministic. */
 #include "atlas.h"
+#include "mem.h"
 #include "fusion.h"
 #include "outbuf.h"
 #include "ply.h"
@@ -53,7 +54,7 @@ static int keep_triangle(void *priv, uint32_t a, uint32_t b, uint32_t c)
 static void drop_fragments(struct fusion_volume *vol, double min_fragment_share)
 {
     uint32_t n = vol->mp.s.vertices, largest = 0, next = 0;
-    memset(vol->mesh_tris, 0, n * sizeof(uint32_t));
+    mem_fill(vol->mesh_tris, 0, n * sizeof(uint32_t));
     for (uint32_t t = 0; t < vol->mp.s.triangles; t++)
         vol->mesh_tris[uf_root(vol->mesh_index, vol->mesh_tri[3 * (size_t)t])]++;
     for (uint32_t v = 0; v < n; v++)

@@ -17,6 +17,7 @@
 #include "align.h"
 #include "camray.h"
 #include "lsq.h"
+#include "mem.h"
 #include "vec3.h"
 
 #include <errno.h>
@@ -70,7 +71,7 @@ int reg_begin(struct reg_ctx *r, const struct reg_params *p, const struct scan_c
         passes > 2 || views % passes != 0)
         return -E2BIG;
     /* the solution and the views' bookkeeping; not the samples (each view writes its own) */
-    memset(&r->p, 0, sizeof(*r) - offsetof(struct reg_ctx, p));
+    mem_fill(&r->p, 0, sizeof(*r) - offsetof(struct reg_ctx, p));
     r->p = *p;
     r->calib = *c;
     r->views = views;
@@ -149,6 +150,7 @@ int reg_add_view(struct reg_ctx *r, uint32_t index, int32_t angle_mdeg, const st
         (m->height + r->stride - 1) / r->stride != r->gh)
         return -EINVAL;
     struct reg_cell *out = reg_view_cells(r, index);
+    mem_prefault(out, (size_t)r->gw * r->gh * sizeof(*out));
     r->valid_cells[index] = 0;
     for (uint32_t y = 0; y < r->gh; y++) {
         for (uint32_t x = 0; x < r->gw; x++) {

@@ -4,6 +4,7 @@
 #include "frames.h"
 #include "fusion.h"
 #include "gray.h"
+#include "mem.h"
 #include "colour.h"
 #include "ply.h"
 #include "refine.h"
@@ -150,6 +151,48 @@ void scan_layout(const struct scan_params *p, const struct scan_calib *c, struct
     l->inverse_bits = p->inverse_bits;
 }
 
+/* The pixel buffers a view of @p n pixels writes whole (its colour and reasons), mapped ahead
+ * (mem.h). */
+static void prefault_colour(struct scan_ctx *s, size_t n)
+{
+    mem_prefault(s->view_rgb, n * 3);
+    mem_prefault(s->view_confidence, n * sizeof(s->view_confidence[0]));
+    mem_prefault(s->view_reason, n);
+}
+
+/* ... and those its frames are read into (the decoder's are its own: decode_begin): the view's
+ * colour, the colour frames its method reads, HDR's merge. */
+static void prefault_view(struct scan_ctx *s, const struct scan_params *p,
+                          const struct scan_calib *c)
+{
+    size_t n = (size_t)p->width * p->height;
+    prefault_colour(s, n);
+    mem_prefault(s->colour_rgb, n * 3);
+    for (uint32_t k = 0; k < s->lights && k < COLOUR_MAX_FRAMES; k++)
+        if (scan_needs_light_frame(p, c, k))
+            mem_prefault(s->light_rgb[k], n * 3);
+    if (p->exposure_count > 0) {
+        mem_prefault(s->hdr_choice, n);
+        mem_prefault(s->hdr_grey, n);
+    }
+}
+
+/* The points' buffers (written only where a pixel decoded), mapped ahead from the first row
+ * with a decoded pixel to the last: the rows of background above and below stay unmapped. */
+static void prefault_points(struct scan_ctx *s, const struct decode_maps *m)
+{
+    size_t w = m->width, first = m->height, last = 0;
+    for (size_t y = 0; y < m->height; y++)
+        if (memchr(m->reason + y * w, SCAN_VALID, w) != NULL)
+            first = first < y ? first : y, last = y;
+    if (first > last)
+        return;
+    size_t i = first * w, n = (last + 1 - first) * w;
+    mem_prefault(s->column + i, n * sizeof(s->column[0]));
+    mem_prefault(s->tri.xyz_mm + 3 * i, 3 * n * sizeof(s->tri.xyz_mm[0]));
+    mem_prefault(s->tri.normal + 3 * i, 3 * n * sizeof(s->tri.normal[0]));
+}
+
 int scan_begin_view(struct scan_ctx *s, const struct scan_params *p, const struct scan_calib *c)
 {
     struct gray_layout layout;
@@ -158,7 +201,10 @@ int scan_begin_view(struct scan_ctx *s, const struct scan_params *p, const struc
     scan_layout(p, c, &layout);
     s->patterns = gray_layout_count(&layout);
     s->lights = scan_light_frame_count(p, c);
-    return decode_begin(&s->decode, p, &layout, c->proj_width, c->proj_height);
+    int rc = decode_begin(&s->decode, p, &layout, c->proj_width, c->proj_height);
+    if (rc == 0)
+        prefault_view(s, p, c);
+    return rc;
 }
 
 int scan_feed_frame(struct scan_ctx *s, uint32_t pattern, const uint8_t *pixels, uint32_t channels,
@@ -314,6 +360,8 @@ int scan_finish_view(struct scan_ctx *s, const struct hal_thread *threads,
     view->confidence = s->view_confidence;
     int rc = decode_finish(&s->decode, &cores, s->view_reason, &view->maps);
     if (rc == 0)
+        prefault_points(s, &view->maps);
+    if (rc == 0)
         rc = refine_columns(&view->maps, &cores, (int)s->params.refine, s->column);
     view->column = s->column;
     if (rc == 0)
@@ -340,6 +388,7 @@ int scan_restore_view(struct scan_ctx *s, uint32_t width, uint32_t height, int32
     int rc = tri_restore(&s->tri, width, height, valid_count, &view->range);
     if (rc != 0)
         return rc;
+    prefault_colour(s, (size_t)width * height);
     fill->xyz_mm = s->tri.xyz_mm;
     fill->normal = s->tri.normal;
     view->width = width;
