@@ -4,11 +4,11 @@
  * chart that folds back over itself, rare on a scan, shares the texels where it overlaps), packed
  * into shelves; then each texel's surface point projected into every view. */
 #include "atlas.h"
-#include "mem.h"
 
 #include "hal_thread.h"
 #include "camray.h"
 #include "frames.h"
+#include "mem.h"
 #include "srgb.h"
 #include "unionfind.h"
 

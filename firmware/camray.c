@@ -2,6 +2,7 @@
 #include "camray.h"
 
 #include "lens.h"
+#include "mem.h"
 
 #include <errno.h>
 #include <string.h>
@@ -32,6 +33,7 @@ int camray_prepare(const struct scan_calib *c, struct camray *out)
     if ((size_t)c->cam_width * c->cam_height > HAL_MAX_PIXELS)
         return -EINVAL;
     table_ready = 0;
+    mem_prefault(ray_xy, 2 * sizeof(ray_xy[0]) * c->cam_width * c->cam_height); /* written whole */
     for (uint32_t y = 0; y < c->cam_height; y++) {
         for (uint32_t x = 0; x < c->cam_width; x++) {
             vec3 d = pinhole_ray(c, x, y); /* distorted normalised coordinates */

@@ -7,8 +7,8 @@
  * MESH_MAX_VERTICES or MESH_MAX_TRIANGLES) keeps every piece and gets no STL; PLY and OBJ then
  * stream from marching cubes again, which is deterministic. */
 #include "atlas.h"
-#include "mem.h"
 #include "fusion.h"
+#include "mem.h"
 #include "outbuf.h"
 #include "ply.h"
 #include "srgb.h"
