@@ -561,6 +561,8 @@ int atlas_add_view(struct atlas *a, struct fusion_volume *vol, const struct hal_
         .confidence = confidence,
         .pixels = pixels,
         .parts = hal_thread_parts(threads, 64)};
+    mem_prefault(a->pixel, 2 * sizeof(a->pixel[0]) * pixels); /* both written whole */
+    mem_prefault(a->vertex_cam, 5 * sizeof(a->vertex_cam[0]) * vol->mp.s.vertices);
     hal_thread_run(threads, p.parts, view_pixels, &p);
     hal_thread_run(threads, p.parts, view_vertices, &p);
     if (a->width == 0)
