@@ -68,26 +68,28 @@ static void test_posix_maps_the_pages_spanned(void **state)
     assert_true(p != MAP_FAILED);
     assert_int_equal(resident(p, 32), 0);
     /* from the middle of page 2 to the first byte of page 6: pages 2 .. 6 */
-    int rc = memory_posix_prefault(p + 2 * page + 100, 4 * page - 99);
-    if (rc == -EINVAL) { /* before Linux 5.14 (or under an emulator that does not pass it on) */
+    int rc = memory_posix_prefault(p + 2 * page + 100, 4 * page - 99), ignored = 0;
+    if (rc == -EINVAL) { /* before Linux 5.14 */
         print_message("MADV_POPULATE_WRITE not supported here: nothing mapped ahead\n");
         assert_int_equal(resident(p, 32), 0);
     } else {
         assert_int_equal(rc, 0);
-#ifndef __x86_64__ /* make test-arm64 runs under qemu-user, which takes madvise and does nothing   \
-                    */
-        if (resident(p, 32) == 0)
+#ifndef __x86_64__ /* make test-arm64: qemu-user takes madvise and does nothing */
+        ignored = resident(p, 32) == 0;
+        if (ignored)
             print_message("madvise taken and ignored (an emulator?): nothing mapped ahead\n");
-        else
 #endif
+        if (!ignored) {
             assert_int_equal(resident(p, 32), 0x7Cu);
-        assert_int_equal(p[2 * page + 100], 0); /* mapped as zeros, writable */
-        p[6 * page] = 1;
+            assert_int_equal(p[2 * page + 100], 0); /* mapped as zeros, writable */
+            p[6 * page] = 1;
+        }
     }
-    /* a range the process has not mapped: an error, nothing else */
+    /* a range the process has not mapped: an error, nothing else (where madvise is heard) */
     assert_int_equal(munmap(p + 16 * page, 16 * page), 0);
     rc = memory_posix_prefault(p + 20 * page, page);
-    assert_true(rc == -ENOMEM || rc == -EFAULT || rc == -EINVAL);
+    if (!ignored)
+        assert_true(rc == -ENOMEM || rc == -EFAULT || rc == -EINVAL);
     assert_int_equal(munmap(p, 16 * page), 0);
 }
 
