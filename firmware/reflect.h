@@ -26,7 +26,12 @@
  * neighbouring nodes, not below 0), so that a material whose tails are not GGX's (the haze of
  * a metallic paint) leaves no light on the diffuse colour. The colours and the relit
  * model use the measured shape (reflect_specular); the GGX lobe stays the cluster's summary
- * (reflectance.ini, the reflectance line) and is what mesh.glb's material takes. */
+ * (reflectance.ini, the reflectance line) and is what mesh.glb's material takes.
+ *
+ * A cluster left without a lobe (matte) may have a diffuse that departs from Lambert's law as
+ * Burley's does (brighter toward grazing light and view: Blender's Principled BSDF, many matte
+ * paints): rho cos(theta_l) is then reflect_diffuse's basis, its roughness fitted per cluster
+ * where it takes a share of the error (reflect.c's fit_retro). */
 #ifndef REFLECT_H
 #define REFLECT_H
 
