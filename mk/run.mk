@@ -9,7 +9,7 @@ run: deps $(BUILD)/scanner
 # second make, so that civetweb, if deps just installed it, is seen.
 ## serve: the web interface on the simulator at http://127.0.0.1:8080
 serve: deps
-	@$(MAKE) --no-print-directory $(BUILD)/scanner $(BUILD)/scanner-web $(BUILD)/mesh-compare
+	@$(MAKE) --no-print-directory $(BUILD)/scanner $(BUILD)/scanner-web $(BUILD)/mesh-compare $(CALIB_TOOL)
 	@echo "make serve: the scanner's page is at http://127.0.0.1:8080 (Ctrl-C ends it)"
 	$(BUILD)/scanner serve --config config/sim.ini --config config/sim-glossy.ini --listen 127.0.0.1:8080
 
@@ -21,7 +21,7 @@ test-browser: deps
 	@scripts/install-deps.sh node
 	@test -f tests/browser/node_modules/playwright-core/package.json || \
 		npm ci --prefix tests/browser --no-audit --no-fund --loglevel=error
-	@$(MAKE) --no-print-directory $(BUILD)/scanner $(BUILD)/scanner-web $(BUILD)/mesh-compare
+	@$(MAKE) --no-print-directory $(BUILD)/scanner $(BUILD)/scanner-web $(BUILD)/mesh-compare $(CALIB_TOOL)
 	node tests/browser/browser_test.mjs $(BUILD)
 
 # Blender 3.4 (Debian's, installed if missing; not in CI: 66 packages) imports a scan's
