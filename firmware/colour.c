@@ -463,9 +463,12 @@ static void fit_pixel(const struct frame_ctx *f, const struct scan_calib *c, str
     }
     const struct reflect_cluster *cl = &fs->model->cluster[reflect_cluster_of(fs->model, rho0)];
     vec3 ln = lobe_normal(m, r, i);
-    double cos_r = v3_dot(ln, view), sp[HAL_MAX_LIGHTS][3], rho[3];
-    for (uint32_t l = 0; l < c->light_count; l++)
+    double cos_r = v3_dot(ln, view), sp[HAL_MAX_LIGHTS][3], ct[HAL_MAX_LIGHTS], rho[3];
+    for (uint32_t l = 0; l < c->light_count; l++) {
         reflect_specular(cl, half_angle(p, ln, view, c->light_pos_mm[l]), cos_r, sp[l]);
+        if (ls.used >> l & 1u) /* the diffuse basis, what rho multiplies (Lambert's or Burley's) */
+            ct[l] = reflect_diffuse(cl, ls.cosine[l], cos_r, half_cos(p, view, c->light_pos_mm[l]));
+    }
     memcpy(rho, rho0, sizeof(rho));
     /* twice: each light weighs by eq. 6 and by the share of its signal the diffuse part is
      * (as the last estimate has it), so that where the lobe is most of the light (dark paint
@@ -479,14 +482,12 @@ static void fit_pixel(const struct frame_ctx *f, const struct scan_calib *c, str
             if (!(ls.used >> l & 1u))
                 continue;
             double sp_grey = (sp[l][0] + sp[l][1] + sp[l][2]) / 3.0;
-            double ct =
-                reflect_diffuse(cl, ls.cosine[l], cos_r, half_cos(p, view, c->light_pos_mm[l]));
-            double share = rho_grey * ct / (rho_grey * ct + sp_grey);
+            double share = rho_grey * ct[l] / (rho_grey * ct[l] + sp_grey);
             double w = ls.weight[l] * share * share;
             for (int ch = 0; ch < 3; ch++)
-                fit_num[ch] += w * (ls.lit[l][ch] * prm->white_scale[ch] - sp[l][ch]) * ct;
-            fit_den += w * ct * ct;
-            share_sum += ls.weight[l] * ct * share, share_den += ls.weight[l] * ct;
+                fit_num[ch] += w * (ls.lit[l][ch] * prm->white_scale[ch] - sp[l][ch]) * ct[l];
+            fit_den += w * ct[l] * ct[l];
+            share_sum += ls.weight[l] * ct[l] * share, share_den += ls.weight[l] * ct[l];
         }
         for (int ch = 0; ch < 3 && fit_den > 1e-12; ch++)
             rho[ch] = fmax(0.0, fit_num[ch] / fit_den);

@@ -272,10 +272,10 @@ static uint32_t kept_lights(struct reflect_pool *pl, uint32_t i, double cos_l[HA
     return n;
 }
 
-/* The lobe's K for the shape of @p shape (its GGX roughness, or its measured shape) over
- * cluster @p c's kept observations, the diffuse colours free (along_cos), per channel, not
- * below 0; @p no_lobe (may be NULL): the squared error of the diffuse colours alone (K = 0).
- * @retval the squared error */
+/* The lobe's K for the shape of @p shape (its GGX roughness, or its measured shape; NULL: no
+ * lobe, K = 0) over cluster @p c's kept observations, the diffuse colours free (along_cos), per
+ * channel, not below 0; @p no_lobe (may be NULL): the squared error of the diffuse colours
+ * alone (K = 0). @retval the squared error */
 static double fit_k(struct reflect_pool *pl, uint32_t c, const struct reflect_cluster *shape,
                     double k_out[3], double *no_lobe)
 {
@@ -287,7 +287,7 @@ static double fit_k(struct reflect_pool *pl, uint32_t c, const struct reflect_cl
         if (n < 2) /* one light: its diffuse colour explains it all */
             continue;
         for (uint32_t l = 0; l < n; l++)
-            g[l] = lobe_shape(shape, alpha[l], pl->obs[i].cos_r);
+            g[l] = shape != NULL ? lobe_shape(shape, alpha[l], pl->obs[i].cos_r) : 0.0;
         double mg = along_cos(cos_l, g, n), ms[3];
         for (int ch = 0; ch < 3; ch++)
             ms[ch] = along_cos(cos_l, sig[ch], n);
@@ -434,20 +434,9 @@ static double fit_lobe(struct reflect_pool *pl, struct reflect_cluster *cl, uint
 static double retro_error(struct reflect_pool *pl, struct reflect_cluster *cl, uint32_t c,
                           double retro)
 {
-    double err = 0.0;
+    double k[3];
     cl->retro = retro;
-    for (uint32_t i = 0; i < pl->count; i++) {
-        double cos_l[HAL_MAX_LIGHTS], alpha[HAL_MAX_LIGHTS], sig[3][HAL_MAX_LIGHTS];
-        uint32_t n = pl->cluster[i] == c ? kept_lights(pl, i, cos_l, alpha, sig) : 0;
-        if (n < 2) /* one light: its diffuse colour explains it all (as fit_k) */
-            continue;
-        for (int ch = 0; ch < 3; ch++) {
-            double ms = along_cos(cos_l, sig[ch], n);
-            for (uint32_t l = 0; l < n; l++)
-                err += (sig[ch][l] - ms * cos_l[l]) * (sig[ch][l] - ms * cos_l[l]);
-        }
-    }
-    return err;
+    return fit_k(pl, c, NULL, k, NULL); /* the diffuse colours alone, on cl's basis */
 }
 
 static void fit_retro(struct reflect_pool *pl, struct reflect_cluster *cl, uint32_t c)

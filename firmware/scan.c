@@ -166,10 +166,12 @@ static void prefault_view(struct scan_ctx *s, const struct scan_params *p,
                           const struct scan_calib *c)
 {
     size_t n = (size_t)p->width * p->height;
+    struct colour_layout lay;
+    colour_layout(&p->colour, c->light_count, &lay);
     prefault_colour(s, n);
     mem_prefault(s->colour_rgb, n * 3);
-    for (uint32_t k = 0; k < s->lights && k < COLOUR_MAX_FRAMES; k++)
-        if (scan_needs_light_frame(p, c, k))
+    for (uint32_t k = 0; k < lay.count && k < COLOUR_MAX_FRAMES; k++)
+        if (colour_needs_frame(&p->colour, &lay, k))
             mem_prefault(s->light_rgb[k], n * 3);
     if (p->exposure_count > 0) {
         mem_prefault(s->hdr_choice, n);

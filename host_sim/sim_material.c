@@ -59,9 +59,10 @@ void sim_material_eval(const struct sim_material *mat, const double albedo[3], v
     for (int c = 0; c < 3; c++)
         rho[c] = albedo[c] * cos_i; /* Lambert: pi * (kd / pi) * cos(theta_i) */
     if (mat->kind == SIM_MAT_BURLEY) {
-        /* Cycles' principled_diffuse (Burley 2015, the retro-reflection apart): f = (1 - FL / 2)
-         * (1 - FV / 2) + RR (FL + FV + FL FV (RR - 1)), RR = 2 roughness (L . H)^2, F* Schlick's
-         * (1 - cos)^5; rho = albedo f cos(theta_i) */
+        /* Cycles' principled_diffuse (Burley 2015's split form: a Lambertian part darkened at
+         * grazing, plus the retro-reflection RR ...): f = (1 - FL / 2) (1 - FV / 2) + RR (FL + FV
+         * + FL FV (RR - 1)), RR = 2 roughness (L . H)^2, F* Schlick's (1 - cos)^5; rho = albedo f
+         * cos(theta_i) */
         double fl = pow(1.0 - cos_i, 5.0), fv = pow(1.0 - cos_o, 5.0);
         double lh = v3_dot(l, v3_norm(v3_add(l, v))), rr = 2.0 * mat->roughness * lh * lh;
         double f = (1.0 - 0.5 * fl) * (1.0 - 0.5 * fv) + rr * (fl + fv + fl * fv * (rr - 1.0));
