@@ -323,11 +323,10 @@ static double half_angle(vec3 p, vec3 n, vec3 view, const double light_pos[3])
 }
 
 /* cos(theta_d) at @p p: half the angle between the light at @p light_pos and the camera (the
- * unit vector @p view), from cos(2 theta_d) = L . V */
+ * unit vector @p view) */
 static double half_cos(vec3 p, vec3 view, const double light_pos[3])
 {
-    double lv = v3_dot(toward(p, v3_from(light_pos)).dir, view);
-    return sqrt(lv > -1.0 ? 0.5 * (1.0 + lv) : 0.0);
+    return reflect_cos_d(v3_dot(toward(p, v3_from(light_pos)).dir, view));
 }
 
 /* Albedo estimate of valid pixel i: numerator per channel and the denominator (0: none), and

@@ -70,6 +70,11 @@ double reflect_diffuse(const struct reflect_cluster *cl, double cos_i, double co
     return cos_i * (1.0 + k * schlick(cos_i)) * (1.0 + k * schlick(cos_r));
 }
 
+double reflect_cos_d(double l_dot_v)
+{
+    return sqrt(l_dot_v > -1.0 ? 0.5 * (1.0 + l_dot_v) : 0.0);
+}
+
 static double node_angle(uint32_t k)
 {
     double t = (double)k / (REFLECT_LOBE_NODES - 1);

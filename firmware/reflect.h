@@ -120,6 +120,10 @@ void reflect_specular(const struct reflect_cluster *cl, double alpha, double cos
  *  theta_d: the angle between the light and the half vector (@p cos_d). */
 double reflect_diffuse(const struct reflect_cluster *cl, double cos_i, double cos_r, double cos_d);
 
+/** cos(theta_d) from @p l_dot_v, the cosine between the unit directions to the light and to the
+ *  camera: cos(2 theta_d) = L . V, so cos(theta_d) = sqrt((1 + L . V) / 2). */
+double reflect_cos_d(double l_dot_v);
+
 /** The lobe's factor D(alpha) / cos(theta_r) (times K: the specular part), D as above. */
 double reflect_lobe(double roughness, double alpha, double cos_r);
 

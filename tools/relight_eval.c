@@ -123,7 +123,7 @@ static int model_at(const struct sim_mesh *m, const struct sim_bvh *bvh,
         const struct reflect_cluster *cl = &lobes->cluster[reflect_cluster_of(lobes, rho)];
         double nh = v3_dot(n, v3_norm(v3_add(l, v)));
         reflect_specular(cl, acos(fmin(1.0, fmax(-1.0, nh))), cr, spec);
-        diffuse = reflect_diffuse(cl, ci, cr, sqrt(fmax(0.0, 0.5 * (1.0 + v3_dot(l, v)))));
+        diffuse = reflect_diffuse(cl, ci, cr, reflect_cos_d(v3_dot(l, v)));
     }
     /* the model's units hold at the reference distance: the new light's falloff times that */
     for (int c = 0; c < 3; c++)
