@@ -11,6 +11,7 @@
 #include "clock_posix.h"
 #include "hal_limits.h"
 #include "image_io.h"
+#include "mem.h"
 #include "thread_posix.h"
 
 #include <errno.h>
@@ -174,6 +175,7 @@ void frame_writer_stop(void)
     pthread_mutex_unlock(&w.lock);
     pthread_join(w.thread, NULL);
     w.running = 0;
+    mem_release(copies, sizeof(copies)); /* every copy written: not read again */
 }
 
 double frame_writer_cpu_s(void)

@@ -329,7 +329,7 @@ static int recolour_from_frames(struct job *j, const char *scan_dir, uint32_t v,
     uint32_t count = gray_layout_count(&layout), lights = scan_light_frame_count(p, j->calib);
     uint32_t white = p->exposure_count > 0 ? count + lights : GRAY_PATTERN_WHITE;
     char err[SCAN_DIR_PATH_MAX + 256];
-    int rc = scan_begin_view(j->scan, p, j->calib);
+    int rc = scan_begin_colour(j->scan, p, j->calib); /* the decoder not needed */
     for (uint32_t f = count; rc == 0 && f <= count + lights; f++) {
         uint32_t frame = f < count + lights ? f : white; /* the lights, then the white colour */
         if (f < count + lights && !scan_needs_light_frame(p, j->calib, f - count))
@@ -502,6 +502,7 @@ static void report_outside(struct job *j, const struct fusion_params *fp)
 int job_make_model(struct job *j, const char *scan_dir)
 {
     struct reg_report rep;
+    scan_release_frames(j->scan); /* the views are taken: their frames' memory serves the grid */
     double t0 = clock_posix_thread_cpu_s();
     reg_solve(j->reg, &rep);
     int rc = report_registration(j, &rep, clock_posix_thread_cpu_s() - t0, scan_dir);

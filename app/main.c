@@ -415,7 +415,9 @@ int main(int argc, char **argv)
     int status = check_command_line(argc, argv, &cmd);
     if (status >= 0)
         return status;
-    mem_use_prefault(memory_posix_prefault); /* the big static buffers mapped as they are begun */
+    /* the big static buffers mapped as they are begun, given back once done with */
+    static const struct mem_platform memory = {memory_posix_prefault, memory_posix_release};
+    mem_use(&memory);
     if (strcmp(argv[1], "--version") == 0) {
         printf("scanner %s (HAL=%s)\n", SCANNER_VERSION, board_name());
         return 0;

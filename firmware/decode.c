@@ -62,7 +62,9 @@ uint32_t decode_mean_threshold(const struct scan_params *p, uint32_t contrast_dn
 
 /* Every per-pixel buffer of the decoder, for @p n pixels, mapped ahead (mem.h): each view
  * writes all of them (the planes no bit reaches are cleared). */
-static void prefault(struct decode_ctx *d, size_t n)
+/* Every per-pixel plane of the decoder, its first @p n pixels: mapped ahead (mem_prefault) or
+ * given back (mem_release). */
+static void planes(struct decode_ctx *d, size_t n, void (*op)(void *addr, size_t bytes))
 {
     uint8_t *bytes[] = {d->white,         d->black,         d->stage[0],       d->stage[1],
                         d->threshold,     d->mean,          d->mean_threshold, d->sat,
@@ -71,9 +73,14 @@ static void prefault(struct decode_ctx *d, size_t n)
                         d->scratch};
     uint16_t *words[] = {d->column_map, d->row_map, d->unclear_col, d->unclear_row};
     for (size_t k = 0; k < sizeof(bytes) / sizeof(bytes[0]); k++)
-        mem_prefault(bytes[k], n);
+        op(bytes[k], n);
     for (size_t k = 0; k < sizeof(words) / sizeof(words[0]); k++)
-        mem_prefault(words[k], n * sizeof(uint16_t));
+        op(words[k], n * sizeof(uint16_t));
+}
+
+void decode_release(struct decode_ctx *d)
+{
+    planes(d, HAL_MAX_PIXELS, mem_release); /* a plane's first use writes it whole */
 }
 
 int decode_begin(struct decode_ctx *d, const struct scan_params *params,
@@ -94,7 +101,7 @@ int decode_begin(struct decode_ctx *d, const struct scan_params *params,
     }
     d->xor_col = gray_code_xor_mask(layout->code, layout->col_bits);
     d->xor_row = gray_code_xor_mask(layout->code, layout->row_bits);
-    prefault(d, (size_t)params->width * params->height);
+    planes(d, (size_t)params->width * params->height, mem_prefault);
     return 0;
 }
 

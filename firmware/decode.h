@@ -89,6 +89,10 @@ uint32_t decode_bit_threshold(const struct scan_params *params, uint32_t contras
  *  quarter of decode_bit_threshold, rounded up (measured: decode.c says why). */
 uint32_t decode_mean_threshold(const struct scan_params *params, uint32_t contrast_dn);
 
+/** Give back the memory of @p d's per-pixel planes (mem_release) until the next decode_begin:
+ *  their contents are not read again before a view writes them (zeros if they are). */
+void decode_release(struct decode_ctx *d);
+
 /** Start a view of a @p proj_width x @p proj_height projector coded as @p layout in @p d.
  *  @retval 0 ok @retval -EINVAL size or pattern count above the compiled limits */
 int decode_begin(struct decode_ctx *d, const struct scan_params *params,

@@ -160,23 +160,17 @@ static void prefault_colour(struct scan_ctx *s, size_t n)
     mem_prefault(s->view_reason, n);
 }
 
-/* ... and those its frames are read into (the decoder's are its own: decode_begin): the view's
- * colour, the colour frames its method reads, HDR's merge. */
-static void prefault_view(struct scan_ctx *s, const struct scan_params *p,
-                          const struct scan_calib *c)
+/* ... and the colour frames its method reads, with the white frame kept as its colour. */
+static void prefault_colour_frames(struct scan_ctx *s, const struct scan_params *p,
+                                   const struct scan_calib *c)
 {
     size_t n = (size_t)p->width * p->height;
     struct colour_layout lay;
     colour_layout(&p->colour, c->light_count, &lay);
-    prefault_colour(s, n);
     mem_prefault(s->colour_rgb, n * 3);
     for (uint32_t k = 0; k < lay.count && k < COLOUR_MAX_FRAMES; k++)
         if (colour_needs_frame(&p->colour, &lay, k))
             mem_prefault(s->light_rgb[k], n * 3);
-    if (p->exposure_count > 0) {
-        mem_prefault(s->hdr_choice, n);
-        mem_prefault(s->hdr_grey, n);
-    }
 }
 
 /* The points' buffers (written only where a pixel decoded), mapped ahead from the first row
@@ -195,18 +189,48 @@ static void prefault_points(struct scan_ctx *s, const struct decode_maps *m)
     mem_prefault(s->tri.normal + 3 * i, 3 * n * sizeof(s->tri.normal[0]));
 }
 
-int scan_begin_view(struct scan_ctx *s, const struct scan_params *p, const struct scan_calib *c)
+int scan_begin_colour(struct scan_ctx *s, const struct scan_params *p, const struct scan_calib *c)
 {
     struct gray_layout layout;
+    if (p->width == 0 || p->height == 0 || p->width > HAL_MAX_WIDTH || p->height > HAL_MAX_HEIGHT)
+        return -EINVAL;
     s->params = *p;
     memset(s->light_present, 0, sizeof(s->light_present));
     scan_layout(p, c, &layout);
     s->patterns = gray_layout_count(&layout);
     s->lights = scan_light_frame_count(p, c);
+    prefault_colour_frames(s, p, c);
+    return 0;
+}
+
+int scan_begin_view(struct scan_ctx *s, const struct scan_params *p, const struct scan_calib *c)
+{
+    struct gray_layout layout;
+    scan_layout(p, c, &layout);
     int rc = decode_begin(&s->decode, p, &layout, c->proj_width, c->proj_height);
     if (rc == 0)
-        prefault_view(s, p, c);
-    return rc;
+        rc = scan_begin_colour(s, p, c);
+    if (rc != 0)
+        return rc;
+    size_t n = (size_t)p->width * p->height;
+    prefault_colour(s, n); /* (the decoder's buffers are its own: decode_begin) */
+    if (p->exposure_count > 0) {
+        mem_prefault(s->hdr_choice, n);
+        mem_prefault(s->hdr_grey, n);
+    }
+    return 0;
+}
+
+void scan_release_frames(struct scan_ctx *s)
+{
+    decode_release(&s->decode);
+    mem_release(s->column, sizeof(s->column));
+    mem_release(s->colour_rgb, sizeof(s->colour_rgb));
+    mem_release(s->frame_rgb, sizeof(s->frame_rgb));
+    mem_release(s->light_rgb, sizeof(s->light_rgb));
+    memset(s->light_present, 0, sizeof(s->light_present));
+    mem_release(s->hdr_choice, sizeof(s->hdr_choice));
+    mem_release(s->hdr_grey, sizeof(s->hdr_grey));
 }
 
 int scan_feed_frame(struct scan_ctx *s, uint32_t pattern, const uint8_t *pixels, uint32_t channels,

@@ -173,6 +173,17 @@ int scan_take_view(struct scan_ctx *s, const struct hal *hal, const struct scan_
  *  @retval 0 or -EINVAL */
 int scan_begin_view(struct scan_ctx *s, const struct scan_params *params,
                     const struct scan_calib *calib);
+/** Begin a view's colour only, its range image restored (scan_restore_view): the colour frames
+ *  and the white frame are then read into scan_frame_buffer and fed (scan_feed_light_frame),
+ *  and scan_attach_colour hands them to the view. The decoder is left as it is.
+ *  @retval 0 @retval -EINVAL a frame size beyond the compiled limits */
+int scan_begin_colour(struct scan_ctx *s, const struct scan_params *params,
+                      const struct scan_calib *calib);
+/** The frames, the decoder's planes and the projector columns of the views taken are not
+ *  needed again until the next view begins (scan_begin_view, scan_begin_colour): their memory
+ *  is given back (mem_release), so that the stages after the views (the fusion grid, the mesh,
+ *  the texture) do not add to it. The range image, the view's colour and its reasons stay. */
+void scan_release_frames(struct scan_ctx *s);
 /** The pattern sequence of a view (columns, and rows when params->decode_rows). */
 void scan_layout(const struct scan_params *params, const struct scan_calib *calib,
                  struct gray_layout *layout);
