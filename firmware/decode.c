@@ -60,27 +60,27 @@ uint32_t decode_mean_threshold(const struct scan_params *p, uint32_t contrast_dn
     return (decode_bit_threshold(p, contrast_dn) + 3u) / 4u;
 }
 
-/* Every per-pixel buffer of the decoder, for @p n pixels, mapped ahead (mem.h): each view
- * writes all of them (the planes no bit reaches are cleared). */
-/* Every per-pixel plane of the decoder, its first @p n pixels: mapped ahead (mem_prefault) or
- * given back (mem_release). */
-static void planes(struct decode_ctx *d, size_t n, void (*op)(void *addr, size_t bytes))
+/* The decoder's per-pixel planes, their first @p n pixels: mapped ahead (mem_prefault) or given
+ * back (mem_release); the rows' (@p rows 0: not) only where rows are coded, for nothing reads
+ * or writes them otherwise (8 bytes a pixel: 128 MB of a 16 MP view). */
+static void planes(struct decode_ctx *d, size_t n, int rows, void (*op)(void *addr, size_t bytes))
 {
-    uint8_t *bytes[] = {d->white,         d->black,         d->stage[0],       d->stage[1],
-                        d->threshold,     d->mean,          d->mean_threshold, d->sat,
-                        d->word_hi[0],    d->word_hi[1],    d->word_lo[0],     d->word_lo[1],
-                        d->unclear_hi[0], d->unclear_hi[1], d->unclear_lo[0],  d->unclear_lo[1],
-                        d->scratch};
-    uint16_t *words[] = {d->column_map, d->row_map, d->unclear_col, d->unclear_row};
-    for (size_t k = 0; k < sizeof(bytes) / sizeof(bytes[0]); k++)
+    uint8_t *bytes[] = {d->white,          d->black,        d->stage[0],       d->stage[1],
+                        d->threshold,      d->mean,         d->mean_threshold, d->sat,
+                        d->word_hi[0],     d->word_lo[0],   d->unclear_hi[0],  d->unclear_lo[0],
+                        d->scratch,        d->word_hi[1],   d->word_lo[1],     d->unclear_hi[1],
+                        d->unclear_lo[1]};
+    uint16_t *words[] = {d->column_map, d->unclear_col, d->row_map, d->unclear_row};
+    const size_t row_bytes = 4, row_words = 2; /* the last of each list */
+    for (size_t k = 0; k < sizeof(bytes) / sizeof(bytes[0]) - (rows ? 0 : row_bytes); k++)
         op(bytes[k], n);
-    for (size_t k = 0; k < sizeof(words) / sizeof(words[0]); k++)
+    for (size_t k = 0; k < sizeof(words) / sizeof(words[0]) - (rows ? 0 : row_words); k++)
         op(words[k], n * sizeof(uint16_t));
 }
 
 void decode_release(struct decode_ctx *d)
 {
-    planes(d, HAL_MAX_PIXELS, mem_release); /* a plane's first use writes it whole */
+    planes(d, HAL_MAX_PIXELS, 1, mem_release); /* a plane's first use writes it whole */
 }
 
 int decode_begin(struct decode_ctx *d, const struct scan_params *params,
@@ -101,7 +101,7 @@ int decode_begin(struct decode_ctx *d, const struct scan_params *params,
     }
     d->xor_col = gray_code_xor_mask(layout->code, layout->col_bits);
     d->xor_row = gray_code_xor_mask(layout->code, layout->row_bits);
-    planes(d, (size_t)params->width * params->height, mem_prefault);
+    planes(d, (size_t)params->width * params->height, layout->row_bits > 0, mem_prefault);
     return 0;
 }
 
@@ -151,10 +151,8 @@ static void begin_bits(struct decode_ctx *d, size_t n)
     }
     for (int axis = 0; axis < 2; axis++) {
         uint32_t bits = axis ? d->layout.row_bits : d->layout.col_bits;
-        if (bits == 0) {
-            memset(d->word_hi[axis], 0, n);
-            memset(d->unclear_hi[axis], 0, n);
-        }
+        if (bits == 0) /* no rows coded: their planes are not read (columns have a bit at least) */
+            continue;
         if (bits <= 8) {
             memset(d->word_lo[axis], 0, n);
             memset(d->unclear_lo[axis], 0, n);
@@ -317,29 +315,40 @@ static void block_unclear_counts(uint8_t *restrict count, const uint16_t *restri
 /* classify, as selects from the last rule to the first so that the first that holds wins.
  * Thresholds are clamped where the comparison no longer changes (contrast is -255..255, a
  * count at most 16), so that everything fits 16-bit lanes. */
-static void block_reasons(uint8_t *restrict reason, const struct decode_ctx *d, size_t start,
-                          const uint8_t *restrict count_c, const uint8_t *restrict count_r,
-                          size_t len)
+static inline void block_reasons_loop(uint8_t *restrict reason, const struct decode_ctx *d,
+                                      size_t start, const uint8_t *restrict count_c,
+                                      const uint8_t *restrict count_r, size_t len, const int rows)
 {
     const struct scan_params *p = &d->params;
     const int16_t shadow = (int16_t)(p->shadow_contrast_dn < 255u ? p->shadow_contrast_dn : 255u);
     const int16_t dark = (int16_t)(p->min_contrast_dn < 256u ? p->min_contrast_dn : 256u);
     const uint8_t most = (uint8_t)(p->max_ambiguous_bits < 255u ? p->max_ambiguous_bits : 255u);
-    /* with no rows coded every row is 0, never outside */
-    const uint16_t width = (uint16_t)d->proj_width;
-    const uint16_t height = d->layout.row_bits > 0 ? (uint16_t)d->proj_height : UINT16_MAX;
+    const uint16_t width = (uint16_t)d->proj_width, height = (uint16_t)d->proj_height;
     const uint8_t *restrict white = d->white + start, *restrict black = d->black + start;
     const uint8_t *restrict sat = d->sat + start;
     const uint16_t *restrict col = d->column_map + start, *restrict row = d->row_map + start;
     for (size_t i = 0; i < len; i++) {
         int16_t contrast = (int16_t)(white[i] - black[i]);
-        uint8_t r = (col[i] >= width) | (row[i] >= height) ? SCAN_INCONSISTENT : SCAN_VALID;
+        uint8_t out = rows ? (col[i] >= width) | (row[i] >= height) : col[i] >= width;
+        uint8_t r = out ? SCAN_INCONSISTENT : SCAN_VALID;
         uint8_t unclear = sat[i] ? SCAN_SATURATED : SCAN_LOW_CONTRAST;
-        r = (count_c[i] > most) | (count_r[i] > most) ? unclear : r;
+        r = (rows ? (count_c[i] > most) | (count_r[i] > most) : count_c[i] > most) ? unclear : r;
         r = contrast < dark ? SCAN_DARK : r;
         r = contrast <= shadow ? SCAN_SHADOW : r;
         reason[i] = black[i] == DECODE_SATURATED ? SCAN_SATURATED : r;
     }
+}
+
+/* The loop with and without rows (a constant where it is inlined: with no rows coded their
+ * planes are neither read nor written, and every pixel's row is as good as 0). */
+static void block_reasons(uint8_t *restrict reason, const struct decode_ctx *d, size_t start,
+                          const uint8_t *restrict count_c, const uint8_t *restrict count_r,
+                          size_t len)
+{
+    if (d->layout.row_bits > 0)
+        block_reasons_loop(reason, d, start, count_c, count_r, len, 1);
+    else
+        block_reasons_loop(reason, d, start, count_c, count_r, len, 0);
 }
 
 /* Pixels whose unclear bits are counted at a time: the counts live on the stack. */
@@ -349,20 +358,22 @@ static void decode_block(struct decode_ctx *d, size_t start, size_t len, uint8_t
 {
     const unsigned cols = d->layout.col_bits, rows = d->layout.row_bits;
     const unsigned lo_col = cols > 8 ? cols - 8 : 0, lo_row = rows > 8 ? rows - 8 : 0;
-    /* with no rows coded their planes stay as begin_bits cleared them: every row word 0 */
     block_words(d->column_map + start, d->word_hi[0] + start, d->word_lo[0] + start, lo_col, len);
-    block_words(d->row_map + start, d->word_hi[1] + start, d->word_lo[1] + start, lo_row, len);
     block_words(d->unclear_col + start, d->unclear_hi[0] + start, d->unclear_lo[0] + start, lo_col,
                 len);
-    block_words(d->unclear_row + start, d->unclear_hi[1] + start, d->unclear_lo[1] + start, lo_row,
-                len);
     block_values(d->column_map + start, (uint16_t)d->xor_col, len);
-    block_values(d->row_map + start, (uint16_t)d->xor_row, len);
+    if (rows > 0) {
+        block_words(d->row_map + start, d->word_hi[1] + start, d->word_lo[1] + start, lo_row, len);
+        block_words(d->unclear_row + start, d->unclear_hi[1] + start, d->unclear_lo[1] + start,
+                    lo_row, len);
+        block_values(d->row_map + start, (uint16_t)d->xor_row, len);
+    }
     for (size_t at = start; at < start + len; at += DECODE_COUNT_CHUNK) {
         size_t n = start + len - at < DECODE_COUNT_CHUNK ? start + len - at : DECODE_COUNT_CHUNK;
         uint8_t count_c[DECODE_COUNT_CHUNK], count_r[DECODE_COUNT_CHUNK];
         block_unclear_counts(count_c, d->unclear_col + at, (uint16_t)d->xor_col, n);
-        block_unclear_counts(count_r, d->unclear_row + at, (uint16_t)d->xor_row, n);
+        if (rows > 0)
+            block_unclear_counts(count_r, d->unclear_row + at, (uint16_t)d->xor_row, n);
         block_reasons(reason + at, d, at, count_c, count_r, n);
     }
 }
@@ -519,10 +530,10 @@ static void resolve_rows(void *arg, unsigned k)
             uint8_t r = reason[i];
             d->scratch[i] = r;
             int pending = r == SCAN_LOW_CONTRAST || r == SCAN_SATURATED || r == SCAN_INCONSISTENT;
-            if ((!pending && r != SCAN_VALID) ||
-                (d->unclear_col[i] == 0 && d->unclear_row[i] == 0) ||
+            uint16_t unclear_row = rows ? d->unclear_row[i] : 0; /* no rows: no row planes */
+            if ((!pending && r != SCAN_VALID) || (d->unclear_col[i] == 0 && unclear_row == 0) ||
                 unclear_count(d->unclear_col[i], d->xor_col) > max_unclear ||
-                unclear_count(d->unclear_row[i], d->xor_row) > max_unclear)
+                unclear_count(unclear_row, d->xor_row) > max_unclear)
                 continue;
             double ref_col, ref_row = 0.0;
             uint16_t col, row = 0;
@@ -531,15 +542,17 @@ static void resolve_rows(void *arg, unsigned k)
                                  d->unclear_col[i], ref_col, d->proj_width, &col) ||
                 (rows && (!neighbourhood_code(d, reason, d->row_map, x, y, &ref_row) ||
                           !nearest_reading(d->layout.code, d->layout.row_bits, d->row_map[i],
-                                           d->unclear_row[i], ref_row, d->proj_height, &row))))
+                                           unclear_row, ref_row, d->proj_height, &row))))
                 continue;
             if (pending) { /* not a reference of this pass: its maps can change now */
                 d->column_map[i] = col;
-                d->row_map[i] = row;
+                if (rows)
+                    d->row_map[i] = row;
                 d->scratch[i] = SCAN_VALID;
             } else if (col != d->column_map[i] || (rows && row != d->row_map[i])) {
                 d->unclear_col[i] = col;
-                d->unclear_row[i] = rows ? row : d->row_map[i];
+                if (rows)
+                    d->unclear_row[i] = row;
                 d->scratch[i] = RESOLVE_CORRECTED;
             }
         }
@@ -571,10 +584,12 @@ static void resolve_apply(void *arg, unsigned k)
     struct decode_ctx *d = p->d;
     size_t i0, i1;
     part_pixels(p, k, &i0, &i1);
+    const int rows = d->layout.row_bits > 0;
     for (size_t i = i0; i < i1; i++) {
         if (d->scratch[i] == RESOLVE_CORRECTED) {
             d->column_map[i] = d->unclear_col[i];
-            d->row_map[i] = d->unclear_row[i];
+            if (rows)
+                d->row_map[i] = d->unclear_row[i];
             d->scratch[i] = SCAN_VALID;
         }
     }

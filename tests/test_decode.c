@@ -342,6 +342,44 @@ static void test_mean_threshold(void **state)
     assert_int_equal(decode_mean_threshold(&p, 100), 3); /* the pair's 12 */
 }
 
+/* Without rows coded the rows' planes are neither read nor written (decode.c maps and clears
+ * none of them): planes left full of ones by an earlier view that coded rows change nothing, in
+ * the per-pixel stage or the neighbourhood's (its unclear pixels resolved), and stay as they
+ * were. */
+static void test_row_planes_untouched_without_rows(void **state)
+{
+    (void)state;
+    static uint8_t reason1[W * H];
+    static uint16_t column1[W * H];
+    uint32_t bits = gray_bits_for_width(PROJ_W);
+    struct scan_params p = params();
+    struct gray_layout l = layout_of(bits);
+    assert_int_equal(l.row_bits, 0);
+    assert_int_equal(decode_begin(&dec, &p, &l, PROJ_W, 1), 0);
+    feed_ambiguous_scene(bits);
+    assert_int_equal(decode_finish(&dec, NULL, reason1, &maps_out), 0);
+    assert_null(maps_out.row);
+    memcpy(column1, maps_out.column, sizeof(column1));
+    assert_int_equal(reason1[20], SCAN_VALID); /* resolved by its neighbourhood */
+    memset(dec.word_hi[1], 0xFF, W * H);
+    memset(dec.word_lo[1], 0xFF, W * H);
+    memset(dec.unclear_hi[1], 0xFF, W * H);
+    memset(dec.unclear_lo[1], 0xFF, W * H);
+    memset(dec.row_map, 0xFF, W * H * sizeof(uint16_t));
+    memset(dec.unclear_row, 0xFF, W * H * sizeof(uint16_t));
+    assert_int_equal(decode_begin(&dec, &p, &l, PROJ_W, 1), 0);
+    feed_ambiguous_scene(bits);
+    assert_int_equal(decode_finish(&dec, NULL, reason_out, &maps_out), 0);
+    assert_memory_equal(reason_out, reason1, sizeof(reason1));
+    for (size_t i = 0; i < W * H; i++) {
+        if (reason1[i] == SCAN_VALID)
+            assert_int_equal(maps_out.column[i], column1[i]);
+        assert_int_equal(dec.row_map[i], 0xFFFFu);
+        assert_int_equal(dec.unclear_row[i], 0xFFFFu);
+        assert_int_equal(dec.word_hi[1][i] & dec.unclear_lo[1][i], 0xFF);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -357,6 +395,7 @@ int main(void)
         cmocka_unit_test(test_xor04_columns_and_reference),
         cmocka_unit_test(test_fewer_inverses),
         cmocka_unit_test(test_mean_threshold),
+        cmocka_unit_test(test_row_planes_untouched_without_rows),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
