@@ -65,10 +65,10 @@ uint32_t decode_mean_threshold(const struct scan_params *p, uint32_t contrast_dn
  * or writes them otherwise (8 bytes a pixel: 128 MB of a 16 MP view). */
 static void planes(struct decode_ctx *d, size_t n, int rows, void (*op)(void *addr, size_t bytes))
 {
-    uint8_t *bytes[] = {d->white,          d->black,        d->stage[0],       d->stage[1],
-                        d->threshold,      d->mean,         d->mean_threshold, d->sat,
-                        d->word_hi[0],     d->word_lo[0],   d->unclear_hi[0],  d->unclear_lo[0],
-                        d->scratch,        d->word_hi[1],   d->word_lo[1],     d->unclear_hi[1],
+    uint8_t *bytes[] = {d->white,        d->black,      d->stage[0],       d->stage[1],
+                        d->threshold,    d->mean,       d->mean_threshold, d->sat,
+                        d->word_hi[0],   d->word_lo[0], d->unclear_hi[0],  d->unclear_lo[0],
+                        d->scratch,      d->word_hi[1], d->word_lo[1],     d->unclear_hi[1],
                         d->unclear_lo[1]};
     uint16_t *words[] = {d->column_map, d->unclear_col, d->row_map, d->unclear_row};
     const size_t row_bytes = 4, row_words = 2; /* the last of each list */
