@@ -2,8 +2,10 @@
 # make measure-large (issue 33): make run's scan with a DSLR's full 4896 x 3264 frames, decoded
 # and fused without binning by the LIMITS=large build, beside the same rig at 1280 x 960: the
 # points a view, the model against the truth, the scan's CPU and rig time, its peak memory and
-# the build's static buffers. The sensor sits behind the same lens: the focal length and the
-# principal point in pixels scale with the width. Writes BUILD/measure-large/; about 4 minutes
+# the build's static buffers; then `scanner process` of the same scan, whose peak memory is the
+# scanner's own (the live scan's includes the simulator's rendering, which a rig has not). The
+# sensor sits behind the same lens: the focal length and the principal point in pixels scale
+# with the width. Writes BUILD/measure-large/; about 4 minutes
 # and 5 GB of kept frames here (removed once measured; KEEP=1 keeps them).
 # Usage: scripts/measure-large.sh BUILD_DIR   (the LIMITS=large build: build/large)
 set -eu
@@ -13,8 +15,8 @@ rm -rf "$out"
 mkdir -p "$out"
 static=$(size -A "$build/scanner" | awk '$1 ~ /^\.(data|bss|lbss|ldata)$/ { s += $2 }
     END { printf "%.0f", s / 1048576 }')
-echo "| frames | points in view 1 | model -> truth mean mm | truth within 1 mm | scan CPU s (cost line) | rig clock s | peak resident MB | static buffers MiB |"
-echo "|---|---|---|---|---|---|---|---|"
+echo "| frames | points in view 1 | model -> truth mean mm | truth within 1 mm | scan CPU s (cost line) | rig clock s | peak resident MB, scan (simulator included) | peak resident MB, process | static buffers MiB |"
+echo "|---|---|---|---|---|---|---|---|---|"
 for size in 1280x960 4896x3264; do
     w=${size%x*} h=${size#*x}
     s=$(awk -v w="$w" 'BEGIN { printf "%.6f", w / 1280 }')
@@ -42,6 +44,12 @@ for size in 1280x960 4896x3264; do
     cpu=$(sed -n 's/^cost: the scan \([0-9.]*\) s CPU.*/\1/p' "$out/scan-$size.log")
     rig=$(sed -n 's/.*; \([0-9.]*\) s on the rig.s clock$/\1/p' "$out/scan-$size.log")
     rss=$(awk '{ printf "%.0f", $1 / 1024 }' "$out/rss-$size.txt")
-    echo "| $w x $h | $points | $mean | $within | $cpu | $rig | $rss | $static |"
+    /usr/bin/time -f "%M" -o "$out/rss-process-$size.txt" \
+        "$build/scanner" process "$out/scan-$size" --out "$out/processed-$size" \
+        > "$out/process-$size.log" 2>&1
+    cmp "$out/scan-$size/mesh.ply" "$out/processed-$size/mesh.ply" # the same scan made again
+    rss_process=$(awk '{ printf "%.0f", $1 / 1024 }' "$out/rss-process-$size.txt")
+    echo "| $w x $h | $points | $mean | $within | $cpu | $rig | $rss | $rss_process | $static |"
+    rm -rf "$out/processed-$size"
     [ "${KEEP:-0}" = 1 ] || rm -rf "$out/scan-$size"/view_*
 done
