@@ -36,7 +36,8 @@ __attribute__((noinline)) void process_view_once(struct test_rig *t, const uint8
     scan_layout(&t->cfg.scan, &t->calib, &layout);
     s[0] = now_ms();
     struct scan_ctx *sc = t->scan;
-    decode_begin(&sc->decode, &t->cfg.scan, &layout, t->calib.proj_width, t->calib.proj_height);
+    decode_begin(&sc->decode, &sc->planes.decoding, &t->cfg.scan, &layout, t->calib.proj_width,
+                 t->calib.proj_height);
     double convert_ms = 0.0; /* the grey conversion apart: each frame's bit is the decode's */
     for (uint32_t i = 0; i < count; i++) {
         double c0 = now_ms();
@@ -58,10 +59,10 @@ __attribute__((noinline)) void process_view_once(struct test_rig *t, const uint8
     refine_columns(&view.maps, NULL, (int)t->cfg.scan.refine, sc->column);
     view.column = sc->column;
     s[3] = now_ms();
-    tri_range_image(&t->calib, NULL, &sc->tri, view.width, view.height, view.column, reason,
+    tri_range_image(&t->calib, NULL, &sc->planes.tri, view.width, view.height, view.column, reason,
                     &view.range);
     s[4] = now_ms();
-    tri_normals(&sc->tri, NULL, &view.range, reason, t->cfg.scan.normal_radius_px,
+    tri_normals(&sc->planes.tri, NULL, &view.range, reason, t->cfg.scan.normal_radius_px,
                 t->cfg.scan.max_depth_jump_mm);
     s[5] = now_ms();
     /* the joint registration keeps each view's samples now and solves once at the end */

@@ -60,36 +60,48 @@ uint32_t decode_mean_threshold(const struct scan_params *p, uint32_t contrast_dn
     return (decode_bit_threshold(p, contrast_dn) + 3u) / 4u;
 }
 
-/* The decoder's per-pixel planes, their first @p n pixels: mapped ahead (mem_prefault) or given
- * back (mem_release); the rows' (@p rows 0: not) only where rows are coded, for nothing reads
- * or writes them otherwise (8 bytes a pixel: 128 MB of a 16 MP view). */
-static void planes(struct decode_ctx *d, size_t n, int rows, void (*op)(void *addr, size_t bytes))
+/* The decoder's own per-pixel planes, their first @p n pixels: mapped ahead (mem_prefault) or
+ * given back (mem_release); the rows' map (@p rows 0: not) only where rows are coded, for
+ * nothing reads or writes the rows' planes otherwise. */
+static void own_planes(struct decode_ctx *d, size_t n, int rows,
+                       void (*op)(void *addr, size_t bytes))
 {
-    uint8_t *bytes[] = {d->white,        d->black,      d->stage[0],       d->stage[1],
-                        d->threshold,    d->mean,       d->mean_threshold, d->sat,
-                        d->word_hi[0],   d->word_lo[0], d->unclear_hi[0],  d->unclear_lo[0],
-                        d->scratch,      d->word_hi[1], d->word_lo[1],     d->unclear_hi[1],
-                        d->unclear_lo[1]};
-    uint16_t *words[] = {d->column_map, d->unclear_col, d->row_map, d->unclear_row};
-    const size_t row_bytes = 4, row_words = 2; /* the last of each list */
+    op(d->white, n);
+    op(d->black, n);
+    op(d->column_map, n * sizeof(uint16_t));
+    if (rows)
+        op(d->row_map, n * sizeof(uint16_t));
+}
+
+/* Its working planes, likewise (without rows 7 bytes a pixel fewer: 112 MB of a 16 MP view). */
+static void work_planes(struct decode_work *w, size_t n, int rows,
+                        void (*op)(void *addr, size_t bytes))
+{
+    uint8_t *bytes[] = {w->stage[0],       w->stage[1],      w->threshold,    w->mean,
+                        w->mean_threshold, w->sat,           w->word_hi[0],   w->word_lo[0],
+                        w->unclear_hi[0],  w->unclear_lo[0], w->scratch,      w->word_hi[1],
+                        w->word_lo[1],     w->unclear_hi[1], w->unclear_lo[1]};
+    const size_t row_bytes = 4; /* the last of the list */
     for (size_t k = 0; k < sizeof(bytes) / sizeof(bytes[0]) - (rows ? 0 : row_bytes); k++)
         op(bytes[k], n);
-    for (size_t k = 0; k < sizeof(words) / sizeof(words[0]) - (rows ? 0 : row_words); k++)
-        op(words[k], n * sizeof(uint16_t));
+    op(w->unclear_col, n * sizeof(uint16_t));
+    if (rows)
+        op(w->unclear_row, n * sizeof(uint16_t));
 }
 
 void decode_release(struct decode_ctx *d)
 {
-    planes(d, HAL_MAX_PIXELS, 1, mem_release); /* a plane's first use writes it whole */
+    own_planes(d, HAL_MAX_PIXELS, 1, mem_release); /* a plane's first use writes it whole */
 }
 
-int decode_begin(struct decode_ctx *d, const struct scan_params *params,
+int decode_begin(struct decode_ctx *d, struct decode_work *work, const struct scan_params *params,
                  const struct gray_layout *layout, uint32_t proj_width, uint32_t proj_height)
 {
     if (params->width == 0 || params->height == 0 || params->width > HAL_MAX_WIDTH ||
         params->height > HAL_MAX_HEIGHT || layout->col_bits == 0 || layout->col_bits > 16 ||
-        layout->row_bits > 16 || gray_layout_count(layout) > DECODE_MAX_PATTERNS)
+        layout->row_bits > 16 || gray_layout_count(layout) > DECODE_MAX_PATTERNS || work == NULL)
         return -EINVAL;
+    d->work = work;
     d->params = *params;
     d->layout = *layout;
     d->proj_width = proj_width;
@@ -101,7 +113,9 @@ int decode_begin(struct decode_ctx *d, const struct scan_params *params,
     }
     d->xor_col = gray_code_xor_mask(layout->code, layout->col_bits);
     d->xor_row = gray_code_xor_mask(layout->code, layout->row_bits);
-    planes(d, (size_t)params->width * params->height, layout->row_bits > 0, mem_prefault);
+    size_t n = (size_t)params->width * params->height;
+    own_planes(d, n, layout->row_bits > 0, mem_prefault);
+    work_planes(work, n, layout->row_bits > 0, mem_prefault);
     return 0;
 }
 
@@ -131,7 +145,7 @@ uint8_t *decode_frame_slot(struct decode_ctx *d, uint32_t pattern)
         return d->black;
     if (pattern_bit(d, pattern, &is_row, &k, &paired, &is_inverse) != 0)
         return NULL;
-    return paired && !is_inverse ? d->stage[0] : d->stage[1];
+    return paired && !is_inverse ? d->work->stage[0] : d->work->stage[1];
 }
 
 /* Black handed over: each pixel's thresholds from its contrast and the mean its bits without
@@ -145,17 +159,17 @@ static void begin_bits(struct decode_ctx *d, size_t n)
     const uint8_t *restrict white = d->white, *restrict black = d->black;
     for (size_t i = 0; i < n; i++) {
         uint8_t contrast = (uint8_t)(white[i] > black[i] ? white[i] - black[i] : 0);
-        d->threshold[i] = d->bit_threshold[contrast];
-        d->mean_threshold[i] = d->mean_threshold_of[contrast];
-        d->mean[i] = (uint8_t)(((unsigned)white[i] + black[i] + 1u) >> 1);
+        d->work->threshold[i] = d->bit_threshold[contrast];
+        d->work->mean_threshold[i] = d->mean_threshold_of[contrast];
+        d->work->mean[i] = (uint8_t)(((unsigned)white[i] + black[i] + 1u) >> 1);
     }
     for (int axis = 0; axis < 2; axis++) {
         uint32_t bits = axis ? d->layout.row_bits : d->layout.col_bits;
         if (bits == 0) /* no rows coded: their planes are not read (columns have a bit at least) */
             continue;
         if (bits <= 8) {
-            memset(d->word_lo[axis], 0, n);
-            memset(d->unclear_lo[axis], 0, n);
+            memset(d->work->word_lo[axis], 0, n);
+            memset(d->work->unclear_lo[axis], 0, n);
         }
     }
 }
@@ -188,16 +202,16 @@ static inline void read_bit_loop(uint8_t *restrict word, uint8_t *restrict unc,
 static void read_bit(struct decode_ctx *d, int is_row, uint32_t k, const uint8_t *restrict pos,
                      const uint8_t *restrict neg, const uint8_t *restrict thr, size_t n)
 {
-    uint8_t *word = k < 8 ? d->word_hi[is_row] : d->word_lo[is_row];
-    uint8_t *unc = k < 8 ? d->unclear_hi[is_row] : d->unclear_lo[is_row];
+    uint8_t *word = k < 8 ? d->work->word_hi[is_row] : d->work->word_lo[is_row];
+    uint8_t *unc = k < 8 ? d->work->unclear_hi[is_row] : d->work->unclear_lo[is_row];
     /* a plane's first bit (0 or 8) writes it whole; the view's first, the columns' top bit
      * (columns come first in every layout and have at least one bit), the saturation plane too */
     if (!is_row && k == 0)
-        read_bit_loop(word, unc, d->sat, pos, neg, thr, n, 1, 1);
+        read_bit_loop(word, unc, d->work->sat, pos, neg, thr, n, 1, 1);
     else if (k == 0 || k == 8)
-        read_bit_loop(word, unc, d->sat, pos, neg, thr, n, 1, 0);
+        read_bit_loop(word, unc, d->work->sat, pos, neg, thr, n, 1, 0);
     else
-        read_bit_loop(word, unc, d->sat, pos, neg, thr, n, 0, 0);
+        read_bit_loop(word, unc, d->work->sat, pos, neg, thr, n, 0, 0);
 }
 
 int decode_frame(struct decode_ctx *d, uint32_t pattern, const uint8_t *grey)
@@ -215,9 +229,9 @@ int decode_frame(struct decode_ctx *d, uint32_t pattern, const uint8_t *grey)
     else if (pattern_bit(d, pattern, &is_row, &k, &paired, &is_inverse) == 0) {
         /* a bit without inverse is read against the mean of white and black */
         if (!paired)
-            read_bit(d, is_row, k, d->stage[1], d->mean, d->mean_threshold, n);
+            read_bit(d, is_row, k, d->work->stage[1], d->work->mean, d->work->mean_threshold, n);
         else if (is_inverse)
-            read_bit(d, is_row, k, d->stage[0], d->stage[1], d->threshold, n);
+            read_bit(d, is_row, k, d->work->stage[0], d->work->stage[1], d->work->threshold, n);
     }
     d->next_pattern++;
     return 0;
@@ -325,7 +339,7 @@ static inline void block_reasons_loop(uint8_t *restrict reason, const struct dec
     const uint8_t most = (uint8_t)(p->max_ambiguous_bits < 255u ? p->max_ambiguous_bits : 255u);
     const uint16_t width = (uint16_t)d->proj_width, height = (uint16_t)d->proj_height;
     const uint8_t *restrict white = d->white + start, *restrict black = d->black + start;
-    const uint8_t *restrict sat = d->sat + start;
+    const uint8_t *restrict sat = d->work->sat + start;
     const uint16_t *restrict col = d->column_map + start, *restrict row = d->row_map + start;
     for (size_t i = 0; i < len; i++) {
         int16_t contrast = (int16_t)(white[i] - black[i]);
@@ -358,22 +372,24 @@ static void decode_block(struct decode_ctx *d, size_t start, size_t len, uint8_t
 {
     const unsigned cols = d->layout.col_bits, rows = d->layout.row_bits;
     const unsigned lo_col = cols > 8 ? cols - 8 : 0, lo_row = rows > 8 ? rows - 8 : 0;
-    block_words(d->column_map + start, d->word_hi[0] + start, d->word_lo[0] + start, lo_col, len);
-    block_words(d->unclear_col + start, d->unclear_hi[0] + start, d->unclear_lo[0] + start, lo_col,
-                len);
+    block_words(d->column_map + start, d->work->word_hi[0] + start, d->work->word_lo[0] + start,
+                lo_col, len);
+    block_words(d->work->unclear_col + start, d->work->unclear_hi[0] + start,
+                d->work->unclear_lo[0] + start, lo_col, len);
     block_values(d->column_map + start, (uint16_t)d->xor_col, len);
     if (rows > 0) {
-        block_words(d->row_map + start, d->word_hi[1] + start, d->word_lo[1] + start, lo_row, len);
-        block_words(d->unclear_row + start, d->unclear_hi[1] + start, d->unclear_lo[1] + start,
+        block_words(d->row_map + start, d->work->word_hi[1] + start, d->work->word_lo[1] + start,
                     lo_row, len);
+        block_words(d->work->unclear_row + start, d->work->unclear_hi[1] + start,
+                    d->work->unclear_lo[1] + start, lo_row, len);
         block_values(d->row_map + start, (uint16_t)d->xor_row, len);
     }
     for (size_t at = start; at < start + len; at += DECODE_COUNT_CHUNK) {
         size_t n = start + len - at < DECODE_COUNT_CHUNK ? start + len - at : DECODE_COUNT_CHUNK;
         uint8_t count_c[DECODE_COUNT_CHUNK], count_r[DECODE_COUNT_CHUNK];
-        block_unclear_counts(count_c, d->unclear_col + at, (uint16_t)d->xor_col, n);
+        block_unclear_counts(count_c, d->work->unclear_col + at, (uint16_t)d->xor_col, n);
         if (rows > 0)
-            block_unclear_counts(count_r, d->unclear_row + at, (uint16_t)d->xor_row, n);
+            block_unclear_counts(count_r, d->work->unclear_row + at, (uint16_t)d->xor_row, n);
         block_reasons(reason + at, d, at, count_c, count_r, n);
     }
 }
@@ -504,9 +520,11 @@ static int nearest_reading(uint32_t code, uint32_t bits, uint16_t plain, uint16_
 /* A pixel with unclear bits takes, of its possible readings, the one its decoded neighbourhood
  * predicts: one with more than max_ambiguous_bits (or decoding outside the projector) becomes
  * valid so; a valid one whose unclear bit read the wrong way (noise, not an edge) is corrected.
- * Verdicts go to d->scratch and corrections wait in the unclear maps (not needed after this) until
- * the pass ends, so that what this pass changes is not the reference of others. */
-#define RESOLVE_CORRECTED SCAN_REASON_COUNT /* in d->scratch: valid, its reading replaced */
+ * Verdicts go to the scratch plane and corrections wait in the unclear maps (not needed after this)
+ * until the pass ends, so that what this pass changes is not the reference of others. */
+#define RESOLVE_CORRECTED                                                                          \
+    SCAN_REASON_COUNT /* in the scratch plane: valid, its reading replaced                         \
+                       */
 
 /* Rows of a neighbourhood stage split into parts (every pixel's verdict is its own: the same
  * maps however many). */
@@ -528,18 +546,19 @@ static void resolve_rows(void *arg, unsigned k)
         for (uint32_t x = 0; x < w; x++) {
             size_t i = (size_t)y * w + x;
             uint8_t r = reason[i];
-            d->scratch[i] = r;
+            d->work->scratch[i] = r;
             int pending = r == SCAN_LOW_CONTRAST || r == SCAN_SATURATED || r == SCAN_INCONSISTENT;
-            uint16_t unclear_row = rows ? d->unclear_row[i] : 0; /* no rows: no row planes */
-            if ((!pending && r != SCAN_VALID) || (d->unclear_col[i] == 0 && unclear_row == 0) ||
-                unclear_count(d->unclear_col[i], d->xor_col) > max_unclear ||
+            uint16_t unclear_row = rows ? d->work->unclear_row[i] : 0; /* no rows: no row planes */
+            if ((!pending && r != SCAN_VALID) ||
+                (d->work->unclear_col[i] == 0 && unclear_row == 0) ||
+                unclear_count(d->work->unclear_col[i], d->xor_col) > max_unclear ||
                 unclear_count(unclear_row, d->xor_row) > max_unclear)
                 continue;
             double ref_col, ref_row = 0.0;
             uint16_t col, row = 0;
             if (!neighbourhood_code(d, reason, d->column_map, x, y, &ref_col) ||
                 !nearest_reading(d->layout.code, d->layout.col_bits, d->column_map[i],
-                                 d->unclear_col[i], ref_col, d->proj_width, &col) ||
+                                 d->work->unclear_col[i], ref_col, d->proj_width, &col) ||
                 (rows && (!neighbourhood_code(d, reason, d->row_map, x, y, &ref_row) ||
                           !nearest_reading(d->layout.code, d->layout.row_bits, d->row_map[i],
                                            unclear_row, ref_row, d->proj_height, &row))))
@@ -548,12 +567,12 @@ static void resolve_rows(void *arg, unsigned k)
                 d->column_map[i] = col;
                 if (rows)
                     d->row_map[i] = row;
-                d->scratch[i] = SCAN_VALID;
+                d->work->scratch[i] = SCAN_VALID;
             } else if (col != d->column_map[i] || (rows && row != d->row_map[i])) {
-                d->unclear_col[i] = col;
+                d->work->unclear_col[i] = col;
                 if (rows)
-                    d->unclear_row[i] = row;
-                d->scratch[i] = RESOLVE_CORRECTED;
+                    d->work->unclear_row[i] = row;
+                d->work->scratch[i] = RESOLVE_CORRECTED;
             }
         }
     }
@@ -573,7 +592,7 @@ static void verdicts_apply(void *arg, unsigned k)
     const struct row_parts *p = arg;
     size_t i0, i1;
     part_pixels(p, k, &i0, &i1);
-    memcpy(p->reason + i0, p->d->scratch + i0, i1 - i0);
+    memcpy(p->reason + i0, p->d->work->scratch + i0, i1 - i0);
 }
 
 /* Part @p k of the rows once every part has read them: the corrections applied, then the
@@ -586,11 +605,11 @@ static void resolve_apply(void *arg, unsigned k)
     part_pixels(p, k, &i0, &i1);
     const int rows = d->layout.row_bits > 0;
     for (size_t i = i0; i < i1; i++) {
-        if (d->scratch[i] == RESOLVE_CORRECTED) {
-            d->column_map[i] = d->unclear_col[i];
+        if (d->work->scratch[i] == RESOLVE_CORRECTED) {
+            d->column_map[i] = d->work->unclear_col[i];
             if (rows)
-                d->row_map[i] = d->unclear_row[i];
-            d->scratch[i] = SCAN_VALID;
+                d->row_map[i] = d->work->unclear_row[i];
+            d->work->scratch[i] = SCAN_VALID;
         }
     }
     verdicts_apply(arg, k);
@@ -599,8 +618,8 @@ static void resolve_apply(void *arg, unsigned k)
 /* A pixel with unclear bits takes, of its possible readings, the one its decoded neighbourhood
  * predicts: one with more than max_ambiguous_bits (or decoding outside the projector) becomes
  * valid so; a valid one whose unclear bit read the wrong way (noise, not an edge) is corrected.
- * Verdicts go to d->scratch and corrections wait in the unclear maps (not needed after this) until
- * the pass ends, so that what this pass changes is not the reference of others. */
+ * Verdicts go to the scratch plane and corrections wait in the unclear maps (not needed after this)
+ * until the pass ends, so that what this pass changes is not the reference of others. */
 static void resolve_unclear(struct decode_ctx *d, const struct hal_thread *threads, uint8_t *reason)
 {
     struct row_parts p = {d, reason, hal_thread_parts(threads, 64)};
@@ -626,7 +645,7 @@ static void check_rows(void *arg, unsigned k)
     for (uint32_t y = h * k / p->parts; y < h * (k + 1u) / p->parts; y++) {
         for (uint32_t x = 0; x < w; x++) {
             size_t i = (size_t)y * w + x;
-            d->scratch[i] = reason[i];
+            d->work->scratch[i] = reason[i];
             if (reason[i] != SCAN_VALID)
                 continue;
             uint32_t agree = 0, valid = 0;
@@ -649,7 +668,7 @@ static void check_rows(void *arg, unsigned k)
                 (d->layout.row_bits > 0 &&
                  (!neighbourhood_code(d, reason, d->row_map, x, y, &ref_row) ||
                   fabs(d->row_map[i] - ref_row) > RESOLVE_FIT_COLUMNS)))
-                d->scratch[i] = SCAN_INCONSISTENT;
+                d->work->scratch[i] = SCAN_INCONSISTENT;
         }
     }
 }

@@ -36,12 +36,10 @@ struct decode_maps {
 /** Pixels converted together by decode_pixels, a block a thread at a time. */
 #define DECODE_BLOCK 4096u
 
-/** One view's decoder (several MB at the compiled limits: kept static by its owner, a struct
- *  scan_ctx, never on the stack). It keeps what it needs of each pixel, not the frames: white
- *  and black, the thresholds they give, and the bits read so far, so its size does not grow
- *  with the patterns. Fields are the decoder's own. */
-struct decode_ctx {
-    uint8_t white[HAL_MAX_PIXELS], black[HAL_MAX_PIXELS]; /* patterns 0 and 1, kept */
+/** The planes a view's decoder works in until decode_finish has run (about 19 bytes a pixel):
+ *  apart from struct decode_ctx so that their owner may give their memory to what comes after
+ *  the decoding (struct scan_ctx: the range image). Fields are the decoder's own. */
+struct decode_work {
     /* Frames being handed over: a bit's stripes wait in stage[0] for their inverse, which (like
      * a bit projected without inverse) comes into stage[1]. */
     uint8_t stage[2][HAL_MAX_PIXELS];
@@ -54,11 +52,21 @@ struct decode_ctx {
      * is 8-bit arithmetic on one plane. */
     uint8_t word_hi[2][HAL_MAX_PIXELS], word_lo[2][HAL_MAX_PIXELS];
     uint8_t unclear_hi[2][HAL_MAX_PIXELS], unclear_lo[2][HAL_MAX_PIXELS];
-    uint16_t column_map[HAL_MAX_PIXELS];
-    uint16_t row_map[HAL_MAX_PIXELS];
     uint16_t unclear_col[HAL_MAX_PIXELS]; /* bit k: Gray bit k of the column was unclear */
     uint16_t unclear_row[HAL_MAX_PIXELS];
     uint8_t scratch[HAL_MAX_PIXELS]; /* the neighbourhood stages' verdicts, applied after */
+};
+
+/** One view's decoder (several MB at the compiled limits: kept static by its owner, a struct
+ *  scan_ctx, never on the stack). It keeps what it needs of each pixel, not the frames: white
+ *  and black, the thresholds they give, and the bits read so far (in its working planes,
+ *  struct decode_work), so its size does not grow with the patterns. What a finished view is
+ *  described by stays here: white, black and the maps. Fields are the decoder's own. */
+struct decode_ctx {
+    uint8_t white[HAL_MAX_PIXELS], black[HAL_MAX_PIXELS]; /* patterns 0 and 1, kept */
+    uint16_t column_map[HAL_MAX_PIXELS];
+    uint16_t row_map[HAL_MAX_PIXELS];
+    struct decode_work *work; /* the owner's, given to decode_begin */
     struct scan_params params;
     struct gray_layout layout;
     uint32_t proj_width, proj_height;
@@ -89,13 +97,16 @@ uint32_t decode_bit_threshold(const struct scan_params *params, uint32_t contras
  *  quarter of decode_bit_threshold, rounded up (measured: decode.c says why). */
 uint32_t decode_mean_threshold(const struct scan_params *params, uint32_t contrast_dn);
 
-/** Give back the memory of @p d's per-pixel planes (mem_release) until the next decode_begin:
- *  their contents are not read again before a view writes them (zeros if they are). */
+/** Give back the memory of @p d's own per-pixel planes (mem_release; not its working planes,
+ *  whose memory is their owner's) until the next decode_begin: their contents are not read
+ *  again before a view writes them (zeros if they are). */
 void decode_release(struct decode_ctx *d);
 
 /** Start a view of a @p proj_width x @p proj_height projector coded as @p layout in @p d.
+ *  @param work  the planes it works in until decode_finish (read again by nothing after it: the
+ *               owner may use their memory then, and decode_finish runs once a view)
  *  @retval 0 ok @retval -EINVAL size or pattern count above the compiled limits */
-int decode_begin(struct decode_ctx *d, const struct scan_params *params,
+int decode_begin(struct decode_ctx *d, struct decode_work *work, const struct scan_params *params,
                  const struct gray_layout *layout, uint32_t proj_width, uint32_t proj_height);
 /** Where frame @p pattern is handed over: a capture may write its grey frame there directly.
  *  It holds the frame until the next frame after it is handed over (white and black: until

@@ -185,8 +185,8 @@ static void prefault_points(struct scan_ctx *s, const struct decode_maps *m)
         return;
     size_t i = first * w, n = (last + 1 - first) * w;
     mem_prefault(s->column + i, n * sizeof(s->column[0]));
-    mem_prefault(s->tri.xyz_mm + 3 * i, 3 * n * sizeof(s->tri.xyz_mm[0]));
-    mem_prefault(s->tri.normal + 3 * i, 3 * n * sizeof(s->tri.normal[0]));
+    mem_prefault(s->planes.tri.xyz_mm + 3 * i, 3 * n * sizeof(s->planes.tri.xyz_mm[0]));
+    mem_prefault(s->planes.tri.normal + 3 * i, 3 * n * sizeof(s->planes.tri.normal[0]));
 }
 
 int scan_begin_colour(struct scan_ctx *s, const struct scan_params *p, const struct scan_calib *c)
@@ -207,7 +207,8 @@ int scan_begin_view(struct scan_ctx *s, const struct scan_params *p, const struc
 {
     struct gray_layout layout;
     scan_layout(p, c, &layout);
-    int rc = decode_begin(&s->decode, p, &layout, c->proj_width, c->proj_height);
+    int rc =
+        decode_begin(&s->decode, &s->planes.decoding, p, &layout, c->proj_width, c->proj_height);
     if (rc == 0)
         rc = scan_begin_colour(s, p, c);
     if (rc != 0)
@@ -224,6 +225,7 @@ int scan_begin_view(struct scan_ctx *s, const struct scan_params *p, const struc
 void scan_release_frames(struct scan_ctx *s)
 {
     decode_release(&s->decode);
+    mem_release(&s->planes, sizeof(s->planes)); /* the decoder's working planes, the range image */
     mem_release(s->column, sizeof(s->column));
     mem_release(s->colour_rgb, sizeof(s->colour_rgb));
     mem_release(s->frame_rgb, sizeof(s->frame_rgb));
@@ -391,11 +393,11 @@ int scan_finish_view(struct scan_ctx *s, const struct hal_thread *threads,
         rc = refine_columns(&view->maps, &cores, (int)s->params.refine, s->column);
     view->column = s->column;
     if (rc == 0)
-        rc = tri_range_image(c, &cores, &s->tri, view->width, view->height, view->column,
+        rc = tri_range_image(c, &cores, &s->planes.tri, view->width, view->height, view->column,
                              s->view_reason, &view->range);
     if (rc == 0)
-        rc = tri_normals(&s->tri, &cores, &view->range, s->view_reason, s->params.normal_radius_px,
-                         s->params.max_depth_jump_mm);
+        rc = tri_normals(&s->planes.tri, &cores, &view->range, s->view_reason,
+                         s->params.normal_radius_px, s->params.max_depth_jump_mm);
     if (rc == 0)
         rc = scan_recolour(&s->params.colour, &cores, c, view, NULL); /* fit: multi's, until the
                                                                    job's model colours it */
@@ -411,12 +413,12 @@ int scan_restore_view(struct scan_ctx *s, uint32_t width, uint32_t height, int32
                       struct scan_view_fill *fill)
 {
     memset(view, 0, sizeof(*view));
-    int rc = tri_restore(&s->tri, width, height, valid_count, &view->range);
+    int rc = tri_restore(&s->planes.tri, width, height, valid_count, &view->range);
     if (rc != 0)
         return rc;
     prefault_colour(s, (size_t)width * height);
-    fill->xyz_mm = s->tri.xyz_mm;
-    fill->normal = s->tri.normal;
+    fill->xyz_mm = s->planes.tri.xyz_mm;
+    fill->normal = s->planes.tri.normal;
     view->width = width;
     view->height = height;
     view->angle_mdeg = angle_mdeg;

@@ -19,9 +19,16 @@ struct fusion_volume;
  *  calibration, a command) keeps it static and passes it by pointer, so there is no allocation;
  *  two contexts are two independent views. Its fields are the firmware's own. */
 struct scan_ctx {
-    struct decode_ctx decode;               /* the pattern frames, decoded */
-    float column[HAL_MAX_PIXELS];           /* continuous projector column (refine.h) */
-    struct tri_maps tri;                    /* the range image */
+    struct decode_ctx decode;     /* the pattern frames, decoded */
+    float column[HAL_MAX_PIXELS]; /* continuous projector column (refine.h) */
+    /* The decoder works in these planes until decode_finish; the range image is made after it
+     * in the same memory (tri_range_image), for the frames' bits are not read again: a view is
+     * finished once. Why: the two are a view's largest buffers after the frames (19 and 24
+     * bytes a pixel), and never needed at once. */
+    union {
+        struct decode_work decoding;
+        struct tri_maps tri; /* the range image */
+    } planes;
     uint8_t colour_rgb[HAL_MAX_PIXELS * 3]; /* projector-white frame, kept as the view's colour */
     uint8_t frame_rgb[HAL_MAX_PIXELS * 3];  /* every other frame, consumed at once */
     /* Light frames for the colour (colour.h): dark, all lights, each light alone. */
@@ -179,10 +186,11 @@ int scan_begin_view(struct scan_ctx *s, const struct scan_params *params,
  *  @retval 0 @retval -EINVAL a frame size beyond the compiled limits */
 int scan_begin_colour(struct scan_ctx *s, const struct scan_params *params,
                       const struct scan_calib *calib);
-/** The frames, the decoder's planes and the projector columns of the views taken are not
- *  needed again until the next view begins (scan_begin_view, scan_begin_colour): their memory
- *  is given back (mem_release), so that the stages after the views (the fusion grid, the mesh,
- *  the texture) do not add to it. The range image, the view's colour and its reasons stay. */
+/** The frames, the decoder's planes, the projector columns and the range image of the views
+ *  taken are not needed again until the next view begins or is restored (scan_begin_view,
+ *  scan_begin_colour, scan_restore_view): their memory is given back (mem_release), so that
+ *  the stages after the views (the fusion grid, the mesh, the texture) do not add to it. The
+ *  view's colour and its reasons stay. */
 void scan_release_frames(struct scan_ctx *s);
 /** The pattern sequence of a view (columns, and rows when params->decode_rows). */
 void scan_layout(const struct scan_params *params, const struct scan_calib *calib,

@@ -15,7 +15,8 @@
 #define H 8
 #define PROJ_W 64
 
-static struct decode_ctx dec; /* the decoder under test */
+static struct decode_ctx dec;   /* the decoder under test */
+static struct decode_work work; /* and its working planes */
 static uint8_t frame[W * H * 3];
 static uint8_t fed[DECODE_MAX_PATTERNS][W * H]; /* every grey frame fed, for the reference */
 
@@ -85,7 +86,7 @@ static struct decode_maps maps_out;
 static int begin(struct scan_params *p, uint32_t bits)
 {
     struct gray_layout l = layout_of(bits);
-    return decode_begin(&dec, p, &l, PROJ_W, 1);
+    return decode_begin(&dec, &work, p, &l, PROJ_W, 1);
 }
 
 static void decode_all(uint32_t bits)
@@ -157,7 +158,10 @@ static void test_size_above_limit_rejected(void **state)
     p = params();
     assert_int_equal(begin(&p, 17), -EINVAL);
     struct gray_layout too_many = {16, 16, GRAY_CODE_GRAY, 0}; /* more than the store holds */
-    assert_int_equal(decode_begin(&dec, &p, &too_many, PROJ_W, 1), -EINVAL);
+    assert_int_equal(decode_begin(&dec, &work, &p, &too_many, PROJ_W, 1), -EINVAL);
+    struct gray_layout fits = {6, 0, GRAY_CODE_GRAY, 0};
+    assert_int_equal(decode_begin(&dec, NULL, &p, &fits, PROJ_W, 1), -EINVAL); /* no planes */
+    assert_int_equal(decode_begin(&dec, &work, &p, &fits, PROJ_W, 1), 0);
 }
 
 /* Every pattern of the synthetic scene, with pixel 10 of row 0 ambiguous in bit 0 and pixel 20
@@ -245,7 +249,7 @@ static unsigned blocked_matches_reference_with(const struct scan_params *p)
 {
     uint32_t bits = gray_bits_for_width(PROJ_W);
     struct gray_layout l = layout_of(bits);
-    assert_int_equal(decode_begin(&dec, p, &l, PROJ_W, 1), 0);
+    assert_int_equal(decode_begin(&dec, &work, p, &l, PROJ_W, 1), 0);
     feed_ambiguous_scene(bits);
     assert_int_equal(decode_pixels(&dec, NULL, reason_out, &maps_out), 0);
     const uint8_t *frames[DECODE_MAX_PATTERNS];
@@ -289,12 +293,12 @@ static void test_blocked_matches_reference_at_every_limit(void **state)
             p.min_contrast_dn = dark[k];
             p.max_ambiguous_bits = ambiguous[a];
             for (int axis = 0; axis < 2; axis++) {
-                memset(dec.word_hi[axis], 0xFF, W * H);
-                memset(dec.word_lo[axis], 0xFF, W * H);
-                memset(dec.unclear_hi[axis], 0xFF, W * H);
-                memset(dec.unclear_lo[axis], 0xFF, W * H);
+                memset(work.word_hi[axis], 0xFF, W * H);
+                memset(work.word_lo[axis], 0xFF, W * H);
+                memset(work.unclear_hi[axis], 0xFF, W * H);
+                memset(work.unclear_lo[axis], 0xFF, W * H);
             }
-            memset(dec.sat, 0xFF, W * H);
+            memset(work.sat, 0xFF, W * H);
             kinds |= blocked_matches_reference_with(&p);
         }
     /* every reason but inconsistent (the neighbour check's) came up */
@@ -355,19 +359,19 @@ static void test_row_planes_untouched_without_rows(void **state)
     struct scan_params p = params();
     struct gray_layout l = layout_of(bits);
     assert_int_equal(l.row_bits, 0);
-    assert_int_equal(decode_begin(&dec, &p, &l, PROJ_W, 1), 0);
+    assert_int_equal(decode_begin(&dec, &work, &p, &l, PROJ_W, 1), 0);
     feed_ambiguous_scene(bits);
     assert_int_equal(decode_finish(&dec, NULL, reason1, &maps_out), 0);
     assert_null(maps_out.row);
     memcpy(column1, maps_out.column, sizeof(column1));
     assert_int_equal(reason1[20], SCAN_VALID); /* resolved by its neighbourhood */
-    memset(dec.word_hi[1], 0xFF, W * H);
-    memset(dec.word_lo[1], 0xFF, W * H);
-    memset(dec.unclear_hi[1], 0xFF, W * H);
-    memset(dec.unclear_lo[1], 0xFF, W * H);
+    memset(work.word_hi[1], 0xFF, W * H);
+    memset(work.word_lo[1], 0xFF, W * H);
+    memset(work.unclear_hi[1], 0xFF, W * H);
+    memset(work.unclear_lo[1], 0xFF, W * H);
     memset(dec.row_map, 0xFF, W * H * sizeof(uint16_t));
-    memset(dec.unclear_row, 0xFF, W * H * sizeof(uint16_t));
-    assert_int_equal(decode_begin(&dec, &p, &l, PROJ_W, 1), 0);
+    memset(work.unclear_row, 0xFF, W * H * sizeof(uint16_t));
+    assert_int_equal(decode_begin(&dec, &work, &p, &l, PROJ_W, 1), 0);
     feed_ambiguous_scene(bits);
     assert_int_equal(decode_finish(&dec, NULL, reason_out, &maps_out), 0);
     assert_memory_equal(reason_out, reason1, sizeof(reason1));
@@ -375,8 +379,8 @@ static void test_row_planes_untouched_without_rows(void **state)
         if (reason1[i] == SCAN_VALID)
             assert_int_equal(maps_out.column[i], column1[i]);
         assert_int_equal(dec.row_map[i], 0xFFFFu);
-        assert_int_equal(dec.unclear_row[i], 0xFFFFu);
-        assert_int_equal(dec.word_hi[1][i] & dec.unclear_lo[1][i], 0xFF);
+        assert_int_equal(work.unclear_row[i], 0xFFFFu);
+        assert_int_equal(work.word_hi[1][i] & work.unclear_lo[1][i], 0xFF);
     }
 }
 

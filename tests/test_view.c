@@ -180,13 +180,12 @@ static void blocked_matches_reference(uint32_t inverse_bits, uint32_t patterns)
     t.cfg.scan.decode_rows = 1;
     t.cfg.scan.inverse_bits = inverse_bits;
     assert_int_equal(test_rig_start(&t), 0);
-    struct scan_view view;
     struct scan_view_info info;
     struct test_frames kept = {.pixels = (size_t)t.cfg.scan.width * t.cfg.scan.height,
                                .saturation_dn = t.cfg.scan.saturation_dn};
     struct scan_frame_sink sink = test_frames_sink(&kept);
-    assert_int_equal(scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, &sink, &view, &info),
-                     0);
+    /* captured, not finished (its range image would take the decoder's working planes) */
+    assert_int_equal(scan_capture_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, &sink, &info), 0);
     /* rows and columns, then the colour frames of config/sim.ini's method */
     assert_int_equal(info.frames_captured,
                      patterns + scan_light_frame_count(&t.cfg.scan, &t.calib));
@@ -246,8 +245,8 @@ static void test_threads_decode_the_same(void **state)
     assert_int_equal(test_rig_start(&t), 0);
     struct scan_view view;
     struct scan_view_info info;
-    assert_int_equal(scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info),
-                     0);
+    /* captured, not finished: decode_finish again and again on the same frames' bits */
+    assert_int_equal(scan_capture_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info), 0);
     static uint8_t reason1[HAL_MAX_PIXELS], reason[HAL_MAX_PIXELS];
     static uint16_t col1[HAL_MAX_PIXELS], row1[HAL_MAX_PIXELS];
     struct decode_maps m;
@@ -266,9 +265,12 @@ static void test_threads_decode_the_same(void **state)
         assert_memory_equal(m.column, col1, n * sizeof(uint16_t));
         assert_memory_equal(m.row, row1, n * sizeof(uint16_t));
     }
-    /* its colour (config/sim.ini's method, multi, both passes): the same on 1 and 4 threads */
+    /* the view finished on one thread (once a view: its range image takes the decoder's
+     * working planes), and its colour (config/sim.ini's method, multi, both passes): the same
+     * on 1 and 4 threads */
     struct hal_thread four;
     thread_posix_init(&four, 4);
+    assert_int_equal(scan_finish_view(t.scan, NULL, &t.calib, 0, &view, &info), 0);
     assert_int_equal(scan_recolour(&t.cfg.scan.colour, NULL, &t.calib, &view, NULL), 0);
     static uint8_t rgb1[3 * HAL_MAX_PIXELS];
     static float conf1[HAL_MAX_PIXELS];
@@ -282,14 +284,17 @@ static void test_threads_decode_the_same(void **state)
     struct fusion_volume *vol = &test_volume;
     struct frame_xform pose;
     frame_object_from_camera(&t.calib, view.angle_mdeg, &pose);
-    assert_int_equal(scan_finish_view(t.scan, NULL, &t.calib, view.angle_mdeg, &view, &info), 0);
-    /* the whole view on 4 threads: refined columns, points, normals and reasons the same */
+    /* the whole view on 4 threads, its frames taken again (the simulator renders them the same
+     * from a fresh start): refined columns, points, normals and reasons the same */
     static float column1[HAL_MAX_PIXELS], xyz1[3 * HAL_MAX_PIXELS], normal1[3 * HAL_MAX_PIXELS];
     memcpy(reason1, view.maps.reason, n);
     memcpy(column1, view.column, n * sizeof(float));
     memcpy(xyz1, view.range.xyz_mm, 3 * n * sizeof(float));
     memcpy(normal1, view.range.normal, 3 * n * sizeof(float));
     uint32_t points1 = view.range.valid_count;
+    test_rig_stop(&t);
+    assert_int_equal(test_rig_start(&t), 0);
+    assert_int_equal(scan_capture_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &info), 0);
     assert_int_equal(scan_finish_view(t.scan, &four, &t.calib, view.angle_mdeg, &view, &info), 0);
     assert_memory_equal(view.maps.reason, reason1, n);
     assert_memory_equal(view.column, column1, n * sizeof(float));
@@ -448,17 +453,18 @@ static int all_zero(const void *p, size_t n)
 }
 
 /* The views' frames given back (scan_release_frames, as a job does once its views are taken):
- * the range image, colour and reasons stay; the colour frames and the decoder's planes read as
- * zeros where the platform gives pages back; the colour made again from the frames read back
- * (scan_begin_colour, the model's path for [colour] method = fit) is the view's, to the byte;
- * and the next view, whose buffers come back as zeros, is the same as one taken before. */
+ * the view's colour and reasons stay; the colour frames, the decoder's planes and the range
+ * image read as zeros where the platform gives pages back; the colour made again from the
+ * frames read back into a restored view (scan_begin_colour, the model's path for [colour]
+ * method = fit) is the view's, to the byte; and the next view, whose buffers come back as
+ * zeros, is the same as one taken before. */
 static void test_frames_given_back(void **state)
 {
     (void)state;
     static struct test_rig t;
     static const struct mem_platform posix = {memory_posix_prefault, memory_posix_release};
     static uint8_t reason_a[HAL_MAX_PIXELS], rgb_a[HAL_MAX_PIXELS * 3];
-    static float xyz_a[HAL_MAX_PIXELS * 3], conf_a[HAL_MAX_PIXELS];
+    static float xyz_a[HAL_MAX_PIXELS * 3], normal_a[HAL_MAX_PIXELS * 3], conf_a[HAL_MAX_PIXELS];
     uint8_t *frames[COLOUR_MAX_FRAMES] = {0};
     mem_use(&posix);
     assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
@@ -472,6 +478,7 @@ static void test_frames_given_back(void **state)
     memcpy(rgb_a, a.rgb, n * 3);
     memcpy(conf_a, a.confidence, n * sizeof(float));
     memcpy(xyz_a, a.range.xyz_mm, n * 3 * sizeof(float));
+    memcpy(normal_a, a.range.normal, n * 3 * sizeof(float));
     uint8_t *white = malloc(n * 3);
     assert_non_null(white);
     memcpy(white, a.white_rgb, n * 3);
@@ -488,9 +495,6 @@ static void test_frames_given_back(void **state)
     scan_release_frames(t.scan);
     assert_memory_equal(reason_a, a.maps.reason, n);
     assert_memory_equal(rgb_a, a.rgb, n * 3);
-    for (size_t i = 0; i < n; i++)
-        if (reason_a[i] == SCAN_VALID)
-            assert_memory_equal(&xyz_a[3 * i], &a.range.xyz_mm[3 * i], 3 * sizeof(float));
     int heard = all_zero(t.scan->light_rgb[COLOUR_FRAME_LIGHT0], n * 3);
 #ifdef __x86_64__ /* make test-arm64: qemu-user may take madvise and do nothing */
     assert_true(heard);
@@ -498,7 +502,21 @@ static void test_frames_given_back(void **state)
     if (heard) {
         assert_true(all_zero(t.scan->decode.white, n));
         assert_true(all_zero(t.scan->colour_rgb, n * 3));
+        assert_true(all_zero(a.range.xyz_mm, n * 3 * sizeof(float))); /* restored, if needed */
     }
+    /* the range image again, as the model restores a view (range.bin's points) */
+    struct scan_view r;
+    struct scan_view_fill fill;
+    assert_int_equal(scan_restore_view(t.scan, a.width, a.height, a.angle_mdeg, a.range.valid_count,
+                                       a.colour_method, &r, &fill),
+                     0);
+    for (size_t i = 0; i < n; i++)
+        if (reason_a[i] == SCAN_VALID) {
+            memcpy(&fill.xyz_mm[3 * i], &xyz_a[3 * i], 3 * sizeof(float));
+            memcpy(&fill.normal[3 * i], &normal_a[3 * i], 3 * sizeof(float));
+        }
+    assert_ptr_equal(r.range.xyz_mm, a.range.xyz_mm);
+    assert_ptr_equal(r.range.normal, a.range.normal);
 
     /* the colour again from its frames read back, as the model's fit path does */
     memset(a.rgb, 0, n * 3);
