@@ -10,6 +10,7 @@
 #include "test_util.h"
 #include "thread_posix.h"
 
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <time.h>
@@ -26,16 +27,33 @@ static double now_ms(void)
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec / 1e6;
 }
 
+/* The view's pattern frames @p kept handed to its decoder again (untimed): a view is finished
+ * once (scan.h: its range image takes the decoder's working planes). */
+static int feed_again(struct test_rig *t, const struct test_frames *kept)
+{
+    struct scan_ctx *s = t->scan;
+    struct gray_layout layout;
+    scan_layout(&t->cfg.scan, &t->calib, &layout);
+    int rc = decode_begin(&s->decode, &s->planes.decoding, &t->cfg.scan, &layout,
+                          t->calib.proj_width, t->calib.proj_height);
+    for (uint32_t p = 0; p < gray_layout_count(&layout) && rc == 0; p++)
+        rc = kept->grey[p] != NULL ? decode_frame(&s->decode, p, kept->grey[p]) : -ENOENT;
+    return rc;
+}
+
 /* Best of REPEAT: the view finished from its decoder's frames (scan_finish_view: every stage
  * after the last frame) and fused, on @p cores. @p finish_ms, @p fuse_ms: out */
-static int time_view(struct test_rig *t, const struct hal_thread *cores, struct scan_view *view,
-                     double *finish_ms, double *fuse_ms)
+static int time_view(struct test_rig *t, const struct test_frames *kept,
+                     const struct hal_thread *cores, struct scan_view *view, double *finish_ms,
+                     double *fuse_ms)
 {
     struct scan_view_info info;
     struct frame_xform pose;
     frame_object_from_camera(&t->calib, view->angle_mdeg, &pose);
     *finish_ms = *fuse_ms = 1e9;
     for (int r = 0; r < REPEAT; r++) {
+        if (feed_again(t, kept) != 0)
+            return -1;
         double t0 = now_ms();
         if (scan_finish_view(t->scan, cores, &t->calib, view->angle_mdeg, view, &info) != 0)
             return -1;
@@ -59,7 +77,11 @@ int main(int argc, char **argv)
         return 1;
     struct scan_view view;
     struct scan_view_info info;
-    if (scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info) != 0)
+    static struct test_frames kept;
+    kept.pixels = (size_t)t.cfg.scan.width * t.cfg.scan.height;
+    kept.saturation_dn = t.cfg.scan.saturation_dn;
+    struct scan_frame_sink sink = test_frames_sink(&kept);
+    if (scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, &sink, &view, &info) != 0)
         return 1;
     long cores_online = sysconf(_SC_NPROCESSORS_ONLN);
     printf("one view %ux%u of '%s', colour '%s', processed after its last frame (best of %d, "
@@ -74,7 +96,7 @@ int main(int argc, char **argv)
         struct hal_thread cores;
         thread_posix_init(&cores, threads);
         double finish_ms, fuse_ms;
-        if (time_view(&t, &cores, &view, &finish_ms, &fuse_ms) != 0)
+        if (time_view(&t, &kept, &cores, &view, &finish_ms, &fuse_ms) != 0)
             return 1;
         double total = finish_ms + fuse_ms;
         if (threads == 1)
@@ -83,5 +105,6 @@ int main(int argc, char **argv)
                one / total);
     }
     test_rig_stop(&t);
+    test_frames_free(&kept);
     return 0;
 }
