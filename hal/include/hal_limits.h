@@ -10,11 +10,11 @@
 #ifdef HAL_LIMITS_SMALL
 /* make LIMITS=small, for a board with 512 MB (a Pi Zero 2 W, a Pi 3A+): frames up to the Pi
  * camera v1's 2x2 binned mode, 1296 x 972, a smaller fusion grid (fusion.h), no bracketed
- * colour frames; about 337 MiB of static buffers instead of 878 (make size). */
+ * colour frames; about 314 MiB of static buffers instead of 822 (make size). */
 #define HAL_MAX_WIDTH 1296u
 #define HAL_MAX_HEIGHT 972u
 #elif defined(HAL_LIMITS_LARGE)
-/* make LIMITS=large, for a computer with memory to spare (about 3 GB of static buffers, mapped
+/* make LIMITS=large, for a computer with memory to spare (about 2.8 GB of static buffers, mapped
  * as they are used): full-resolution frames of the sensors people put on these rigs, the
  * Raspberry Pi HQ camera's 4056 x 3040, Camera Module 3's 4608 x 2592, a 16 MP 4608 x 3456 and
  * the 4896 x 3264 of a DSLR (docs/performance.md). */
