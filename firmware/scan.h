@@ -208,8 +208,10 @@ uint32_t scan_frame_channels(const struct scan_params *params, const struct scan
  *  other patterns @retval NULL no such frame */
 uint8_t *scan_frame_buffer(struct scan_ctx *s, uint32_t frame);
 /** Decode, refine, triangulate, take normals and colour of the frames fed since
- *  scan_begin_view. @param threads  the cores the per-pixel stages may split across (NULL:
- *  this thread; at most [scan] threads of them): the view the same to the byte however many
+ *  scan_begin_view: once (the range image is made where the decoder worked; finishing the same
+ *  frames again needs them fed again). @param threads  the cores the per-pixel stages may
+ *  split across (NULL: this thread; at most [scan] threads of them): the view the same to the
+ *  byte however many
  *  @param view  out @param info  out: reasons counted, valid points */
 int scan_finish_view(struct scan_ctx *s, const struct hal_thread *threads,
                      const struct scan_calib *calib, int32_t angle_mdeg, struct scan_view *view,
