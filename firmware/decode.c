@@ -77,16 +77,18 @@ static void own_planes(struct decode_ctx *d, size_t n, int rows,
 static void work_planes(struct decode_work *w, size_t n, int rows,
                         void (*op)(void *addr, size_t bytes))
 {
-    uint8_t *bytes[] = {w->stage[0],       w->stage[1],      w->threshold,    w->mean,
-                        w->mean_threshold, w->sat,           w->word_hi[0],   w->word_lo[0],
-                        w->unclear_hi[0],  w->unclear_lo[0], w->scratch,      w->word_hi[1],
-                        w->word_lo[1],     w->unclear_hi[1], w->unclear_lo[1]};
-    const size_t row_bytes = 4; /* the last of the list */
-    for (size_t k = 0; k < sizeof(bytes) / sizeof(bytes[0]) - (rows ? 0 : row_bytes); k++)
+    uint8_t *bytes[] = {w->stage[0],       w->stage[1],      w->threshold,  w->mean,
+                        w->mean_threshold, w->sat,           w->word_hi[0], w->word_lo[0],
+                        w->unclear_hi[0],  w->unclear_lo[0], w->scratch};
+    uint8_t *row_bytes[] = {w->word_hi[1], w->word_lo[1], w->unclear_hi[1], w->unclear_lo[1]};
+    for (size_t k = 0; k < sizeof(bytes) / sizeof(bytes[0]); k++)
         op(bytes[k], n);
     op(w->unclear_col, n * sizeof(uint16_t));
-    if (rows)
-        op(w->unclear_row, n * sizeof(uint16_t));
+    if (!rows)
+        return;
+    for (size_t k = 0; k < sizeof(row_bytes) / sizeof(row_bytes[0]); k++)
+        op(row_bytes[k], n);
+    op(w->unclear_row, n * sizeof(uint16_t));
 }
 
 void decode_release(struct decode_ctx *d)

@@ -160,16 +160,15 @@ static void prefault_colour(struct scan_ctx *s, size_t n)
     mem_prefault(s->view_reason, n);
 }
 
-/* ... and the colour frames its method reads, with the white frame kept as its colour. */
+/* ... and the colour frames its method reads (of layout @p lay), with the white frame kept as
+ * its colour. */
 static void prefault_colour_frames(struct scan_ctx *s, const struct scan_params *p,
-                                   const struct scan_calib *c)
+                                   const struct colour_layout *lay)
 {
     size_t n = (size_t)p->width * p->height;
-    struct colour_layout lay;
-    colour_layout(&p->colour, c->light_count, &lay);
     mem_prefault(s->colour_rgb, n * 3);
-    for (uint32_t k = 0; k < lay.count && k < COLOUR_MAX_FRAMES; k++)
-        if (colour_needs_frame(&p->colour, &lay, k))
+    for (uint32_t k = 0; k < lay->count && k < COLOUR_MAX_FRAMES; k++)
+        if (colour_needs_frame(&p->colour, lay, k))
             mem_prefault(s->light_rgb[k], n * 3);
 }
 
@@ -192,14 +191,16 @@ static void prefault_points(struct scan_ctx *s, const struct decode_maps *m)
 int scan_begin_colour(struct scan_ctx *s, const struct scan_params *p, const struct scan_calib *c)
 {
     struct gray_layout layout;
+    struct colour_layout lay;
     if (p->width == 0 || p->height == 0 || p->width > HAL_MAX_WIDTH || p->height > HAL_MAX_HEIGHT)
         return -EINVAL;
     s->params = *p;
     memset(s->light_present, 0, sizeof(s->light_present));
     scan_layout(p, c, &layout);
+    colour_layout(&p->colour, c->light_count, &lay);
     s->patterns = gray_layout_count(&layout);
-    s->lights = scan_light_frame_count(p, c);
-    prefault_colour_frames(s, p, c);
+    s->lights = lay.count; /* scan_light_frame_count */
+    prefault_colour_frames(s, p, &lay);
     return 0;
 }
 
