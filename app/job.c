@@ -39,14 +39,30 @@ static struct reflect_pool reflectance;
 /* One view's frames, maps and colour, likewise: the process's only one (the commands that take a
  * single view outside a job borrow it through scan_job_views). */
 static struct scan_ctx views;
-/* The volume the views are fused in and the mesh made from, likewise. */
-static struct fusion_volume volume;
+/* Its colour frames, and the volume the views are fused in and the mesh made from, in one
+ * memory: the frames are read while the views are taken and, by [colour] method = fit, before
+ * the fusion begins (job_make_model); the volume from fusion_begin on, which sets every part of
+ * it it reads. Why: they are the largest buffers after the views' (189 and 380 MiB at the
+ * default limits, 1,023 and 639 MiB at LIMITS=large), never needed at once; a job lends the
+ * frames to the volume (job.h: frames_lent) and reads no colour frame after. */
+static union {
+    struct scan_light_frames light;
+    struct fusion_volume volume;
+} frames_or_volume;
 /* The model's texture atlas and its work space, likewise. */
 static struct atlas texture;
 
 struct scan_ctx *scan_job_views(void)
 {
+    scan_use_light_frames(&views, &frames_or_volume.light);
     return &views;
+}
+
+void job_lend_frames(struct job *j)
+{
+    scan_release_frames(j->scan);
+    scan_use_light_frames(j->scan, NULL); /* a colour frame read now is refused, not written */
+    j->frames_lent = 1;
 }
 
 void job_init(struct job *j, const struct hal *hal, const struct app_config *cfg,
@@ -62,10 +78,10 @@ void job_init(struct job *j, const struct hal *hal, const struct app_config *cfg
                       .start_cpu_s = clock_posix_process_cpu_s(),
                       .start_sim_cpu_s = board_simulator_cpu_s(),
                       .start_thread_cpu_s = clock_posix_thread_cpu_s(),
-                      .scan = &views,
+                      .scan = scan_job_views(),
                       .reg = &registration,
                       .pool = &reflectance,
-                      .vol = &volume,
+                      .vol = &frames_or_volume.volume,
                       .atlas = &texture,
                       .tty = isatty(STDOUT_FILENO) && !opts->json};
     if (hal_clock_now_us(&hal->clock, &j->start_rig_us) != 0)

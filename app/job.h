@@ -60,7 +60,8 @@ struct job {
         uint32_t first_done, last_done;
         double first_ms, last_ms;
     } eta;
-    int said_dark;        /* a view's object was too dark to decode: said once, at that view */
+    int frames_lent; /* 1 from the fusion on: the colour frames' memory is the volume's (job.c) */
+    int said_dark;   /* a view's object was too dark to decode: said once, at that view */
     int said_off_image;   /* a view's object ran off the image: said once, at that view */
     struct job_warnings { /* what the model lacks, as said (warnings.txt, report.html) */
         char text[JOB_MAX_WARNINGS][JOB_WARNING_LEN];
@@ -74,6 +75,10 @@ struct job {
 };
 
 /* ---- job.c ---- */
+/** The fusion begins: the memory of the view's colour frames becomes the volume's (job.c), the
+ *  frames' pages given back first; the view context reads no colour frame from now on (it
+ *  refuses one), and a view whose range.bin is gone cannot be decoded again (job_load_range). */
+void job_lend_frames(struct job *j);
 double job_wall_ms(void);
 /** Now, UTC, as 2026-12-03T08:00:00Z. */
 void job_utc_now(char *buf, size_t len);
@@ -173,7 +178,8 @@ int job_begin_model(struct job *j);
 /** Once every view is in: registration, reflectance, fusion, the mesh. */
 int job_make_model(struct job *j, const char *scan_dir);
 /** View @p v as the model is made of it: its range image read back from @p scan_dir, recoloured
- *  from its frames for the reflectance. @retval 0 @retval -errno (said) */
+ *  from its frames while the reflectance collects its samples (once fitted, range.bin holds the
+ *  colour under it). @retval 0 @retval -errno (said) */
 int job_view_for_model(struct job *j, const char *scan_dir, uint32_t v, struct scan_view *view,
                        struct scan_view_info *info);
 

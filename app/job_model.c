@@ -330,6 +330,8 @@ static int recolour_from_frames(struct job *j, const char *scan_dir, uint32_t v,
     uint32_t white = p->exposure_count > 0 ? count + lights : GRAY_PATTERN_WHITE;
     char err[SCAN_DIR_PATH_MAX + 256];
     int rc = scan_begin_colour(j->scan, p, j->calib); /* the decoder not needed */
+    if (rc != 0)
+        snprintf(err, sizeof(err), "view %u: no room for them (%s)", (unsigned)v, strerror(-rc));
     for (uint32_t f = count; rc == 0 && f <= count + lights; f++) {
         uint32_t frame = f < count + lights ? f : white; /* the lights, then the white colour */
         if (f < count + lights && !scan_needs_light_frame(p, j->calib, f - count))
@@ -349,16 +351,37 @@ static int recolour_from_frames(struct job *j, const char *scan_dir, uint32_t v,
 }
 
 /* View @p v as the model is made of it (load_range), coloured again from its frames while the
- * reflectance pool collects or once its model is fitted (fit); stopped by request between
- * views. */
+ * reflectance pool collects (fit); stopped by request between views. Once the reflectance is
+ * fitted, each view's range.bin holds the colour under it (recolour_views). */
 int job_view_for_model(struct job *j, const char *scan_dir, uint32_t v, struct scan_view *view,
                        struct scan_view_info *info)
 {
     int rc = job_stopped_offline(j, scan_dir, v);
     if (rc == 0)
         rc = job_load_range(j, scan_dir, v, view, info);
-    if (rc == 0 && (reflect_collecting(j->pool) || reflect_model(j->pool) != NULL))
+    if (rc == 0 && reflect_collecting(j->pool))
         rc = recolour_from_frames(j, scan_dir, v, view);
+    return rc;
+}
+
+/* [colour] method = fit, the reflectance fitted: each view coloured again from its frames under
+ * it and kept so in its range.bin in the output directory, which the fusion and the texture read
+ * (the colour frames' memory is the volume's from the fusion on: job.c). */
+static int recolour_views(struct job *j, const char *scan_dir)
+{
+    int rc = 0;
+    for (uint32_t v = 0; v < j->views && rc == 0; v++) {
+        struct scan_view view;
+        struct scan_view_info info;
+        rc = job_stopped_offline(j, scan_dir, v);
+        if (rc == 0)
+            rc = job_load_range(j, scan_dir, v, &view, &info);
+        if (rc == 0)
+            rc = recolour_from_frames(j, scan_dir, v, &view);
+        if (rc == 0)
+            rc = job_write_failed(j, v, SCAN_FILE_RANGE,
+                                  scan_dir_write_range(&j->hal->storage, j->out_dir, v, &view));
+    }
     return rc;
 }
 
@@ -388,6 +411,8 @@ static int fit_reflectance(struct job *j, const char *scan_dir)
     if (rc == 0)
         rc = job_write_failed_at(j, j->out_dir, SCAN_FILE_REFLECTANCE,
                                  scan_dir_write_reflectance(&j->hal->storage, j->out_dir, &m));
+    if (rc == 0)
+        rc = recolour_views(j, scan_dir);
     if (rc != 0)
         return rc;
     char detail[128 + REFLECT_MAX_CLUSTERS * 112];
@@ -511,6 +536,7 @@ int job_make_model(struct job *j, const char *scan_dir)
     struct fusion_params fp = j->cfg->fusion;
     if (rc == 0) {
         fit_volume(j, &fp);
+        job_lend_frames(j);
         rc = fusion_begin(j->vol, &fp);
     }
     for (uint32_t v = 0; v < j->views && rc == 0; v++) {

@@ -320,6 +320,13 @@ int job_load_range(struct job *j, const char *scan_dir, uint32_t v, struct scan_
         j->hal->log(HAL_LOG_ERROR, "%s; the scan kept no pattern frames to decode it from", err);
         return rc;
     }
+    if (j->frames_lent) { /* the decoder's colour frames are the volume now (job.c) */
+        j->hal->log(HAL_LOG_ERROR,
+                    "%s: it went while the model was being made, and cannot be decoded again "
+                    "now; 'scanner process %s' makes the model again",
+                    err, scan_dir);
+        return rc != -ENOENT ? rc : -EIO;
+    }
     if (rc != -ENOENT)
         j->hal->log(HAL_LOG_WARN, "%s: decoded again from its frames", err);
     return load_view(j, scan_dir, v, view, info);

@@ -169,7 +169,7 @@ static void prefault_colour_frames(struct scan_ctx *s, const struct scan_params 
     mem_prefault(s->colour_rgb, n * 3);
     for (uint32_t k = 0; k < lay->count && k < COLOUR_MAX_FRAMES; k++)
         if (colour_needs_frame(&p->colour, lay, k))
-            mem_prefault(s->light_rgb[k], n * 3);
+            mem_prefault(s->light->rgb[k], n * 3);
 }
 
 /* The points' buffers (written only where a pixel decoded), mapped ahead from the first row
@@ -188,16 +188,23 @@ static void prefault_points(struct scan_ctx *s, const struct decode_maps *m)
     mem_prefault(s->planes.tri.normal + 3 * i, 3 * n * sizeof(s->planes.tri.normal[0]));
 }
 
+void scan_use_light_frames(struct scan_ctx *s, struct scan_light_frames *frames)
+{
+    s->light = frames;
+}
+
 int scan_begin_colour(struct scan_ctx *s, const struct scan_params *p, const struct scan_calib *c)
 {
     struct gray_layout layout;
     struct colour_layout lay;
     if (p->width == 0 || p->height == 0 || p->width > HAL_MAX_WIDTH || p->height > HAL_MAX_HEIGHT)
         return -EINVAL;
+    colour_layout(&p->colour, c->light_count, &lay);
+    if (lay.count > 0 && s->light == NULL)
+        return -EINVAL;
     s->params = *p;
     memset(s->light_present, 0, sizeof(s->light_present));
     scan_layout(p, c, &layout);
-    colour_layout(&p->colour, c->light_count, &lay);
     s->patterns = gray_layout_count(&layout);
     s->lights = lay.count; /* scan_light_frame_count */
     prefault_colour_frames(s, p, &lay);
@@ -230,7 +237,8 @@ void scan_release_frames(struct scan_ctx *s)
     mem_release(s->column, sizeof(s->column));
     mem_release(s->colour_rgb, sizeof(s->colour_rgb));
     mem_release(s->frame_rgb, sizeof(s->frame_rgb));
-    mem_release(s->light_rgb, sizeof(s->light_rgb));
+    if (s->light != NULL)
+        mem_release(s->light, sizeof(*s->light));
     memset(s->light_present, 0, sizeof(s->light_present));
     mem_release(s->hdr_choice, sizeof(s->hdr_choice));
     mem_release(s->hdr_grey, sizeof(s->hdr_grey));
@@ -281,7 +289,8 @@ uint8_t *scan_frame_buffer(struct scan_ctx *s, uint32_t frame)
         return frame == GRAY_PATTERN_WHITE && !hdr ? s->colour_rgb
                                                    : decode_frame_slot(&s->decode, frame);
     if (frame < count + lights)
-        return frame - count < COLOUR_MAX_FRAMES ? s->light_rgb[frame - count] : NULL;
+        return frame - count < COLOUR_MAX_FRAMES && s->light != NULL ? s->light->rgb[frame - count]
+                                                                     : NULL;
     return hdr && frame == count + lights ? s->colour_rgb : NULL;
 }
 
@@ -308,10 +317,10 @@ int scan_needs_light_frame(const struct scan_params *p, const struct scan_calib 
 
 int scan_feed_light_frame(struct scan_ctx *s, uint32_t k, const uint8_t *rgb)
 {
-    if (k >= COLOUR_MAX_FRAMES)
+    if (k >= COLOUR_MAX_FRAMES || s->light == NULL)
         return -EINVAL;
-    if (rgb != s->light_rgb[k])
-        memcpy(s->light_rgb[k], rgb, (size_t)s->params.width * s->params.height * 3);
+    if (rgb != s->light->rgb[k])
+        memcpy(s->light->rgb[k], rgb, (size_t)s->params.width * s->params.height * 3);
     s->light_present[k] = 1;
     return 0;
 }
@@ -384,7 +393,7 @@ int scan_finish_view(struct scan_ctx *s, const struct hal_thread *threads,
     view->angle_mdeg = angle_mdeg;
     view->white_rgb = s->colour_rgb;
     for (uint32_t k = 0; k < COLOUR_MAX_FRAMES; k++)
-        view->lights[k] = s->light_present[k] ? s->light_rgb[k] : NULL;
+        view->lights[k] = s->light_present[k] && s->light != NULL ? s->light->rgb[k] : NULL;
     view->rgb = s->view_rgb;
     view->confidence = s->view_confidence;
     int rc = decode_finish(&s->decode, &cores, s->view_reason, &view->maps);
@@ -554,13 +563,13 @@ static int capture_lights(struct scan_ctx *s, const struct hal *hal, const struc
         if (rc == 0 && hal_should_stop(hal))
             rc = -EINTR;
         if (rc == 0)
-            rc = capture(s, hal, p, s->light_rgb[k], first_index + k, info);
+            rc = capture(s, hal, p, s->light->rgb[k], first_index + k, info);
         if (rc == 0) {
             info->frames_captured++;
-            rc = scan_feed_light_frame(s, k, s->light_rgb[k]);
+            rc = scan_feed_light_frame(s, k, s->light->rgb[k]);
         }
         if (rc == 0 && sink != NULL && sink->save != NULL)
-            rc = sink->save(sink->priv, first_index + k, s->light_rgb[k], p->width, p->height, 3);
+            rc = sink->save(sink->priv, first_index + k, s->light->rgb[k], p->width, p->height, 3);
     }
     int rc_off = lights_off(hal, c->light_count);
     int rc_exp = camera_exposure_back(hal, p, exposure_us);
@@ -680,7 +689,9 @@ int scan_probe_lights(struct scan_ctx *s, const struct hal *hal, const struct sc
     memset(&info, 0, sizeof(info));
     memset(out, 0, sizeof(*out));
     const size_t n = (size_t)p->width * p->height;
-    uint8_t *dark = s->light_rgb[COLOUR_FRAME_DARK]; /* free between views */
+    if (s->light == NULL)
+        return -EINVAL;
+    uint8_t *dark = s->light->rgb[COLOUR_FRAME_DARK]; /* free between views */
     int rc = hal_gpio_set(&hal->gpio, HAL_GPIO_PROJECTOR_ENABLE, 0);
     for (uint32_t l = 0; l <= c->light_count && rc == 0; l++) { /* dark, then each light */
         rc = lights_off(hal, c->light_count);
@@ -794,7 +805,7 @@ void scan_attach_colour(struct scan_ctx *s, struct scan_view *view)
 {
     view->white_rgb = s->colour_rgb;
     for (uint32_t k = 0; k < COLOUR_MAX_FRAMES; k++)
-        view->lights[k] = s->light_present[k] ? s->light_rgb[k] : NULL;
+        view->lights[k] = s->light_present[k] && s->light != NULL ? s->light->rgb[k] : NULL;
 }
 
 int scan_recolour(const struct colour_params *colour, const struct hal_thread *cores,

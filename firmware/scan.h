@@ -13,6 +13,15 @@
 
 struct fusion_volume;
 
+/** A view's colour frames (colour.h order: dark, all lights, each light alone, the bracketed
+ *  ones, their dark frames), RGB24 at the compiled limits: its largest buffer (COLOUR_MAX_FRAMES
+ *  x 3 bytes a pixel). Apart from struct scan_ctx so that their owner may give their memory to
+ *  what comes after the views (the job: the fusion volume, app/job.c); given to the context by
+ *  scan_use_light_frames. */
+struct scan_light_frames {
+    uint8_t rgb[COLOUR_MAX_FRAMES][HAL_MAX_PIXELS * 3];
+};
+
 /** One view's buffers and state, from its first frame to its range image and colour: what
  *  scan_begin_view (or scan_capture_view) starts and scan_finish_view completes; the views it
  *  hands out point into it. Tens of MB at the compiled limits: its owner (the job, the
@@ -31,8 +40,7 @@ struct scan_ctx {
     } planes;
     uint8_t colour_rgb[HAL_MAX_PIXELS * 3]; /* projector-white frame, kept as the view's colour */
     uint8_t frame_rgb[HAL_MAX_PIXELS * 3];  /* every other frame, consumed at once */
-    /* Light frames for the colour (colour.h): dark, all lights, each light alone. */
-    uint8_t light_rgb[COLOUR_MAX_FRAMES][HAL_MAX_PIXELS * 3];
+    struct scan_light_frames *light; /* the owner's (scan_use_light_frames); NULL: none yet */
     int light_present[COLOUR_MAX_FRAMES];
     uint8_t view_rgb[HAL_MAX_PIXELS * 3]; /* the view's colour: compensated, or raw */
     float view_confidence[HAL_MAX_PIXELS];
@@ -143,7 +151,8 @@ struct scan_light_probe {
 /** A dark frame and each light alone at the camera's exposure, projector off, without turning
  *  the table ([colour] light_exposure_us chosen by the scan: app/job_live.c); lights off again
  *  when it returns, the rig safe on every failure. @param out  what the brightest light shows
- *  @retval 0 ok @retval -EINTR stop requested @retval the camera's or GPIO's error */
+ *  @retval 0 ok @retval -EINTR stop requested @retval -EINVAL no memory for the dark frame
+ *  (scan_use_light_frames) @retval the camera's or GPIO's error */
 int scan_probe_lights(struct scan_ctx *s, const struct hal *hal, const struct scan_params *params,
                       const struct scan_calib *calib, struct scan_light_probe *out);
 
@@ -180,10 +189,14 @@ int scan_take_view(struct scan_ctx *s, const struct hal *hal, const struct scan_
  *  @retval 0 or -EINVAL */
 int scan_begin_view(struct scan_ctx *s, const struct scan_params *params,
                     const struct scan_calib *calib);
+/** Give @p s the memory its colour frames are kept in (its owner's, kept as long as @p s is
+ *  used; NULL: none). A view whose method takes colour frames cannot begin without it. */
+void scan_use_light_frames(struct scan_ctx *s, struct scan_light_frames *frames);
 /** Begin a view's colour only, its range image restored (scan_restore_view): the colour frames
  *  and the white frame are then read into scan_frame_buffer and fed (scan_feed_light_frame),
  *  and scan_attach_colour hands them to the view. The decoder is left as it is.
- *  @retval 0 @retval -EINVAL a frame size beyond the compiled limits */
+ *  @retval 0 @retval -EINVAL a frame size beyond the compiled limits, or colour frames to take
+ *  and no memory for them (scan_use_light_frames) */
 int scan_begin_colour(struct scan_ctx *s, const struct scan_params *params,
                       const struct scan_calib *calib);
 /** The frames, the decoder's planes, the projector columns and the range image of the views

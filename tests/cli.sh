@@ -336,6 +336,12 @@ check fit_keeps_reflectance_and_materials sh -c "$bin process $out/scan --config
     node tests/gltf/validate.mjs $out/fit/mesh.glb > $out/fit-glb.txt &&
     grep -q ' 0 errors, 0 warnings' $out/fit-glb.txt &&
     test \$(grep -a -o 'KHR_materials_specular' $out/fit/mesh.glb | wc -l) -ge 2"
+# ... and each view's range.bin holds the colour the model was made with, the fitted one (the
+# colour frames' memory is the fusion volume's once it begins: the fusion and the texture read
+# it there): the same reasons as the multi scan's, other colours.
+check fit_keeps_its_colour_in_range_bin sh -c "cmp -i 32 -n \$((1280 * 960)) $out/scan/view_000/range.bin \
+    $out/fit/view_000/range.bin && ! cmp -s -i \$((32 + 1280 * 960)) $out/scan/view_000/range.bin \
+    $out/fit/view_000/range.bin"
 # ... and the bunny's paints, lit by the simulator's Lambertian light, keep Lambert's law (issue 34).
 check fit_keeps_lambert_on_lambertian_paint sh -c "grep -q '^diffuse_roughness = ' $out/fit/reflectance.ini &&
     ! grep '^diffuse_roughness = ' $out/fit/reflectance.ini | grep -v ' = 0.0000$'"
@@ -425,7 +431,7 @@ rm -rf "$out/two-default" "$out/two-large"
     for f in mesh.ply mesh.glb texture.png view_000/range.bin view_001/cloud.ply; do
         cmp $out/two-default/\$f $out/two-large/\$f || exit 1; done"
 # make LIMITS=small, for a board with 512 MB: under a 512 MiB address-space limit the default
-# build cannot even start (878 MiB of static buffers), the small one takes the same scan and
+# build cannot even start (633 MiB of static buffers), the small one takes the same scan and
 # gives the same model. (ASan reserves terabytes of address space: no limit under SAN=1.)
 sbin=${BUILD:-build}/small/scanner
 rm -rf "$out/scan_small"

@@ -1,5 +1,6 @@
 /* One simulated view against ground truth: decoding rate, depth error, and no outliers
  * (issue "scanner core", done-when). Sphere and Stanford bunny, default noise. */
+#include <errno.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -15,6 +16,9 @@
 #include "gray.h"
 #include "mem.h"
 #include "memory_posix.h"
+#include "job.h"
+#include "scan_job.h"
+#include "storage_posix.h"
 #include "test_util.h"
 #include "thread_posix.h"
 
@@ -411,8 +415,10 @@ static void test_two_scan_contexts_are_independent(void **state)
     (void)state;
     static struct test_rig t;
     static struct scan_ctx other;
+    static struct scan_light_frames other_light; /* its colour frames, its own too */
     static uint8_t reason_a[HAL_MAX_PIXELS], rgb_a[HAL_MAX_PIXELS * 3];
     static float xyz_a[HAL_MAX_PIXELS * 3];
+    scan_use_light_frames(&other, &other_light);
     assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
     assert_int_equal(test_rig_start(&t), 0);
     struct scan_view a, b;
@@ -490,12 +496,12 @@ static void test_frames_given_back(void **state)
         }
     assert_true(kept >= 5); /* config/sim.ini: multi, four lights and their dark frame */
     assert_false(all_zero(t.scan->decode.white, n));
-    assert_false(all_zero(t.scan->light_rgb[COLOUR_FRAME_LIGHT0], n * 3));
+    assert_false(all_zero(t.scan->light->rgb[COLOUR_FRAME_LIGHT0], n * 3));
 
     scan_release_frames(t.scan);
     assert_memory_equal(reason_a, a.maps.reason, n);
     assert_memory_equal(rgb_a, a.rgb, n * 3);
-    int heard = all_zero(t.scan->light_rgb[COLOUR_FRAME_LIGHT0], n * 3);
+    int heard = all_zero(t.scan->light->rgb[COLOUR_FRAME_LIGHT0], n * 3);
 #ifdef __x86_64__ /* make test-arm64: qemu-user may take madvise and do nothing */
     assert_true(heard);
 #endif
@@ -548,6 +554,133 @@ static void test_frames_given_back(void **state)
     mem_use(NULL);
 }
 
+/* A view context whose colour frames' memory is lent (scan_use_light_frames(NULL), as a job
+ * does once its fusion begins: app/job.c): a method that reads colour frames cannot begin a
+ * view, take the lights or be fed a frame, and no buffer is handed out for one; the method none
+ * still decodes; the frames given back, the same view is taken as before. */
+static void test_colour_frames_lent(void **state)
+{
+    (void)state;
+    static struct test_rig t;
+    static uint8_t rgb[HAL_MAX_PIXELS * 3];
+    static uint8_t reason_a[HAL_MAX_PIXELS];
+    assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
+    struct scan_params none = t.cfg.scan;
+    none.colour.method = COLOUR_NONE;
+    struct gray_layout layout;
+    scan_layout(&t.cfg.scan, &t.calib, &layout);
+    uint32_t first_light = gray_layout_count(&layout);
+    struct scan_light_probe probe;
+    assert_true(scan_light_frame_count(&t.cfg.scan, &t.calib) >= 5);
+    assert_int_equal(test_rig_start(&t), 0);
+    struct scan_view a, b;
+    struct scan_view_info info;
+    assert_int_equal(scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &a, &info), 0);
+    size_t n = (size_t)a.width * a.height;
+    memcpy(reason_a, a.maps.reason, n);
+
+    scan_use_light_frames(t.scan, NULL);
+    assert_int_equal(scan_begin_colour(t.scan, &t.cfg.scan, &t.calib), -EINVAL);
+    assert_int_equal(scan_begin_view(t.scan, &t.cfg.scan, &t.calib), -EINVAL);
+    assert_null(scan_frame_buffer(t.scan, first_light));
+    assert_int_equal(scan_feed_light_frame(t.scan, COLOUR_FRAME_LIGHT0, rgb), -EINVAL);
+    assert_int_equal(scan_probe_lights(t.scan, &t.hal, &t.cfg.scan, &t.calib, &probe), -EINVAL);
+    assert_true(test_rig_dark());
+    assert_int_equal(scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &b, &info),
+                     -EINVAL);
+    assert_true(test_rig_dark());
+    /* no colour frames to read: the view is decoded as before */
+    assert_int_equal(scan_take_view(t.scan, &t.hal, &none, &t.calib, 0, NULL, &b, &info), 0);
+    assert_memory_equal(b.maps.reason, reason_a, n);
+
+    assert_ptr_equal(scan_job_views(), t.scan); /* the job's memory given back to it */
+    assert_int_equal(scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &b, &info), 0);
+    test_rig_stop(&t);
+    assert_memory_equal(b.maps.reason, reason_a, n);
+    assert_non_null(b.lights[COLOUR_FRAME_LIGHT0]);
+}
+
+/* The volume needs no zeroed memory: a job gives it the memory its views' colour frames were in
+ * (app/job.c). The bunny's view fused into a volume of zeros and into one of other bytes, its
+ * holes filled, closed watertight, meshed and its mesh's holes closed, gives the same mesh.ply,
+ * mesh.obj, mesh.stl and mesh.glb to the byte. */
+static void test_volume_begins_on_any_bytes(void **state)
+{
+    (void)state;
+    static struct test_rig t;
+    static const char *const names[] = {"mesh.ply", "mesh.obj", "mesh.stl", "mesh.glb"};
+    struct fusion_volume *vol = &test_volume;
+    struct hal_storage st;
+    storage_posix_init(&st);
+    assert_int_equal(system("mkdir -p build/test_view/zeros build/test_view/bytes"), 0);
+    assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
+    assert_int_equal(test_rig_start(&t), 0);
+    struct scan_view view;
+    struct scan_view_info info;
+    assert_int_equal(scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info),
+                     0);
+    test_rig_stop(&t);
+    struct frame_xform pose;
+    frame_object_from_camera(&t.calib, view.angle_mdeg, &pose);
+    struct mesh_summary ms[2];
+    for (int bytes = 0; bytes < 2; bytes++) {
+        char path[4][64];
+        for (int k = 0; k < 4; k++)
+            snprintf(path[k], sizeof(path[k]), "build/test_view/%s/%s", bytes ? "bytes" : "zeros",
+                     names[k]);
+        memset(vol, bytes ? 0xa5 : 0, sizeof(*vol));
+        uint32_t filled, inside;
+        struct mesh_hole_report holes;
+        assert_int_equal(fusion_begin(vol, &t.cfg.fusion), 0);
+        assert_int_equal(scan_fuse_view(vol, NULL, &t.calib, &view, &pose), 0);
+        assert_int_equal(fusion_fill_holes(vol, 10.0, &filled), 0);
+        assert_int_equal(fusion_close_watertight(vol, 10.0, 1, &inside), 0);
+        assert_int_equal(fusion_mesh_prepare(vol, 0.01, &ms[bytes]), 0);
+        assert_int_equal(fusion_mesh_fill_holes(vol, 10.0, &holes), 0);
+        assert_int_equal(fusion_write_ply(vol, &st, path[0]), 0);
+        assert_int_equal(fusion_write_obj(vol, &st, path[1]), 0);
+        assert_int_equal(fusion_write_stl(vol, &st, path[2]), 0);
+        assert_int_equal(fusion_write_glb(vol, &st, path[3], NULL), 0);
+    }
+    assert_true(ms[0].kept_vertices > 10000);
+    for (int k = 0; k < 4; k++) {
+        char a[64], b[64];
+        snprintf(a, sizeof(a), "build/test_view/zeros/%s", names[k]);
+        snprintf(b, sizeof(b), "build/test_view/bytes/%s", names[k]);
+        assert_true(test_files_equal(a, b));
+    }
+    print_message("%u vertices, the same mesh from a volume of zeros and of 0xa5 bytes\n",
+                  (unsigned)ms[0].kept_vertices);
+}
+
+/* Once a job has lent its colour frames to the volume (job_lend_frames, as the fusion begins), a
+ * view whose range.bin has gone is not decoded again (the decoder's colour frames are the
+ * volume's now): one error, naming the file and what makes the model again. */
+static void test_no_view_decoded_once_frames_lent(void **state)
+{
+    (void)state;
+    static struct test_rig t;
+    const char *dir = "build/test_view/lent";
+    struct scan_job_opts opts;
+    struct job j;
+    struct scan_view view;
+    struct scan_view_info info;
+    memset(&opts, 0, sizeof(opts));
+    assert_int_equal(system("rm -rf build/test_view/lent && mkdir -p build/test_view/lent"), 0);
+    assert_int_equal(test_rig_start_box(&t), 0);
+    job_init(&j, &t.hal, &t.cfg, &t.calib, &opts, dir);
+    j.views = 1;
+    job_lend_frames(&j);
+    test_log_clear();
+    assert_int_equal(job_load_range(&j, dir, 0, &view, &info), -EIO);
+    assert_true(test_log_one_error("view_000/range.bin"));
+    assert_true(test_log_has("cannot be decoded again now; 'scanner process build/test_view/lent"));
+    assert_null(t.scan->light); /* a colour frame is refused, not written over the volume */
+    test_rig_stop(&t);
+    assert_ptr_equal(scan_job_views(), t.scan); /* the next job's frames again */
+    assert_non_null(t.scan->light);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -562,6 +695,9 @@ int main(void)
         cmocka_unit_test(test_fewer_inverses),
         cmocka_unit_test(test_two_scan_contexts_are_independent),
         cmocka_unit_test(test_frames_given_back),
+        cmocka_unit_test(test_colour_frames_lent),
+        cmocka_unit_test(test_volume_begins_on_any_bytes),
+        cmocka_unit_test(test_no_view_decoded_once_frames_lent),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
