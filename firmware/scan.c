@@ -45,6 +45,24 @@ int scan_check(const struct scan_params *p, const struct scan_calib *c, char *ms
                  (unsigned)c->light_count, COLOUR_MAX_BRACKETED);
         return -EINVAL;
     }
+    /* the colour frames a view may take: the lights' exposure, when the scan is to choose it,
+     * counted as one of its own (a dark frame more) */
+    struct colour_params most = p->colour;
+    if (most.light_exposure_us == 0)
+        most.light_exposure_us = most.exposure_us + 1u;
+    struct colour_layout lay;
+    colour_layout(&most, c->light_count, &lay);
+    if ((uint64_t)lay.count * p->width * p->height >
+        (uint64_t)COLOUR_POOL_FRAMES * HAL_MAX_PIXELS) {
+        snprintf(msg, len,
+                 "[colour]: %u colour frames a view of %ux%u (%u lights%s) are more than this "
+                 "build keeps (%u of %ux%u, COLOUR_POOL_FRAMES): fewer lights, bracket = 0, or "
+                 "[camera] binning",
+                 (unsigned)lay.count, (unsigned)p->width, (unsigned)p->height,
+                 (unsigned)c->light_count, lay.long_of[COLOUR_FRAME_LIGHT0] ? ", bracketed" : "",
+                 COLOUR_POOL_FRAMES, HAL_MAX_WIDTH, HAL_MAX_HEIGHT);
+        return -EINVAL;
+    }
     return 0;
 }
 
@@ -151,6 +169,20 @@ void scan_layout(const struct scan_params *p, const struct scan_calib *c, struct
     l->inverse_bits = p->inverse_bits;
 }
 
+static size_t pixels(const struct scan_params *p)
+{
+    return (size_t)p->width * p->height;
+}
+
+/* Colour frame @p k of a view of @p n pixels, where the frames' memory keeps it (one after the
+ * other at their size), or NULL: no memory (lent, app/job.c), or not that much of it. */
+static uint8_t *light_frame(const struct scan_ctx *s, uint32_t k, size_t n)
+{
+    if (s->light == NULL || ((size_t)k + 1u) * n * 3u > sizeof(s->light->rgb))
+        return NULL;
+    return s->light->rgb + (size_t)k * n * 3u;
+}
+
 /* The pixel buffers a view of @p n pixels writes whole (its colour and reasons), mapped ahead
  * (mem.h). */
 static void prefault_colour(struct scan_ctx *s, size_t n)
@@ -169,7 +201,7 @@ static void prefault_colour_frames(struct scan_ctx *s, const struct scan_params 
     mem_prefault(s->colour_rgb, n * 3);
     for (uint32_t k = 0; k < lay->count && k < COLOUR_MAX_FRAMES; k++)
         if (colour_needs_frame(&p->colour, lay, k))
-            mem_prefault(s->light->rgb[k], n * 3);
+            mem_prefault(light_frame(s, k, n), n * 3);
 }
 
 /* The points' buffers (written only where a pixel decoded), mapped ahead from the first row
@@ -200,8 +232,8 @@ int scan_begin_colour(struct scan_ctx *s, const struct scan_params *p, const str
     if (p->width == 0 || p->height == 0 || p->width > HAL_MAX_WIDTH || p->height > HAL_MAX_HEIGHT)
         return -EINVAL;
     colour_layout(&p->colour, c->light_count, &lay);
-    if (lay.count > 0 && s->light == NULL)
-        return -EINVAL;
+    if (lay.count > 0 && light_frame(s, lay.count - 1u, pixels(p)) == NULL)
+        return -EINVAL; /* no memory for them, or not enough (scan_check) */
     s->params = *p;
     memset(s->light_present, 0, sizeof(s->light_present));
     scan_layout(p, c, &layout);
@@ -289,8 +321,7 @@ uint8_t *scan_frame_buffer(struct scan_ctx *s, uint32_t frame)
         return frame == GRAY_PATTERN_WHITE && !hdr ? s->colour_rgb
                                                    : decode_frame_slot(&s->decode, frame);
     if (frame < count + lights)
-        return frame - count < COLOUR_MAX_FRAMES && s->light != NULL ? s->light->rgb[frame - count]
-                                                                     : NULL;
+        return light_frame(s, frame - count, pixels(&s->params));
     return hdr && frame == count + lights ? s->colour_rgb : NULL;
 }
 
@@ -317,10 +348,11 @@ int scan_needs_light_frame(const struct scan_params *p, const struct scan_calib 
 
 int scan_feed_light_frame(struct scan_ctx *s, uint32_t k, const uint8_t *rgb)
 {
-    if (k >= COLOUR_MAX_FRAMES || s->light == NULL)
+    uint8_t *frame = light_frame(s, k, pixels(&s->params));
+    if (k >= COLOUR_MAX_FRAMES || frame == NULL)
         return -EINVAL;
-    if (rgb != s->light->rgb[k])
-        memcpy(s->light->rgb[k], rgb, (size_t)s->params.width * s->params.height * 3);
+    if (rgb != frame)
+        memcpy(frame, rgb, pixels(&s->params) * 3);
     s->light_present[k] = 1;
     return 0;
 }
@@ -393,7 +425,7 @@ int scan_finish_view(struct scan_ctx *s, const struct hal_thread *threads,
     view->angle_mdeg = angle_mdeg;
     view->white_rgb = s->colour_rgb;
     for (uint32_t k = 0; k < COLOUR_MAX_FRAMES; k++)
-        view->lights[k] = s->light_present[k] && s->light != NULL ? s->light->rgb[k] : NULL;
+        view->lights[k] = s->light_present[k] ? light_frame(s, k, pixels(&s->params)) : NULL;
     view->rgb = s->view_rgb;
     view->confidence = s->view_confidence;
     int rc = decode_finish(&s->decode, &cores, s->view_reason, &view->maps);
@@ -563,13 +595,14 @@ static int capture_lights(struct scan_ctx *s, const struct hal *hal, const struc
         if (rc == 0 && hal_should_stop(hal))
             rc = -EINTR;
         if (rc == 0)
-            rc = capture(s, hal, p, s->light->rgb[k], first_index + k, info);
+            rc = capture(s, hal, p, light_frame(s, k, pixels(p)), first_index + k, info);
         if (rc == 0) {
             info->frames_captured++;
-            rc = scan_feed_light_frame(s, k, s->light->rgb[k]);
+            rc = scan_feed_light_frame(s, k, light_frame(s, k, pixels(p)));
         }
         if (rc == 0 && sink != NULL && sink->save != NULL)
-            rc = sink->save(sink->priv, first_index + k, s->light->rgb[k], p->width, p->height, 3);
+            rc = sink->save(sink->priv, first_index + k, light_frame(s, k, pixels(p)), p->width,
+                            p->height, 3);
     }
     int rc_off = lights_off(hal, c->light_count);
     int rc_exp = camera_exposure_back(hal, p, exposure_us);
@@ -688,10 +721,10 @@ int scan_probe_lights(struct scan_ctx *s, const struct hal *hal, const struct sc
     struct scan_view_info info;
     memset(&info, 0, sizeof(info));
     memset(out, 0, sizeof(*out));
-    const size_t n = (size_t)p->width * p->height;
-    if (s->light == NULL)
+    const size_t n = pixels(p);
+    uint8_t *dark = light_frame(s, COLOUR_FRAME_DARK, n); /* free between views */
+    if (dark == NULL || n > HAL_MAX_PIXELS)
         return -EINVAL;
-    uint8_t *dark = s->light->rgb[COLOUR_FRAME_DARK]; /* free between views */
     int rc = hal_gpio_set(&hal->gpio, HAL_GPIO_PROJECTOR_ENABLE, 0);
     for (uint32_t l = 0; l <= c->light_count && rc == 0; l++) { /* dark, then each light */
         rc = lights_off(hal, c->light_count);
@@ -805,7 +838,7 @@ void scan_attach_colour(struct scan_ctx *s, struct scan_view *view)
 {
     view->white_rgb = s->colour_rgb;
     for (uint32_t k = 0; k < COLOUR_MAX_FRAMES; k++)
-        view->lights[k] = s->light_present[k] && s->light != NULL ? s->light->rgb[k] : NULL;
+        view->lights[k] = s->light_present[k] ? light_frame(s, k, pixels(&s->params)) : NULL;
 }
 
 int scan_recolour(const struct colour_params *colour, const struct hal_thread *cores,

@@ -13,13 +13,14 @@
 
 struct fusion_volume;
 
-/** A view's colour frames (colour.h order: dark, all lights, each light alone, the bracketed
- *  ones, their dark frames), RGB24 at the compiled limits: its largest buffer (COLOUR_MAX_FRAMES
- *  x 3 bytes a pixel). Apart from struct scan_ctx so that their owner may give their memory to
- *  what comes after the views (the job: the fusion volume, app/job.c); given to the context by
- *  scan_use_light_frames. */
+/** The memory of a view's colour frames (colour.h order: dark, all lights, each light alone,
+ *  the bracketed ones, their dark frames), RGB24, one after the other at the frames' size:
+ *  COLOUR_POOL_FRAMES frames at the compiled frame limit, more of smaller ones (scan_check
+ *  refuses a config whose frames do not fit). A view's largest buffer; apart from struct
+ *  scan_ctx so that its owner may give it to what comes after the views (the job: the fusion
+ *  volume, app/job.c); given to the context by scan_use_light_frames. */
 struct scan_light_frames {
-    uint8_t rgb[COLOUR_MAX_FRAMES][HAL_MAX_PIXELS * 3];
+    uint8_t rgb[(size_t)COLOUR_POOL_FRAMES * HAL_MAX_PIXELS * 3u];
 };
 
 /** One view's buffers and state, from its first frame to its range image and colour: what

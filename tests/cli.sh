@@ -420,6 +420,33 @@ sed -e 's/^width = 1280$/width = 4896/' -e 's/^height = 960$/height = 3264/' \
     grep -q 'width: 4896 exceeds the compiled limit 2048' $out/dslr.txt &&
     $lbin_large --version > /dev/null && $lbin_large check-config --config $out/dslr.ini 2>&1 |
     grep -q 'calibration is for a 1280x960 camera but the camera is set to 4896x3264'"
+# ... where a view's colour frames share the fusion volume's 639 MiB (13 frames at the limit,
+# COLOUR_POOL_FRAMES, so that the build starts on a 2 GB board): the DSLR's frames with four
+# lights bracketed fit, eight do not and are refused at start, named, with what to change;
+# at half the size (as binned 2 x 2) they fit. (The lens scaled as make measure-large scales it.)
+awk '/^\[/ { sec = $0 }
+    sec == "[camera]" && $1 ~ /^f[xy]_px$/ { $3 = $3 * 4896 / 1280 }
+    sec == "[camera]" && $1 == "cx_px" { $3 = 2447.5 }
+    sec == "[camera]" && $1 == "cy_px" { $3 = 1631.5 }
+    sec == "[camera]" && $1 == "width" { $3 = 4896 }
+    sec == "[camera]" && $1 == "height" { $3 = 3264 }
+    { print }
+    /^light_3_mm/ { for (l = 4; l < 8; l++) printf "light_%d_mm = %d, -250, 300\n", l, 100 * l }' \
+    config/sim-calib.ini > "$out/dslr-calib.ini"
+sed -e "s|^calibration = .*|calibration = $out/dslr-calib.ini|" -e '/^\[colour\]/a bracket = 4' \
+    "$out/dslr.ini" > "$out/dslr-4.ini"
+sed -e 's/^count = 4$/count = 8/' "$out/dslr-4.ini" > "$out/dslr-8.ini"
+awk '/^\[/ { sec = $0 } sec == "[camera]" && $1 == "width" { $3 = 2448 }
+    sec == "[camera]" && $1 == "height" { $3 = 1632 }
+    sec == "[camera]" && $1 ~ /^(f[xy]|c[xy])_px$/ { $3 = $3 / 2 } { print }' \
+    "$out/dslr-calib.ini" > "$out/dslr-calib-half.ini"
+sed -e "s|^calibration = .*|calibration = $out/dslr-calib-half.ini|" -e 's/^width = 4896$/width = 2448/' \
+    -e 's/^height = 3264$/height = 1632/' "$out/dslr-8.ini" > "$out/dslr-8-half.ini"
+[ -x "$lbin_large" ] && check large_limits_keep_colour_frames_in_the_volumes_memory sh -c "
+    $lbin_large check-config --config $out/dslr-4.ini > $out/dslr-4.txt 2>&1 &&
+    ! $lbin_large check-config --config $out/dslr-8.ini > $out/dslr-8.txt 2>&1 &&
+    grep -q '20 colour frames a view of 4896x3264 (8 lights, bracketed) are more than this build keeps (13 of 4928x3456, COLOUR_POOL_FRAMES): fewer lights, bracket = 0, or \[camera\] binning' $out/dslr-8.txt &&
+    $lbin_large check-config --config $out/dslr-8-half.ini > $out/dslr-8-half.txt 2>&1"
 # ... and it scans as the default build does: make run's rig in 2 views, the same files to the
 # byte (its larger buffers and code model change no arithmetic).
 sed -e 's/^views = 8$/views = 2/' -e "s|^calibration = .*|calibration = $PWD/config/sim-calib.ini|" \

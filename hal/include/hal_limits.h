@@ -10,7 +10,7 @@
 #ifdef HAL_LIMITS_SMALL
 /* make LIMITS=small, for a board with 512 MB (a Pi Zero 2 W, a Pi 3A+): frames up to the Pi
  * camera v1's 2x2 binned mode, 1296 x 972, a smaller fusion grid (fusion.h), no bracketed
- * colour frames; about 314 MiB of static buffers instead of 822 (make size). */
+ * colour frames; about 271 MiB of static buffers instead of 633 (make size). */
 #define HAL_MAX_WIDTH 1296u
 #define HAL_MAX_HEIGHT 972u
 #elif defined(HAL_LIMITS_LARGE)
@@ -51,6 +51,17 @@
 #endif
 #define COLOUR_MAX_FRAMES                                                                          \
     (2u + HAL_MAX_LIGHTS + 2u + (COLOUR_MAX_BRACKETED > 0u ? COLOUR_MAX_BRACKETED + 1u : 0u))
+/* The memory a view's colour frames are kept in, in frames at the compiled frame limit; smaller
+ * frames are packed, so more of them fit. It shares its memory with the fusion volume (app/job.c),
+ * which is the larger of the two except at LIMITS=large, where every light bracketed at 16 MP
+ * would take 1 GB: there it holds 13 frames (a dark and an all-lights frame, four lights alone
+ * and bracketed, their three dark frames), as much as the volume's 639 MiB, so that the build
+ * starts on a 2 GB board. A config whose frames do not fit is refused at start (scan_check). */
+#ifdef HAL_LIMITS_LARGE
+#define COLOUR_POOL_FRAMES 13u
+#else
+#define COLOUR_POOL_FRAMES COLOUR_MAX_FRAMES
+#endif
 /* The fusion grid (fusion.h): at most FUSION_MAX_DIM voxels along an axis, FUSION_MAX_VOXELS in
  * all, 8 bytes each. */
 #ifdef HAL_LIMITS_SMALL
@@ -136,6 +147,7 @@ HAL_STATIC_ASSERT((1u << HAL_MAX_CODE_BITS) >= HAL_MAX_PROJECTOR_WIDTH &&
                   "every projector column and row must have a code");
 HAL_STATIC_ASSERT(DECODE_MAX_PATTERNS <= 255u, "pattern indices are counted in small integers");
 HAL_STATIC_ASSERT(HAL_MAX_LIGHTS <= 31u, "light masks are 32-bit words");
+HAL_STATIC_ASSERT(COLOUR_POOL_FRAMES <= COLOUR_MAX_FRAMES, "the pool holds at most every frame");
 HAL_STATIC_ASSERT(FUSION_MAX_VOXELS <= (uint64_t)FUSION_MAX_DIM * FUSION_MAX_DIM * FUSION_MAX_DIM,
                   "the voxel budget fits in a grid of the largest dimensions");
 HAL_STATIC_ASSERT(REG_MAX_CELLS / REG_MAX_VIEWS >= 64u, "every view keeps some samples");
