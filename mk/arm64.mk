@@ -27,6 +27,7 @@ test-gpio-chip:
 	@{ command -v qemu-system-aarch64 && command -v cpio && command -v systemd-analyze && command -v socat; } >/dev/null 2>&1 || scripts/install-deps.sh gpio-chip
 	@$(MAKE) --no-print-directory $(ARM64) HAL=linux all
 	@$(MAKE) --no-print-directory $(ARM64) HAL=linux LIMITS=small all
+	@$(MAKE) --no-print-directory $(ARM64) HAL=linux LIMITS=large all
 	@$(MAKE) --no-print-directory $(ARM64) HAL=linux seccomp-tool vivid-tool
 	@tests/run.sh tests/gpio_chip.sh
 arm64-check-elf: $(BUILD)/scanner

@@ -3,9 +3,10 @@
 # machine (qemu-system-aarch64, machine "virt", whose PL061 GPIO controller Debian's arm64
 # kernel drives), where gpioset holds one of the scanner's lines as another program would.
 # Checks: with every line free the selftest requests them all; with one held it names the line
-# and its holder; afterwards the kernel shows no line left requested by the scanner. Twice: the
-# default build on a 1 GB machine, the LIMITS=small build on a 512 MB one (where the default
-# build cannot start). Run by `make test-gpio-chip`, which cross-builds both.
+# and its holder; afterwards the kernel shows no line left requested by the scanner. Three times:
+# the default build on a 1 GB machine (where the LIMITS=large build cannot start), the
+# LIMITS=small build on a 512 MB one (where the default build cannot start), the LIMITS=large
+# build on a 2 GB one. Run by `make test-gpio-chip`, which cross-builds the three.
 # The same VM (default build) loads vivid, the kernel's virtual video driver, and runs the V4L2
 # backend on it (tools/vivid_capture.c: format, the mmap ring, drop_frames, frame timestamps,
 # binning, a timeout when frames stop) and the selftest with it as the rig's camera; and it has
@@ -17,6 +18,7 @@ set -eu
 cd "$(dirname "$0")/.."
 SCANNER=${SCANNER:-build/aarch64-linux-gnu/linux/scanner}
 SCANNER_SMALL=${SCANNER_SMALL:-build/aarch64-linux-gnu/small/linux/scanner}
+SCANNER_LARGE=${SCANNER_LARGE:-build/aarch64-linux-gnu/large/linux/scanner}
 SECCOMP_RUN=${SECCOMP_RUN:-build/aarch64-linux-gnu/linux/seccomp-run}
 VIVID_CAPTURE=${VIVID_CAPTURE:-build/aarch64-linux-gnu/linux/vivid-capture}
 DRM_SHOW=${DRM_SHOW:-build/aarch64-linux-gnu/linux/drm-show}
@@ -55,6 +57,7 @@ mkdir -p "$R/bin" "$R/lib/$TRIPLET" "$R/etc/scanner" "$R/proc" "$R/sys" "$R/dev"
 cp "$WORK/unpacked/bin/busybox" "$R/bin/"
 cp "$SCANNER" "$R/bin/scanner-default"
 cp "$SCANNER_SMALL" "$R/bin/scanner-small"
+cp "$SCANNER_LARGE" "$R/bin/scanner-large"
 cp "$WORK/unpacked/usr/bin/gpioset" "$WORK/unpacked/usr/bin/gpioinfo" "$R/bin/"
 cp "$VIVID_CAPTURE" "$R/bin/vivid-capture"
 cp "$DRM_SHOW" "$R/bin/drm-show"
@@ -102,7 +105,8 @@ copy_libs() { # every library an ELF needs, recursively
         [ -e "$R/lib/$TRIPLET/$lib" ] || { echo "gpio_chip: no $lib for $1" >&2; exit 1; }
     done
 }
-for elf in "$R/bin/scanner-default" "$R/bin/scanner-small" "$R/bin/gpioset" "$R/bin/gpioinfo" \
+for elf in "$R/bin/scanner-default" "$R/bin/scanner-small" "$R/bin/scanner-large" \
+    "$R/bin/gpioset" "$R/bin/gpioinfo" \
     "$R/bin/seccomp-run" "$R/bin/udevadm" "$R/bin/vivid-capture" "$R/bin/drm-show" \
     "$R"/usr/lib/$TRIPLET/systemd/libsystemd-shared-*.so; do
     copy_libs "$elf"
@@ -117,8 +121,8 @@ sed -e 's/^chip = .*/chip = gpiochip0/' -e 's/^projector_enable = .*/projector_e
     -e 's/^light_1 = .*/light_1 = 5/' -e 's/^light_2 = .*/light_2 = 6/' \
     -e 's/^light_3 = .*/light_3 = 7/' config/pi-v4l2.ini > "$R/etc/scanner/rig.ini"
 
-# The checks run the build named on the kernel command line (scanner=default or small); the
-# default build's --version shows whether it can start with this much memory.
+# The checks run the build named on the kernel command line (scanner=default, small or large);
+# the default and large builds' --version show whether they can start with this much memory.
 cat > "$R/init" <<'EOF'
 #!/bin/busybox sh
 /bin/busybox --install -s /bin
@@ -126,6 +130,7 @@ mount -t proc proc /proc; mount -t sysfs sys /sys; mount -t devtmpfs dev /dev
 build=$(sed -n 's/.*scanner=\([a-z]*\).*/\1/p' /proc/cmdline)
 ln -s /bin/scanner-$build /bin/scanner
 echo "== default build starts"; scanner-default --version 2>&1; echo "exit $?"
+echo "== large build starts"; scanner-large --version 2>&1; echo "exit $?"
 echo "== gpioinfo"; gpioinfo
 udev() { # the rule file to run on the chip
     rm -f /etc/udev/rules.d/*; cp "$1" /etc/udev/rules.d/
@@ -242,6 +247,7 @@ boot() { # memory in MB, the build the checks run
 
 boot 1024 default
 check "the default build starts" "default build starts" "^scanner .*HAL=linux" "^exit 0$"
+check "the LIMITS=large build cannot start" "large build starts" "!^scanner .*HAL=linux" "!^exit 0$"
 check "vivid loads and makes a capture node" "vivid" "^capture node /dev/video[0-9]+$" "!failed"
 check "V4L2 on vivid: format negotiated, streaming" "vivid capture" "^open 640x480 yuyv: ok$" \
     "^frame 5: 640x480 sequence"
@@ -269,8 +275,12 @@ for name in "pattern 0" "pattern 1" "pattern 2" "pattern 3" "pattern 12" "patter
 done
 check "the selftest with vivid as the camera" "selftest, vivid as the camera" \
     "^camera +/dev/video[0-9]+ +ok +v4l2 frame 1280x720" "!^turntable +/dev/video"
-# 512 MB: the default build's 657 MiB of static buffers do not fit; LIMITS=small's do.
+# 512 MB: the default build's 633 MiB of static buffers do not fit; LIMITS=small's do.
 boot 512 small
 check "the default build cannot start" "default build starts" "!^scanner .*HAL=linux" "!^exit 0$"
+# 2 GB: the LIMITS=large build's 1.8 GB (16 MP frames; its colour frames in the fusion
+# volume's memory) fit.
+boot 2048 large
+check "the LIMITS=large build starts" "large build starts" "^scanner .*HAL=linux" "^exit 0$"
 if [ $failed -eq 0 ]; then echo "[  PASSED  ] $passed test(s)."; else echo "[  FAILED  ] $failed test(s)."; fi
 [ $failed -eq 0 ]

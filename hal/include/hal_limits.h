@@ -14,8 +14,8 @@
 #define HAL_MAX_WIDTH 1296u
 #define HAL_MAX_HEIGHT 972u
 #elif defined(HAL_LIMITS_LARGE)
-/* make LIMITS=large, for a computer with memory to spare (about 2.8 GB of static buffers, mapped
- * as they are used): full-resolution frames of the sensors people put on these rigs, the
+/* make LIMITS=large, for a board with 2 GB or more (about 1.8 GB of static buffers, mapped as
+ * they are used): full-resolution frames of the sensors people put on these rigs, the
  * Raspberry Pi HQ camera's 4056 x 3040, Camera Module 3's 4608 x 2592, a 16 MP 4608 x 3456 and
  * the 4896 x 3264 of a DSLR (docs/performance.md). */
 #define HAL_MAX_WIDTH 4928u
