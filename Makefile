@@ -48,8 +48,9 @@ BUILD := $(BUILD)/small
 LIMITS_CFLAGS := -DHAL_LIMITS_SMALL
 else ifeq ($(LIMITS),large)
 BUILD := $(BUILD)/large
-# more than 2 GB of static buffers: x86-64's medium code model puts them beyond the code's reach
-LIMITS_CFLAGS := -DHAL_LIMITS_LARGE $(if $(filter x86_64,$(shell uname -m)),-mcmodel=medium,)
+# static buffers near 2 GB: x86-64's medium code model puts them beyond the code's reach (the
+# target's, so not for a cross build to arm64, whose small model reaches 4 GB)
+LIMITS_CFLAGS := -DHAL_LIMITS_LARGE $(if $(filter x86_64-%,$(shell $(CC) -dumpmachine)),-mcmodel=medium,)
 else ifneq ($(LIMITS),default)
 $(error LIMITS must be default, small or large, not '$(LIMITS)')
 endif
