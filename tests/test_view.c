@@ -496,12 +496,12 @@ static void test_frames_given_back(void **state)
         }
     assert_true(kept >= 5); /* config/sim.ini: multi, four lights and their dark frame */
     assert_false(all_zero(t.scan->decode.white, n));
-    assert_false(all_zero(t.scan->light->rgb[COLOUR_FRAME_LIGHT0], n * 3));
+    assert_false(all_zero(a.lights[COLOUR_FRAME_LIGHT0], n * 3));
 
     scan_release_frames(t.scan);
     assert_memory_equal(reason_a, a.maps.reason, n);
     assert_memory_equal(rgb_a, a.rgb, n * 3);
-    int heard = all_zero(t.scan->light->rgb[COLOUR_FRAME_LIGHT0], n * 3);
+    int heard = all_zero(a.lights[COLOUR_FRAME_LIGHT0], n * 3);
 #ifdef __x86_64__ /* make test-arm64: qemu-user may take madvise and do nothing */
     assert_true(heard);
 #endif
