@@ -433,14 +433,14 @@ awk '/^\[/ { sec = $0 }
     { print }
     /^light_3_mm/ { for (l = 4; l < 8; l++) printf "light_%d_mm = %d, -250, 300\n", l, 100 * l }' \
     config/sim-calib.ini > "$out/dslr-calib.ini"
-sed -e "s|^calibration = .*|calibration = $out/dslr-calib.ini|" -e '/^\[colour\]/a bracket = 4' \
+sed -e "s|^calibration = .*|calibration = $PWD/$out/dslr-calib.ini|" -e '/^\[colour\]/a bracket = 4' \
     "$out/dslr.ini" > "$out/dslr-4.ini"
 sed -e 's/^count = 4$/count = 8/' "$out/dslr-4.ini" > "$out/dslr-8.ini"
 awk '/^\[/ { sec = $0 } sec == "[camera]" && $1 == "width" { $3 = 2448 }
     sec == "[camera]" && $1 == "height" { $3 = 1632 }
     sec == "[camera]" && $1 ~ /^(f[xy]|c[xy])_px$/ { $3 = $3 / 2 } { print }' \
     "$out/dslr-calib.ini" > "$out/dslr-calib-half.ini"
-sed -e "s|^calibration = .*|calibration = $out/dslr-calib-half.ini|" -e 's/^width = 4896$/width = 2448/' \
+sed -e "s|^calibration = .*|calibration = $PWD/$out/dslr-calib-half.ini|" -e 's/^width = 4896$/width = 2448/' \
     -e 's/^height = 3264$/height = 1632/' "$out/dslr-8.ini" > "$out/dslr-8-half.ini"
 [ -x "$lbin_large" ] && check large_limits_keep_colour_frames_in_the_volumes_memory sh -c "
     $lbin_large check-config --config $out/dslr-4.ini > $out/dslr-4.txt 2>&1 &&
