@@ -519,14 +519,8 @@ static int nearest_reading(uint32_t code, uint32_t bits, uint16_t plain, uint16_
     return 1;
 }
 
-/* A pixel with unclear bits takes, of its possible readings, the one its decoded neighbourhood
- * predicts: one with more than max_ambiguous_bits (or decoding outside the projector) becomes
- * valid so; a valid one whose unclear bit read the wrong way (noise, not an edge) is corrected.
- * Verdicts go to the scratch plane and corrections wait in the unclear maps (not needed after this)
- * until the pass ends, so that what this pass changes is not the reference of others. */
-#define RESOLVE_CORRECTED                                                                          \
-    SCAN_REASON_COUNT /* in the scratch plane: valid, its reading replaced                         \
-                       */
+/* A verdict of resolve_unclear in the scratch plane: valid, its reading replaced. */
+#define RESOLVE_CORRECTED SCAN_REASON_COUNT
 
 /* Rows of a neighbourhood stage split into parts (every pixel's verdict is its own: the same
  * maps however many). */

@@ -13,6 +13,12 @@
 #include <stdio.h>
 #include <string.h>
 
+/* The pixels of a frame of @p p. */
+static size_t frame_pixels(const struct scan_params *p)
+{
+    return (size_t)p->width * p->height;
+}
+
 int scan_check(const struct scan_params *p, const struct scan_calib *c, char *msg, size_t len)
 {
     if (p->width > HAL_MAX_WIDTH || p->height > HAL_MAX_HEIGHT) {
@@ -169,11 +175,6 @@ void scan_layout(const struct scan_params *p, const struct scan_calib *c, struct
     l->inverse_bits = p->inverse_bits;
 }
 
-static size_t pixels(const struct scan_params *p)
-{
-    return (size_t)p->width * p->height;
-}
-
 /* Colour frame @p k of a view of @p n pixels, where the frames' memory keeps it (one after the
  * other at their size), or NULL: no memory (lent, app/job.c), or not that much of it. */
 static uint8_t *light_frame(const struct scan_ctx *s, uint32_t k, size_t n)
@@ -197,7 +198,7 @@ static void prefault_colour(struct scan_ctx *s, size_t n)
 static void prefault_colour_frames(struct scan_ctx *s, const struct scan_params *p,
                                    const struct colour_layout *lay)
 {
-    size_t n = (size_t)p->width * p->height;
+    size_t n = frame_pixels(p);
     mem_prefault(s->colour_rgb, n * 3);
     for (uint32_t k = 0; k < lay->count && k < COLOUR_MAX_FRAMES; k++)
         if (colour_needs_frame(&p->colour, lay, k))
@@ -232,7 +233,7 @@ int scan_begin_colour(struct scan_ctx *s, const struct scan_params *p, const str
     if (p->width == 0 || p->height == 0 || p->width > HAL_MAX_WIDTH || p->height > HAL_MAX_HEIGHT)
         return -EINVAL;
     colour_layout(&p->colour, c->light_count, &lay);
-    if (lay.count > 0 && light_frame(s, lay.count - 1u, pixels(p)) == NULL)
+    if (lay.count > 0 && light_frame(s, lay.count - 1u, frame_pixels(p)) == NULL)
         return -EINVAL; /* no memory for them, or not enough (scan_check) */
     s->params = *p;
     memset(s->light_present, 0, sizeof(s->light_present));
@@ -253,7 +254,7 @@ int scan_begin_view(struct scan_ctx *s, const struct scan_params *p, const struc
         rc = scan_begin_colour(s, p, c);
     if (rc != 0)
         return rc;
-    size_t n = (size_t)p->width * p->height;
+    size_t n = frame_pixels(p);
     prefault_colour(s, n); /* (the decoder's buffers are its own: decode_begin) */
     if (p->exposure_count > 0) {
         mem_prefault(s->hdr_choice, n);
@@ -279,7 +280,7 @@ void scan_release_frames(struct scan_ctx *s)
 int scan_feed_frame(struct scan_ctx *s, uint32_t pattern, const uint8_t *pixels, uint32_t channels,
                     const struct scan_frame_sink *sink)
 {
-    size_t n = (size_t)s->params.width * s->params.height;
+    size_t n = frame_pixels(&s->params);
     const uint8_t *grey = pixels;
     uint8_t *slot = decode_frame_slot(&s->decode, pattern);
     if (slot == NULL)
@@ -321,14 +322,14 @@ uint8_t *scan_frame_buffer(struct scan_ctx *s, uint32_t frame)
         return frame == GRAY_PATTERN_WHITE && !hdr ? s->colour_rgb
                                                    : decode_frame_slot(&s->decode, frame);
     if (frame < count + lights)
-        return light_frame(s, frame - count, pixels(&s->params));
+        return light_frame(s, frame - count, frame_pixels(&s->params));
     return hdr && frame == count + lights ? s->colour_rgb : NULL;
 }
 
 int scan_feed_white_colour(struct scan_ctx *s, const uint8_t *rgb)
 {
     if (rgb != s->colour_rgb)
-        memcpy(s->colour_rgb, rgb, (size_t)s->params.width * s->params.height * 3);
+        memcpy(s->colour_rgb, rgb, frame_pixels(&s->params) * 3);
     return 0;
 }
 
@@ -348,11 +349,11 @@ int scan_needs_light_frame(const struct scan_params *p, const struct scan_calib 
 
 int scan_feed_light_frame(struct scan_ctx *s, uint32_t k, const uint8_t *rgb)
 {
-    uint8_t *frame = light_frame(s, k, pixels(&s->params));
+    uint8_t *frame = light_frame(s, k, frame_pixels(&s->params));
     if (k >= COLOUR_MAX_FRAMES || frame == NULL)
         return -EINVAL;
     if (rgb != frame)
-        memcpy(frame, rgb, pixels(&s->params) * 3);
+        memcpy(frame, rgb, frame_pixels(&s->params) * 3);
     s->light_present[k] = 1;
     return 0;
 }
@@ -399,7 +400,7 @@ static void count_reasons(const struct scan_ctx *s, const struct hal_thread *cor
 {
     static struct reason_parts p; /* 34 KiB of counts: one view is finished at a time */
     p.s = s;
-    p.pixels = (size_t)s->params.width * s->params.height;
+    p.pixels = frame_pixels(&s->params);
     p.parts = hal_thread_parts(cores, HAL_MAX_PARTS);
     hal_thread_run(cores, p.parts, reason_part, &p);
     uint32_t dark_hist[256] = {0}, dark_n = 0;
@@ -425,7 +426,7 @@ int scan_finish_view(struct scan_ctx *s, const struct hal_thread *threads,
     view->angle_mdeg = angle_mdeg;
     view->white_rgb = s->colour_rgb;
     for (uint32_t k = 0; k < COLOUR_MAX_FRAMES; k++)
-        view->lights[k] = s->light_present[k] ? light_frame(s, k, pixels(&s->params)) : NULL;
+        view->lights[k] = s->light_present[k] ? light_frame(s, k, frame_pixels(&s->params)) : NULL;
     view->rgb = s->view_rgb;
     view->confidence = s->view_confidence;
     int rc = decode_finish(&s->decode, &cores, s->view_reason, &view->maps);
@@ -481,7 +482,7 @@ int scan_restore_view(struct scan_ctx *s, uint32_t width, uint32_t height, int32
 static int capture_hdr(struct scan_ctx *s, const struct hal *hal, const struct scan_params *p,
                        uint32_t i, uint32_t *exposure_us, struct scan_view_info *info)
 {
-    const size_t n = (size_t)p->width * p->height;
+    const size_t n = frame_pixels(p);
     uint8_t *slot = decode_frame_slot(&s->decode, i);
     int rc = 0;
     for (uint32_t e = 0; e < p->exposure_count && rc == 0; e++) {
@@ -594,15 +595,15 @@ static int capture_lights(struct scan_ctx *s, const struct hal *hal, const struc
             rc = settle(s, hal, p);
         if (rc == 0 && hal_should_stop(hal))
             rc = -EINTR;
+        uint8_t *frame = light_frame(s, k, frame_pixels(p)); /* scan_begin_view: it fits */
         if (rc == 0)
-            rc = capture(s, hal, p, light_frame(s, k, pixels(p)), first_index + k, info);
+            rc = capture(s, hal, p, frame, first_index + k, info);
         if (rc == 0) {
             info->frames_captured++;
-            rc = scan_feed_light_frame(s, k, light_frame(s, k, pixels(p)));
+            rc = scan_feed_light_frame(s, k, frame);
         }
         if (rc == 0 && sink != NULL && sink->save != NULL)
-            rc = sink->save(sink->priv, first_index + k, light_frame(s, k, pixels(p)), p->width,
-                            p->height, 3);
+            rc = sink->save(sink->priv, first_index + k, frame, p->width, p->height, 3);
     }
     int rc_off = lights_off(hal, c->light_count);
     int rc_exp = camera_exposure_back(hal, p, exposure_us);
@@ -668,7 +669,7 @@ int scan_probe_contrast(struct scan_ctx *s, const struct hal *hal, const struct 
         hal->gpio.ops->safe_state(hal->gpio.priv);
         return rc != 0 ? rc : rc_off;
     }
-    const size_t n = (size_t)p->width * p->height;
+    const size_t n = frame_pixels(p);
     uint8_t *white = s->hdr_grey, *black = s->hdr_choice; /* both free between views */
     decode_rgb_to_grey(s->colour_rgb, white, n, p->saturation_dn);
     decode_rgb_to_grey(s->frame_rgb, black, n, p->saturation_dn);
@@ -721,7 +722,7 @@ int scan_probe_lights(struct scan_ctx *s, const struct hal *hal, const struct sc
     struct scan_view_info info;
     memset(&info, 0, sizeof(info));
     memset(out, 0, sizeof(*out));
-    const size_t n = pixels(p);
+    const size_t n = frame_pixels(p);
     uint8_t *dark = light_frame(s, COLOUR_FRAME_DARK, n); /* free between views */
     if (dark == NULL || n > HAL_MAX_PIXELS)
         return -EINVAL;
@@ -838,7 +839,7 @@ void scan_attach_colour(struct scan_ctx *s, struct scan_view *view)
 {
     view->white_rgb = s->colour_rgb;
     for (uint32_t k = 0; k < COLOUR_MAX_FRAMES; k++)
-        view->lights[k] = s->light_present[k] ? light_frame(s, k, pixels(&s->params)) : NULL;
+        view->lights[k] = s->light_present[k] ? light_frame(s, k, frame_pixels(&s->params)) : NULL;
 }
 
 int scan_recolour(const struct colour_params *colour, const struct hal_thread *cores,
