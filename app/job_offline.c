@@ -193,9 +193,11 @@ static int reads_add(uint32_t f, uint32_t channels)
     return 0;
 }
 
-/* The pattern frames, two at a time where their buffers differ (white and black, a bit's stripes
- * and its inverse: a bit without inverse shares its buffer with the next), each pair read side
- * by side and then fed in order. */
+/* The pattern frames, two at a time where the second's buffer is free before the first is fed
+ * (white and black, a bit's stripes and its inverse; not a bit without inverse and the next,
+ * which share a buffer, nor an inverse and the next bit's stripes, whose buffer the inverse is
+ * read against: with [scan] inverse_bits the pairs fell out of step there and each inverse was
+ * read against the next bit's stripes), each pair read side by side and then fed in order. */
 static int feed_pattern_frames(struct scan_ctx *s, const char *scan_dir, uint32_t v, uint32_t count,
                                const struct scan_params *params, const struct scan_calib *calib,
                                const struct hal_thread *cores, char *err, size_t err_len)
@@ -204,7 +206,7 @@ static int feed_pattern_frames(struct scan_ctx *s, const char *scan_dir, uint32_
     for (uint32_t f = 0; rc == 0 && f < count; f += reads.count) {
         reads_begin(s, scan_dir, v, params);
         for (uint32_t g = f; rc == 0 && g < count && g < f + 2u; g++) {
-            if (g > f && scan_frame_buffer(s, g) == scan_frame_buffer(s, f))
+            if (g > f && !scan_frame_read_ahead(s, f, g))
                 break;
             rc = reads_add(g, scan_frame_channels(params, calib, g));
         }

@@ -216,6 +216,20 @@ static void read_bit(struct decode_ctx *d, int is_row, uint32_t k, const uint8_t
         read_bit_loop(word, unc, d->work->sat, pos, neg, thr, n, 0, 0);
 }
 
+int decode_slot_free_before(struct decode_ctx *d, uint32_t pattern, uint32_t next)
+{
+    int is_row, paired, is_inverse;
+    uint32_t k;
+    uint8_t *own = decode_frame_slot(d, pattern), *slot = decode_frame_slot(d, next);
+    if (own == NULL || slot == NULL || slot == own)
+        return 0;
+    if (pattern == GRAY_PATTERN_BLACK) /* begin_bits reads the white frame */
+        return slot != d->white;
+    /* decode_frame reads an inverse against its stripes' frame, kept in stage[0] */
+    return pattern_bit(d, pattern, &is_row, &k, &paired, &is_inverse) != 0 || !is_inverse ||
+           slot != d->work->stage[0];
+}
+
 int decode_frame(struct decode_ctx *d, uint32_t pattern, const uint8_t *grey)
 {
     int is_row, paired, is_inverse;

@@ -112,6 +112,11 @@ int decode_begin(struct decode_ctx *d, struct decode_work *work, const struct sc
  *  It holds the frame until the next frame after it is handed over (white and black: until
  *  the next view begins). @retval NULL when @p pattern is outside the layout */
 uint8_t *decode_frame_slot(struct decode_ctx *d, uint32_t pattern);
+/** Whether pattern @p next's frame may be written into its slot before pattern @p pattern is
+ *  handed over (a reader of kept frames reads two at once): its slot is neither @p pattern's
+ *  nor one the hand-over of @p pattern reads (an inverse is read against its stripes' frame).
+ *  @retval 1 it may @retval 0 it may not, or either is outside the layout */
+int decode_slot_free_before(struct decode_ctx *d, uint32_t pattern, uint32_t next);
 /** Hand over the grey frame of pattern @p pattern, in sequence order (copied into its slot
  *  unless it already is the slot), and read its bit into every pixel.
  *  @retval 0 ok @retval -EINVAL out of order */

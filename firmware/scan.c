@@ -326,6 +326,13 @@ uint8_t *scan_frame_buffer(struct scan_ctx *s, uint32_t frame)
     return hdr && frame == count + lights ? s->colour_rgb : NULL;
 }
 
+int scan_frame_read_ahead(struct scan_ctx *s, uint32_t frame, uint32_t next)
+{
+    uint8_t *own = scan_frame_buffer(s, frame), *buf = scan_frame_buffer(s, next);
+    return frame < s->patterns && next < s->patterns && own != NULL && buf != NULL && buf != own &&
+           decode_slot_free_before(&s->decode, frame, next);
+}
+
 int scan_feed_white_colour(struct scan_ctx *s, const uint8_t *rgb)
 {
     if (rgb != s->colour_rgb)

@@ -221,6 +221,9 @@ uint32_t scan_frame_channels(const struct scan_params *params, const struct scan
  *  HAL_MAX_PIXELS RGB pixels for the white and colour frames, HAL_MAX_PIXELS grey ones for the
  *  other patterns @retval NULL no such frame */
 uint8_t *scan_frame_buffer(struct scan_ctx *s, uint32_t frame);
+/** Whether pattern frame @p next may be read into its scan_frame_buffer before pattern frame
+ *  @p frame is fed (decode_slot_free_before). @retval 1 it may @retval 0 it may not */
+int scan_frame_read_ahead(struct scan_ctx *s, uint32_t frame, uint32_t next);
 /** Decode, refine, triangulate, take normals and colour of the frames fed since
  *  scan_begin_view: once (the range image is made where the decoder worked; finishing the same
  *  frames again needs them fed again). @param threads  the cores the per-pixel stages may

@@ -332,6 +332,68 @@ static void test_fewer_inverses(void **state)
     render_inverse = 0;
 }
 
+/* Frames as a reader of kept frames hands them over (scanner process): frame i + 1 read into its
+ * slot before frame i is handed over wherever @p ahead says so. @retval frames read ahead */
+static unsigned decode_reading_ahead(uint32_t bits, int (*ahead)(uint32_t i))
+{
+    struct scan_params p = params();
+    unsigned read_ahead = 0;
+    assert_int_equal(begin(&p, bits), 0);
+    for (uint32_t i = 0, count = pattern_count(bits); i < count;) {
+        uint32_t n = i + 1 < count && ahead(i) ? 2u : 1u;
+        for (uint32_t k = i; k < i + n; k++) {
+            render(k, bits);
+            decode_rgb_to_grey(frame, decode_frame_slot(&dec, k), W * H, 250);
+        }
+        for (uint32_t k = i; k < i + n; k++)
+            assert_int_equal(decode_frame(&dec, k, decode_frame_slot(&dec, k)), 0);
+        read_ahead += n - 1u;
+        i += n;
+    }
+    assert_int_equal(decode_finish(&dec, NULL, reason_out, &maps_out), 0);
+    return read_ahead;
+}
+
+static int ahead_where_free(uint32_t i)
+{
+    return decode_slot_free_before(&dec, i, i + 1);
+}
+
+/* scanner process until 2026-12-07: two frames at a time wherever their slots differ */
+static int ahead_where_slots_differ(uint32_t i)
+{
+    return decode_frame_slot(&dec, i) != decode_frame_slot(&dec, i + 1);
+}
+
+/* A frame read into its slot before the one before it is handed over, where the decoder says
+ * the slot is free, decodes as frames handed over one by one; with every inverse and with the
+ * finest 3 only, Gray and XOR-04. Where the coarse bits have none, reading ahead wherever the
+ * slots differ reads an inverse against the next bit's stripes (what scanner process did). */
+static void test_read_ahead_where_free(void **state)
+{
+    (void)state;
+    static uint8_t reason1[W * H];
+    static uint16_t column1[W * H];
+    uint32_t bits = gray_bits_for_width(PROJ_W);
+    for (render_inverse = 0; render_inverse <= 3; render_inverse += 3)
+        for (render_code = GRAY_CODE_GRAY; render_code <= GRAY_CODE_XOR04; render_code++) {
+            decode_all(bits);
+            memcpy(reason1, reason_out, sizeof(reason1));
+            memcpy(column1, maps_out.column, sizeof(column1));
+            /* white and black, and each bit's stripes and inverse */
+            unsigned pairs = 1u + (render_inverse ? render_inverse : bits);
+            assert_int_equal(decode_reading_ahead(bits, ahead_where_free), pairs);
+            assert_memory_equal(reason_out, reason1, sizeof(reason1));
+            assert_memory_equal(maps_out.column, column1, sizeof(column1));
+            decode_reading_ahead(bits, ahead_where_slots_differ);
+            int same = memcmp(reason_out, reason1, sizeof(reason1)) == 0 &&
+                       memcmp(maps_out.column, column1, sizeof(column1)) == 0;
+            assert_int_equal(same, render_inverse == 0);
+        }
+    render_code = GRAY_CODE_GRAY;
+    render_inverse = 0;
+}
+
 /* A bit read against the mean: a quarter of the pair's threshold, rounded up. */
 static void test_mean_threshold(void **state)
 {
@@ -398,6 +460,7 @@ int main(void)
         cmocka_unit_test(test_blocked_matches_reference_at_every_limit),
         cmocka_unit_test(test_xor04_columns_and_reference),
         cmocka_unit_test(test_fewer_inverses),
+        cmocka_unit_test(test_read_ahead_where_free),
         cmocka_unit_test(test_mean_threshold),
         cmocka_unit_test(test_row_planes_untouched_without_rows),
     };
