@@ -18,9 +18,9 @@
     {                                                                                              \
         sec, key, INI_F64, K(member), 0, lo, hi, 0, NULL, NULL, doc, NULL, NULL                    \
     }
-#define CU(sec, key, member, hi, doc)                                                              \
+#define CU(sec, key, member, hi, limit, doc)                                                       \
     {                                                                                              \
-        sec, key, INI_U32, K(member), 0, 1, hi, 1, NULL, NULL, doc, NULL, NULL                     \
+        sec, key, INI_U32, K(member), 0, 1, hi, limit, NULL, NULL, doc, NULL, NULL                 \
     }
 #define CV(sec, key, member, n, lo, hi, def, doc)                                                  \
     {                                                                                              \
@@ -41,16 +41,17 @@ static const struct ini_key calib_keys[] = {
     CF("camera", "fy_px", cam_fy_px, 1, 1e6, "focal length y"),
     CF("camera", "cx_px", cam_cx_px, -1e5, 1e5, "principal point x"),
     CF("camera", "cy_px", cam_cy_px, -1e5, 1e5, "principal point y"),
-    CU("camera", "width", cam_width, HAL_MAX_WIDTH, "image width the intrinsics belong to"),
-    CU("camera", "height", cam_height, HAL_MAX_HEIGHT, "image height"),
+    CU("camera", "width", cam_width, HAL_MAX_WIDTH, HAL_FRAME_LIMIT_ADVICE,
+       "image width the intrinsics belong to"),
+    CU("camera", "height", cam_height, HAL_MAX_HEIGHT, HAL_FRAME_LIMIT_ADVICE, "image height"),
     CV("camera", "distortion", cam_dist, 5, -100, 100, "0, 0, 0, 0, 0",
        "lens distortion k1, k2, p1, p2, k3 (Brown-Conrady, OpenCV's order; 0: a pinhole)"),
     CF("projector", "fx_px", proj_fx_px, 1, 1e6, "focal length x"),
     CF("projector", "fy_px", proj_fy_px, 1, 1e6, "focal length y"),
     CF("projector", "cx_px", proj_cx_px, -1e5, 1e5, "principal point x"),
     CF("projector", "cy_px", proj_cy_px, -1e5, 1e5, "principal point y"),
-    CU("projector", "width", proj_width, HAL_MAX_PROJECTOR_WIDTH, "projector columns"),
-    CU("projector", "height", proj_height, HAL_MAX_PROJECTOR_HEIGHT, "projector rows"),
+    CU("projector", "width", proj_width, HAL_MAX_PROJECTOR_WIDTH, "", "projector columns"),
+    CU("projector", "height", proj_height, HAL_MAX_PROJECTOR_HEIGHT, "", "projector rows"),
     CV("projector", "distortion", proj_dist, 5, -100, 100, "0, 0, 0, 0, 0",
        "lens distortion k1, k2, p1, p2, k3, as for the camera"),
     CV("projector", "rotation", proj_rot, 9, -1, 1, NULL,

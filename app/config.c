@@ -19,9 +19,9 @@
     {                                                                                              \
         sec, key, INI_U32, C(member), 0, lo, hi, 0, def, NULL, doc, NULL, NULL                     \
     }
-#define LIM(sec, key, member, lo, hi, def, doc)                                                    \
+#define LIM(sec, key, member, lo, hi, limit, def, doc)                                             \
     {                                                                                              \
-        sec, key, INI_U32, C(member), 0, lo, hi, 1, def, NULL, doc, NULL, NULL                     \
+        sec, key, INI_U32, C(member), 0, lo, hi, limit, def, NULL, doc, NULL, NULL                 \
     }
 #define F64(sec, key, member, lo, hi, def, doc)                                                    \
     {                                                                                              \
@@ -45,8 +45,10 @@ static const struct ini_key config_keys[] = {
     ENUM("camera", "backend", camera_backend, "sim|v4l2|libcamera", NULL,
          "which camera backend drives the camera (only those built in are accepted)"),
     STR("camera", "device", camera.device, "/dev/video0", "V4L2 device path or libcamera id"),
-    LIM("camera", "width", camera.width, 16, HAL_MAX_WIDTH, NULL, "frame width in pixels"),
-    LIM("camera", "height", camera.height, 16, HAL_MAX_HEIGHT, NULL, "frame height in pixels"),
+    LIM("camera", "width", camera.width, 16, HAL_MAX_WIDTH, HAL_FRAME_LIMIT_ADVICE, NULL,
+        "frame width in pixels"),
+    LIM("camera", "height", camera.height, 16, HAL_MAX_HEIGHT, HAL_FRAME_LIMIT_ADVICE, NULL,
+        "frame height in pixels"),
     ENUM("camera", "pixel_format", camera_pixel_format, "rgb24|yuyv|grey", "rgb24",
          "pixel format requested from the device (converted to RGB)"),
     U32("camera", "exposure_us", camera.exposure_us, 10, 10000000, NULL,
@@ -81,7 +83,7 @@ static const struct ini_key config_keys[] = {
         "the DRM device of the HDMI output (backend = drm)"),
     U32("projector", "trigger_pulse_us", scan.trigger_pulse_us, 1, 100000, "100",
         "width of the trigger and reset pulses"),
-    LIM("lights", "count", light_count, 0, HAL_MAX_LIGHTS, "0",
+    LIM("lights", "count", light_count, 0, HAL_MAX_LIGHTS, "", "0",
         "white lights wired to light_0 .. light_N-1"),
     U32("scan", "views", views, 1, 360, "1", "views per pass (a turn of the table)"),
     U32("scan", "passes", passes, 1, 2, "1",
@@ -772,7 +774,7 @@ void config_print_doc(FILE *out)
             "required key, or a size above the compiled buffer limits "
             "(`hal/include/hal_limits.h`) stops the scanner before it touches any device, "
             "with a message naming the file, the line and the key, for example:\n\n"
-            "    config/rig.ini:12: [camera] width: 4096 exceeds the compiled limit 2048 "
+            "    config/rig.ini:12: [lights] count: 9 exceeds the compiled limit 8 "
             "(see hal/include/hal_limits.h)\n\n"
             "Relative paths (`calibration`, `mesh_file`, `merl_file`) are resolved against "
             "the directory of the file that names them; `[output] dir` against the working "

@@ -116,7 +116,9 @@ static int range_error(const struct ini_key *k, double v, char *msg, size_t len)
 {
     if (v >= k->min && v <= k->max)
         return 0;
-    if (k->max_is_limit && v > k->max)
+    if (k->limit != NULL && k->limit[0] != '\0' && v > k->max)
+        snprintf(msg, len, "%g exceeds the compiled limit %g: %s", v, k->max, k->limit);
+    else if (k->limit != NULL && v > k->max)
         snprintf(msg, len, "%g exceeds the compiled limit %g (see hal/include/hal_limits.h)", v,
                  k->max);
     else
@@ -247,7 +249,7 @@ static int set_value(const struct ini_key *k, void *target, const char *value, c
 static int handler(void *user, const char *section, const char *name, const char *value)
 {
     struct parse_state *st = user;
-    char msg[256];
+    char msg[512];
     if (st->failed) /* report the first error, not the last */
         return 0;
     if (strcmp(section, "color") == 0) /* both spellings of the one section */
@@ -328,7 +330,7 @@ int ini_schema_load_with(const struct ini_key *keys, size_t key_count, void *tar
     for (size_t i = 0; i < key_count; i++) {
         if (st.seen_line[i] != 0)
             continue;
-        char msg[256];
+        char msg[512];
         const char *value = missing_value(&keys[i], fallbacks, fallback_count);
         if (value == NULL) {
             format_where(err, err_len, path, 0, &keys[i], "required key is missing");
@@ -395,7 +397,7 @@ void ini_schema_print_doc(const struct ini_key *keys, size_t key_count, FILE *ou
         if (k->type == INI_U32 || k->type == INI_I32 || k->type == INI_F64 || k->type == INI_VEC ||
             k->type == INI_LINE || k->type == INI_LIST)
             snprintf(range, sizeof(range), "%.10g .. %.10g%s", k->min, k->max,
-                     k->max_is_limit ? " (compiled limit)" : "");
+                     k->limit != NULL ? " (compiled limit)" : "");
         fprintf(out, "| `%s` | %s | %s | %s | %s |\n", k->name,
                 type_name(k, type_buf, sizeof(type_buf)),
                 k->def == NULL ? "**required**" : (k->def[0] ? k->def : "(empty)"), range, k->doc);

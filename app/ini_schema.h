@@ -26,10 +26,12 @@ struct ini_key {
     const char *section;
     const char *name;
     enum ini_type type;
-    size_t offset;       /**< into the target struct */
-    size_t size;         /**< INI_STR: buffer size; INI_VEC: number of doubles; INI_LIST: most */
-    double min, max;     /**< numeric range (each element of a vector) */
-    int max_is_limit;    /**< max is a compiled buffer limit: say so in the error */
+    size_t offset;   /**< into the target struct */
+    size_t size;     /**< INI_STR: buffer size; INI_VEC: number of doubles; INI_LIST: most */
+    double min, max; /**< numeric range (each element of a vector) */
+    /** Non-NULL: max is a compiled buffer limit, said so in the error with this, what a person
+     *  can do instead ("": the header that sets it is named) */
+    const char *limit;
     const char *def;     /**< default, as it would be written in the file; NULL = required */
     const char *choices; /**< INI_ENUM: "a|b|c" */
     const char *doc;     /**< one sentence for docs/config.md */

@@ -171,6 +171,23 @@ static void test_width_over_limit(void **state)
                                              "exposure_us = 10000\n[scan]\ncalibration = x.ini\n");
     assert_int_equal(config_load(&cfg, path, err, sizeof(err)), -EINVAL);
     assert_non_null(strstr(err, "big.ini:3: [camera] width: 4096 exceeds the compiled limit 2048"));
+    /* what to do instead: bin the sensor, or a build that takes its whole frame */
+    assert_non_null(strstr(err, "limit 2048: a larger sensor: [camera] binning = 2, 3 or 4"));
+    assert_non_null(strstr(err, "or the whole frame with 'make LIMITS=large' (up to 4928 x 3456"));
+    /* a limit without such advice names the header that sets it */
+    path = write_file("lights.ini", "[camera]\nbackend = sim\nwidth = 640\nheight = 480\n"
+                                    "exposure_us = 10000\n[lights]\ncount = 9\n[scan]\n"
+                                    "calibration = x.ini\n");
+    assert_int_equal(config_load(&cfg, path, err, sizeof(err)), -EINVAL);
+    assert_non_null(strstr(err, "lights.ini:7: [lights] count: 9 exceeds the compiled limit 8 "
+                                "(see hal/include/hal_limits.h)"));
+    /* a calibration of a larger sensor, the same */
+    struct scan_calib calib;
+    path = write_file("bigcal.ini", "[camera]\nfx_px = 100\nfy_px = 100\ncx_px = 1\ncy_px = 1\n"
+                                    "width = 4056\nheight = 3040\n");
+    assert_int_equal(calib_load(&calib, path, 0, err, sizeof(err)), -EINVAL);
+    assert_non_null(strstr(err, "bigcal.ini:6: [camera] width: 4056 exceeds the compiled limit "
+                                "2048: a larger sensor: [camera] binning"));
 }
 
 static void test_calibration_errors(void **state)

@@ -13,6 +13,9 @@
  * colour frames; about 271 MiB of static buffers instead of 633 (make size). */
 #define HAL_MAX_WIDTH 1296u
 #define HAL_MAX_HEIGHT 972u
+#define HAL_LARGER_FRAMES                                                                          \
+    ", or more of it with 'make' (frames up to 2048 x 1536) or 'make LIMITS=large' (4928 x 3456, " \
+    "a board with 2 GB or more)"
 #elif defined(HAL_LIMITS_LARGE)
 /* make LIMITS=large, for a board with 2 GB or more (about 1.8 GB of static buffers, mapped as
  * they are used): full-resolution frames of the sensors people put on these rigs, the
@@ -20,12 +23,20 @@
  * the 4896 x 3264 of a DSLR (docs/performance.md). */
 #define HAL_MAX_WIDTH 4928u
 #define HAL_MAX_HEIGHT 3456u
+#define HAL_LARGER_FRAMES ""
 #else
 /* The Raspberry Pi HQ camera's 2x2 binned mode is 2028 x 1520; leave room for it. */
 #define HAL_MAX_WIDTH 2048u
 #define HAL_MAX_HEIGHT 1536u
+#define HAL_LARGER_FRAMES                                                                          \
+    ", or the whole frame with 'make LIMITS=large' (up to 4928 x 3456, a board with 2 GB or "      \
+    "more)"
 #endif
 #define HAL_MAX_PIXELS (HAL_MAX_WIDTH * HAL_MAX_HEIGHT)
+/* What a person whose camera's frames exceed the limits can do (a config's error says it). */
+#define HAL_FRAME_LIMIT_ADVICE                                                                     \
+    "a larger sensor: [camera] binning = 2, 3 or 4 (width, height and calibration of the binned "  \
+    "frame)" HAL_LARGER_FRAMES
 /* [camera] binning: a sensor frame up to this many times the frame, each way, binned down. */
 #define HAL_MAX_BINNING 4u
 /* White lights around the object (Jost et al. method 3 needs several). */
