@@ -245,6 +245,26 @@ static void test_v4l2_missing_device(void **state)
     assert_int_equal(hal_cam_close(&hc), 0);
 }
 
+/* A frame's exposure as its metadata say (libcamera): as asked within the sensor's line time,
+ * the one before a change the sensor had not yet applied (taken again), or another. */
+static void test_frame_exposure_against_the_change(void **state)
+{
+    (void)state;
+    assert_int_equal(v4l2_frame_exposure(10000, 10000, 10000), V4L2_EXPOSURE_AS_ASKED);
+    assert_int_equal(v4l2_frame_exposure(15000, 10000, 15020), V4L2_EXPOSURE_AS_ASKED);
+    assert_int_equal(v4l2_frame_exposure(15000, 10000, 14700), V4L2_EXPOSURE_AS_ASKED);
+    assert_int_equal(v4l2_frame_exposure(15000, 10000, 14650), V4L2_EXPOSURE_OTHER);
+    assert_int_equal(v4l2_frame_exposure(100, 10000, 199), V4L2_EXPOSURE_AS_ASKED); /* 100 us */
+    /* the colour frames' exposure asked for, the patterns' still in the frame; and back */
+    assert_int_equal(v4l2_frame_exposure(15000, 10000, 10000), V4L2_EXPOSURE_BEFORE);
+    assert_int_equal(v4l2_frame_exposure(15000, 10000, 9850), V4L2_EXPOSURE_BEFORE);
+    assert_int_equal(v4l2_frame_exposure(10000, 15000, 15000), V4L2_EXPOSURE_BEFORE);
+    /* HDR's 40 ms where a 30 fps frame holds 33 ms: neither */
+    assert_int_equal(v4l2_frame_exposure(40000, 10000, 33000), V4L2_EXPOSURE_OTHER);
+    /* no change since: a mismatch is another exposure, not a late one */
+    assert_int_equal(v4l2_frame_exposure(40000, 40000, 33000), V4L2_EXPOSURE_OTHER);
+}
+
 #ifdef HAVE_LIBCAMERA
 static void test_libcamera_missing_camera(void **state)
 {
@@ -273,6 +293,7 @@ int main(void)
         cmocka_unit_test(test_controls_turn_automatics_off_first),
         cmocka_unit_test(test_controls_out_of_range_are_named),
         cmocka_unit_test(test_frame_start_from_timestamp),
+        cmocka_unit_test(test_frame_exposure_against_the_change),
         cmocka_unit_test(test_v4l2_missing_device),
 #ifdef HAVE_LIBCAMERA
         cmocka_unit_test(test_libcamera_missing_camera),

@@ -46,7 +46,9 @@ struct hal_camera_ops {
     int (*open)(void *priv, const struct hal_camera_config *cfg);
     /** Capture one frame showing the current light/projector state.
      *  @retval 0 ok @retval -ETIMEDOUT no frame in time @retval -EIO corrupt or short frame
-     *  @retval -ENOSPC buffer too small */
+     *  @retval -ENOSPC buffer too small @retval -EAGAIN a frame the device says was taken
+     *  before the last change had reached the sensor (an exposure not yet applied): said, and
+     *  to be taken again as a stale one is */
     int (*capture)(void *priv, struct hal_image *img);
     /** Optional: change the fixed exposure and gain for the frames that follow (colour frames
      *  under different lights). @retval 0 ok @retval -EINVAL out of the device's range */

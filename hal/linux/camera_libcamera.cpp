@@ -17,6 +17,7 @@
 #include <linux/videodev2.h>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <sys/mman.h>
 
 using namespace libcamera;
@@ -35,6 +36,8 @@ struct lc_state {
     size_t map_len = 0;
     bool acquired = false, started = false;
     hal_camera_config cfg{};
+    uint32_t before_us = 0;     // the exposure until the last change (cfg's: none since)
+    uint32_t said_other_us = 0; // the exposure asked for whose frames came out another, said
     uint32_t fourcc = 0, stride = 0;
     std::mutex lock; // libcamera completes requests on its own thread
     std::condition_variable completed;
@@ -131,6 +134,8 @@ int lc_open(void *priv, const hal_camera_config *cfg)
     lc_state *s = static_cast<lc_state *>(cam->impl);
     lc_close(priv);
     s->cfg = *cfg;
+    s->before_us = cfg->exposure_us;
+    s->said_other_us = 0;
     setenv("LIBCAMERA_LOG_LEVELS", "*:ERROR", 0); // its INFO lines are noise in a scan log
     s->manager = std::make_unique<CameraManager>();
     int rc = s->manager->start();
@@ -192,6 +197,39 @@ int one_frame(camera_libcamera *cam, lc_state *s)
     return 0;
 }
 
+// The exposure the frame's metadata say it had (where the pipeline says): one of the exposure
+// before a change is taken again, as a stale frame is (-EAGAIN: the scan retries it, within
+// [camera] capture_retries; more [camera] drop_frames let the sensor apply the change first);
+// one of another exposure is kept and said once for each exposure asked for.
+int check_exposure(camera_libcamera *cam, lc_state *s, unsigned sequence)
+{
+    const std::optional<int32_t> actual = s->request->metadata().get(controls::ExposureTime);
+    if (!actual || *actual <= 0)
+        return 0;
+    const uint32_t got = static_cast<uint32_t>(*actual), want = s->cfg.exposure_us;
+    switch (v4l2_frame_exposure(want, s->before_us, got)) {
+    case V4L2_EXPOSURE_AS_ASKED:
+        s->before_us = want; // applied: the change is behind
+        return 0;
+    case V4L2_EXPOSURE_BEFORE:
+        if (cam->log != nullptr)
+            cam->log(HAL_LOG_WARN,
+                     "camera libcamera '%s': frame %u was exposed %u us, the exposure before "
+                     "the change to %u us (the sensor had not applied it yet): taken again",
+                     s->cfg.device, sequence, (unsigned)got, (unsigned)want);
+        return -EAGAIN;
+    case V4L2_EXPOSURE_OTHER:
+        if (s->said_other_us != want && cam->log != nullptr)
+            cam->log(HAL_LOG_WARN,
+                     "camera libcamera '%s': frames asked for at %u us come out at %u us (the "
+                     "sensor's limits at its frame rate?): kept",
+                     s->cfg.device, (unsigned)want, (unsigned)got);
+        s->said_other_us = want;
+        return 0;
+    }
+    return 0;
+}
+
 int lc_capture(void *priv, hal_image *img)
 {
     camera_libcamera *cam = static_cast<camera_libcamera *>(priv);
@@ -207,6 +245,8 @@ int lc_capture(void *priv, hal_image *img)
     const FrameMetadata &md = fb->metadata();
     if (md.status != FrameMetadata::FrameSuccess)
         return fail(cam, -EIO, "capture", "frame %u flagged corrupt", md.sequence);
+    if ((rc = check_exposure(cam, s, md.sequence)) != 0)
+        return rc;
     const FrameBuffer::Plane &plane = fb->planes().at(0);
     const uint8_t *pixels = static_cast<const uint8_t *>(s->map) + plane.offset;
     rc = v4l2_to_rgb(s->fourcc, pixels, md.planes()[0].bytesused, s->stride, s->cfg.width,
@@ -230,7 +270,9 @@ int lc_set_exposure(void *priv, uint32_t exposure_us, uint32_t gain_milli)
 {
     camera_libcamera *cam = static_cast<camera_libcamera *>(priv);
     lc_state *s = static_cast<lc_state *>(cam->impl);
-    s->cfg.exposure_us = exposure_us; // every request carries the controls
+    if (exposure_us != s->cfg.exposure_us)
+        s->before_us = s->cfg.exposure_us; // until a frame shows the new one (check_exposure)
+    s->cfg.exposure_us = exposure_us;      // every request carries the controls
     s->cfg.gain_milli = gain_milli;
     return 0;
 }

@@ -46,6 +46,21 @@ uint64_t v4l2_frame_start_us(uint32_t flags, int64_t sec, int64_t usec, uint32_t
     return stamp_us > back_us ? stamp_us - back_us : 1u; /* 0 means "cannot tell" */
 }
 
+/* |a - b| within 2% of @p of (at least 100 us) */
+static int exposure_near(uint32_t a, uint32_t b, uint32_t of)
+{
+    uint32_t diff = a > b ? a - b : b - a, tol = of / 50u > 100u ? of / 50u : 100u;
+    return diff <= tol;
+}
+
+enum v4l2_exposure v4l2_frame_exposure(uint32_t wanted_us, uint32_t before_us, uint32_t actual_us)
+{
+    if (exposure_near(actual_us, wanted_us, wanted_us))
+        return V4L2_EXPOSURE_AS_ASKED;
+    return exposure_near(actual_us, before_us, before_us) ? V4L2_EXPOSURE_BEFORE
+                                                          : V4L2_EXPOSURE_OTHER;
+}
+
 static uint8_t clamp_u8(int32_t v)
 {
     return (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : v);

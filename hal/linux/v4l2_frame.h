@@ -39,6 +39,18 @@ int v4l2_to_rgb(uint32_t fourcc, const uint8_t *src, size_t used, uint32_t bytes
 uint64_t v4l2_frame_start_us(uint32_t flags, int64_t sec, int64_t usec, uint32_t exposure_us,
                              uint32_t frame_us);
 
+/** A frame whose metadata say how long it was exposed (libcamera's ExposureTime), against what
+ *  was asked for: sensors take a change of exposure a few frames late, so a frame of the old
+ *  one must be taken again (its signal is scaled wrong: the colour frames', the HDR patterns'). */
+enum v4l2_exposure {
+    V4L2_EXPOSURE_AS_ASKED, /**< within 2% (at least 100 us: the sensor's line time) */
+    V4L2_EXPOSURE_BEFORE,   /**< the exposure before the last change: not applied yet */
+    V4L2_EXPOSURE_OTHER,    /**< neither (the sensor's limits at its frame rate, say) */
+};
+/** The exposure of a frame exposed @p actual_us when @p wanted_us was asked for, and
+ *  @p before_us until the last change (equal to @p wanted_us when none since). */
+enum v4l2_exposure v4l2_frame_exposure(uint32_t wanted_us, uint32_t before_us, uint32_t actual_us);
+
 /** What the driver said of one control (VIDIOC_QUERYCTRL). */
 struct v4l2_ctrl_info {
     uint32_t id;
