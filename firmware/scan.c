@@ -328,9 +328,9 @@ uint8_t *scan_frame_buffer(struct scan_ctx *s, uint32_t frame)
 
 int scan_frame_read_ahead(struct scan_ctx *s, uint32_t frame, uint32_t next)
 {
-    uint8_t *own = scan_frame_buffer(s, frame), *buf = scan_frame_buffer(s, next);
-    return frame < s->patterns && next < s->patterns && own != NULL && buf != NULL && buf != own &&
-           decode_slot_free_before(&s->decode, frame, next);
+    /* a pattern's buffer is its decoder slot but the white frame's, the view's colour, which
+     * is no slot: the decoder's answer is the whole answer */
+    return decode_slot_free_before(&s->decode, frame, next);
 }
 
 int scan_feed_white_colour(struct scan_ctx *s, const uint8_t *rgb)

@@ -10,15 +10,11 @@ import sys
 import time
 
 
-def sample(pid):
+def sample(pid, exe):
     """(kB resident in the program's static buffers, kB resident in all), or None once gone."""
     try:
         with open(f"/proc/{pid}/smaps") as f:
             lines = f.read().splitlines()
-    except OSError:
-        return None
-    try:
-        exe = os.readlink(f"/proc/{pid}/exe")
     except OSError:
         return None
     static = total = 0
@@ -48,8 +44,12 @@ def sample(pid):
 def main():
     pid = int(sys.argv[1])
     peak_static = peak_rest = peak_all = 0
-    while True:
-        got = sample(pid)
+    try:
+        exe = os.readlink(f"/proc/{pid}/exe")
+    except OSError:
+        exe = None  # gone already (or never was): nothing sampled
+    while exe is not None:
+        got = sample(pid, exe)
         if got is None:
             break
         static, total = got
