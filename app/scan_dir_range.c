@@ -90,7 +90,8 @@ static int range_open(const char *dir, uint32_t view, char *path, size_t path_le
 }
 
 /* The points of range.bin after the reasons @p reason (n pixels) already read: @p each is called
- * for every pixel in order, with its point where it is valid and NULL elsewhere.
+ * for every valid pixel in order, with its point (the caller has cleared the others: a call for
+ * each of a view's million pixels cost more than the points' reading).
  * @retval 0 @retval -EINVAL cut short, or more points than valid pixels */
 static int read_range_points(FILE *fp, const uint8_t *reason, size_t n,
                              void (*each)(void *priv, size_t i, const struct range_point *p),
@@ -99,11 +100,9 @@ static int read_range_points(FILE *fp, const uint8_t *reason, size_t n,
     struct range_point *chunk = malloc(RANGE_CHUNK * sizeof(*chunk)); /* callers in threads */
     size_t have = 0, next = 0;
     int rc = chunk != NULL ? 0 : -ENOMEM;
-    for (size_t i = 0; i < n && rc == 0; i++) {
-        if (reason[i] != SCAN_VALID) {
-            each(priv, i, NULL);
-            continue;
-        }
+    const uint8_t *at = reason, *end = reason + n;
+    _Static_assert(SCAN_VALID == 0, "valid pixels are found by memchr for 0");
+    while (rc == 0 && at < end && (at = memchr(at, SCAN_VALID, (size_t)(end - at))) != NULL) {
         if (next == have) {
             have = fread(chunk, sizeof(chunk[0]), RANGE_CHUNK, fp);
             next = 0;
@@ -112,7 +111,7 @@ static int read_range_points(FILE *fp, const uint8_t *reason, size_t n,
                 break;
             }
         }
-        each(priv, i, &chunk[next++]);
+        each(priv, (size_t)(at++ - reason), &chunk[next++]);
     }
     if (rc == 0 && (next != have || fgetc(fp) != EOF))
         rc = -EINVAL; /* nothing left over */
@@ -124,27 +123,22 @@ static int read_range_points(FILE *fp, const uint8_t *reason, size_t n,
 static void fill_point(void *priv, size_t i, const struct range_point *p)
 {
     struct scan_view_fill *fill = priv;
-    if (p == NULL) {
-        memset(fill->rgb + 3 * i, 0, 3);
-        fill->confidence[i] = 0.0f;
-        return;
-    }
     memcpy(fill->xyz_mm + 3 * i, p->xyz_mm, sizeof(p->xyz_mm));
     memcpy(fill->normal + 3 * i, p->normal, sizeof(p->normal));
     fill->confidence[i] = p->confidence;
     memcpy(fill->rgb + 3 * i, p->rgb, 3);
 }
 
-/* A point's colour into an RGB image, black where no point is (scan_dir_read_range_image). */
+/* Nothing: the points counted only. */
+static void skip_point(void *priv, size_t i, const struct range_point *p)
+{
+    (void)priv, (void)i, (void)p;
+}
+
+/* A point's colour into an RGB image (scan_dir_read_range_image). */
 static void image_point(void *priv, size_t i, const struct range_point *p)
 {
-    uint8_t *rgb = priv;
-    if (rgb == NULL)
-        return;
-    if (p != NULL)
-        memcpy(rgb + 3 * i, p->rgb, 3);
-    else
-        memset(rgb + 3 * i, 0, 3);
+    memcpy((uint8_t *)priv + 3 * i, p->rgb, 3);
 }
 
 int scan_dir_read_range_image(const char *dir, uint32_t view, uint8_t *reason, uint8_t *rgb,
@@ -163,7 +157,12 @@ int scan_dir_read_range_image(const char *dir, uint32_t view, uint8_t *reason, u
     for (size_t i = 0; i < n; i++)
         if (reason[i] >= SCAN_REASON_COUNT)
             goto out_close;
-    rc = read_range_points(fp, reason, n, image_point, rgb);
+    if (rgb == NULL) { /* the points are not read: only that they are all there */
+        rc = read_range_points(fp, reason, n, skip_point, NULL);
+    } else {
+        memset(rgb, 0, 3 * n); /* black where no point is */
+        rc = read_range_points(fp, reason, n, image_point, rgb);
+    }
     if (rc == 0) {
         *width = h.width;
         *height = h.height;
@@ -204,6 +203,8 @@ int scan_dir_read_range(struct scan_ctx *s, const char *dir, uint32_t view, uint
             goto out_close;
         valid += fill.reason[i] == SCAN_VALID;
     }
+    memset(fill.rgb, 0, 3 * n); /* no colour and no trust where no point is */
+    memset(fill.confidence, 0, n * sizeof(fill.confidence[0]));
     if (valid == h.valid_count && read_range_points(fp, fill.reason, n, fill_point, &fill) == 0)
         rc = 0;
 out_close:

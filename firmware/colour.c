@@ -175,14 +175,22 @@ static int clipped(const struct colour_params *prm, const uint8_t *px)
 static inline int frame_light(const struct frame_ctx *f, uint32_t k, const uint8_t *px, size_t i,
                               double out[3])
 {
-    uint32_t d = f->lay->dark_of[k];
-    double gain = f->gain[k];
-    for (int c = 0; c < 3; c++) {
-        size_t at = 3 * i + (size_t)c;
-        double ca =
-            f->prm->ca == COLOUR_CA_PIXEL ? f->frames[d][at] : f->ca_of_albedo[d][c][f->albedo[at]];
-        out[c] = (px[c] - ca) * gain;
+    const uint32_t d = f->lay->dark_of[k];
+    const double gain = f->gain[k];
+    double ca[3];
+    /* every byte read before out is written: the frames are bytes, which may alias anything,
+     * and would be read again after each store */
+    if (f->prm->ca == COLOUR_CA_PIXEL) {
+        const uint8_t *dark = &f->frames[d][3 * i];
+        ca[0] = dark[0], ca[1] = dark[1], ca[2] = dark[2];
+    } else {
+        const uint8_t *albedo = &f->albedo[3 * i];
+        for (int c = 0; c < 3; c++)
+            ca[c] = f->ca_of_albedo[d][c][albedo[c]];
     }
+    const int v[3] = {px[0], px[1], px[2]};
+    for (int c = 0; c < 3; c++)
+        out[c] = (v[c] - ca[c]) * gain;
     return !clipped(f->prm, px);
 }
 
@@ -268,17 +276,19 @@ static void light_signals(const struct frame_ctx *f, const struct scan_calib *c,
     double est[HAL_MAX_LIGHTS], best = 0.0;
     out->used = 0;
     for (uint32_t l = 0; l < c->light_count; l++) {
+        struct toward s = toward(p, v3_from(c->light_pos_mm[l]));
+        double fall, ct = incidence(prm, nn, s, &fall);
+        est[l] = -1.0;
+        if (ct < min_cos) /* turned away from it: its frame is not read (a third of them) */
+            continue;
         uint32_t k = COLOUR_FRAME_LIGHT0 + l, kl = f->lay->long_of[k];
         if (kl != 0 && !clipped(prm, &f->frames[kl][3 * i]))
             k = kl;
-        struct toward s = toward(p, v3_from(c->light_pos_mm[l]));
-        double fall, ct = incidence(prm, nn, s, &fall);
         double *lit = out->lit[l];
         int ok = frame_light(f, k, &f->frames[k][3 * i], i, lit);
         /* the signal in grey levels of the frame it was read in: below shadow_dn it is noise */
         double raw = (lit[0] + lit[1] + lit[2]) / 3.0 * f->lay->exposure_us[k] / prm->exposure_us;
-        est[l] = -1.0;
-        if ((!ok && !relaxed) || ct < min_cos || raw <= prm->shadow_dn)
+        if ((!ok && !relaxed) || raw <= prm->shadow_dn)
             continue;
         out->weight[l] = specular_weight(prm, nn, view, s.dir);
         /* a brighter light gives more signal for the same albedo: its gain takes that out */

@@ -5,6 +5,7 @@
 #include "hal.h"
 
 #include <stdint.h>
+#include <string.h>
 
 struct outbuf {
     const struct hal_storage *st;
@@ -27,6 +28,16 @@ void outbuf_fixed(struct outbuf *o, double v, unsigned decimals);
 void outbuf_u32(struct outbuf *o, uint32_t v);
 /** Append a float, little-endian. */
 void outbuf_f32le(struct outbuf *o, float f);
+/** Put float @p f little-endian at @p dst (a record made whole, then appended at once).
+ *  @retval dst + 4 */
+static inline uint8_t *outbuf_f32le_at(uint8_t *dst, float f)
+{
+    uint32_t u;
+    memcpy(&u, &f, sizeof(u));
+    for (int k = 0; k < 4; k++)
+        dst[k] = (uint8_t)(u >> (8 * k));
+    return dst + 4;
+}
 /** Append a uint32, little-endian. */
 void outbuf_u32le(struct outbuf *o, uint32_t v);
 /** Flush and commit, or abort on any earlier error. @retval 0 or the first error */
