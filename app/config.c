@@ -316,8 +316,9 @@ static const struct ini_key config_keys[] = {
         "highest height fused (grown to hold a taller object: fit_volume)"),
     U32("fusion", "fit_volume", fusion.fit_volume, 0, 1, "1",
         "1: the volume grows past radius_mm and top_mm to hold what the registered views saw "
-        "(within this build's limits), and says so; 0: they cut the object, and the scan says "
-        "what was left out"),
+        "(within this build's limits; moved off the axis towards an object placed far from it "
+        "where a volume about the axis would be beyond them), and says so; 0: they cut the "
+        "object, and the scan says what was left out"),
     F64("fusion", "truncation_mm", fusion.truncation_mm, 0.1, 100, "2.5",
         "signed distances are clamped to +- this"),
     F64("fusion", "max_weight", fusion.max_weight, 1, 60, "50", "a voxel's weight stops here"),

@@ -456,13 +456,17 @@ static void fit_volume(struct job *j, struct fusion_params *fp)
     reg_each_point(j->reg, count_seen, &seen);
     if (fusion_fit(cfg, &seen.o, fp) != 1)
         return;
-    char top[96] = "", radius[96] = "";
+    char top[96] = "", radius[192] = "", centre[96] = "";
     if (fp->top_mm != cfg->top_mm)
         snprintf(top, sizeof(top), "top_mm %g -> %.1f (it reaches %.0f mm up)", cfg->top_mm,
                  fp->top_mm, seen.o.top_seen_mm);
+    if (fp->centre_mm[0] != cfg->centre_mm[0] || fp->centre_mm[1] != cfg->centre_mm[1])
+        snprintf(centre, sizeof(centre),
+                 ", about x = %.0f, y = %.0f mm (the object stands off the axis)", fp->centre_mm[0],
+                 fp->centre_mm[1]);
     if (fp->radius_mm != cfg->radius_mm)
-        snprintf(radius, sizeof(radius), "radius_mm %g -> %g (%.0f mm out)", cfg->radius_mm,
-                 fp->radius_mm, seen.o.reach_seen_mm);
+        snprintf(radius, sizeof(radius), "radius_mm %g -> %g (%.0f mm out)%s", cfg->radius_mm,
+                 fp->radius_mm, seen.o.reach_seen_mm, centre);
     j->hal->log(HAL_LOG_INFO,
                 "the fused volume grown to hold the object ([fusion] fit_volume): %s%s%s", top,
                 top[0] != '\0' && radius[0] != '\0' ? ", " : "", radius);
@@ -510,13 +514,16 @@ static void report_outside(struct job *j, const struct fusion_params *fp)
                      "%u in all): a larger voxel_mm",
                      side ? "radius_mm" : "top_mm", side ? want.radius_mm : want.top_mm,
                      fp->voxel_mm, FUSION_MAX_DIM, FUSION_MAX_VOXELS);
+        int off_axis = fp->centre_mm[0] != 0.0 || fp->centre_mm[1] != 0.0;
         job_warn(j,
                  "the object %s the fused volume: %.1f%% of the views' points lie %s [fusion] "
                  "%s = %g, up to %.0f mm, and are not in the model: %s in [fusion]",
                  side ? "reaches beyond the sides of" : "rises above",
                  100.0 * (double)n / (double)o.fused,
-                 side ? "farther from the axis than" : "higher than", side ? "radius_mm" : "top_mm",
-                 side ? fp->radius_mm : fp->top_mm, seen, fix);
+                 !side      ? "higher than"
+                 : off_axis ? "farther from the volume's centre (moved off the axis) than"
+                            : "farther from the axis than",
+                 side ? "radius_mm" : "top_mm", side ? fp->radius_mm : fp->top_mm, seen, fix);
     }
 }
 

@@ -17,7 +17,9 @@ struct fusion_volume;
 
 struct fusion_params {
     double voxel_mm;          /**< edge of a voxel */
-    double radius_mm;         /**< grid spans [-radius, radius] in x and y (object frame) */
+    double radius_mm;         /**< grid spans centre +- radius in x and y (object frame) */
+    double centre_mm[2];      /**< the grid's centre in x and y: the axis (0, 0) unless fusion_fit
+                                   moved it to hold an object placed far off the axis */
     double bottom_mm, top_mm; /**< and [bottom, top] in z */
     double truncation_mm;     /**< distances are clamped to +-this */
     double max_weight;        /**< a voxel's weight stops growing here (older views fade) */
@@ -52,13 +54,16 @@ struct fusion_outside {
     uint64_t fused;       /**< the points counted (those fused: weight above 0) */
     uint64_t above;       /**< of them over the table (5 mm up, within twice radius_mm of the
                                axis) and higher than top_mm */
-    uint64_t beside;      /**< of them over the table and beyond the grid's square (|x| or |y|
-                               over radius_mm); a point may be both */
+    uint64_t beside;      /**< of them over the table and beyond the grid's square (x or y
+                               farther than radius_mm from its centre); a point may be both */
     double top_seen_mm;   /**< the highest point above (0: none) */
-    double reach_seen_mm; /**< the largest |x| or |y| of the points beside (0: none) */
-    uint32_t views_cut;   /**< views whose object runs off the image: at least
-                               FUSION_EDGE_POINTS valid pixels on its border rows and columns
-                               are points above the table (5 mm up, within twice radius_mm) */
+    double reach_seen_mm; /**< the farthest in x or y from the centre of the points beside (0:
+                               none) */
+    double low_seen_mm[2], high_seen_mm[2]; /**< the least and greatest x and y of the points
+                                                 beside (0 where none is lower or higher) */
+    uint32_t views_cut;                     /**< views whose object runs off the image: at least
+                                                 FUSION_EDGE_POINTS valid pixels on its border rows and columns
+                                                 are points above the table (5 mm up, within twice radius_mm) */
 };
 #define FUSION_EDGE_POINTS 16u
 
@@ -80,7 +85,9 @@ int fusion_outside_many(uint64_t n, uint64_t fused, uint64_t least);
 /** The volume grown to hold what @p seen counted beyond @p p's (points beyond it by the
  *  thousand of them, and at least 8): top_mm to their highest, radius_mm to their farthest,
  *  each with the truncation band and two voxels to spare, the radius by whole voxels (the
- *  grid's voxels stay where they were). A part already inside is left as it is.
+ *  grid's voxels stay where they were). A part already inside is left as it is. Where the
+ *  square about the axis that holds them is beyond the compiled limits (an object placed far
+ *  off the axis), the square is moved by whole voxels to hold p's and theirs (centre_mm).
  *  @param fitted  out: the grown parameters (@p p where nothing grows, or beyond the limits)
  *  @retval 1 grown @retval 0 nothing to grow, or p->fit_volume is 0 @retval -E2BIG the grown
  *  volume is beyond the compiled limits (FUSION_MAX_*) */

@@ -479,6 +479,49 @@ static void test_volume_fitted_to_what_was_seen(void **state)
     assert_memory_equal(&f, &p, sizeof(p));
 }
 
+/* An object placed far off the axis (a bunny 150 mm from it, on the table's rim): the square
+ * about the axis that would hold it is beyond the compiled limits, one moved towards it (by
+ * whole voxels) holds it and the configured volume both; points on both sides that far are
+ * beyond any square this build has. */
+static void test_volume_moved_to_an_object_off_the_axis(void **state)
+{
+    (void)state;
+    struct fusion_params p = grid_params(), f;
+    p.fit_volume = 1;
+    p.voxel_mm = 1.0;
+    p.radius_mm = 0.35 * FUSION_MAX_DIM; /* 140 mm: points within 280 mm count as the object */
+    const double far_x = 0.6 * FUSION_MAX_DIM, spare = 3.0 + 2.0;
+    struct fusion_outside seen = {0};
+    for (int i = 0; i < 2000; i++) /* the object, from inside the square to far_x beyond it */
+        fusion_outside_add(&seen, &p,
+                           v3(p.radius_mm - 20.0 + (far_x - p.radius_mm + 20.0) * i / 1999.0,
+                              10.0 * sin(i), 20.0));
+    assert_true(seen.beside > 100);
+    struct fusion_params about_axis = p;
+    about_axis.radius_mm = far_x + spare; /* what the square about the axis would need */
+    uint32_t dims[3];
+    assert_int_equal(fusion_dims(&about_axis, dims), -E2BIG);
+    assert_int_equal(fusion_fit(&p, &seen, &f), 1);
+    assert_int_equal(fusion_dims(&f, dims), 0);
+    /* it holds the configured square and the object, with the room asked for */
+    assert_true(f.centre_mm[0] - f.radius_mm <= -p.radius_mm + 1e-9);
+    assert_true(f.centre_mm[0] + f.radius_mm >= far_x + spare - 1e-9);
+    assert_true(f.centre_mm[1] - f.radius_mm <= -p.radius_mm + 1e-9 &&
+                f.centre_mm[1] + f.radius_mm >= p.radius_mm - 1e-9);
+    assert_true(f.centre_mm[0] > 0.0 && f.centre_mm[1] == 0.0);
+    /* the grid's voxels stay where they were: its corner moved by whole voxels */
+    for (int a = 0; a < 2; a++) {
+        double moved = (f.centre_mm[a] - f.radius_mm + p.radius_mm) / p.voxel_mm;
+        assert_true(fabs(moved - round(moved)) < 1e-9);
+    }
+    assert_true(f.top_mm == p.top_mm && f.voxel_mm == p.voxel_mm);
+    /* as far on the other side too: no square this build has holds both */
+    for (int i = 0; i < 2000; i++)
+        fusion_outside_add(&seen, &p, v3(-far_x, 10.0 * sin(i), 20.0));
+    assert_int_equal(fusion_fit(&p, &seen, &f), -E2BIG);
+    assert_memory_equal(&f, &p, sizeof(p));
+}
+
 static void test_two_volumes_are_independent(void **state)
 {
     (void)state;
@@ -515,6 +558,7 @@ int main(void)
         cmocka_unit_test(test_uncoloured_surface_takes_its_neighbours_colour),
         cmocka_unit_test(test_watertight_closes_at_the_table),
         cmocka_unit_test(test_volume_fitted_to_what_was_seen),
+        cmocka_unit_test(test_volume_moved_to_an_object_off_the_axis),
         cmocka_unit_test(test_two_volumes_are_independent),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
