@@ -15,6 +15,9 @@
 
 /** Frames a view can hold: the patterns, then the colour frames. */
 #define SCAN_DIR_MAX_FRAMES (DECODE_MAX_PATTERNS + COLOUR_MAX_FRAMES + 1) /* + HDR colour */
+/** Frames a view can take (view.ini's frames): with HDR each pattern at every exposure. */
+#define SCAN_DIR_MAX_CAPTURED                                                                      \
+    (DECODE_MAX_PATTERNS * SCAN_MAX_EXPOSURES + COLOUR_MAX_FRAMES + 1) /* + HDR colour */
 /** Longest description of a frame in view.ini ("light 3 alone, 20000 us, RGB"). */
 #define SCAN_DIR_FRAME_NAME 64u
 /* The files of a scan directory (docs/scan-format.md), named here only. At its top: */

@@ -109,6 +109,43 @@ static void test_view_ini_round_trip(void **state)
     assert_int_equal(scan_dir_read_view(DIR "/round", 4, &none, err, sizeof(err)), -ENOENT);
 }
 
+/* A view taken with every frame a config can ask for (HDR at the most exposures, rows, every
+ * light bracketed) says in view.ini how many it took, each pattern at each exposure, more than
+ * it keeps: its scan is read back (process, resume). It was refused, naming the key, past the
+ * frames a view keeps: an HDR scan at three exposures could not be processed again. */
+static void test_view_ini_of_the_most_frames(void **state)
+{
+    (void)state;
+    static struct scan_dir_view out, in;
+    struct test_rig t;
+    assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
+    struct scan_params *p = &t.cfg.scan;
+    p->exposure_count = SCAN_MAX_EXPOSURES;
+    for (uint32_t e = 0; e < SCAN_MAX_EXPOSURES; e++)
+        p->exposures_us[e] = 5000u << e; /* 10000 us, the camera's, among them */
+    p->decode_rows = 1;
+    p->colour.method = COLOUR_FIT;
+    p->colour.bracket = 2;
+    struct gray_layout layout;
+    scan_layout(p, &t.calib, &layout);
+    memset(&out, 0, sizeof(out));
+    out.frames = gray_layout_count(&layout) * SCAN_MAX_EXPOSURES +
+                 scan_light_frame_count(p, &t.calib) + 1u; /* + the view's colour */
+    assert_true(out.frames > SCAN_DIR_MAX_FRAMES && out.frames <= SCAN_DIR_MAX_CAPTURED);
+    scan_dir_describe_frames(p, &t.calib, &out);
+    assert_true(out.frame_count <= SCAN_DIR_MAX_FRAMES && out.frame_count < out.frames);
+    assert_int_equal(scan_dir_path(err, sizeof(err), DIR "/most", 0, NULL), 0);
+    assert_int_equal(hal_storage_mkdir_p(&hal.storage, err), 0);
+    assert_int_equal(scan_dir_write_view(&hal.storage, DIR "/most", 0, &out), 0);
+    assert_int_equal(scan_dir_read_view(DIR "/most", 0, &in, err, sizeof(err)), 0);
+    assert_memory_equal(&in, &out, sizeof(in));
+    /* more than any view can take is still refused, naming the key */
+    char text[96];
+    snprintf(text, sizeof(text), "[view]\nindex = 0\nangle_mdeg = 0\nframes = %u\n",
+             (unsigned)SCAN_DIR_MAX_CAPTURED + 1u);
+    expect_view_error("most_frames", text, "[view] frames:");
+}
+
 /* Every key is checked: nothing is guessed, and the message names file, line and key. */
 static void test_view_ini_bad_values(void **state)
 {
@@ -412,6 +449,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_view_ini_round_trip),
+        cmocka_unit_test(test_view_ini_of_the_most_frames),
         cmocka_unit_test(test_view_ini_bad_values),
         cmocka_unit_test(test_bad_frames_say_why),
         cmocka_unit_test(test_pnm_frames_round_trip),
