@@ -115,7 +115,7 @@ static int check_fresh(struct scan_ctx *s, const struct hal *hal, const struct h
 static int capture(struct scan_ctx *s, const struct hal *hal, const struct scan_params *p,
                    uint8_t *buf, uint32_t pattern, struct scan_view_info *info)
 {
-    struct hal_image img = {.rgb = buf, .capacity = sizeof(s->frame_rgb)};
+    struct hal_image img = {.rgb = buf, .capacity = sizeof(s->phase.taking.frame_rgb)};
     int rc = -EIO;
     for (uint32_t attempt = 0; attempt <= p->capture_retries; attempt++) {
         if (attempt > 0)
@@ -188,8 +188,8 @@ static uint8_t *light_frame(const struct scan_ctx *s, uint32_t k, size_t n)
  * (mem.h). */
 static void prefault_colour(struct scan_ctx *s, size_t n)
 {
-    mem_prefault(s->view_rgb, n * 3);
-    mem_prefault(s->view_confidence, n * sizeof(s->view_confidence[0]));
+    mem_prefault(s->phase.colour.rgb, n * 3);
+    mem_prefault(s->phase.colour.confidence, n * sizeof(s->phase.colour.confidence[0]));
     mem_prefault(s->view_reason, n);
 }
 
@@ -216,7 +216,7 @@ static void prefault_points(struct scan_ctx *s, const struct decode_maps *m)
     if (first > last)
         return;
     size_t i = first * w, n = (last + 1 - first) * w;
-    mem_prefault(s->column + i, n * sizeof(s->column[0]));
+    mem_prefault(s->phase.column + i, n * sizeof(s->phase.column[0]));
     mem_prefault(s->planes.tri.xyz_mm + 3 * i, 3 * n * sizeof(s->planes.tri.xyz_mm[0]));
     mem_prefault(s->planes.tri.normal + 3 * i, 3 * n * sizeof(s->planes.tri.normal[0]));
 }
@@ -257,8 +257,8 @@ int scan_begin_view(struct scan_ctx *s, const struct scan_params *p, const struc
     size_t n = frame_pixels(p);
     prefault_colour(s, n); /* (the decoder's buffers are its own: decode_begin) */
     if (p->exposure_count > 0) {
-        mem_prefault(s->hdr_choice, n);
-        mem_prefault(s->hdr_grey, n);
+        mem_prefault(s->phase.taking.hdr_choice, n);
+        mem_prefault(s->phase.taking.hdr_grey, n);
     }
     return 0;
 }
@@ -267,14 +267,11 @@ void scan_release_frames(struct scan_ctx *s)
 {
     decode_release(&s->decode);
     mem_release(&s->planes, sizeof(s->planes)); /* the decoder's working planes, the range image */
-    mem_release(s->column, sizeof(s->column));
     mem_release(s->colour_rgb, sizeof(s->colour_rgb));
-    mem_release(s->frame_rgb, sizeof(s->frame_rgb));
     if (s->light != NULL)
         mem_release(s->light, sizeof(*s->light));
     memset(s->light_present, 0, sizeof(s->light_present));
-    mem_release(s->hdr_choice, sizeof(s->hdr_choice));
-    mem_release(s->hdr_grey, sizeof(s->hdr_grey));
+    /* not s->phase: the view's colour is in it */
 }
 
 int scan_feed_frame(struct scan_ctx *s, uint32_t pattern, const uint8_t *pixels, uint32_t channels,
@@ -434,16 +431,15 @@ int scan_finish_view(struct scan_ctx *s, const struct hal_thread *threads,
     view->white_rgb = s->colour_rgb;
     for (uint32_t k = 0; k < COLOUR_MAX_FRAMES; k++)
         view->lights[k] = s->light_present[k] ? light_frame(s, k, frame_pixels(&s->params)) : NULL;
-    view->rgb = s->view_rgb;
-    view->confidence = s->view_confidence;
+    view->rgb = s->phase.colour.rgb;
+    view->confidence = s->phase.colour.confidence;
     int rc = decode_finish(&s->decode, &cores, s->view_reason, &view->maps);
     if (rc == 0)
         prefault_points(s, &view->maps);
     if (rc == 0)
-        rc = refine_columns(&view->maps, &cores, (int)s->params.refine, s->column);
-    view->column = s->column;
-    if (rc == 0)
-        rc = tri_range_image(c, &cores, &s->planes.tri, view->width, view->height, view->column,
+        rc = refine_columns(&view->maps, &cores, (int)s->params.refine, s->phase.column);
+    if (rc == 0) /* the column's last use: the colour made next takes its memory */
+        rc = tri_range_image(c, &cores, &s->planes.tri, view->width, view->height, s->phase.column,
                              s->view_reason, &view->range);
     if (rc == 0)
         rc = tri_normals(&s->planes.tri, &cores, &view->range, s->view_reason,
@@ -473,18 +469,18 @@ int scan_restore_view(struct scan_ctx *s, uint32_t width, uint32_t height, int32
     view->height = height;
     view->angle_mdeg = angle_mdeg;
     view->maps = (struct decode_maps){.reason = s->view_reason, .width = width, .height = height};
-    view->rgb = fill->rgb = s->view_rgb;
-    view->confidence = fill->confidence = s->view_confidence;
+    view->rgb = fill->rgb = s->phase.colour.rgb;
+    view->confidence = fill->confidence = s->phase.colour.confidence;
     view->colour_method = colour_method;
     fill->reason = s->view_reason;
     return 0;
 }
 
 /* HDR: pattern @p i at every exposure, merged in the decoder's slot before it is fed: each
- * pixel at the exposure s->hdr_choice holds, chosen on the white pattern as the longest whose
- * white is not saturated (the brightest unsaturated). The pixel's patterns, inverses, white and
- * black are then all read at one exposure, so the decoder's comparisons stay within it and
- * need no scaling. The white at the camera's own exposure is kept as the view's colour.
+ * pixel at the exposure s->phase.taking.hdr_choice holds, chosen on the white pattern as the
+ * longest whose white is not saturated (the brightest unsaturated). The pixel's patterns, inverses,
+ * white and black are then all read at one exposure, so the decoder's comparisons stay within it
+ * and need no scaling. The white at the camera's own exposure is kept as the view's colour.
  * @p exposure_us  in/out: the camera's exposure now */
 static int capture_hdr(struct scan_ctx *s, const struct hal *hal, const struct scan_params *p,
                        uint32_t i, uint32_t *exposure_us, struct scan_view_info *info)
@@ -498,20 +494,20 @@ static int capture_hdr(struct scan_ctx *s, const struct hal *hal, const struct s
             *exposure_us = p->exposures_us[e];
         }
         int colour = i == GRAY_PATTERN_WHITE && p->exposures_us[e] == p->colour.exposure_us;
-        uint8_t *buf = colour ? s->colour_rgb : s->frame_rgb;
+        uint8_t *buf = colour ? s->colour_rgb : s->phase.taking.frame_rgb;
         if (rc == 0)
             rc = capture(s, hal, p, buf, i, info);
         if (rc != 0)
             break;
         info->frames_captured++;
-        decode_rgb_to_grey(buf, s->hdr_grey, n, p->saturation_dn);
+        decode_rgb_to_grey(buf, s->phase.taking.hdr_grey, n, p->saturation_dn);
         if (i == GRAY_PATTERN_WHITE) /* ascending: a longer unsaturated exposure wins */
             for (size_t k = 0; k < n; k++)
-                if (e == 0 || s->hdr_grey[k] != DECODE_SATURATED)
-                    s->hdr_choice[k] = (uint8_t)e;
+                if (e == 0 || s->phase.taking.hdr_grey[k] != DECODE_SATURATED)
+                    s->phase.taking.hdr_choice[k] = (uint8_t)e;
         for (size_t k = 0; k < n; k++)
-            if (s->hdr_choice[k] == e)
-                slot[k] = s->hdr_grey[k];
+            if (s->phase.taking.hdr_choice[k] == e)
+                slot[k] = s->phase.taking.hdr_grey[k];
     }
     return rc;
 }
@@ -525,7 +521,7 @@ static int capture_pattern(struct scan_ctx *s, const struct hal *hal, const stru
         int rc = capture_hdr(s, hal, p, i, exposure_us, info);
         return rc != 0 ? rc : scan_feed_frame(s, i, decode_frame_slot(&s->decode, i), 1, sink);
     }
-    uint8_t *buf = i == GRAY_PATTERN_WHITE ? s->colour_rgb : s->frame_rgb;
+    uint8_t *buf = i == GRAY_PATTERN_WHITE ? s->colour_rgb : s->phase.taking.frame_rgb;
     int rc = capture(s, hal, p, buf, i, info);
     if (rc != 0)
         return rc;
@@ -628,17 +624,17 @@ int scan_snapshot(struct scan_ctx *s, const struct hal *hal, const struct scan_p
     memset(&info, 0, sizeof(info));
     int rc = projector_start(s, hal, p, c->light_count);
     if (rc == 0)
-        rc = capture(s, hal, p, s->frame_rgb, 0, &info);
+        rc = capture(s, hal, p, s->phase.taking.frame_rgb, 0, &info);
     /* the projector off again at once, and the rig safe on every failure */
     int rc_off = hal_gpio_set(&hal->gpio, HAL_GPIO_PROJECTOR_ENABLE, 0);
     if (rc != 0 || rc_off != 0)
         hal->gpio.ops->safe_state(hal->gpio.priv);
-    *rgb = s->frame_rgb;
+    *rgb = s->phase.taking.frame_rgb;
     return rc != 0 ? rc : rc_off;
 }
 
-/* The white (in s->colour_rgb) and black (in s->frame_rgb) projector frames at @p exposure_us,
- * the camera back at the colour exposure after. */
+/* The white (in s->colour_rgb) and black (in s->phase.taking.frame_rgb) projector frames at @p
+ * exposure_us, the camera back at the colour exposure after. */
 static int capture_white_black(struct scan_ctx *s, const struct hal *hal,
                                const struct scan_params *p, const struct scan_calib *c,
                                uint32_t exposure_us, struct scan_view_info *info)
@@ -658,7 +654,7 @@ static int capture_white_black(struct scan_ctx *s, const struct hal *hal,
     if (rc == 0)
         rc = settle(s, hal, p);
     if (rc == 0)
-        rc = capture(s, hal, p, s->frame_rgb, GRAY_PATTERN_BLACK, info);
+        rc = capture(s, hal, p, s->phase.taking.frame_rgb, GRAY_PATTERN_BLACK, info);
     int rc_exp = camera_exposure_back(hal, p, exposure_us);
     return rc != 0 ? rc : rc_exp;
 }
@@ -677,9 +673,10 @@ int scan_probe_contrast(struct scan_ctx *s, const struct hal *hal, const struct 
         return rc != 0 ? rc : rc_off;
     }
     const size_t n = frame_pixels(p);
-    uint8_t *white = s->hdr_grey, *black = s->hdr_choice; /* both free between views */
+    uint8_t *white = s->phase.taking.hdr_grey,
+            *black = s->phase.taking.hdr_choice; /* both free between views */
     decode_rgb_to_grey(s->colour_rgb, white, n, p->saturation_dn);
-    decode_rgb_to_grey(s->frame_rgb, black, n, p->saturation_dn);
+    decode_rgb_to_grey(s->phase.taking.frame_rgb, black, n, p->saturation_dn);
     uint32_t hist[256] = {0};
     for (size_t i = 0; i < n; i++) {
         if (white[i] == DECODE_SATURATED || white[i] <= black[i] ||
@@ -743,13 +740,13 @@ int scan_probe_lights(struct scan_ctx *s, const struct hal *hal, const struct sc
         if (rc == 0 && hal_should_stop(hal))
             rc = -EINTR;
         if (rc == 0)
-            rc = capture(s, hal, p, l == 0 ? dark : s->frame_rgb,
+            rc = capture(s, hal, p, l == 0 ? dark : s->phase.taking.frame_rgb,
                          l == 0 ? COLOUR_FRAME_DARK : COLOUR_FRAME_LIGHT0 + l - 1, &info);
         if (rc != 0 || l == 0)
             continue;
         uint32_t count;
-        light_levels(s->frame_rgb, dark, n, p->colour.shadow_dn, p->saturation_dn, level_hist,
-                     dark_hist, &count);
+        light_levels(s->phase.taking.frame_rgb, dark, n, p->colour.shadow_dn, p->saturation_dn,
+                     level_hist, dark_hist, &count);
         uint32_t level = hist_percentile(level_hist, count, 95);
         if (count > 0 && (out->lit == 0 || level > out->level_dn))
             *out = (struct scan_light_probe){.lit = count,

@@ -29,8 +29,7 @@ struct scan_light_frames {
  *  calibration, a command) keeps it static and passes it by pointer, so there is no allocation;
  *  two contexts are two independent views. Its fields are the firmware's own. */
 struct scan_ctx {
-    struct decode_ctx decode;     /* the pattern frames, decoded */
-    float column[HAL_MAX_PIXELS]; /* continuous projector column (refine.h) */
+    struct decode_ctx decode; /* the pattern frames, decoded */
     /* The decoder works in these planes until decode_finish; the range image is made after it
      * in the same memory (tri_range_image), for the frames' bits are not read again: a view is
      * finished once. Why: the two are a view's largest buffers after the frames (19 and 24
@@ -39,15 +38,27 @@ struct scan_ctx {
         struct decode_work decoding;
         struct tri_maps tri; /* the range image */
     } planes;
+    /* A view uses these in three phases, one after the other, never two at once: while its
+     * frames come (every frame but the white one in RGB, HDR's choice and grey), from its
+     * decoding to its range image (the continuous column), and from its colour until the next
+     * view's frames come (what the stages after it read). Why: 16 bytes a pixel in buffers of
+     * their own, 7 in one memory (scan_release_frames keeps it: the colour stays). */
+    union {
+        struct {
+            uint8_t frame_rgb[HAL_MAX_PIXELS * 3]; /* every other frame, consumed at once */
+            uint8_t hdr_choice[HAL_MAX_PIXELS];    /* HDR: the exposure each pixel is read at */
+            uint8_t hdr_grey[HAL_MAX_PIXELS]; /* HDR: one exposure of the pattern being merged */
+        } taking;
+        float column[HAL_MAX_PIXELS]; /* continuous projector column (refine.h) */
+        struct {
+            uint8_t rgb[HAL_MAX_PIXELS * 3]; /* the view's colour: compensated, or raw */
+            float confidence[HAL_MAX_PIXELS];
+        } colour;
+    } phase;
     uint8_t colour_rgb[HAL_MAX_PIXELS * 3]; /* projector-white frame, kept as the view's colour */
-    uint8_t frame_rgb[HAL_MAX_PIXELS * 3];  /* every other frame, consumed at once */
     struct scan_light_frames *light; /* the owner's (scan_use_light_frames); NULL: none yet */
     int light_present[COLOUR_MAX_FRAMES];
-    uint8_t view_rgb[HAL_MAX_PIXELS * 3]; /* the view's colour: compensated, or raw */
-    float view_confidence[HAL_MAX_PIXELS];
     uint8_t view_reason[HAL_MAX_PIXELS]; /* decoded, then refined by each later stage */
-    uint8_t hdr_choice[HAL_MAX_PIXELS];  /* HDR: the exposure each pixel is read at */
-    uint8_t hdr_grey[HAL_MAX_PIXELS];    /* HDR: one exposure of the pattern being merged */
     struct scan_params params;           /* of the view being fed */
     uint32_t patterns, lights;           /* its pattern and colour frames */
     uint64_t settled_us; /* when the last light or pattern change had settled (HAL clock; 0: the
@@ -73,7 +84,6 @@ struct scan_view {
     uint32_t width, height;   /**< frame size */
     int32_t angle_mdeg;       /**< turntable angle it was taken at */
     struct decode_maps maps;  /**< projector columns (rows), reason per pixel */
-    const float *column;      /**< continuous projector column (refine.h) */
     struct tri_range range;   /**< points and normals, camera frame, mm */
     const uint8_t *white_rgb; /**< projector-white frame, RGB24 */
     const uint8_t

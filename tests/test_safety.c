@@ -142,7 +142,8 @@ static void test_camera_drops_the_frame_in_flight(void **state)
     double next = ceil((double)now / period) * period;
     assert_int_equal(hal_clock_sleep_us(&t.hal.clock, (uint64_t)(next + 10000.0) - now), 0);
     assert_int_equal(hal_clock_now_us(&t.hal.clock, &asked), 0);
-    struct hal_image img = {.rgb = t.scan->frame_rgb, .capacity = sizeof(t.scan->frame_rgb)};
+    struct hal_image img = {.rgb = t.scan->phase.taking.frame_rgb,
+                            .capacity = sizeof(t.scan->phase.taking.frame_rgb)};
     assert_int_equal(hal_cam_capture(&t.hal.camera, &img), 0);
     assert_int_equal(hal_clock_now_us(&t.hal.clock, &now), 0);
     double frame_start = (double)asked - 10000.0 + period; /* the next start after asking */
