@@ -381,6 +381,65 @@ static void test_object_beyond_the_volume_counted(void **state)
     assert_int_equal(o.above + o.beside + o.views_cut, 0);
 }
 
+/* A volume moved off the axis by whole blocks of voxels (fusion_fit's centre_mm, for an object
+ * near the table's rim) fuses a view into the same voxels at the same places: the bunny's view
+ * in the volume about the axis and in one centred 20 mm away and 20 mm wider, every voxel the
+ * two share the same to the byte, and every voxel the view reached inside both. */
+static void test_volume_off_the_axis_fuses_the_same(void **state)
+{
+    (void)state;
+    static struct test_rig t;
+    struct fusion_volume *vol = &test_volume;
+    assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
+    snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "mesh");
+    t.cfg.scan.colour.method = COLOUR_NONE;
+    assert_int_equal(test_rig_start(&t), 0);
+    struct scan_view view;
+    struct scan_view_info info;
+    assert_int_equal(scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info),
+                     0);
+    assert_int_equal(scan_finish_view(t.scan, NULL, &t.calib, view.angle_mdeg, &view, &info), 0);
+    struct frame_xform pose;
+    frame_object_from_camera(&t.calib, view.angle_mdeg, &pose);
+    struct fusion_params p = t.cfg.fusion, moved;
+    assert_true(p.voxel_mm == 1.0 && p.centre_mm[0] == 0.0 && p.centre_mm[1] == 0.0);
+    assert_int_equal(fusion_begin(vol, &p), 0);
+    assert_int_equal(scan_fuse_view(vol, NULL, &t.calib, &view, &pose), 0);
+    const uint32_t a[3] = {vol->dims[0], vol->dims[1], vol->dims[2]};
+    const vec3 origin_a = vol->origin;
+    size_t na = (size_t)a[0] * a[1] * a[2];
+    struct voxel *one = malloc(na * sizeof(*one));
+    assert_non_null(one);
+    memcpy(one, vol->grid, na * sizeof(*one));
+    moved = p;
+    moved.centre_mm[1] = 20.0; /* 20 voxels: whole blocks of 4, as the fusion marks them */
+    moved.radius_mm = p.radius_mm + 20.0;
+    assert_int_equal(fusion_begin(vol, &moved), 0);
+    assert_int_equal(scan_fuse_view(vol, NULL, &t.calib, &view, &pose), 0);
+    test_rig_stop(&t);
+    const long dx = lround(origin_a.x - vol->origin.x), dy = lround(origin_a.y - vol->origin.y);
+    assert_true(dx == 20 && dy == 0 && vol->origin.z == origin_a.z);
+    size_t same = 0, reached = 0;
+    for (uint32_t z = 0; z < a[2]; z++)
+        for (uint32_t y = 0; y < a[1]; y++)
+            for (uint32_t x = 0; x < a[0]; x++) {
+                const struct voxel *va = &one[((size_t)z * a[1] + y) * a[0] + x];
+                long bx = (long)x + dx, by = (long)y + dy;
+                if (bx >= (long)vol->dims[0] || by >= (long)vol->dims[1]) {
+                    assert_int_equal(va->weight, 0); /* only the axis' volume reaches there */
+                    continue;
+                }
+                const struct voxel *vb =
+                    &vol->grid[((size_t)z * vol->dims[1] + (size_t)by) * vol->dims[0] + (size_t)bx];
+                assert_memory_equal(va, vb, sizeof(*va));
+                same++;
+                reached += va->weight > 0;
+            }
+    print_message("%zu voxels in both, %zu of them reached by the view\n", same, reached);
+    assert_true(reached > 100000);
+    free(one);
+}
+
 /* Inverses for the finest 3 bits only ([scan] inverse_bits = 3: 28 patterns with rows, 15
  * without): the decoders still agree, and the bunny's view keeps its quality (check_quality), its
  * lit surface decoded right within 0.2 points of every inverse's, nothing more than 2 mm off
@@ -691,6 +750,7 @@ int main(void)
         cmocka_unit_test(test_blocked_decoder_matches_reference),
         cmocka_unit_test(test_threads_decode_the_same),
         cmocka_unit_test(test_object_beyond_the_volume_counted),
+        cmocka_unit_test(test_volume_off_the_axis_fuses_the_same),
         cmocka_unit_test(test_fewer_inverses),
         cmocka_unit_test(test_two_scan_contexts_are_independent),
         cmocka_unit_test(test_frames_given_back),
