@@ -674,7 +674,7 @@ int scan_probe_contrast(struct scan_ctx *s, const struct hal *hal, const struct 
     }
     const size_t n = frame_pixels(p);
     uint8_t *white = s->phase.taking.hdr_grey,
-            *black = s->phase.taking.hdr_choice; /* both free between views */
+            *black = s->phase.taking.hdr_choice; /* both free once a view is saved */
     decode_rgb_to_grey(s->colour_rgb, white, n, p->saturation_dn);
     decode_rgb_to_grey(s->phase.taking.frame_rgb, black, n, p->saturation_dn);
     uint32_t hist[256] = {0};

@@ -168,7 +168,9 @@ int scan_probe_lights(struct scan_ctx *s, const struct hal *hal, const struct sc
                       const struct scan_calib *calib, struct scan_light_probe *out);
 
 /** One picture of what the camera sees lit by the projector's white (the web page's live view),
- *  without turning the table; the projector is off again when it returns.
+ *  without turning the table; the projector is off again when it returns. Like the probes above
+ *  it takes the memory of the last view's colour (scan_ctx.phase): call it once that view has
+ *  been saved, as between views.
  *  @param rgb  out: the RGB24 frame (params' width x height), valid until the next capture
  *  @retval 0 ok @retval capture error */
 int scan_snapshot(struct scan_ctx *s, const struct hal *hal, const struct scan_params *params,
