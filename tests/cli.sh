@@ -409,6 +409,19 @@ check light_exposure_chosen_is_the_scans sh -c "rm -rf $out/hdr-again &&
     $bin process $out/hdr-scan --config $out/hdr-fixed.ini --out $out/hdr-again --replace 2>&1 |
     grep -q 'was taken with \[colour\] light_exposure_us = [0-9]*, not 10000'"
 rm -rf "$out/hdr-scan" "$out/hdr-processed" "$out/hdr-again"
+# At the most exposures, three, a view takes more frames than it keeps (73 against 30): view.ini
+# says so, and the scan is processed and resumed again. It was refused, as a damaged file:
+# 'view.ini:7: [view] frames: 73 is out of range 0..68'.
+sed 's/^views = 4$/views = 1/; s/^exposures_us = 10000, 40000$/exposures_us = 5000, 10000, 20000/' \
+    "$out/hdr.ini" > "$out/hdr3.ini"
+check hdr_at_three_exposures_processed_again sh -c "rm -rf $out/hdr3-scan $out/hdr3-processed &&
+    $bin scan --config $out/hdr3.ini --out $out/hdr3-scan >/dev/null 2>&1 &&
+    grep -q '^frames = 73$' $out/hdr3-scan/view_000/view.ini &&
+    $bin process $out/hdr3-scan --out $out/hdr3-processed > $out/hdr3-process.txt 2>&1 &&
+    cmp $out/hdr3-scan/mesh.ply $out/hdr3-processed/mesh.ply &&
+    $bin resume $out/hdr3-scan > $out/hdr3-resume.txt 2>&1 &&
+    grep -q '^resume 1 of 1 views kept' $out/hdr3-resume.txt"
+rm -rf "$out/hdr3-scan" "$out/hdr3-processed"
 # make LIMITS=large (issue 33): a DSLR's 4896 x 3264 frames, unbinned. The default build refuses
 # the config, naming the compiled limit; the large one takes the frames and goes on to the next
 # check, the calibration of a 1280 x 960 camera (make measure-large scans with one of its own).
