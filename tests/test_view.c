@@ -326,6 +326,24 @@ static void test_threads_decode_the_same(void **state)
     assert_true(observed > 100000);
 }
 
+/* One view of @p object (@p height_mm tall; 0: config/sim.ini's) taken and finished on the
+ * started rig @p t, without colour, and its pose. */
+static void take_one_view(struct test_rig *t, const char *object, double height_mm,
+                          struct scan_view *view, struct frame_xform *pose)
+{
+    assert_int_equal(test_rig_load(t, "config/sim.ini"), 0);
+    snprintf(t->cfg.sim.object, sizeof(t->cfg.sim.object), "%s", object);
+    if (height_mm > 0.0)
+        t->cfg.sim.object_height_mm = height_mm;
+    t->cfg.scan.colour.method = COLOUR_NONE;
+    assert_int_equal(test_rig_start(t), 0);
+    struct scan_view_info info;
+    assert_int_equal(
+        scan_take_view(t->scan, &t->hal, &t->cfg.scan, &t->calib, 0, NULL, view, &info), 0);
+    assert_int_equal(scan_finish_view(t->scan, NULL, &t->calib, view->angle_mdeg, view, &info), 0);
+    frame_object_from_camera(&t->calib, view->angle_mdeg, pose);
+}
+
 /* One view of @p object, @p height_mm tall, fused with @p top_mm and @p radius_mm: what the
  * fusion counted beyond its volume and the image (struct fusion_outside). */
 static void fuse_one_view(const char *object, double height_mm, double top_mm, double radius_mm,
@@ -333,18 +351,9 @@ static void fuse_one_view(const char *object, double height_mm, double top_mm, d
 {
     static struct test_rig t;
     struct fusion_volume *vol = &test_volume;
-    assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
-    snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "%s", object);
-    t.cfg.sim.object_height_mm = height_mm;
-    t.cfg.scan.colour.method = COLOUR_NONE;
-    assert_int_equal(test_rig_start(&t), 0);
     struct scan_view view;
-    struct scan_view_info info;
-    assert_int_equal(scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info),
-                     0);
-    assert_int_equal(scan_finish_view(t.scan, NULL, &t.calib, view.angle_mdeg, &view, &info), 0);
     struct frame_xform pose;
-    frame_object_from_camera(&t.calib, view.angle_mdeg, &pose);
+    take_one_view(&t, object, height_mm, &view, &pose);
     struct fusion_params p = t.cfg.fusion;
     p.top_mm = top_mm;
     p.radius_mm = radius_mm;
@@ -390,17 +399,9 @@ static void test_volume_off_the_axis_fuses_the_same(void **state)
     (void)state;
     static struct test_rig t;
     struct fusion_volume *vol = &test_volume;
-    assert_int_equal(test_rig_load(&t, "config/sim.ini"), 0);
-    snprintf(t.cfg.sim.object, sizeof(t.cfg.sim.object), "mesh");
-    t.cfg.scan.colour.method = COLOUR_NONE;
-    assert_int_equal(test_rig_start(&t), 0);
     struct scan_view view;
-    struct scan_view_info info;
-    assert_int_equal(scan_take_view(t.scan, &t.hal, &t.cfg.scan, &t.calib, 0, NULL, &view, &info),
-                     0);
-    assert_int_equal(scan_finish_view(t.scan, NULL, &t.calib, view.angle_mdeg, &view, &info), 0);
     struct frame_xform pose;
-    frame_object_from_camera(&t.calib, view.angle_mdeg, &pose);
+    take_one_view(&t, "mesh", 0.0, &view, &pose);
     struct fusion_params p = t.cfg.fusion, moved;
     assert_true(p.voxel_mm == 1.0 && p.centre_mm[0] == 0.0 && p.centre_mm[1] == 0.0);
     assert_int_equal(fusion_begin(vol, &p), 0);
