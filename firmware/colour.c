@@ -279,7 +279,7 @@ static void light_signals(const struct frame_ctx *f, const struct scan_calib *c,
         struct toward s = toward(p, v3_from(c->light_pos_mm[l]));
         double fall, ct = incidence(prm, nn, s, &fall);
         est[l] = -1.0;
-        if (ct < min_cos) /* turned away from it: its frame is not read (a third of them) */
+        if (ct < min_cos) /* turned away from it: its frame is not read */
             continue;
         uint32_t k = COLOUR_FRAME_LIGHT0 + l, kl = f->lay->long_of[k];
         if (kl != 0 && !clipped(prm, &f->frames[kl][3 * i]))
