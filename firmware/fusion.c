@@ -302,8 +302,8 @@ int fusion_outside_many(uint64_t n, uint64_t fused, uint64_t least)
  * moved from p's by whole voxels (the grid's voxels stay where they were) and its half side by
  * whole voxels with one to spare for the centre's rounding: @p fitted's radius and centre (its
  * top as fusion_fit grew it). Why: a person who puts the object near the table's rim (a
- * bunny 150 mm off the axis) had 70% of it cut off, for a square about the axis holding it was
- * beyond the grid's limits where one about the object was not. @retval 0 @retval -E2BIG beyond
+ * bunny 150 mm off the axis) had 69% of its points cut off, for a square about the axis holding it
+ * was beyond the grid's limits where one about the object was not. @retval 0 @retval -E2BIG beyond
  * the limits all the same */
 static int grown_off_axis(const struct fusion_params *p, const struct fusion_outside *seen,
                           double spare, struct fusion_params *fitted)

@@ -102,7 +102,8 @@ void outbuf_fixed(struct outbuf *o, double v, unsigned decimals)
 
 void outbuf_u32le(struct outbuf *o, uint32_t u)
 {
-    uint8_t b[4] = {(uint8_t)u, (uint8_t)(u >> 8), (uint8_t)(u >> 16), (uint8_t)(u >> 24)};
+    uint8_t b[4];
+    outbuf_u32le_at(b, u);
     if (o->used + 4u > sizeof(chunk)) { /* the chunk's end: outbuf_put flushes it */
         outbuf_put(o, b, 4);
         return;

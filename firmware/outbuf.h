@@ -28,15 +28,20 @@ void outbuf_fixed(struct outbuf *o, double v, unsigned decimals);
 void outbuf_u32(struct outbuf *o, uint32_t v);
 /** Append a float, little-endian. */
 void outbuf_f32le(struct outbuf *o, float f);
-/** Put float @p f little-endian at @p dst (a record made whole, then appended at once).
- *  @retval dst + 4 */
+/** Put @p u little-endian at @p dst (outbuf_u32le's bytes; a record made whole, then appended
+ *  at once). @retval dst + 4 */
+static inline uint8_t *outbuf_u32le_at(uint8_t *dst, uint32_t u)
+{
+    for (int k = 0; k < 4; k++)
+        dst[k] = (uint8_t)(u >> (8 * k));
+    return dst + 4;
+}
+/** The same for float @p f. @retval dst + 4 */
 static inline uint8_t *outbuf_f32le_at(uint8_t *dst, float f)
 {
     uint32_t u;
     memcpy(&u, &f, sizeof(u));
-    for (int k = 0; k < 4; k++)
-        dst[k] = (uint8_t)(u >> (8 * k));
-    return dst + 4;
+    return outbuf_u32le_at(dst, u);
 }
 /** Append a uint32, little-endian. */
 void outbuf_u32le(struct outbuf *o, uint32_t v);

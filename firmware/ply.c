@@ -18,7 +18,8 @@ static uint32_t count_valid(const struct decode_maps *maps)
 
 /* A vertex: its position and normal, @p encoded (sRGB bytes: viewers show 8-bit colours as
  * sRGB), then the linear values @p num / @p den as floats. Made whole and appended at once
- * (a view's cloud has 10^5 to 10^6 of them: ten appends each were a third of its writing). */
+ * (a view's cloud has 10^5 to 10^6 of them: ten appends each were a fifth of its writing's
+ * instructions, callgrind). */
 static void put_vertex(struct outbuf *o, vec3 p, vec3 n, const uint8_t encoded[3],
                        const float num[3], float den)
 {

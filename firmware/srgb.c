@@ -5,7 +5,7 @@
 
 /* srgb_encode(i) for i = 0..255: the formula in srgb.h, rounded (tests/test_ply.c checks every
  * entry against it). A table rather than pow() per channel: a fused mesh has ~10^6 channels. */
-const uint8_t srgb_encode_table[256] = {
+static const uint8_t encode_table[256] = {
     0,   13,  22,  28,  34,  38,  42,  46,  50,  53,  56,  59,  61,  64,  66,  69,  71,  73,  75,
     77,  79,  81,  83,  85,  86,  88,  90,  92,  93,  95,  96,  98,  99,  101, 102, 104, 105, 106,
     108, 109, 110, 112, 113, 114, 115, 117, 118, 119, 120, 121, 122, 124, 125, 126, 127, 128, 129,
@@ -21,6 +21,11 @@ const uint8_t srgb_encode_table[256] = {
     243, 243, 244, 244, 245, 245, 246, 246, 246, 247, 247, 248, 248, 249, 249, 250, 250, 251, 251,
     251, 252, 252, 253, 253, 254, 254, 255, 255,
 };
+
+uint8_t srgb_encode(uint8_t linear)
+{
+    return encode_table[linear];
+}
 
 /* The formula at every 16-bit linear value, made on the first call (64 KB: a pow() per channel
  * of a texture's millions of texels cost a third of its time). */

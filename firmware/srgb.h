@@ -5,16 +5,10 @@
 
 #include <stdint.h>
 
-/** srgb_encode of every byte (srgb.c; tests/test_ply.c checks each against the formula). */
-extern const uint8_t srgb_encode_table[256];
-
 /** The sRGB encoding of a linear byte (IEC 61966-2-1: 12.92 x below 0.0031308, else
  *  1.055 x^(1/2.4) - 0.055), both as 0..255, rounded.
  *  @param linear  linear value 0..255 @retval the sRGB-encoded value 0..255 */
-static inline uint8_t srgb_encode(uint8_t linear)
-{
-    return srgb_encode_table[linear]; /* inline: the report's thumbnails read 10^7 pixels */
-}
+uint8_t srgb_encode(uint8_t linear);
 
 /** The same for a 16-bit linear value (0..65535): a linear byte b given as b x 257 is encoded as
  *  srgb_encode(b). Its table is made on the first call: make that call from one thread.
