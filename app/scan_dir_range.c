@@ -92,7 +92,7 @@ static int range_open(const char *dir, uint32_t view, char *path, size_t path_le
 /* The points of range.bin after the reasons @p reason (n pixels) already read: @p each is called
  * for every valid pixel in order, with its point (the caller has cleared the others: a call for
  * each of a view's million pixels cost more than the points' reading).
- * @retval 0 @retval -EINVAL cut short, or more points than valid pixels */
+ * @retval 0 @retval -EINVAL cut short, or more points than valid pixels, or bytes after them */
 static int read_range_points(FILE *fp, const uint8_t *reason, size_t n,
                              void (*each)(void *priv, size_t i, const struct range_point *p),
                              void *priv)
@@ -104,9 +104,11 @@ static int read_range_points(FILE *fp, const uint8_t *reason, size_t n,
     _Static_assert(SCAN_VALID == 0, "valid pixels are found by memchr for 0");
     while (rc == 0 && at < end && (at = memchr(at, SCAN_VALID, (size_t)(end - at))) != NULL) {
         if (next == have) {
-            have = fread(chunk, sizeof(chunk[0]), RANGE_CHUNK, fp);
+            /* read as bytes: fread of whole points drops a part of one at the end unsaid */
+            size_t bytes = fread(chunk, 1, RANGE_CHUNK * sizeof(chunk[0]), fp);
+            have = bytes / sizeof(chunk[0]);
             next = 0;
-            if (have == 0) {
+            if (have == 0 || bytes % sizeof(chunk[0]) != 0) {
                 rc = -EINVAL;
                 break;
             }

@@ -150,6 +150,11 @@ dark_test() {
     rm "$out/dark-bad/view_001/range.bin" && mkfifo "$out/dark-bad/view_001/range.bin"
     timeout 60 "$bin" process "$out/dark-bad" >"$out/dark-bad.log" 2>&1 && return 1
     grep -q 'error: .*dark-bad/view_001/range.bin: not a range image' "$out/dark-bad.log" || return 1
+    # two bytes after its last point, less than a point (read in whole points, they went unsaid)
+    rm "$out/dark-bad/view_001/range.bin" && cp "$out/dark/view_001/range.bin" "$out/dark-bad/view_001/"
+    printf 'xx' >>"$out/dark-bad/view_000/range.bin"
+    timeout 60 "$bin" process "$out/dark-bad" >"$out/dark-bad.log" 2>&1 && return 1
+    grep -q 'error: .*dark-bad/view_000/range.bin: cut short or damaged' "$out/dark-bad.log" || return 1
     want=$(sed -n 's/.*raise \[camera\] exposure_us from 10000 to about \([0-9]*\).*/\1/p' "$out/dark.log")
     [ -n "$want" ] && [ "$want" -gt 10000 ] || return 1
     # kept with its frames, processing says the same exposure
