@@ -31,11 +31,16 @@
  * shading, which changes with the angle to the light (a flat face seen 45 degrees apart differs
  * by a third in brightness): @p a is brought to @p b's brightness (white light scales the
  * channels alike, so the chromaticity is kept) and then compared; too dark to tell, they agree
- * (Jost et al.: colour helps registration once it is intrinsic). */
-static int colours_agree(const struct reg_params *p, const uint8_t a[3], const uint8_t b[3])
+ * (Jost et al.: colour helps registration once it is intrinsic). A cell no light coloured (each
+ * shadowed there) agrees with any: with one light, half of each view has no colour, and a pair
+ * across that half would otherwise never couple (a 4-view scan with one light failed, 4% of the
+ * overlap coupled). */
+static int colours_agree(const struct reg_params *p, const struct reg_cell *ca,
+                         const struct reg_cell *cb)
 {
-    if (!p->use_colour)
+    if (!p->use_colour || reg_cell_uncoloured(ca) || reg_cell_uncoloured(cb))
         return 1;
+    const uint8_t *a = ca->rgb, *b = cb->rgb;
     double scale = 1.0;
     if (!p->colour_intrinsic) {
         double sa = (double)a[0] + a[1] + a[2], sb = (double)b[0] + b[1] + b[2];
@@ -99,8 +104,8 @@ int reg_begin(struct reg_ctx *r, const struct reg_params *p, const struct scan_c
  * on the box of data/objects with exact poses: 0.5 mm at a stride of 4, 0.2 at 2, 0 at 1); the
  * box-filtered cell holds the share of each paint, which bilinear sampling (reg_place.c) turns
  * back into where the boundary is: 0.1 mm. */
-static void cell_colour(const struct decode_maps *m, const uint8_t *rgb, uint32_t stride,
-                        uint32_t px, uint32_t py, struct reg_cell *cl)
+static void cell_colour(const struct decode_maps *m, const uint8_t *rgb, const float *confidence,
+                        uint32_t stride, uint32_t px, uint32_t py, struct reg_cell *cl)
 {
     const int half = (int)stride / 2, even = stride % 2 == 0;
     double sum[3] = {0.0, 0.0, 0.0}, hue_sum[2] = {0.0, 0.0}, weight = 0.0;
@@ -111,7 +116,8 @@ static void cell_colour(const struct decode_maps *m, const uint8_t *rgb, uint32_
         for (int dx = -half; dx <= half; dx++) {
             long x = (long)px + dx;
             size_t i = (size_t)y * m->width + (size_t)x;
-            if (x < 0 || x >= (long)m->width || m->reason[i] != SCAN_VALID)
+            if (x < 0 || x >= (long)m->width || m->reason[i] != SCAN_VALID ||
+                (confidence != NULL && confidence[i] < 0.0f))
                 continue;
             double w = (even && (dy == -half || dy == half) ? 0.5 : 1.0) *
                        (even && (dx == -half || dx == half) ? 0.5 : 1.0);
@@ -123,6 +129,11 @@ static void cell_colour(const struct decode_maps *m, const uint8_t *rgb, uint32_
             hue_sum[0] += w * h[0], hue_sum[1] += w * h[1];
             weight += w;
         }
+    }
+    if (weight <= 0.0) { /* every light shadowed there: no colour to compare (colours_agree) */
+        memset(cl->rgb, 0, sizeof(cl->rgb));
+        cl->hue[0] = REG_NO_HUE, cl->hue[1] = REG_UNCOLOURED;
+        return;
     }
     double mean[3], h[2];
     for (int c = 0; c < 3; c++) {
@@ -144,7 +155,7 @@ static void cell_colour(const struct decode_maps *m, const uint8_t *rgb, uint32_
 }
 
 int reg_add_view(struct reg_ctx *r, uint32_t index, int32_t angle_mdeg, const struct decode_maps *m,
-                 const struct tri_range *range, const uint8_t *rgb)
+                 const struct tri_range *range, const uint8_t *rgb, const float *confidence)
 {
     if (index >= r->views || (m->width + r->stride - 1) / r->stride != r->gw ||
         (m->height + r->stride - 1) / r->stride != r->gh)
@@ -160,7 +171,7 @@ int reg_add_view(struct reg_ctx *r, uint32_t index, int32_t angle_mdeg, const st
             r->valid_cells[index] += cl->valid;
             memcpy(cl->xyz, &range->xyz_mm[3 * i], sizeof(cl->xyz));
             memcpy(cl->normal, &range->normal[3 * i], sizeof(cl->normal));
-            cell_colour(m, rgb, r->stride, x * r->stride, y * r->stride, cl);
+            cell_colour(m, rgb, confidence, r->stride, x * r->stride, y * r->stride, cl);
         }
     }
     r->reported_mdeg[index] = angle_mdeg;
@@ -289,7 +300,7 @@ static void pair_views(struct reg_ctx *r, uint32_t src, uint32_t dst, double gat
         vec3 q = v3(cq->xyz[0], cq->xyz[1], cq->xyz[2]);
         vec3 diff = v3_sub(p, q);
         double dist = v3_len(diff);
-        int ok = dist <= gate_mm && colours_agree(&r->p, cp->rgb, cq->rgb);
+        int ok = dist <= gate_mm && colours_agree(&r->p, cp, cq);
         double res = v3_dot(diff, nq);
         double cap = fmin(res * res, r->p.max_pair_mm * r->p.max_pair_mm);
         st->trunc_sq += ok ? cap : r->p.max_pair_mm * r->p.max_pair_mm;

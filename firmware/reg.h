@@ -111,7 +111,8 @@ struct reg_cell {
     float normal[3];
     uint8_t rgb[3];
     uint8_t valid;
-    int16_t hue[2]; /* the mean of its pixels' hues x 32767 (reg_priv.h); REG_NO_HUE: too dark */
+    int16_t hue[2]; /* the mean of its pixels' hues x 32767 (reg_priv.h); REG_NO_HUE: too dark,
+                       with REG_UNCOLOURED: no colour at all */
 };
 _Static_assert(sizeof(struct reg_cell) == 32, "cell layout");
 
@@ -184,9 +185,13 @@ int reg_begin(struct reg_ctx *r, const struct reg_params *params, const struct s
               uint32_t views, uint32_t passes, uint32_t width, uint32_t height);
 
 /** Keep samples of view @p index (camera frame) taken at the reported @p angle_mdeg.
+ *  @param rgb  the view's colour, 3 bytes a pixel
+ *  @param confidence  its confidence a pixel: a negative one has no colour (colour.h's
+ *         COLOUR_NO_ESTIMATE), left out of a sample's colour; NULL: every pixel has one
  *  @retval 0 @retval -EINVAL index or size outside what reg_begin was given */
 int reg_add_view(struct reg_ctx *r, uint32_t index, int32_t angle_mdeg,
-                 const struct decode_maps *maps, const struct tri_range *range, const uint8_t *rgb);
+                 const struct decode_maps *maps, const struct tri_range *range, const uint8_t *rgb,
+                 const float *confidence);
 
 /** Register every added view jointly. @param report out
  *  @retval 0 (a failed match is reported in report->failed_view, not as an error) */

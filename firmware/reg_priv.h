@@ -33,8 +33,16 @@
 
 /* A colour whose distance from grey is under this share of its brightness is grey. */
 #define REG_HUE_MIN_SATURATION 0.15
-/* A cell's hue[0] when its pixels are too dark to have one. */
+/* A cell's hue[0] when its pixels are too dark to have one; hue[1] is then REG_UNCOLOURED when
+ * none of them had a colour at all (every light shadowed there, colour.h), else 0. */
 #define REG_NO_HUE INT16_MIN
+#define REG_UNCOLOURED 1
+
+/* @retval 1 no pixel of cell @p cl had a colour: there is nothing to compare it by */
+static inline int reg_cell_uncoloured(const struct reg_cell *cl)
+{
+    return cl->hue[0] == REG_NO_HUE && cl->hue[1] == REG_UNCOLOURED;
+}
 
 /* A colour's hue: the unit direction of its distance from grey, in the plane across the grey
  * axis. The same under any brightness of white light and under any grey added to it (ambient

@@ -805,7 +805,8 @@ int scan_take_view(struct scan_ctx *s, const struct hal *hal, const struct scan_
 
 int scan_keep_for_registration(struct reg_ctx *reg, uint32_t index, const struct scan_view *view)
 {
-    return reg_add_view(reg, index, view->angle_mdeg, &view->maps, &view->range, view->rgb);
+    return reg_add_view(reg, index, view->angle_mdeg, &view->maps, &view->range, view->rgb,
+                        view->confidence);
 }
 
 struct hal_thread scan_cores(const struct hal_thread *threads, const struct scan_params *p)

@@ -89,7 +89,7 @@ struct scan_view {
     const uint8_t
         *lights[COLOUR_MAX_FRAMES]; /**< colour frames (colour.h order); NULL: not taken */
     uint8_t *rgb;           /**< the view's colour as saved and fused: compensated, else raw */
-    float *confidence;      /**< colour confidence per pixel (0: no estimate) */
+    float *confidence;      /**< colour confidence per pixel (COLOUR_NO_ESTIMATE: none) */
     uint32_t colour_method; /**< enum colour_method the colour was made with */
 };
 

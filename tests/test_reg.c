@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "camray.h"
+#include "colour.h"
 #include "config.h"
 #include "lsq.h"
 #include "reg.h"
@@ -28,7 +29,7 @@ static struct reg_ctx reg;        /* the registration under test */
 static struct reg_ctx other;      /* a second one beside it */
 static struct reg_ctx *to = &reg; /* where add_view adds */
 static uint8_t reason[HAL_MAX_PIXELS], rgb[HAL_MAX_PIXELS * 3];
-static float xyz[HAL_MAX_PIXELS * 3], normal[HAL_MAX_PIXELS * 3];
+static float xyz[HAL_MAX_PIXELS * 3], normal[HAL_MAX_PIXELS * 3], confidence[HAL_MAX_PIXELS];
 
 /* How the object lies: its spheres at rot c + shift (object frame). */
 static double placed_rot[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
@@ -38,6 +39,10 @@ static double radius_scale = 1.0; /* another object altogether */
  * point's colour changes with its angle to the light as the table turns (method none) */
 static int raw_shading;
 static int only_sphere = -1; /* >= 0: that sphere alone (3 stands on the axis) */
+/* 1: one light beside the camera: where it is shadowed a pixel has no colour (0 and confidence
+ * COLOUR_NO_ESTIMATE, as colour.c gives it), elsewhere the grey paint; 2: the same pixels but no
+ * confidence handed over (their 0 taken for black paint) */
+static int one_light;
 
 static vec3 sphere_centre(int k)
 {
@@ -85,6 +90,11 @@ static void add_view(uint32_t v, double angle_deg, double reported_deg, vec3 sli
             memcpy(&xyz[3 * i], pc, sizeof(pc));
             memcpy(&normal[3 * i], nc, sizeof(nc));
             memset(&rgb[3 * i], 128, 3);
+            confidence[i] = 1.0f;
+            if (one_light && v3_dot(n_cam, v3_norm(v3(1.0, 0.0, -0.4))) <= 0.0) {
+                memset(&rgb[3 * i], 0, 3);
+                confidence[i] = COLOUR_NO_ESTIMATE;
+            }
             if (raw_shading) {
                 static const double paint[3] = {230, 140, 70};
                 vec3 light = v3_norm(v3(-0.5, -0.3, -1.0)); /* towards the light, camera frame */
@@ -97,8 +107,9 @@ static void add_view(uint32_t v, double angle_deg, double reported_deg, vec3 sli
     }
     struct decode_maps maps = {.reason = reason, .width = w, .height = h};
     struct tri_range range = {.xyz_mm = xyz, .normal = normal, .width = w, .height = h};
-    assert_int_equal(
-        reg_add_view(to, v, (int32_t)lround(reported_deg * 1000.0), &maps, &range, rgb), 0);
+    assert_int_equal(reg_add_view(to, v, (int32_t)lround(reported_deg * 1000.0), &maps, &range, rgb,
+                                  one_light == 2 ? NULL : confidence),
+                     0);
 }
 
 static struct reg_params params(void)
@@ -273,6 +284,41 @@ static void test_raw_colour_compared_at_one_brightness(void **state)
     print_message("raw colour: %llu pairs coupled at one brightness, %llu as they are\n",
                   (unsigned long long)coupled_good, (unsigned long long)coupled_lost);
     assert_true(coupled_good > 2 * coupled_lost);
+    assert_int_equal(good.failed_view, -1);
+    assert_true(good.solved && good.accepted);
+    assert_true(worst_angle_error(truth) < 0.05);
+}
+
+/* One light: the side of the object it does not reach has no colour, and a surface lit in one
+ * view is shadowed in the next as the table turns. Such a pixel's colour is unknown, not black:
+ * taken for black paint it would not pair with the same surface lit, and with one light a real
+ * scan of 4 views failed its registration that way (4% of the overlap coupled, 20% needed). */
+static void test_one_light_leaves_the_shadowed_side_uncompared(void **state)
+{
+    (void)state;
+    static const double err_deg[VIEWS] = {0.7, -1.9, 1.2, 0.4, -0.8, 2.0, -1.3, 1.6};
+    double truth[VIEWS];
+    struct reg_params p = params();
+    assert_int_equal(reg_begin(&reg, &p, &calib, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
+    assert_int_equal(reg_begin(&other, &p, &calib, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
+    for (uint32_t v = 0; v < VIEWS; v++) {
+        truth[v] = 45.0 * v + err_deg[v];
+        to = &other;
+        one_light = 2;
+        add_view(v, truth[v], 45.0 * v, v3(0, 0, 0));
+        to = &reg;
+        one_light = 1;
+        add_view(v, truth[v], 45.0 * v, v3(0, 0, 0));
+    }
+    one_light = 0;
+    struct reg_report good, black;
+    assert_int_equal(reg_solve(&reg, &good), 0);
+    assert_int_equal(reg_solve(&other, &black), 0);
+    uint64_t coupled_good = coupled_pairs(&reg), coupled_black = coupled_pairs(&other);
+    print_message("one light: %llu pairs coupled with the shadowed side uncoloured, %llu with it "
+                  "taken for black\n",
+                  (unsigned long long)coupled_good, (unsigned long long)coupled_black);
+    assert_true(coupled_good > coupled_black + coupled_black / 4);
     assert_int_equal(good.failed_view, -1);
     assert_true(good.solved && good.accepted);
     assert_true(worst_angle_error(truth) < 0.05);
@@ -504,6 +550,7 @@ int main(void)
         cmocka_unit_test(test_table_errors_are_found),
         cmocka_unit_test(test_two_registrations_are_independent),
         cmocka_unit_test(test_raw_colour_compared_at_one_brightness),
+        cmocka_unit_test(test_one_light_leaves_the_shadowed_side_uncompared),
         cmocka_unit_test(test_surface_of_revolution_keeps_the_table),
         cmocka_unit_test(test_axis_is_reestimated),
         cmocka_unit_test(test_slip_places_the_moved_views_and_bounds_refuse),
