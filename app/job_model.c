@@ -155,7 +155,15 @@ static int report_registration(struct job *j, const struct reg_report *r, double
     char detail[768];
     uint32_t turning = j->views - j->cfg->passes; /* the views whose angle is registered */
     int no_turn_seen = r->solved && r->turns_from_table > 0 && r->turns_from_table >= turning;
-    if (!r->solved)
+    if (r->few_samples > 0) /* before !solved: nothing was solved for it */
+        snprintf(detail, sizeof(detail),
+                 "turntable angles kept, the axis as calibrated: the views hold too few points "
+                 "to register (the fullest %u samples, one every %u pixels across; %u needed)%s",
+                 (unsigned)r->few_samples, (unsigned)r->stride, REG_MIN_VIEW_SAMPLES,
+                 j->said_dark ? "" /* the error below says why */
+                              : ": the object is small in the camera's image. A camera nearer "
+                                "the object, or a longer lens, scans it in more detail");
+    else if (!r->solved)
         snprintf(detail, sizeof(detail),
                  "turntable angles kept ([registration] icp = 0 or one "
                  "view)");
@@ -266,6 +274,15 @@ static int report_registration(struct job *j, const struct reg_report *r, double
              r->solved, r->accepted, r->rms_mm, r->loop_rms_mm, cpu_seconds,
              (unsigned)r->turns_from_table, (unsigned)r->turns_little_shared, r->moved_view);
     job_progress_with(j, EV_REGISTRATION, -1, j->views, fields, detail);
+    if (r->few_samples > 0 && j->said_dark) { /* nearly empty views: not a model worth making */
+        j->hal->log(HAL_LOG_ERROR,
+                    "registration failed: the views hold almost nothing (the fullest %u "
+                    "samples), the object too dark to decode at exposure_us = %u (the warning "
+                    "above says more). No model was made; the views are kept in %s. Scan again "
+                    "with the longer exposure",
+                    (unsigned)r->few_samples, (unsigned)j->cfg->camera.exposure_us, scan_dir);
+        return -EPROTO;
+    }
     if (r->failed_view >= 0 && r->failed_against < 0) {
         j->hal->log(HAL_LOG_ERROR,
                     "registration failed: the second pass (from view %d) matches nothing of the "

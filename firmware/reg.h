@@ -96,11 +96,19 @@ struct reg_report {
                           (one pass): from it, moved_views views were placed freely */
     uint32_t moved_views;
     double moved_mm, moved_deg; /**< how far the object had moved, and turned */
+    uint32_t few_samples;       /**< > 0: every view had fewer than REG_MIN_VIEW_SAMPLES valid
+                                     samples, the fullest this many: nothing solved, no pair failed */
     int moved_by_colour; /**< the directions its shape left free, which its paint fixed (1 or 2;
                               0: its shape alone placed it) */
     int moved_unfixed;   /**< 1: failed_view's views fit the others only up to a slide
                               neither shape nor colour fixes */
 };
+
+/** A view with fewer valid samples than this holds too little to register by. When every view
+ *  has fewer (the object small in the camera's image), the table's angles and the calibrated
+ *  axis are kept (reg_report.few_samples); one among fuller views is a view of nothing, and a
+ *  pair with it that overlaps and does not couple fails. */
+#define REG_MIN_VIEW_SAMPLES 200u
 
 #define REG_PARAMS (REG_MAX_VIEWS + 4u) /* every angle, two shifts, two tilts */
 #define REG_EDGES REG_MAX_VIEWS         /* a ring: one edge per view */
@@ -150,6 +158,7 @@ struct reg_ctx {
                                                across it, over every pair */
     int axis_from_calib;                  /**< the pairs do not see the axis: calibrated kept */
     int views_alike;                      /**< reg_views_alike: the axis held to the calibrated */
+    uint32_t few_samples;                 /**< as reg_report's: the table's angles kept */
     uint8_t from_table[REG_MAX_VIEWS];    /**< the turn kept at the table's angle */
     uint8_t little_shared[REG_MAX_VIEWS]; /**< why: too little surface shared (reg.c) */
     uint8_t by_paint[REG_MAX_VIEWS];      /**< of those, turned where its paint agrees */

@@ -34,21 +34,23 @@ double reg_edge_share(const struct reg_ctx *r, const struct reg_edge_stats *st)
 /* Two neighbouring views share no surface to compare when the samples of one that land on a
  * surface of the other facing the same way are fewer than this share of the smaller view's
  * samples (two views half a turn apart see opposite sides: none land), while each view sees
- * something (REG_MIN_VIEW_CELLS): the pair says nothing, the table's angle stands, no failure.
+ * something (REG_MIN_VIEW_SAMPLES): the pair says nothing, the table's angle stands, no failure.
  * A view of nothing (fewer samples) still fails, as does a pair that overlaps and does not
  * couple (the object moved, another object). */
 #define REG_APART_SHARE 0.01
-#define REG_MIN_VIEW_CELLS 200u
 int reg_edge_apart(const struct reg_ctx *r, uint32_t e)
 {
     uint32_t a = r->valid_cells[r->edge_from[e]], b = r->valid_cells[r->edge_to[e]];
-    return a >= REG_MIN_VIEW_CELLS && b >= REG_MIN_VIEW_CELLS &&
+    return a >= REG_MIN_VIEW_SAMPLES && b >= REG_MIN_VIEW_SAMPLES &&
            r->stats[e].overlap < REG_APART_SHARE * (a < b ? a : b);
 }
 
-/* Whether edge @p e's views do not match: they overlap, and too little of it couples. */
+/* Whether edge @p e's views do not match: they overlap, and too little of it couples. Where
+ * every view holds too few samples to tell (few_samples), none does. */
 int reg_edge_fails(const struct reg_ctx *r, uint32_t e)
 {
+    if (r->few_samples > 0)
+        return 0;
     return (reg_edge_share(r, &r->stats[e]) < r->p.min_coupled_share && !reg_edge_apart(r, e)) ||
            r->quiet_break_after[r->edge_from[e]];
 }

@@ -27,9 +27,13 @@ int scan_check(const struct scan_params *p, const struct scan_calib *c, char *ms
         return -EINVAL;
     }
     if (c->cam_width != p->width || c->cam_height != p->height) {
-        snprintf(msg, len, "calibration is for a %ux%u camera but the camera is set to %ux%u",
+        snprintf(msg, len,
+                 "calibration is for a %ux%u camera but the camera is set to %ux%u ([camera] "
+                 "width and height: set them to %ux%u, or calibrate the camera at %ux%u with "
+                 "'scanner calibrate')",
                  (unsigned)c->cam_width, (unsigned)c->cam_height, (unsigned)p->width,
-                 (unsigned)p->height);
+                 (unsigned)p->height, (unsigned)c->cam_width, (unsigned)c->cam_height,
+                 (unsigned)p->width, (unsigned)p->height);
         return -EINVAL;
     }
     if (c->proj_width == 0 || c->proj_width > HAL_MAX_PROJECTOR_WIDTH) {

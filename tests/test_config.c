@@ -211,6 +211,7 @@ static void test_calibration_errors(void **state)
     calib.cam_width = 640;
     assert_int_equal(scan_check(&cfg.scan, &calib, err, sizeof(err)), -EINVAL);
     assert_non_null(strstr(err, "calibration is for a 640x960 camera"));
+    assert_non_null(strstr(err, "set them to 640x960, or calibrate the camera at 1280x960"));
     /* lights configured but not calibrated */
     assert_int_equal(calib_load(&calib, path, 2, err, sizeof(err)), -EINVAL);
 }
