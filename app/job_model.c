@@ -139,7 +139,10 @@ static int write_model(struct job *j, const char *scan_dir)
 int job_begin_model(struct job *j)
 {
     struct reg_params p = j->cfg->registration;
-    p.colour_intrinsic = j->cfg->scan.colour.method != COLOUR_NONE; /* else raw: reg.c */
+    /* uniform is C - Ca under the lights as they fall: shaded like raw colour unless the light
+     * is even all round (one or two lights: pairs lost, a scan failed), so compared as raw */
+    enum colour_method m = j->cfg->scan.colour.method;
+    p.colour_intrinsic = m != COLOUR_NONE && m != COLOUR_UNIFORM; /* else raw: reg.c */
     int rc = reg_begin(j->reg, &p, j->calib, j->views, j->cfg->passes, j->cfg->scan.width,
                        j->cfg->scan.height);
     if (rc != 0)
