@@ -137,7 +137,7 @@ static void cell_colour(const struct decode_maps *m, const uint8_t *rgb, const f
     }
     double mean[3], h[2];
     for (int c = 0; c < 3; c++) {
-        mean[c] = weight > 0.0 ? sum[c] / weight : 0.0;
+        mean[c] = sum[c] / weight;
         cl->rgb[c] = (uint8_t)lround(mean[c]);
     }
     /* The hue of each pixel, averaged: a cell across a paint boundary holds each paint's hue by
@@ -905,8 +905,8 @@ static void place_moved_views(struct reg_ctx *r, struct reg_report *rep)
 }
 
 /* The most valid samples a view has, when every view has fewer than REG_MIN_VIEW_SAMPLES and
- * one has some; else 0. An object that small in the camera's image (the bunny 5 mm tall, 9 to
- * 14 samples a view at 1280 x 960) gives its pairs too few samples to couple or to fix a turn
+ * one has some; else 0. An object that small in the camera's image (the bunny 5 mm tall, 8 to
+ * 13 samples a view at 1280 x 960) gives its pairs too few samples to couple or to fix a turn
  * (at 20 mm, 150 to 190, every turn was left at the table's for sharing too little), and a
  * pair of them failed as if a view held nothing: no model. A view of nothing among fuller ones
  * still fails. */
