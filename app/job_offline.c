@@ -107,11 +107,18 @@ static int check_frames(const struct job *j, const char *scan_dir, uint32_t v,
     for (uint32_t f = 0; f < want.frame_count; f++) {
         if (f < have->frame_count && strcmp(have->frame_name[f], want.frame_name[f]) == 0)
             continue;
-        snprintf(err, err_len,
-                 "%s/view_%03u/view.ini: frame_%02u is '%s', but these settings need '%s' "
-                 "there (other [scan] or [colour] settings than the scan was taken with?)",
-                 scan_dir, (unsigned)v, (unsigned)f,
-                 f < have->frame_count ? have->frame_name[f] : "(none)", want.frame_name[f]);
+        if (f >= have->frame_count) /* a view of fewer frames: [colour] method = none takes none */
+            snprintf(err, err_len,
+                     "%s/view_%03u/view.ini: the view took %u frames, and these settings need "
+                     "frame_%02u, '%s' (other [scan] or [colour] settings than the scan was "
+                     "taken with? its config.ini says how it was taken)",
+                     scan_dir, (unsigned)v, (unsigned)have->frame_count, (unsigned)f,
+                     want.frame_name[f]);
+        else
+            snprintf(err, err_len,
+                     "%s/view_%03u/view.ini: frame_%02u is '%s', but these settings need '%s' "
+                     "there (other [scan] or [colour] settings than the scan was taken with?)",
+                     scan_dir, (unsigned)v, (unsigned)f, have->frame_name[f], want.frame_name[f]);
         return -EINVAL;
     }
     return 0;

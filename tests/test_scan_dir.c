@@ -396,6 +396,15 @@ static void test_process_other_frames_refused(void **state)
     assert_true(test_log_one_error(
         "build/test_scan_dir/multi/view_000/view.ini: frame_24 is 'light 0 alone, 10000 us, "
         "RGB', but these settings need 'light 0 alone, 20000 us, RGB' there"));
+    /* a scan taken without colour processed for colour: the frames it never took said so (it
+     * was "frame_22 is '(none)'") */
+    fake_scan(DIR "/plain", config_text("method = none\n"), png_magic, sizeof(png_magic));
+    write_text(other, config_text("method = multi\n"));
+    opts.out_dir = DIR "/plain_out";
+    test_log_clear();
+    assert_int_equal(scan_job_process(&hal, DIR "/plain", &opts), -EINVAL);
+    assert_true(test_log_one_error("plain/view_000/view.ini: the view took 22 frames, and these "
+                                   "settings need frame_22, 'dark: projector and lights off"));
 }
 
 /* The storage thread keeps a grey frame handed to it for copying as it was when handed over,
