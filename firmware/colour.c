@@ -148,12 +148,23 @@ struct frame_ctx {
     double ca_of_albedo[COLOUR_MAX_FRAMES][3][256];
     double gain[COLOUR_MAX_FRAMES]; /* the camera's exposure over the frame's */
     const uint8_t *albedo;          /* the first pass's albedo bytes (ca = albedo) */
+    int ke_whole, ko_whole; /* eq. 6's exponents where whole, up to 64; -1: not (whole_power) */
 };
+
+/* @p e as power() takes it: whole up to 64 (the exponents of eq. 6 as people set them, 10 and
+ * 4 by default), else -1. Told once a view, not at each of its 7 million weights (0.8% of a
+ * re-processing's instructions). */
+static int whole_power(double e)
+{
+    return e >= 0.0 && e <= 64.0 && e == (double)(int)e ? (int)e : -1;
+}
 
 /* The tables of @p f from its Ca and the layout's exposures (again whenever the Ca changes);
  * every slot, as frame_light would have computed it for any frame it is asked for. */
 static void frame_tables(struct frame_ctx *f)
 {
+    f->ke_whole = whole_power(f->prm->ke);
+    f->ko_whole = whole_power(f->prm->ko);
     for (uint32_t k = 0; k < COLOUR_MAX_FRAMES; k++) {
         f->gain[k] = (double)f->prm->exposure_us / f->lay->exposure_us[k];
         for (int c = 0; c < 3 && f->lay->dark_of[k] == k; c++)
@@ -215,14 +226,14 @@ static double incidence(const struct colour_params *prm, vec3 n, struct toward s
     return v3_dot(n, s.dir);
 }
 
-/* @p x to the power @p e: by repeated squaring for a whole @p e up to 64 (the exponents of eq. 6
- * as people set them, 10 and 4 by default; pow() cost 5% of a re-processing's CPU), else pow. */
-static inline double power(double x, double e)
+/* @p x to the power @p e: by repeated squaring where @p whole (whole_power) is one (pow() cost 5%
+ * of a re-processing's CPU), else pow. */
+static inline double power(double x, double e, int whole)
 {
-    if (!(e >= 0.0 && e <= 64.0 && e == (double)(int)e))
+    if (whole < 0)
         return pow(x, e);
     double r = 1.0;
-    for (unsigned k = (unsigned)e; k != 0; k >>= 1, x *= x)
+    for (unsigned k = (unsigned)whole; k != 0; k >>= 1, x *= x)
         if (k & 1u)
             r *= x;
     return r;
@@ -237,11 +248,13 @@ static vec3 view_of(vec3 p)
 /* How far the mirror reflection of a source in direction @p s at a surface of normal n is from
  * the camera (direction @p view), as the weight of Jost et al., eq. 6: (1 - cos^ke alpha)^ko;
  * 0 in the middle of a highlight, 1 away from it. */
-static double specular_weight(const struct colour_params *prm, vec3 n, vec3 view, vec3 s)
+static double specular_weight(const struct frame_ctx *f, vec3 n, vec3 view, vec3 s)
 {
+    const struct colour_params *prm = f->prm;
     vec3 refl = v3_sub(v3_scale(n, 2.0 * v3_dot(s, n)), s);
     double cos_a = v3_dot(refl, view);
-    return power(1.0 - power(cos_a > 0.0 ? cos_a : 0.0, prm->ke), prm->ko);
+    return power(1.0 - power(cos_a > 0.0 ? cos_a : 0.0, prm->ke, f->ke_whole), prm->ko,
+                 f->ko_whole);
 }
 
 /* Albedo 0..1 as the stored byte 0..255, rounded and clamped. */
@@ -290,7 +303,7 @@ static void light_signals(const struct frame_ctx *f, const struct scan_calib *c,
         double raw = (lit[0] + lit[1] + lit[2]) / 3.0 * f->lay->exposure_us[k] / prm->exposure_us;
         if ((!ok && !relaxed) || raw <= prm->shadow_dn)
             continue;
-        out->weight[l] = specular_weight(prm, nn, view, s.dir);
+        out->weight[l] = specular_weight(f, nn, view, s.dir);
         /* a brighter light gives more signal for the same albedo: its gain takes that out */
         double gain = c->light_gain[l] > 0.0 ? c->light_gain[l] : 1.0;
         for (int ch = 0; ch < 3; ch++)
@@ -359,7 +372,7 @@ static double pixel_estimate(const struct frame_ctx *f, const struct scan_calib 
             return 0.0;
         for (int k = 0; k < 3; k++)
             num[k] = light[k] * fall;
-        *confidence = ct * specular_weight(prm, nn, view, s.dir);
+        *confidence = ct * specular_weight(f, nn, view, s.dir);
         return ct;
     }
     if (prm->method == COLOUR_UNIFORM) { /* method 2 */
@@ -370,7 +383,7 @@ static double pixel_estimate(const struct frame_ctx *f, const struct scan_calib 
         *confidence = 1.0;
         for (uint32_t l = 0; l < c->light_count; l++) {
             vec3 src = v3_from(c->light_pos_mm[l]);
-            double w = specular_weight(prm, nn, view, toward(p, src).dir);
+            double w = specular_weight(f, nn, view, toward(p, src).dir);
             if (v3_dot(nn, v3_sub(src, p)) > 0.0 && w < *confidence)
                 *confidence = w;
         }
