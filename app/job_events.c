@@ -56,16 +56,41 @@ static void job_report_cost(struct job *j, const char *what)
     job_progress_with(j, EV_COST, -1, j->views, fields, detail);
 }
 
+/* The bytes of the UTF-8 character at @p s (RFC 3629, section 4: no overlong form, surrogate
+ * or code point beyond U+10FFFF); 0 where none begins. Stops at the first byte that does not
+ * continue it, so never reads past a terminating NUL. */
+static size_t utf8_length(const unsigned char *s)
+{
+    unsigned c = s[0];
+    size_t n = c < 0x80u                  ? 1
+               : c >= 0xC2u && c <= 0xDFu ? 2
+               : c >= 0xE0u && c <= 0xEFu ? 3
+               : c >= 0xF0u && c <= 0xF4u ? 4
+                                          : 0;
+    unsigned lo = c == 0xE0u ? 0xA0u : c == 0xF0u ? 0x90u : 0x80u; /* the second byte's range */
+    unsigned hi = c == 0xEDu ? 0x9Fu : c == 0xF4u ? 0x8Fu : 0xBFu;
+    for (size_t k = 1; k < n; k++)
+        if (s[k] < (k == 1 ? lo : 0x80u) || s[k] > (k == 1 ? hi : 0xBFu))
+            return 0;
+    return n;
+}
+
+/* JSON text is UTF-8 (RFC 8259): a byte that is not (a path in another encoding, made by a
+ * person's --out) is written as U+FFFD, so that every line still parses. */
 void job_json_string(FILE *out, const char *s)
 {
     fputc('"', out);
-    for (; *s != '\0'; s++) {
+    while (*s != '\0') {
+        size_t n = utf8_length((const unsigned char *)s);
         if (*s == '"' || *s == '\\')
             fprintf(out, "\\%c", *s);
         else if ((unsigned char)*s < 0x20)
             fprintf(out, "\\u%04x", (unsigned)(unsigned char)*s);
+        else if (n == 0)
+            fputs("\\ufffd", out);
         else
-            fputc(*s, out);
+            fwrite(s, 1, n, out);
+        s += n > 0 ? n : 1;
     }
     fputc('"', out);
 }

@@ -519,6 +519,20 @@ assert abs(by[\"fused\"][\"angle_deg\"] - 315) < 1, by[\"fused\"]
 # time left: unknown until the time of a view is measured, then an estimate, 0 at the end
 fused = [e[\"left_s\"] for e in lines if e[\"event\"] == \"fused\"]
 assert fused[0] == -1 and min(fused[1:]) >= 0 and fused[-1] == 0, fused'"
+# --out named in another encoding than UTF-8 (a Latin-1 e-acute, as from an old USB stick), and
+# one in UTF-8: every event is still JSON (UTF-8, RFC 8259), the foreign byte as U+FFFD, the
+# UTF-8 name kept as it is (the byte went into the JSON as it was, which no parser takes)
+latin1_dir=$(printf '%s/lat\351n' "$out") utf8_dir=$(printf '%s/caf\303\251' "$out")
+rm -rf "$latin1_dir" "$utf8_dir" && mkdir -p "$latin1_dir" "$utf8_dir"
+check json_events_are_utf8 sh -c "$bin process $out/scan --out '$latin1_dir/x' --json > $out/latin1.json &&
+    $bin process $out/scan --out '$utf8_dir/x' --json > $out/utf8.json && /usr/bin/python3 -c '
+import json, sys
+latin = [json.loads(line.decode(\"utf-8\")) for line in open(sys.argv[1], \"rb\")]
+utf8 = [json.loads(line.decode(\"utf-8\")) for line in open(sys.argv[2], \"rb\")]
+assert any(\"lat\\ufffdn/x\" in e[\"detail\"] for e in latin), latin[:2]
+assert any(\"caf\\u00e9/x\" in e[\"detail\"] for e in utf8), utf8[:2]
+' $out/latin1.json $out/utf8.json"
+rm -rf "$latin1_dir" "$utf8_dir"
 # Processed again in place with [output] texture = 0 (issue 34): the earlier model's texture.png
 # and mesh.mtl go with it, not left beside a mesh.obj that no longer names them
 rm -rf "$out/inplace" && cp -r "$out/scan" "$out/inplace"
