@@ -273,7 +273,7 @@ static const struct ini_key config_keys[] = {
         "1: compensate the inverse-square falloff from each calibrated source"),
     F64("colour", "reference_mm", scan.colour.reference_mm, 1, 100000, "600",
         "distance at which the falloff compensation is 1"),
-    {"colour", "white_scale", INI_VEC, C(scan.colour.white_scale), 3, 0, 1000, 0,
+    {"colour", "white_scale", INI_VEC, C(scan.colour.white_scale), 3, 1e-6, 1000, 0,
      "0.00392157, 0.00392157, 0.00392157", NULL,
      "per channel, grey levels to albedo: a white surface comes out as 1 (from scanner "
      "calibrate-white; the default 1/255 keeps grey levels)",

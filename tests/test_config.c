@@ -108,6 +108,9 @@ static void test_errors_name_file_line_and_key(void **state)
     expect_error("[sim]\nobject_offset_mm = 30, nan\n", "'30, nan' is not a list of 2");
     expect_error("[sim]\nobject_offset_mm = 300, 0\n",
                  "[sim] object_offset_mm: 300 is out of range -200..200");
+    /* a channel scaled by 0 is every colour black in it (a hand-edited white reference) */
+    expect_error("[colour]\nwhite_scale = 0.004, 0, 0.004\n",
+                 "bad.ini:9: [colour] white_scale: 0 is out of range 1e-06..1000");
     expect_error("[sim]\nmaterial = burly\n", "bad.ini:9: [sim] material: 'burly' is not one of");
     expect_error("[sim]\nmaterial = burley\nburley_roughness = 1.5\n",
                  "bad.ini:10: [sim] burley_roughness: 1.5 is out of range 0..1");
