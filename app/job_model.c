@@ -286,6 +286,15 @@ static int report_registration(struct job *j, const struct reg_report *r, double
                     (unsigned)r->few_samples, (unsigned)j->cfg->camera.exposure_us, scan_dir);
         return -EPROTO;
     }
+    if (r->failed_view >= 0 && r->failed_against < 0 && r->few_samples > 0) {
+        j->hal->log(HAL_LOG_ERROR,
+                    "registration failed: the second pass (from view %d) cannot be found in the "
+                    "first: the views hold too few points (the object is small in the camera's "
+                    "image, as said above). No model was made; the views are kept in %s. Scan "
+                    "it in one pass, or with the camera nearer the object",
+                    r->failed_view, scan_dir);
+        return -EPROTO;
+    }
     if (r->failed_view >= 0 && r->failed_against < 0) {
         j->hal->log(HAL_LOG_ERROR,
                     "registration failed: the second pass (from view %d) matches nothing of the "
