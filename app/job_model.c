@@ -158,15 +158,21 @@ static int report_registration(struct job *j, const struct reg_report *r, double
     char detail[768];
     uint32_t turning = j->views - j->cfg->passes; /* the views whose angle is registered */
     int no_turn_seen = r->solved && r->turns_from_table > 0 && r->turns_from_table >= turning;
-    if (r->few_samples > 0) /* before !solved: nothing was solved for it */
+    if (r->few_samples > 0) {  /* before !solved: nothing was solved for it */
+        char sparse[160] = ""; /* the samples thinned to fit this many views (reg_begin) */
+        if (r->stride > j->cfg->registration.sample_stride)
+            snprintf(sparse, sizeof(sparse),
+                     " (thinned from one every %u to fit %u views: fewer views keep more)",
+                     (unsigned)j->cfg->registration.sample_stride, (unsigned)j->views);
         snprintf(detail, sizeof(detail),
                  "turntable angles kept, the axis as calibrated: the views hold too few points "
-                 "to register (the fullest %u samples, one every %u pixels across; %u needed)%s",
-                 (unsigned)r->few_samples, (unsigned)r->stride, REG_MIN_VIEW_SAMPLES,
+                 "to register (the fullest %u samples, one every %u pixels across%s; %u "
+                 "needed)%s",
+                 (unsigned)r->few_samples, (unsigned)r->stride, sparse, REG_MIN_VIEW_SAMPLES,
                  j->said_dark ? "" /* the error below says why */
                               : ": the object is small in the camera's image. A camera nearer "
                                 "the object, or a longer lens, scans it in more detail");
-    else if (!r->solved)
+    } else if (!r->solved)
         snprintf(detail, sizeof(detail),
                  "turntable angles kept ([registration] icp = 0 or one "
                  "view)");
