@@ -131,6 +131,29 @@ static struct reg_params params(void)
                                .axis_tilt_accuracy_deg = 0.033};
 }
 
+/* A table up to 2 degrees off the angles it reports, view by view (the tests' open-loop stepper).
+ */
+static const double table_err_deg[VIEWS] = {0.7, -1.9, 1.2, 0.4, -0.8, 2.0, -1.3, 1.6};
+
+/* Both registrations begun for the 8 views of one pass: @c reg with @p a, @c other with @p b. */
+static void begin_both(const struct reg_params *a, const struct reg_params *b)
+{
+    assert_int_equal(reg_begin(&reg, a, &calib, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
+    assert_int_equal(reg_begin(&other, b, &calib, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
+}
+
+/* The 8 views, each turned table_err_deg from the angle the table reports, into @p r (then
+ * @c reg again takes what add_view adds). @p truth: out, their true angles. */
+static void add_views_off_table(struct reg_ctx *r, double truth[VIEWS])
+{
+    to = r;
+    for (uint32_t v = 0; v < VIEWS; v++) {
+        truth[v] = 45.0 * v + table_err_deg[v];
+        add_view(v, truth[v], 45.0 * v, v3(0, 0, 0));
+    }
+    to = &reg;
+}
+
 static int setup(void **state)
 {
     (void)state;
@@ -158,14 +181,10 @@ static double worst_angle_error(const double *truth_deg)
 static void test_table_errors_are_found(void **state)
 {
     (void)state;
-    static const double err_deg[VIEWS] = {0.7, -1.9, 1.2, 0.4, -0.8, 2.0, -1.3, 1.6};
     double truth[VIEWS];
     struct reg_params p = params();
     assert_int_equal(reg_begin(&reg, &p, &calib, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
-    for (uint32_t v = 0; v < VIEWS; v++) {
-        truth[v] = 45.0 * v + err_deg[v];
-        add_view(v, truth[v], 45.0 * v, v3(0, 0, 0));
-    }
+    add_views_off_table(&reg, truth);
     struct reg_report rep;
     assert_int_equal(reg_solve(&reg, &rep), 0);
     double worst = worst_angle_error(truth);
@@ -217,13 +236,11 @@ static void test_axis_is_reestimated(void **state)
 static void test_two_registrations_are_independent(void **state)
 {
     (void)state;
-    static const double err_deg[VIEWS] = {0.7, -1.9, 1.2, 0.4, -0.8, 2.0, -1.3, 1.6};
     double truth[VIEWS];
     struct reg_params p = params();
-    assert_int_equal(reg_begin(&reg, &p, &calib, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
-    assert_int_equal(reg_begin(&other, &p, &calib, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
+    begin_both(&p, &p);
     for (uint32_t v = 0; v < VIEWS; v++) {
-        truth[v] = 45.0 * v + err_deg[v];
+        truth[v] = 45.0 * v + table_err_deg[v];
         to = &reg;
         add_view(v, truth[v], 45.0 * v, v3(0, 0, 0));
         to = &other;
@@ -259,23 +276,13 @@ static uint64_t coupled_pairs(struct reg_ctx *r)
 static void test_raw_colour_compared_at_one_brightness(void **state)
 {
     (void)state;
-    static const double err_deg[VIEWS] = {0.7, -1.9, 1.2, 0.4, -0.8, 2.0, -1.3, 1.6};
     double truth[VIEWS];
     struct reg_params as_is = params(), shading_free = params();
     shading_free.colour_intrinsic = 0;
     raw_shading = 1;
-    assert_int_equal(
-        reg_begin(&reg, &shading_free, &calib, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
-    assert_int_equal(reg_begin(&other, &as_is, &calib, VIEWS, 1, calib.cam_width, calib.cam_height),
-                     0);
-    for (uint32_t v = 0; v < VIEWS; v++) {
-        truth[v] = 45.0 * v + err_deg[v];
-        to = &reg;
-        add_view(v, truth[v], 45.0 * v, v3(0, 0, 0));
-        to = &other;
-        add_view(v, truth[v], 45.0 * v, v3(0, 0, 0));
-    }
-    to = &reg;
+    begin_both(&shading_free, &as_is);
+    add_views_off_table(&reg, truth);
+    add_views_off_table(&other, truth);
     raw_shading = 0;
     struct reg_report good, lost;
     assert_int_equal(reg_solve(&reg, &good), 0);
@@ -296,20 +303,13 @@ static void test_raw_colour_compared_at_one_brightness(void **state)
 static void test_one_light_leaves_the_shadowed_side_uncompared(void **state)
 {
     (void)state;
-    static const double err_deg[VIEWS] = {0.7, -1.9, 1.2, 0.4, -0.8, 2.0, -1.3, 1.6};
     double truth[VIEWS];
     struct reg_params p = params();
-    assert_int_equal(reg_begin(&reg, &p, &calib, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
-    assert_int_equal(reg_begin(&other, &p, &calib, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
-    for (uint32_t v = 0; v < VIEWS; v++) {
-        truth[v] = 45.0 * v + err_deg[v];
-        to = &other;
-        one_light = 2;
-        add_view(v, truth[v], 45.0 * v, v3(0, 0, 0));
-        to = &reg;
-        one_light = 1;
-        add_view(v, truth[v], 45.0 * v, v3(0, 0, 0));
-    }
+    begin_both(&p, &p);
+    one_light = 2;
+    add_views_off_table(&other, truth);
+    one_light = 1;
+    add_views_off_table(&reg, truth);
     one_light = 0;
     struct reg_report good, black;
     assert_int_equal(reg_solve(&reg, &good), 0);
@@ -330,12 +330,11 @@ static void test_one_light_leaves_the_shadowed_side_uncompared(void **state)
 static void test_surface_of_revolution_keeps_the_table(void **state)
 {
     (void)state;
-    static const double err_deg[VIEWS] = {0.7, -1.9, 1.2, 0.4, -0.8, 2.0, -1.3, 1.6};
     struct reg_params p = params();
     only_sphere = 3;
     assert_int_equal(reg_begin(&reg, &p, &calib, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
     for (uint32_t v = 0; v < VIEWS; v++)
-        add_view(v, 45.0 * v + err_deg[v], 45.0 * v, v3(0, 0, 0));
+        add_view(v, 45.0 * v + table_err_deg[v], 45.0 * v, v3(0, 0, 0));
     only_sphere = -1;
     struct reg_report rep;
     assert_int_equal(reg_solve(&reg, &rep), 0);
@@ -353,7 +352,7 @@ static void test_surface_of_revolution_keeps_the_table(void **state)
     /* the same spheres with the others beside them: every turn is fixed by the shape */
     assert_int_equal(reg_begin(&reg, &p, &calib, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
     for (uint32_t v = 0; v < VIEWS; v++)
-        add_view(v, 45.0 * v + err_deg[v], 45.0 * v, v3(0, 0, 0));
+        add_view(v, 45.0 * v + table_err_deg[v], 45.0 * v, v3(0, 0, 0));
     assert_int_equal(reg_solve(&reg, &rep), 0);
     assert_int_equal(rep.turns_from_table, 0);
 }
@@ -386,12 +385,12 @@ static double worst_centre_mm(uint32_t first, uint32_t last, const double *truth
 static void test_slip_places_the_moved_views_and_bounds_refuse(void **state)
 {
     (void)state;
-    static const double err_deg[VIEWS] = {0.0, 0.6, -0.4, 0.3, 0.8, -0.5, 0.2, -0.7};
+    static const double slip_err_deg[VIEWS] = {0.0, 0.6, -0.4, 0.3, 0.8, -0.5, 0.2, -0.7};
     double truth[VIEWS];
     struct reg_params p = params();
     assert_int_equal(reg_begin(&reg, &p, &calib, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
     for (uint32_t v = 0; v < VIEWS; v++) {
-        truth[v] = 45.0 * v + err_deg[v];
+        truth[v] = 45.0 * v + slip_err_deg[v];
         add_view(v, truth[v], 45.0 * v, v >= 4 ? v3(6, 0, 0) : v3(0, 0, 0));
     }
     struct reg_report rep;
@@ -507,12 +506,11 @@ static void test_second_pass_of_another_object_fails(void **state)
 static void test_small_object_keeps_the_table(void **state)
 {
     (void)state;
-    static const double err_deg[VIEWS] = {0.7, -1.9, 1.2, 0.4, -0.8, 2.0, -1.3, 1.6};
     struct reg_params p = params();
     assert_int_equal(reg_begin(&reg, &p, &calib, VIEWS, 1, calib.cam_width, calib.cam_height), 0);
     radius_scale = 0.1;
     for (uint32_t v = 0; v < VIEWS; v++)
-        add_view(v, 45.0 * v + err_deg[v], 45.0 * v, v3(0, 0, 0));
+        add_view(v, 45.0 * v + table_err_deg[v], 45.0 * v, v3(0, 0, 0));
     radius_scale = 1.0;
     struct reg_report rep;
     assert_int_equal(reg_solve(&reg, &rep), 0);
