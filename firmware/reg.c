@@ -935,7 +935,8 @@ int reg_solve(struct reg_ctx *r, struct reg_report *rep)
     rep->moved_view = -1;
     for (uint32_t v = 0; v < r->views; v++)
         rep->views += r->present[v];
-    r->few_samples = rep->few_samples = few_samples(r);
+    /* with icp = 0 or one view nothing is registered anyway: said as such (reg_report) */
+    r->few_samples = rep->few_samples = r->p.enabled && r->views > 1 ? few_samples(r) : 0;
     memset(r->cut_after, 0, sizeof(r->cut_after));
     memset(r->quiet_break_after, 0, sizeof(r->quiet_break_after));
     r->second_aligned = 0;
