@@ -171,6 +171,18 @@ int job_begin_model(struct job *j)
     return rc;
 }
 
+/* A registration that failed on views nearly empty for an object too dark to decode (which
+ * job_say_if_dark said): that, not the calibration, and the exposure to scan again at. @p why:
+ * what the registration found. */
+static void say_too_dark(struct job *j, const char *why, const char *scan_dir)
+{
+    j->hal->log(HAL_LOG_ERROR,
+                "registration failed: %s: the views hold almost nothing, the object too dark to "
+                "decode at exposure_us = %u (the warning above says more). No model was made; "
+                "the views are kept in %s. Scan again with the longer exposure",
+                why, (unsigned)j->cfg->camera.exposure_us, scan_dir);
+}
+
 /* The registration's one quality line, and a refused or failed one said plainly. */
 static int report_registration(struct job *j, const struct reg_report *r, double cpu_seconds,
                                const char *scan_dir)
@@ -304,12 +316,9 @@ static int report_registration(struct job *j, const struct reg_report *r, double
              (unsigned)r->turns_from_table, (unsigned)r->turns_little_shared, r->moved_view);
     job_progress_with(j, EV_REGISTRATION, -1, j->views, fields, detail);
     if (r->few_samples > 0 && j->said_dark) { /* nearly empty views: not a model worth making */
-        j->hal->log(HAL_LOG_ERROR,
-                    "registration failed: the views hold almost nothing (the fullest %u "
-                    "samples), the object too dark to decode at exposure_us = %u (the warning "
-                    "above says more). No model was made; the views are kept in %s. Scan again "
-                    "with the longer exposure",
-                    (unsigned)r->few_samples, (unsigned)j->cfg->camera.exposure_us, scan_dir);
+        char why[64];
+        snprintf(why, sizeof(why), "the fullest view holds %u samples", (unsigned)r->few_samples);
+        say_too_dark(j, why, scan_dir);
         return -EPROTO;
     }
     if (r->failed_view >= 0 && r->failed_against < 0 && r->few_samples > 0) {
@@ -348,16 +357,13 @@ static int report_registration(struct job *j, const struct reg_report *r, double
                     "from it fits the others. No model was made; the views are kept in %s. "
                     "Scan again without touching the object",
                     r->failed_view, r->failed_against, 100.0 * r->failed_colour, scan_dir);
-    else if (j->said_dark) /* the views are nearly empty: that, not the calibration */
-        j->hal->log(HAL_LOG_ERROR,
-                    "registration failed: view %d does not match view %d (%.0f%% of their "
-                    "overlap couples): the views hold almost nothing, the object too dark to "
-                    "decode at exposure_us = %u (the warning above says more). No "
-                    "model was made; the views are kept in %s. Scan again with the longer "
-                    "exposure",
-                    r->failed_view, r->failed_against, 100.0 * r->failed_share,
-                    (unsigned)j->cfg->camera.exposure_us, scan_dir);
-    else
+    else if (j->said_dark) { /* the views are nearly empty: that, not the calibration */
+        char why[96];
+        snprintf(why, sizeof(why),
+                 "view %d does not match view %d (%.0f%% of their overlap couples)", r->failed_view,
+                 r->failed_against, 100.0 * r->failed_share);
+        say_too_dark(j, why, scan_dir);
+    } else
         j->hal->log(
             HAL_LOG_ERROR,
             "registration failed: view %d does not match view %d (%.0f%% of their overlap "
