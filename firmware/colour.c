@@ -163,8 +163,6 @@ static int whole_power(double e)
  * every slot, as frame_light would have computed it for any frame it is asked for. */
 static void frame_tables(struct frame_ctx *f)
 {
-    f->ke_whole = whole_power(f->prm->ke);
-    f->ko_whole = whole_power(f->prm->ko);
     for (uint32_t k = 0; k < COLOUR_MAX_FRAMES; k++) {
         f->gain[k] = (double)f->prm->exposure_us / f->lay->exposure_us[k];
         for (int c = 0; c < 3 && f->lay->dark_of[k] == k; c++)
@@ -659,6 +657,8 @@ int colour_compute(const struct colour_params *prm, const struct hal_thread *thr
     colour_layout(prm, c->light_count, &lay);
     memset(&f, 0, sizeof(f));
     f.prm = prm;
+    f.ke_whole = whole_power(prm->ke);
+    f.ko_whole = whole_power(prm->ko);
     f.lay = &lay;
     f.frames = lights;
     f.albedo = albedo;
